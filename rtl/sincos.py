@@ -1,0 +1,77 @@
+"""Quarter-wave sine/cosine unit: the toolchain vertical slice (DESIGN §4)."""
+
+from amaranth.hdl import Module, Mux, signed, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from .config import Config
+from .pipe import StallPipe
+from .tables import quarter_sine
+
+__all__ = ["SinCos"]
+
+
+class SinCos(wiring.Component):
+    """Sine and cosine of a binary angle from one quarter-wave ROM.
+
+    Parameters
+    ----------
+    cfg : Config
+        Reads ``angle_bits`` (k + 2), ``frac_bits`` (B) and ``tag_bits``.
+
+    Members
+    -------
+    i : In(stream.Signature({angle: unsigned(k+2), tag: unsigned(tag_bits)}))
+    o : Out(stream.Signature({sin: signed(B+2), cos: signed(B+2), tag}))
+        ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
+        :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
+
+    Latency 2 cycles (ROM read, sign); throughput 1 angle per clock when not stalled.
+    """
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        super().__init__({
+            "i": In(stream.Signature(data.StructLayout({
+                "angle": unsigned(cfg.angle_bits),
+                "tag": unsigned(cfg.tag_bits),
+            }))),
+            "o": Out(stream.Signature(data.StructLayout({
+                "sin": signed(cfg.sincos_width),
+                "cos": signed(cfg.sincos_width),
+                "tag": unsigned(cfg.tag_bits),
+            }))),
+        })
+
+    @property
+    def latency(self):
+        return 2
+
+    def elaborate(self, platform):
+        cfg, k = self.cfg, self.cfg.k
+        m = Module()
+        pipe = StallPipe(m, self.i, self.o, self.latency)
+        m.submodules.rom = rom = Memory(shape=unsigned(cfg.frac_bits + 1),
+                                        depth=cfg.sincos_depth, init=quarter_sine(cfg).tolist())
+
+        angle = self.i.payload.angle
+        outputs = {}
+        for name, offset in (("sin", 0), ("cos", 1 << k)):   # cos(a) = sin(a + 90 deg)
+            a = (angle + offset)[:cfg.angle_bits]
+            quadrant, index = a[k:], a[:k]
+            port = rom.read_port(domain="sync")
+            # Quadrants 1 and 3 read the ROM backwards: index 2**k - i (entry 2**k is 1.0).
+            m.d.comb += [
+                port.en.eq(pipe.adv),
+                port.addr.eq(Mux(quadrant[0], (1 << k) - index, index)),
+            ]
+            negative = pipe.register(quadrant[1], f"{name}_negative")  # quadrants 2 and 3
+            value = port.data
+            outputs[name] = pipe.register(Mux(negative, -value, value), f"{name}_value")
+        m.d.comb += [
+            self.o.payload.sin.eq(outputs["sin"]),
+            self.o.payload.cos.eq(outputs["cos"]),
+            self.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag")),
+        ]
+        return m
