@@ -1,0 +1,36 @@
+"""Stream payload layouts shared by the units (DESIGN §5), all derived from a Config."""
+
+from amaranth.hdl import unsigned
+from amaranth.lib import data
+
+from .config import Config
+
+__all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout"]
+
+
+def angle_shape(cfg: Config):
+    """A binary angle: full circle = 2**angle_bits (DESIGN §4)."""
+    return unsigned(cfg.angle_bits)
+
+
+def polar_layout(cfg: Config):
+    """A direction in polar angles: phi (azimuth), theta (from +z)."""
+    return data.StructLayout({"phi": angle_shape(cfg), "theta": angle_shape(cfg)})
+
+
+def pixel_layout(cfg: Config):
+    """Per-pixel inputs of the rotation unit: world N, L, H and tangent-space bump normal
+    N' (``b``), plus the side-band tag. H is present only when the Config has specular."""
+    fields = {"n": polar_layout(cfg), "l": polar_layout(cfg)}
+    if cfg.specular:
+        fields["h"] = polar_layout(cfg)
+    fields["b"] = polar_layout(cfg)
+    fields["tag"] = unsigned(cfg.tag_bits)
+    return data.StructLayout(fields)
+
+
+def shade_layout(cfg: Config):
+    """Per-pixel outputs of the illumination unit: 8-bit diffuse, specular and Phong sum."""
+    out = unsigned(cfg.out_bits)
+    return data.StructLayout({"diffuse": out, "specular": out, "color": out,
+                              "tag": unsigned(cfg.tag_bits)})
