@@ -138,5 +138,7 @@ def shade(ndotl, ndoth, cfg: Config, l_prime=None):
 
 
 def to_8bit(x):
-    """[0, 1] -> 0..255, rounded to nearest (outputs are 8-bit, DESIGN §4)."""
-    return np.clip(np.rint(np.asarray(x) * 255.0), 0, 255).astype(np.uint8)
+    """[0, 1] -> 0..255, rounded to nearest (outputs are 8-bit, DESIGN §4). NaN (where the
+    printed Lee equations have no value) becomes 0, i.e. black."""
+    x = np.nan_to_num(np.asarray(x, dtype=np.float64), nan=0.0)
+    return np.clip(np.rint(x * 255.0), 0, 255).astype(np.uint8)

@@ -1,0 +1,159 @@
+"""Scenes: height fields -> tangent-space bump maps, geometry, lights and viewer.
+
+World frame: x to the right of the screen, z up the screen, the viewer looks along +y from
+far away (orthographic), so V = (0, -1, 0). The tangent frame is the one Lee et al.'s two
+rotations define (rotate -phi_N about z, then -theta_N about y): its x axis T points along
+increasing theta_N and its y axis B along increasing phi_N. Every geometry maps texture
+``v`` along T and ``u`` along B, so a bump map built with tangent x = d/dv and
+tangent y = d/du lights the same way on every surface.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...rtl.config import BumpError
+from ..golden.common import PixelInputs, cartesian_to_polar
+from .heightfields import HEIGHTFIELDS, height_to_normals
+
+__all__ = ["SCENES", "GEOMETRIES", "Scene", "load_scene", "light_direction"]
+
+GEOMETRIES = ("plane", "sphere", "cylinder")
+
+# name -> (height field, geometry, bump strength, description)
+SCENES = {
+    "bricks": ("bricks", "plane", 6.0, "procedural brick wall on a plane (the default)"),
+    "wood": ("wood", "plane", 3.0, "wood-grain rings on a plane (like the paper's Fig. 9)"),
+    "bumps": ("bumps", "plane", 4.0, "sinusoidal bumps on a plane"),
+    "text": ("text", "plane", 6.0, "engraved text on a plane"),
+    "brick-photo": ("brick", "plane", 4.0, "scikit-image brick photograph as a height field"),
+    "gravel": ("gravel", "plane", 4.0, "scikit-image gravel photograph as a height field"),
+    "moon": ("moon", "plane", 4.0, "scikit-image moon photograph as a height field"),
+    "globe": ("moon", "sphere", 4.0, "moon relief on a sphere (a globe, like the paper's Fig. 11)"),
+    "cylinder": ("bricks", "cylinder", 6.0, "brick wall wrapped on a cylinder"),
+}
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything a renderer needs, per pixel and per texel.
+
+    ``px`` holds per-pixel world N, L, H and the tangent-space N' fetched from the bump map
+    (``px.b_phi == b_phi_map[v, u]``); ``mask`` marks the pixels the geometry covers.
+    """
+    name: str
+    geometry: str
+    px: PixelInputs
+    mask: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    height: np.ndarray
+    b_phi_map: np.ndarray
+    b_theta_map: np.ndarray
+    albedo: np.ndarray | None
+
+    @property
+    def size(self):
+        return self.mask.shape[0]
+
+    @property
+    def texture_size(self):
+        return self.height.shape[0]
+
+
+def _power_of_two(name, value, lo, hi):
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or \
+            not lo <= value <= hi or value & (value - 1):
+        raise BumpError(f"{name} must be a power of two in [{lo}, {hi}], got {value!r}")
+
+
+def light_direction(elevation_deg, azimuth_deg):
+    """World light direction from elevation above the screen plane (90 = from the viewer)
+    and azimuth in the screen plane (0 = from the right, 90 = from the top)."""
+    el, az = np.radians(elevation_deg), np.radians(azimuth_deg)
+    right, up, toward_viewer = np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([0, -1.0, 0])
+    return np.cos(el) * np.cos(az) * right + np.cos(el) * np.sin(az) * up + np.sin(el) * toward_viewer
+
+
+def _geometry(kind, size, tex):
+    """Per-pixel surface points P, normals N, texel coordinates (u, v) and coverage mask."""
+    c = (np.arange(size) + 0.5) / size * 2 - 1
+    sx, sz = np.meshgrid(c, -c)                    # screen right, screen up
+    if kind == "plane":                            # facing the viewer: N = -y
+        mask = np.ones((size, size), bool)
+        p = np.stack([sx, np.zeros_like(sx), sz], -1)
+        n = np.broadcast_to(np.array([0, -1.0, 0]), p.shape).copy()
+        u = (sx + 1) / 2 * tex
+        v = (1 - sz) / 2 * tex                     # v grows down the screen = along T
+    elif kind == "sphere":                         # pole up the screen: phi = longitude
+        r2 = sx ** 2 + sz ** 2
+        mask = r2 < 1
+        p = np.stack([sx, -np.sqrt(np.clip(1 - r2, 0, 1)), sz], -1)
+        n = p.copy()
+        phi, theta = cartesian_to_polar(np.where(mask[..., None], n, [0, -1.0, 0]))
+        u = phi / (2 * np.pi) * tex
+        v = theta / np.pi * tex
+    elif kind == "cylinder":                       # axis up the screen
+        mask = np.abs(sx) < 1
+        y = -np.sqrt(np.clip(1 - sx ** 2, 0, 1))
+        p = np.stack([sx, y, sz], -1)
+        n = np.stack([sx, y, np.zeros_like(sx)], -1)
+        phi, _ = cartesian_to_polar(np.where(mask[..., None], n, [0, -1.0, 0]))
+        u = phi / (2 * np.pi) * 2 * tex
+        v = (1 - sz) / 2 * tex
+    else:
+        raise BumpError(f"geometry must be one of {', '.join(GEOMETRIES)}, got {kind!r}")
+    n = np.where(mask[..., None], n, [0, -1.0, 0])
+    to_texel = lambda t: np.mod(np.floor(t).astype(np.int64), tex)
+    return p, n, to_texel(u), to_texel(v), mask
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
+               light="directional", texture_size=None):
+    """Build scene ``name`` at ``size`` x ``size`` pixels (see :data:`SCENES`)."""
+    if name not in SCENES:
+        raise BumpError(f"scene must be one of {', '.join(SCENES)}, got {name!r}")
+    _power_of_two("size", size, 16, 4096)
+    tex = size if texture_size is None else texture_size
+    _power_of_two("texture_size", tex, 16, 4096)
+    for pname, val, lo, hi in (("light_elevation", light_elevation, -90, 90),
+                               ("light_azimuth", light_azimuth, -360, 360)):
+        if not isinstance(val, (int, float)) or not lo <= val <= hi or not np.isfinite(val):
+            raise BumpError(f"{pname} must be in [{lo}, {hi}] degrees, got {val!r}")
+    if light not in ("directional", "point"):
+        raise BumpError(f"light must be directional or point, got {light!r}")
+
+    field, geometry, strength, _ = SCENES[name]
+    height = HEIGHTFIELDS[field](tex)
+    b_phi_map, b_theta_map = height_to_normals(height, strength)
+    p, n, u, v, mask = _geometry(geometry, size, tex)
+
+    ldir = light_direction(light_elevation, light_azimuth)
+    if light == "directional":
+        l_vec = np.broadcast_to(ldir, p.shape)
+    else:                                          # a point light 3 radii away
+        l_vec = _unit(3.0 * ldir - p)
+    view = np.array([0, -1.0, 0])
+    h_vec = _unit(l_vec + view)
+    n_phi, n_theta = cartesian_to_polar(n)
+    l_phi, l_theta = cartesian_to_polar(l_vec)
+    h_phi, h_theta = cartesian_to_polar(h_vec)
+    px = PixelInputs(n_phi, n_theta, l_phi, l_theta, h_phi, h_theta,
+                     b_phi_map[v, u], b_theta_map[v, u])
+    albedo = None
+    if field in ("bricks",):
+        albedo = _brick_albedo(height)
+    elif field == "wood":
+        albedo = np.stack([0.75 + 0.2 * height, 0.5 + 0.2 * height, 0.3 + 0.1 * height], -1)
+    return Scene(name, geometry, px, mask, u, v, height, b_phi_map, b_theta_map, albedo)
+
+
+def _brick_albedo(height):
+    brick = np.array([0.72, 0.33, 0.24])
+    mortar = np.array([0.78, 0.76, 0.72])
+    w = np.clip(height, 0, 1)[..., None]
+    return w * brick + (1 - w) * mortar
