@@ -7,7 +7,9 @@ import importlib
 
 # kind -> module (relative to bumprtl.gen) providing add_parser(subparsers); each
 # benchmark module adds its own line here.
-BENCHES = {}
+BENCHES = {
+    "float64": "bench_float",
+}
 
 
 def add_parser(sub):

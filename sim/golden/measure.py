@@ -13,8 +13,9 @@ __all__ = ["angle_error_deg", "error_stats"]
 def angle_error_deg(a, b):
     """Angle in degrees between direction arrays given as (phi, theta) pairs."""
     va, vb = polar_to_cartesian(*a), polar_to_cartesian(*b)
-    cosang = np.clip(np.einsum("...i,...i", va, vb), -1.0, 1.0)
-    return np.degrees(np.arccos(cosang))
+    # atan2(|a x b|, a.b): accurate for tiny angles, where arccos(a.b) loses half the bits.
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(va, vb), axis=-1),
+                                 np.einsum("...i,...i", va, vb)))
 
 
 def _summary(err):
