@@ -33,10 +33,46 @@ def _sincos_sidecar(cfg, dut):
             "error_bound_ulp": 0.5}
 
 
+def _rotation_sidecar(cfg, dut):
+    from ..sim.golden.fixed_exact import predicted_error_bound_lsb
+    return {"latency": dut.latency, "throughput": 1, "method": cfg.method,
+            "roms": _roms(dut),
+            "error_bound_lsb": predicted_error_bound_lsb(cfg) if cfg.method == "exact" else None}
+
+
+def _roms(dut):
+    """Every memory of an elaborated unit: name -> depth, width, bits (ROM sizes in bits)."""
+    from amaranth.hdl import Fragment, MemoryData, Shape
+    roms = {}
+
+    def walk(frag, path):
+        data = getattr(frag, "_data", None)      # a MemoryInstance carries its MemoryData
+        if isinstance(data, MemoryData):
+            width = Shape.cast(data.shape).width
+            roms[path] = {"depth": data.depth, "width": width, "bits": data.depth * width}
+        for sub, name, _ in getattr(frag, "subfragments", ()):
+            walk(sub, f"{path}.{name}" if path else str(name))
+
+    walk(Fragment.get(dut, None), "")
+    return roms
+
+
 UNITS = {
     "sincos": Unit("sincos", "quarter-wave sin/cos ROM unit (toolchain slice)",
                    lambda cfg: _sincos()(cfg), _sincos_sidecar),
+    "rotation": Unit("rotation", "VectorRotation (Lee Sec. 3.1; --method exact|lee)",
+                     lambda cfg: _rtl("rotation", "VectorRotation")(cfg), _rotation_sidecar,
+                     ("method", "angle_bits", "frac_bits", "tag_bits", "specular")),
+    "illumination": Unit("illumination", "Illumination (Lee Sec. 3.2; --method exact|lee)",
+                         lambda cfg: _rtl("illumination", "Illumination")(cfg), _rotation_sidecar,
+                         ("method", "angle_bits", "frac_bits", "tag_bits", "specular",
+                          "spec_exponent", "ka", "kd", "ks")),
 }
+
+
+def _rtl(module, name):
+    import importlib
+    return getattr(importlib.import_module(f"..rtl.{module}", __package__), name)
 
 
 def canonical_command(unit, cfg):

@@ -9,7 +9,28 @@ from .config import Config
 from .pipe import StallPipe
 from .tables import quarter_sine
 
-__all__ = ["SinCos"]
+__all__ = ["SinCos", "quarter_wave_rom", "sine_read"]
+
+
+def quarter_wave_rom(cfg: Config):
+    """The quarter-wave sine ROM as an Amaranth Memory (contents: tables.quarter_sine)."""
+    return Memory(shape=unsigned(cfg.frac_bits + 1), depth=cfg.sincos_depth,
+                  init=quarter_sine(cfg).tolist())
+
+
+def sine_read(m, pipe, port, angle, cfg: Config, name):
+    """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
+    appears two ``adv`` stages later (ROM read, then sign). ``cos(a)`` is ``sin(a + 2**k)``.
+
+    Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
+    quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
+    """
+    k = cfg.k
+    a = angle[:cfg.angle_bits]
+    quadrant, index = a[k:], a[:k]
+    m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))]
+    negative = pipe.register(quadrant[1], f"{name}_negative")
+    return pipe.register(Mux(negative, -port.data, port.data), name)
 
 
 class SinCos(wiring.Component):
@@ -52,23 +73,11 @@ class SinCos(wiring.Component):
         cfg, k = self.cfg, self.cfg.k
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency)
-        m.submodules.rom = rom = Memory(shape=unsigned(cfg.frac_bits + 1),
-                                        depth=cfg.sincos_depth, init=quarter_sine(cfg).tolist())
-
+        m.submodules.rom = rom = quarter_wave_rom(cfg)
         angle = self.i.payload.angle
-        outputs = {}
-        for name, offset in (("sin", 0), ("cos", 1 << k)):   # cos(a) = sin(a + 90 deg)
-            a = (angle + offset)[:cfg.angle_bits]
-            quadrant, index = a[k:], a[:k]
-            port = rom.read_port(domain="sync")
-            # Quadrants 1 and 3 read the ROM backwards: index 2**k - i (entry 2**k is 1.0).
-            m.d.comb += [
-                port.en.eq(pipe.adv),
-                port.addr.eq(Mux(quadrant[0], (1 << k) - index, index)),
-            ]
-            negative = pipe.register(quadrant[1], f"{name}_negative")  # quadrants 2 and 3
-            value = port.data
-            outputs[name] = pipe.register(Mux(negative, -value, value), f"{name}_value")
+        outputs = {name: sine_read(m, pipe, rom.read_port(domain="sync"), angle + offset, cfg,
+                                   f"{name}_value")
+                   for name, offset in (("sin", 0), ("cos", 1 << k))}   # cos a = sin(a + 90)
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),
             self.o.payload.cos.eq(outputs["cos"]),

@@ -1,0 +1,137 @@
+"""The exact angular method in hardware (DESIGN §3): rotate N' once, not L and H.
+
+N'.(M A) = (R_y(th_N) n') . A_z with A_z = R_z(-ph_N) A. Everything is a sum of sines and
+cosines of angle sums read from quarter-wave ROMs (product-to-sum), then 3 multiplies per
+vector: 6 multipliers, 24 sin/cos reads and no division or inverse trig per pixel.
+Bit-exact with ``sim/golden/fixed_exact.py``.
+"""
+
+from amaranth.hdl import signed
+from amaranth.lib import data
+
+from .config import Config
+from .fixed import round_shift
+from .illumination import SHADE_LATENCY, shade_stages
+from .layouts import pixel_layout, shade_layout
+from .pipe import StallPipe
+from .sincos import quarter_wave_rom, sine_read
+
+__all__ = ["Rotation", "Illumination", "rotated_layout"]
+
+
+def vectors(cfg: Config):
+    """The vectors dotted with N': L, and H when the scene has specular."""
+    return ("l", "h") if cfg.specular else ("l",)
+
+
+def rotated_layout(cfg: Config):
+    """Rotation output: n'' (scaled x4, x2, x4) and p, y, cos th per vector (scaled x2, x2,
+    x1), all with frac_bits fractional bits; widths hold the exact sums (no rounding)."""
+    b = cfg.frac_bits
+    fields = {"n": data.StructLayout({"x4": signed(b + 5), "y2": signed(b + 3), "z4": signed(b + 5)})}
+    for v in vectors(cfg):
+        fields[v] = data.StructLayout({"p2": signed(b + 3), "y2": signed(b + 3), "z": signed(b + 2)})
+    fields["tag"] = pixel_layout(cfg)["tag"].shape
+    return data.StructLayout(fields)
+
+
+class _SineBank:
+    """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA)."""
+
+    def __init__(self, m, pipe, cfg):
+        self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], None
+
+    def _port(self):
+        if self.pending is None:
+            self.pending = rom = quarter_wave_rom(self.cfg)
+            self.m.submodules[f"sine_rom{len(self.roms)}"] = rom
+            self.roms.append(rom)
+            return rom.read_port(domain="sync")
+        port, self.pending = self.pending.read_port(domain="sync"), None
+        return port
+
+    def sin(self, angle, name):
+        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name)
+
+    def cos(self, angle, name):
+        return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)
+
+
+class Rotation:
+    """VectorRotation datapath, exact method (elaborated into ``rotation.VectorRotation``).
+
+    Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. With a = th_N' + ph_N',
+    b = th_N' - ph_N', t = th_N:
+      4 n''x = s(a+t) + s(a-t) + s(b+t) + s(b-t) + 2[s(t+th_N') + s(t-th_N')]
+      2 n''y = c(b) - c(a)
+      4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
+    and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
+      2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
+    Latency 3 (ROM read, sign, sums); 1 pixel per clock.
+    """
+
+    latency = 3
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        self.in_layout, self.out_layout = pixel_layout(cfg), rotated_layout(cfg)
+
+    def build(self, m, i, o):
+        cfg = self.cfg
+        pipe = StallPipe(m, i, o, self.latency)
+        rom = _SineBank(m, pipe, cfg)
+        px, o = i.payload, o.payload
+        t, bt, bp = px.n.theta, px.b.theta, px.b.phi
+        a, b = bt + bp, bt - bp
+        s = {f"s{n}": rom.sin(x, f"n_s{n}") for n, x in
+             enumerate((a + t, a - t, b + t, b - t, t + bt, t - bt))}
+        c = {f"c{n}": rom.cos(x, f"n_c{n}") for n, x in
+             enumerate((b, a, a - t, a + t, b - t, b + t, bt - t, bt + t))}
+        sums = {
+            "x4": s["s0"] + s["s1"] + s["s2"] + s["s3"] + 2 * (s["s4"] + s["s5"]),
+            "y2": c["c0"] - c["c1"],
+            "z4": -(c["c2"] - c["c3"] + c["c4"] - c["c5"]) + 2 * (c["c6"] + c["c7"]),
+        }
+        for name, value in sums.items():
+            m.d.comb += o.n[name].eq(pipe.register(value, f"n_{name}"))
+        for v in vectors(cfg):
+            th, d = px[v].theta, px[v].phi - px.n.phi
+            x, y = th + d, th - d
+            terms = {"p2": rom.sin(x, f"{v}_sx") + rom.sin(y, f"{v}_sy"),
+                     "y2": rom.cos(y, f"{v}_cy") - rom.cos(x, f"{v}_cx"),
+                     "z": rom.cos(th, f"{v}_cth")}
+            for name, value in terms.items():
+                m.d.comb += o[v][name].eq(pipe.register(value, f"{v}_{name}"))
+        m.d.comb += o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
+
+
+class Illumination:
+    """Illumination datapath, exact method: N'.A' = (x4 p2 + 2 y2 y2 + 2 z4 z) / 8, rounded once,
+    then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
+
+    Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
+    Latency 2 (products, sum) + SHADE_LATENCY; 1 pixel per clock.
+    """
+
+    latency = 2 + SHADE_LATENCY
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        self.in_layout, self.out_layout = rotated_layout(cfg), shade_layout(cfg)
+
+    def build(self, m, i, o):
+        cfg = self.cfg
+        pipe = StallPipe(m, i, o, self.latency)
+        n = i.payload.n
+        dots = {}
+        for v in vectors(cfg):
+            a = i.payload[v]
+            px_ = pipe.register(n.x4 * a.p2, f"{v}_xp")                 # 3 multipliers per vector
+            py_ = pipe.register(n.y2 * a.y2, f"{v}_yy")
+            pz_ = pipe.register(n.z4 * a.z, f"{v}_zz")
+            acc = px_ + 2 * py_ + 2 * pz_
+            dots[v] = pipe.register(round_shift(acc, cfg.frac_bits + 3), f"{v}_dot")
+        diffuse, specular, color = shade_stages(m, pipe, cfg, dots["l"], dots.get("h", 0))
+        m.d.comb += [o.payload.diffuse.eq(diffuse), o.payload.specular.eq(specular),
+                     o.payload.color.eq(color),
+                     o.payload.tag.eq(pipe.delay(i.payload.tag, self.latency, "tag"))]

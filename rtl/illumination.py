@@ -1,0 +1,94 @@
+"""Illumination unit (Lee Sec. 3.2, Fig. 8) and its shared back end.
+
+The back end turns the dot products N'.L' and N'.H' into 8-bit diffuse and specular
+intensities and the Phong sum of eq. (2); it is shared by every method and mirrored
+operation for operation by ``sim/golden/fixed_common.shade_fixed``.
+"""
+
+from amaranth.hdl import Module, Mux, unsigned
+from amaranth.lib import stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from .config import Config
+from .fixed import round_shift
+from .tables import phong_coefficients, specular_index_bits, specular_table
+
+__all__ = ["Illumination", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
+
+# Registers of shade_stages: clamp/index, table read + diffuse, Phong sum.
+SHADE_LATENCY = 3
+
+
+def _clamp01(x, cfg):
+    """clamp(x, 0, 1.0) of a signed value with frac_bits fractional bits, as unsigned B+1."""
+    return Mux(x[-1], 0, Mux(x > cfg.one, cfg.one, x))[:cfg.frac_bits + 1]
+
+
+def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
+    """Eq. (2) from the dot products; returns (diffuse, specular, color), SHADE_LATENCY
+    ``adv`` stages after ``ndotl``/``ndoth`` (signed, ``frac_bits`` fractional bits).
+
+    diffuse  = round(255 clamp(N'.L))                    (constant multiply)
+    specular = cos^n table[round(clamp(N'.H) 2**s)]      (block-RAM table, Fig. 8)
+    color    = clamp(round((KA + KD diffuse + KS specular) / 256), 0, 255)
+    """
+    b = cfg.frac_bits
+    d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                 # stage 1
+    diffuse = pipe.register(round_shift(d * 255, b)[:8], "diffuse")               # stage 2
+    if cfg.specular:
+        s_bits = specular_index_bits(cfg)
+        index = pipe.register(round_shift(_clamp01(ndoth, cfg), b - s_bits), "spec_index")
+        table = specular_table(cfg)
+        m.submodules.specular_table = rom = Memory(shape=unsigned(8), depth=len(table),
+                                                   init=table.tolist())
+        port = rom.read_port(domain="sync")
+        m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(index)]
+        specular = port.data                                                      # stage 2
+    else:
+        specular = 0
+    ka, kd, ks = phong_coefficients(cfg)
+    total = round_shift(ka + diffuse * kd + specular * ks, 8)
+    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 3
+    diffuse = pipe.register(diffuse, "diffuse_out")
+    specular = pipe.register(specular, "specular_out") if cfg.specular else 0
+    return diffuse, specular, color
+
+
+class MethodUnit(wiring.Component):
+    """A unit whose datapath is chosen by ``cfg.method``: the datapath object (from
+    rtl/exact.py or rtl/lee.py) gives the payload layouts and latency and elaborates straight
+    into this component's module, so the emitted Verilog is one module per unit."""
+
+    _unit = None       # "Rotation" or "Illumination": the datapath class name
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        if cfg.method == "exact":
+            from . import exact as methods
+        else:
+            from . import lee as methods
+        self.datapath = getattr(methods, self._unit)(cfg)
+        super().__init__({"i": In(stream.Signature(self.datapath.in_layout)),
+                          "o": Out(stream.Signature(self.datapath.out_layout))})
+
+    @property
+    def latency(self):
+        return self.datapath.latency
+
+    def elaborate(self, platform):
+        m = Module()
+        self.datapath.build(m, self.i, self.o)
+        return m
+
+
+class Illumination(MethodUnit):
+    """Per-pixel illumination: the rotation unit's output in, 8-bit shading out.
+
+    ``cfg.method`` picks the datapath: ``exact`` (rtl/exact.py) or ``lee`` (rtl/lee.py).
+    Input payload: the matching rotation unit's output layout; output payload:
+    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, tag).
+    Throughput 1 pixel per clock; ``latency`` depends on the method.
+    """
+
+    _unit = "Illumination"

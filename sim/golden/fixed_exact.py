@@ -1,0 +1,74 @@
+"""Bit-exact int64 model of the ``exact`` datapath (rtl/exact.py), vectorized.
+
+Scales (all integers carry ``frac_bits`` = B fractional bits; no rounding until the dot):
+  n.x4 = 4 n''x, n.y2 = 2 n''y, n.z4 = 4 n''z     (DESIGN §3, product-to-sum sums)
+  a.p2 = 2 p, a.y2 = 2 y, a.z = cos th_A          per vector A in {L, H}
+  N'.A' = (n.x4 a.p2 + 2 n.y2 a.y2 + 2 n.z4 a.z) / 8, one rounding back to B bits.
+"""
+
+import numpy as np
+
+from ...rtl.config import Config
+from ...rtl.fixed import round_shift
+from ...rtl.tables import cos_lookup, sin_lookup
+from .fixed_common import shade_fixed
+
+__all__ = ["exact_rotation_fixed", "exact_dot_fixed", "exact_fixed", "vectors"]
+
+
+def vectors(cfg: Config):
+    """The vectors whose dot products with N' the datapath forms: L, and H with specular."""
+    return ("l", "h") if cfg.specular else ("l",)
+
+
+def exact_rotation_fixed(codes, cfg: Config):
+    """VectorRotation (exact): n'' of the bump normal and p, y, cos th of L and H."""
+    s, c = (lambda a: sin_lookup(cfg, a)), (lambda a: cos_lookup(cfg, a))
+    t, bt, bp = codes["n.theta"], codes["b.theta"], codes["b.phi"]
+    a, b = bt + bp, bt - bp                   # a = th_N' + ph_N', b = th_N' - ph_N'
+    out = {
+        "n.x4": s(a + t) + s(a - t) + s(b + t) + s(b - t) + 2 * (s(t + bt) + s(t - bt)),
+        "n.y2": c(b) - c(a),
+        "n.z4": -(c(a - t) - c(a + t) + c(b - t) - c(b + t)) + 2 * (c(bt - t) + c(bt + t)),
+    }
+    for v in vectors(cfg):
+        th, d = codes[f"{v}.theta"], codes[f"{v}.phi"] - codes["n.phi"]
+        x, y = th + d, th - d                 # X = th_A + D, Y = th_A - D (binary angles wrap)
+        out[f"{v}.p2"] = s(x) + s(y)
+        out[f"{v}.y2"] = c(y) - c(x)
+        out[f"{v}.z"] = c(th)
+    return out
+
+
+def exact_dot_fixed(rot, v, cfg: Config):
+    """N'.A' with B fractional bits: (x4 p2 + 2 y2 y2 + 2 z4 z) / 8 / 2**B, rounded once."""
+    wide = lambda key: rot[key].astype(np.int64)          # products need up to 2B + 8 bits
+    acc = (wide("n.x4") * rot[f"{v}.p2"] + 2 * wide("n.y2") * rot[f"{v}.y2"]
+           + 2 * wide("n.z4") * rot[f"{v}.z"])
+    return round_shift(acc, cfg.frac_bits + 3)
+
+
+def exact_fixed(codes, cfg: Config):
+    """The whole exact datapath: dict with the rotation terms, ndotl, ndoth and 8-bit
+    diffuse, specular and color."""
+    rot = exact_rotation_fixed(codes, cfg)
+    ndotl = exact_dot_fixed(rot, "l", cfg)
+    ndoth = exact_dot_fixed(rot, "h", cfg) if cfg.specular else np.zeros_like(ndotl)
+    return {**rot, "ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
+
+
+def predicted_error_bound_lsb(cfg: Config):
+    """Worst-case |diffuse8 - round(255 * clamp(N.L))| of the exact datapath, in 8-bit LSB.
+
+    Inputs are rounded to the angle grid: each of the 6 angles that N'.L' depends on is off
+    by at most half a step, delta = pi / 2**(k+2) rad, and |d(N'.L')/d angle| <= 1 for each,
+    so the dot is off by at most 6 delta. Every ROM value is off by at most half an LSB
+    (ulp = 2**-B): n''x and n''z (4 values / 4 + 2 values / 2) by 1 ulp, n''y, p, y and
+    cos th_A by 1/2 ulp; every component is multiplied by one of magnitude <= 1, so the dot
+    gains at most 4 ulp, and the final rounding of the dot another 1/2 ulp.
+    The diffuse output rounds 255 x (that) to an integer: an error e before rounding gives at
+    most floor(e) + 1 after it.
+    """
+    delta = np.pi / (1 << (cfg.k + 2))
+    before = 255.0 * (6 * delta + 4.5 * 2.0 ** -cfg.frac_bits)
+    return int(np.floor(before)) + 1
