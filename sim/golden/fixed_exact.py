@@ -13,7 +13,8 @@ from ...rtl.fixed import round_shift
 from ...rtl.tables import cos_lookup, sin_lookup
 from .fixed_common import shade_fixed
 
-__all__ = ["exact_rotation_fixed", "exact_dot_fixed", "exact_fixed", "vectors"]
+__all__ = ["exact_rotation_fixed", "exact_illumination_fixed", "exact_dot_fixed", "exact_fixed",
+           "vectors", "predicted_error_bound_lsb"]
 
 
 def vectors(cfg: Config):
@@ -48,13 +49,18 @@ def exact_dot_fixed(rot, v, cfg: Config):
     return round_shift(acc, cfg.frac_bits + 3)
 
 
+def exact_illumination_fixed(rot, cfg: Config):
+    """Illumination (exact): ndotl, ndoth and 8-bit diffuse, specular, color."""
+    ndotl = exact_dot_fixed(rot, "l", cfg)
+    ndoth = exact_dot_fixed(rot, "h", cfg) if cfg.specular else np.zeros_like(ndotl)
+    return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
+
+
 def exact_fixed(codes, cfg: Config):
     """The whole exact datapath: dict with the rotation terms, ndotl, ndoth and 8-bit
     diffuse, specular and color."""
     rot = exact_rotation_fixed(codes, cfg)
-    ndotl = exact_dot_fixed(rot, "l", cfg)
-    ndoth = exact_dot_fixed(rot, "h", cfg) if cfg.specular else np.zeros_like(ndotl)
-    return {**rot, "ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
+    return {**rot, **exact_illumination_fixed(rot, cfg)}
 
 
 def predicted_error_bound_lsb(cfg: Config):

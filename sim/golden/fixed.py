@@ -1,0 +1,31 @@
+"""Dispatch to the bit-exact golden model of a unit by method: one entry point for the
+tests, testbenches and benchmarks."""
+
+from ...rtl.config import Config
+
+__all__ = ["rotation_fixed", "illumination_fixed", "datapath_fixed"]
+
+
+def _methods(cfg):
+    if cfg.method == "exact":
+        from . import fixed_exact as m
+        return m.exact_rotation_fixed, m.exact_illumination_fixed
+    from . import fixed_lee as m
+    return m.lee_rotation_fixed, m.lee_illumination_fixed
+
+
+def rotation_fixed(codes, cfg: Config):
+    """VectorRotation's output fields (flattened names) from the input angle codes."""
+    return _methods(cfg)[0](codes, cfg)
+
+
+def illumination_fixed(rot, cfg: Config):
+    """Illumination's output (diffuse, specular, color, ndotl, ndoth) from rotation fields."""
+    return _methods(cfg)[1](rot, cfg)
+
+
+def datapath_fixed(codes, cfg: Config):
+    rot = rotation_fixed(codes, cfg)
+    return {**rot, **illumination_fixed(rot, cfg)}
+
+

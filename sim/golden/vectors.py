@@ -1,0 +1,49 @@
+"""Test vectors for the datapath units: random valid pixels and the edge cases, as the
+flattened input payloads the RTL takes (binary-angle codes)."""
+
+import numpy as np
+
+from ...rtl.config import Config
+from .common import PixelInputs
+from .fixed_common import quantize_pixels
+
+__all__ = ["edge_codes", "random_codes", "as_payloads"]
+
+KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
+
+
+def random_codes(n, cfg: Config, seed=0):
+    return quantize_pixels(PixelInputs.random(n, np.random.default_rng(seed)), cfg)
+
+
+def edge_codes(cfg: Config):
+    """theta 0, 90, 180 degrees; azimuth wrap (ph_A just below 0 and ph_N just above, and the
+    reverse); L = N; grazing light; light below the horizon; in all combinations with a few
+    N and N' directions."""
+    full, q = cfg.full_circle, cfg.full_circle // 4
+    thetas = [0, 1, q - 1, q, q + 1, 2 * q - 1, 2 * q]            # 0, 90, 180 degrees
+    phis = [0, 1, full - 1, q, 2 * q, 3 * q]
+    rows = []
+    for n_phi in phis:
+        for n_theta in thetas:
+            for b_theta in (0, q // 3, q - 1):
+                b_phi = (n_phi * 7 + b_theta) % full
+                lights = [(n_phi, n_theta),                        # L = N
+                          ((n_phi + q) % full, q),                 # grazing (in the xy-plane)
+                          ((n_phi + 1) % full, min(2 * q, n_theta + q)),  # 90 deg from N
+                          ((n_phi - 1) % full, 2 * q - 1),         # below the world horizon
+                          ((full - 1 - n_phi) % full, q // 2)]     # azimuth wraps past 360
+                for l_phi, l_theta in lights:
+                    rows.append((n_phi, n_theta, l_phi, l_theta, (l_phi + n_phi) // 2 % full,
+                                 (l_theta + n_theta) // 2, b_phi, b_theta))
+    arr = np.array(rows, dtype=np.int32)
+    return {k: arr[:, i] for i, k in enumerate(KEYS)}
+
+
+def as_payloads(codes, cfg: Config, keys=None):
+    """Dict of arrays -> list of payload dicts (with a running tag)."""
+    keys = [k for k in (keys or codes) if cfg.specular or not k.startswith("h.")]
+    n = len(next(iter(codes.values())))
+    mask = (1 << cfg.tag_bits) - 1
+    cols = {k: np.asarray(codes[k]).tolist() for k in keys}
+    return [{**{k: cols[k][i] for k in keys}, "tag": i & mask} for i in range(n)]
