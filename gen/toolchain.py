@@ -49,6 +49,11 @@ def tool_env(base=None):
     # when the venv is not activated).
     venv_bin = str(Path(sys.executable).parent)
     env["PATH"] = os.pathsep.join([str(root / "bin"), venv_bin, env.get("PATH", "")])
+    # The wheel's verilated.mk leaves the precompiled-header include flag empty, so designs
+    # big enough to use a PCH pass "Vtop__pch.h.fast" to g++ as a linker input. A variable
+    # in MAKEFLAGS is a command-line override for the make that cocotb runs.
+    if "CFG_CXXFLAGS_PCH_I" not in env.get("MAKEFLAGS", ""):
+        env["MAKEFLAGS"] = (env.get("MAKEFLAGS", "") + " CFG_CXXFLAGS_PCH_I=-include").strip()
     return env
 
 

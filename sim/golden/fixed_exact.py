@@ -64,17 +64,23 @@ def exact_fixed(codes, cfg: Config):
 
 
 def predicted_error_bound_lsb(cfg: Config):
-    """Worst-case |diffuse8 - round(255 * clamp(N.L))| of the exact datapath, in 8-bit LSB.
+    """Worst-case |diffuse8 - round(255 * clamp(N'.L))| of the exact datapath, in 8-bit LSB,
+    against float64 on unquantized inputs.
 
-    Inputs are rounded to the angle grid: each of the 6 angles that N'.L' depends on is off
-    by at most half a step, delta = pi / 2**(k+2) rad, and |d(N'.L')/d angle| <= 1 for each,
-    so the dot is off by at most 6 delta. Every ROM value is off by at most half an LSB
-    (ulp = 2**-B): n''x and n''z (4 values / 4 + 2 values / 2) by 1 ulp, n''y, p, y and
-    cos th_A by 1/2 ulp; every component is multiplied by one of magnitude <= 1, so the dot
-    gains at most 4 ulp, and the final rounding of the dot another 1/2 ulp.
-    The diffuse output rounds 255 x (that) to an integer: an error e before rounding gives at
-    most floor(e) + 1 after it.
+    With delta = pi / 2**(k+2) rad (half an angle step) and u = 2**-B:
+    * input rounding: N' moves by at most sqrt(5) delta (th_N, th_N', ph_N' through
+      Cauchy-Schwarz) and A by at most sqrt(5) delta (th_A, and ph_A, ph_N which move it
+      along one direction, worth 2 sin th_A), so N'.A' moves by at most 2 sqrt(5) delta to
+      first order, plus at most 14 delta**2;
+    * arithmetic: the ROM values are off by at most u/2 each, so n'' (4 values / 4 + 2 / 2,
+      2 / 2, 4 / 4 + 2 / 2) is off by at most sqrt(1 + 1/4 + 1) u = 1.5 u, the vector terms
+      (p, y, cos th_A) by sqrt(3)/2 u, and the dot's final rounding adds u/2 (1.3 u**2 covers
+      the product of the two errors);
+    * the 8-bit rounding turns an error e before it into at most floor(e) + 1 after it.
+    Measured maxima stay under the bound (tests/sim/golden/test_fixed_exact.py).
     """
     delta = np.pi / (1 << (cfg.k + 2))
-    before = 255.0 * (6 * delta + 4.5 * 2.0 ** -cfg.frac_bits)
+    u = 2.0 ** -cfg.frac_bits
+    before = 255.0 * (2 * np.sqrt(5) * delta + 14 * delta ** 2
+                      + (1.5 + np.sqrt(3) / 2 + 0.5 + 1.3 * u) * u)
     return int(np.floor(before)) + 1
