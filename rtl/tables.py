@@ -11,7 +11,9 @@ import numpy as np
 from .config import Config
 
 __all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits", "specular_table",
-           "phong_coefficients"]
+           "phong_coefficients", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",
+           "lee_reciprocal_table", "lee_atan_mantissa_bits", "lee_atan_ratio_bits", "lee_atan_depth",
+           "lee_atan_table", "lee_prop_index_bits", "lee_prop_table"]
 
 
 def quarter_sine(cfg: Config) -> np.ndarray:
@@ -80,3 +82,85 @@ def phong_coefficients(cfg: Config):
     so KA = round(255 * 256 * ka) and KD, KS = round(256 * k) (8 fractional bits)."""
     return (int(round(255 * 256 * cfg.ka)), int(round(256 * cfg.kd)),
             int(round(256 * cfg.ks)) if cfg.specular else 0)
+
+
+# --- Lee et al. 2003: the vector-rotation ROMs of Fig. 7 (rtl/lee.py) -----------------------
+# Angles out of these tables are binary-angle codes (full circle = 2**(k+2)); fractions carry
+# frac_bits = B fractional bits. Each table is indexed by a magnitude; signs, quadrants and
+# the errata's branch fixes are logic in rtl/lee.py and sim/golden/fixed_lee.py.
+
+def _angle_code(rad, cfg: Config):
+    return np.rint(rad * (cfg.full_circle / (2 * np.pi))).astype(np.int64)
+
+
+def lee_asin_index_bits(cfg: Config) -> int:
+    """Address bits of the asin ROM: |s| = |sin X + sin Y| / 2 in [0, 1] with this many
+    fractional bits (the angle resolution, and no more bits than s carries)."""
+    return min(cfg.k + 2, cfg.frac_bits + 1)
+
+
+def lee_asin_table(cfg: Config) -> np.ndarray:
+    """Eq. 7's Sin^-1: entry i = asin(i / 2**a) as a binary angle (0 .. 90 deg), i = 0 .. 2**a."""
+    a = lee_asin_index_bits(cfg)
+    return _angle_code(np.arcsin(np.arange((1 << a) + 1) / (1 << a)), cfg)
+
+
+def lee_reciprocal_bits(cfg: Config) -> int:
+    """Width of the 1/|sin| ROM values: k integer bits (1/sin of one angle step is
+    2**(k+2) / 2pi < 2**k) and B fractional bits."""
+    return cfg.k + cfg.frac_bits
+
+
+def lee_reciprocal_table(cfg: Config) -> np.ndarray:
+    """Quarter-wave 1/sin (eqs 9 and 27's 1/(2 sin Z), 1/(2 cos Z); Sec. 4.1 reads them
+    straight from Z): entry i = 1/sin(i * 90deg / 2**k) with B fractional bits, i = 0 .. 2**k,
+    saturated at the largest value of lee_reciprocal_bits (erratum 8: 1/sin 0 is unbounded)."""
+    i = np.arange(cfg.sincos_depth, dtype=np.float64)
+    top = (1 << lee_reciprocal_bits(cfg)) - 1
+    with np.errstate(divide="ignore"):
+        r = cfg.one / np.sin(i * (np.pi / 2) / (1 << cfg.k))
+    return np.rint(np.minimum(r, top)).astype(np.int64)
+
+
+def lee_atan_mantissa_bits(cfg: Config) -> int:
+    """Mantissa bits M of the atan ROM's floating-point address (relative step 2**-M:
+    the atan error stays below 2**-(M+2) rad, under half an angle step)."""
+    return cfg.k - 2
+
+
+def lee_atan_ratio_bits(cfg: Config) -> int:
+    """Width W of the ratio |y / sin Z| fed to the atan address: k integer bits (the
+    saturated 1/sin bounds it by 2**k) and k fractional bits."""
+    return 2 * cfg.k
+
+
+def lee_atan_depth(cfg: Config) -> int:
+    """Entries of the atan ROM: (W - M + 1) * 2**M (one 2**M block per exponent)."""
+    m = lee_atan_mantissa_bits(cfg)
+    return (lee_atan_ratio_bits(cfg) - m + 1) << m
+
+
+def lee_atan_table(cfg: Config) -> np.ndarray:
+    """Eq. 9's Tan^-1 of a ratio t >= 0 given as a floating-point address (rtl/lee.py
+    ``ratio_index``): address (e + 1) * 2**M + f stands for the ratios q * 2**e .. (q+1) * 2**e
+    (q = 2**M + f, in units of 2**-k; exponent block 0 is linear), and holds atan of the middle
+    of that interval, so the address's truncation rounds to nearest. Binary angles 0 .. 90 deg."""
+    m = lee_atan_mantissa_bits(cfg)
+    idx = np.arange(lee_atan_depth(cfg), dtype=np.int64)
+    e = np.maximum((idx >> m) - 1, 0)
+    q = idx - (e << m)
+    t = (q + 0.5) * np.exp2(e) / (1 << cfg.k)
+    return _angle_code(np.arctan(t), cfg)
+
+
+def lee_prop_index_bits(cfg: Config) -> int:
+    """Address bits of T_prop: |y_k| in [0, 1] with k + 2 fractional bits."""
+    return cfg.k + 2
+
+
+def lee_prop_table(cfg: Config) -> np.ndarray:
+    """T_prop, eq. 26: theta_prop = 1 - acos(y_k) / 90deg for y_k = i / 2**p, i = 0 .. 2**p,
+    with B fractional bits (erratum 4: indexed by |y_k| clamped to [0, 1])."""
+    p = lee_prop_index_bits(cfg)
+    y = np.arange((1 << p) + 1, dtype=np.float64) / (1 << p)
+    return np.rint((1.0 - np.arccos(y) / (np.pi / 2)) * cfg.one).astype(np.int64)
