@@ -9,6 +9,8 @@ import importlib
 # benchmark module adds its own line here.
 BENCHES = {
     "float64": "bench_float",
+    "golden": "bench_golden",
+    "accuracy": "bench_accuracy",
 }
 
 
