@@ -2,30 +2,44 @@
 
 import time
 
-import numpy as np
+
+def _cols(s):
+    return f"{s['mean']:.3g} | {s['p99']:.3g} | {s['max']:.3g}"
+
+
+def _model_table(px, cfg):
+    from ..sim.golden.measure import compare
+    from ..sim.golden.models import FLOAT_MODELS
+    print("| method | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max | NaN | Mpix/s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    ref = FLOAT_MODELS["conventional"](px, cfg)
+    for name, model in FLOAT_MODELS.items():
+        t0 = time.perf_counter()
+        res = model(px, cfg)                             # timed side by side, same inputs
+        rate = len(px) / (time.perf_counter() - t0) / 1e6
+        s = compare(res, ref)
+        lcols = _cols(s["l_prime_deg"]) if "l_prime_deg" in s else "- | - | -"
+        print(f"| {name} | {lcols} | {_cols(s['diffuse_lsb'])} | {s['diffuse_lsb']['nan']} | {rate:.2f} |")
+
+
+def _theta_n_table(args, cfg):
+    from ..sim.golden.measure import error_by_theta_n
+    print("\nlee_fixed by theta_N (the rigid circle of Lee Sec. 3.1.2 is exact at theta_N = 0)\n")
+    print("| theta_N (deg) | pixels | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max |")
+    print("|---|---|---|---|---|---|---|---|")
+    for lo, hi, count, s in error_by_theta_n("lee_fixed", args.samples, args.seed, 15, cfg):
+        print(f"| {lo}-{hi} | {count} | {_cols(s['l_prime_deg'])} | {_cols(s['diffuse_lsb'])} |")
 
 
 def run(args):
     from ..rtl.config import Config
-    from ..sim.golden.common import PixelInputs
-    from ..sim.golden.measure import error_stats
-    from ..sim.golden.models import FLOAT_MODELS
+    from ..sim.golden.measure import random_pixels
     cfg = Config()
+    px = random_pixels(args.samples, args.seed)
     print(f"bumprtl bench float64 --samples {args.samples} --seed {args.seed}")
     print(f"{args.samples} random valid inputs (seed {args.seed}); errors against 'conventional'\n")
-    print("| method | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max | NaN | Mpix/s |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    px = PixelInputs.random(args.samples, np.random.default_rng(args.seed))
-    for name, model in FLOAT_MODELS.items():
-        s = error_stats(name, n=args.samples, seed=args.seed, cfg=cfg)
-        t0 = time.perf_counter()
-        model(px, cfg)                                   # timed side by side, same inputs
-        rate = args.samples / (time.perf_counter() - t0) / 1e6
-        lp = s.get("l_prime_deg")
-        lcols = f"{lp['mean']:.3g} | {lp['p99']:.3g} | {lp['max']:.3g}" if lp else "- | - | -"
-        d = s["diffuse_lsb"]
-        print(f"| {name} | {lcols} | {d['mean']:.3g} | {d['p99']:.3g} | {d['max']:.3g} | "
-              f"{d['nan']} | {rate:.2f} |")
+    _model_table(px, cfg)
+    _theta_n_table(args, cfg)
     return 0
 
 
@@ -33,7 +47,8 @@ def add_parser(sub):
     p = sub.add_parser("float64", help="error and speed of the float64 golden models",
                        description="Mean, p99 and max of the L' angle error (degrees) and of the "
                                    "diffuse error (8-bit LSB) of every float64 model against the "
-                                   "Cartesian reference, and each model's speed, in one run.")
+                                   "Cartesian reference, and each model's speed, in one run; "
+                                   "then lee_fixed's errors binned by theta_N.")
     p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
     p.add_argument("--seed", type=int, default=1)
     p.set_defaults(func=run)

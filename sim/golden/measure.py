@@ -2,12 +2,12 @@
 
 import numpy as np
 
-from ...rtl.config import Config
+from ...rtl.config import BumpError, Config
 from .common import PixelInputs, polar_to_cartesian
 from .conventional import conventional
 from .models import FLOAT_MODELS
 
-__all__ = ["angle_error_deg", "error_stats"]
+__all__ = ["angle_error_deg", "compare", "error_stats", "error_by_theta_n", "random_pixels"]
 
 
 def angle_error_deg(a, b):
@@ -27,14 +27,44 @@ def _summary(err):
             "max": float(finite.max()), "nan": int(err.size - finite.size)}
 
 
-def error_stats(method, n=100_000, seed=1, cfg=Config()):
-    """Mean, p99 and max of the L' angle error (degrees, when the method computes L') and
-    of the diffuse error in 8-bit LSB, on ``n`` random valid inputs; NaN counts too."""
-    px = PixelInputs.random(n, np.random.default_rng(seed))
-    ref = conventional(px, cfg)
-    res = FLOAT_MODELS[method](px, cfg)
-    out = {"method": method, "n": n,
-           "diffuse_lsb": _summary(np.abs(res.diffuse - ref.diffuse) * 255.0)}
+def random_pixels(n, seed):
+    """``n`` random valid inputs (:meth:`PixelInputs.random`) from ``seed``."""
+    if not isinstance(n, (int, np.integer)) or n < 1:
+        raise BumpError(f"samples = {n!r} is out of range: allowed integers >= 1")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise BumpError(f"seed = {seed!r} is out of range: allowed integers >= 0")
+    return PixelInputs.random(int(n), np.random.default_rng(seed))
+
+
+def _errors(res, ref):
+    """Per-pixel errors of ``res`` against ``ref``: diffuse in 8-bit LSB, and the L' angle
+    in degrees when ``res`` computes L'."""
+    out = {"diffuse_lsb": np.abs(res.diffuse - ref.diffuse) * 255.0}
     if res.l_prime is not None:
-        out["l_prime_deg"] = _summary(angle_error_deg(res.l_prime, ref.l_prime))
+        out["l_prime_deg"] = angle_error_deg(res.l_prime, ref.l_prime)
     return out
+
+
+def compare(res, ref):
+    """Mean, p99 and max of the L' angle error (degrees, when ``res`` has L') and of the
+    diffuse error in 8-bit LSB of ``res`` against ``ref``; NaNs are counted, not averaged."""
+    return {k: _summary(v) for k, v in _errors(res, ref).items()}
+
+
+def error_stats(method, n=100_000, seed=1, cfg=Config()):
+    """:func:`compare` of ``method`` against ``conventional`` on ``n`` random valid inputs."""
+    px = random_pixels(n, seed)
+    return {"method": method, "n": n, **compare(FLOAT_MODELS[method](px, cfg), conventional(px, cfg))}
+
+
+def error_by_theta_n(method="lee_fixed", n=100_000, seed=1, step_deg=15, cfg=Config()):
+    """Errors of ``method`` binned by th_N: where the rigid-circle approximation of Lee
+    Sec. 3.1.2 (exact at th_N = 0) costs most. Rows (lo_deg, hi_deg, count, summaries)."""
+    if not isinstance(step_deg, int) or step_deg < 1 or 180 % step_deg:
+        raise BumpError(f"step_deg = {step_deg!r} is out of range: allowed divisors of 180")
+    px = random_pixels(n, seed)
+    err = _errors(FLOAT_MODELS[method](px, cfg), conventional(px, cfg))
+    bins = np.minimum(np.degrees(px.n_theta) // step_deg, 180 // step_deg - 1)   # 180 -> last
+    return [(lo * step_deg, (lo + 1) * step_deg, int((bins == lo).sum()),
+             {k: _summary(v[bins == lo]) for k, v in err.items()})
+            for lo in range(180 // step_deg) if (bins == lo).any()]
