@@ -1,0 +1,216 @@
+"""The lee datapaths (rtl/lee.py): ROM contents, structure against the paper's counts,
+bit-exactness against sim/golden/fixed_lee.py in the Amaranth simulator under the three
+traffic patterns, a tiny configuration walked exhaustively, emission, and cocotb on the
+emitted Verilog (one Icarus and one Verilator build here; 10^6 vectors in `make regress`)."""
+
+import numpy as np
+import pytest
+
+from bumprtl.gen.emit import lint
+from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.rtl import tables
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
+from bumprtl.sim.amaranth_stream import PATTERNS, simulate_stream
+from bumprtl.sim.golden.fixed_lee import lee_illumination_fixed, lee_rotation_fixed
+from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+from bumprtl.sim.tb.runner import run_cocotb
+
+DEFAULT = Config(method="lee")
+TINY = Config(method="lee", angle_bits=4, frac_bits=4, tag_bits=16)
+
+
+def concat(*codes):
+    return {k: np.concatenate([c[k] for c in codes]) for k in codes[0]}
+
+
+def check(out, golden, inputs):
+    assert len(out) == len(inputs)
+    assert [o["tag"] for o in out] == [i["tag"] for i in inputs]        # in order, each once
+    for field in out[0]:
+        if field != "tag":
+            got = np.array([o[field] for o in out])
+            bad = np.flatnonzero(got != golden[field])
+            assert bad.size == 0, (f"{field}: {bad.size} mismatches, first at {bad[0]}: "
+                                   f"RTL {got[bad[0]]} golden {golden[field][bad[0]]} "
+                                   f"(input {inputs[bad[0]]})")
+
+
+def run_both(cfg, codes, pattern, seed=0):
+    """Rotation on ``codes``, then illumination on the golden rotation output; returns the
+    cycles each took minus its latency."""
+    inputs = as_payloads(codes, cfg)
+    duts = LeeRotation(cfg), LeeIllumination(cfg)
+    out, rot_cycles = simulate_stream(duts[0], inputs, pattern, seed=seed)
+    rot = lee_rotation_fixed(codes, cfg)
+    check(out, rot, inputs)
+    inputs = as_payloads(rot, cfg)
+    out, ill_cycles = simulate_stream(duts[1], inputs, pattern, seed=seed + 1)
+    check(out, lee_illumination_fixed(rot, cfg), inputs)
+    return rot_cycles - duts[0].latency, ill_cycles - duts[1].latency
+
+
+# --- ROM contents (tables.py, Lee section) ----------------------------------------------------
+
+@pytest.mark.parametrize("cfg", [DEFAULT, TINY, Config(angle_bits=14, frac_bits=20)])
+def test_tables_against_float(cfg):
+    step = 2 * np.pi / cfg.full_circle                      # one binary-angle step, radians
+    a = tables.lee_asin_index_bits(cfg)
+    s = np.arange((1 << a) + 1) / (1 << a)
+    assert np.all(np.abs(tables.lee_asin_table(cfg) * step - np.arcsin(s)) <= step / 2 + 1e-12)
+    inv = tables.lee_reciprocal_table(cfg)
+    top = (1 << tables.lee_reciprocal_bits(cfg)) - 1
+    assert inv[0] == top and inv[1] < top                   # only 1/sin 0 saturates (erratum 8)
+    angles = np.arange(1, cfg.sincos_depth) * (np.pi / 2) / (1 << cfg.k)
+    assert np.all(np.abs(inv[1:] - cfg.one / np.sin(angles)) <= 0.5 + 1e-9)
+    p = tables.lee_prop_index_bits(cfg)
+    y = np.arange((1 << p) + 1) / (1 << p)
+    prop = tables.lee_prop_table(cfg) / cfg.one
+    assert prop[0] == 0.0 and prop[-1] == 1.0 and np.all(np.diff(prop) >= 0)
+    assert np.all(np.abs(prop - (1 - np.arccos(y) / (np.pi / 2))) <= 0.5 / cfg.one + 1e-12)
+
+
+@pytest.mark.parametrize("cfg", [DEFAULT, TINY, Config(angle_bits=8, frac_bits=7)])
+def test_atan_address_and_table(cfg):
+    """Every ratio p < 2**W (k fractional bits) gets an address whose entry is atan(p / 2**k)
+    within half an angle step plus the mantissa's error 2**-(M+2) rad; the address is
+    monotone, and its exponent is the leading-one position (checked with int.bit_length)."""
+    w, m = tables.lee_atan_ratio_bits(cfg), tables.lee_atan_mantissa_bits(cfg)
+    p = np.arange(1 << w, dtype=np.int64)
+    index = ratio_index(p, cfg)
+    assert index.max() == tables.lee_atan_depth(cfg) - 1 and np.all(np.diff(index) >= 0)
+    sample = p[:: max(1, len(p) // 5000)]
+    expect = [max(0, int(v).bit_length() - m - 1) for v in sample]
+    assert np.array_equal(np.maximum((ratio_index(sample, cfg) >> m) - 1, 0), expect)
+    step = 2 * np.pi / cfg.full_circle
+    atan = tables.lee_atan_table(cfg)[index] * step
+    exact = np.arctan((p + 0.5) / (1 << cfg.k))             # the floor of the pre-shift: +0.5
+    assert np.max(np.abs(atan - exact)) <= step / 2 + 2.0 ** -(m + 2) + 1e-12
+
+
+# --- structure against the paper --------------------------------------------------------------
+
+def _memories(unit, cfg):
+    _, sidecar, _ = build_unit(unit, cfg)
+    return sidecar["roms"]
+
+
+def test_rom_count_matches_table_1():
+    """Fig. 7: six tables per vector (sin & cos, asin, 1/sin, 1/cos, atan, T_prop) -> Table 1's
+    12 for L and H; Fig. 8: six cosine tables plus the specular table. Without specular the
+    H sub-datapaths (and their tables) are not built (DESIGN §6)."""
+    roms = _memories("rotation", DEFAULT)
+    kinds = ("sincos", "asin", "inv_sin", "inv_cos", "atan", "prop")
+    assert sorted(roms) == sorted(f"{v}_{kind}_rom" for v in "lh" for kind in kinds)
+    assert len(_memories("rotation", DEFAULT.replace(specular=False))) == 6
+    ill = _memories("illumination", DEFAULT)
+    cosines = [name for name in ill if "_cos_" in name]
+    assert len(cosines) == 6 and len(ill) == 7
+
+
+def test_latency_and_one_pixel_per_clock():
+    """Without stalls N pixels take N cycles plus the latency property."""
+    cfg = DEFAULT
+    codes = random_codes(300, cfg, seed=5)
+    rot_cycles, ill_cycles = run_both(cfg, codes, "no_stall")
+    assert rot_cycles == ill_cycles == 300
+
+
+# --- bit-exact against the golden model -----------------------------------------------------
+
+@pytest.mark.parametrize("pattern", list(PATTERNS))
+def test_bit_exact_random_and_edges(pattern):
+    """20 000 random valid vectors plus the edge cases (theta 0, 90, 180 deg, azimuth wrap,
+    L = N, grazing light, light below the horizon) without stalls; 3 000 under stalls."""
+    n = 20_000 if pattern == "no_stall" else 3_000
+    codes = concat(edge_codes(DEFAULT), random_codes(n, DEFAULT, seed=len(pattern)))
+    rot_cycles, ill_cycles = run_both(DEFAULT, codes, pattern, seed=len(pattern))
+    if pattern != "no_stall":                 # the stalls happened and lost nothing
+        assert min(rot_cycles, ill_cycles) > len(codes["n.phi"])
+
+
+def _class_walk(cfg):
+    """4 096 vectors: each vector's rotation output depends on (th_N, ph_A - ph_N, th_A) only
+    (tests/sim/golden/test_fixed_lee.py checks that on all 16^4 inputs), and L and H walk all
+    16^3 such triples at once; N' walks all 16^2 values."""
+    idx = np.arange(16 ** 3, dtype=np.int64)
+    t, u, w = idx & 15, (idx >> 4) & 15, idx >> 8
+    n_phi = (idx * 7 + w) & 15
+    return {"n.phi": n_phi, "n.theta": t, "l.phi": (n_phi + u) & 15, "l.theta": w,
+            "h.phi": (n_phi + w) & 15, "h.theta": u, "b.phi": u, "b.theta": w}
+
+
+def test_tiny_config_exhaustive_classes():
+    """k = 2: rotation over every (th_N, D, th_A) of both vectors, and illumination over every
+    (th_A', th_N', ph_A' - ph_N') of both vectors (inputs fed directly, not only reachable ones)."""
+    codes = _class_walk(TINY)
+    inputs = as_payloads(codes, TINY)
+    out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
+    check(out, lee_rotation_fixed(codes, TINY), inputs)
+    idx = np.arange(16 ** 3, dtype=np.int64)
+    t, u, w = idx & 15, (idx >> 4) & 15, idx >> 8
+    b_phi = (idx * 5 + t) & 15
+    rot = {"l.phi": (b_phi + u) & 15, "l.theta": w, "h.phi": (b_phi + w) & 15, "h.theta": u,
+           "b.phi": b_phi, "b.theta": t}
+    inputs = as_payloads(rot, TINY)
+    out, _ = simulate_stream(LeeIllumination(TINY), inputs, "backpressure")
+    check(out, lee_illumination_fixed(rot, TINY), inputs)
+
+
+@pytest.mark.regress
+def test_tiny_config_exhaustive_all_inputs():
+    """k = 2: all 16^4 (ph_N, th_N, ph_A, th_A) for L (H and N' permuted), no equivalence
+    argument needed; and all 16^4 (ph_A', th_A', ph_N', th_N') of the illumination."""
+    idx = np.arange(16 ** 4, dtype=np.int64)
+    d = [(idx >> (4 * j)) & 15 for j in range(4)]
+    codes = {"n.phi": d[0], "n.theta": d[1], "l.phi": d[2], "l.theta": d[3],
+             "h.phi": d[3], "h.theta": d[0], "b.phi": d[2], "b.theta": d[1]}
+    inputs = as_payloads(codes, TINY)
+    out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
+    check(out, lee_rotation_fixed(codes, TINY), inputs)
+    rot = {"l.phi": d[0], "l.theta": d[1], "h.phi": d[1], "h.theta": d[2], "b.phi": d[2],
+           "b.theta": d[3]}
+    inputs = as_payloads(rot, TINY)
+    out, _ = simulate_stream(LeeIllumination(TINY), inputs, "no_stall")
+    check(out, lee_illumination_fixed(rot, TINY), inputs)
+
+
+@pytest.mark.parametrize("cfg", [Config(method="lee", angle_bits=6, frac_bits=5, specular=False),
+                                 Config(method="lee", angle_bits=9, frac_bits=8, spec_exponent=3),
+                                 Config(method="lee", angle_bits=14, frac_bits=18, tag_bits=3)])
+def test_other_configurations(cfg):
+    codes = concat(edge_codes(cfg), random_codes(500, cfg, seed=11))
+    run_both(cfg, codes, "backpressure")
+
+
+# --- emission and cocotb on the emitted Verilog ----------------------------------------------
+
+@pytest.mark.parametrize("unit", ["rotation", "illumination"])
+def test_emitted_verilog_lint_clean(unit, build_dir):
+    v, j = emit_unit(unit, DEFAULT, build_dir)
+    assert lint(v) == []
+    assert v.read_text().splitlines()[0].find("--method lee") > 0   # the command that made it
+
+
+@pytest.mark.parametrize("sim, unit", [("icarus", "rotation"), ("verilator", "illumination")])
+def test_cocotb(sim, unit, build_dir):
+    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
+    tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
+                                 {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 500})
+    assert (tests, failures) == (4, 0)
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("sim, unit", [("icarus", "illumination"), ("verilator", "rotation")])
+def test_cocotb_other_pairing(sim, unit, build_dir):
+    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
+    run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
+               {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 2000})
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("unit", ["rotation", "illumination"])
+def test_cocotb_regress_1e6_verilator(unit, build_dir):
+    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
+    run_cocotb("verilator", v, "bumprtl.sim.tb.tb_datapath", build_dir / "verilator",
+               {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 250_000})   # x 4 patterns = 10^6
