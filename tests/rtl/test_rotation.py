@@ -11,7 +11,7 @@ from bumprtl.sim.amaranth_stream import PATTERNS, simulate_stream
 from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
 
-METHODS = ["exact"]
+METHODS = ["exact", "lee"]
 
 
 def concat(*codes):

@@ -7,7 +7,7 @@ from bumprtl.gen.units import emit_unit
 from bumprtl.rtl.config import Config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
-METHODS = ["exact"]
+METHODS = ["exact", "lee"]
 
 
 @pytest.mark.parametrize("sim", SIMULATORS)
