@@ -31,6 +31,23 @@ def _theta_n_table(args, cfg):
         print(f"| {lo}-{hi} | {count} | {_cols(s['l_prime_deg'])} | {_cols(s['diffuse_lsb'])} |")
 
 
+def _approximations(args, cfg):
+    import numpy as np
+    from ..sim.golden.measure import error_at_theta_n, proportion_worst_case_deg, worst_pixel
+    at = {deg: error_at_theta_n("lee_fixed", np.radians(deg), args.samples, args.seed, cfg)
+          for deg in (0, 90, 180)}
+    print(f"\nlinear proportion (eqs 10-13) alone, closed-form worst case: "
+          f"{proportion_worst_case_deg():.3g} deg")
+    print("lee_fixed max L' error (deg) / max diffuse error (LSB) with theta_N fixed at "
+          + ", ".join(f"{deg} deg: {s['l_prime_deg']['max']:.3g} / {s['diffuse_lsb']['max']:.3g}"
+                      for deg, s in at.items()))
+    w = worst_pixel("lee_fixed", args.samples, args.seed, cfg)
+    pair = lambda key: f"({w[key][0]:.1f}, {w[key][1]:.1f})"
+    print(f"lee_fixed worst L' pixel (phi, theta in deg): N {pair('N')}, L {pair('L')}, D = {w['D']:.1f}; "
+          f"L' {pair('l_prime_ref')}, lee_fixed gives {pair('l_prime')}: {w['l_prime_deg']:.3g} deg, "
+          f"{w['diffuse_lsb']:.3g} LSB")
+
+
 def run(args):
     from ..rtl.config import Config
     from ..sim.golden.measure import random_pixels
@@ -40,6 +57,7 @@ def run(args):
     print(f"{args.samples} random valid inputs (seed {args.seed}); errors against 'conventional'\n")
     _model_table(px, cfg)
     _theta_n_table(args, cfg)
+    _approximations(args, cfg)
     return 0
 
 

@@ -7,7 +7,8 @@ from .common import PixelInputs, polar_to_cartesian
 from .conventional import conventional
 from .models import FLOAT_MODELS
 
-__all__ = ["angle_error_deg", "compare", "error_stats", "error_by_theta_n", "random_pixels"]
+__all__ = ["angle_error_deg", "compare", "error_stats", "error_by_theta_n", "error_at_theta_n",
+           "proportion_worst_case_deg", "random_pixels", "worst_pixel"]
 
 
 def angle_error_deg(a, b):
@@ -68,3 +69,35 @@ def error_by_theta_n(method="lee_fixed", n=100_000, seed=1, step_deg=15, cfg=Con
     return [(lo * step_deg, (lo + 1) * step_deg, int((bins == lo).sum()),
              {k: _summary(v[bins == lo]) for k, v in err.items()})
             for lo in range(180 // step_deg) if (bins == lo).any()]
+
+
+def error_at_theta_n(method, n_theta, n=50_000, seed=12, cfg=Config()):
+    """:func:`compare` on random inputs with th_N replaced by ``n_theta`` (radians); pixels
+    whose light is no longer above the surface (N.L <= 0.02) are dropped."""
+    px = random_pixels(n, seed)
+    px = PixelInputs(**{**px.__dict__, "n_theta": np.full(px.shape, float(n_theta))})
+    px = px.subset(conventional(px, cfg).l_prime[1] < np.arccos(0.02))
+    return compare(FLOAT_MODELS[method](px, cfg), conventional(px, cfg))
+
+
+def proportion_worst_case_deg(steps=1801):
+    """Worst case (degrees) of Lee's linear proportion, eq 13: th = th_xz + th_prop (90 -
+    th_xz) with th_prop = th_yz / 90, against the exact cos th = cos th_xz cos th_yz, over
+    a grid of th_xz, th_yz in [0, 90] degrees."""
+    a, b = np.meshgrid(np.linspace(0, np.pi / 2, steps), np.linspace(0, np.pi / 2, steps))
+    linear = a + (np.pi / 2 - a) * b / (np.pi / 2)
+    return float(np.degrees(np.max(np.abs(linear - np.arccos(np.cos(a) * np.cos(b))))))
+
+
+def worst_pixel(method, n=100_000, seed=1, cfg=Config()):
+    """The random valid input where ``method``'s L' is farthest from the reference: the
+    input angles, both L' (all in degrees) and the L' and diffuse errors there."""
+    px = random_pixels(n, seed)
+    res, ref = FLOAT_MODELS[method](px, cfg), conventional(px, cfg)
+    err = _errors(res, ref)
+    i = int(np.nanargmax(err["l_prime_deg"]))
+    deg = lambda pair: tuple(float(np.degrees(v[i])) for v in pair)
+    return {"N": deg((px.n_phi, px.n_theta)), "L": deg((px.l_phi, px.l_theta)),
+            "D": float(np.degrees(np.mod(px.l_phi[i] - px.n_phi[i], 2 * np.pi))),
+            "l_prime_ref": deg(ref.l_prime), "l_prime": deg(res.l_prime),
+            "l_prime_deg": float(err["l_prime_deg"][i]), "diffuse_lsb": float(err["diffuse_lsb"][i])}

@@ -11,6 +11,7 @@ import pytest
 from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, tangent_rotation
 from bumprtl.sim.golden.conventional import conventional
 from bumprtl.sim.golden.lee import ALL_ERRATA, illuminate, lee_fixed, lee_printed, rotate
+from bumprtl.sim.golden import measure
 from bumprtl.sim.golden.measure import angle_error_deg, error_stats
 
 d = np.radians
@@ -92,8 +93,10 @@ def test_lee_fixed_error_bracket():
     `bumprtl bench float64`). The bracket keeps the numbers from changing silently."""
     s = error_stats("lee_fixed", n=100_000, seed=1)
     assert 55.0 <= s["l_prime_deg"]["max"] <= 62.0
+    assert 45.0 <= s["l_prime_deg"]["p99"] <= 53.0
     assert 14.0 <= s["l_prime_deg"]["mean"] <= 20.0
     assert 170.0 <= s["diffuse_lsb"]["max"] <= 230.0
+    assert 120.0 <= s["diffuse_lsb"]["p99"] <= 150.0
     assert 18.0 <= s["diffuse_lsb"]["mean"] <= 26.0
     assert s["l_prime_deg"]["nan"] == 0 and s["diffuse_lsb"]["nan"] == 0
 
@@ -106,3 +109,26 @@ def test_lee_fixed_exact_when_light_in_the_normal_plane(n_theta):
         ref = reference_rotation(np.full(50, a_phi), a_theta, np.full(50, d(25)), np.full(50, n_theta))
         got = rotate(np.full(50, a_phi), a_theta, np.full(50, d(25)), np.full(50, n_theta))
         assert np.max(angle_error_deg(got, ref)) < 1e-5
+
+
+def proportion_worst_case_deg():
+    """Max over th_xz, th_yz in [0, 90] of |linear eq 13 - exact acos(cos th_xz cos th_yz)|,
+    on a 0.05-degree grid (independent of measure.py's grid)."""
+    a, b = np.meshgrid(np.radians(np.arange(0, 90.01, 0.05)), np.radians(np.arange(0, 90.01, 0.05)))
+    return np.degrees(np.max(np.abs(a + (np.pi / 2 - a) * b / (np.pi / 2) - np.arccos(np.cos(a) * np.cos(b)))))
+
+
+@pytest.mark.parametrize("n_theta", [0.0, np.pi])
+def test_lee_fixed_proportion_alone_where_the_rigid_circle_is_exact(n_theta):
+    """th_N = 0 or 180 deg: the rigid circle is exact, only the linear proportion of
+    eqs 10-13 is left, and it costs at most its closed-form worst case (8.61 deg)."""
+    worst = proportion_worst_case_deg()
+    assert 8.5 < worst < 8.7
+    assert abs(measure.proportion_worst_case_deg() - worst) < 1e-3
+    err = measure.error_at_theta_n("lee_fixed", n_theta)["l_prime_deg"]["max"]
+    assert worst - 0.5 < err <= worst + 1e-3
+
+
+def test_lee_fixed_rigid_circle_dominates_at_theta_n_90():
+    """th_N = 90 deg: the rigid circle takes L' up to ~60 deg away (the DESIGN's ~59 deg)."""
+    assert 50.0 < measure.error_at_theta_n("lee_fixed", np.pi / 2)["l_prime_deg"]["max"] < 62.0
