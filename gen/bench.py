@@ -11,6 +11,7 @@ BENCHES = {
     "float64": "bench_float",
     "golden": "bench_golden",
     "accuracy": "bench_accuracy",
+    "lee-widths": "bench_lee",
 }
 
 

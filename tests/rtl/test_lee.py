@@ -1,7 +1,11 @@
 """The lee datapaths (rtl/lee.py): ROM contents, structure against the paper's counts,
-bit-exactness against sim/golden/fixed_lee.py in the Amaranth simulator under the three
-traffic patterns, a tiny configuration walked exhaustively, emission, and cocotb on the
-emitted Verilog (one Icarus and one Verilator build here; 10^6 vectors in `make regress`)."""
+latency, a tiny configuration walked exhaustively against sim/golden/fixed_lee.py, emission.
+
+The method-parametrized suites run the rest for lee as well, so it is not repeated here:
+tests/rtl/test_rotation.py (20 000 random vectors + the edge cases without stalls, 4 000
+under input gaps and under backpressure, other widths, specular off) and
+tests/sim/test_tb_datapath.py (cocotb on the emitted Verilog, Icarus and Verilator;
+10^6 vectors on Verilator in `make regress`)."""
 
 import numpy as np
 import pytest
@@ -11,17 +15,12 @@ from bumprtl.gen.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
-from bumprtl.sim.amaranth_stream import PATTERNS, simulate_stream
+from bumprtl.sim.amaranth_stream import simulate_stream
 from bumprtl.sim.golden.fixed_lee import lee_illumination_fixed, lee_rotation_fixed
-from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
-from bumprtl.sim.tb.runner import run_cocotb
+from bumprtl.sim.golden.vectors import as_payloads, random_codes
 
 DEFAULT = Config(method="lee")
 TINY = Config(method="lee", angle_bits=4, frac_bits=4, tag_bits=16)
-
-
-def concat(*codes):
-    return {k: np.concatenate([c[k] for c in codes]) for k in codes[0]}
 
 
 def check(out, golden, inputs):
@@ -118,17 +117,6 @@ def test_latency_and_one_pixel_per_clock():
 
 # --- bit-exact against the golden model -----------------------------------------------------
 
-@pytest.mark.parametrize("pattern", list(PATTERNS))
-def test_bit_exact_random_and_edges(pattern):
-    """20 000 random valid vectors plus the edge cases (theta 0, 90, 180 deg, azimuth wrap,
-    L = N, grazing light, light below the horizon) without stalls; 3 000 under stalls."""
-    n = 20_000 if pattern == "no_stall" else 3_000
-    codes = concat(edge_codes(DEFAULT), random_codes(n, DEFAULT, seed=len(pattern)))
-    rot_cycles, ill_cycles = run_both(DEFAULT, codes, pattern, seed=len(pattern))
-    if pattern != "no_stall":                 # the stalls happened and lost nothing
-        assert min(rot_cycles, ill_cycles) > len(codes["n.phi"])
-
-
 def _class_walk(cfg):
     """4 096 vectors: each vector's rotation output depends on (th_N, ph_A - ph_N, th_A) only
     (tests/sim/golden/test_fixed_lee.py checks that on all 16^4 inputs), and L and H walk all
@@ -175,14 +163,6 @@ def test_tiny_config_exhaustive_all_inputs():
     check(out, lee_illumination_fixed(rot, TINY), inputs)
 
 
-@pytest.mark.parametrize("cfg", [Config(method="lee", angle_bits=6, frac_bits=5, specular=False),
-                                 Config(method="lee", angle_bits=9, frac_bits=8, spec_exponent=3),
-                                 Config(method="lee", angle_bits=14, frac_bits=18, tag_bits=3)])
-def test_other_configurations(cfg):
-    codes = concat(edge_codes(cfg), random_codes(500, cfg, seed=11))
-    run_both(cfg, codes, "backpressure")
-
-
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------
 
 @pytest.mark.parametrize("unit", ["rotation", "illumination"])
@@ -190,27 +170,3 @@ def test_emitted_verilog_lint_clean(unit, build_dir):
     v, j = emit_unit(unit, DEFAULT, build_dir)
     assert lint(v) == []
     assert v.read_text().splitlines()[0].find("--method lee") > 0   # the command that made it
-
-
-@pytest.mark.parametrize("sim, unit", [("icarus", "rotation"), ("verilator", "illumination")])
-def test_cocotb(sim, unit, build_dir):
-    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
-    tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
-                                 {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 500})
-    assert (tests, failures) == (4, 0)
-
-
-@pytest.mark.regress
-@pytest.mark.parametrize("sim, unit", [("icarus", "illumination"), ("verilator", "rotation")])
-def test_cocotb_other_pairing(sim, unit, build_dir):
-    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
-    run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
-               {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 2000})
-
-
-@pytest.mark.regress
-@pytest.mark.parametrize("unit", ["rotation", "illumination"])
-def test_cocotb_regress_1e6_verilator(unit, build_dir):
-    v, j = emit_unit(unit, DEFAULT, build_dir / "rtl")
-    run_cocotb("verilator", v, "bumprtl.sim.tb.tb_datapath", build_dir / "verilator",
-               {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 250_000})   # x 4 patterns = 10^6
