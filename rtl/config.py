@@ -67,6 +67,8 @@ class Config:
         Number of quantized normals ``sN`` of the palette method (Tarini et al.); 16 to 16384.
     color_bits : int
         Bits per colour channel of the palette colour table; 8.
+    palette_blend : bool
+        Whether PaletteLUT has the eq. 2 blend stage (Tarini Sec. 7.2) with a base-colour input.
     """
 
     angle_bits: int = 12
@@ -82,6 +84,7 @@ class Config:
     specular: bool = True
     palette_size: int = 256
     color_bits: int = 8
+    palette_blend: bool = False
 
     def __post_init__(self):
         _check_int("angle_bits", self.angle_bits, 4, 16, "k = angle_bits - 2 must be >= 2")
@@ -101,6 +104,8 @@ class Config:
             raise ConfigError(f"specular must be true or false, got {self.specular!r}")
         _check_int("palette_size", self.palette_size, 16, 16384)
         _check_int("color_bits", self.color_bits, 8, 8)
+        if not isinstance(self.palette_blend, bool):
+            raise ConfigError(f"palette_blend must be true or false, got {self.palette_blend!r}")
 
     # Derived facts: read-only, never stored.
     @property
