@@ -4,7 +4,7 @@ import numpy as np
 
 from ...rtl.config import BumpError
 
-__all__ = ["HEIGHTFIELDS", "height_to_normals", "normals_from_gradient"]
+__all__ = ["HEIGHTFIELDS", "height_to_normals", "normals_from_gradient", "smooth_noise"]
 
 
 def _grid(t):
@@ -12,15 +12,28 @@ def _grid(t):
     return np.meshgrid(c, c)           # (u, v), each in (0, 1)
 
 
+def smooth_noise(t, cells=16, seed=0):
+    """Tileable smooth noise on a T x T grid, zero mean and unit standard deviation: the
+    Fourier interpolation of a ``cells`` x ``cells`` grid of Gaussian samples, so the
+    pattern is nearly the same at every power-of-two size T >= ``cells``."""
+    coarse = np.random.default_rng(seed).standard_normal((cells, cells))
+    spec = np.fft.fftshift(np.fft.fft2(coarse))
+    pad = (t - cells) // 2
+    fine = np.fft.ifft2(np.fft.ifftshift(np.pad(spec, pad))).real
+    return (fine - fine.mean()) / fine.std()
+
+
 def bricks(t):
-    """Running-bond bricks: 8 courses, mortar grooves with bevelled edges."""
+    """Running-bond bricks: 8 courses, mortar grooves with bevelled edges, slightly rough
+    faces (so that the map has many distinct normals, as a real one has)."""
     u, v = _grid(t)
     rows = 8
     row = np.floor(v * rows)
     fu = np.mod(u * 4 + 0.5 * (row % 2), 1.0)
     fv = np.mod(v * rows, 1.0)
     edge = np.minimum(np.minimum(fu, 1 - fu) * 4, np.minimum(fv, 1 - fv) * 2)
-    return np.clip(edge / 0.12, 0, 1)            # 0 in the mortar, 1 on the brick face
+    face = np.clip(edge / 0.12, 0, 1)            # 0 in the mortar, 1 on the brick face
+    return np.clip(face * (0.9 + 0.03 * smooth_noise(t)), 0, 1)
 
 
 def wood(t):
