@@ -57,6 +57,15 @@ def _roms(dut):
     return roms
 
 
+def _palette_sidecar(cfg, dut):
+    from ..rtl.palette import index_bits
+    return {"latency": dut.latency, "throughput": 1, "index_bits": index_bits(cfg),
+            "blend": "eq2" if cfg.palette_blend else None, "roms": _roms(dut),
+            "memory_bits": dut.memory_bits, "double_buffered": True,
+            "out_of_range_index": "reads as all zeros (rgba = 0) and sets oor = 1; "
+                                  "host writes to addresses >= palette_size are ignored"}
+
+
 UNITS = {
     "sincos": Unit("sincos", "quarter-wave sin/cos ROM unit (toolchain slice)",
                    lambda cfg: _sincos()(cfg), _sincos_sidecar),
@@ -67,6 +76,9 @@ UNITS = {
                          lambda cfg: _rtl("illumination", "Illumination")(cfg), _rotation_sidecar,
                          ("method", "angle_bits", "frac_bits", "tag_bits", "specular",
                           "spec_exponent", "ka", "kd", "ks")),
+    "palette": Unit("palette", "PaletteLUT (Tarini Sec. 5/7.2): index -> RGBA, double-buffered table",
+                    lambda cfg: _rtl("palette", "PaletteLUT")(cfg), _palette_sidecar,
+                    ("palette_size", "color_bits", "palette_blend", "tag_bits")),
 }
 
 

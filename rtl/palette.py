@@ -1,0 +1,165 @@
+"""PaletteLUT: the per-pixel half of Tarini et al.'s palette method (Sec. 5, step 2).
+
+Blend arithmetic shared with the golden model (``sim/golden/palette_lut.py``): 8-bit
+channels (``cfg.color_bits``); a product of two channel values is ``x * a / 255`` with
+``a`` expanded to a Q0.8 factor ``a + (a >> 7)`` (0..256, 256 = 1.0, so 255 * 255 -> 255
+and x * 0 -> 0), rounded to nearest by :func:`fixed.mul_round`.
+
+Each frame the host shades the ``sN`` quantized normals into a colour table (Sec. 5.1) and
+writes it here; per pixel only a table lookup remains, optionally blended with a base
+colour by eq. 2 (Sec. 7.2).
+"""
+
+from amaranth.hdl import Module, Mux, Signal, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from .config import Config
+from .fixed import Q, mul_round, saturate
+from .pipe import StallPipe
+
+__all__ = ["PaletteLUT", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
+
+CHANNELS = ("r", "g", "b", "a")
+
+
+def index_bits(cfg: Config):
+    """Width of a palette index: enough for ``palette_size`` entries."""
+    return max(1, (cfg.palette_size - 1).bit_length())
+
+
+def _u8(cfg):
+    return Q(cfg.color_bits, 0, signed=False)
+
+
+def mul8(x, a, cfg: Config = Config()):
+    """``x * a`` of two ``color_bits`` values in [0, 1], rounded to nearest."""
+    b = cfg.color_bits
+    return mul_round(x, a + (a >> (b - 1)), b)
+
+
+def blend_eq2(entry, base, cfg: Config = Config()):
+    """Eq. 2 (Sec. 7.2, one pass): ``r = ro * ai + (1 - ro) * ri`` per colour channel,
+    ``a = ao``. ``entry`` and ``base`` map r, g, b, a to integers or int arrays."""
+    top = (1 << cfg.color_bits) - 1
+    out = {c: saturate(mul8(base[c], entry["a"], cfg) + mul8(entry[c], top - base[c], cfg), _u8(cfg))
+           for c in CHANNELS[:3]}
+    return {**out, "a": base["a"]}
+
+
+def blend_eq1(entry, base, cfg: Config = Config()):
+    """Eq. 1 (Sec. 7.1, exact specular): ``p = ro * ai``, ``r = p + (1 - p) * ri``."""
+    top = (1 << cfg.color_bits) - 1
+    out = {}
+    for c in CHANNELS[:3]:
+        p = mul8(base[c], entry["a"], cfg)
+        out[c] = saturate(p + mul8(entry[c], top - p, cfg), _u8(cfg))
+    return {**out, "a": base["a"]}
+
+
+def rgba_layout(cfg: Config):
+    """One colour-table entry: ``color_bits`` per channel, r in the low bits."""
+    return data.StructLayout({c: unsigned(cfg.color_bits) for c in CHANNELS})
+
+
+def _channels(word, cfg):
+    """A packed rgba word as a dict of channel slices (r in the low bits)."""
+    b = cfg.color_bits
+    return {c: word[n * b:(n + 1) * b] for n, c in enumerate(CHANNELS)}
+
+
+class PaletteLUT(wiring.Component):
+    """Colour-table lookup, one pixel per clock, double-buffered host-written table.
+
+    Parameters
+    ----------
+    cfg : Config
+        Reads ``palette_size`` (sN), ``color_bits``, ``palette_blend`` and ``tag_bits``.
+
+    Members
+    -------
+    i : In(stream.Signature({index: unsigned(ceil log2 sN), [base: rgba], tag}))
+        ``base`` (only with ``palette_blend``) is the base colour ``(ro, go, bo, ao)``.
+    o : Out(stream.Signature({color: rgba, oor: 1, tag}))
+        ``color`` is the table entry, or with ``palette_blend`` eq. 2:
+        ``r = ro * ai + (1 - ro) * ri`` (products rounded to nearest, see
+        :mod:`bumprtl.sim.golden.palette_lut`), ``a = ao``.
+        ``oor`` = 1 when ``index >= sN``: the entry then reads as all zeros (defined,
+        never X). Only possible when sN is not a power of two.
+    w_en, w_addr, w_data : In
+        Host write port: ``w_data`` (rgba) goes to entry ``w_addr`` of the back bank when
+        ``w_en``; addresses ``>= sN`` are ignored.
+    swap : In(1)
+        Strobe: exchanges front and back banks at the end of the cycle (a write in the same
+        cycle belongs to the bank being published). A pixel reads the bank that was in front
+        in the cycle it was accepted, so no lookup ever sees a half-written table; swaps may
+        come at any time, also under backpressure.
+    bank : Out(1)
+        The current front bank.
+
+    Memory: one block RAM of ``2 * sN`` entries of ``4 * color_bits`` bits (bank b at
+    offset ``b * sN``). Latency 1 cycle (RAM read), 2 with the blend stage; throughput 1
+    pixel per clock when not stalled.
+    """
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        ib = index_bits(cfg)
+        fields = {"index": unsigned(ib)}
+        if cfg.palette_blend:
+            fields["base"] = rgba_layout(cfg)
+        fields["tag"] = unsigned(cfg.tag_bits)
+        super().__init__({
+            "i": In(stream.Signature(data.StructLayout(fields))),
+            "o": Out(stream.Signature(data.StructLayout({
+                "color": rgba_layout(cfg), "oor": unsigned(1), "tag": unsigned(cfg.tag_bits)}))),
+            "w_en": In(1),
+            "w_addr": In(ib),
+            "w_data": In(rgba_layout(cfg)),
+            "swap": In(1),
+            "bank": Out(1),
+        })
+
+    @property
+    def latency(self):
+        return 2 if self.cfg.palette_blend else 1
+
+    @property
+    def memory_bits(self):
+        return 2 * self.cfg.palette_size * 4 * self.cfg.color_bits
+
+    def elaborate(self, platform):
+        cfg, size = self.cfg, self.cfg.palette_size
+        m = Module()
+        pipe = StallPipe(m, self.i, self.o, self.latency)
+        m.submodules.table = table = Memory(shape=unsigned(4 * cfg.color_bits), depth=2 * size, init=[])
+        front = Signal(name="front")
+        with m.If(self.swap):
+            m.d.sync += front.eq(~front)
+        m.d.comb += self.bank.eq(front)
+
+        wp = table.write_port()
+        m.d.comb += [wp.en.eq(self.w_en & (self.w_addr < size)),
+                     wp.addr.eq(self.w_addr + Mux(front, 0, size)),     # the back bank
+                     wp.data.eq(self.w_data.as_value())]
+
+        index = self.i.payload.index
+        oor_in = index >= size
+        rp = table.read_port(domain="sync")
+        m.d.comb += [rp.en.eq(pipe.adv),
+                     rp.addr.eq(Mux(oor_in, 0, index) + Mux(front, size, 0))]
+        oor = pipe.register(oor_in, "oor_d1")
+        word = Mux(oor, 0, rp.data)
+        entry = _channels(word, cfg)
+        if cfg.palette_blend:
+            base = _channels(pipe.register(self.i.payload.base.as_value(), "base_d1"), cfg)
+            blended = blend_eq2(entry, base, cfg)
+            color = {c: pipe.register(blended[c], f"blend_{c}") for c in CHANNELS}
+            oor = pipe.register(oor, "oor_d2")
+        else:
+            color = entry
+        m.d.comb += [getattr(self.o.payload.color, c).eq(color[c]) for c in CHANNELS]
+        m.d.comb += [self.o.payload.oor.eq(oor),
+                     self.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag"))]
+        return m
