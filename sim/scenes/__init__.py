@@ -122,7 +122,8 @@ def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
     _power_of_two("texture_size", tex, 16, 4096)
     for pname, val, lo, hi in (("light_elevation", light_elevation, -90, 90),
                                ("light_azimuth", light_azimuth, -360, 360)):
-        if not isinstance(val, (int, float)) or not lo <= val <= hi or not np.isfinite(val):
+        if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
+                or not lo <= val <= hi:            # NaN fails the comparison too
             raise BumpError(f"{pname} must be in [{lo}, {hi}] degrees, got {val!r}")
     if light not in ("directional", "point"):
         raise BumpError(f"light must be directional or point, got {light!r}")

@@ -102,9 +102,15 @@ def height_to_normals(height, strength=1.0):
     The slope per texel step is ``strength * (h[i+1] - h[i-1]) / 2`` (heights in [0, 1]
     times ``strength`` texels). Returns the ``(phi, theta)`` maps.
     """
-    h = np.asarray(height, dtype=np.float64)
+    h = np.asarray(height)
+    if h.dtype.kind not in "fiu":
+        raise BumpError(f"height map must be a real-valued array, got dtype {h.dtype}")
     if h.ndim != 2 or h.shape[0] != h.shape[1] or h.size == 0:
         raise BumpError(f"height map must be a non-empty square 2-D array, got shape {h.shape}")
+    if isinstance(strength, bool) or not isinstance(strength, (int, float)) or \
+            not 0 < strength < np.inf:
+        raise BumpError(f"strength must be a positive finite number, got {strength!r}")
+    h = h.astype(np.float64)
     if not np.all(np.isfinite(h)):
         raise BumpError("height map contains NaN or infinity")
     dh_du = strength * (np.roll(h, -1, axis=1) - np.roll(h, 1, axis=1)) / 2
