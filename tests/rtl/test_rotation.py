@@ -31,9 +31,10 @@ def check(out, golden, inputs):
 
 def run_rotation(cfg, codes, pattern):
     inputs = as_payloads(codes, cfg)
-    out, cycles = simulate_stream(VectorRotation(cfg), inputs, pattern)
+    dut = VectorRotation(cfg)
+    out, cycles = simulate_stream(dut, inputs, pattern)
     check(out, rotation_fixed(codes, cfg), inputs)
-    return out, cycles
+    return dut.latency, cycles
 
 
 def run_illumination(cfg, codes, pattern):
@@ -51,11 +52,11 @@ def test_rotation_and_illumination_bit_exact(method, pattern):
     cfg = Config(method=method)
     n = 20_000 if pattern == "no_stall" else 4_000
     codes = concat(edge_codes(cfg), random_codes(n, cfg, seed=hash(pattern) % 1000))
-    _, cycles = run_rotation(cfg, codes, pattern)
+    latency, cycles = run_rotation(cfg, codes, pattern)
     run_illumination(cfg, codes, pattern)
     total = len(codes["n.phi"])
     if pattern == "no_stall":                 # 1 pixel per clock: latency + N cycles
-        assert cycles == total + VectorRotation(cfg).latency
+        assert cycles == total + latency
     else:
         assert cycles > total
 
