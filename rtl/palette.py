@@ -1,9 +1,10 @@
 """PaletteLUT: the per-pixel half of Tarini et al.'s palette method (Sec. 5, step 2).
 
 Blend arithmetic shared with the golden model (``sim/golden/palette_lut.py``): 8-bit
-channels (``cfg.color_bits``); a product of two channel values is ``x * a / 255`` with
-``a`` expanded to a Q0.8 factor ``a + (a >> 7)`` (0..256, 256 = 1.0, so 255 * 255 -> 255
-and x * 0 -> 0), rounded to nearest by :func:`fixed.mul_round`.
+channels (``cfg.color_bits``, 255 = 1.0); a product of two channel values is
+``x * a / 255`` rounded to nearest, exactly, by the divide-by-255 identity
+``round(t / 255) = round_shift(t + round_shift(t, 8), 8)`` for ``t = x * a <= 255**2``
+(:func:`fixed.round_shift`). Eq. 2 is then within 1 LSB of float64, eq. 1 within 1.5.
 
 Each frame the host shades the ``sN`` quantized normals into a colour table (Sec. 5.1) and
 writes it here; per pixel only a table lookup remains, optionally blended with a base
@@ -16,7 +17,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from .config import Config
-from .fixed import Q, mul_round, saturate
+from .fixed import Q, mul_round, round_shift, saturate
 from .pipe import StallPipe
 
 __all__ = ["PaletteLUT", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
@@ -34,9 +35,10 @@ def _u8(cfg):
 
 
 def mul8(x, a, cfg: Config = Config()):
-    """``x * a`` of two ``color_bits`` values in [0, 1], rounded to nearest."""
+    """``x * a / 255`` of two ``color_bits`` values (255 = 1.0), rounded to nearest."""
     b = cfg.color_bits
-    return mul_round(x, a + (a >> (b - 1)), b)
+    t = mul_round(x, a, 0)
+    return round_shift(t + round_shift(t, b), b)
 
 
 def blend_eq2(entry, base, cfg: Config = Config()):
