@@ -1,3 +1,5 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -6,7 +8,7 @@ from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.golden.conventional import conventional
 from bumprtl.sim.golden.exact import exact
 from bumprtl.sim.scenes import SCENES, light_direction, load_scene
-from bumprtl.sim.scenes.heightfields import height_to_normals
+from bumprtl.sim.scenes.heightfields import height_to_normals, smooth_noise
 from bumprtl.sim.scenes.imaging import compose, psnr
 
 
@@ -75,3 +77,117 @@ def test_bad_height_map():
         height_to_normals(np.zeros((4, 5)))
     with pytest.raises(BumpError, match="NaN"):
         height_to_normals(np.full((4, 4), np.nan))
+
+
+def _screen(size):
+    """Pixel centres: screen x to the right, screen z up, in (-1, 1) (independent of the code)."""
+    c = (np.arange(size) + 0.5) / size * 2 - 1
+    return np.meshgrid(c, -c)
+
+
+def _vec(phi, theta):
+    return polar_to_cartesian(phi, theta)
+
+
+@pytest.mark.parametrize("name", ["bumps", "globe", "cylinder"])
+@pytest.mark.parametrize("light", ["directional", "point"])
+def test_halfway_is_light_plus_viewer(name, light):
+    s = load_scene(name, size=32, light_elevation=20, light_azimuth=-70, light=light)
+    h = _vec(s.px.h_phi, s.px.h_theta)
+    want = _vec(s.px.l_phi, s.px.l_theta) + [0, -1, 0]      # viewer along -y (orthographic)
+    assert np.allclose(h, want / np.linalg.norm(want, axis=-1, keepdims=True), atol=1e-12)
+
+
+def test_world_normals_of_each_geometry():
+    sx, sz = _screen(64)
+    plane = load_scene("bumps", size=64)
+    assert plane.mask.all() and np.allclose(_vec(plane.px.n_phi, plane.px.n_theta), [0, -1, 0])
+    globe = load_scene("globe", size=64)
+    assert np.array_equal(globe.mask, sx ** 2 + sz ** 2 < 1)
+    n = _vec(globe.px.n_phi, globe.px.n_theta)[globe.mask]
+    m = globe.mask
+    assert np.allclose(n, np.stack([sx[m], -np.sqrt(1 - sx[m] ** 2 - sz[m] ** 2), sz[m]], -1))
+    cyl = load_scene("cylinder", size=64)
+    n = _vec(cyl.px.n_phi, cyl.px.n_theta)
+    assert np.allclose(n, np.stack([sx, -np.sqrt(1 - sx ** 2), 0 * sx], -1))
+
+
+def test_point_light_direction_per_pixel():
+    """A point light three units away in the light direction (plane at y = 0)."""
+    sx, sz = _screen(32)
+    s = load_scene("bumps", size=32, light_elevation=35, light_azimuth=120, light="point")
+    to_light = 3 * light_direction(35, 120) - np.stack([sx, 0 * sx, sz], -1)
+    want = to_light / np.linalg.norm(to_light, axis=-1, keepdims=True)
+    assert np.allclose(_vec(s.px.l_phi, s.px.l_theta), want, atol=1e-12)
+    d = load_scene("bumps", size=32, light_elevation=35, light_azimuth=120)
+    assert np.allclose(_vec(d.px.l_phi, d.px.l_theta), light_direction(35, 120))
+
+
+@pytest.mark.parametrize("name", ["bumps", "globe", "cylinder"])
+def test_slopes_facing_the_light_are_brighter(name):
+    """Light from the right (azimuth 0) brightens texels whose height falls to the right
+    (dh/du < 0); light from the top (azimuth 90) those whose height rises down the screen
+    (dh/dv > 0). Brightening = N'.L minus N.L of the unbumped surface, near the middle of
+    the image where u runs to the right. Catches a mirrored tangent frame or texture
+    mapping on every geometry."""
+    sx, sz = _screen(128)
+    for azimuth, axis, brighter_sign in ((0, 1, -1), (90, 0, +1)):
+        s = load_scene(name, size=128, light_elevation=40, light_azimuth=azimuth)
+        flat = dataclasses.replace(s.px, b_theta=np.zeros_like(s.px.b_theta))
+        gain = conventional(s.px).ndotl - conventional(flat).ndotl
+        slope = (np.roll(s.height, -1, axis) - np.roll(s.height, 1, axis))[s.v, s.u]
+        near = s.mask & (np.abs(sx) < 0.5) & (np.abs(sz) < 0.5)
+        r = np.corrcoef(brighter_sign * slope[near], gain[near])[0, 1]
+        assert r > 0.8, (azimuth, r)
+
+
+def test_texture_size_is_independent_of_image_size():
+    s = load_scene("moon", size=32, texture_size=128)
+    assert s.height.shape == s.b_phi_map.shape == (128, 128) and s.px.shape == (32, 32)
+    assert s.u.max() < 128 and s.v.max() < 128 and s.u.max() > 64
+    assert np.array_equal(s.px.b_theta, s.b_theta_map[s.v, s.u])
+
+
+def test_bump_maps_are_central_differences_of_the_height():
+    s = load_scene("text", size=64)
+    strength = SCENES["text"][2]
+    phi, theta = height_to_normals(s.height, strength)
+    assert np.array_equal(phi, s.b_phi_map) and np.array_equal(theta, s.b_theta_map)
+    assert s.height.std() > 0.05                   # the text is really there
+
+
+def test_image_scenes_ship_inside_the_wheel():
+    """brick, gravel, moon load from scikit-image's package directory (no download)."""
+    import skimage.data
+    from pathlib import Path
+    here = Path(skimage.data.__file__).parent
+    for name in ("brick", "gravel", "moon"):
+        assert (here / f"{name}.png").is_file()
+
+
+def test_smooth_noise_is_normalized_and_tiles():
+    n = smooth_noise(128)
+    assert abs(n.mean()) < 1e-12 and abs(n.std() - 1) < 1e-12
+    inner = max(np.abs(np.diff(n, axis=a)).max() for a in (0, 1))
+    seam = max(np.abs(n[0] - n[-1]).max(), np.abs(n[:, 0] - n[:, -1]).max())
+    assert seam <= inner                            # no step at the wrap: the map tiles
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"name": "bricks", "texture_size": 24}, ["texture_size", "power of two"]),
+    ({"name": "bricks", "size": 8}, ["size", "[16, 4096]"]),
+    ({"name": "bricks", "light_azimuth": 400.0}, ["light_azimuth", "[-360, 360]"]),
+    ({"name": "bricks", "light_elevation": float("nan")}, ["light_elevation"]),
+    ({"name": "bricks", "light_elevation": True}, ["light_elevation"]),
+])
+def test_more_bad_scene_arguments(kwargs, words):
+    with pytest.raises(BumpError) as e:
+        load_scene(**kwargs)
+    assert all(w in str(e.value) for w in words)
+
+
+def test_bad_height_map_dtype_and_strength():
+    with pytest.raises(BumpError, match="dtype"):
+        height_to_normals(np.full((4, 4), "a"))
+    with pytest.raises(BumpError, match="strength"):
+        height_to_normals(np.zeros((4, 4)), strength=-1.0)
