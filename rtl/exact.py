@@ -11,8 +11,8 @@ from amaranth.lib import data
 
 from .config import Config
 from .fixed import round_shift
-from .illumination import SHADE_LATENCY, shade_stages
-from .layouts import pixel_layout, shade_layout
+from .illumination import IlluminationDatapath
+from .layouts import pixel_layout
 from .pipe import StallPipe
 from .sincos import quarter_wave_rom, sine_read
 
@@ -105,33 +105,26 @@ class Rotation:
         m.d.comb += o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
 
 
-class Illumination:
-    """Illumination datapath, exact method: N'.A' = (x4 p2 + 2 y2 y2 + 2 z4 z) / 8, rounded once,
-    then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
+class Illumination(IlluminationDatapath):
+    """Illumination datapath, exact method: N'.A' = (x4 p2 + 2 y2 y2 + 2 z4 z) / 8, rounded
+    once, then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
     Latency 2 (products, sum) + SHADE_LATENCY; 1 pixel per clock.
     """
 
-    latency = 2 + SHADE_LATENCY
+    dot_latency = 2
 
     def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = rotated_layout(cfg), shade_layout(cfg)
+        super().__init__(cfg, rotated_layout(cfg))
 
-    def build(self, m, i, o):
-        cfg = self.cfg
-        pipe = StallPipe(m, i, o, self.latency)
-        n = i.payload.n
-        dots = {}
-        for v in vectors(cfg):
-            a = i.payload[v]
-            px_ = pipe.register(n.x4 * a.p2, f"{v}_xp")                 # 3 multipliers per vector
-            py_ = pipe.register(n.y2 * a.y2, f"{v}_yy")
-            pz_ = pipe.register(n.z4 * a.z, f"{v}_zz")
-            acc = px_ + 2 * py_ + 2 * pz_
-            dots[v] = pipe.register(round_shift(acc, cfg.frac_bits + 3), f"{v}_dot")
-        diffuse, specular, color = shade_stages(m, pipe, cfg, dots["l"], dots.get("h", 0))
-        m.d.comb += [o.payload.diffuse.eq(diffuse), o.payload.specular.eq(specular),
-                     o.payload.color.eq(color),
-                     o.payload.tag.eq(pipe.delay(i.payload.tag, self.latency, "tag"))]
+    def dots(self, m, pipe, payload):
+        n, dots = payload.n, {}
+        for v in vectors(self.cfg):
+            a = payload[v]
+            xp = pipe.register(n.x4 * a.p2, f"{v}_xp")                  # 3 multipliers per vector
+            yy = pipe.register(n.y2 * a.y2, f"{v}_yy")
+            zz = pipe.register(n.z4 * a.z, f"{v}_zz")
+            dots[v] = pipe.register(round_shift(xp + 2 * yy + 2 * zz, self.cfg.frac_bits + 3),
+                                    f"{v}_dot")
+        return dots

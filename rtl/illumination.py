@@ -12,9 +12,11 @@ from amaranth.lib.wiring import In, Out
 
 from .config import Config
 from .fixed import round_shift
+from .layouts import shade_layout
+from .pipe import StallPipe
 from .tables import phong_coefficients, specular_index_bits, specular_table
 
-__all__ = ["Illumination", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
+__all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
 
 # Registers of shade_stages: clamp/index, table read + diffuse, Phong sum.
 SHADE_LATENCY = 3
@@ -53,6 +55,33 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     diffuse = pipe.register(diffuse, "diffuse_out")
     specular = pipe.register(specular, "specular_out") if cfg.specular else 0
     return diffuse, specular, color
+
+
+class IlluminationDatapath:
+    """The shell every method's illumination datapath shares: the method's ``dots`` gives
+    N'.L' and N'.H' (signed, ``frac_bits`` fractional bits) ``dot_latency`` stages after the
+    input, :func:`shade_stages` does eq. (2), and the tag rides along.
+
+    Subclasses set ``dot_latency`` and implement ``dots(m, pipe, payload) -> {"l": .., "h": ..}``.
+    """
+
+    dot_latency = None
+
+    def __init__(self, cfg: Config, in_layout):
+        self.cfg = cfg
+        self.in_layout, self.out_layout = in_layout, shade_layout(cfg)
+
+    @property
+    def latency(self):
+        return self.dot_latency + SHADE_LATENCY
+
+    def build(self, m, i, o):
+        pipe = StallPipe(m, i, o, self.latency)
+        dots = self.dots(m, pipe, i.payload)
+        diffuse, specular, color = shade_stages(m, pipe, self.cfg, dots["l"], dots.get("h", 0))
+        m.d.comb += [o.payload.diffuse.eq(diffuse), o.payload.specular.eq(specular),
+                     o.payload.color.eq(color),
+                     o.payload.tag.eq(pipe.delay(i.payload.tag, self.latency, "tag"))]
 
 
 class MethodUnit(wiring.Component):

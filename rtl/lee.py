@@ -41,8 +41,8 @@ from amaranth.lib.memory import Memory
 from .config import Config
 from .exact import vectors
 from .fixed import round_shift
-from .illumination import SHADE_LATENCY, Illumination as _Illumination, shade_stages
-from .layouts import pixel_layout, polar_layout, shade_layout
+from .illumination import Illumination as _Illumination, IlluminationDatapath
+from .layouts import pixel_layout, polar_layout
 from .pipe import StallPipe
 from .rotation import VectorRotation
 from .sincos import quarter_wave_rom, sine_read
@@ -203,7 +203,7 @@ class Rotation:
         return phi, theta                                                   # stage 7
 
 
-class Illumination:
+class Illumination(IlluminationDatapath):
     """Illumination datapath, lee method (Fig. 8): eq. 24 with erratum 2 per vector,
     N'.A' = ((c- + c+) 2**B + (c- - c+) c_phi) / 2**(B+1), one rounding, where
     c+- = cos(th_A' +- th_N') and c_phi = cos(ph_A' - ph_N'); then the shared back end.
@@ -212,21 +212,13 @@ class Illumination:
     Latency 4 (cosines, product, sum) + SHADE_LATENCY; 1 pixel per clock.
     """
 
-    latency = 4 + SHADE_LATENCY
+    dot_latency = 4
 
     def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = rotated_layout(cfg), shade_layout(cfg)
+        super().__init__(cfg, rotated_layout(cfg))
 
-    def build(self, m, i, o):
-        cfg = self.cfg
-        pipe = StallPipe(m, i, o, self.latency)
-        px = i.payload
-        dots = {v: self._dot(m, pipe, v, px[v], px.b) for v in vectors(cfg)}
-        diffuse, specular, color = shade_stages(m, pipe, cfg, dots["l"], dots.get("h", 0))
-        m.d.comb += [o.payload.diffuse.eq(diffuse), o.payload.specular.eq(specular),
-                     o.payload.color.eq(color),
-                     o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
+    def dots(self, m, pipe, payload):
+        return {v: self._dot(m, pipe, v, payload[v], payload.b) for v in vectors(self.cfg)}
 
     def _dot(self, m, pipe, v, a, n):
         cfg = self.cfg

@@ -10,7 +10,7 @@ import random
 from amaranth.lib import data
 from amaranth.sim import Simulator
 
-__all__ = ["PATTERNS", "simulate_stream"]
+__all__ = ["PATTERNS", "simulate_stream", "assert_bit_exact"]
 
 # name -> (probability of an input gap, probability of output backpressure)
 PATTERNS = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4)}
@@ -71,3 +71,16 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     else:
         sim.run()
     return outputs, state["cycles"]
+
+
+def assert_bit_exact(out, golden, inputs):
+    """Every output field equals the golden model's array, and the tags come out in order,
+    each once (nothing lost or duplicated)."""
+    assert len(out) == len(inputs)
+    assert [o["tag"] for o in out] == [i["tag"] for i in inputs]
+    for field in out[0]:
+        if field != "tag":
+            got = [o[field] for o in out]
+            bad = [n for n, (g, e) in enumerate(zip(got, golden[field])) if g != e]
+            assert not bad, (f"{field}: {len(bad)} mismatches, first at {bad[0]}: RTL {got[bad[0]]} "
+                             f"golden {golden[field][bad[0]]} (input {inputs[bad[0]]})")

@@ -15,24 +15,12 @@ from bumprtl.gen.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
-from bumprtl.sim.amaranth_stream import simulate_stream
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed_lee import lee_illumination_fixed, lee_rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, random_codes
 
 DEFAULT = Config(method="lee")
 TINY = Config(method="lee", angle_bits=4, frac_bits=4, tag_bits=16)
-
-
-def check(out, golden, inputs):
-    assert len(out) == len(inputs)
-    assert [o["tag"] for o in out] == [i["tag"] for i in inputs]        # in order, each once
-    for field in out[0]:
-        if field != "tag":
-            got = np.array([o[field] for o in out])
-            bad = np.flatnonzero(got != golden[field])
-            assert bad.size == 0, (f"{field}: {bad.size} mismatches, first at {bad[0]}: "
-                                   f"RTL {got[bad[0]]} golden {golden[field][bad[0]]} "
-                                   f"(input {inputs[bad[0]]})")
 
 
 def run_both(cfg, codes, pattern, seed=0):
@@ -42,10 +30,10 @@ def run_both(cfg, codes, pattern, seed=0):
     duts = LeeRotation(cfg), LeeIllumination(cfg)
     out, rot_cycles = simulate_stream(duts[0], inputs, pattern, seed=seed)
     rot = lee_rotation_fixed(codes, cfg)
-    check(out, rot, inputs)
+    assert_bit_exact(out, rot, inputs)
     inputs = as_payloads(rot, cfg)
     out, ill_cycles = simulate_stream(duts[1], inputs, pattern, seed=seed + 1)
-    check(out, lee_illumination_fixed(rot, cfg), inputs)
+    assert_bit_exact(out, lee_illumination_fixed(rot, cfg), inputs)
     return rot_cycles - duts[0].latency, ill_cycles - duts[1].latency
 
 
@@ -134,7 +122,7 @@ def test_tiny_config_exhaustive_classes():
     codes = _class_walk(TINY)
     inputs = as_payloads(codes, TINY)
     out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
-    check(out, lee_rotation_fixed(codes, TINY), inputs)
+    assert_bit_exact(out, lee_rotation_fixed(codes, TINY), inputs)
     idx = np.arange(16 ** 3, dtype=np.int64)
     t, u, w = idx & 15, (idx >> 4) & 15, idx >> 8
     b_phi = (idx * 5 + t) & 15
@@ -142,7 +130,7 @@ def test_tiny_config_exhaustive_classes():
            "b.phi": b_phi, "b.theta": t}
     inputs = as_payloads(rot, TINY)
     out, _ = simulate_stream(LeeIllumination(TINY), inputs, "backpressure")
-    check(out, lee_illumination_fixed(rot, TINY), inputs)
+    assert_bit_exact(out, lee_illumination_fixed(rot, TINY), inputs)
 
 
 @pytest.mark.regress
@@ -155,12 +143,12 @@ def test_tiny_config_exhaustive_all_inputs():
              "h.phi": d[3], "h.theta": d[0], "b.phi": d[2], "b.theta": d[1]}
     inputs = as_payloads(codes, TINY)
     out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
-    check(out, lee_rotation_fixed(codes, TINY), inputs)
+    assert_bit_exact(out, lee_rotation_fixed(codes, TINY), inputs)
     rot = {"l.phi": d[0], "l.theta": d[1], "h.phi": d[1], "h.theta": d[2], "b.phi": d[2],
            "b.theta": d[3]}
     inputs = as_payloads(rot, TINY)
     out, _ = simulate_stream(LeeIllumination(TINY), inputs, "no_stall")
-    check(out, lee_illumination_fixed(rot, TINY), inputs)
+    assert_bit_exact(out, lee_illumination_fixed(rot, TINY), inputs)
 
 
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------

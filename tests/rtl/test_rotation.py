@@ -7,7 +7,7 @@ import pytest
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.amaranth_stream import PATTERNS, simulate_stream
+from bumprtl.sim.amaranth_stream import assert_bit_exact, PATTERNS, simulate_stream
 from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
 
@@ -18,22 +18,11 @@ def concat(*codes):
     return {k: np.concatenate([c[k] for c in codes]) for k in codes[0]}
 
 
-def check(out, golden, inputs):
-    assert len(out) == len(inputs)
-    assert [o["tag"] for o in out] == [i["tag"] for i in inputs]        # in order, each once
-    for field in out[0]:
-        if field != "tag":
-            got = np.array([o[field] for o in out])
-            bad = np.flatnonzero(got != golden[field])
-            assert bad.size == 0, (f"{field}: {bad.size} mismatches, first at {bad[0]}: "
-                                   f"RTL {got[bad[0]]} golden {golden[field][bad[0]]}")
-
-
 def run_rotation(cfg, codes, pattern):
     inputs = as_payloads(codes, cfg)
     dut = VectorRotation(cfg)
     out, cycles = simulate_stream(dut, inputs, pattern)
-    check(out, rotation_fixed(codes, cfg), inputs)
+    assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
     return dut.latency, cycles
 
 
@@ -41,7 +30,7 @@ def run_illumination(cfg, codes, pattern):
     rot = rotation_fixed(codes, cfg)
     inputs = as_payloads(rot, cfg)
     out, cycles = simulate_stream(Illumination(cfg), inputs, pattern)
-    check(out, illumination_fixed(rot, cfg), inputs)
+    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
     return cycles
 
 
