@@ -112,6 +112,7 @@ def add_parser(sub):
     p.add_argument("--quantizer", default=None, choices=QUANTIZERS,
                    help="palette method only (default: the palette model's)")
     p.add_argument("--lighting", default=None, metavar="NAME",
-                   help="palette method only: lighting model of the colour table (Tarini Sec. 5.1)")
+                   help="palette method only: a lighting model of sim/golden/palette.py "
+                        "(Tarini Sec. 5.1; a bad name lists them)")
     add_config_flags(p, fields=("spec_exponent", "ka", "kd", "ks", "specular", "palette_size"))
     p.set_defaults(func=run)

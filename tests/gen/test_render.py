@@ -99,6 +99,7 @@ def test_methods_are_the_registry_plus_palette():
     (["--palette-size", "8", "--method", "palette"], "palette_size"),
     (["--quantizer", "kmeans"], "--quantizer"),
     (["--quantizer", "octree", "--method", "palette"], "--quantizer"),
+    (["--lighting", "sunset", "--method", "palette", "--size", "32"], "lighting"),
 ])
 def test_render_bad_input_exit_2_one_line(tmp_path, argv, word):
     r = subprocess.run(CLI + ["render", "--out", str(tmp_path / "x.png")] + argv,
