@@ -21,6 +21,11 @@ def test_scene_shapes_ranges_and_texel_lookup(name):
     assert np.array_equal(s.px.b_theta, s.b_theta_map[s.v, s.u])
     assert s.u.min() >= 0 and s.u.max() < 64 and s.v.min() >= 0 and s.v.max() < 64
     assert np.all(s.b_theta_map < np.pi / 2)          # bump normals face outwards
+    assert s.u.dtype == s.v.dtype == np.int64 and s.mask.dtype == bool
+    assert s.height.shape == (64, 64) and s.b_theta_map.dtype == np.float64
+    assert s.albedo is None or (s.albedo.shape == (64, 64, 3) and 0 <= s.albedo.min()
+                                and s.albedo.max() <= 1)
+    assert s.name == name and s.geometry in ("plane", "sphere", "cylinder")
 
 
 def test_normals_of_a_tilted_plane_are_constant_and_exact():
