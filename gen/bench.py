@@ -12,6 +12,7 @@ BENCHES = {
     "golden": "bench_golden",
     "accuracy": "bench_accuracy",
     "lee-widths": "bench_lee",
+    "palette": "bench_palette",
 }
 
 
