@@ -83,7 +83,7 @@ UNITS = {
     "illumination": Unit("illumination", "Illumination (Lee Sec. 3.2; --method exact|lee)",
                          lambda cfg: _rtl("illumination", "Illumination")(cfg), _rotation_sidecar,
                          ("method", "angle_bits", "frac_bits", "tag_bits", "specular",
-                          "spec_exponent", "ka", "kd", "ks")),
+                          "spec_exponent", "spec_index_bits", "ka", "kd", "ks")),
     "palette": Unit("palette", "PaletteLUT (Tarini Sec. 5/7.2): index -> RGBA, double-buffered table",
                     lambda cfg: _rtl("palette", "PaletteLUT")(cfg), _palette_sidecar,
                     ("palette_size", "color_bits", "palette_blend", "tag_bits")),

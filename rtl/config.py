@@ -57,6 +57,10 @@ class Config:
         Width of the clamped output intensities; 8 (DESIGN §4).
     spec_exponent : int
         Phong exponent ``n`` of the specular table ``cos^n``; 1 to 1024.
+    spec_index_bits : int
+        Address bits of the specular table (at most ``frac_bits`` are used); 4 to 16. 10 (the
+        default) fits one ECP5 block RAM; 12 halves the specular error for 2 block RAMs and
+        a slower table read (docs/fixed_point.md).
     ka, kd, ks : float
         Ambient, diffuse and specular coefficients of eq. (2), each in [0, 1].
     lights : int
@@ -77,6 +81,7 @@ class Config:
     tag_bits: int = 16
     out_bits: int = 8
     spec_exponent: int = 16
+    spec_index_bits: int = 10
     ka: float = 0.1
     kd: float = 0.7
     ks: float = 0.2
@@ -97,6 +102,7 @@ class Config:
         _check_int("tag_bits", self.tag_bits, 0, 32)
         _check_int("out_bits", self.out_bits, 8, 8, "DESIGN §4 fixes 8-bit outputs")
         _check_int("spec_exponent", self.spec_exponent, 1, 1024)
+        _check_int("spec_index_bits", self.spec_index_bits, 4, 16)
         for name in ("ka", "kd", "ks"):
             _check_unit(name, getattr(self, name))
         _check_int("lights", self.lights, 1, 8)

@@ -51,7 +51,7 @@ class _SineBank:
         return port
 
     def sin(self, angle, name):
-        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name)
+        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True)
 
     def cos(self, angle, name):
         return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)
@@ -67,10 +67,11 @@ class Rotation:
       4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
-    Latency 3 (ROM read, sign, sums); 1 pixel per clock.
+    Latency 5 (ROM read, block-RAM output register, sign, two adder levels); 1 pixel per
+    clock.
     """
 
-    latency = 3
+    latency = 5
 
     def __init__(self, cfg: Config):
         self.cfg = cfg
@@ -87,13 +88,15 @@ class Rotation:
              enumerate((a + t, a - t, b + t, b - t, t + bt, t - bt))}
         c = {f"c{n}": rom.cos(x, f"n_c{n}") for n, x in
              enumerate((b, a, a - t, a + t, b - t, b + t, bt - t, bt + t))}
-        sums = {
-            "x4": s["s0"] + s["s1"] + s["s2"] + s["s3"] + 2 * (s["s4"] + s["s5"]),
-            "y2": c["c0"] - c["c1"],
-            "z4": -(c["c2"] - c["c3"] + c["c4"] - c["c5"]) + 2 * (c["c6"] + c["c7"]),
-        }
+        # Two adder levels, each registered: pairs first, then the weighted sum.
+        reg = pipe.register
+        x = [reg(s["s0"] + s["s1"], "x4_a"), reg(s["s2"] + s["s3"], "x4_b"), reg(s["s4"] + s["s5"], "x4_c")]
+        z = [reg(c["c2"] - c["c3"], "z4_a"), reg(c["c4"] - c["c5"], "z4_b"), reg(c["c6"] + c["c7"], "z4_c")]
+        sums = {"x4": x[0] + x[1] + 2 * x[2],
+                "y2": reg(c["c0"] - c["c1"], "y2_a"),
+                "z4": -(z[0] + z[1]) + 2 * z[2]}
         for name, value in sums.items():
-            m.d.comb += o.n[name].eq(pipe.register(value, f"n_{name}"))
+            m.d.comb += o.n[name].eq(reg(value, f"n_{name}"))
         for v in vectors(cfg):
             th, d = px[v].theta, px[v].phi - px.n.phi
             x, y = th + d, th - d
@@ -101,7 +104,7 @@ class Rotation:
                      "y2": rom.cos(y, f"{v}_cy") - rom.cos(x, f"{v}_cx"),
                      "z": rom.cos(th, f"{v}_cth")}
             for name, value in terms.items():
-                m.d.comb += o[v][name].eq(pipe.register(value, f"{v}_{name}"))
+                m.d.comb += o[v][name].eq(pipe.delay(value, 2, f"{v}_{name}"))
         m.d.comb += o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
 
 

@@ -18,8 +18,9 @@ from .tables import phong_coefficients, specular_index_bits, specular_table
 
 __all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp/index, table read + diffuse, Phong sum.
-SHADE_LATENCY = 3
+# Registers of shade_stages: clamp/index, table read + diffuse, table output register,
+# Phong products, Phong sum (each multiply and each block-RAM output gets its own stage).
+SHADE_LATENCY = 5
 
 
 def _clamp01(x, cfg):
@@ -36,7 +37,7 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     color    = clamp(round((KA + KD diffuse + KS specular) / 256), 0, 255)
     """
     b = cfg.frac_bits
-    d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                 # stage 1
+    d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
     diffuse = pipe.register(round_shift(d * 255, b)[:8], "diffuse")               # stage 2
     if cfg.specular:
         s_bits = specular_index_bits(cfg)
@@ -46,14 +47,17 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
                                                    init=table.tolist())
         port = rom.read_port(domain="sync")
         m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(index)]
-        specular = port.data                                                      # stage 2
+        specular = pipe.register(port.data, "specular")                           # stage 3
     else:
         specular = 0
+    diffuse = pipe.register(diffuse, "diffuse_d3")                                 # stage 3
     ka, kd, ks = phong_coefficients(cfg)
-    total = round_shift(ka + diffuse * kd + specular * ks, 8)
-    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 3
-    diffuse = pipe.register(diffuse, "diffuse_out")
-    specular = pipe.register(specular, "specular_out") if cfg.specular else 0
+    kd_term = pipe.register(diffuse * kd, "kd_diffuse")                           # stage 4
+    ks_term = pipe.register(specular * ks, "ks_specular") if cfg.specular else 0
+    total = round_shift(ka + kd_term + ks_term, 8)
+    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 5
+    diffuse = pipe.delay(diffuse, 2, "diffuse_out")
+    specular = pipe.delay(specular, 2, "specular_out") if cfg.specular else 0
     return diffuse, specular, color
 
 

@@ -18,9 +18,12 @@ def quarter_wave_rom(cfg: Config):
                   init=quarter_sine(cfg).tolist())
 
 
-def sine_read(m, pipe, port, angle, cfg: Config, name):
+def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
-    appears two ``adv`` stages later (ROM read, then sign). ``cos(a)`` is ``sin(a + 2**k)``.
+    appears two ``adv`` stages later (ROM read, then sign), or three with ``registered``
+    (ROM read, a plain register on the block-RAM output, then sign: the block RAM's
+    clock-to-out then does not share a cycle with the negation). ``cos(a)`` is
+    ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
@@ -30,7 +33,11 @@ def sine_read(m, pipe, port, angle, cfg: Config, name):
     quadrant, index = a[k:], a[:k]
     m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))]
     negative = pipe.register(quadrant[1], f"{name}_negative")
-    return pipe.register(Mux(negative, -port.data, port.data), name)
+    value = port.data
+    if registered:
+        value = pipe.register(value, f"{name}_rom_out")
+        negative = pipe.register(negative, f"{name}_negative_d")
+    return pipe.register(Mux(negative, -value, value), name)
 
 
 class SinCos(wiring.Component):
@@ -48,7 +55,8 @@ class SinCos(wiring.Component):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency 2 cycles (ROM read, sign); throughput 1 angle per clock when not stalled.
+    Latency 3 cycles (ROM read, block-RAM output register, sign); throughput 1 angle per
+    clock when not stalled.
     """
 
     def __init__(self, cfg: Config):
@@ -67,7 +75,7 @@ class SinCos(wiring.Component):
 
     @property
     def latency(self):
-        return 2
+        return 3
 
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
@@ -76,7 +84,7 @@ class SinCos(wiring.Component):
         m.submodules.rom = rom = quarter_wave_rom(cfg)
         angle = self.i.payload.angle
         outputs = {name: sine_read(m, pipe, rom.read_port(domain="sync"), angle + offset, cfg,
-                                   f"{name}_value")
+                                   f"{name}_value", registered=True)
                    for name, offset in (("sin", 0), ("cos", 1 << k))}   # cos a = sin(a + 90)
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),

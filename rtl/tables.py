@@ -65,9 +65,10 @@ def cos_lookup(cfg: Config, angle) -> np.ndarray:
 # --- Illumination back end (Lee Sec. 3.2 / Fig. 8: diffuse and specular tables) -------------
 
 def specular_index_bits(cfg: Config) -> int:
-    """Address bits of the specular table: the clamped N'.H' with at most 12 fractional bits
-    (2**12 + 1 entries x 8 bits = one ECP5 block RAM at most)."""
-    return min(cfg.frac_bits, 12)
+    """Address bits of the specular table: the clamped N'.H' with ``spec_index_bits``
+    fractional bits (at most ``frac_bits``). At the default 10, 2**10 + 1 entries x 8 bits
+    fit one ECP5 DP16KD (2048 x 9), so the read has no multiplexer between block RAMs."""
+    return min(cfg.frac_bits, cfg.spec_index_bits)
 
 
 def specular_table(cfg: Config) -> np.ndarray:
