@@ -5,28 +5,32 @@ import numpy as np
 
 def run(args):
     from ..rtl.config import Config, ConfigError
-    from ..sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
+    from ..sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb, term_errors_lsb
     from ..sim.golden.common import PixelInputs
     from ..sim.golden.fixed import datapath_fixed
     from .units import build_unit
     print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} "
-          f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))}")
+          f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
+          f"--spec-index-bits {args.spec_index_bits}")
     print(f"\ndiffuse error in 8-bit LSB against float64 on unquantized inputs "
           f"({args.samples} random valid pixels, seed 11; adversarial search, seed 7)\n")
-    print("| angle bits (k+2) | frac bits B | random max | random mean | adversarial max | adversarial mean | sidecar bound |")
-    print("|---|---|---|---|---|---|---|")
+    print("| angle bits (k+2) | frac bits B | random max | random mean | adversarial max | adversarial mean "
+          "| sidecar bound | specular max (random) | colour max (random) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     px = PixelInputs.random(args.samples, np.random.default_rng(11))
     for a in args.angle_bits:
         for b in args.frac_bits:
             try:
-                cfg = Config(method=args.method, angle_bits=a, frac_bits=b)
+                cfg = Config(method=args.method, angle_bits=a, frac_bits=b,
+                             spec_index_bits=args.spec_index_bits)
             except ConfigError:
                 continue
             rnd = diffuse_error_lsb(datapath_fixed, px, cfg)
             adv = diffuse_error_lsb(datapath_fixed, adversarial_pixels(cfg), cfg)
             bound = build_unit("illumination", cfg)[1]["error_bound_lsb"]
+            other = term_errors_lsb(datapath_fixed, px, cfg)
             print(f"| {a} | {b} | {rnd.max()} | {rnd.mean():.4f} | {adv.max()} | {adv.mean():.4f} | "
-                  f"{bound if bound is not None else '-'} |", flush=True)
+                  f"{bound} | {other['specular'].max()} | {other['color'].max()} |", flush=True)
     return 0
 
 
@@ -39,4 +43,5 @@ def add_parser(sub):
     p.add_argument("--samples", type=int, default=1_000_000)
     p.add_argument("--angle-bits", type=int, nargs="+", default=[10, 11, 12, 13])
     p.add_argument("--frac-bits", type=int, nargs="+", default=[10, 13, 16])
+    p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
     p.set_defaults(func=run)

@@ -193,12 +193,17 @@ FPGA_NOTES = """
 ## Notes
 
 - The Fmax target of issue 7 (the default exact pipeline at >= 150 MHz) is not reached;
-  the numbers above are what nextpnr reports. The critical paths start at an unregistered
-  DP16KD output (5.8 ns clock-to-out without the block RAM's output register) and run
-  through the quarter-wave sign logic of `rtl/sincos.sine_read` in the same cycle, and in
-  the illumination unit through the multiplier sum; the stall signal
-  `adv = ~o.valid | o.ready` (`rtl/pipe.py`) also fans out to every enable. Adding a
-  register after each ROM read and after each DSP product (one more latency stage each)
-  is the change that would lift Fmax; those files belong to the datapath issues.
+  the numbers above are what nextpnr reports (speed grade 6, out of context).
+- The exact datapath was pipelined for this report: a plain register after every block-RAM
+  read (sine ROMs, specular table), two registered adder levels for n'', the Phong
+  products in their own stage, 255 x diffuse as a carry chain instead of a DSP block, and a
+  specular table of 2^10 + 1 entries that fits one DP16KD (`Config.spec_index_bits`). That
+  took the exact pipeline from 48.8 MHz to the figure above; the bits computed are the same
+  (the bit-exact tests read the latency from each unit).
+- What is left: the exact setup is bounded by the DP16KD clock-to-out itself (5.8 ns
+  without the block RAM's internal output register, which this Yosys flow does not infer)
+  plus routing into the next flip-flop; the illumination and pipeline paths are a 3-term
+  carry chain (the Phong sum or the dot's rounding) and its routing. The lee datapath was
+  not pipelined further (its setup runs ROM, multiply and ROM in few stages).
 - Units are placed out of context: no I/O buffers, ports are internal nets.
 """

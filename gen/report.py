@@ -151,7 +151,9 @@ is classified cell by cell:
 
 - **multipliers**: product terms of `$macc_v2`/`$mul` with two signal operands.
   **const. mult**: a product with a constant operand that is not a power of two (the
-  back end's `255 x diffuse`, `KD x diffuse`, `KS x specular`); powers of two are shifts.
+  back end's `KD x diffuse`, `KS x specular`); powers of two are shifts. The back end's
+  `255 x diffuse` is written `(d << 8) - d` so that it maps to a carry chain, not a DSP
+  block: it counts as one adder.
 - **adders**: two-signal additions/subtractions; a `$macc_v2` summing T signal terms is
   T - 1 adders. **const. adders**: one operand constant (rounding `+half`, negation
   `0 - x`, the quarter-wave mirror `2^k - i`, `cos a = sin(a + 90 deg)`, `90 deg - |Z|`).
@@ -175,9 +177,10 @@ is classified cell by cell:
 - **lee illumination, adders**: Table 1 says 11 and Sec. 4.2 says 13 (DESIGN erratum 9).
   Per vector th_A' + th_N', th_A' - th_N', ph_A' - ph_N', c- + c-, c- - c+ and the final
   sum are 6 two-signal adders, 12 for L and H, plus the Phong sum of eq. 2 in the shared
-  back end. The recount sides with Sec. 4.2.
+  back end: 13, as Sec. 4.2 counts; the recount sides with Sec. 4.2. Our netlist shows one
+  more, the shift-and-subtract `(d << 8) - d` that computes 255 x diffuse.
 - **lee illumination, tables**: 6 cosine ROMs + the specular table = 7; the paper's
-  diffuse table is our constant multiply by 255 (a const. mult, 8 in the paper's count).
+  diffuse table is our 255 x diffuse (the shift-and-subtract above), 8 in the paper's count.
 - **exact**: DESIGN §3's exact angular method; same budget of 6 two-signal multipliers
   but 24 sin/cos reads from 12 dual-port quarter-wave ROMs, and no asin/atan/reciprocal
   tables.

@@ -18,9 +18,9 @@ from .tables import phong_coefficients, specular_index_bits, specular_table
 
 __all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp/index, table read + diffuse, table output register,
-# Phong products, Phong sum (each multiply and each block-RAM output gets its own stage).
-SHADE_LATENCY = 5
+# Registers of shade_stages: clamp, round (diffuse, table index), table read, table output
+# register, Phong products, Phong sum (each multiply and block-RAM output has its own stage).
+SHADE_LATENCY = 6
 
 
 def _clamp01(x, cfg):
@@ -38,24 +38,26 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     """
     b = cfg.frac_bits
     d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
-    diffuse = pipe.register(round_shift(d * 255, b)[:8], "diffuse")               # stage 2
+    # 255 d as (d << 8) - d: a carry chain instead of a DSP block (same integers as d * 255).
+    diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage 2
     if cfg.specular:
         s_bits = specular_index_bits(cfg)
-        index = pipe.register(round_shift(_clamp01(ndoth, cfg), b - s_bits), "spec_index")
+        h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
+        index = pipe.register(round_shift(h, b - s_bits), "spec_index")           # stage 2
         table = specular_table(cfg)
         m.submodules.specular_table = rom = Memory(shape=unsigned(8), depth=len(table),
                                                    init=table.tolist())
-        port = rom.read_port(domain="sync")
+        port = rom.read_port(domain="sync")                                       # stage 3
         m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(index)]
-        specular = pipe.register(port.data, "specular")                           # stage 3
+        specular = pipe.register(port.data, "specular")                           # stage 4
     else:
         specular = 0
-    diffuse = pipe.register(diffuse, "diffuse_d3")                                 # stage 3
+    diffuse = pipe.delay(diffuse, 2, "diffuse_d")                                 # stage 4
     ka, kd, ks = phong_coefficients(cfg)
-    kd_term = pipe.register(diffuse * kd, "kd_diffuse")                           # stage 4
+    kd_term = pipe.register(diffuse * kd, "kd_diffuse")                           # stage 5
     ks_term = pipe.register(specular * ks, "ks_specular") if cfg.specular else 0
     total = round_shift(ka + kd_term + ks_term, 8)
-    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 5
+    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 6
     diffuse = pipe.delay(diffuse, 2, "diffuse_out")
     specular = pipe.delay(specular, 2, "specular_out") if cfg.specular else 0
     return diffuse, specular, color
