@@ -14,3 +14,12 @@ def test_sincos_cocotb(sim, angle_bits, frac_bits, build_dir):
     tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_sincos", build_dir / sim,
                                  {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 600})
     assert (tests, failures) == (4, 0)
+
+
+def test_missing_simulator_fails_with_install_hint(monkeypatch, tmp_path):
+    """A simulator that is not on PATH is an error naming the install command, never a skip."""
+    from bumprtl.gen import toolchain
+    monkeypatch.setattr(toolchain.shutil, "which", lambda *a, **k: None)
+    v, _ = emit_unit("sincos", Config(angle_bits=8, frac_bits=8), tmp_path)
+    with pytest.raises(toolchain.ToolMissing, match="apt-get install -y iverilog"):
+        run_cocotb("icarus", v, "bumprtl.sim.tb.tb_sincos", tmp_path / "icarus")
