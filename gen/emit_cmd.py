@@ -2,13 +2,16 @@
 
 from pathlib import Path
 
-from .units import UNITS, emit_unit
+from .units import SCENE_UNITS, UNITS, emit_unit
 
 
 def run(args):
     from .cli import config_from_args
     from .emit import lint
     cfg = config_from_args(args)
+    if args.unit in SCENE_UNITS:                     # built from a SceneConfig, not flags
+        from ..rtl.scene import load_scene_config
+        cfg = load_scene_config(args.scene)
     v_path, j_path = emit_unit(args.unit, cfg, args.out)
     print(f"wrote {v_path}")
     print(f"wrote {j_path}")
@@ -33,5 +36,7 @@ def add_parser(sub):
     p.add_argument("unit", choices=sorted(UNITS), metavar="UNIT", help="unit to emit (see above)")
     p.add_argument("--out", type=Path, default=Path("build/emit"), help="output directory (default: build/emit)")
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only -Wall (DESIGN §5 waivers) afterwards")
+    p.add_argument("--scene", default="default", metavar="FILE|NAME",
+                   help="pipeline/fetch: a scene TOML file or built-in scene (default: default)")
     add_config_flags(p)
     p.set_defaults(func=run)

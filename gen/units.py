@@ -9,7 +9,7 @@ from typing import Callable
 
 from ..rtl.config import BumpError, Config
 
-__all__ = ["UNITS", "Unit", "build_unit", "canonical_command"]
+__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "canonical_command"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,19 @@ def _palette_sidecar(cfg, dut):
                                   "host writes to addresses >= palette_size are ignored"}
 
 
+def _pipeline_sidecar(scene, dut):
+    """Which units were built and why, which were skipped, latency, memories."""
+    return {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
+            "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
+
+
+def _fetch_sidecar(scene, dut):
+    from ..rtl.bumpfetch import fetched_field, level_bases
+    return {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
+            "throughput": 1, "output": fetched_field(scene), "level_bases": level_bases(scene),
+            "memory_bits": dut.memory_bits, "addressing": scene.addressing}
+
+
 UNITS = {
     "sincos": Unit("sincos", "quarter-wave sin/cos ROM unit (toolchain slice)",
                    lambda cfg: _sincos()(cfg), _sincos_sidecar),
@@ -87,7 +100,15 @@ UNITS = {
     "palette": Unit("palette", "PaletteLUT (Tarini Sec. 5/7.2): index -> RGBA, double-buffered table",
                     lambda cfg: _rtl("palette", "PaletteLUT")(cfg), _palette_sidecar,
                     ("palette_size", "color_bits", "palette_blend", "tag_bits")),
+    # These two take a SceneConfig (``bumprtl emit pipeline --scene FILE|NAME``).
+    "pipeline": Unit("pipeline", "BumpPipeline: the units a scene needs (--scene FILE|NAME)",
+                     lambda scene: _rtl("pipeline", "BumpPipeline")(scene), _pipeline_sidecar,
+                     ("scene",)),
+    "fetch": Unit("fetch", "BumpMapFetch: (u, v[, level]) -> N' or palette index (--scene FILE|NAME)",
+                  lambda scene: _rtl("bumpfetch", "BumpMapFetch")(scene), _fetch_sidecar,
+                  ("scene",)),
 }
+SCENE_UNITS = ("pipeline", "fetch")
 
 
 def _rtl(module, name):
@@ -122,4 +143,4 @@ def emit_unit(name, cfg, out_dir):
     """Emit ``<out_dir>/<name>.v`` and ``.json``; returns the two paths."""
     from .emit import emit
     dut, sidecar, command = build_unit(name, cfg)
-    return emit(dut, name, command, out_dir, sidecar)
+    return emit(dut, name, command, out_dir, sidecar, flatten=name in SCENE_UNITS)

@@ -1,0 +1,336 @@
+"""BumpPipeline: the per-pixel system a scene needs, generated from a SceneConfig (DESIGN §6).
+
+texel coordinates + world N, L, H in; shaded pixels out. Only what the scene needs is built:
+
+* varying bump map: BumpMapFetch -> VectorRotation -> Illumination (``wiring.connect``);
+* flat bump map: no map and no per-pixel N' rotation: n'' is rotated once per polygon
+  (``sim/golden/fixed_pipeline.polygon_fixed``) and written to the polygon registers, per
+  pixel only the light terms (:class:`VectorTerms`) and the dots remain;
+* palette shading: BumpMapFetch (indices) -> PaletteLUT, no rotation at all;
+* m lights share the one rotated normal n'' (exact method): light 0 rides in VectorRotation,
+  lights 1..m-1 in one :class:`VectorTerms`, one Illumination per light, :class:`LightSum`;
+* no H path and no specular table without specular (the units read ``cfg.specular``).
+
+Units that run side by side in one layer have equal latency and share the downstream ready,
+so their ``adv`` signals are identical and they stay in lock step.
+"""
+
+from amaranth.hdl import Module, Mux, Signal, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from .bumpfetch import BumpMapFetch
+from .exact import Rotation as ExactRotation, _SineBank, rotated_layout
+from .fixed import round_shift
+from .illumination import Illumination
+from .layouts import angle_shape, pixel_layout, polar_layout, shade_layout
+from .palette import PaletteLUT
+from .pipe import StallPipe
+from .rotation import VectorRotation
+from .scene import SceneConfig, light_fields, load_scene_config
+from .tables import phong_coefficients
+
+__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "light_fields"]
+
+
+def _vector_layout(cfg):
+    return rotated_layout(cfg)["l"].shape
+
+
+class VectorTerms(wiring.Component):
+    """The per-vector half of the exact rotation (DESIGN §3) for vectors ``names``:
+    D = ph_A - ph_N, X = th_A + D, Y = th_A - D, 2p = s(X) + s(Y), 2y = c(Y) - c(X),
+    z = c(th_A). Same arithmetic and latency (5) as ``exact.Rotation``'s vector terms, so it
+    runs in lock step beside it. Input {n_phi, <name>: polar, tag}; output {<name>: p2, y2,
+    z, tag}."""
+
+    latency = ExactRotation.latency
+
+    def __init__(self, cfg, names):
+        self.cfg, self.names = cfg, tuple(names)
+        fields_in = {"n_phi": angle_shape(cfg), **{v: polar_layout(cfg) for v in names},
+                     "tag": unsigned(cfg.tag_bits)}
+        fields_out = {**{v: _vector_layout(cfg) for v in names}, "tag": unsigned(cfg.tag_bits)}
+        super().__init__({"i": In(stream.Signature(data.StructLayout(fields_in))),
+                          "o": Out(stream.Signature(data.StructLayout(fields_out)))})
+
+    def elaborate(self, platform):
+        m = Module()
+        pipe = StallPipe(m, self.i, self.o, self.latency)
+        rom = _SineBank(m, pipe, self.cfg)
+        px, out = self.i.payload, self.o.payload
+        for v in self.names:
+            th, d = px[v].theta, px[v].phi - px.n_phi
+            x, y = th + d, th - d
+            terms = {"p2": rom.sin(x, f"{v}_sx") + rom.sin(y, f"{v}_sy"),
+                     "y2": rom.cos(y, f"{v}_cy") - rom.cos(x, f"{v}_cx"),
+                     "z": rom.cos(th, f"{v}_cth")}
+            for name, value in terms.items():
+                m.d.comb += out[v][name].eq(pipe.delay(value, 2, f"{v}_{name}"))
+        m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
+        return m
+
+
+class LightSum(wiring.Component):
+    """m lights' 8-bit diffuse and specular -> the pixel (eq. 2 summed over the lights):
+    diffuse = min(255, sum d_j), specular = min(255, sum s_j),
+    color = clamp(round((KA + KD sum d_j + KS sum s_j) / 256), 0, 255).
+    Latency 3 (sums, products, clamp); bit-exact with ``fixed_pipeline.combine_lights_fixed``."""
+
+    latency = 3
+
+    def __init__(self, scene: SceneConfig):
+        self.cfg, self.lights = scene.config, scene.lights
+        u8 = unsigned(8)
+        fields = {**{f"d{j}": u8 for j in range(self.lights)},
+                  **{f"s{j}": u8 for j in range(self.lights)}, "tag": unsigned(self.cfg.tag_bits)}
+        super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
+                          "o": Out(stream.Signature(shade_layout(self.cfg)))})
+
+    def elaborate(self, platform):
+        m = Module()
+        pipe = StallPipe(m, self.i, self.o, self.latency)
+        px = self.i.payload
+        d = pipe.register(sum(px[f"d{j}"] for j in range(self.lights)), "diffuse_sum")
+        s = pipe.register(sum(px[f"s{j}"] for j in range(self.lights)), "specular_sum")
+        ka, kd, ks = phong_coefficients(self.cfg)
+        kd_term, ks_term = pipe.register(d * kd, "kd_sum"), pipe.register(s * ks, "ks_sum")
+        total = round_shift(ka + kd_term + ks_term, 8)
+        sat = lambda x: Mux(x > 255, 255, x)[:8]
+        m.d.comb += [self.o.payload.color.eq(pipe.register(sat(total), "color")),
+                     self.o.payload.diffuse.eq(pipe.delay(sat(d), 2, "diffuse")),
+                     self.o.payload.specular.eq(pipe.delay(sat(s), 2, "specular")),
+                     self.o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
+        return m
+
+
+def _lockstep(m, src, dsts):
+    """Feed one stream to units that run in lock step: valid to all, ready from all."""
+    ready = 1
+    for dst in dsts:
+        m.d.comb += dst.valid.eq(src.valid)
+        ready = ready & dst.ready
+    m.d.comb += src.ready.eq(ready)
+
+
+class BumpPipeline(wiring.Component):
+    """The per-pixel pipeline of one scene.
+
+    Parameters
+    ----------
+    scene : SceneConfig, str or path
+        What to build (rtl/scene.py); a name or TOML path is loaded.
+    init : sequence of int, optional
+        Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
+
+    Members
+    -------
+    i : In(stream.Signature(...))
+        varying map: {u, v, [level], n, l, [h], [l1, h1, ...], tag}; flat map:
+        {l, [h], ..., tag}; palette: {u, v, [level], tag}. Angles are binary angles.
+    o : Out(stream.Signature(...))
+        ``shade_layout`` (diffuse, specular, color, tag), or PaletteLUT's {color: rgba, oor,
+        tag} with palette shading.
+    map_w_en, map_w_addr, map_w_data : In
+        Host write port of the bump map (varying map and palette).
+    poly_en, poly : In
+        Flat map: the polygon registers {n_phi, x4, y2, z4} (n'' rotated once per polygon).
+    lut_w_en, lut_w_addr, lut_w_data, lut_swap, lut_bank :
+        Palette: PaletteLUT's host port.
+
+    ``latency`` is the sum of the units' latencies; 1 pixel per clock when not stalled.
+    ``built`` lists the units and why each was built.
+    """
+
+    def __init__(self, scene, init=None):
+        self.scene = scene = load_scene_config(scene)
+        if scene.texture:
+            from .scene import SceneError
+            self._MustUse__silence = True        # never elaborated: no unused-elaboratable warning
+            raise SceneError("texture = true: this generator has no colour-texture blend unit "
+                             "yet; set texture = false")
+        self.cfg = cfg = scene.config
+        self.units, self.built = {}, []
+        ports = {}
+        if scene.shading == "palette":
+            self._plan_palette(init)
+        else:
+            self._plan_shading(init)
+        if "fetch" in self.units:
+            in_layout = self.units["fetch"].i.payload.shape()
+        else:                                       # flat map: the light vectors and the tag
+            terms = self.units["terms"].i.payload.shape()
+            in_layout = data.StructLayout({f: terms[f].shape for f, _ in terms if f != "n_phi"})
+        ports["i"] = In(stream.Signature(in_layout))
+        ports["o"] = Out(stream.Signature(self.units[self._last].o.payload.shape()))
+        if "fetch" in self.units:
+            f = self.units["fetch"]
+            ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
+                          "map_w_data": In(f.w_data.shape())})
+        if scene.rotation == "per-polygon":
+            ports.update({"poly_en": In(1), "poly": In(self._poly_layout())})
+        if scene.shading == "palette":
+            lut = self.units["palette"]
+            ports.update({"lut_w_en": In(1), "lut_w_addr": In(lut.w_addr.shape()),
+                          "lut_w_data": In(lut.w_data.shape()), "lut_swap": In(1),
+                          "lut_bank": Out(1)})
+        super().__init__(ports)
+
+    # --- planning: which units, and why -----------------------------------------------------
+    def _add(self, name, unit, why):
+        self.units[name] = unit
+        self.built.append({"unit": name, "class": type(unit).__name__, "latency": unit.latency,
+                           "why": why})
+
+    def _fetch(self, out_layout, init, what):
+        s = self.scene
+        self._add("fetch", BumpMapFetch(s, out_layout, init),
+                  f"bump_map = 'varying': {what} per texel in block RAM ({s.texture_size}^2 texels, "
+                  f"{s.mip_levels} level(s), {s.addressing} addressing)")
+
+    def _plan_palette(self, init):
+        lut = PaletteLUT(self.cfg)
+        self._fetch(lut.i.payload.shape(), init, "a palette index")
+        self._add("palette", lut, "shading = 'palette': one colour-table lookup per pixel, "
+                                  "no per-pixel rotation")
+        self._first, self._last, self._layers = "fetch", "palette", [["fetch"], ["palette"]]
+
+    def _plan_shading(self, init):
+        s, cfg = self.scene, self.cfg
+        lights = light_fields(s)
+        extra = [v for names in lights[1:] for v in names]
+        spec = "with the H path and specular table" if s.specular else \
+            "specular = false: no H path, no specular table"
+        rot_layer = []
+        if s.rotation == "per-pixel":
+            fields = {name: f.shape for name, f in pixel_layout(cfg)}
+            tag = fields.pop("tag")
+            self._fetch(data.StructLayout({**fields, **{v: polar_layout(cfg) for v in extra},
+                                           "tag": tag}), init, "N' (polar angles)")
+            self._add("rotation", VectorRotation(cfg),
+                      f"rotation = 'per-pixel': N' rotated into N's frame every pixel ({spec})")
+            rot_layer.append("rotation")
+            term_names = extra
+        else:
+            term_names = [v for names in lights for v in names]
+        if term_names:
+            why = ("bump_map = 'flat': n'' written once per polygon, per pixel only the light "
+                   "terms" if s.rotation == "per-polygon" else
+                   f"lights = {s.lights}: lights 1..{s.lights - 1} share light 0's rotated normal")
+            self._add("terms", VectorTerms(cfg, term_names), why)
+            rot_layer.append("terms")
+        ill = []
+        for j in range(s.lights):
+            self._add(f"illumination{j}" if s.lights > 1 else "illumination", Illumination(cfg),
+                      f"light {j}: N'.L' (and N'.H') and the shade of eq. 2 ({spec})")
+            ill.append(self.built[-1]["unit"])
+        self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
+        if s.lights > 1:
+            self._add("lightsum", LightSum(s), f"lights = {s.lights}: eq. 2 summed over the lights")
+            self._layers.append(["lightsum"])
+        self._first, self._last = self._layers[0][0], self._layers[-1][0]
+
+    def _poly_layout(self):
+        n = rotated_layout(self.cfg)["n"].shape
+        return data.StructLayout({"n_phi": angle_shape(self.cfg), "n": n})
+
+    @property
+    def skipped(self):
+        """The units of the full pipeline this scene does not build, and why."""
+        s, out = self.scene, []
+        if not s.specular and s.shading == "per-pixel":
+            out.append({"unit": "H path + specular table", "why": "specular = false"})
+        if s.rotation == "per-polygon":
+            out.append({"unit": "fetch + per-pixel N' rotation",
+                        "why": "bump_map = 'flat': n'' rotated once per polygon"})
+        if s.shading == "palette":
+            out.append({"unit": "rotation + illumination", "why": "shading = 'palette'"})
+        if s.lights == 1 and s.shading == "per-pixel":
+            out.append({"unit": "extra light terms + light sum", "why": "lights = 1"})
+        out.append({"unit": "colour-texture blend", "why": "texture = false"})
+        return out
+
+    @property
+    def latency(self):
+        return sum(self.units[layer[0]].latency for layer in self._layers)
+
+    # --- elaboration ------------------------------------------------------------------------
+    def elaborate(self, platform):
+        m = Module()
+        for name, unit in self.units.items():
+            m.submodules[name] = unit
+        s, u = self.scene, self.units
+        if "fetch" in u:
+            m.d.comb += [u["fetch"].w_en.eq(self.map_w_en), u["fetch"].w_addr.eq(self.map_w_addr),
+                         u["fetch"].w_data.eq(self.map_w_data)]
+        if s.shading == "palette":
+            lut = u["palette"]
+            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
+            wiring.connect(m, u["fetch"].o, lut.i)
+            wiring.connect(m, lut.o, wiring.flipped(self.o))
+            m.d.comb += [lut.w_en.eq(self.lut_w_en), lut.w_addr.eq(self.lut_w_addr),
+                         lut.w_data.eq(self.lut_w_data), lut.swap.eq(self.lut_swap),
+                         self.lut_bank.eq(lut.bank)]
+            return m
+        if s.lights == 1 and s.rotation == "per-pixel":       # fetch -> rotation -> illumination
+            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
+            wiring.connect(m, u["fetch"].o, u["rotation"].i)
+            wiring.connect(m, u["rotation"].o, u["illumination"].i)
+            wiring.connect(m, u["illumination"].o, wiring.flipped(self.o))
+            return m
+        self._elaborate_layers(m)
+        return m
+
+    def _elaborate_layers(self, m):
+        s, u, cfg = self.scene, self.units, self.cfg
+        lights = light_fields(s)
+        if "fetch" in u:
+            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
+            src = u["fetch"].o
+        else:
+            src = self.i
+        rot_layer, ill_layer = self._layers[-3 if s.lights > 1 else -2:][:2]
+        _lockstep(m, src, [u[n].i for n in rot_layer])
+        if "rotation" in u:
+            m.d.comb += [u["rotation"].i.payload[f].eq(src.payload[f])
+                         for f, _ in pixel_layout(cfg)]
+        terms = u.get("terms")
+        if terms is not None:
+            for f, _ in terms.i.payload.shape():
+                if f == "n_phi":
+                    value = src.payload.n.phi if "rotation" in u else self._poly_reg(m).n_phi
+                else:
+                    value = src.payload[f]
+                m.d.comb += terms.i.payload[f].eq(value)
+        lead = u[rot_layer[0]].o
+        _lockstep(m, lead, [u[n].i for n in ill_layer])
+        for n in rot_layer[1:]:
+            m.d.comb += u[n].o.ready.eq(lead.ready)
+        n_src = u["rotation"].o.payload.n if "rotation" in u else self._poly_reg(m).n
+        for j, names in enumerate(lights):
+            ill = u[ill_layer[j]].i.payload
+            m.d.comb += [ill.n.eq(n_src), ill.tag.eq(lead.payload.tag)]
+            for std, name in zip(("l", "h"), names):
+                rot_out = u["rotation"].o.payload if j == 0 and "rotation" in u else terms.o.payload
+                m.d.comb += ill[std].eq(rot_out[name])
+        lead = u[ill_layer[0]].o
+        for n in ill_layer[1:]:
+            m.d.comb += u[n].o.ready.eq(lead.ready)
+        if s.lights == 1:
+            wiring.connect(m, u[ill_layer[0]].o, wiring.flipped(self.o))
+            return
+        total = u["lightsum"]
+        _lockstep(m, lead, [total.i])
+        for j, n in enumerate(ill_layer):
+            m.d.comb += [total.i.payload[f"d{j}"].eq(u[n].o.payload.diffuse),
+                         total.i.payload[f"s{j}"].eq(u[n].o.payload.specular)]
+        m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
+        wiring.connect(m, total.o, wiring.flipped(self.o))
+
+    def _poly_reg(self, m):
+        """The polygon registers, written by the host when ``poly_en`` (once per polygon)."""
+        if not hasattr(self, "_poly_signal"):
+            self._poly_signal = Signal(self._poly_layout(), name="polygon")
+            with m.If(self.poly_en):
+                m.d.sync += self._poly_signal.eq(self.poly)
+        return self._poly_signal
