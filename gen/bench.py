@@ -13,6 +13,7 @@ BENCHES = {
     "accuracy": "bench_accuracy",
     "lee-widths": "bench_lee",
     "palette": "bench_palette",
+    "sweep": "bench_sweep",
 }
 
 
