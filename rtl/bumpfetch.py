@@ -131,6 +131,7 @@ class BumpMapFetch(wiring.Component):
         self.word_bits = Shape.cast(texel_shape(scene)).width
         self.init = [int(w) for w in init] if init is not None else []
         if len(self.init) not in (0, self.depth):
+            self._MustUse__silence = True
             raise ValueError(f"init has {len(self.init)} words, the map needs {self.depth}")
         super().__init__({
             "i": In(stream.Signature(data.StructLayout(fields))),
