@@ -337,7 +337,7 @@ def _memory_bits(p):
     return p["cost"]["table_bits"] + p["cost"]["ram_bits"]
 
 
-def _label(p):
+def point_label(p):
     if p["method"] == "palette":
         return f"palette sN={p['palette_size']}"
     return f"{p['method']} a{p['angle_bits']} b{p['frac_bits']}" if "angle_bits" in p else p["method"]
@@ -356,7 +356,7 @@ def _row(p, front):
     rnd, adv = err.get("random"), err.get("adversarial")
     f = cost.get("fpga", {})
     hw = speed.get("hw_pix_s")
-    return (f"| {_label(p)} | {_fmt(rnd and rnd['max'])} / {_fmt(rnd and rnd['mean'], '{:.3f}')} "
+    return (f"| {point_label(p)} | {_fmt(rnd and rnd['max'])} / {_fmt(rnd and rnd['mean'], '{:.3f}')} "
             f"| {_fmt(adv and adv['max'])} / {_fmt(adv and adv['mean'], '{:.3f}')} "
             f"| {_fmt(psnr)} / {_fmt(max((s['max_lsb'] for s in scenes), default=None))} "
             f"| **{error_lsb(p)}** | {cost['multipliers']} | {cost['adders']} | {cost['table_bits']} "
@@ -390,7 +390,7 @@ def markdown(data, command, plot_paths=()):
     other = [p for p in data["points"] if p["status"] != "ok"]
     if other:
         lines += ["", "Not measured:", ""]
-        lines += [f"- {_label(p)}: **{p['status']}** — {p['reason']}" for p in other]
+        lines += [f"- {point_label(p)}: **{p['status']}** — {p['reason']}" for p in other]
     lines += [""] + [f"![{name}](img/{Path(path).name})" for name, path in plot_paths]
     return "\n".join(lines)
 

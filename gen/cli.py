@@ -14,7 +14,7 @@ from ..rtl.config import BumpError, Config
 from .toolchain import ToolMissing
 
 # Subcommand modules, in the order `bumprtl --help` lists them.
-COMMANDS = ["doctor", "demo", "render", "emit_cmd", "bench", "report"]
+COMMANDS = ["doctor", "demo", "render", "emit_cmd", "bench", "report", "recommend"]
 
 
 class _Parser(argparse.ArgumentParser):

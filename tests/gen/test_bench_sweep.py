@@ -1,0 +1,102 @@
+"""bench sweep: Pareto front on toy sets, and one tiny sweep through the real models
+(errors re-derived from the models, invalid widths recorded, missing baselines reported)."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from bumprtl.gen import bench_sweep
+from bumprtl.gen.bench_sweep import Grid, error_lsb, pareto_front, sweep, write_section
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.accuracy import diffuse_error_lsb
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.fixed import datapath_fixed
+
+
+def _front(pairs):
+    pts = [{"x": x, "y": y} for x, y in pairs]
+    return sorted(pareto_front(pts, lambda p: p["x"], lambda p: p["y"]))
+
+
+def test_pareto_toy():
+    #            0       1       2       3 (dominated by 1)  4 (None: skipped)
+    assert _front([(1, 10), (2, 3), (5, 1), (3, 4)]) == [0, 1, 2]
+    assert _front([(1, 1), (2, 2), (3, 3)]) == [0]
+
+
+def test_pareto_duplicates_and_none():
+    pts = [{"x": 1, "y": 1}, {"x": 1, "y": 1}, {"x": None, "y": 0}, {"x": 0, "y": 5}]
+    assert sorted(pareto_front(pts, lambda p: p["x"], lambda p: p["y"])) == [0, 3]
+
+
+def test_pareto_random_against_brute_force():
+    rng = np.random.default_rng(3)
+    pairs = [tuple(v) for v in rng.integers(0, 20, (60, 2))]
+    front = _front(pairs)
+    for i, (x, y) in enumerate(pairs):
+        better = any(x2 <= x and y2 <= y and (x2, y2) != (x, y) for x2, y2 in pairs)
+        assert (i in front) == (not better and pairs.index((x, y)) == i)
+
+
+def test_error_lsb_is_worst_of_sets():
+    p = {"error": {"random": {"max": 2}, "adversarial": {"max": 5},
+                   "scenes": {"a": {"max_lsb": 7}, "b": {"reason": "skipped"}}}}
+    assert error_lsb(p) == 7
+    assert error_lsb({"error": {}}) is None
+
+
+def test_write_section_keeps_other_sections(tmp_path):
+    doc = tmp_path / "bench.md"
+    write_section(doc, "sweep", "one")
+    write_section(doc, "skip", "two")
+    write_section(doc, "sweep", "three")
+    text = doc.read_text()
+    assert "three" in text and "two" in text and "one" not in text
+    assert text.index("three") < text.index("two")
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    grid = Grid(angle_bits=(6, 14), frac_bits=(5,), palette_sizes=(16,), samples=300,
+                scenes=("bumps",), size=16)
+    opts = SimpleNamespace(methods=("exact", "palette", "baselines"), fpga=False, sim=False,
+                           device="LFE5U-85F")
+    work = tmp_path_factory.mktemp("sweep")
+    return sweep(grid, opts, work, seed=4, progress=False)
+
+
+def test_tiny_sweep_points(tiny):
+    by = {(p["method"], p.get("angle_bits"), p.get("palette_size")): p for p in tiny["points"]}
+    exact6 = by[("exact", 6, None)]
+    assert exact6["status"] == "ok"
+    # the same vectors through the model directly give the same numbers
+    cfg = Config(angle_bits=6, frac_bits=5)
+    err = diffuse_error_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)
+    assert exact6["error"]["random"]["max"] == err.max()
+    assert error_lsb(exact6) >= err.max()
+    assert exact6["cost"]["multipliers"] > 0 and exact6["cost"]["table_bits"] > 0
+    assert exact6["speed"]["golden_mpix_s"] > 0
+
+
+def test_tiny_sweep_invalid_and_missing(tiny):
+    by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
+    invalid = by[("exact", 14)]                       # B = 5 < k - 1 = 11
+    assert invalid["status"] == "invalid" and "frac_bits" in invalid["reason"]
+    for name in ("peercy", "kim"):
+        assert by[(name, None)]["status"] in ("not available", "ok")
+        if by[(name, None)]["status"] == "not available":
+            assert by[(name, None)]["reason"]
+    palette = by[("palette", None)]
+    assert palette["status"] == "ok" and "random" not in palette["error"]
+    assert palette["error"]["scenes"]["bumps"]["max_lsb"] == error_lsb(palette)
+    json.dumps(tiny)                                  # the sweep is JSON-serializable
+
+
+def test_markdown_and_plot(tiny, tmp_path):
+    text = bench_sweep.markdown(tiny, "bumprtl bench sweep --test")
+    assert "`bumprtl bench sweep --test`" in text
+    assert "exact a6 b5" in text and "invalid" in text
+    png = bench_sweep.plot(tiny, tmp_path / "p.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
