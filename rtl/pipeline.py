@@ -290,6 +290,7 @@ class BumpPipeline(wiring.Component):
         else:
             src = self.i
         rot_layer, ill_layer = self._layers[-3 if s.lights > 1 else -2:][:2]
+        poly = self._poly_reg(m) if s.rotation == "per-polygon" else None
         _lockstep(m, src, [u[n].i for n in rot_layer])
         if "rotation" in u:
             m.d.comb += [u["rotation"].i.payload[f].eq(src.payload[f])
@@ -298,7 +299,7 @@ class BumpPipeline(wiring.Component):
         if terms is not None:
             for f, _ in terms.i.payload.shape():
                 if f == "n_phi":
-                    value = src.payload.n.phi if "rotation" in u else self._poly_reg(m).n_phi
+                    value = src.payload.n.phi if poly is None else poly.n_phi
                 else:
                     value = src.payload[f]
                 m.d.comb += terms.i.payload[f].eq(value)
@@ -306,7 +307,7 @@ class BumpPipeline(wiring.Component):
         _lockstep(m, lead, [u[n].i for n in ill_layer])
         for n in rot_layer[1:]:
             m.d.comb += u[n].o.ready.eq(lead.ready)
-        n_src = u["rotation"].o.payload.n if "rotation" in u else self._poly_reg(m).n
+        n_src = u["rotation"].o.payload.n if poly is None else poly.n
         for j, names in enumerate(lights):
             ill = u[ill_layer[j]].i.payload
             m.d.comb += [ill.n.eq(n_src), ill.tag.eq(lead.payload.tag)]
@@ -329,8 +330,7 @@ class BumpPipeline(wiring.Component):
 
     def _poly_reg(self, m):
         """The polygon registers, written by the host when ``poly_en`` (once per polygon)."""
-        if not hasattr(self, "_poly_signal"):
-            self._poly_signal = Signal(self._poly_layout(), name="polygon")
-            with m.If(self.poly_en):
-                m.d.sync += self._poly_signal.eq(self.poly)
-        return self._poly_signal
+        reg = Signal(self._poly_layout(), name="polygon")
+        with m.If(self.poly_en):
+            m.d.sync += reg.eq(self.poly)
+        return reg

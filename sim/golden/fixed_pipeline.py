@@ -65,11 +65,12 @@ def _light_codes(codes, names):
 
 def polygon_fixed(n_phi, n_theta, b_phi, b_theta, scene: SceneConfig):
     """The once-per-polygon rotation of a flat bump map's N' (polygon normal N): the n''
-    terms x4, y2, z4 and ph_N, which the per-pixel vector terms need."""
+    terms x4, y2, z4 and ph_N (``n_phi``), which the per-pixel vector terms need; keyed
+    like the pipeline's ``poly`` port."""
     codes = {"n.phi": n_phi, "n.theta": n_theta, "b.phi": b_phi, "b.theta": b_theta,
              "l.phi": 0, "l.theta": 0, "h.phi": 0, "h.theta": 0}
     rot = exact_rotation_fixed({k: np.asarray(c, np.int64) for k, c in codes.items()}, scene.config)
-    return {"n.phi": int(n_phi), **{k: int(rot[k]) for k in ("n.x4", "n.y2", "n.z4")}}
+    return {"n_phi": int(n_phi), **{k: int(rot[k]) for k in ("n.x4", "n.y2", "n.z4")}}
 
 
 def combine_lights_fixed(shades, scene: SceneConfig):
@@ -105,7 +106,7 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None):
             shape = light["l.phi"].shape
             poly = {k: np.full(shape, v, np.int64) for k, v in polygon.items()}
             zero = np.zeros(shape, np.int64)
-            rot = {**exact_rotation_fixed({**light, "n.phi": poly["n.phi"], "n.theta": zero,
+            rot = {**exact_rotation_fixed({**light, "n.phi": poly.pop("n_phi"), "n.theta": zero,
                                            "b.phi": zero, "b.theta": zero}, cfg), **poly}
         shades.append(illumination_fixed(rot, cfg))
     if len(shades) == 1:

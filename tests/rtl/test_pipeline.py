@@ -54,7 +54,7 @@ class _Host(wiring.Component):
         m.submodules.dut = dut = self.dut
         ready = 1
         if self.polygon is not None:
-            m.d.comb += [dut.poly_en.eq(1), dut.poly.n_phi.eq(self.polygon["n.phi"])]
+            m.d.comb += [dut.poly_en.eq(1), dut.poly.n_phi.eq(self.polygon["n_phi"])]
             m.d.comb += [dut.poly.n[k].eq(self.polygon[f"n.{k}"]) for k in ("x4", "y2", "z4")]
             loaded = Signal()                    # the polygon registers load in cycle 0
             m.d.sync += loaded.eq(1)
