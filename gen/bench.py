@@ -14,6 +14,7 @@ BENCHES = {
     "lee-widths": "bench_lee",
     "palette": "bench_palette",
     "sweep": "bench_sweep",
+    "stress": "bench_stress",
 }
 
 

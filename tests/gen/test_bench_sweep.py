@@ -100,3 +100,20 @@ def test_markdown_and_plot(tiny, tmp_path):
     assert "exact a6 b5" in text and "invalid" in text
     png = bench_sweep.plot(tiny, tmp_path / "p.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_stress_rows_and_markdown():
+    from bumprtl.gen.bench_stress import _float_row, markdown, stress_rows
+    rows = stress_rows(200, 0, configs=["default"], cases=["below_horizon"])
+    by = {r[2]: r[3] for r in rows}
+    assert by["lee_printed (float64)"]["nan"] > 0
+    assert by["exact (fixed)"]["overflow"] == 0 and by["exact (fixed)"]["diffuse_max_lsb"] <= 1
+
+    def boom(px, cfg):
+        raise ZeroDivisionError("model fell over")
+
+    crash = _float_row(boom, None, Config(), None)
+    text = markdown(rows + [("default", "below_horizon", "boom (float64)", crash)], "bumprtl bench stress --x", 200)
+    assert "`bumprtl bench stress --x`" in text
+    assert "**crash**: `ZeroDivisionError: model fell over`" in text
+    assert "crashes** in 1: default / below_horizon" in text
