@@ -68,6 +68,9 @@ def run(args):
     from ..sim.scenes import load_scene
     from ..sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
     from .cli import config_from_args
+    if args.rtl:                                   # through the emitted pipeline (gen/render_rtl.py)
+        from .render_rtl import cli_render
+        return cli_render(args)
     cfg, palette_opts = config_from_args(args), _palette_opts(args)
     scene = load_scene(args.scene, size=args.size, light_elevation=args.light_elevation,
                        light_azimuth=args.light_azimuth, light=args.light,
@@ -114,5 +117,10 @@ def add_parser(sub):
     p.add_argument("--lighting", default=None, metavar="NAME",
                    help="palette method only: a lighting model of sim/golden/palette.py "
                         "(Tarini Sec. 5.1; a bad name lists them)")
+    p.add_argument("--rtl", action="store_true",
+                   help="render through the emitted BumpPipeline with cocotb; checks it equals the golden render")
+    p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"], help="with --rtl")
+    p.add_argument("--pipeline", default="default", metavar="FILE|NAME",
+                   help="with --rtl: the scene class (rtl/scene.py built-in or TOML) to build")
     add_config_flags(p, fields=("spec_exponent", "ka", "kd", "ks", "specular", "palette_size"))
     p.set_defaults(func=run)

@@ -130,7 +130,7 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     from ..sim.tb.runner import run_cocotb
     from .emit import emit
     from .units import build_unit, canonical_command, UNITS
-    build_dir = Path(build_dir)
+    build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
     dut = BumpPipeline(scene, init=words)
     sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
     v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), build_dir / "rtl",
@@ -158,3 +158,26 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
         raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
     return RtlRender(_image(base, pixels, scene), golden_render(scene, size, **light),
                      cycles["no_stall"], times["run_s"], times["build_s"])
+
+
+def cli_render(args):
+    """``bumprtl render --rtl``: the scene class ``--pipeline`` (built-in name or TOML)
+    rendering image ``--scene``; writes the RTL image, checks it against the golden render."""
+    from ..sim.scenes.imaging import save_png
+    scene = load_scene_config(args.pipeline)
+    keys = {"image": args.scene}
+    if args.texture_size is not None:
+        keys["texture_size"] = args.texture_size
+    scene = load_scene_config({**scene.to_dict(), **keys, "rotation": None})
+    light = {"light_elevation": args.light_elevation, "light": args.light}
+    t0 = time.perf_counter()
+    r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / scene.name,
+                   progress=True, **light)
+    out = save_png(args.out, r.image)
+    same = r.image.tobytes() == r.golden.tobytes()
+    print(f"rtl ({args.simulator}): {args.size}x{args.size} {args.scene} with pipeline "
+          f"{scene.name}: {r.cycles} cycles, simulation {r.seconds:.2f} s "
+          f"({args.size ** 2 / r.seconds:.0f} pix/s), build {r.build_seconds:.1f} s, "
+          f"total {time.perf_counter() - t0:.1f} s -> {out}")
+    print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
+    return 0 if same else 1
