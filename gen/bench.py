@@ -15,6 +15,7 @@ BENCHES = {
     "palette": "bench_palette",
     "sweep": "bench_sweep",
     "stress": "bench_stress",
+    "skip": "bench_skip",
 }
 
 

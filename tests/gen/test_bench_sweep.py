@@ -117,3 +117,17 @@ def test_stress_rows_and_markdown():
     assert "`bumprtl bench stress --x`" in text
     assert "**crash**: `ZeroDivisionError: model fell over`" in text
     assert "crashes** in 1: default / below_horizon" in text
+
+
+def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
+    """Skipping must not change the picture: the unskipped diffuse and flat scenes give the
+    same colour bytes; an unbuildable scene is reported, not crashed on."""
+    from bumprtl.gen import bench_skip
+    from bumprtl.rtl.scene import load_scene_config
+    monkeypatch.setattr(bench_skip, "_cost", lambda scene, work: {"multipliers": 0})
+    rows = {r["scene"]: r for r in bench_skip.skip_rows(["diffuse", "flat", "full"], 16, tmp_path)}
+    assert rows["diffuse"]["same_image"] and rows["flat"]["same_image"]
+    assert "H path + specular table" in rows["diffuse"]["skipped"]
+    assert rows["full"]["status"] == "not available" and "texture" in rows["full"]["reason"]
+    off = bench_skip.unskipped(load_scene_config("flat"))
+    assert (off.bump_map, off.shading, off.specular) == ("varying", "per-pixel", True)
