@@ -102,8 +102,10 @@ def run(scene, n, pattern, seed=0):
 
 
 @pytest.mark.parametrize("keys", combinations(), ids=lambda k: "-".join(str(v) for v in k.values()))
-def test_every_switch_combination_bit_exact(keys):
+def test_every_switch_combination_lint_clean_and_bit_exact(keys, build_dir):
     scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
+    v, _ = emit_unit("pipeline", scene, build_dir)
+    assert lint(v) == []
     run(scene, 60, "no_stall")
 
 
@@ -131,9 +133,3 @@ def test_one_pixel_per_clock(keys):
 def test_texture_blend_not_built_is_an_error():
     with pytest.raises(Exception, match="texture"):
         BumpPipeline(load_scene_config({"name": "t", "texture": True}))
-
-
-@pytest.mark.parametrize("name", ["default", "two-lights", "flat", "palette", "diffuse"])
-def test_emitted_pipeline_is_lint_clean(name, build_dir):
-    v, j = emit_unit("pipeline", load_scene_config(name), build_dir)
-    assert lint(v) == []
