@@ -181,3 +181,40 @@ def cli_render(args):
           f"total {time.perf_counter() - t0:.1f} s -> {out}")
     print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
     return 0 if same else 1
+
+
+
+SCENES_TABLE_SIZE = 256
+
+
+def _built_units(scene):
+    from ..rtl.pipeline import BumpPipeline
+    dut = BumpPipeline(scene)
+    for unit in (dut, *dut.units.values()):        # only the plan is read, never elaborated
+        unit._MustUse__silence = True
+    return ", ".join(u["unit"] for u in dut.built)
+
+
+def scenes_table(work_dir="build/scenes"):
+    """The table of docs/scenes.md: per built-in scene class (without texture), the units
+    built, multipliers, ROM and RAM bits and adders of the emitted pipeline (Yosys netlist,
+    gen/resources.py) and the golden render time at SCENES_TABLE_SIZE^2."""
+    from ..rtl.scene import BUILTIN
+    from .resources import count_unit
+    rows = ["| scene class | units built | multipliers | ROM bits | RAM bits | adders | "
+            f"golden render {SCENES_TABLE_SIZE}² (s) | command |", "|---" * 8 + "|"]
+    for name in [n for n in BUILTIN if not load_scene_config(n).texture]:
+        scene = load_scene_config(name)
+        netlist = count_unit("pipeline", scene, Path(work_dir) / name)
+        counts, ram = netlist.summary(), sum(r["bits"] for r in netlist.rams)
+        t0 = time.perf_counter()
+        golden_render(scene, SCENES_TABLE_SIZE)
+        seconds = time.perf_counter() - t0
+        rows.append(f"| {name} | {_built_units(scene)} | {counts['multipliers']} | "
+                    f"{counts['table_bits']} | {ram} | {counts['adders']} | {seconds:.2f} | "
+                    f"`bumprtl emit pipeline --scene {name}` |")
+    return "\n".join(rows)
+
+
+if __name__ == "__main__":            # python -m bumprtl.gen.render_rtl > build/scenes.md
+    print(scenes_table())
