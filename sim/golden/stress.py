@@ -198,3 +198,30 @@ def float_stats(result, ref):
     return {"nan": int(nan.sum()), "overflow": int(bad.sum()),
             "diffuse_max_lsb": int(dl.max()) if dl.size else None,
             "color_max_lsb": int(cl.max()) if cl.size else None}
+
+
+def stress_codes(n, cfg: Config, seed=0):
+    """``n`` pixels cycling through every case of :data:`CASES`, quantized for ``cfg``."""
+    from .fixed_common import quantize_pixels
+    per = -(-n // len(CASES))
+    parts = [quantize_pixels(stress_case(name, per, seed + i), cfg) for i, name in enumerate(CASES)]
+    order = np.arange(per * len(CASES)).reshape(len(CASES), per).T.ravel()[:n]   # interleave
+    return {k: np.concatenate([p[k] for p in parts])[order] for k in parts[0]}
+
+
+def pipeline_stimulus(scene, n, seed=0):
+    """Stress vectors for BumpPipeline(scene) (varying map, per-pixel shading): ``(inputs,
+    words)``. Pixel i reads texel i mod T^2, and the map holds the N' of the first T^2
+    stress pixels, so every case's N' reaches the datapath through the fetch unit."""
+    from ...rtl.bumpfetch import pack_texels
+    from .fixed_pipeline import map_words
+    t = scene.texture_size
+    codes = stress_codes(max(n, t * t), scene.config, seed)
+    texel = np.arange(n) % (t * t)
+    inputs = {"u": texel % t, "v": texel // t}
+    inputs.update({k: codes[k][:n] for k in ("n.phi", "n.theta", "l.phi", "l.theta")})
+    if scene.specular:
+        inputs.update({k: codes[k][:n] for k in ("h.phi", "h.theta")})
+    inputs["tag"] = np.arange(n) & ((1 << scene.tag_bits) - 1)
+    level0 = pack_texels(scene, codes["b.phi"][:t * t].reshape(t, t), codes["b.theta"][:t * t].reshape(t, t))
+    return {k: np.asarray(v, np.int64) for k, v in inputs.items()}, map_words([level0], scene)
