@@ -99,16 +99,20 @@ def markdown(rows, command, n):
 
 
 def summary(rows):
-    """Per method: crashes, NaN and overflow totals, and the worst error over all cases."""
+    """Per method: NaN and overflow totals, crashes, and the worst diffuse error over the
+    cases of each configuration."""
     out = []
     for method in dict.fromkeys(r[2] for r in rows):
         sel = [r for r in rows if r[2] == method]
-        ok = [r[3] for r in sel if "crash" not in r[3]]
+        ok = [s for _, _, _, s in sel if "crash" not in s]
+        worst = {}
+        for c, _, _, s in sel:
+            if "crash" not in s and s["diffuse_max_lsb"] is not None:
+                worst[c] = max(worst.get(c, 0), s["diffuse_max_lsb"])
         crashes = [f"{c} / {case}" for c, case, _, s in sel if "crash" in s]
-        worst = max((s["diffuse_max_lsb"] for s in ok if s["diffuse_max_lsb"] is not None), default=None)
         out.append(f"- {method}: NaN {sum(s['nan'] for s in ok)}, overflow "
-                   f"{sum(s['overflow'] for s in ok)}, worst diffuse {worst} LSB over "
-                   f"{len(ok)} (configuration, case) runs"
+                   f"{sum(s['overflow'] for s in ok)}; worst diffuse LSB per configuration: "
+                   + ", ".join(f"{c} {w}" for c, w in worst.items())
                    + (f"; **crashes** in {len(crashes)}: {', '.join(crashes)}" if crashes else ""))
     return out
 

@@ -116,7 +116,7 @@ def test_stress_rows_and_markdown():
     text = markdown(rows + [("default", "below_horizon", "boom (float64)", crash)], "bumprtl bench stress --x", 200)
     assert "`bumprtl bench stress --x`" in text
     assert "**crash**: `ZeroDivisionError: model fell over`" in text
-    assert "crashes** in 1: default / below_horizon" in text
+    assert "**crashes** in 1: default / below_horizon" in text
 
 
 def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
