@@ -116,7 +116,9 @@ def markdown(rows, command, size):
              "Yosys coarse netlist of BumpPipeline (gen/resources.py). `same image`: the off "
              "pipeline produced identical colour outputs (palette shading cannot: it quantizes normals). "
              "The palette's golden time covers the index fetch only (the per-frame colour table "
-             "and lookup are in the sweep above).", "",
+             "and lookup are in the sweep above). Where on and off build the same pipeline (nothing "
+             "skipped but the unused extra-light units), the speed-up column shows this run's "
+             "timing noise.", "",
              "| scene | skipped | golden ms on / off | speed-up | mult on / off | adders on / off "
              "| ROM bits on / off | RAM bits on / off | register bits on / off | same image |",
              "|---|---|---|---|---|---|---|---|---|---|"]
