@@ -12,9 +12,14 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 
 from dataclasses import dataclass, fields, asdict
 
-__all__ = ["Config", "ConfigError", "BumpError", "METHODS"]
+__all__ = ["Config", "ConfigError", "BumpError", "METHODS", "BASELINES", "ALL_METHODS",
+           "datapath_module"]
 
-METHODS = ("exact", "lee")
+METHODS = ("exact", "lee")              # the per-pixel methods scenes and pipelines use
+# Lee et al. Table 1's comparison designs, built as real RTL for the cost comparison only
+# (rtl/baselines/<name>.py, golden model sim/golden/fixed_<name>.py).
+BASELINES = ("peercy", "ernst", "kim")
+ALL_METHODS = METHODS + BASELINES
 
 
 class BumpError(ValueError):
@@ -97,8 +102,8 @@ class Config:
         _check_int("frac_bits", self.frac_bits, max(4, k - 1), 24,
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
                    f"half an LSB; B <= 24 keeps every product inside 64 bits")
-        if self.method not in METHODS:
-            raise ConfigError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
+        if self.method not in ALL_METHODS:
+            raise ConfigError(f"method must be one of {', '.join(ALL_METHODS)}, got {self.method!r}")
         _check_int("tag_bits", self.tag_bits, 0, 32)
         _check_int("out_bits", self.out_bits, 8, 8, "DESIGN §4 fixes 8-bit outputs")
         _check_int("spec_exponent", self.spec_exponent, 1, 1024)
@@ -147,3 +152,9 @@ class Config:
 
     def to_dict(self):
         return asdict(self)
+
+
+def datapath_module(method):
+    """Dotted module (relative to ``bumprtl.rtl``) holding ``method``'s Rotation (the
+    setup) and Illumination datapaths."""
+    return method if method in METHODS else f"baselines.{method}"

@@ -10,7 +10,7 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from .config import Config
+from .config import BumpError, Config
 from .fixed import round_shift
 from .layouts import shade_layout
 from .pipe import StallPipe
@@ -99,10 +99,13 @@ class MethodUnit(wiring.Component):
 
     def __init__(self, cfg: Config):
         self.cfg = cfg
-        if cfg.method == "exact":
-            from . import exact as methods
-        else:
-            from . import lee as methods
+        import importlib
+        from .config import datapath_module
+        try:
+            methods = importlib.import_module(f".{datapath_module(cfg.method)}", __package__)
+        except ModuleNotFoundError:
+            raise BumpError(f"method {cfg.method!r}: rtl/{datapath_module(cfg.method).replace('.', '/')}"
+                            f".py is not built in this checkout") from None
         self.datapath = getattr(methods, self._unit)(cfg)
         super().__init__({"i": In(stream.Signature(self.datapath.in_layout)),
                           "o": Out(stream.Signature(self.datapath.out_layout))})

@@ -110,6 +110,9 @@ class SceneConfig:
             self.config
         except BumpError as e:
             raise SceneError(f"scene {self.name!r}: {e}") from None
+        if self.method not in METHODS:
+            raise SceneError(f"method must be one of {', '.join(METHODS)} in a scene (the "
+                             f"baselines are built for the cost comparison only), got {self.method!r}")
         self._check_rotation()
         if self.rotation == "per-polygon" and self.method != "exact":
             raise SceneError(f"bump_map = 'flat' needs method = 'exact' (its rotation of N' once "

@@ -10,8 +10,13 @@ def _methods(cfg):
     if cfg.method == "exact":
         from . import fixed_exact as m
         return m.exact_rotation_fixed, m.exact_illumination_fixed
-    from . import fixed_lee as m
-    return m.lee_rotation_fixed, m.lee_illumination_fixed
+    if cfg.method == "lee":
+        from . import fixed_lee as m
+        return m.lee_rotation_fixed, m.lee_illumination_fixed
+    # Baselines (rtl/baselines/<name>.py): sim/golden/fixed_<name>.py
+    import importlib
+    m = importlib.import_module(f".fixed_{cfg.method}", __package__)
+    return m.rotation_fixed, m.illumination_fixed
 
 
 def rotation_fixed(codes, cfg: Config):
