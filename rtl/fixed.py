@@ -66,7 +66,9 @@ def round_shift(x, n):
     if n < 0:
         raise ValueError(f"shift must be >= 0, got {n}")
     if not _is_hdl(x):
-        x = np.asarray(x, dtype=np.int64)
+        x = np.asarray(x)
+        if x.dtype != object:          # object arrays: Python ints wider than 64 bits
+            x = x.astype(np.int64)
     return (x + (1 << (n - 1))) >> n
 
 

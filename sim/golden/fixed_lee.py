@@ -51,10 +51,11 @@ def rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg: Config):
     theta_x = np.where(s2 < 0, -asin, asin)                            # eq. 7
     theta_x = np.where(below_horizon(a_theta, cfg), (1 << (k + 1)) - theta_x, theta_x)  # erratum 6
     z = (theta_x - n_theta) & (cfg.full_circle - 1)                    # Z, read as [-180, 180)
-    ay2 = np.abs(y2)
-    ratio = (ay2 * _reciprocal(z, cfg)) >> (2 * b + 1 - k)              # |eq. 9's argument|
+    # |y2| x 1/|sin| needs k + 2B + 1 bits (RTL: exact width); past int64, Python ints.
+    ay2 = np.abs(y2).astype(np.int64 if k + 2 * b + 2 <= 63 else object)
+    ratio = ((ay2 * _reciprocal(z, cfg)) >> (2 * b + 1 - k)).astype(np.int64)  # |eq. 9's argument|
     atan = lee_atan_table(cfg)[ratio_index(ratio, cfg)]
-    prop = lee_prop_table(cfg)[prop_address(ay2 * _reciprocal(z + (1 << k), cfg), cfg)]
+    prop = lee_prop_table(cfg)[prop_address(ay2 * _reciprocal(z + (1 << k), cfg), cfg).astype(np.int64)]
     z_negative, abs_z = magnitude(z, cfg)
     phi = phi_quadrant(atan, z_negative, y2 < 0, cfg)                  # eq. 9, erratum 3
     theta = theta_from_prop(abs_z, prop, cfg)                          # eqs 19, 26, errata 4, 5

@@ -158,3 +158,12 @@ def test_emitted_verilog_lint_clean(unit, build_dir):
     v, j = emit_unit(unit, DEFAULT, build_dir)
     assert lint(v) == []
     assert v.read_text().splitlines()[0].find("--method lee") > 0   # the command that made it
+
+
+def test_widest_config_bit_exact_on_stress_cases():
+    """angle_bits 16, frac_bits 24: |y2| x 1/|sin Z| needs k + 2B + 1 = 63 bits, past int64;
+    the golden model must still match the RTL (exact widths) on every stress case,
+    grid extremes included (the IndexError of docs/stability.md's first run)."""
+    from bumprtl.sim.golden.stress import stress_codes
+    cfg = Config(method="lee", angle_bits=16, frac_bits=24, spec_index_bits=16)
+    run_both(cfg, stress_codes(180, cfg, seed=3), "no_stall")
