@@ -166,37 +166,50 @@ def _summary(counts):
     return {**{k: s[k] for k in COST_FIELDS if k in s}, "ram_bits": sum(r["bits"] for r in counts.rams)}
 
 
+def _digest(*texts):
+    """Cache key of generated Verilog: a changed datapath never reuses an old count."""
+    import hashlib
+    h = hashlib.sha256()
+    for t in texts:
+        h.update(t.encode())
+    return h.hexdigest()[:12]
+
+
 def unit_cost(units, cfg, work):
-    """Yosys counts of ``units`` (gen/units.py names) summed, cached per config under work."""
-    from .resources import count_unit
+    """Yosys counts of ``units`` (gen/units.py names) summed, cached per emitted Verilog."""
+    from .resources import count_verilog
+    from .units import emit_unit
+    paths = {u: emit_unit(u, cfg, work / "netlists" / _tag(cfg) / u)[0] for u in units}
 
     def compute():
         total = None
-        for u in units:
-            c = count_unit(u, cfg, work / "netlists" / _tag(cfg) / u)
+        for u, v in paths.items():
+            c = count_verilog(v, u, v.parent)
             total = c if total is None else total + c
         return _summary(total)
 
-    return _cached(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}.json", compute)
+    key = _digest(*(v.read_text() for v in paths.values()))
+    return _cached(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}_{key}.json", compute)
 
 
 def fpga_cost(component_fn, label, cfg, device, work):
-    """Place a component on ``device`` (gen/fpga.py), cached; adds the device's capacity."""
+    """Place a component on ``device`` (gen/fpga.py), cached per emitted Verilog; adds the
+    device's capacity."""
     from amaranth.back import verilog
     from .fpga import place_and_route
+    d = work / "fpga" / device / _tag(cfg)
+    d.mkdir(parents=True, exist_ok=True)
+    v = d / f"{label}.v"
+    v.write_text(verilog.convert(component_fn(cfg), name=label, emit_src=False))
 
     def compute():
-        d = work / "fpga" / device / _tag(cfg)
-        d.mkdir(parents=True, exist_ok=True)
-        v = d / f"{label}.v"
-        v.write_text(verilog.convert(component_fn(cfg), name=label, emit_src=False))
         row = place_and_route(v, label, device, d)
         report = json.loads((d / f"{label}.pnr.json").read_text())["utilization"]
         row["available"] = {k: report.get(n, {}).get("available") for k, n in
                             (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
         return row
 
-    return _cached(work / "fpga" / device / f"{_tag(cfg)}_{label}.json", compute)
+    return _cached(work / "fpga" / device / f"{_tag(cfg)}_{label}_{_digest(v.read_text())}.json", compute)
 
 
 def _pipeline(cfg):
@@ -235,10 +248,23 @@ def perpixel_point(ctx, method, a, b, opts):
              "error": perpixel_error(ctx, cfg), "speed": perpixel_speed(ctx, cfg),
              "cost": {**unit_cost(("rotation", "illumination"), cfg, ctx.work),
                       "map_bits_per_texel": 2 * cfg.angle_bits}}      # N' as (phi, theta)
-    _hardware(point, cfg, _pipeline, "pipeline", ctx, opts)
+    if fpga_selected(ctx.grid, a, b, opts):
+        _hardware(point, cfg, _pipeline, "pipeline", ctx, opts)
     if opts.sim and (a, b) == (Config().angle_bits, Config().frac_bits):
         point["speed"]["sim_pix_s"] = sim_rate(cfg, ctx.work)
     return point
+
+
+FPGA_POINTS = ("diagonal", "all")
+
+
+def fpga_selected(grid, a, b, opts):
+    """Which width points ``--fpga`` places: ``all``, or ``diagonal`` (the i-th angle width
+    with the i-th value width: cost against precision at a quarter of the flow time)."""
+    if getattr(opts, "fpga_points", "all") == "all":
+        return True
+    ia, ib = grid.angle_bits.index(a), grid.frac_bits.index(b)
+    return ia == ib
 
 
 def _hardware(point, cfg, component_fn, label, ctx, opts):
@@ -445,7 +471,7 @@ def command_line(args):
     if set(args.methods) != set(METHOD_CHOICES):
         parts += ["--methods", *args.methods]
     if args.fpga:
-        parts += ["--fpga", "--device", args.device]
+        parts += ["--fpga", "--device", args.device, "--fpga-points", args.fpga_points]
     if args.sim:
         parts.append("--sim")
     return " ".join(parts)
@@ -489,6 +515,9 @@ def add_parser(sub):
     p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
     p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
     p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
+    p.add_argument("--fpga-points", default="diagonal", choices=FPGA_POINTS,
+                   help="with --fpga: place every width point (all) or the i-th angle width with "
+                        "the i-th value width only (diagonal, default); palette sizes always")
     p.add_argument("--sim", action="store_true",
                    help="cocotb/Verilator pixels/s for the points at the default widths")
     p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))

@@ -131,3 +131,29 @@ def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
     assert rows["full"]["status"] == "not available" and "texture" in rows["full"]["reason"]
     off = bench_skip.unskipped(load_scene_config("flat"))
     assert (off.bump_map, off.shading, off.specular) == ("varying", "per-pixel", True)
+
+
+def test_fpga_points_diagonal_and_all():
+    grid = bench_sweep.GRIDS["default"]
+    diag = SimpleNamespace(fpga_points="diagonal")
+    chosen = [(a, b) for a in grid.angle_bits for b in grid.frac_bits
+              if bench_sweep.fpga_selected(grid, a, b, diag)]
+    assert chosen == list(zip(grid.angle_bits, grid.frac_bits))
+    every = SimpleNamespace(fpga_points="all")
+    assert all(bench_sweep.fpga_selected(grid, a, b, every)
+               for a in grid.angle_bits for b in grid.frac_bits)
+
+
+def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
+    """The cost cache is keyed by the emitted Verilog: a different datapath is counted anew."""
+    from bumprtl.gen import resources
+    calls = []
+    real = resources.count_verilog
+    monkeypatch.setattr(resources, "count_verilog", lambda *a, **k: calls.append(a) or real(*a, **k))
+    cfg = Config(angle_bits=6, frac_bits=5)
+    first = bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
+    assert bench_sweep.unit_cost(("sincos",), cfg, tmp_path) == first and len(calls) == 1
+    from bumprtl.gen import units          # same Config, different Verilog text: counted anew
+    monkeypatch.setattr(units, "canonical_command", lambda unit, c: "changed datapath")
+    bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
+    assert len(calls) == 2
