@@ -13,7 +13,8 @@ from .config import Config
 __all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits", "specular_table",
            "phong_coefficients", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",
            "lee_reciprocal_table", "lee_atan_mantissa_bits", "lee_atan_ratio_bits", "lee_atan_depth",
-           "lee_atan_table", "lee_prop_index_bits", "lee_prop_table"]
+           "lee_atan_table", "lee_prop_index_bits", "lee_prop_table", "kim_reciprocal_bits",
+           "kim_reciprocal_table"]
 
 
 def quarter_sine(cfg: Config) -> np.ndarray:
@@ -165,3 +166,20 @@ def lee_prop_table(cfg: Config) -> np.ndarray:
     p = lee_prop_index_bits(cfg)
     y = np.arange((1 << p) + 1, dtype=np.float64) / (1 << p)
     return np.rint((1.0 - np.arccos(y) / (np.pi / 2)) * cfg.one).astype(np.int64)
+
+
+# --- Kim et al. 2001 baseline: the Cartesian -> polar divide (rtl/baselines/kim.py) ---------
+
+def kim_reciprocal_bits(cfg: Config) -> int:
+    """Address bits R of the reciprocal ROM: the mantissa bits of the normalized divisor
+    (relative step 2**-R, so the ratio's relative error is at most 2**-(R+1))."""
+    return min(cfg.k, cfg.frac_bits)
+
+
+def kim_reciprocal_table(cfg: Config) -> np.ndarray:
+    """1/P for a divisor P in [1, 2) (its leading one at bit B): entry i holds
+    round(2**B / (1 + (i + 0.5) / 2**R)), the reciprocal of the middle of the interval the
+    R mantissa bits i select, i = 0 .. 2**R - 1, with B fractional bits (width B + 1)."""
+    r = kim_reciprocal_bits(cfg)
+    i = np.arange(1 << r, dtype=np.float64)
+    return np.rint(cfg.one / (1.0 + (i + 0.5) / (1 << r))).astype(np.int64)

@@ -1,0 +1,327 @@
+"""Kim, Lee and Park 2001 (Lee et al. ref. 9) as real RTL at the same Config widths: the
+polar-coordinate baseline of Lee et al. Table 1, bit-exact with ``sim/golden/fixed_kim.py``
+(which calls the helpers below on int64 arrays where the RTL calls them on Amaranth values).
+
+Kim 2001 is known here only through the Lee paper: its setup does "transformation
+computations in the polar coordinate system" with 31 multipliers, 6 LUTs and 18 adders, and
+its illumination takes the inner products with angles, Lee eqs (3)/(4),
+N'.A = cos th_A cos th_N' + sin th_A sin th_N' cos(ph_A - ph_N'), with 6 multipliers,
+12 LUTs and 5 adders for L and H. What follows the paper and what is guessed:
+
+* **Followed**: L and H are taken from polar to Cartesian, rotated by the reference-frame
+  matrix of N, M = R_y(-th_N) R_z(-ph_N) (sim/golden/common.tangent_rotation; a matrix
+  rebuilt per pixel, as Lee Sec. 4.3 says of ref. 9), and brought back to polar angles
+  (ph_A', th_A'); the illumination is eqs (3)/(4) per vector and the diffuse/specular
+  tables of eq. (2) (the shared back end, rtl/illumination.py, as for every method).
+* **Guessed** (the paper gives no datapath): how the polar angles are recovered without a
+  divider or square root, since Table 1 lists neither for Kim. ph_A' = atan2(y', x') by
+  octant: the smaller of |x'|, |y'| over the larger through a reciprocal ROM on the
+  normalized larger one (a leading-one shift, no divider) and Lee's floating-point-address
+  atan ROM; then rho = sin th_A' = p cos a0 + q sin a0 (the projection on the found
+  azimuth, no square root) and th_A' = asin(rho) when rho <= |z'|, 90 deg - asin(|z'|)
+  otherwise, mirrored to 180 deg - th when z' < 0 (Lee's asin ROM, always read where it
+  is not steep). A plain acos(z') would lose half the bits near the poles (an error of
+  sqrt(2 u) rad), so it is not used.
+
+Poles (th_A' = 0 or 180 deg, where ph_A' is undefined): x' = y' = 0 gives p = q = 0, ratio 0
+and ph_A' = 0 exactly; any tiny (x', y') gives some definite azimuth, and the product
+sin th_A' sin th_N' cos(ph_A' - ph_N') of eq. (3) makes its value irrelevant there.
+
+Setup (``Rotation``, Table 1's "illumination environment setup"), per pixel:
+
+======================  =====================================================================
+element                 hardware here
+======================  =====================================================================
+sin & cos LUT of N      ``n_sincos_rom``: quarter-wave ROM, 4 reads (sin/cos ph_N, th_N)
+matrix M (4 mult)       ct cp, ct sp, st cp, st sp; the other entries are -st, -sp, cp, 0, ct
+per vector A in {L, H}:
+sin & cos LUT           ``{a}_sincos_rom``: 6 reads (sin/cos th_A, ph_A; sin/cos a0)
+polar -> Cartesian      x = sin th cos ph, y = sin th sin ph (2 mult), z = cos th
+M A (8 mult, 5 add)     x' = m00 x + m01 y - st z, y' = cp y - sp x, z' = m20 x + m21 y + ct z
+divide (1 mult)         ``{a}_recip_rom`` (tables.kim_reciprocal_table) x the smaller
+atan (octant)           ``{a}_atan_rom`` (tables.lee_atan_table at lee.ratio_index)
+rho (2 mult, 1 add)     p cos a0 + q sin a0
+asin                    ``{a}_asin_rom`` (tables.lee_asin_table)
+======================  =====================================================================
+
+That is 4 + 2 x 13 = 30 multipliers (Table 1: 31), 1 + 2 x 4 = 9 tables (Table 1: 6; the
+sin & cos ROM with several reads counts once, as in rtl/lee.py) and 2 x 6 = 12 signal
+adders (Table 1: 18). The octant and quadrant logic (|x'|, |y'|, the swaps, 90 - a,
+180 - a, negation), the leading-one normalizer and the clamps of x', y', z' to [-1, 1]
+are comparators, constant adders and multiplexers the paper does not count. M could be
+skipped altogether (R_z(-ph_N) is the angle difference ph_A - ph_N, the trick of Lee and
+of rtl/exact.py); Kim's matrix is kept because Table 1 counts it.
+
+Illumination per vector: ``{a}_sincos_rom`` with 3 reads (sin/cos th_A', cos(ph_A' - ph_N')),
+shared ``b_sincos_rom`` (sin/cos th_N'), 3 multipliers (cos cos, sin sin, x cos), 2 adders
+(ph_A' - ph_N', the sum): Table 1's 6 multipliers; 8 reads in 3 ROMs plus the specular
+table against its 12 LUTs; 4 adders plus the back end's Phong sum against its 5.
+"""
+
+import numpy as np
+from amaranth.hdl import C, Cat, Mux, Value, ValueCastable, unsigned
+from amaranth.lib.memory import Memory
+
+from ..config import Config
+from ..exact import vectors
+from ..fixed import mul_round, round_shift
+from ..illumination import IlluminationDatapath
+from ..layouts import pixel_layout
+from ..lee import ratio_index, rotated_layout
+from ..pipe import StallPipe
+from ..sincos import quarter_wave_rom, sine_read
+from ..tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
+                      lee_asin_table, lee_atan_table)
+
+__all__ = ["Rotation", "Illumination", "rotated_layout", "matrix_entries", "cartesian",
+           "transform", "octant", "normalize", "reciprocal_address", "ratio_of",
+           "phi_from_octant", "rho_of", "theta_select", "asin_address", "theta_from_octant",
+           "dot_terms", "dot_sum"]
+
+
+# --- Arithmetic shared with sim/golden/fixed_kim.py (Amaranth values or int64 arrays) -------
+
+def _hdl(x):
+    return isinstance(x, (Value, ValueCastable))
+
+
+def _select(cond, a, b):
+    return Mux(cond, a, b) if _hdl(cond) else np.where(cond, a, b)
+
+
+def _fit(x, width, signed=True):
+    """The low ``width`` bits of an HDL value whose range is known to fit (a no-op on arrays)."""
+    if not _hdl(x):
+        return x
+    return x[:width].as_signed() if signed else x[:width]
+
+
+def _abs(x):
+    return abs(x) if _hdl(x) else np.abs(x)
+
+
+def _clamp_unit(x, cfg: Config):
+    """clamp(x, -1, 1): a rotated unit vector's coordinate never leaves [-1, 1]."""
+    one = cfg.one
+    return _fit(_select(x > one, one, _select(x < -one, -one, x)), cfg.frac_bits + 2)
+
+
+def matrix_entries(st, ct, sp, cp, cfg: Config):
+    """The four product entries of M = R_y(-th_N) R_z(-ph_N) =
+    [[ct cp, ct sp, -st], [-sp, cp, 0], [st cp, st sp, ct]], each rounded to B bits."""
+    b = cfg.frac_bits
+    return tuple(_fit(mul_round(u, w, b), b + 2) for u, w in ((ct, cp), (ct, sp), (st, cp), (st, sp)))
+
+
+def cartesian(st, ct, sp, cp, cfg: Config):
+    """Polar -> Cartesian: (sin th cos ph, sin th sin ph, cos th), products rounded to B bits."""
+    b = cfg.frac_bits
+    return _fit(mul_round(st, cp, b), b + 2), _fit(mul_round(st, sp, b), b + 2), ct
+
+
+def transform(mat, n, a, cfg: Config):
+    """A' = M A: each coordinate one sum of full products, rounded once and clamped to
+    [-1, 1]. ``mat`` = (m00, m01, m20, m21), ``n`` = (st, ct, sp, cp) of N, ``a`` = (x, y, z)."""
+    (m00, m01, m20, m21), (st, ct, sp, cp), (x, y, z) = mat, n, a
+    b = cfg.frac_bits
+    return (_clamp_unit(round_shift(m00 * x + m01 * y - st * z, b), cfg),
+            _clamp_unit(round_shift(cp * y - sp * x, b), cfg),
+            _clamp_unit(round_shift(m20 * x + m21 * y + ct * z, b), cfg))
+
+
+def octant(x, y):
+    """(swap, p, q): swap = |y| > |x|, p = max(|x|, |y|), q = min(|x|, |y|)."""
+    ax, ay = _abs(x), _abs(y)
+    swap = ay > ax
+    return swap, _select(swap, ay, ax), _select(swap, ax, ay)
+
+
+def normalize(p, q, cfg: Config):
+    """(p << e, q << e) with e the leading zeros of the B + 1 bit p, so p << e has its leading
+    one at bit B (a value in [1, 2)); p = 0 gives (0, 0). A leading-one detector and two
+    shifters: the ratio q / p is unchanged and the reciprocal ROM sees a mantissa."""
+    b = cfg.frac_bits
+    pn, qn = p, q
+    for e in range(1, b + 1):                      # the last (largest) true e wins
+        small = p < (1 << (b + 1 - e))
+        pn, qn = _select(small, p << e, pn), _select(small, q << e, qn)
+    return _fit(pn, b + 1, signed=False), _fit(qn, b + 1, signed=False)
+
+
+def reciprocal_address(pn, cfg: Config):
+    """The R mantissa bits under the leading one of the normalized divisor."""
+    b, r = cfg.frac_bits, kim_reciprocal_bits(cfg)
+    return (pn >> (b - r)) & ((1 << r) - 1)
+
+
+def ratio_of(product, cfg: Config):
+    """q / p in units of 2**-k (lee.ratio_index's input) from qn x 1/pn (2B fractional
+    bits), truncated: the atan ROM holds atan of each interval's middle."""
+    return product >> (2 * cfg.frac_bits - cfg.k)
+
+
+def phi_from_octant(a0, swap, x_negative, y_negative, cfg: Config):
+    """atan2(y', x') from a0 = atan(q / p) in [0, 45] deg: 90 - a0 when |y'| > |x'|,
+    180 - that when x' < 0, negated when y' < 0. atan2(0, 0) = 0."""
+    k = cfg.k
+    first = _select(swap, (1 << k) - a0, a0)
+    half = _select(x_negative, (1 << (k + 1)) - first, first)
+    phi = _select(y_negative, -half, half)
+    return phi[:cfg.angle_bits] if _hdl(phi) else phi & (cfg.full_circle - 1)
+
+
+def rho_of(p, q, ca0, sa0, cfg: Config):
+    """rho = sqrt(x'^2 + y'^2) = p cos a0 + q sin a0 (the projection of (p, q) on the unit
+    vector at a0), rounded to B bits."""
+    b = cfg.frac_bits
+    return _fit(round_shift(p * ca0 + q * sa0, b), b + 3)
+
+
+def theta_select(rho, z, cfg: Config):
+    """(use_rho, z_negative, v): v = min(rho, |z'|) <= 1/sqrt(2) (up to rounding), the
+    argument of the asin read where asin is not steep."""
+    az = _abs(z)
+    use_rho = rho <= az
+    return use_rho, z < 0, _select(use_rho, rho, az)
+
+
+def asin_address(v, cfg: Config):
+    """v (B fractional bits, 0 <= v <= 1) rounded to the asin ROM's a address bits."""
+    a, b = lee_asin_index_bits(cfg), cfg.frac_bits
+    return round_shift(v, b - a) if a <= b else v << (a - b)
+
+
+def theta_from_octant(asin, use_rho, z_negative, cfg: Config):
+    """th_A' = asin(rho) or 90 - asin(|z'|), mirrored to 180 - th when z' < 0."""
+    k = cfg.k
+    th0 = _select(use_rho, asin, (1 << k) - asin)
+    theta = _select(z_negative, (1 << (k + 1)) - th0, th0)
+    return theta[:cfg.angle_bits] if _hdl(theta) else theta & (cfg.full_circle - 1)
+
+
+def dot_terms(st_a, ct_a, st_n, ct_n, cfg: Config):
+    """Eq. (3)'s products: cos th_A cos th_N' (kept at 2B fractional bits) and
+    sin th_A sin th_N' (rounded to B bits before the third multiply)."""
+    return ct_a * ct_n, _fit(mul_round(st_a, st_n, cfg.frac_bits), cfg.frac_bits + 2)
+
+
+def dot_sum(cc, ss, cphi, cfg: Config):
+    """Eq. (3): N'.A = cc + ss cos(ph_A - ph_N'), rounded once to B bits."""
+    return round_shift(cc + ss * cphi, cfg.frac_bits)
+
+
+# --- The datapaths ---------------------------------------------------------------------------
+
+def _read(m, pipe, rom, address):
+    """One synchronous read, enabled by ``adv``: the data is one stage after ``address``."""
+    port = rom.read_port(domain="sync")
+    m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(address)]
+    return port.data
+
+
+def _rom(m, name, table, width):
+    m.submodules[name] = rom = Memory(shape=unsigned(width), depth=len(table), init=table.tolist())
+    return rom
+
+
+class Rotation:
+    """VectorRotation datapath, kim method (the module table): polar -> Cartesian, M, back
+    to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
+    through, polar binary angles, as rtl/lee.py).
+
+    Stages: 1-2 sin/cos; 3 M, x, y; 4 x', y', z'; 5 octant; 6 1/p; 7 q/p; 8 atan; 9 ph';
+    10 sin/cos a0; 11 rho; 12 asin; 13 th'. Latency 13; 1 pixel per clock.
+    """
+
+    latency = 13
+
+    def __init__(self, cfg: Config):
+        self.cfg = cfg
+        self.in_layout, self.out_layout = pixel_layout(cfg), rotated_layout(cfg)
+
+    def build(self, m, i, o):
+        cfg, k = self.cfg, self.cfg.k
+        pipe = StallPipe(m, i, o, self.latency)
+        px = i.payload
+        m.submodules.n_sincos_rom = rom = quarter_wave_rom(cfg)
+        read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg, name)
+        n = (read(px.n.theta, "n_sin_theta"), read(px.n.theta + (1 << k), "n_cos_theta"),
+             read(px.n.phi, "n_sin_phi"), read(px.n.phi + (1 << k), "n_cos_phi"))   # stage 2
+        mat = tuple(pipe.register(e, f"m{nm}") for e, nm in
+                    zip(matrix_entries(*n, cfg), ("00", "01", "20", "21")))         # stage 3
+        n = tuple(pipe.register(e, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp")))
+        for v in vectors(cfg):
+            phi, theta = self._vector(m, pipe, v, px[v], mat, n)
+            m.d.comb += [o.payload[v].phi.eq(phi), o.payload[v].theta.eq(theta)]
+        m.d.comb += [o.payload.b.eq(pipe.delay(px.b, self.latency, "b")),
+                     o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
+
+    def _vector(self, m, pipe, v, a, mat, n):
+        cfg, k = self.cfg, self.cfg.k
+        reg, delay = pipe.register, pipe.delay
+        m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
+        read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg,
+                                             f"{v}_{name}")
+        st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
+        sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # stage 2
+        x, y, z = cartesian(st, ct, sp, cp, cfg)
+        x, y, z = reg(x, f"{v}_x"), reg(y, f"{v}_y"), reg(z, f"{v}_z")             # stage 3
+        xp, yp, zp = (reg(c, f"{v}_{nm}_rot") for c, nm in
+                      zip(transform(mat, n, (x, y, z), cfg), "xyz"))                # stage 4
+        swap, p, q = octant(xp, yp)
+        swap, p, q = reg(swap, f"{v}_swap"), reg(p, f"{v}_p"), reg(q, f"{v}_q")     # stage 5
+        x_neg, y_neg = reg(xp < 0, f"{v}_x_negative"), reg(yp < 0, f"{v}_y_negative")
+        pn, qn = normalize(p, q, cfg)
+        recip = _read(m, pipe, _rom(m, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1),
+                      reciprocal_address(pn, cfg))                                  # stage 6
+        qn = reg(qn, f"{v}_qn")
+        product = reg(qn * recip, f"{v}_ratio_product")                             # stage 7
+        a0 = _read(m, pipe, _rom(m, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
+                   ratio_index(ratio_of(product, cfg), cfg))                        # stage 8
+        phi = reg(phi_from_octant(a0, delay(swap, 3, f"{v}_swap"), delay(x_neg, 3, f"{v}_x_neg"),
+                                  delay(y_neg, 3, f"{v}_y_neg"), cfg), f"{v}_phi")  # stage 9
+        a0 = Cat(a0, C(0, cfg.angle_bits - (k + 1)))        # a binary angle, 0 .. 45 deg
+        sa0, ca0 = read(a0, "sin_a0"), read(a0 + (1 << k), "cos_a0")                # stage 10
+        rho = reg(rho_of(delay(p, 5, f"{v}_p"), delay(q, 5, f"{v}_q"), ca0, sa0, cfg),
+                  f"{v}_rho")                                                       # stage 11
+        use_rho, z_neg, val = theta_select(rho, delay(zp, 7, f"{v}_z_rot"), cfg)
+        asin = _read(m, pipe, _rom(m, f"{v}_asin_rom", lee_asin_table(cfg), k + 1),
+                     asin_address(val, cfg))                                        # stage 12
+        theta = reg(theta_from_octant(asin, reg(use_rho, f"{v}_use_rho"), reg(z_neg, f"{v}_z_negative"),
+                                      cfg), f"{v}_theta")                           # stage 13
+        return delay(phi, 4, f"{v}_phi"), theta
+
+
+class Illumination(IlluminationDatapath):
+    """Illumination datapath, kim method: Lee eqs (3)/(4) per vector,
+    N'.A' = cos th_A' cos th_N' + round(sin th_A' sin th_N') cos(ph_A' - ph_N'), rounded once
+    to B bits (:func:`dot_terms`, :func:`dot_sum`), then the shared back end.
+
+    Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
+    Latency 4 (sin/cos, products, sum) + SHADE_LATENCY; 1 pixel per clock.
+    """
+
+    dot_latency = 4
+
+    def __init__(self, cfg: Config):
+        super().__init__(cfg, rotated_layout(cfg))
+
+    def dots(self, m, pipe, payload):
+        cfg, k = self.cfg, self.cfg.k
+        b = payload.b
+        m.submodules.b_sincos_rom = rom = quarter_wave_rom(cfg)
+        st_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta, cfg, "b_sin_theta")
+        ct_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta + (1 << k), cfg, "b_cos_theta")
+        dots = {}
+        for v in vectors(cfg):
+            a = payload[v]
+            m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
+            read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle,
+                                                 cfg, f"{v}_{name}")
+            st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
+            cphi = read(a.phi - b.phi + (1 << k), "cos_dphi")                      # stage 2
+            cc, ss = dot_terms(st, ct, st_n, ct_n, cfg)
+            cc, ss = pipe.register(cc, f"{v}_cc"), pipe.register(ss, f"{v}_ss")     # stage 3
+            cphi = pipe.register(cphi, f"{v}_cos_dphi_d")
+            dots[v] = pipe.register(dot_sum(cc, ss, cphi, cfg), f"{v}_dot")       # stage 4
+        return dots

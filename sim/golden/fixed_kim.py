@@ -1,0 +1,102 @@
+"""Bit-exact int64 model of the ``kim`` baseline datapath (rtl/baselines/kim.py), vectorized.
+
+Kim et al. 2001 as the Lee paper summarizes it (Table 1; eqs (3)/(4)); the datapath choices
+the paper leaves open are documented in rtl/baselines/kim.py. Every step below is one of that
+module's helpers, applied here to int64 arrays and there to Amaranth values. Angles are
+binary-angle codes (full circle 2**(k+2)); values carry B = frac_bits fractional bits.
+
+Setup, per vector A in {L, H} (``rotate_fixed``):
+  (x, y, z) = (sin th cos ph, sin th sin ph, cos th)            polar -> Cartesian
+  (x', y', z') = M (x, y, z),  M = R_y(-th_N) R_z(-ph_N)        clamped to [-1, 1]
+  ph_A' = atan2(y', x') by octant: a0 = atan(min / max) through 1/max (reciprocal ROM)
+  rho = max cos a0 + min sin a0 = sin th_A'
+  th_A' = asin(rho) if rho <= |z'| else 90 - asin(|z'|); 180 - th_A' if z' < 0
+Illumination: N'.A' = cos th_A' cos th_N' + sin th_A' sin th_N' cos(ph_A' - ph_N')  eqs (3)/(4).
+"""
+
+import numpy as np
+
+from ...rtl.baselines.kim import (asin_address, cartesian, dot_sum, dot_terms, matrix_entries,
+                                  normalize, octant, phi_from_octant, ratio_of,
+                                  reciprocal_address, rho_of, theta_from_octant, theta_select,
+                                  transform)
+from ...rtl.config import Config
+from ...rtl.lee import ratio_index
+from ...rtl.tables import (cos_lookup, kim_reciprocal_table, lee_asin_table, lee_atan_table,
+                           sin_lookup)
+from .fixed_common import shade_fixed
+from .fixed_exact import vectors
+
+__all__ = ["rotate_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
+           "kim_fixed", "predicted_error_bound_lsb"]
+
+
+def _sincos(angle, cfg: Config):
+    """(sin, cos) of binary angles as int64, bit-exact with the quarter-wave ROM reads."""
+    angle = np.asarray(angle, dtype=np.int64)
+    return sin_lookup(cfg, angle).astype(np.int64), cos_lookup(cfg, angle).astype(np.int64)
+
+
+def _frame(n_phi, n_theta, cfg: Config):
+    """((m00, m01, m20, m21), (st, ct, sp, cp)) of N: the matrix M's product entries."""
+    st, ct = _sincos(n_theta, cfg)
+    sp, cp = _sincos(n_phi, cfg)
+    return matrix_entries(st, ct, sp, cp, cfg), (st, ct, sp, cp)
+
+
+def rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg: Config):
+    """(ph_A', th_A') codes of one vector A in the reference frame of N."""
+    mat, n = _frame(n_phi, n_theta, cfg)
+    st, ct = _sincos(a_theta, cfg)
+    sp, cp = _sincos(a_phi, cfg)
+    xp, yp, zp = transform(mat, n, cartesian(st, ct, sp, cp, cfg), cfg)
+    swap, p, q = octant(xp, yp)
+    pn, qn = normalize(p, q, cfg)
+    recip = kim_reciprocal_table(cfg)[reciprocal_address(pn, cfg)]
+    a0 = lee_atan_table(cfg)[ratio_index(ratio_of(qn * recip, cfg), cfg)]
+    phi = phi_from_octant(a0, swap, xp < 0, yp < 0, cfg)
+    sa0, ca0 = _sincos(a0, cfg)
+    use_rho, z_negative, v = theta_select(rho_of(p, q, ca0, sa0, cfg), zp, cfg)
+    asin = lee_asin_table(cfg)[asin_address(v, cfg)]
+    return phi, theta_from_octant(asin, use_rho, z_negative, cfg)
+
+
+def illuminate_fixed(a_phi, a_theta, b_phi, b_theta, cfg: Config):
+    """N'.A' (signed, B fractional bits) by eq. (3)/(4), rounded as the RTL rounds."""
+    st_a, ct_a = _sincos(a_theta, cfg)
+    st_n, ct_n = _sincos(b_theta, cfg)
+    _, cphi = _sincos(np.asarray(a_phi, dtype=np.int64) - np.asarray(b_phi, dtype=np.int64), cfg)
+    cc, ss = dot_terms(st_a, ct_a, st_n, ct_n, cfg)
+    return dot_sum(cc, ss, cphi, cfg)
+
+
+def rotation_fixed(codes, cfg: Config):
+    """VectorRotation (kim): the output payload fields L', H' and the passed-through N'."""
+    out = {}
+    for v in vectors(cfg):
+        out[f"{v}.phi"], out[f"{v}.theta"] = rotate_fixed(
+            codes[f"{v}.phi"], codes[f"{v}.theta"], codes["n.phi"], codes["n.theta"], cfg)
+    out["b.phi"] = np.asarray(codes["b.phi"], dtype=np.int64)
+    out["b.theta"] = np.asarray(codes["b.theta"], dtype=np.int64)
+    return out
+
+
+def illumination_fixed(rot, cfg: Config):
+    """Illumination (kim): ndotl, ndoth and the 8-bit diffuse, specular and color."""
+    dots = {v: illuminate_fixed(rot[f"{v}.phi"], rot[f"{v}.theta"], rot["b.phi"], rot["b.theta"], cfg)
+            for v in vectors(cfg)}
+    ndotl = dots["l"]
+    ndoth = dots.get("h", np.zeros_like(ndotl))
+    return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
+
+
+def kim_fixed(codes, cfg: Config):
+    """The whole kim datapath from input angle codes: L', H' codes, ndotl, ndoth, diffuse,
+    specular, color."""
+    rot = rotation_fixed(codes, cfg)
+    return {**rot, **illumination_fixed(rot, cfg)}
+
+
+def predicted_error_bound_lsb(cfg: Config):
+    """Placeholder, replaced below once the error terms are derived."""
+    raise NotImplementedError
