@@ -98,5 +98,45 @@ def kim_fixed(codes, cfg: Config):
 
 
 def predicted_error_bound_lsb(cfg: Config):
-    """Placeholder, replaced below once the error terms are derived."""
-    raise NotImplementedError
+    """Worst-case |diffuse8 - round(255 * clamp(N'.L))| of the kim datapath, in 8-bit LSB,
+    against float64 on unquantized inputs.
+
+    With delta = pi / 2**(k+2) rad (half an angle step), u = 2**-B, a = lee_asin_index_bits,
+    R = kim_reciprocal_bits and M = lee_atan_mantissa_bits; first order, a few u**2 ignored:
+
+    * input rounding: the same N'.A' on quantized angles moves by at most
+      2 sqrt(5) delta + 14 delta**2 (fixed_exact.predicted_error_bound_lsb's argument: it is a
+      property of the inputs, not of the method);
+    * A' = M A: the ROM values are off by u/2; the four product entries of M and x, y by
+      u/2 + u/2 + u/2 = 1.5 u, so |dM|_F <= sqrt(4 (1.5u)**2 + 4 (u/2)**2) = sqrt(10) u and
+      |dA| <= sqrt(2 (1.5u)**2 + (u/2)**2) = sqrt(4.75) u; with the final rounding of the
+      three coordinates (sqrt(3)/2 u) |dA'| <= e = (sqrt(10) + sqrt(4.75) + sqrt(3)/2) u
+      (the clamp to [-1, 1] only moves A' toward the true vector);
+    * ph_A': the azimuth of the perturbed (x', y') is within a chord of 2 e / sin th_A of the
+      true one (distance of rho e^(i ph') from rho e^(i ph) <= 2 |d(x', y')|); the octant
+      angle a0 is off by e_atan = (2**-(R+1) + u) / 2 (the reciprocal ROM's middle-of-interval
+      divisor and rounding, a relative error of q/p, times d atan(t)/dt * t <= 1/2) plus
+      2**-(M+2) (lee atan ROM address) plus delta (the ROM's rounded codes);
+    * th_A': asin is read at v = min(rho, |z'|) <= 1/sqrt(2) (+ e), where its slope is below
+      1.5; v is off by e (z') or e + (sqrt(2)/2 + 1/2) u + e_atan**2 / 2 (rho = p cos a0 +
+      q sin a0: two ROM values, one rounding, the second-order loss of a wrong a0), the ROM
+      address by 2**-(a+1), and the ROM's code by delta:
+      d_th = 1.5 (e + 1.21 u + e_atan**2 / 2 + 2**-(a+1)) + delta;
+    * so the output direction (th_A', ph_A') is within d_th + 2 e + e_atan of the true A'
+      (move th first, then ph along the true parallel of radius sin th_A), and so is
+      N'.A' computed exactly from it;
+    * eqs (3)/(4): four ROM values (|cos| + |sin| <= sqrt(2) per angle) and cos(dph) off by
+      u/2, the rounding of sin sin and of the sum: (sqrt(2) + 1.5) u;
+    * the 8-bit rounding turns an error E before it into at most floor(255 E) + 1 after it.
+    Measured maxima stay under the bound (tests/sim/golden/test_fixed_kim.py).
+    """
+    from ...rtl.tables import kim_reciprocal_bits, lee_asin_index_bits, lee_atan_mantissa_bits
+    delta = np.pi / (1 << (cfg.k + 2))
+    u = 2.0 ** -cfg.frac_bits
+    e = (np.sqrt(10) + np.sqrt(4.75) + np.sqrt(3) / 2) * u
+    e_atan = ((2.0 ** -(kim_reciprocal_bits(cfg) + 1) + u) / 2
+              + 2.0 ** -(lee_atan_mantissa_bits(cfg) + 2) + delta)
+    d_th = 1.5 * (e + 1.21 * u + e_atan ** 2 / 2 + 2.0 ** -(lee_asin_index_bits(cfg) + 1)) + delta
+    before = (2 * np.sqrt(5) * delta + 14 * delta ** 2 + d_th + 2 * e + e_atan
+              + (np.sqrt(2) + 1.5) * u)
+    return int(np.floor(255.0 * before)) + 1
