@@ -2,8 +2,11 @@
 
 The bump vector map (Lee Sec. 2: per texel the tangent-space N' as polar angles) or the
 index map of the palette method (Tarini Sec. 4) sits in one block RAM, mip levels one after
-the other. :func:`texel_address` is the addressing arithmetic; it runs on Amaranth values
-here and on int64 arrays in ``sim/golden/fixed_pipeline.py``, so both address alike.
+the other. With a colour texture (``texture = true``) a second block RAM of the same
+geometry holds the RGB texels (8 bits per channel, r low) and is read at the same address
+in the same cycle (``texel`` field). A flat bump map with a texture keeps only that memory.
+:func:`texel_address` is the addressing arithmetic; it runs on Amaranth values here and on
+int64 arrays in ``sim/golden/fixed_pipeline.py``, so both address alike.
 """
 
 import numpy as np
@@ -19,7 +22,10 @@ from .pipe import StallPipe
 from .scene import SceneConfig
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
-           "level_bits", "texel_shape", "fetched_field", "pack_texels"]
+           "level_bits", "texel_shape", "fetched_field", "fetched_fields", "has_map",
+           "pack_texels", "pack_rgb", "TEXEL_BITS"]
+
+TEXEL_BITS = 24               # one colour texel: r, g, b 8 bits each (Config.color_bits)
 
 
 def coord_bits(scene: SceneConfig):
@@ -45,6 +51,22 @@ def memory_depth(scene: SceneConfig):
 def fetched_field(scene: SceneConfig):
     """The output field the fetch fills: ``b`` (N' angles) or ``index`` (palette)."""
     return "index" if scene.shading == "palette" else "b"
+
+
+def has_map(scene: SceneConfig):
+    """The scene stores a per-texel map (N' angles or palette indices) in block RAM."""
+    return scene.shading == "palette" or scene.bump_map == "varying"
+
+
+def fetched_fields(scene: SceneConfig):
+    """Every field the fetch fills: the map's (:func:`fetched_field`) and ``texel``."""
+    return ([fetched_field(scene)] if has_map(scene) else []) + (["texel"] if scene.texture else [])
+
+
+def pack_rgb(rgb):
+    """``(..., 3)`` 8-bit RGB -> one texture word per texel, r in the low bits."""
+    v = np.asarray(rgb, np.int64)
+    return v[..., 0] | (v[..., 1] << 8) | (v[..., 2] << 16)
 
 
 def texel_shape(scene: SceneConfig):
@@ -100,6 +122,9 @@ class BumpMapFetch(wiring.Component):
     init : sequence of int, optional
         Initial memory words (:func:`pack_texels`, levels one after the other from
         :func:`level_bases`); zeros when omitted.
+    texture : sequence of int, optional
+        Initial colour-texture words (:func:`pack_rgb`, same level layout); only with
+        ``scene.texture``.
 
     Members
     -------
@@ -107,52 +132,77 @@ class BumpMapFetch(wiring.Component):
         Texel coordinates of level 0; ``level`` (only with ``mip_levels > 1``) values past
         the last level read the last level.
     o : Out(stream.Signature(out_layout))
+        ``texel`` (rgb, with a texture) is filled like the map's field.
     w_en, w_addr, w_data : In
         Host write port (a scene's map loaded at run time). A read in the cycle of a write to
-        the same word returns the old word.
+        the same word returns the old word. Absent with a flat bump map.
+    tex_w_en, tex_w_addr, tex_w_data : In
+        The colour texture's host write port (``texture = true``).
 
     Latency 2 (address register, block-RAM read); 1 texel per clock when not stalled.
     """
 
     latency = 2
 
-    def __init__(self, scene: SceneConfig, out_layout=None, init=None):
+    def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None):
+        from .texture import rgb_layout
         self.scene, self.cfg = scene, scene.config
-        field = fetched_field(scene)
+        self.fetched = fetched_fields(scene)
+        if not self.fetched:
+            self._MustUse__silence = True
+            raise ValueError("a flat bump map without a texture has nothing to fetch")
         if out_layout is None:
-            out_layout = data.StructLayout({field: texel_shape(scene),
+            shapes = {fetched_field(scene): texel_shape(scene), "texel": rgb_layout(self.cfg)}
+            out_layout = data.StructLayout({**{f: shapes[f] for f in self.fetched},
                                             "tag": unsigned(self.cfg.tag_bits)})
         self.out_layout = out_layout
         fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
         if scene.mip_levels > 1:
             fields["level"] = unsigned(level_bits(scene))
-        fields.update({name: f.shape for name, f in out_layout if name != field})
+        fields.update({name: f.shape for name, f in out_layout if name not in self.fetched})
         self.depth = memory_depth(scene)
-        self.word_bits = Shape.cast(texel_shape(scene)).width
+        self.word_bits = Shape.cast(texel_shape(scene)).width if has_map(scene) else 0
         self.init = [int(w) for w in init] if init is not None else []
-        if len(self.init) not in (0, self.depth):
+        self.texture = [int(w) for w in texture] if texture is not None else []
+        for what, words in (("init", self.init), ("texture", self.texture)):
+            if len(words) not in (0, self.depth):
+                self._MustUse__silence = True
+                raise ValueError(f"{what} has {len(words)} words, the map needs {self.depth}")
+        if self.texture and not scene.texture:
             self._MustUse__silence = True
-            raise ValueError(f"init has {len(self.init)} words, the map needs {self.depth}")
-        super().__init__({
-            "i": In(stream.Signature(data.StructLayout(fields))),
-            "o": Out(stream.Signature(out_layout)),
-            "w_en": In(1),
-            "w_addr": In(range(self.depth)),
-            "w_data": In(self.word_bits),
-        })
+            raise ValueError("texture words given but the scene has texture = false")
+        ports = {"i": In(stream.Signature(data.StructLayout(fields))),
+                 "o": Out(stream.Signature(out_layout))}
+        if has_map(scene):
+            ports.update({"w_en": In(1), "w_addr": In(range(self.depth)),
+                          "w_data": In(self.word_bits)})
+        if scene.texture:
+            ports.update({"tex_w_en": In(1), "tex_w_addr": In(range(self.depth)),
+                          "tex_w_data": In(TEXEL_BITS)})
+        super().__init__(ports)
 
     @property
     def memory_bits(self):
-        return self.depth * self.word_bits
+        return self.depth * (self.word_bits + (TEXEL_BITS if self.scene.texture else 0))
 
     def elaborate(self, platform):
-        scene, field = self.scene, fetched_field(self.scene)
+        scene = self.scene
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency)
-        m.submodules.map = mem = Memory(shape=unsigned(self.word_bits), depth=self.depth,
-                                        init=self.init)
-        wp = mem.write_port()
-        m.d.comb += [wp.en.eq(self.w_en), wp.addr.eq(self.w_addr), wp.data.eq(self.w_data)]
+        mems = {}                                   # output field -> (memory, host port prefix)
+        if has_map(scene):
+            m.submodules.map = mem = Memory(shape=unsigned(self.word_bits), depth=self.depth,
+                                            init=self.init)
+            mems[fetched_field(scene)] = mem, ""
+        if scene.texture:
+            m.submodules.texture = mem = Memory(shape=unsigned(TEXEL_BITS), depth=self.depth,
+                                                init=self.texture)
+            mems["texel"] = mem, "tex_"
+        for mem, prefix in mems.values():
+            wp = mem.write_port()
+            m.d.comb += [wp.en.eq(getattr(self, f"{prefix}w_en")),
+                         wp.addr.eq(getattr(self, f"{prefix}w_addr")),
+                         wp.data.eq(getattr(self, f"{prefix}w_data"))]
 
         px = self.i.payload
         addr = Signal(range(self.depth), name="texel_addr")
@@ -165,11 +215,12 @@ class BumpMapFetch(wiring.Component):
                         m.d.comb += addr.eq(texel_address(px.u, px.v, level, scene))
                 with m.Default():                         # last level, and past it
                     m.d.comb += addr.eq(texel_address(px.u, px.v, scene.mip_levels - 1, scene))
-        rp = mem.read_port(domain="sync")
-        m.d.comb += [rp.en.eq(pipe.adv),
-                     rp.addr.eq(pipe.register(addr, "texel_addr_d1"))]     # stage 1
-        m.d.comb += self.o.payload[field].eq(rp.data)                       # stage 2
+        addr_d1 = pipe.register(addr, "texel_addr_d1")                        # stage 1
+        for field, (mem, _) in mems.items():        # the same address, the same cycle
+            rp = mem.read_port(domain="sync")
+            m.d.comb += [rp.en.eq(pipe.adv), rp.addr.eq(addr_d1)]
+            m.d.comb += self.o.payload[field].eq(rp.data)                   # stage 2
         for name, _ in self.out_layout:
-            if name != field:
+            if name not in self.fetched:
                 m.d.comb += self.o.payload[name].eq(pipe.delay(px[name], self.latency, name))
         return m

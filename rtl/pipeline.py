@@ -9,17 +9,22 @@ texel coordinates + world N, L, H in; shaded pixels out. Only what the scene nee
 * palette shading: BumpMapFetch (indices) -> PaletteLUT, no rotation at all;
 * m lights share the one rotated normal n'' (exact method): light 0 rides in VectorRotation,
   lights 1..m-1 in one :class:`VectorTerms`, one Illumination per light, :class:`LightSum`;
-* no H path and no specular table without specular (the units read ``cfg.specular``).
+* no H path and no specular table without specular (the units read ``cfg.specular``);
+* colour texture (``texture = true``): the RGB texel is read from a second block RAM at the
+  same (u, v[, level]) as the bump map, carried beside the rotation and illumination layers
+  (:class:`TexelDelay`) and blended with the shade by :class:`TextureBlend` (rtl/texture.py;
+  the shape of Tarini et al.'s eq. 2), which also sums the lights; palette shading blends it
+  in PaletteLUT's eq. 2 as the base colour. Without a texture none of this is built.
 
 Units that run side by side in one layer have equal latency and share the downstream ready,
 so their ``adv`` signals are identical and they stay in lock step.
 """
 
-from amaranth.hdl import Module, Mux, Signal, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from .bumpfetch import BumpMapFetch
+from .bumpfetch import BumpMapFetch, has_map
 from .exact import Rotation as ExactRotation, _SineBank, rotated_layout
 from .fixed import round_shift
 from .illumination import Illumination
@@ -29,6 +34,7 @@ from .pipe import StallPipe
 from .rotation import VectorRotation
 from .scene import SceneConfig, light_fields, load_scene_config
 from .tables import phong_coefficients
+from .texture import TexelDelay, TextureBlend, rgb_layout
 
 __all__ = ["BumpPipeline", "VectorTerms", "LightSum", "light_fields"]
 
@@ -122,17 +128,23 @@ class BumpPipeline(wiring.Component):
         What to build (rtl/scene.py); a name or TOML path is loaded.
     init : sequence of int, optional
         Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
+    texture : sequence of int, optional
+        Colour-texture words (``bumpfetch.pack_rgb``, same level layout as the map).
 
     Members
     -------
     i : In(stream.Signature(...))
         varying map: {u, v, [level], n, l, [h], [l1, h1, ...], tag}; flat map:
-        {l, [h], ..., tag}; palette: {u, v, [level], tag}. Angles are binary angles.
+        {[u, v, [level] with a texture], l, [h], ..., tag}; palette: {u, v, [level], tag}.
+        Angles are binary angles.
     o : Out(stream.Signature(...))
-        ``shade_layout`` (diffuse, specular, color, tag), or PaletteLUT's {color: rgba, oor,
-        tag} with palette shading.
+        ``shade_layout`` (diffuse, specular, color, tag); with a texture TextureBlend's
+        {diffuse, specular, color: rgb, tag}; or PaletteLUT's {color: rgba, oor, tag} with
+        palette shading.
     map_w_en, map_w_addr, map_w_data : In
         Host write port of the bump map (varying map and palette).
+    tex_w_en, tex_w_addr, tex_w_data : In
+        Host write port of the colour texture (``texture = true``).
     poly_en, poly : In
         Flat map: the polygon registers {n_phi, x4, y2, z4} (n'' rotated once per polygon).
     lut_w_en, lut_w_addr, lut_w_data, lut_swap, lut_bank :
@@ -142,15 +154,11 @@ class BumpPipeline(wiring.Component):
     ``built`` lists the units and why each was built.
     """
 
-    def __init__(self, scene, init=None):
+    def __init__(self, scene, init=None, texture=None):
         self.scene = scene = load_scene_config(scene)
-        if scene.texture:
-            from .scene import SceneError
-            self._MustUse__silence = True        # never elaborated: no unused-elaboratable warning
-            raise SceneError("texture = true: this generator has no colour-texture blend unit "
-                             "yet; set texture = false")
         self.cfg = cfg = scene.config
         self.units, self.built = {}, []
+        self._texture = texture
         ports = {}
         if scene.shading == "palette":
             self._plan_palette(init)
@@ -163,10 +171,14 @@ class BumpPipeline(wiring.Component):
             in_layout = data.StructLayout({f: terms[f].shape for f, _ in terms if f != "n_phi"})
         ports["i"] = In(stream.Signature(in_layout))
         ports["o"] = Out(stream.Signature(self.units[self._last].o.payload.shape()))
-        if "fetch" in self.units:
+        if "fetch" in self.units and has_map(scene):
             f = self.units["fetch"]
             ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
                           "map_w_data": In(f.w_data.shape())})
+        if scene.texture:
+            f = self.units["fetch"]
+            ports.update({"tex_w_en": In(1), "tex_w_addr": In(f.tex_w_addr.shape()),
+                          "tex_w_data": In(f.tex_w_data.shape())})
         if scene.rotation == "per-polygon":
             ports.update({"poly_en": In(1), "poly": In(self._poly_layout())})
         if scene.shading == "palette":
@@ -184,16 +196,25 @@ class BumpPipeline(wiring.Component):
 
     def _fetch(self, out_layout, init, what):
         s = self.scene
-        self._add("fetch", BumpMapFetch(s, out_layout, init),
-                  f"bump_map = 'varying': {what} per texel in block RAM ({s.texture_size}^2 texels, "
+        if s.texture:                          # the RGB texel from the parallel texture RAM
+            fields = {f: out_layout[f].shape for f, _ in out_layout if f not in ("tag", "base")}
+            out_layout = data.StructLayout({**fields, "texel": rgb_layout(self.cfg),
+                                            "tag": out_layout["tag"].shape})
+        maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
+            (["texture = true: the RGB colour texel"] if s.texture else [])
+        self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture),
+                  f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):
         lut = PaletteLUT(self.cfg)
         self._fetch(lut.i.payload.shape(), init, "a palette index")
+        if self.scene.texture:
+            self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
         self._add("palette", lut, "shading = 'palette': one colour-table lookup per pixel, "
                                   "no per-pixel rotation")
         self._first, self._last, self._layers = "fetch", "palette", [["fetch"], ["palette"]]
+        self._rot_layer = self._ill_layer = None
 
     def _plan_shading(self, init):
         s, cfg = self.scene, self.cfg
@@ -213,6 +234,9 @@ class BumpPipeline(wiring.Component):
             term_names = extra
         else:
             term_names = [v for names in lights for v in names]
+            if s.texture:                      # no bump map, but the colour texture is fetched
+                terms = {v: polar_layout(cfg) for v in term_names}
+                self._fetch(data.StructLayout({**terms, "tag": unsigned(cfg.tag_bits)}), init, "")
         if term_names:
             why = ("bump_map = 'flat': n'' written once per polygon, per pixel only the light "
                    "terms" if s.rotation == "per-polygon" else
@@ -224,8 +248,21 @@ class BumpPipeline(wiring.Component):
             self._add(f"illumination{j}" if s.lights > 1 else "illumination", Illumination(cfg),
                       f"light {j}: N'.L' (and N'.H') and the shade of eq. 2 ({spec})")
             ill.append(self.built[-1]["unit"])
+        if s.texture:                          # the texel rides beside both layers
+            for name, layer in (("texel_r", rot_layer), ("texel_i", ill)):
+                latency = self.units[layer[0]].latency
+                self._add(name, TexelDelay(cfg, latency),
+                          f"texture = true: the texel waits {latency} stages beside {layer[0]}")
+                layer.append(name)
         self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
-        if s.lights > 1:
+        self._rot_layer, self._ill_layer = rot_layer, ill
+        if s.texture:
+            self._add("blend", TextureBlend(cfg, s.lights),
+                      "texture = true: out_c = tex_c min(1, ka + kd d) + ks s (Lee eq. 2 with a "
+                      "textured albedo, Tarini eq. 2's shape)" +
+                      (f", summed over the {s.lights} lights" if s.lights > 1 else ""))
+            self._layers.append(["blend"])
+        elif s.lights > 1:
             self._add("lightsum", LightSum(s), f"lights = {s.lights}: eq. 2 summed over the lights")
             self._layers.append(["lightsum"])
         self._first, self._last = self._layers[0][0], self._layers[-1][0]
@@ -241,13 +278,17 @@ class BumpPipeline(wiring.Component):
         if not s.specular and s.shading == "per-pixel":
             out.append({"unit": "H path + specular table", "why": "specular = false"})
         if s.rotation == "per-polygon":
-            out.append({"unit": "fetch + per-pixel N' rotation",
+            out.append({"unit": "bump map RAM + per-pixel N' rotation" if s.texture else
+                        "fetch + per-pixel N' rotation",
                         "why": "bump_map = 'flat': n'' rotated once per polygon"})
         if s.shading == "palette":
             out.append({"unit": "rotation + illumination", "why": "shading = 'palette'"})
         if s.lights == 1 and s.shading == "per-pixel":
             out.append({"unit": "extra light terms + light sum", "why": "lights = 1"})
-        out.append({"unit": "colour-texture blend", "why": "texture = false"})
+        elif s.texture and s.shading == "per-pixel":
+            out.append({"unit": "light sum", "why": "texture = true: the blend sums the lights"})
+        if not s.texture:
+            out.append({"unit": "colour-texture blend", "why": "texture = false"})
         return out
 
     @property
@@ -260,19 +301,28 @@ class BumpPipeline(wiring.Component):
         for name, unit in self.units.items():
             m.submodules[name] = unit
         s, u = self.scene, self.units
-        if "fetch" in u:
-            m.d.comb += [u["fetch"].w_en.eq(self.map_w_en), u["fetch"].w_addr.eq(self.map_w_addr),
-                         u["fetch"].w_data.eq(self.map_w_data)]
+        for prefix in ("map_", "tex_"):
+            if hasattr(self, f"{prefix}w_en"):
+                f, port = u["fetch"], prefix.replace("map_", "")
+                m.d.comb += [getattr(f, f"{port}w_{k}").eq(getattr(self, f"{prefix}w_{k}"))
+                             for k in ("en", "addr", "data")]
         if s.shading == "palette":
-            lut = u["palette"]
-            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
-            wiring.connect(m, u["fetch"].o, lut.i)
+            lut, f = u["palette"], u["fetch"]
+            wiring.connect(m, wiring.flipped(self.i), f.i)
+            if s.texture:                      # Tarini eq. 2: the texel is the base colour
+                m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
+                             lut.i.payload.index.eq(f.o.payload.index),
+                             lut.i.payload.base.eq(Cat(f.o.payload.texel.as_value(),
+                                                       Const(255, 8))),
+                             lut.i.payload.tag.eq(f.o.payload.tag)]
+            else:
+                wiring.connect(m, f.o, lut.i)
             wiring.connect(m, lut.o, wiring.flipped(self.o))
             m.d.comb += [lut.w_en.eq(self.lut_w_en), lut.w_addr.eq(self.lut_w_addr),
                          lut.w_data.eq(self.lut_w_data), lut.swap.eq(self.lut_swap),
                          self.lut_bank.eq(lut.bank)]
             return m
-        if s.lights == 1 and s.rotation == "per-pixel":       # fetch -> rotation -> illumination
+        if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
             wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
             wiring.connect(m, u["fetch"].o, u["rotation"].i)
             wiring.connect(m, u["rotation"].o, u["illumination"].i)
@@ -289,7 +339,7 @@ class BumpPipeline(wiring.Component):
             src = u["fetch"].o
         else:
             src = self.i
-        rot_layer, ill_layer = self._layers[-3 if s.lights > 1 else -2:][:2]
+        rot_layer, ill_layer = self._rot_layer, self._ill_layer
         poly = self._poly_reg(m) if s.rotation == "per-polygon" else None
         _lockstep(m, src, [u[n].i for n in rot_layer])
         if "rotation" in u:
@@ -303,6 +353,8 @@ class BumpPipeline(wiring.Component):
                 else:
                     value = src.payload[f]
                 m.d.comb += terms.i.payload[f].eq(value)
+        if s.texture:
+            m.d.comb += u["texel_r"].i.payload.texel.eq(src.payload.texel)
         lead = u[rot_layer[0]].o
         _lockstep(m, lead, [u[n].i for n in ill_layer])
         for n in rot_layer[1:]:
@@ -314,17 +366,21 @@ class BumpPipeline(wiring.Component):
             for std, name in zip(("l", "h"), names):
                 rot_out = u["rotation"].o.payload if j == 0 and "rotation" in u else terms.o.payload
                 m.d.comb += ill[std].eq(rot_out[name])
+        if s.texture:
+            m.d.comb += u["texel_i"].i.payload.texel.eq(u["texel_r"].o.payload.texel)
         lead = u[ill_layer[0]].o
         for n in ill_layer[1:]:
             m.d.comb += u[n].o.ready.eq(lead.ready)
-        if s.lights == 1:
+        if s.lights == 1 and not s.texture:
             wiring.connect(m, u[ill_layer[0]].o, wiring.flipped(self.o))
             return
-        total = u["lightsum"]
+        total = u["blend"] if s.texture else u["lightsum"]
         _lockstep(m, lead, [total.i])
-        for j, n in enumerate(ill_layer):
+        for j, n in enumerate(ill_layer[:s.lights]):
             m.d.comb += [total.i.payload[f"d{j}"].eq(u[n].o.payload.diffuse),
                          total.i.payload[f"s{j}"].eq(u[n].o.payload.specular)]
+        if s.texture:
+            m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
         wiring.connect(m, total.o, wiring.flipped(self.o))
 

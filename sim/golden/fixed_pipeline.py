@@ -9,20 +9,33 @@ Several lights (DESIGN §6; eq. 2 of Lee et al. summed over lights): each light 
 diffuse_j and specular_j (8 bits, rtl/illumination.shade_stages); the pipeline outputs
   diffuse  = min(255, sum diffuse_j),  specular = min(255, sum specular_j),
   color    = clamp(round((KA + KD sum diffuse_j + KS sum specular_j) / 256), 0, 255).
+
+Colour texture (``texture = true``): the RGB texel at the same (u, v, level) as the bump map
+(``texels``: the texture memory) and :func:`rtl.texture.texture_blend`, the very function the
+RTL's TextureBlend elaborates: per channel
+  color.c  = clamp(tex_c min(1, ka + kd sum d_j) + ks sum s_j)   (rounded as in rtl/texture.py);
+palette shading returns the texel word beside the index (PaletteLUT's eq. 2 base colour).
 """
 
 import numpy as np
 
-from ...rtl.bumpfetch import level_bases, pack_texels, texel_address
+from ...rtl.bumpfetch import has_map, level_bases, pack_texels, texel_address
 from ...rtl.fixed import round_shift
 from ...rtl.scene import SceneConfig, light_fields
 from ...rtl.tables import phong_coefficients
+from ...rtl.texture import RGB, texture_blend
 from .fixed_exact import exact_rotation_fixed
 from .fixed import illumination_fixed, rotation_fixed
 
 __all__ = ["light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
-           "polygon_fixed", "combine_lights_fixed", "random_map", "random_inputs",
-           "as_payload_list"]
+           "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
+           "random_inputs", "as_payload_list", "unpack_rgb"]
+
+
+def unpack_rgb(words):
+    """Texture words (r low) -> {r, g, b} 8-bit arrays."""
+    w = np.asarray(words, np.int64)
+    return {c: (w >> (8 * n)) & 0xFF for n, c in enumerate(RGB)}
 
 
 def fetch_fixed(u, v, level, words, scene: SceneConfig):
@@ -83,20 +96,22 @@ def combine_lights_fixed(shades, scene: SceneConfig):
     return {"diffuse": np.minimum(d, 255), "specular": np.minimum(s, 255), "color": color}
 
 
-def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None):
+def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=None):
     """The outputs of BumpPipeline(scene) for the input payload arrays ``inputs``.
 
     ``words``: the bump map memory (varying map); ``polygon``: the per-polygon n'' terms
-    (flat map, :func:`polygon_fixed`). Palette shading returns the ``index`` of each pixel
-    (the colour is PaletteLUT's: ``sim/golden/palette_lut.py``).
+    (flat map, :func:`polygon_fixed`); ``texels``: the colour-texture memory (texture =
+    true). Palette shading returns the ``index`` of each pixel (and the ``texel`` word with
+    a texture; the colour is PaletteLUT's: ``sim/golden/palette_lut.py``).
     """
     cfg = scene.config
     codes = dict(inputs)
-    if scene.bump_map == "varying":
-        codes.update(unpack_texels(fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"),
-                                               words, scene), scene))
+    fetch = lambda mem: fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"), mem, scene)
+    if has_map(scene):
+        codes.update(unpack_texels(fetch(words), scene))
+    tex = fetch(texels) if scene.texture else None
     if scene.shading == "palette":
-        return {"index": codes["index"]}
+        return {"index": codes["index"], **({"texel": tex} if scene.texture else {})}
     shades = []
     for names in light_fields(scene):
         light = _light_codes(codes, names)
@@ -109,6 +124,10 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None):
             rot = {**exact_rotation_fixed({**light, "n.phi": poly.pop("n_phi"), "n.theta": zero,
                                            "b.phi": zero, "b.theta": zero}, cfg), **poly}
         shades.append(illumination_fixed(rot, cfg))
+    if scene.texture:
+        color, d, s = texture_blend([sh["diffuse"] for sh in shades],
+                                    [sh["specular"] for sh in shades], unpack_rgb(tex), cfg)
+        return {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
     if len(shades) == 1:
         return {k: shades[0][k] for k in ("diffuse", "specular", "color")}
     return combine_lights_fixed(shades, scene)
@@ -124,13 +143,19 @@ def random_map(scene: SceneConfig, rng):
     return pack_texels(scene, phi=rng.integers(0, full, n), theta=rng.integers(0, full // 4 + 1, n))
 
 
+def random_texture(scene: SceneConfig, rng):
+    """A random colour-texture memory image (24-bit RGB words), or None without a texture."""
+    from ...rtl.bumpfetch import memory_depth
+    return rng.integers(0, 1 << 24, memory_depth(scene)) if scene.texture else None
+
+
 def random_inputs(scene: SceneConfig, n, rng):
     """``n`` random input payloads (dict of arrays): texel coordinates over the whole signed
     port range (so wrap/clamp are exercised), levels past the last, random angles."""
     from ...rtl.bumpfetch import coord_bits, level_bits
     from .vectors import random_codes
     out = {}
-    if scene.bump_map == "varying":
+    if has_map(scene) or scene.texture:
         half = 1 << (coord_bits(scene) - 1)
         out["u"], out["v"] = rng.integers(-half, half, n), rng.integers(-half, half, n)
         if scene.mip_levels > 1:

@@ -17,24 +17,26 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed_pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
-                                               random_inputs, random_map)
+                                               random_inputs, random_map, random_texture,
+                                               unpack_rgb)
 from bumprtl.sim.golden.palette_lut import PaletteLUTModel
 
 SWITCHES = {"lights": (1, 2), "specular": (True, False), "bump_map": ("varying", "flat"),
             "shading": ("per-pixel", "palette"), "addressing": ("wrap", "clamp"),
-            "mip_levels": (1, 3)}
+            "mip_levels": (1, 3), "texture": (False, True)}
 
 
 def combinations():
     """Every combination of the switches the generator honours (palette ignores lights and
-    specular; a flat map ignores addressing and mip levels: those collapse)."""
+    specular; a flat map without a texture ignores addressing and mip levels: those
+    collapse; with a texture they address the colour texture)."""
     seen = {}
     for values in itertools.product(*SWITCHES.values()):
         keys = dict(zip(SWITCHES, values))
         scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
         if scene.shading == "palette":
             keys.update(lights=1, specular=True, bump_map="varying")
-        if scene.bump_map == "flat":
+        if scene.bump_map == "flat" and not scene.texture:
             keys.update(addressing="wrap", mip_levels=1)
         seen[tuple(sorted(keys.items()))] = keys
     return list(seen.values())
@@ -81,20 +83,26 @@ def run(scene, n, pattern, seed=0):
     Returns (cycles, latency)."""
     rng = np.random.default_rng(seed)
     words = random_map(scene, rng) if scene.bump_map == "varying" else None
+    texels = random_texture(scene, rng)
     inputs = random_inputs(scene, n, rng)
     polygon = table = None
     if scene.bump_map == "flat":
         polygon = polygon_fixed(*rng.integers(0, 1 << scene.angle_bits, 2),
                                 rng.integers(0, 1 << scene.angle_bits),
                                 rng.integers(0, 1 << (scene.angle_bits - 2)), scene)
-    golden = pipeline_fixed(inputs, scene, words, polygon)
+    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
     if scene.shading == "palette":
         table = [int(x) for x in rng.integers(0, 1 << 32, 1 << index_bits(scene.config))]
         model = PaletteLUTModel(scene.config)
         model.banks[0, :scene.palette_size] = table[:scene.palette_size]
-        looked = [model.lookup(i) for i in golden["index"]]
+        if scene.texture:                 # Tarini eq. 2 with the texel as the base colour
+            bases = [{**{c: int(v) for c, v in unpack_rgb(t).items()}, "a": 255}
+                     for t in golden["texel"]]
+            looked = [model.lookup(i, b, blend=True) for i, b in zip(golden["index"], bases)]
+        else:
+            looked = [model.lookup(i) for i in golden["index"]]
         golden = {k: [d[k] for d in looked] for k in looked[0]}
-    dut = BumpPipeline(scene, init=words)
+    dut = BumpPipeline(scene, init=words, texture=texels)
     payloads = as_payload_list(inputs)
     out, cycles = simulate_stream(_Host(dut, polygon, table), payloads, pattern, seed=seed)
     assert_bit_exact(out, golden, payloads)
@@ -130,6 +138,40 @@ def test_one_pixel_per_clock(keys):
     assert cycles / n <= 1 + (latency + 1) / n
 
 
-def test_texture_blend_not_built_is_an_error():
-    with pytest.raises(Exception, match="texture"):
-        BumpPipeline(load_scene_config({"name": "t", "texture": True}))
+def _plan(keys):
+    """Built and skipped lists of a pipeline that is never elaborated."""
+    dut = BumpPipeline(load_scene_config({"name": "t", "texture_size": 16, **keys}))
+    for unit in (dut, *dut.units.values()):
+        unit._MustUse__silence = True
+    return [b["unit"] for b in dut.built], [k["unit"] for k in dut.skipped], dut
+
+
+def test_texture_builds_the_blend_only_when_asked():
+    built, skipped, dut = _plan({})
+    assert "blend" not in built and "colour-texture blend" in skipped
+    assert not any(p.startswith("tex_") for p in dut.signature.members)
+    built, skipped, dut = _plan({"texture": True, "lights": 2})
+    assert built[-1] == "blend" and "lightsum" not in built and "colour-texture blend" not in skipped
+    assert {"texel_r", "texel_i", "tex_w_en"} <= set(built) | set(dut.signature.members)
+    assert set(dut.o.payload.shape().members["color"].members) == {"r", "g", "b"}
+    built, _, dut = _plan({"texture": True, "bump_map": "flat"})     # the texture RAM only
+    assert built[0] == "fetch" and "map_w_en" not in dut.signature.members
+    assert dut.units["fetch"].memory_bits == 16 * 16 * 24
+
+
+def test_textured_scene_the_texture_reaches_the_output():
+    """A white texture and a black one give different colours through the RTL (the blend
+    is not a pass-through of the grey shade), each equal to the golden model."""
+    from bumprtl.rtl.bumpfetch import memory_depth
+    scene = load_scene_config({"name": "t", "texture_size": 16, "texture": True})
+    rng = np.random.default_rng(4)
+    words, inputs = random_map(scene, rng), random_inputs(scene, 40, rng)
+    payloads = as_payload_list(inputs)
+    colors = {}
+    for name, value in (("white", 0xFFFFFF), ("black", 0)):
+        texels = np.full(memory_depth(scene), value)
+        out, _ = simulate_stream(BumpPipeline(scene, init=words, texture=texels), payloads)
+        golden = pipeline_fixed(inputs, scene, words, None, texels)
+        assert_bit_exact(out, golden, payloads)
+        colors[name] = np.array([o["color.g"] for o in out])
+    assert (colors["black"] <= golden["specular"]).all() and colors["white"].mean() > 80
