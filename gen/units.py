@@ -39,6 +39,10 @@ def _rotation_sidecar(cfg, dut):
     if cfg.method == "exact":
         facts["error_bound_lsb"] = predicted_error_bound_lsb(cfg)
         facts["error_note"] = "diffuse vs float64 on unquantized inputs (proof: predicted_error_bound_lsb)"
+    elif cfg.method == "kim":
+        from ..sim.golden.fixed_kim import predicted_error_bound_lsb as kim_bound
+        facts["error_bound_lsb"] = kim_bound(cfg)
+        facts["error_note"] = "diffuse vs float64 on unquantized inputs (proof: fixed_kim.predicted_error_bound_lsb)"
     else:
         # The rigid-circle and proportion approximations (DESIGN §3 item 7) are geometric:
         # no width bounds the error below the full 8-bit range.

@@ -27,7 +27,7 @@ from ...rtl.tables import (cos_lookup, kim_reciprocal_table, lee_asin_table, lee
 from .fixed_common import shade_fixed
 from .fixed_exact import vectors
 
-__all__ = ["rotate_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
+__all__ = ["rotate_fixed", "to_polar_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
            "kim_fixed", "predicted_error_bound_lsb"]
 
 
@@ -49,7 +49,13 @@ def rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg: Config):
     mat, n = _frame(n_phi, n_theta, cfg)
     st, ct = _sincos(a_theta, cfg)
     sp, cp = _sincos(a_phi, cfg)
-    xp, yp, zp = transform(mat, n, cartesian(st, ct, sp, cp, cfg), cfg)
+    return to_polar_fixed(*transform(mat, n, cartesian(st, ct, sp, cp, cfg), cfg), cfg)
+
+
+def to_polar_fixed(xp, yp, zp, cfg: Config):
+    """(ph, th) codes of a Cartesian vector (x', y', z'), B fractional bits, |.| <= 1: the
+    back-to-polar half of the setup (octant atan, rho, octant asin)."""
+    xp, yp, zp = (np.asarray(c, dtype=np.int64) for c in (xp, yp, zp))
     swap, p, q = octant(xp, yp)
     pn, qn = normalize(p, q, cfg)
     recip = kim_reciprocal_table(cfg)[reciprocal_address(pn, cfg)]
