@@ -22,13 +22,14 @@ from ...rtl.baselines.kim import (asin_address, cartesian, dot_sum, dot_terms, m
                                   transform)
 from ...rtl.config import Config
 from ...rtl.lee import ratio_index
-from ...rtl.tables import (cos_lookup, kim_reciprocal_table, lee_asin_table, lee_atan_table,
-                           sin_lookup)
+from ...rtl.tables import (cos_lookup, kim_reciprocal_bits, kim_reciprocal_table,
+                           lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
+                           lee_atan_table, sin_lookup)
 from .fixed_common import shade_fixed
 from .fixed_exact import vectors
 
 __all__ = ["rotate_fixed", "to_polar_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
-           "kim_fixed", "predicted_error_bound_lsb"]
+           "kim_fixed", "predicted_error_bound_lsb", "direction_error_bound"]
 
 
 def _sincos(angle, cfg: Config):
@@ -136,13 +137,21 @@ def predicted_error_bound_lsb(cfg: Config):
     * the 8-bit rounding turns an error E before it into at most floor(255 E) + 1 after it.
     Measured maxima stay under the bound (tests/sim/golden/test_fixed_kim.py).
     """
-    from ...rtl.tables import kim_reciprocal_bits, lee_asin_index_bits, lee_atan_mantissa_bits
+    delta = np.pi / (1 << (cfg.k + 2))
+    u = 2.0 ** -cfg.frac_bits
+    before = (2 * np.sqrt(5) * delta + 14 * delta ** 2 + direction_error_bound(cfg)
+              + (np.sqrt(2) + 1.5) * u)
+    return int(np.floor(255.0 * before)) + 1
+
+
+def direction_error_bound(cfg: Config):
+    """|A'_out - A'| (Euclidean, unit vectors) of the setup on quantized inputs: the output
+    codes (ph_A', th_A') against the exact M A of the same angles;
+    d_th + 2 e + e_atan of :func:`predicted_error_bound_lsb`."""
     delta = np.pi / (1 << (cfg.k + 2))
     u = 2.0 ** -cfg.frac_bits
     e = (np.sqrt(10) + np.sqrt(4.75) + np.sqrt(3) / 2) * u
     e_atan = ((2.0 ** -(kim_reciprocal_bits(cfg) + 1) + u) / 2
               + 2.0 ** -(lee_atan_mantissa_bits(cfg) + 2) + delta)
     d_th = 1.5 * (e + 1.21 * u + e_atan ** 2 / 2 + 2.0 ** -(lee_asin_index_bits(cfg) + 1)) + delta
-    before = (2 * np.sqrt(5) * delta + 14 * delta ** 2 + d_th + 2 * e + e_atan
-              + (np.sqrt(2) + 1.5) * u)
-    return int(np.floor(255.0 * before)) + 1
+    return d_th + 2 * e + e_atan
