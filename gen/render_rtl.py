@@ -4,7 +4,9 @@ every pixel through it with cocotb (Icarus or Verilator), collect the image.
 The same stimulus gives the fixed-point golden render (sim/golden/fixed_pipeline.py); the
 two must agree byte for byte. Per pixel the stimulus carries the texel coordinates (u, v),
 world N, L and H as binary angles and a tag (the pixel index); the bump map (N' angles of
-every texel, or palette indices) is the fetch unit's block-RAM initial contents.
+every texel, or palette indices) is the fetch unit's block-RAM initial contents, and with
+``texture = true`` the scene's albedo (8-bit RGB per texel, :func:`scene_texels`) is the
+colour texture's; the pipeline then outputs RGB itself.
 """
 
 import time
@@ -16,7 +18,7 @@ import numpy as np
 from ..rtl.config import BumpError
 from ..rtl.scene import SceneConfig, light_fields, load_scene_config
 
-__all__ = ["RtlRender", "scene_stimulus", "golden_render", "render_rtl"]
+__all__ = ["RtlRender", "scene_stimulus", "scene_texels", "golden_render", "render_rtl"]
 
 LIGHT_AZIMUTH_STEP = 120.0        # light j sits 120 degrees further round than light j - 1
 
@@ -50,7 +52,7 @@ def scene_stimulus(scene: SceneConfig, size, **light):
     cfg = scene.config
     base = _sim_scene(scene, size, **light)
     inputs, words, polygon, table = {}, None, None, None
-    if scene.bump_map == "varying":
+    if scene.bump_map == "varying" or scene.shading == "palette" or scene.texture:
         inputs["u"], inputs["v"] = base.u, base.v
         if scene.mip_levels > 1:
             inputs["level"] = np.zeros_like(base.u)
@@ -76,6 +78,22 @@ def scene_stimulus(scene: SceneConfig, size, **light):
     return inputs, words, polygon, table, base
 
 
+def scene_texels(scene: SceneConfig, base):
+    """The colour-texture memory of a textured scene (None without a texture): the sim
+    scene's albedo as 8-bit RGB words, mip levels point-sampled like the bump map."""
+    if not scene.texture:
+        return None
+    if base.albedo is None:
+        from ..sim.scenes import SCENES
+        have = [n for n, v in SCENES.items() if v[0] in ("bricks", "wood")]
+        raise BumpError(f"texture = true needs an image with a colour texture ({', '.join(have)}), "
+                        f"got image {scene.image!r}")
+    from ..rtl.bumpfetch import pack_rgb
+    from ..sim.golden.common import to_8bit
+    from ..sim.golden.fixed_pipeline import map_words
+    return map_words(_levels(pack_rgb(to_8bit(base.albedo)), scene), scene)
+
+
 def _palette_maps(base, scene):
     """Index map words (mip levels by Tarini Sec. 5.2) and the 8-bit RGBA colour table."""
     from ..sim.golden.common import to_8bit
@@ -93,10 +111,11 @@ def _palette_maps(base, scene):
 
 def _image(base, pixels, scene):
     """Output fields (flat arrays) -> 8-bit RGB image: grey shading times the albedo, or the
-    palette colour; black outside the geometry."""
+    pipeline's own RGB (palette colour, or the colour-texture blend); black outside the
+    geometry."""
     from ..sim.scenes.imaging import compose
     size = base.size
-    if scene.shading == "palette":
+    if "color.r" in pixels:
         rgb = np.stack([pixels[f"color.{c}"] for c in "rgb"], -1).reshape(size, size, 3)
         return np.where(base.mask[..., None], rgb, 0).astype(np.uint8)
     return compose(base, np.asarray(pixels["color"]).reshape(size, size) / 255.0)
@@ -105,12 +124,16 @@ def _image(base, pixels, scene):
 def golden_render(scene, size, **light):
     """The fixed-point golden image of ``scene``: 8-bit RGB."""
     from ..sim.golden.fixed_pipeline import pipeline_fixed
-    from ..sim.golden.palette_lut import unpack_rgba
+    from ..sim.golden.palette_lut import blend_eq2, unpack_rgba
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
-    out = pipeline_fixed(inputs, scene, words, polygon)
+    out = pipeline_fixed(inputs, scene, words, polygon, scene_texels(scene, base))
     if scene.shading == "palette":
-        out = {f"color.{c}": v for c, v in unpack_rgba(table[out["index"]], scene.config).items()}
+        entry = unpack_rgba(table[out["index"]], scene.config)
+        if scene.texture:                  # Tarini eq. 2, the texel as the base colour
+            rgb = unpack_rgba(out["texel"] | (255 << 24), scene.config)
+            entry = blend_eq2(entry, rgb, scene.config)
+        out = {f"color.{c}": v for c, v in entry.items()}
     return _image(base, out, scene)
 
 
@@ -123,15 +146,16 @@ def write_stimulus(path, inputs, polygon, table):
 
 
 def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, patterns=("no_stall",),
-                 progress=True):
-    """Emit BumpPipeline(scene) with ``words`` in its map, run ``inputs`` through it under
-    each traffic pattern; returns ({pattern: {field: array}}, {pattern: cycles}, times)."""
+                 progress=True, texels=None):
+    """Emit BumpPipeline(scene) with ``words`` in its map (and ``texels`` in its colour
+    texture), run ``inputs`` through it under each traffic pattern; returns
+    ({pattern: {field: array}}, {pattern: cycles}, times)."""
     from ..rtl.pipeline import BumpPipeline
     from ..sim.tb.runner import run_cocotb
     from .emit import emit
     from .units import build_unit, canonical_command, UNITS
     build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
-    dut = BumpPipeline(scene, init=words)
+    dut = BumpPipeline(scene, init=words, texture=texels)
     sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
     v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), build_dir / "rtl",
                 sidecar, flatten=True)
@@ -152,7 +176,8 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
     outs, cycles, times = run_pipeline(scene, inputs, words, polygon, table, simulator,
-                                       build_dir, progress=progress)
+                                       build_dir, progress=progress,
+                                       texels=scene_texels(scene, base))
     pixels = outs["no_stall"]
     if not np.array_equal(pixels["tag"], inputs["tag"]):
         raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
@@ -196,14 +221,14 @@ def _built_units(scene):
 
 
 def scenes_table(work_dir="build/scenes"):
-    """The table of docs/scenes.md: per built-in scene class (without texture), the units
+    """The table of docs/scenes.md: per built-in scene class, the units
     built, multipliers, ROM and RAM bits and adders of the emitted pipeline (Yosys netlist,
     gen/resources.py) and the golden render time at SCENES_TABLE_SIZE^2."""
     from ..rtl.scene import BUILTIN
     from .resources import count_unit
     rows = ["| scene class | units built | multipliers | ROM bits | RAM bits | adders | "
             f"golden render {SCENES_TABLE_SIZE}² (s) | command |", "|---" * 8 + "|"]
-    for name in [n for n in BUILTIN if not load_scene_config(n).texture]:
+    for name in BUILTIN:
         scene = load_scene_config(name)
         netlist = count_unit("pipeline", scene, Path(work_dir) / name)
         counts, ram = netlist.summary(), sum(r["bits"] for r in netlist.rams)

@@ -43,7 +43,7 @@ async def _reset(dut, meta):
     dut.rst.value = 1
     dut.i__valid.value = 0
     dut.o__ready.value = 0
-    for port in ("poly_en", "lut_w_en", "lut_swap", "map_w_en"):
+    for port in ("poly_en", "lut_w_en", "lut_swap", "map_w_en", "tex_w_en"):
         if port in meta["ports"]:
             getattr(dut, port).value = 0
     for _ in range(3):
