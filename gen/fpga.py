@@ -15,6 +15,7 @@ import subprocess
 from pathlib import Path
 
 from ..rtl.config import BumpError
+from ..rtl.pipe import ECP5
 from .resources import run_yosys
 from .toolchain import require, tool_env
 
@@ -131,7 +132,7 @@ def fpga_report(cfg, args, units):
         work.mkdir(parents=True, exist_ok=True)
         v_path = work / f"{label}.v"
         v_path.write_text(verilog.convert(_component(DESIGNS[design][2], row, cfg), name=label,
-                                          emit_src=False))
+                                          platform=ECP5(), emit_src=False))
         rows.append({**place_and_route(v_path, label, args.device, work), "design": design, "row": row})
         print(f"{label}: {rows[-1]}", flush=True)
     acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}

@@ -13,8 +13,8 @@ from .config import Config
 from .fixed import round_shift
 from .illumination import IlluminationDatapath
 from .layouts import pixel_layout
-from .pipe import StallPipe
-from .sincos import quarter_wave_rom, sine_read
+from .pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
+from .sincos import registered_quarter_wave_rom, sine_read
 
 __all__ = ["Rotation", "Illumination", "rotated_layout"]
 
@@ -39,16 +39,14 @@ class _SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA)."""
 
     def __init__(self, m, pipe, cfg):
-        self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], None
+        self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], []
 
     def _port(self):
-        if self.pending is None:
-            self.pending = rom = quarter_wave_rom(self.cfg)
-            self.m.submodules[f"sine_rom{len(self.roms)}"] = rom
+        if not self.pending:
+            rom = registered_quarter_wave_rom(self.pipe, self.cfg, f"sine_rom{len(self.roms)}")
             self.roms.append(rom)
-            return rom.read_port(domain="sync")
-        port, self.pending = self.pending.read_port(domain="sync"), None
-        return port
+            self.pending = list(rom.ports)
+        return self.pending.pop(0)
 
     def sin(self, angle, name):
         return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True)
@@ -71,7 +69,7 @@ class Rotation:
     clock.
     """
 
-    latency = 5
+    latency = ROM_LATENCY + 3          # read, output register, sign, two adder levels
 
     def __init__(self, cfg: Config):
         self.cfg = cfg
@@ -113,10 +111,11 @@ class Illumination(IlluminationDatapath):
     once, then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency 2 (products, sum) + SHADE_LATENCY; 1 pixel per clock.
+    Latency PRODUCT_LATENCY (operand and product registers) + 1 (sum) + SHADE_LATENCY;
+    1 pixel per clock.
     """
 
-    dot_latency = 2
+    dot_latency = PRODUCT_LATENCY + 1
 
     def __init__(self, cfg: Config):
         super().__init__(cfg, rotated_layout(cfg))
@@ -125,9 +124,9 @@ class Illumination(IlluminationDatapath):
         n, dots = payload.n, {}
         for v in vectors(self.cfg):
             a = payload[v]
-            xp = pipe.register(n.x4 * a.p2, f"{v}_xp")                  # 3 multipliers per vector
-            yy = pipe.register(n.y2 * a.y2, f"{v}_yy")
-            zz = pipe.register(n.z4 * a.z, f"{v}_zz")
+            xp = pipe.multiply(n.x4, a.p2, f"{v}_xp")                  # 3 multipliers per vector
+            yy = pipe.multiply(n.y2, a.y2, f"{v}_yy")
+            zz = pipe.multiply(n.z4, a.z, f"{v}_zz")
             dots[v] = pipe.register(round_shift(xp + 2 * yy + 2 * zz, self.cfg.frac_bits + 3),
                                     f"{v}_dot")
         return dots

@@ -7,20 +7,20 @@ operation for operation by ``sim/golden/fixed_common.shade_fixed``.
 
 from amaranth.hdl import Module, Mux, unsigned
 from amaranth.lib import stream, wiring
-from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from .config import BumpError, Config
 from .fixed import round_shift
 from .layouts import shade_layout
-from .pipe import StallPipe
+from .pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
 from .tables import phong_coefficients, specular_index_bits, specular_table
 
 __all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp, round (diffuse, table index), table read, table output
-# register, Phong products, Phong sum (each multiply and block-RAM output has its own stage).
-SHADE_LATENCY = 6
+# Registers of shade_stages: clamp, round (diffuse, table index), table read and table
+# output register (ROM_LATENCY), Phong products (operand and product registers,
+# PRODUCT_LATENCY), Phong sum.
+SHADE_LATENCY = 3 + ROM_LATENCY + PRODUCT_LATENCY
 
 
 def _clamp01(x, cfg):
@@ -44,22 +44,19 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
         s_bits = specular_index_bits(cfg)
         h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
         index = pipe.register(round_shift(h, b - s_bits), "spec_index")           # stage 2
-        table = specular_table(cfg)
-        m.submodules.specular_table = rom = Memory(shape=unsigned(8), depth=len(table),
-                                                   init=table.tolist())
-        port = rom.read_port(domain="sync")                                       # stage 3
-        m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(index)]
-        specular = pipe.register(port.data, "specular")                           # stage 4
+        rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8), "specular_table", ports=1)
+        m.d.comb += rom.ports[0].addr.eq(index)                                   # stage 2
+        specular = rom.ports[0].data                                              # 2 + ROM
     else:
         specular = 0
-    diffuse = pipe.delay(diffuse, 2, "diffuse_d")                                 # stage 4
+    diffuse = pipe.delay(diffuse, ROM_LATENCY, "diffuse_d")                       # 2 + ROM
     ka, kd, ks = phong_coefficients(cfg)
-    kd_term = pipe.register(diffuse * kd, "kd_diffuse")                           # stage 5
-    ks_term = pipe.register(specular * ks, "ks_specular") if cfg.specular else 0
+    kd_term = pipe.multiply(diffuse, kd, "kd_diffuse")                            # + PRODUCT
+    ks_term = pipe.multiply(specular, ks, "ks_specular") if cfg.specular else 0
     total = round_shift(ka + kd_term + ks_term, 8)
-    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # stage 6
-    diffuse = pipe.delay(diffuse, 2, "diffuse_out")
-    specular = pipe.delay(specular, 2, "specular_out") if cfg.specular else 0
+    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 1
+    diffuse = pipe.delay(diffuse, PRODUCT_LATENCY + 1, "diffuse_out")
+    specular = pipe.delay(specular, PRODUCT_LATENCY + 1, "specular_out") if cfg.specular else 0
     return diffuse, specular, color
 
 

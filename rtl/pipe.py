@@ -6,9 +6,145 @@ The whole pipe advances when the output is empty or being taken,
 from a register and never depends on ``o.ready`` (stream rule 1).
 """
 
-from amaranth.hdl import Signal, Value
+from amaranth.hdl import (ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
+                          Value, signed)
+from amaranth.lib.memory import Memory
 
-__all__ = ["StallPipe"]
+__all__ = ["StallPipe", "RegisteredProduct", "RegisteredROM", "PRODUCT_LATENCY",
+           "ROM_LATENCY", "ECP5"]
+
+# Stages of StallPipe.multiply: operand registers, product register.
+PRODUCT_LATENCY = 2
+# Stages of a RegisteredROM read: the synchronous read, the output register.
+ROM_LATENCY = 2
+
+
+class ECP5:
+    """Elaboration hint passed as ``platform`` by the ECP5 flow (gen/fpga.py): products
+    become MULT18X18D blocks with their own input and output registers, which Yosys
+    ``synth_ecp5`` does not infer from the generic netlist (a DSP block used without its
+    registers costs ~3.9 ns of its own). Every other flow elaborates the generic form."""
+    dsp = "MULT18X18D"
+    dsp_width = 18
+    bram = "DP16KD"
+    bram_words = 1024            # DP16KD as 1024 x 18 with its output register (REGMODE OUTREG)
+    bram_width = 18
+
+
+class RegisteredProduct(Elaboratable):
+    """``p = a * b`` two ``en`` cycles after ``a``/``b`` (operand registers, product
+    register): exactly the registers of an ECP5 MULT18X18D with REG_INPUTA/B and
+    REG_OUTPUT, so on ECP5 (``platform`` :class:`ECP5`) the whole product is one DSP block
+    and the generic form (plain ``*`` between flip-flops) is what every simulator runs."""
+
+    def __init__(self, a_shape, b_shape, name):
+        self.a, self.b = Signal(a_shape, name=f"{name}_a"), Signal(b_shape, name=f"{name}_b")
+        self.en = Signal(name=f"{name}_en")
+        self.p = Signal((self.a * self.b).shape(), name=name)
+
+    def _fits(self, width):
+        """Each operand as a signed 18-bit DSP input (an unsigned one needs a zero bit)."""
+        return all(s.width + (not s.signed) <= width for s in (self.a.shape(), self.b.shape()))
+
+    def elaborate(self, platform):
+        m = Module()
+        if getattr(platform, "dsp", None) == "MULT18X18D" and self._fits(platform.dsp_width):
+            a, b, p = Signal(signed(18)), Signal(signed(18)), Signal(signed(36))
+            m.d.comb += [a.eq(self.a), b.eq(self.b), self.p.eq(p)]       # sign/zero-extend
+            ports = {f"i_A{n}": a[n] for n in range(18)}
+            ports.update({f"i_B{n}": b[n] for n in range(18)})
+            ports.update({f"i_C{n}": Const(0, 1) for n in range(18)})
+            ports.update({f"o_P{n}": p[n] for n in range(36)})
+            regs = {f"p_REG_{r}_{k}": v for r in ("INPUTA", "INPUTB", "OUTPUT")
+                    for k, v in (("CLK", "CLK0"), ("CE", "CE0"), ("RST", "RST0"))}
+            m.submodules.dsp = Instance(
+                "MULT18X18D", **regs, p_GSR="DISABLED", p_RESETMODE="SYNC",
+                i_SIGNEDA=Const(1, 1), i_SIGNEDB=Const(1, 1), i_SOURCEA=Const(0, 1),
+                i_SOURCEB=Const(0, 1), i_CLK0=ClockSignal(), i_CE0=self.en, i_RST0=Const(0, 1),
+                **ports)
+            return m
+        a, b = Signal.like(self.a, name="a_r"), Signal.like(self.b, name="b_r")
+        with m.If(self.en):
+            m.d.sync += [a.eq(self.a), b.eq(self.b), self.p.eq(a * b)]
+        return m
+
+
+class _ReadPort:
+    def __init__(self, addr_bits, shape, name):
+        self.addr = Signal(addr_bits, name=f"{name}_addr")
+        self.data = Signal(shape, name=f"{name}_data")
+
+
+class RegisteredROM(Elaboratable):
+    """A ROM whose ``ports`` read ports give ``data`` ROM_LATENCY ``en`` cycles after
+    ``addr`` (synchronous read, then an output register). On ECP5 (``platform``
+    :class:`ECP5`) that is one DP16KD with both ports and its own output registers
+    (REGMODE OUTREG: the 5.8 ns clock-to-out of an unregistered block RAM leaves the
+    cycle); a table of 2**n + 1 words whose word 0 is 0 keeps its last word in a flip-flop
+    (the address wraps to word 0 and the word is OR'ed in). Elsewhere: an Amaranth Memory
+    and a register."""
+
+    def __init__(self, init, shape, ports, name):
+        self.init, self.shape, self.name = [int(x) for x in init], shape, name
+        addr_bits = max(1, (len(self.init) - 1).bit_length())
+        self.en = Signal(name=f"{name}_en")
+        self.ports = [_ReadPort(addr_bits, shape, f"{name}_p{n}") for n in range(ports)]
+
+    def _fits(self, platform):
+        words, width = len(self.init), Shape.cast(self.shape).width
+        spill = words == platform.bram_words + 1 and self.init[0] == 0
+        return (len(self.ports) <= 2 and width <= platform.bram_width
+                and (words <= platform.bram_words or spill))
+
+    def elaborate(self, platform):
+        m = Module()
+        if getattr(platform, "bram", None) == "DP16KD" and self._fits(platform):
+            self._dp16kd(m, platform)
+            return m
+        m.submodules.mem = mem = Memory(shape=self.shape, depth=len(self.init), init=self.init)
+        for port in self.ports:
+            read = mem.read_port(domain="sync")
+            m.d.comb += [read.en.eq(self.en), read.addr.eq(port.addr)]
+            with m.If(self.en):
+                m.d.sync += port.data.eq(read.data)
+        return m
+
+    def _dp16kd(self, m, platform):
+        words = platform.bram_words
+        slots = [0] * words
+        for n, x in enumerate(self.init[:words]):
+            slots[n] = x & ((1 << 18) - 1)
+        params = {}
+        for row in range(64):                   # INITVAL_xx: 16 words in 20-bit slots
+            value = 0
+            for n in range(16):
+                value |= slots[row * 16 + n] << (20 * n)
+            params[f"p_INITVAL_{row:02X}"] = Const(value, 320)
+        params.update(p_DATA_WIDTH_A=18, p_DATA_WIDTH_B=18, p_REGMODE_A="OUTREG",
+                      p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
+                      p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
+                      p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+        zero = Const(0, 1)
+        for side, port in zip("AB", self.ports + self.ports[:1]):
+            addr, dout = Signal(14, name=f"{port.addr.name}_{side}"), Signal(18)
+            m.d.comb += addr[4:].eq(port.addr[:10])           # 18-bit mode: word address 13:4
+            params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
+                           f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
+            params.update({f"i_CS{side}{n}": zero for n in range(3)})
+            params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
+            params.update({f"i_DI{side}{n}": zero for n in range(18)})
+            params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+            if side == "B" and len(self.ports) == 1:
+                break
+            data = dout
+            if len(self.init) > words:          # the last word: address wrapped to word 0 (= 0)
+                last = Signal(name=f"{port.addr.name}_last")
+                last_d = Signal(name=f"{port.addr.name}_last_d")
+                with m.If(self.en):
+                    m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
+                data = dout | Mux(last_d, self.init[words], 0)
+            m.d.comb += port.data.eq(data)
+        m.submodules.bram = Instance("DP16KD", **params)
 
 
 class StallPipe:
@@ -44,6 +180,21 @@ class StallPipe:
         with self.m.If(self.adv):
             self.m.d.sync += reg.eq(value)
         return reg
+
+    def rom(self, init, shape, name, ports=2):
+        """A :class:`RegisteredROM` with ``ports`` read ports enabled by ``adv``."""
+        unit = RegisteredROM(init, shape, ports, name)
+        self.m.submodules[name] = unit
+        self.m.d.comb += unit.en.eq(self.adv)
+        return unit
+
+    def multiply(self, a, b, name):
+        """``a * b`` PRODUCT_LATENCY ``adv`` stages later (:class:`RegisteredProduct`)."""
+        a, b = Value.cast(a), Value.cast(b)
+        unit = RegisteredProduct(a.shape(), b.shape(), name)
+        self.m.submodules[name] = unit
+        self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.adv)]
+        return unit.p
 
     def delay(self, value, stages, name):
         """``value`` delayed by ``stages`` ``adv``-enabled registers (0 returns it as is)."""

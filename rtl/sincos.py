@@ -6,10 +6,10 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from .config import Config
-from .pipe import StallPipe
+from .pipe import ROM_LATENCY, StallPipe
 from .tables import quarter_sine
 
-__all__ = ["SinCos", "quarter_wave_rom", "sine_read"]
+__all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read"]
 
 
 def quarter_wave_rom(cfg: Config):
@@ -18,10 +18,17 @@ def quarter_wave_rom(cfg: Config):
                   init=quarter_sine(cfg).tolist())
 
 
+def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
+    """The quarter-wave sine ROM as a :class:`pipe.RegisteredROM` (read, output register;
+    one DP16KD with both ports on ECP5)."""
+    return pipe.rom(quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
+
+
 def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
-    appears two ``adv`` stages later (ROM read, then sign), or three with ``registered``
-    (ROM read, a plain register on the block-RAM output, then sign: the block RAM's
+    appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
+    ROM_LATENCY + 1 stages later from a :class:`pipe.RegisteredROM` port with
+    ``registered`` (ROM read, block-RAM output register, then sign: the block RAM's
     clock-to-out then does not share a cycle with the negation). ``cos(a)`` is
     ``sin(a + 2**k)``.
 
@@ -31,12 +38,13 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False):
     k = cfg.k
     a = angle[:cfg.angle_bits]
     quadrant, index = a[k:], a[:k]
-    m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))]
-    negative = pipe.register(quadrant[1], f"{name}_negative")
-    value = port.data
+    m.d.comb += port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))
     if registered:
-        value = pipe.register(value, f"{name}_rom_out")
-        negative = pipe.register(negative, f"{name}_negative_d")
+        negative = pipe.delay(quadrant[1], ROM_LATENCY, f"{name}_negative")
+    else:
+        m.d.comb += port.en.eq(pipe.adv)
+        negative = pipe.register(quadrant[1], f"{name}_negative")
+    value = port.data
     return pipe.register(Mux(negative, -value, value), name)
 
 
@@ -55,8 +63,8 @@ class SinCos(wiring.Component):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency 3 cycles (ROM read, block-RAM output register, sign); throughput 1 angle per
-    clock when not stalled.
+    Latency ROM_LATENCY + 1 = 3 cycles (ROM read, block-RAM output register, sign);
+    throughput 1 angle per clock when not stalled.
     """
 
     def __init__(self, cfg: Config):
@@ -75,17 +83,17 @@ class SinCos(wiring.Component):
 
     @property
     def latency(self):
-        return 3
+        return ROM_LATENCY + 1
 
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency)
-        m.submodules.rom = rom = quarter_wave_rom(cfg)
+        rom = registered_quarter_wave_rom(pipe, cfg, "rom")
         angle = self.i.payload.angle
-        outputs = {name: sine_read(m, pipe, rom.read_port(domain="sync"), angle + offset, cfg,
-                                   f"{name}_value", registered=True)
-                   for name, offset in (("sin", 0), ("cos", 1 << k))}   # cos a = sin(a + 90)
+        outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
+                                   registered=True)
+                   for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)))}
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),
             self.o.payload.cos.eq(outputs["cos"]),
