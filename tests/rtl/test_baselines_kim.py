@@ -1,0 +1,240 @@
+"""The kim baseline datapaths (rtl/baselines/kim.py): bit for bit against
+sim/golden/fixed_kim.py in the Amaranth simulator (random, edge, stress and tiny-width vectors,
+with and without stalls), the reciprocal ROM against float64, emission (lint-clean,
+deterministic, ``bumprtl emit rotation --method kim``) and the Yosys counts implied by the
+structure in the module docstring (Lee Table 1's Kim column)."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from amaranth.hdl import Module, signed, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
+
+from bumprtl.gen.emit import lint
+from bumprtl.gen.resources import count_component, count_verilog
+from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.rtl import tables
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.illumination import Illumination, IlluminationDatapath
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.fixed_kim import predicted_error_bound_lsb
+from bumprtl.sim.golden.stress import stress_codes
+from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+
+DEFAULT = Config(method="kim")
+NARROW = Config(method="kim", angle_bits=8, frac_bits=9)
+
+
+def concat(*codes):
+    return {k: np.concatenate([np.asarray(c[k]) for c in codes]) for k in codes[0]}
+
+
+def run_both(cfg, codes, pattern, seed=0):
+    """Rotation on ``codes``, then illumination on the golden rotation output, both bit-exact;
+    returns (cycles - latency) of each."""
+    inputs = as_payloads(codes, cfg)
+    rot_dut, ill_dut = VectorRotation(cfg), Illumination(cfg)
+    out, rot_cycles = simulate_stream(rot_dut, inputs, pattern, seed=seed)
+    rot = rotation_fixed(codes, cfg)
+    assert_bit_exact(out, rot, inputs)
+    inputs = as_payloads(rot, cfg)
+    out, ill_cycles = simulate_stream(ill_dut, inputs, pattern, seed=seed + 1)
+    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
+    return rot_cycles - rot_dut.latency, ill_cycles - ill_dut.latency
+
+
+# --- bit-exact against the golden model -----------------------------------------------------
+
+@pytest.mark.parametrize("pattern,n", [("no_stall", 800), ("input_gaps", 300), ("backpressure", 300)])
+def test_bit_exact_random_and_edges(pattern, n):
+    """Random valid pixels, and without stalls also the edge cases (poles, azimuth wrap,
+    L = N, grazing, below the horizon); without stalls one pixel per clock (N + latency
+    cycles)."""
+    codes = random_codes(n, DEFAULT, seed=len(pattern))
+    if pattern == "no_stall":
+        codes = concat(edge_codes(DEFAULT), codes)
+    rot, ill = run_both(DEFAULT, codes, pattern)
+    total = len(codes["n.phi"])
+    if pattern == "no_stall":
+        assert rot == ill == total
+    else:
+        assert rot > total and ill > total
+
+
+def test_bit_exact_stress_cases_at_the_widest_widths():
+    """angle_bits 16, frac_bits 24: the widest products (M A: 26 x 26 bits, three summed)
+    and the 25 x 25 bit divide must stay inside int64 in the golden model."""
+    cfg = Config(method="kim", angle_bits=16, frac_bits=24, spec_index_bits=16)
+    run_both(cfg, stress_codes(240, cfg, seed=3), "backpressure")
+
+
+def test_bit_exact_narrow_without_specular():
+    """8-bit angles, B = 9, no H path (its ROMs and multipliers are not built)."""
+    cfg = NARROW.replace(specular=False)
+    run_both(cfg, random_codes(300, cfg, seed=4), "input_gaps")
+
+
+def test_bit_exact_tiny_config():
+    """k = 2 (4-bit angles, B = 4, so the asin address is shifted left): 2048 vectors; L walks
+    all 16^2 (th_N, th_L) for 8 azimuth pairs (ph_N, ph_L), H and N' move too."""
+    cfg = Config(method="kim", angle_bits=4, frac_bits=4, tag_bits=12)
+    idx = np.arange(2048, dtype=np.int64)
+    a, b, c = idx & 15, (idx >> 4) & 15, idx >> 8
+    codes = {"n.phi": (3 * c) & 15, "n.theta": a, "l.theta": b, "l.phi": (5 * c + a) & 15,
+             "h.theta": (a + b) & 15, "h.phi": (7 * b + c) & 15, "b.phi": (a + c) & 15, "b.theta": b}
+    run_both(cfg, codes, "no_stall")
+
+
+# --- tables and structure --------------------------------------------------------------------
+
+@pytest.mark.parametrize("cfg", [DEFAULT, NARROW, Config(method="kim", angle_bits=16, frac_bits=24)])
+def test_reciprocal_table_against_float(cfg):
+    """Every divisor P in [1, 2) whose mantissa selects entry i gets 1/P within a relative
+    2**-(R+1) (the middle of the interval) plus the entry's rounding."""
+    r, one = tables.kim_reciprocal_bits(cfg), cfg.one
+    table = tables.kim_reciprocal_table(cfg)
+    assert len(table) == 1 << r and table.max() < 1 << (cfg.frac_bits + 1)
+    i = np.arange(1 << r)
+    for edge in (0.0, 1.0):                         # both ends of each interval
+        p = 1.0 + (i + edge) / (1 << r)
+        rel = np.abs(table / one * p - 1.0)
+        assert rel.max() <= 2.0 ** -(r + 1) + 0.5 / one * 2 + 1e-12
+
+
+def _roms(unit, cfg):
+    return build_unit(unit, cfg)[1]["roms"]
+
+
+def test_roms_and_latency():
+    """Setup: N's sin & cos ROM, and per vector sin & cos, reciprocal, atan, asin ROMs;
+    illumination: N' and per-vector sin & cos ROMs plus the specular table. Without specular
+    the H path is not built."""
+    per_vector = ("sincos", "recip", "atan", "asin")
+    assert sorted(_roms("rotation", DEFAULT)) == sorted(
+        ["n_sincos_rom"] + [f"{v}_{kind}_rom" for v in "lh" for kind in per_vector])
+    assert sorted(_roms("rotation", DEFAULT.replace(specular=False))) == sorted(
+        ["n_sincos_rom"] + [f"l_{kind}_rom" for kind in per_vector])
+    ill = _roms("illumination", DEFAULT)
+    assert sorted(n for n in ill if not n.startswith("specular")) == sorted(
+        ["b_sincos_rom", "l_sincos_rom", "h_sincos_rom"])
+    assert len(ill) == 4                              # + the back end's specular table
+    assert build_unit("rotation", DEFAULT)[1]["latency"] == 13
+
+
+# --- emission ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("unit", ["rotation", "illumination"])
+def test_emission_lint_clean_and_deterministic(unit, build_dir):
+    v1, j1 = emit_unit(unit, DEFAULT, build_dir / "a")
+    v2, j2 = emit_unit(unit, DEFAULT, build_dir / "b")
+    assert v1.read_bytes() == v2.read_bytes() and j1.read_bytes() == j2.read_bytes()
+    assert "--method kim" in v1.read_text().splitlines()[0]
+    assert lint(v1) == []
+
+
+def test_cli_emit_rotation_method_kim(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+                        "kim", "--out", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "rotation.v").read_text().startswith(
+        "// Generated by: bumprtl emit rotation --method kim --angle-bits 12 --frac-bits 13")
+    meta = json.loads((tmp_path / "rotation.json").read_text())
+    assert meta["method"] == "kim" and meta["latency"] == 13
+    assert meta["error_bound_lsb"] == predicted_error_bound_lsb(DEFAULT)
+    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+                          "kim", "--frac-bits", "40", "--out", str(tmp_path)],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr
+
+
+# --- Yosys counts against the structure (module docstring) -----------------------------------
+
+def _pairs(mults):
+    return sorted(tuple(sorted(int(w) for w in m.split("x"))) for m in mults)
+
+
+def _table(t):
+    return (t["name"], t["depth"], t["width"], t["read_ports"])
+
+
+def _width(table):
+    """Bits that vary from word to word: Yosys drops ROM bits that are constant (0 or 1) in
+    every word (e.g. the leading one of every reciprocal in (1/2, 1])."""
+    t = np.asarray(table, dtype=np.int64)
+    return sum(len(np.unique((t >> n) & 1)) > 1 for n in range(int(t.max()).bit_length()))
+
+
+def test_rotation_counts_match_the_structure(build_dir):
+    """Per pixel 4 products for M; per vector 2 (polar -> Cartesian) + 8 (M A) of Q1.B
+    values, the divide qn x 1/pn (unsigned B+1 bits each), rho = p cos a0 + q sin a0 (p, q
+    unsigned B+2 bits; sin a0 >= 0 for a0 <= 45 deg, so its sign logic folds away);
+    6 signal adders per vector (2 + 1 + 2 in M A, 1 in rho); the tables of the docstring."""
+    cfg = NARROW
+    b, vs = cfg.frac_bits, ("h", "l")
+    v_path, _ = emit_unit("rotation", cfg, build_dir)
+    c = count_verilog(v_path, "rotation", build_dir / "yosys")
+    q = b + 2                                                   # a signed Q1.B value
+    expected = [(q, q)] * (4 + len(vs) * 10)
+    expected += [(b + 1, b + 1), (q + 1, q), (q, b + 1)] * len(vs)
+    assert _pairs(c.multipliers) == _pairs(f"{x}x{y}" for x, y in expected)
+    assert len(c.adders) == 6 * len(vs)
+    assert c.dividers == [] and c.sqrts == 0
+    roms = {"sincos": tables.quarter_sine(cfg), "recip": tables.kim_reciprocal_table(cfg),
+            "atan": tables.lee_atan_table(cfg), "asin": tables.lee_asin_table(cfg)}
+    assert len(roms["recip"]) == 1 << tables.kim_reciprocal_bits(cfg)
+    assert len(roms["atan"]) == tables.lee_atan_depth(cfg)
+    assert len(roms["asin"]) == (1 << tables.lee_asin_index_bits(cfg)) + 1
+    reads = {"sincos": 6, "recip": 1, "atan": 1, "asin": 1}
+    want = [("n_sincos_rom", len(roms["sincos"]), _width(roms["sincos"]), 4)]
+    want += [(f"{v}_{kind}_rom", len(t), _width(t), reads[kind]) for v in vs for kind, t in roms.items()]
+    assert sorted(map(_table, c.tables)) == sorted(want)
+
+
+class _ShadeOnly(IlluminationDatapath):
+    """The shared back end alone: the dot products come in on the stream, one register."""
+    dot_latency = 1
+
+    def __init__(self, cfg):
+        b = cfg.frac_bits
+        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
+                                                 "tag": unsigned(cfg.tag_bits)}))
+
+    def dots(self, m, pipe, payload):
+        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
+
+
+class _Unit(wiring.Component):
+    def __init__(self, datapath):
+        self.datapath = datapath
+        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
+                          "o": Out(stream.Signature(datapath.out_layout))})
+
+    def elaborate(self, platform):
+        m = Module()
+        self.datapath.build(m, self.i, self.o)
+        return m
+
+
+def test_illumination_counts_are_the_back_end_plus_eqs_3_and_4(build_dir):
+    """Eqs (3)/(4) per vector: cos cos, sin sin, (sin sin) cos(dph): 3 products of Q1.B
+    values; 2 adders (ph_A' - ph_N', the sum); one sin & cos ROM with 3 reads, plus N''s with
+    2. Everything else is the shared back end, counted on its own."""
+    cfg = NARROW
+    b = cfg.frac_bits
+    v_path, _ = emit_unit("illumination", cfg, build_dir)
+    c = count_verilog(v_path, "illumination", build_dir / "yosys")
+    shade = count_component(_Unit(_ShadeOnly(cfg)), "shade_only", build_dir / "shade")
+    q = b + 2
+    assert _pairs(c.multipliers) == _pairs(shade.multipliers + [f"{q}x{q}"] * 6)
+    assert len(c.adders) == len(shade.adders) + 4
+    sincos = len(tables.quarter_sine(cfg))
+    want = sorted(map(_table, shade.tables)) + [("b_sincos_rom", sincos, b + 1, 2),
+                                                ("h_sincos_rom", sincos, b + 1, 3),
+                                                ("l_sincos_rom", sincos, b + 1, 3)]
+    assert sorted(map(_table, c.tables)) == sorted(want)
