@@ -146,10 +146,11 @@ def write_stimulus(path, inputs, polygon, table):
 
 
 def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, patterns=("no_stall",),
-                 progress=True, texels=None):
+                 progress=True, texels=None, rtl_dir=None):
     """Emit BumpPipeline(scene) with ``words`` in its map (and ``texels`` in its colour
     texture), run ``inputs`` through it under each traffic pattern; returns
-    ({pattern: {field: array}}, {pattern: cycles}, times)."""
+    ({pattern: {field: array}}, {pattern: cycles}, times). The Verilog goes to ``rtl_dir``
+    (default ``<build_dir>/rtl``)."""
     from ..rtl.pipeline import BumpPipeline
     from ..sim.tb.runner import run_cocotb
     from .emit import emit
@@ -157,8 +158,10 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
     dut = BumpPipeline(scene, init=words, texture=texels)
     sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
-    v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), build_dir / "rtl",
+    rtl_dir = build_dir / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
+    v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), rtl_dir,
                 sidecar, flatten=True)
+    build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, table)
     run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
@@ -170,14 +173,15 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run_cocotb.last_times
 
 
-def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl", progress=True, **light):
+def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl", progress=True,
+               rtl_dir=None, **light):
     """Render ``scene`` (SceneConfig, name or TOML path) through the emitted RTL; returns an
     :class:`RtlRender` with the RTL image and the golden image of the same stimulus."""
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
     outs, cycles, times = run_pipeline(scene, inputs, words, polygon, table, simulator,
                                        build_dir, progress=progress,
-                                       texels=scene_texels(scene, base))
+                                       texels=scene_texels(scene, base), rtl_dir=rtl_dir)
     pixels = outs["no_stall"]
     if not np.array_equal(pixels["tag"], inputs["tag"]):
         raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
