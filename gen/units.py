@@ -43,6 +43,11 @@ def _rotation_sidecar(cfg, dut):
         from ..sim.golden.fixed_kim import predicted_error_bound_lsb as kim_bound
         facts["error_bound_lsb"] = kim_bound(cfg)
         facts["error_note"] = "diffuse vs float64 on unquantized inputs (proof: fixed_kim.predicted_error_bound_lsb)"
+    elif cfg.method in ("peercy", "ernst"):
+        from ..sim.golden.fixed_peercy import predicted_error_bound_lsb as cartesian_bound
+        facts["error_bound_lsb"] = cartesian_bound(cfg)
+        facts["error_note"] = ("diffuse vs float64 on unquantized inputs, Cartesian input codes from "
+                               "fixed_peercy.encode (proof: fixed_peercy.predicted_error_bound_lsb)")
     else:
         # The rigid-circle and proportion approximations (DESIGN §3 item 7) are geometric:
         # no width bounds the error below the full 8-bit range.
@@ -94,10 +99,12 @@ def _fetch_sidecar(scene, dut):
 UNITS = {
     "sincos": Unit("sincos", "quarter-wave sin/cos ROM unit (toolchain slice)",
                    lambda cfg: _sincos()(cfg), _sincos_sidecar),
-    "rotation": Unit("rotation", "VectorRotation (Lee Sec. 3.1; --method exact|lee)",
+    "rotation": Unit("rotation", ("VectorRotation or a baseline's setup (Lee Sec. 3.1, Table 1; "
+                                  "--method exact|lee|peercy|ernst|kim)"),
                      lambda cfg: _rtl("rotation", "VectorRotation")(cfg), _rotation_sidecar,
                      ("method", "angle_bits", "frac_bits", "tag_bits", "specular")),
-    "illumination": Unit("illumination", "Illumination (Lee Sec. 3.2; --method exact|lee)",
+    "illumination": Unit("illumination", ("Illumination (Lee Sec. 3.2, Table 1; "
+                                          "--method exact|lee|peercy|ernst|kim)"),
                          lambda cfg: _rtl("illumination", "Illumination")(cfg), _rotation_sidecar,
                          ("method", "angle_bits", "frac_bits", "tag_bits", "specular",
                           "spec_exponent", "spec_index_bits", "ka", "kd", "ks")),

@@ -9,8 +9,10 @@ Peercy's (rtl/baselines/peercy.py, where our 24/6/2/16 against the paper's 27/9/
 explained). Illumination is Ernst's "straightforward Phong" (Table 1: 7 multipliers, 1 power
 table, 5 adders): N'.L_n and N'.H_n with 6 multipliers and 4 adders, then eq. (2) with the
 cos^n power table; Peercy's datapath already is exactly that, so :class:`Illumination` is
-it too. Our back end (rtl/illumination.py) weights diffuse and specular by kd and ks with
-constant multipliers, where the paper's seventh multiplier is a general one.
+it too. Yosys counts 8 multipliers and 6 adders for it (tests/rtl/test_baselines_cartesian.py):
+the 6 dot-product multipliers plus the shared back end's kd and ks weights (registered
+products, rtl/illumination.py), 4 dot adders plus the back end's Phong sum, against the
+paper's 7 and 5.
 """
 
 from .peercy import Illumination as _PeercyIllumination, Rotation as _PeercyRotation

@@ -51,7 +51,7 @@ from amaranth.lib import data
 from ..config import Config
 from ..fixed import round_shift
 from ..illumination import IlluminationDatapath
-from ..pipe import StallPipe
+from ..pipe import PRODUCT_LATENCY, StallPipe
 
 __all__ = ["Rotation", "Illumination", "PeercySqrt", "vectors", "cartesian_layout",
            "setup_input_layout", "setup_output_layout", "component_width", "square_bits",
@@ -59,10 +59,11 @@ __all__ = ["Rotation", "Illumination", "PeercySqrt", "vectors", "cartesian_layou
 
 AXES = ("x", "y", "z")
 FRAME = ("t", "b", "n")       # tangent, binormal, normal: the rows of the 3x3 transform
-# Registers of the setup: products, transformed sums, squares (and |a|), |A_t|**2, square
-# root, quotient, signed result.
-ROTATION_LATENCY = 7
-DOT_LATENCY = 2               # products, sum (then rtl/illumination.SHADE_LATENCY)
+# Registers of the setup: products (PRODUCT_LATENCY: operand and product registers, one
+# DSP block on ECP5), transformed sums, squares (PRODUCT_LATENCY; |a| rides along),
+# |A_t|**2, square root, quotient, signed result.
+ROTATION_LATENCY = 2 * PRODUCT_LATENCY + 5
+DOT_LATENCY = PRODUCT_LATENCY + 1     # products, sum (then rtl/illumination.SHADE_LATENCY)
 
 
 def vectors(cfg: Config):
@@ -136,7 +137,8 @@ class Rotation:
     """Setup datapath, Peercy (elaborated into ``rotation.VectorRotation``).
 
     Input :func:`setup_input_layout`; output :func:`setup_output_layout` (L_n, H_n in tangent
-    space, N' passed through). Latency :data:`ROTATION_LATENCY` = 7; 1 pixel per clock.
+    space, N' passed through). Latency :data:`ROTATION_LATENCY` (2 PRODUCT_LATENCY + 5 = 9);
+    1 pixel per clock.
     """
 
     latency = ROTATION_LATENCY
@@ -155,23 +157,25 @@ class Rotation:
             a = px[v]
             comps = {}
             for row, axis in zip(FRAME, AXES):             # A_t = (T.A, B.A, N.A)
-                p = [reg(px[row][c] * a[c], f"{v}_{row}{c}") for c in AXES]          # stage 1
+                p = [pipe.multiply(px[row][c], a[c], f"{v}_{row}{c}") for c in AXES]  # + P
                 comps[axis] = reg(round_shift(p[0] + p[1] + p[2], b)[:cw].as_signed(),
-                                  f"{v}t_{axis}")                                    # stage 2
-            sq = [reg((comps[c] * comps[c])[:square_bits(cfg) - 1], f"{v}t_{c}_sq") for c in AXES]
-            mag = {c: reg(Mux(comps[c] < 0, -comps[c], comps[c])[:cw - 1], f"{v}t_{c}_mag")
-                   for c in AXES}                                                    # stage 3
-            neg = {c: pipe.delay(comps[c][-1], 4, f"{v}t_{c}_neg") for c in AXES}
-            s = reg(sq[0] + sq[1] + sq[2], f"{v}t_len2")                             # stage 4
+                                  f"{v}t_{axis}")                                    # + 1
+            sq = [pipe.multiply(comps[c], comps[c], f"{v}t_{c}_sq") for c in AXES]   # + P
+            mag = {c: pipe.delay(Mux(comps[c] < 0, -comps[c], comps[c])[:cw - 1],
+                                 PRODUCT_LATENCY, f"{v}t_{c}_mag") for c in AXES}
+            neg = {c: pipe.delay(comps[c][-1], PRODUCT_LATENCY + 3, f"{v}t_{c}_neg") for c in AXES}
+            # x**2 >= 0 and < 2**(2B+8): the low 2B+8 bits of each signed square are exact
+            sq = [q[:square_bits(cfg) - 1] for q in sq]
+            s = reg(sq[0] + sq[1] + sq[2], f"{v}t_len2")                             # + 1
             m.submodules[f"{v}_sqrt"] = root = PeercySqrt(square_bits(cfg) + 2)
             m.d.comb += root.radicand.eq(s << 2)
-            r = reg(root.root, f"{v}t_len")                                          # stage 5
+            r = reg(root.root, f"{v}t_len")                                          # + 1
             for c in AXES:
-                num = pipe.delay(mag[c], 2, f"{v}t_{c}_mag") << (b + 2)
-                q = reg(num // r, f"{v}n_{c}_q")                                     # stage 6
+                num = pipe.delay(mag[c], 2, f"{v}t_{c}_num") << (b + 2)
+                q = reg(num // r, f"{v}n_{c}_q")                                     # + 1
                 q = round_shift(q, 1)
                 m.d.comb += out[v][c].eq(reg(Mux(neg[c], -q, q)[:cfg.sincos_width],
-                                             f"{v}n_{c}"))                           # stage 7
+                                             f"{v}n_{c}"))                           # + 1
         for c in AXES:
             m.d.comb += out.np[c].eq(pipe.delay(px.np[c], self.latency, f"np_{c}"))
         m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
@@ -183,7 +187,8 @@ class Illumination(IlluminationDatapath):
     table, Phong sum of eq. 2).
 
     Input :func:`setup_output_layout`; output ``shade_layout(cfg)``.
-    Latency 2 (products, sum) + SHADE_LATENCY; 1 pixel per clock.
+    Latency PRODUCT_LATENCY (operand and product registers) + 1 (sum) + SHADE_LATENCY;
+    1 pixel per clock.
     """
 
     dot_latency = DOT_LATENCY
@@ -195,7 +200,7 @@ class Illumination(IlluminationDatapath):
         n, dots = payload.np, {}
         for v in vectors(self.cfg):
             a = payload[v]
-            p = [pipe.register(n[c] * a[c], f"{v}_dot_{c}") for c in AXES]           # stage 1
+            p = [pipe.multiply(n[c], a[c], f"{v}_dot_{c}") for c in AXES]            # + P
             dots[v] = pipe.register(round_shift(p[0] + p[1] + p[2], self.cfg.frac_bits),
-                                    f"{v}_dot")                                      # stage 2
+                                    f"{v}_dot")                                      # + 1
         return dots

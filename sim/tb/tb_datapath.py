@@ -16,6 +16,9 @@ from .stream import PATTERNS, load_sidecar, run_stream, samples
 def _stimulus(unit, cfg, n, seed):
     edges, rand = edge_codes(cfg), random_codes(n, cfg, seed=seed)
     codes = {k: np.concatenate([edges[k], rand[k]]) for k in edges}
+    if cfg.method in ("peercy", "ernst"):      # Cartesian inputs: the same directions
+        from ..golden.fixed_peercy import from_angle_codes
+        codes = from_angle_codes(codes, cfg)
     if unit == "rotation":
         return as_payloads(codes, cfg), lambda acc: _golden(acc, cfg, rotation_fixed)
     rot = rotation_fixed(codes, cfg)
