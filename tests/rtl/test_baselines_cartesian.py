@@ -1,0 +1,264 @@
+"""Peercy and Ernst baselines (rtl/baselines/peercy.py, ernst.py): the Amaranth simulator bit
+for bit against sim/golden/fixed_peercy.py (random, edge, full-range and narrow/wide inputs,
+with and without stalls), the combinational square root against math.isqrt, emission
+(lint-clean, deterministic, CLI) and the Yosys counts against the structure."""
+
+import json
+import math
+import random
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from amaranth.hdl import Module, signed, unsigned
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.wiring import In, Out
+from amaranth.sim import Simulator
+
+from bumprtl.gen.emit import lint
+from bumprtl.gen.resources import count_component, count_verilog
+from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.rtl.baselines.peercy import PeercySqrt
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.illumination import IlluminationDatapath, Illumination
+from bumprtl.rtl.pipe import PRODUCT_LATENCY
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden import fixed_peercy
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.vectors import as_payloads, edge_codes
+
+METHODS = ["peercy", "ernst"]
+NARROW = Config(method="peercy", angle_bits=8, frac_bits=9, tag_bits=12, spec_exponent=3)
+
+
+def concat(*codes):
+    return {k: np.concatenate([np.asarray(c[k]) for c in codes]) for k in codes[0]}
+
+
+def stimulus(cfg, n, seed):
+    """The shared polar edge cases as Cartesian codes, then ``n`` random valid pixels."""
+    edges = fixed_peercy.from_angle_codes(edge_codes(cfg), cfg)
+    rand = fixed_peercy.encode(PixelInputs.random(n, np.random.default_rng(seed)), cfg)
+    return concat(edges, rand)
+
+
+def full_range_codes(cfg, n, seed):
+    """Any input code at all: uniform over the whole signed(B + 2) range, plus zero vectors
+    and the most negative code everywhere (the widths must hold them without wrapping)."""
+    rng = np.random.default_rng(seed)
+    lo, hi = -(1 << (cfg.frac_bits + 1)), (1 << (cfg.frac_bits + 1)) - 1
+    keys = fixed_peercy.input_keys(cfg)
+    codes = {k: rng.integers(lo, hi + 1, n) for k in keys}
+    for k in keys:
+        codes[k][:3] = [0, lo, hi]
+    return codes
+
+
+def run_rotation(cfg, codes, pattern):
+    inputs = as_payloads(codes, cfg)
+    dut = VectorRotation(cfg)
+    out, cycles = simulate_stream(dut, inputs, pattern)
+    assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
+    return dut.latency, cycles
+
+
+def run_illumination(cfg, codes, pattern):
+    rot = rotation_fixed(codes, cfg)
+    inputs = as_payloads(rot, cfg)
+    dut = Illumination(cfg)
+    out, cycles = simulate_stream(dut, inputs, pattern)
+    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
+    return dut.latency, cycles
+
+
+# --- bit-exact in the Amaranth simulator -----------------------------------------------------
+
+@pytest.mark.parametrize("method", METHODS)
+def test_bit_exact_no_stall_one_pixel_per_clock(method):
+    cfg = Config(method=method)
+    codes = stimulus(cfg, 1500, seed=1)
+    total = len(codes["l.x"])
+    for run in (run_rotation, run_illumination):
+        latency, cycles = run(cfg, codes, "no_stall")
+        assert cycles == total + latency
+
+
+@pytest.mark.parametrize("pattern", ["input_gaps", "backpressure"])
+def test_bit_exact_under_stalls(pattern):
+    cfg = Config(method="peercy")
+    codes = stimulus(cfg, 400, seed=2)
+    run_rotation(cfg, codes, pattern)
+    run_illumination(cfg, codes, pattern)
+
+
+def test_bit_exact_on_full_range_and_degenerate_inputs():
+    """Non-unit, zero and extreme vectors: r = 0 gives a zero quotient in both models."""
+    cfg = Config(method="peercy")
+    codes = full_range_codes(cfg, 600, seed=3)
+    run_rotation(cfg, codes, "backpressure")
+    run_illumination(cfg, codes, "no_stall")
+
+
+@pytest.mark.parametrize("specular", [True, False])
+def test_narrow_and_wide_configurations(specular):
+    for cfg in (NARROW.replace(specular=specular),
+                Config(method="ernst", angle_bits=14, frac_bits=20, specular=specular,
+                       spec_exponent=128)):
+        codes = concat(stimulus(cfg, 200, seed=4), full_range_codes(cfg, 100, seed=5))
+        run_rotation(cfg, codes, "input_gaps")
+        run_illumination(cfg, codes, "backpressure")
+
+
+def test_latencies_follow_the_structure():
+    """Setup: products and squares are registered products (PRODUCT_LATENCY each), plus the
+    transformed sum, |A_t|**2, square root, quotient and signed result: 5 single stages.
+    Illumination: the dot's products, its sum, then the shared back end."""
+    import importlib
+    from bumprtl.rtl.illumination import SHADE_LATENCY
+    for method in METHODS:
+        cfg = Config(method=method)
+        datapaths = importlib.import_module(f"bumprtl.rtl.baselines.{method}")
+        assert datapaths.Rotation(cfg).latency == 2 * PRODUCT_LATENCY + 5
+        assert datapaths.Illumination(cfg).latency == PRODUCT_LATENCY + 1 + SHADE_LATENCY
+
+
+# --- the square root ------------------------------------------------------------------------
+
+def _sqrt_results(width, values):
+    dut = PeercySqrt(width)
+    got = []
+
+    async def testbench(ctx):
+        for v in values:
+            ctx.set(dut.radicand, v)
+            got.append(ctx.get(dut.root))
+
+    sim = Simulator(dut)
+    sim.add_testbench(testbench)
+    sim.run()
+    return got
+
+
+@pytest.mark.parametrize("width", [1, 2, 7, 10])
+def test_sqrt_exhaustive_small_widths(width):
+    values = list(range(1 << width))
+    assert _sqrt_results(width, values) == [math.isqrt(v) for v in values]
+
+
+def test_sqrt_random_at_the_default_width():
+    """The default setup's radicand 4 s: 2B + 11 bits, around perfect squares and random."""
+    width = 2 * Config().frac_bits + 11
+    rng = random.Random(6)
+    roots = [rng.randrange(1, 1 << (width // 2)) for _ in range(300)]
+    values = [r * r + d for r in roots for d in (-1, 0, 1)] + [(1 << width) - 1, 0]
+    values += [rng.randrange(1 << width) for _ in range(600)]
+    assert _sqrt_results(width, values) == [math.isqrt(v) for v in values]
+
+
+# --- emission -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("unit", ["rotation", "illumination"])
+def test_emission_lint_clean_and_deterministic(unit, build_dir):
+    cfg = Config(method="peercy")
+    v1, j1 = emit_unit(unit, cfg, build_dir / "a")
+    v2, j2 = emit_unit(unit, cfg, build_dir / "b")
+    assert v1.read_bytes() == v2.read_bytes() and j1.read_bytes() == j2.read_bytes()
+    assert "--method peercy" in v1.read_text().splitlines()[0]
+    assert lint(v1) == []
+
+
+def test_ernst_emits_the_same_setup_hardware(build_dir):
+    """Ernst's setup is Peercy's: the same Verilog apart from the command in the header."""
+    vp, _ = emit_unit("rotation", Config(method="peercy"), build_dir / "p")
+    ve, _ = emit_unit("rotation", Config(method="ernst"), build_dir / "e")
+    assert vp.read_text().splitlines()[2:] == ve.read_text().splitlines()[2:]
+    assert "--method ernst" in ve.read_text().splitlines()[0]
+
+
+def test_cli_emit_rotation_method_peercy(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+                        "peercy", "--out", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "rotation.v").read_text().startswith(
+        "// Generated by: bumprtl emit rotation --method peercy --angle-bits 12 --frac-bits 13")
+    meta = json.loads((tmp_path / "rotation.json").read_text())
+    assert meta["method"] == "peercy" and meta["latency"] == 2 * PRODUCT_LATENCY + 5
+    assert meta["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
+    assert sorted(meta["ports"]["i__payload"]["fields"]) == sorted(
+        fixed_peercy.input_keys(Config()) + ["tag"])
+    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+                          "peercy", "--frac-bits", "40", "--out", str(tmp_path)],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr
+
+
+# --- Yosys counts against the structure (rtl/baselines/peercy.py docstring) -------------------
+
+def _pairs(mults):
+    return sorted(tuple(sorted(int(w) for w in m.split("x"))) for m in mults)
+
+
+@pytest.mark.parametrize("specular", [True, False])
+def test_setup_counts_match_the_structure(specular, build_dir):
+    """Per normalized vector: 9 transform products of two signed(B + 2) inputs and 3 squares
+    of signed(B + 5) components; 6 + 2 adders; one square root; 3 dividers of |a| 2**(B+2)
+    (B + 4 + B + 2 bits) by r (B + 6 bits). No tables. With L and H: 24 multipliers,
+    16 adders, 2 square roots, 6 dividers (Table 1: 27, 18, 3, 9 for three vectors)."""
+    cfg = NARROW.replace(specular=specular)
+    b, nvec = cfg.frac_bits, 2 if specular else 1
+    v_path, _ = emit_unit("rotation", cfg, build_dir)
+    c = count_verilog(v_path, "rotation", build_dir / "yosys")
+    expected = [(b + 2, b + 2)] * (9 * nvec) + [(b + 5, b + 5)] * (3 * nvec)
+    assert _pairs(c.multipliers) == sorted(expected)
+    assert len(c.adders) == 8 * nvec
+    assert c.sqrts == nvec
+    assert sorted(c.dividers) == [f"{2 * b + 6}/{b + 6}"] * (3 * nvec)
+    assert c.tables == [] and c.const_multipliers == []
+
+
+class _ShadeOnly(IlluminationDatapath):
+    """The shared back end alone: the dot products come in on the stream, one register."""
+    dot_latency = 1
+
+    def __init__(self, cfg):
+        b = cfg.frac_bits
+        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
+                                                 "tag": unsigned(cfg.tag_bits)}))
+
+    def dots(self, m, pipe, payload):
+        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
+
+
+class _Unit(wiring.Component):
+    def __init__(self, datapath):
+        self.datapath = datapath
+        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
+                          "o": Out(stream.Signature(datapath.out_layout))})
+
+    def elaborate(self, platform):
+        m = Module()
+        self.datapath.build(m, self.i, self.o)
+        return m
+
+
+def test_illumination_counts_are_the_back_end_plus_two_dots(build_dir):
+    """N'.L_n and N'.H_n: 3 products of signed(B + 2) values and 2 adders each; the rest
+    (Phong weights, power table, Phong sum) is the shared back end, counted on its own."""
+    cfg = NARROW.replace(method="ernst")
+    q = cfg.frac_bits + 2
+    v_path, _ = emit_unit("illumination", cfg, build_dir)
+    c = count_verilog(v_path, "illumination", build_dir / "yosys")
+    shade = count_component(_Unit(_ShadeOnly(cfg)), "shade_only", build_dir / "shade")
+    assert _pairs(c.multipliers) == _pairs(shade.multipliers + [f"{q}x{q}"] * 6)
+    assert len(c.adders) == len(shade.adders) + 4
+    assert c.tables == shade.tables and len(c.tables) == 1          # the power (cos^n) table
+    assert c.dividers == [] and c.sqrts == 0
+
+
+def test_sidecar_of_ernst_names_its_method():
+    _, sidecar, command = build_unit("illumination", Config(method="ernst"))
+    assert sidecar["method"] == "ernst" and "--method ernst" in command
+    assert sidecar["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
