@@ -58,17 +58,19 @@ shared ``b_sincos_rom`` (sin/cos th_N'), 3 multipliers (cos cos, sin sin, x cos)
 table against its 12 LUTs; 4 adders plus the back end's Phong sum against its 5.
 """
 
+import itertools
+
 import numpy as np
 from amaranth.hdl import C, Cat, Mux, Value, ValueCastable, unsigned
 from amaranth.lib.memory import Memory
 
 from ..config import Config
 from ..exact import vectors
-from ..fixed import mul_round, round_shift
+from ..fixed import round_shift
 from ..illumination import IlluminationDatapath
 from ..layouts import pixel_layout
 from ..lee import ratio_index, rotated_layout
-from ..pipe import StallPipe
+from ..pipe import PRODUCT_LATENCY, StallPipe
 from ..sincos import quarter_wave_rom, sine_read
 from ..tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
                       lee_asin_table, lee_atan_table)
@@ -106,27 +108,37 @@ def _clamp_unit(x, cfg: Config):
     return _fit(_select(x > one, one, _select(x < -one, -one, x)), cfg.frac_bits + 2)
 
 
-def matrix_entries(st, ct, sp, cp, cfg: Config):
+def _times(a, b):
+    return a * b
+
+
+# Every helper that multiplies takes ``mul``: the plain product for the golden model, a
+# registered product (StallPipe.multiply, PRODUCT_LATENCY stages) in the RTL. All the terms a
+# helper adds are products, so they arrive together.
+
+def matrix_entries(st, ct, sp, cp, cfg: Config, mul=_times):
     """The four product entries of M = R_y(-th_N) R_z(-ph_N) =
     [[ct cp, ct sp, -st], [-sp, cp, 0], [st cp, st sp, ct]], each rounded to B bits."""
     b = cfg.frac_bits
-    return tuple(_fit(mul_round(u, w, b), b + 2) for u, w in ((ct, cp), (ct, sp), (st, cp), (st, sp)))
+    return tuple(_fit(round_shift(mul(u, w), b), b + 2)
+                 for u, w in ((ct, cp), (ct, sp), (st, cp), (st, sp)))
 
 
-def cartesian(st, ct, sp, cp, cfg: Config):
-    """Polar -> Cartesian: (sin th cos ph, sin th sin ph, cos th), products rounded to B bits."""
+def cartesian(st, sp, cp, cfg: Config, mul=_times):
+    """Polar -> Cartesian x = sin th cos ph, y = sin th sin ph, rounded to B bits (z = cos th
+    is a ROM value)."""
     b = cfg.frac_bits
-    return _fit(mul_round(st, cp, b), b + 2), _fit(mul_round(st, sp, b), b + 2), ct
+    return _fit(round_shift(mul(st, cp), b), b + 2), _fit(round_shift(mul(st, sp), b), b + 2)
 
 
-def transform(mat, n, a, cfg: Config):
+def transform(mat, n, a, cfg: Config, mul=_times):
     """A' = M A: each coordinate one sum of full products, rounded once and clamped to
     [-1, 1]. ``mat`` = (m00, m01, m20, m21), ``n`` = (st, ct, sp, cp) of N, ``a`` = (x, y, z)."""
     (m00, m01, m20, m21), (st, ct, sp, cp), (x, y, z) = mat, n, a
     b = cfg.frac_bits
-    return (_clamp_unit(round_shift(m00 * x + m01 * y - st * z, b), cfg),
-            _clamp_unit(round_shift(cp * y - sp * x, b), cfg),
-            _clamp_unit(round_shift(m20 * x + m21 * y + ct * z, b), cfg))
+    return (_clamp_unit(round_shift(mul(m00, x) + mul(m01, y) - mul(st, z), b), cfg),
+            _clamp_unit(round_shift(mul(cp, y) - mul(sp, x), b), cfg),
+            _clamp_unit(round_shift(mul(m20, x) + mul(m21, y) + mul(ct, z), b), cfg))
 
 
 def octant(x, y):
@@ -170,11 +182,11 @@ def phi_from_octant(a0, swap, x_negative, y_negative, cfg: Config):
     return phi[:cfg.angle_bits] if _hdl(phi) else phi & (cfg.full_circle - 1)
 
 
-def rho_of(p, q, ca0, sa0, cfg: Config):
+def rho_of(p, q, ca0, sa0, cfg: Config, mul=_times):
     """rho = sqrt(x'^2 + y'^2) = p cos a0 + q sin a0 (the projection of (p, q) on the unit
     vector at a0), rounded to B bits."""
     b = cfg.frac_bits
-    return _fit(round_shift(p * ca0 + q * sa0, b), b + 3)
+    return _fit(round_shift(mul(p, ca0) + mul(q, sa0), b), b + 3)
 
 
 def theta_select(rho, z, cfg: Config):
@@ -199,15 +211,15 @@ def theta_from_octant(asin, use_rho, z_negative, cfg: Config):
     return theta[:cfg.angle_bits] if _hdl(theta) else theta & (cfg.full_circle - 1)
 
 
-def dot_terms(st_a, ct_a, st_n, ct_n, cfg: Config):
+def dot_terms(st_a, ct_a, st_n, ct_n, cfg: Config, mul=_times):
     """Eq. (3)'s products: cos th_A cos th_N' (kept at 2B fractional bits) and
     sin th_A sin th_N' (rounded to B bits before the third multiply)."""
-    return ct_a * ct_n, _fit(mul_round(st_a, st_n, cfg.frac_bits), cfg.frac_bits + 2)
+    return mul(ct_a, ct_n), _fit(round_shift(mul(st_a, st_n), cfg.frac_bits), cfg.frac_bits + 2)
 
 
-def dot_sum(cc, ss, cphi, cfg: Config):
+def dot_sum(cc, ss, cphi, cfg: Config, mul=_times):
     """Eq. (3): N'.A = cc + ss cos(ph_A - ph_N'), rounded once to B bits."""
-    return round_shift(cc + ss * cphi, cfg.frac_bits)
+    return round_shift(cc + mul(ss, cphi), cfg.frac_bits)
 
 
 # --- The datapaths ---------------------------------------------------------------------------
@@ -224,16 +236,28 @@ def _rom(m, name, table, width):
     return rom
 
 
+def _multiplier(pipe, prefix):
+    """``mul`` for the helpers: each product a RegisteredProduct (StallPipe.multiply) named
+    ``{prefix}_mul{n}``, PRODUCT_LATENCY stages after its operands."""
+    count = itertools.count()
+    return lambda a, b: pipe.multiply(a, b, f"{prefix}_mul{next(count)}")
+
+
+P = PRODUCT_LATENCY
+
+
 class Rotation:
     """VectorRotation datapath, kim method (the module table): polar -> Cartesian, M, back
     to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
     through, polar binary angles, as rtl/lee.py).
 
-    Stages: 1-2 sin/cos; 3 M, x, y; 4 x', y', z'; 5 octant; 6 1/p; 7 q/p; 8 atan; 9 ph';
-    10 sin/cos a0; 11 rho; 12 asin; 13 th'. Latency 13; 1 pixel per clock.
+    Stages (P = PRODUCT_LATENCY, every product a RegisteredProduct as in rtl/exact.py):
+    2 sin/cos; +P+1 M, x, y; +P+1 x', y', z'; +1 octant; +1 1/p; +P q/p; +1 atan; +1 ph';
+    sin/cos a0 at atan + 2; +P+1 rho; +1 asin; +1 th'. Latency 12 + 4P = 20; 1 pixel per
+    clock.
     """
 
-    latency = 13
+    latency = 12 + 4 * P
 
     def __init__(self, cfg: Config):
         self.cfg = cfg
@@ -246,11 +270,11 @@ class Rotation:
         m.submodules.n_sincos_rom = rom = quarter_wave_rom(cfg)
         read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg, name)
         n = (read(px.n.theta, "n_sin_theta"), read(px.n.theta + (1 << k), "n_cos_theta"),
-             read(px.n.phi, "n_sin_phi"), read(px.n.phi + (1 << k), "n_cos_phi"))   # stage 2
+             read(px.n.phi, "n_sin_phi"), read(px.n.phi + (1 << k), "n_cos_phi"))   # 2
         mat = tuple(pipe.register(e, f"m{nm}") for e, nm in
-                    zip(matrix_entries(*n, cfg), ("00", "01", "20", "21")))         # stage 3
-        n = tuple(pipe.register(e, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp")))
-        for v in vectors(cfg):
+                    zip(matrix_entries(*n, cfg, _multiplier(pipe, "m")), ("00", "01", "20", "21")))
+        n = tuple(pipe.delay(e, P + 1, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp")))
+        for v in vectors(cfg):                                                      # 3 + P
             phi, theta = self._vector(m, pipe, v, px[v], mat, n)
             m.d.comb += [o.payload[v].phi.eq(phi), o.payload[v].theta.eq(theta)]
         m.d.comb += [o.payload.b.eq(pipe.delay(px.b, self.latency, "b")),
@@ -259,37 +283,37 @@ class Rotation:
     def _vector(self, m, pipe, v, a, mat, n):
         cfg, k = self.cfg, self.cfg.k
         reg, delay = pipe.register, pipe.delay
+        mul = _multiplier(pipe, v)
         m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
         read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg,
                                              f"{v}_{name}")
         st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
-        sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # stage 2
-        x, y, z = cartesian(st, ct, sp, cp, cfg)
-        x, y, z = reg(x, f"{v}_x"), reg(y, f"{v}_y"), reg(z, f"{v}_z")             # stage 3
+        sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # 2
+        x, y = (reg(c, f"{v}_{nm}") for c, nm in zip(cartesian(st, sp, cp, cfg, mul), "xy"))
+        z = delay(ct, P + 1, f"{v}_z")                                              # 3 + P
         xp, yp, zp = (reg(c, f"{v}_{nm}_rot") for c, nm in
-                      zip(transform(mat, n, (x, y, z), cfg), "xyz"))                # stage 4
+                      zip(transform(mat, n, (x, y, z), cfg, mul), "xyz"))           # 4 + 2P
         swap, p, q = octant(xp, yp)
-        swap, p, q = reg(swap, f"{v}_swap"), reg(p, f"{v}_p"), reg(q, f"{v}_q")     # stage 5
+        swap, p, q = reg(swap, f"{v}_swap"), reg(p, f"{v}_p"), reg(q, f"{v}_q")     # 5 + 2P
         x_neg, y_neg = reg(xp < 0, f"{v}_x_negative"), reg(yp < 0, f"{v}_y_negative")
         pn, qn = normalize(p, q, cfg)
         recip = _read(m, pipe, _rom(m, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1),
-                      reciprocal_address(pn, cfg))                                  # stage 6
-        qn = reg(qn, f"{v}_qn")
-        product = reg(qn * recip, f"{v}_ratio_product")                             # stage 7
+                      reciprocal_address(pn, cfg))                                  # 6 + 2P
+        product = mul(reg(qn, f"{v}_qn"), recip)                                    # 6 + 3P
         a0 = _read(m, pipe, _rom(m, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
-                   ratio_index(ratio_of(product, cfg), cfg))                        # stage 8
-        phi = reg(phi_from_octant(a0, delay(swap, 3, f"{v}_swap"), delay(x_neg, 3, f"{v}_x_neg"),
-                                  delay(y_neg, 3, f"{v}_y_neg"), cfg), f"{v}_phi")  # stage 9
+                   ratio_index(ratio_of(product, cfg), cfg))                        # 7 + 3P
+        phi = reg(phi_from_octant(a0, delay(swap, P + 2, f"{v}_swap"), delay(x_neg, P + 2, f"{v}_x_neg"),
+                                  delay(y_neg, P + 2, f"{v}_y_neg"), cfg), f"{v}_phi")  # 8 + 3P
         a0 = Cat(a0, C(0, cfg.angle_bits - (k + 1)))        # a binary angle, 0 .. 45 deg
-        sa0, ca0 = read(a0, "sin_a0"), read(a0 + (1 << k), "cos_a0")                # stage 10
-        rho = reg(rho_of(delay(p, 5, f"{v}_p"), delay(q, 5, f"{v}_q"), ca0, sa0, cfg),
-                  f"{v}_rho")                                                       # stage 11
-        use_rho, z_neg, val = theta_select(rho, delay(zp, 7, f"{v}_z_rot"), cfg)
+        sa0, ca0 = read(a0, "sin_a0"), read(a0 + (1 << k), "cos_a0")                # 9 + 3P
+        rho = reg(rho_of(delay(p, P + 4, f"{v}_p"), delay(q, P + 4, f"{v}_q"), ca0, sa0, cfg, mul),
+                  f"{v}_rho")                                                       # 10 + 4P
+        use_rho, z_neg, val = theta_select(rho, delay(zp, 2 * P + 6, f"{v}_z_rot"), cfg)
         asin = _read(m, pipe, _rom(m, f"{v}_asin_rom", lee_asin_table(cfg), k + 1),
-                     asin_address(val, cfg))                                        # stage 12
+                     asin_address(val, cfg))                                        # 11 + 4P
         theta = reg(theta_from_octant(asin, reg(use_rho, f"{v}_use_rho"), reg(z_neg, f"{v}_z_negative"),
-                                      cfg), f"{v}_theta")                           # stage 13
-        return delay(phi, 4, f"{v}_phi"), theta
+                                      cfg), f"{v}_theta")                           # 12 + 4P
+        return delay(phi, P + 4, f"{v}_phi"), theta
 
 
 class Illumination(IlluminationDatapath):
@@ -298,10 +322,11 @@ class Illumination(IlluminationDatapath):
     to B bits (:func:`dot_terms`, :func:`dot_sum`), then the shared back end.
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency 4 (sin/cos, products, sum) + SHADE_LATENCY; 1 pixel per clock.
+    Latency 4 + 2P (sin/cos; cos cos and sin sin, rounding; x cos(dph), sum) + SHADE_LATENCY;
+    1 pixel per clock.
     """
 
-    dot_latency = 4
+    dot_latency = 4 + 2 * P
 
     def __init__(self, cfg: Config):
         super().__init__(cfg, rotated_layout(cfg))
@@ -315,13 +340,15 @@ class Illumination(IlluminationDatapath):
         dots = {}
         for v in vectors(cfg):
             a = payload[v]
+            mul = _multiplier(pipe, f"{v}_dot")
             m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
             read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle,
                                                  cfg, f"{v}_{name}")
             st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
-            cphi = read(a.phi - b.phi + (1 << k), "cos_dphi")                      # stage 2
-            cc, ss = dot_terms(st, ct, st_n, ct_n, cfg)
-            cc, ss = pipe.register(cc, f"{v}_cc"), pipe.register(ss, f"{v}_ss")     # stage 3
-            cphi = pipe.register(cphi, f"{v}_cos_dphi_d")
-            dots[v] = pipe.register(dot_sum(cc, ss, cphi, cfg), f"{v}_dot")       # stage 4
+            cphi = read(a.phi - b.phi + (1 << k), "cos_dphi")                      # 2
+            cc, ss = dot_terms(st, ct, st_n, ct_n, cfg, mul)                         # 2 + P
+            ss = pipe.register(ss, f"{v}_ss")                                       # 3 + P
+            cc = pipe.delay(cc, P + 1, f"{v}_cc")                                   # 3 + 2P
+            cphi = pipe.delay(cphi, P + 1, f"{v}_cos_dphi")
+            dots[v] = pipe.register(dot_sum(cc, ss, cphi, cfg, mul), f"{v}_dot")  # 4 + 2P
         return dots

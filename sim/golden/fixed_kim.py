@@ -50,7 +50,7 @@ def rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg: Config):
     mat, n = _frame(n_phi, n_theta, cfg)
     st, ct = _sincos(a_theta, cfg)
     sp, cp = _sincos(a_phi, cfg)
-    return to_polar_fixed(*transform(mat, n, cartesian(st, ct, sp, cp, cfg), cfg), cfg)
+    return to_polar_fixed(*transform(mat, n, (*cartesian(st, sp, cp, cfg), ct), cfg), cfg)
 
 
 def to_polar_fixed(xp, yp, zp, cfg: Config):
