@@ -23,7 +23,9 @@ def test_datapath_cocotb(sim, unit, method, build_dir):
 # Table 1 baselines: one short run per simulator (edge cases + 200 random pixels per pattern),
 # each unit on one of them; the Amaranth-simulator tests cover the rest (tests/rtl/test_baselines_*).
 @pytest.mark.parametrize("sim,unit,method", [("verilator", "rotation", "kim"),
-                                             ("icarus", "illumination", "kim")])
+                                             ("icarus", "illumination", "kim"),
+                                             ("icarus", "rotation", "peercy"),
+                                             ("verilator", "illumination", "peercy")])
 def test_baseline_cocotb(sim, unit, method, build_dir):
     v, j = emit_unit(unit, Config(method=method), build_dir / "rtl")
     tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
