@@ -111,11 +111,11 @@ class Illumination(IlluminationDatapath):
     once, then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency PRODUCT_LATENCY (operand and product registers) + 1 (sum) + SHADE_LATENCY;
-    1 pixel per clock.
+    Latency PRODUCT_LATENCY (operand and product registers) + 2 (sum, rounding) +
+    SHADE_LATENCY; 1 pixel per clock.
     """
 
-    dot_latency = PRODUCT_LATENCY + 1
+    dot_latency = PRODUCT_LATENCY + 2
 
     def __init__(self, cfg: Config):
         super().__init__(cfg, rotated_layout(cfg))
@@ -127,6 +127,10 @@ class Illumination(IlluminationDatapath):
             xp = pipe.multiply(n.x4, a.p2, f"{v}_xp")                  # 3 multipliers per vector
             yy = pipe.multiply(n.y2, a.y2, f"{v}_yy")
             zz = pipe.multiply(n.z4, a.z, f"{v}_zz")
-            dots[v] = pipe.register(round_shift(xp + 2 * yy + 2 * zz, self.cfg.frac_bits + 3),
-                                    f"{v}_dot")
+            # round_shift(xp + 2 yy + 2 zz, B + 3) in two carry-chain stages: the rounding
+            # half rides with 2 zz, so each stage adds two operands.
+            n_shift = self.cfg.frac_bits + 3
+            pair = pipe.register(xp + 2 * yy, f"{v}_xp_yy")
+            zz_half = pipe.register(2 * zz + (1 << (n_shift - 1)), f"{v}_zz_half")
+            dots[v] = pipe.register((pair + zz_half) >> n_shift, f"{v}_dot")
         return dots

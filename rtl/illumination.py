@@ -19,8 +19,8 @@ __all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY"
 
 # Registers of shade_stages: clamp, round (diffuse, table index), table read and table
 # output register (ROM_LATENCY), Phong products (operand and product registers,
-# PRODUCT_LATENCY), Phong sum.
-SHADE_LATENCY = 3 + ROM_LATENCY + PRODUCT_LATENCY
+# PRODUCT_LATENCY), Phong sum, rounding and clamp.
+SHADE_LATENCY = 4 + ROM_LATENCY + PRODUCT_LATENCY
 
 
 def _clamp01(x, cfg):
@@ -53,10 +53,13 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     ka, kd, ks = phong_coefficients(cfg)
     kd_term = pipe.multiply(diffuse, kd, "kd_diffuse")                            # + PRODUCT
     ks_term = pipe.multiply(specular, ks, "ks_specular") if cfg.specular else 0
-    total = round_shift(ka + kd_term + ks_term, 8)
-    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 1
-    diffuse = pipe.delay(diffuse, PRODUCT_LATENCY + 1, "diffuse_out")
-    specular = pipe.delay(specular, PRODUCT_LATENCY + 1, "specular_out") if cfg.specular else 0
+    # round_shift(KA + kd + ks, 8) as two 2-operand stages: KA and the rounding half are
+    # one constant added in the second.
+    terms = pipe.register(kd_term + ks_term, "phong_terms")                       # + 1
+    total = (terms + (ka + 128)) >> 8
+    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 2
+    diffuse = pipe.delay(diffuse, PRODUCT_LATENCY + 2, "diffuse_out")
+    specular = pipe.delay(specular, PRODUCT_LATENCY + 2, "specular_out") if cfg.specular else 0
     return diffuse, specular, color
 
 
