@@ -46,8 +46,8 @@ GRIDS = {
                     100_000, ("bricks", "wood", "globe"), 128),
 }
 PER_PIXEL = ("exact", "lee")
-BASELINES = ("peercy", "kim")
-COST_FIELDS = ("multipliers", "const_multipliers", "adders", "table_bits", "ram_bits",
+BASELINES = ("peercy", "ernst", "kim")     # Lee Table 1's designs as RTL (rtl/baselines/)
+COST_FIELDS = ("multipliers", "const_multipliers", "dividers", "sqrts", "adders", "table_bits", "ram_bits",
                "register_bits")
 
 
@@ -130,21 +130,21 @@ def _scene_stats(ctx, name, img):
 def perpixel_error(ctx, cfg):
     from ..sim.golden.accuracy import diffuse_error_lsb
     from ..sim.golden.fixed import datapath_fixed
-    from ..sim.golden.fixed_common import quantize_pixels
+    from ..sim.golden.fixed import encode_pixels
     from ..sim.scenes.imaging import compose
     out = {"random": _stats(diffuse_error_lsb(datapath_fixed, ctx.px, cfg)),
            "adversarial": _stats(diffuse_error_lsb(datapath_fixed, ctx.adversarial(cfg), cfg)),
            "scenes": {}}
     for name, scene in ctx.scenes.items():
-        color = datapath_fixed(quantize_pixels(scene.px, cfg), cfg)["color"] / 255.0
+        color = datapath_fixed(encode_pixels(scene.px, cfg), cfg)["color"] / 255.0
         out["scenes"][name] = _scene_stats(ctx, name, compose(scene, color))
     return out
 
 
 def perpixel_speed(ctx, cfg):
     from ..sim.golden.fixed import datapath_fixed
-    from ..sim.golden.fixed_common import quantize_pixels
-    codes = quantize_pixels(ctx.px, cfg)
+    from ..sim.golden.fixed import encode_pixels
+    codes = encode_pixels(ctx.px, cfg)
     return {"golden_mpix_s": round(len(ctx.px) / _best_time(lambda: datapath_fixed(codes, cfg)) / 1e6, 3)}
 
 
@@ -247,7 +247,7 @@ def perpixel_point(ctx, method, a, b, opts):
     point = {"method": method, **params, "status": "ok", "config": cfg.to_dict(),
              "error": perpixel_error(ctx, cfg), "speed": perpixel_speed(ctx, cfg),
              "cost": {**unit_cost(("rotation", "illumination"), cfg, ctx.work),
-                      "map_bits_per_texel": 2 * cfg.angle_bits}}      # N' as (phi, theta)
+                      "map_bits_per_texel": map_bits_per_texel(cfg)}}
     if fpga_selected(ctx.grid, a, b, opts):
         _hardware(point, cfg, _pipeline, "pipeline", ctx, opts)
     if opts.sim and (a, b) == (Config().angle_bits, Config().frac_bits):
@@ -265,6 +265,12 @@ def fpga_selected(grid, a, b, opts):
         return True
     ia, ib = grid.angle_bits.index(a), grid.frac_bits.index(b)
     return ia == ib
+
+
+def map_bits_per_texel(cfg):
+    """Bump-map bits per texel: N' as two binary angles (polar methods) or three signed
+    components of B + 2 bits (Peercy, Ernst: Cartesian N')."""
+    return 3 * (cfg.frac_bits + 2) if cfg.method in ("peercy", "ernst") else 2 * cfg.angle_bits
 
 
 def _hardware(point, cfg, component_fn, label, ctx, opts):
@@ -305,38 +311,20 @@ def palette_point(ctx, size, opts):
     return point
 
 
-def baseline_point(ctx, name):
-    """Baselines: float64 models exist; a bit-exact model and RTL are needed for a point."""
-    import importlib.util
-    from ..rtl.config import Config
-    from ..sim.golden.models import FLOAT_MODELS
-    from ..sim.golden.conventional import conventional
-    from .report import PAPER
-    missing = [m for m in (f"bumprtl.rtl.baselines.{name}", "bumprtl.sim.golden.fixed_baselines")
-               if importlib.util.find_spec(m) is None]
-    res, ref = FLOAT_MODELS[name](ctx.px, Config()), conventional(ctx.px, Config())
-    speed = len(ctx.px) / _best_time(lambda: FLOAT_MODELS[name](ctx.px, Config())) / 1e6
-    return {"method": name, "status": "not available",
-            "reason": f"no fixed-point model or RTL: missing {', '.join(missing) or 'a sweep adapter'}",
-            "float64": {"diffuse_max_lsb_vs_conventional": float(np.abs(res.diffuse - ref.diffuse).max() * 255),
-                        "mpix_s": round(speed, 3)},
-            "paper_table1": PAPER[name]}
-
-
 def sweep(grid, opts, work, seed=11, progress=True):
     """Every point of ``grid``; ``opts`` has ``fpga``, ``device``, ``sim``, ``methods``."""
     from tqdm import tqdm
     ctx = Context(grid, seed, work)
-    jobs = [(perpixel_point, (m, a, b, opts)) for m in PER_PIXEL if m in opts.methods
+    methods = [m for m in PER_PIXEL if m in opts.methods]
+    methods += list(BASELINES) if "baselines" in opts.methods else []
+    jobs = [(perpixel_point, (m, a, b, opts)) for m in methods
             for a in grid.angle_bits for b in grid.frac_bits]
     if "palette" in opts.methods:
         jobs += [(palette_point, (s, opts)) for s in grid.palette_sizes]
-    if "baselines" in opts.methods:
-        jobs += [(baseline_point, (name,)) for name in BASELINES]
     points = []
     with tqdm(jobs, desc="sweep", unit="point", disable=not progress, file=sys.stderr) as bar:
         for fn, args in bar:
-            bar.set_postfix_str(" ".join(map(str, args[:-1] if fn is not baseline_point else args)))
+            bar.set_postfix_str(" ".join(map(str, args[:-1])))
             points.append(fn(ctx, *args))
     reference = len(ctx.px) / _best_time(lambda: _conventional(ctx)) / 1e6
     return {"grid": grid.__dict__, "seed": seed, "float64_conventional_mpix_s": round(reference, 3),
@@ -385,7 +373,8 @@ def _row(p, front):
     return (f"| {point_label(p)} | {_fmt(rnd and rnd['max'])} / {_fmt(rnd and rnd['mean'], '{:.3f}')} "
             f"| {_fmt(adv and adv['max'])} / {_fmt(adv and adv['mean'], '{:.3f}')} "
             f"| {_fmt(psnr)} / {_fmt(max((s['max_lsb'] for s in scenes), default=None))} "
-            f"| **{error_lsb(p)}** | {cost['multipliers']} | {cost['adders']} | {cost['table_bits']} "
+            f"| **{error_lsb(p)}** | {cost['multipliers']} | {cost.get('dividers', 0)} / {cost.get('sqrts', 0)} "
+            f"| {cost['adders']} | {cost['table_bits']} "
             f"| {cost['ram_bits']} | {cost['map_bits_per_texel']} | {_fmt(f.get('LUT4'))} | {_fmt(f.get('DSP'))} | {_fmt(f.get('BRAM'))} "
             f"| {_fmt(f.get('fmax_mhz'))} | {speed['golden_mpix_s']:.2f} | {_fmt(speed.get('sim_pix_s'), '{:,}')} "
             f"| {_fmt(hw and hw / 1e6, '{:.1f}')} | {'yes' if id(p) in front else ''} |")
@@ -405,13 +394,14 @@ def markdown(data, command, plot_paths=()):
              "scenes. **error** = the worst max over all sets (what `bumprtl recommend` uses). "
              "Cost: Yosys coarse netlist of the per-pixel units (rotation + illumination, or the "
              "palette LUT; gen/resources.py); the bump map itself is not in it: `map bits` per texel is "
-             "2 x angle bits for N' angles, log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
+             "2 x angle bits for N' angles, 3 x (frac bits + 2) for Peercy's and Ernst's Cartesian N', "
+             "log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
              f"of 3; float64 `conventional` ran at {data['float64_conventional_mpix_s']:.2f} Mpix/s "
              "on the same vectors). `pareto` = on the front of error against ROM+RAM bits.", "",
              "| point | random max / mean | adversarial max / mean | scenes PSNR / max | error "
-             "| mult | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM | Fmax MHz | golden Mpix/s "
-             "| sim pix/s | hw Mpix/s | pareto |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| mult | div / sqrt | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM | Fmax MHz "
+             "| golden Mpix/s | sim pix/s | hw Mpix/s | pareto |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [_row(p, front) for p in pts]
     other = [p for p in data["points"] if p["status"] != "ok"]
     if other:

@@ -8,7 +8,7 @@ import numpy as np
 from ...rtl.config import Config
 from .common import PixelInputs, to_8bit
 from .conventional import conventional
-from .fixed_common import quantize_pixels
+from .fixed import encode_pixels
 
 __all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "ANGLES_OF_NDOTL"]
 
@@ -19,13 +19,13 @@ ANGLES_OF_NDOTL = ("n_phi", "n_theta", "l_phi", "l_theta", "b_phi", "b_theta")
 def diffuse_error_lsb(model, px: PixelInputs, cfg: Config):
     """|fixed diffuse8 - round(255 clamp(N'.L'))| per pixel, with the float64 reference on
     the unquantized inputs. ``model(codes, cfg)`` is a fixed-point golden model."""
-    fixed = model(quantize_pixels(px, cfg), cfg)["diffuse"]
+    fixed = model(encode_pixels(px, cfg), cfg)["diffuse"]
     return np.abs(fixed.astype(np.int64) - to_8bit(conventional(px, cfg).diffuse).astype(np.int64))
 
 
 def term_errors_lsb(model, px: PixelInputs, cfg: Config):
     """Per-pixel |fixed - round(255 x float64)| of diffuse, specular and colour (8-bit)."""
-    fixed = model(quantize_pixels(px, cfg), cfg)
+    fixed = model(encode_pixels(px, cfg), cfg)
     ref = conventional(px, cfg)
     return {k: np.abs(fixed[k].astype(np.int64) - to_8bit(getattr(ref, k)).astype(np.int64))
             for k in ("diffuse", "specular", "color")}

@@ -3,7 +3,7 @@ tests, testbenches and benchmarks."""
 
 from ...rtl.config import Config
 
-__all__ = ["rotation_fixed", "illumination_fixed", "datapath_fixed"]
+__all__ = ["rotation_fixed", "illumination_fixed", "datapath_fixed", "encode_pixels"]
 
 
 def _methods(cfg):
@@ -34,3 +34,15 @@ def datapath_fixed(codes, cfg: Config):
     return {**rot, **illumination_fixed(rot, cfg)}
 
 
+
+
+def encode_pixels(px, cfg: Config):
+    """Float64 pixels -> the input codes of ``cfg.method``'s setup unit: binary angles for
+    the polar methods (exact, lee, kim), Cartesian components for Peercy and Ernst (their
+    module's ``encode``: what a Cartesian rasterizer would interpolate)."""
+    import importlib
+    from .fixed_common import quantize_pixels
+    if cfg.method in ("exact", "lee"):
+        return quantize_pixels(px, cfg)
+    m = importlib.import_module(f".fixed_{cfg.method}", __package__)
+    return m.encode(px, cfg) if hasattr(m, "encode") else quantize_pixels(px, cfg)

@@ -169,8 +169,8 @@ def check_fixed(model, px: PixelInputs, cfg: Config):
     """Run a bit-exact model on ``px`` quantized for ``cfg``: per pixel the diffuse and
     colour error against float64 (8-bit LSB), and the overflow count (pixels with some
     field outside its payload width, :func:`payload_fields`; fields per name)."""
-    from .fixed_common import quantize_pixels
-    out = model(quantize_pixels(px, cfg), cfg)
+    from .fixed import encode_pixels
+    out = model(encode_pixels(px, cfg), cfg)
     ref = conventional(px, cfg)
     overflow = {k: int((~_fits(out[k], w, s)).sum()) for k, (w, s) in payload_fields(cfg).items()
                 if k in out}

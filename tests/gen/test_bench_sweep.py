@@ -84,10 +84,15 @@ def test_tiny_sweep_invalid_and_missing(tiny):
     by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
     invalid = by[("exact", 14)]                       # B = 5 < k - 1 = 11
     assert invalid["status"] == "invalid" and "frac_bits" in invalid["reason"]
-    for name in ("peercy", "kim"):
-        assert by[(name, None)]["status"] in ("not available", "ok")
-        if by[(name, None)]["status"] == "not available":
-            assert by[(name, None)]["reason"]
+    for name in ("peercy", "ernst", "kim"):             # baselines: real points at valid widths
+        point = by[(name, 6)]
+        assert point["status"] == "ok" and point["cost"]["multipliers"] > 0
+        cfg = Config(method=name, angle_bits=6, frac_bits=5)
+        err = diffuse_error_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)
+        assert point["error"]["random"]["max"] == err.max()
+        assert by[(name, 14)]["status"] == "invalid"
+    assert by[("peercy", 6)]["cost"]["dividers"] > 0 and by[("peercy", 6)]["cost"]["sqrts"] > 0
+    assert by[("kim", 6)]["cost"]["dividers"] == 0 == by[("exact", 6)]["cost"]["sqrts"]
     palette = by[("palette", None)]
     assert palette["status"] == "ok" and "random" not in palette["error"]
     assert palette["error"]["scenes"]["bumps"]["max_lsb"] == error_lsb(palette)
@@ -121,14 +126,14 @@ def test_stress_rows_and_markdown():
 
 def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
     """Skipping must not change the picture: the unskipped diffuse and flat scenes give the
-    same colour bytes; an unbuildable scene is reported, not crashed on."""
+    same colour bytes; so does the full scene (texture, two lights, mipmaps)."""
     from bumprtl.gen import bench_skip
     from bumprtl.rtl.scene import load_scene_config
     monkeypatch.setattr(bench_skip, "_cost", lambda scene, work: {"multipliers": 0})
     rows = {r["scene"]: r for r in bench_skip.skip_rows(["diffuse", "flat", "full"], 16, tmp_path)}
     assert rows["diffuse"]["same_image"] and rows["flat"]["same_image"]
     assert "H path + specular table" in rows["diffuse"]["skipped"]
-    assert rows["full"]["status"] == "not available" and "texture" in rows["full"]["reason"]
+    assert rows["full"]["status"] == "ok" and rows["full"]["same_image"]   # textured, 2 lights
     off = bench_skip.unskipped(load_scene_config("flat"))
     assert (off.bump_map, off.shading, off.specular) == ("varying", "per-pixel", True)
 
