@@ -34,9 +34,11 @@ so a transformed component needs signed(B + 5) (18 bits at B = 13: one 18x18 DSP
 square), s < 2**(2B+9), r < 2**(B+6), and |q'| <= sqrt(2) 2**B + 1 (2|a|/r <= 2 sqrt(s) /
 floor(2 sqrt(s)) <= sqrt 2 for s >= 1), which fits the signed(B + 2) output.
 
-Timing: the square root and the dividers are combinational (each alone between two
-registers); Yosys must see a ``$divfloor`` cell to count a divider, so they are not
-hand-pipelined. They set this unit's Fmax, which is part of the baseline's cost.
+Timing: every product is a ``StallPipe.multiply`` (operand and product registers, one
+MULT18X18D on ECP5 when both operands fit 18 bits: all 30 of them at B = 13). The square
+root and the dividers are combinational, each alone between two registers: Yosys must see a
+``$div`` cell to count a divider, so they are not hand-pipelined, and they set this unit's
+Fmax, which is part of the baseline's cost.
 
 Illumination (:class:`Illumination`): N'.L_n and N'.H_n (6 multipliers, 4 adders, one
 rounding each), then the shared Phong back end of eq. (2) with the same cos^n specular
