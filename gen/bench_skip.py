@@ -7,7 +7,8 @@ For each built-in scene class (rtl/scene.py BUILTIN) two pipelines, side by side
 * **off**: the same scene with nothing skipped: per-pixel shading with a per-pixel bump map
   and the H path + specular table (lights and widths unchanged). A scene without specular
   gets ks = 0, a flat map becomes a map of the same constant N', so the off pipeline
-  computes the same image the long way; ``same image`` says whether it did.
+  computes the same image the long way; ``same image`` says whether it did. A textured
+  scene keeps its colour texture (and blend) in both.
 
 Golden-model time (best of 3, one frame) and Yosys cost (gen/resources.py) of each. The
 section goes into docs/bench.md.
@@ -31,25 +32,26 @@ def unskipped(scene):
 
 def _stimulus(scene, size, flat_like=None):
     """scene_stimulus; for the off-version of a flat scene, the map holds the flat N'."""
-    from .render_rtl import scene_stimulus
+    from .render_rtl import scene_stimulus, scene_texels
     from ..rtl.bumpfetch import pack_texels
     from ..sim.golden.fixed_pipeline import map_words
-    inputs, words, polygon, _, _ = scene_stimulus(scene, size)
+    inputs, words, polygon, _, base = scene_stimulus(scene, size)
+    texels = scene_texels(scene, base)
     if flat_like is not None:
         sizes = [scene.texture_size >> n for n in range(scene.mip_levels)]
         zeros = [np.zeros((t, t), np.int64) for t in sizes]  # N' = +z, as polygon_fixed(.., 0, 0)
         words = map_words([pack_texels(scene, z, z) for z in zeros], scene)
-    return inputs, words, polygon
+    return inputs, words, polygon, texels
 
 
 def _golden(scene, size, flat_like=None):
     from ..sim.golden.fixed_pipeline import pipeline_fixed
-    inputs, words, polygon = _stimulus(scene, size, flat_like)
-    out = pipeline_fixed(inputs, scene, words, polygon)
+    inputs, words, polygon, texels = _stimulus(scene, size, flat_like)
+    out = pipeline_fixed(inputs, scene, words, polygon, texels)
     best = float("inf")
     for _ in range(3):
         t0 = time.perf_counter()
-        pipeline_fixed(inputs, scene, words, polygon)
+        pipeline_fixed(inputs, scene, words, polygon, texels)
         best = min(best, time.perf_counter() - t0)
     return out, best
 
@@ -96,7 +98,8 @@ def _row(name, size, work):
         return {"scene": name, "status": "not available", "reason": str(e)}
     on_out, on_t = _golden(scene, size)
     off_out, off_t = _golden(off, size, flat_like=scene if scene.bump_map == "flat" else None)
-    same = scene.shading == "per-pixel" and np.array_equal(on_out["color"], off_out["color"])
+    colors = [k for k in on_out if k.startswith("color")]      # grey, or color.r/g/b
+    same = scene.shading == "per-pixel" and all(np.array_equal(on_out[k], off_out[k]) for k in colors)
     return {"scene": name, "status": "ok", "skipped": skipped,
             "on": {"golden_s": on_t, **_cost(scene, work)},
             "off": {"golden_s": off_t, **_cost(off, work)}, "same_image": same}
