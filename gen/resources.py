@@ -25,7 +25,7 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
 """
 
 import json
-import shutil
+import re
 import subprocess
 from collections import Counter
 from dataclasses import asdict, dataclass, field
@@ -219,6 +219,16 @@ def run_yosys(commands, log_name, cwd):
     return out
 
 
+_ZERO_INIT = re.compile(r"^ *initial begin\n(?: *\\?[\w$.]+ *\[\d+\] = \d+'[dh]0+;\n)+ *end\n", re.M)
+
+
+def strip_zero_init(text):
+    """Drop memory ``initial`` blocks that only write zeros (a RAM filled by its host port,
+    e.g. the palette's colour table): Yosys's front end takes minutes on 2 x 16384 such
+    lines and a zero-initialised RAM costs the same hardware. Non-zero ROM contents stay."""
+    return _ZERO_INIT.sub("", text)
+
+
 def count_verilog(v_path, top, work_dir=None):
     """Synthesize ``v_path`` (top module ``top``) with :data:`SCRIPT` and count it."""
     v_path = Path(v_path)
@@ -227,7 +237,7 @@ def count_verilog(v_path, top, work_dir=None):
     work_dir = Path(work_dir or v_path.parent).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
     src = f"{top}.in.v"                       # YoWASP only sees its working directory
-    shutil.copyfile(v_path, work_dir / src)
+    (work_dir / src).write_text(strip_zero_init(v_path.read_text()))
     run_yosys(f"read_verilog {src}; hierarchy -check -top {top}; {SCRIPT}; "
               f"write_json {top}.coarse.json", f"{top}.coarse.log", work_dir)
     return count_netlist(json.loads((work_dir / f"{top}.coarse.json").read_text()), top)

@@ -108,3 +108,20 @@ def test_unknown_top_shows_yosys_message(build_dir):
     ok.write_text("module ok(input a, output b); assign b = a; endmodule\n")
     with pytest.raises(SynthesisError, match="ERROR.*nothere"):
         count_verilog(ok, "nothere", build_dir)
+
+
+def test_zero_initialised_ram_counts_the_same_without_its_init(tmp_path):
+    """strip_zero_init drops only all-zero memory inits: the palette RAM is still counted as
+    its 2 x sN x 32 bits (double-buffered), and a ROM's non-zero contents are kept."""
+    from bumprtl.gen.resources import strip_zero_init
+    from bumprtl.gen.units import emit_unit
+    from bumprtl.rtl.config import Config
+    v, _ = emit_unit("palette", Config(palette_size=64), tmp_path / "pal")
+    text = v.read_text()
+    stripped = strip_zero_init(text)
+    init = "\\table [127] = 32'd0;"                  # the last zero of the init block
+    assert init in text and init not in stripped
+    counts = count_verilog(v, "palette", tmp_path / "a")
+    assert counts.rams == [{"name": "table", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
+    rom, _ = emit_unit("sincos", Config(angle_bits=6, frac_bits=5), tmp_path / "rom")
+    assert strip_zero_init(rom.read_text()) == rom.read_text()       # non-zero contents stay
