@@ -248,7 +248,7 @@ def perpixel_point(ctx, method, a, b, opts):
              "error": perpixel_error(ctx, cfg), "speed": perpixel_speed(ctx, cfg),
              "cost": {**unit_cost(("rotation", "illumination"), cfg, ctx.work),
                       "map_bits_per_texel": map_bits_per_texel(cfg)}}
-    if fpga_selected(ctx.grid, a, b, opts):
+    if fpga_selected(ctx.grid, a, b, opts, method):
         _hardware(point, cfg, _pipeline, "pipeline", ctx, opts)
     if opts.sim and (a, b) == (Config().angle_bits, Config().frac_bits):
         point["speed"]["sim_pix_s"] = sim_rate(cfg, ctx.work)
@@ -258,11 +258,16 @@ def perpixel_point(ctx, method, a, b, opts):
 FPGA_POINTS = ("diagonal", "all")
 
 
-def fpga_selected(grid, a, b, opts):
+def fpga_selected(grid, a, b, opts, method="exact"):
     """Which width points ``--fpga`` places: ``all``, or ``diagonal`` (the i-th angle width
-    with the i-th value width: cost against precision at a quarter of the flow time)."""
+    with the i-th value width: cost against precision at a quarter of the flow time). With
+    ``diagonal`` the baselines are placed at the default widths only: their combinational
+    dividers and square roots take synth_ecp5 10+ minutes per point."""
     if getattr(opts, "fpga_points", "all") == "all":
         return True
+    if method in BASELINES:
+        from ..rtl.config import Config
+        return (a, b) == (Config().angle_bits, Config().frac_bits)
     ia, ib = grid.angle_bits.index(a), grid.frac_bits.index(b)
     return ia == ib
 
@@ -507,7 +512,8 @@ def add_parser(sub):
     p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
     p.add_argument("--fpga-points", default="diagonal", choices=FPGA_POINTS,
                    help="with --fpga: place every width point (all) or the i-th angle width with "
-                        "the i-th value width only (diagonal, default); palette sizes always")
+                        "the i-th value width only (diagonal, default; baselines at the default "
+                        "widths only); palette sizes always")
     p.add_argument("--sim", action="store_true",
                    help="cocotb/Verilator pixels/s for the points at the default widths")
     p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
