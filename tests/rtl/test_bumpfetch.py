@@ -92,3 +92,32 @@ def test_host_write_port_replaces_texels():
 def test_init_of_the_wrong_size_is_rejected():
     with pytest.raises(ValueError, match="words"):
         BumpMapFetch(load_scene_config({"texture_size": 16}), init=[0] * 10)
+
+
+@pytest.mark.parametrize("keys", [{"texture": True, "mip_levels": 2, "addressing": "clamp"},
+                                  {"texture": True, "bump_map": "flat"}])
+def test_texture_ram_read_at_the_same_address(keys):
+    """The colour texture is read beside the map at the same (u, v, level); a flat map
+    keeps only the texture RAM (no map port). Against the independent reference."""
+    from bumprtl.sim.golden.fixed_pipeline import random_texture
+    scene = load_scene_config({"texture_size": 16, **keys})
+    rng = np.random.default_rng(11)
+    words = random_map(scene, rng) if scene.bump_map == "varying" else None
+    texels = random_texture(scene, rng)
+    inputs = random_inputs(scene, 300, rng)
+    payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
+                for n in range(300)]
+    dut = BumpMapFetch(scene, init=words, texture=texels)
+    assert ("w_en" in dut.signature.members) == (words is not None)
+    out, _ = simulate_stream(dut, payloads, "backpressure")
+    got = [o["texel.r"] | (o["texel.g"] << 8) | (o["texel.b"] << 16) for o in out]
+    want = [reference_word(texels, p["u"], p["v"], p.get("level", 0), scene) for p in payloads]
+    assert got == want and [o["tag"] for o in out] == [p["tag"] for p in payloads]
+    if words is not None:
+        flat = [o["b.phi"] | (o["b.theta"] << scene.angle_bits) for o in out]
+        assert flat == [reference_word(words, p["u"], p["v"], p.get("level", 0), scene) for p in payloads]
+
+
+def test_texture_words_need_a_textured_scene():
+    with pytest.raises(ValueError, match="texture = false"):
+        BumpMapFetch(load_scene_config({"texture_size": 16}), texture=[0] * 256)
