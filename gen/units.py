@@ -90,9 +90,9 @@ def _pipeline_sidecar(scene, dut):
 
 
 def _fetch_sidecar(scene, dut):
-    from ..rtl.bumpfetch import fetched_field, level_bases
+    from ..rtl.bumpfetch import fetched_fields, level_bases
     return {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
-            "throughput": 1, "output": fetched_field(scene), "level_bases": level_bases(scene),
+            "throughput": 1, "outputs": fetched_fields(scene), "level_bases": level_bases(scene),
             "memory_bits": dut.memory_bits, "addressing": scene.addressing}
 
 

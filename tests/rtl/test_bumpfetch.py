@@ -121,3 +121,13 @@ def test_texture_ram_read_at_the_same_address(keys):
 def test_texture_words_need_a_textured_scene():
     with pytest.raises(ValueError, match="texture = false"):
         BumpMapFetch(load_scene_config({"texture_size": 16}), texture=[0] * 256)
+
+
+@pytest.mark.parametrize("name, outputs", [("default", ["b"]), ("palette", ["index"]),
+                                           ("textured", ["b", "texel"])])
+def test_fetch_sidecar_lists_every_output(name, outputs):
+    from bumprtl.gen.units import build_unit
+    from bumprtl.rtl.scene import load_scene_config
+    dut, sidecar, _ = build_unit("fetch", load_scene_config(name))
+    assert sidecar["outputs"] == outputs
+    assert set(outputs) <= set(dut.o.payload.shape().members)
