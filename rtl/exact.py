@@ -13,10 +13,10 @@ from .config import Config
 from .fixed import round_shift
 from .illumination import IlluminationDatapath
 from .layouts import pixel_layout
-from .pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
-from .sincos import registered_quarter_wave_rom, sine_read
+from .pipe import PRODUCT_LATENCY, StallPipe
+from .sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
 
-__all__ = ["Rotation", "Illumination", "rotated_layout"]
+__all__ = ["Rotation", "Illumination", "SineBank", "rotated_layout", "vector_terms"]
 
 
 def vectors(cfg: Config):
@@ -35,8 +35,12 @@ def rotated_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-class _SineBank:
-    """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA)."""
+class SineBank:
+    """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
+    a value read appears ``latency`` ``adv`` stages after its angle (angle register, read,
+    block-RAM output register, sign)."""
+
+    latency = REGISTERED_SINE_LATENCY
 
     def __init__(self, m, pipe, cfg):
         self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], []
@@ -55,6 +59,24 @@ class _SineBank:
         return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)
 
 
+def vector_terms(pipe, bank, vec, n_phi, name, latency):
+    """The per-vector half of the exact rotation for a vector A = ``vec`` (polar angles):
+    D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
+      2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A)
+    read from ``bank`` (a :class:`SineBank`) and delayed to ``latency`` ``adv`` stages
+    after the input. Shared by :class:`Rotation` and ``pipeline.VectorTerms``, so units
+    built from it run in lock step."""
+    bits = bank.cfg.angle_bits                          # binary angles wrap (mod 2**bits)
+    d = pipe.register((vec.phi - n_phi)[:bits], f"{name}_d")             # input stage
+    th = pipe.register(vec.theta, f"{name}_th")
+    x, y = th + d, th - d
+    terms = {"p2": bank.sin(x, f"{name}_sx") + bank.sin(y, f"{name}_sy"),
+             "y2": bank.cos(y, f"{name}_cy") - bank.cos(x, f"{name}_cx"),
+             "z": bank.cos(th, f"{name}_cth")}
+    return {k: pipe.delay(v, latency - 1 - SineBank.latency, f"{name}_{k}")
+            for k, v in terms.items()}
+
+
 class Rotation:
     """VectorRotation datapath, exact method (elaborated into ``rotation.VectorRotation``).
 
@@ -65,11 +87,11 @@ class Rotation:
       4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
-    Latency 5 (ROM read, block-RAM output register, sign, two adder levels); 1 pixel per
-    clock.
+    Latency 7: the input sums (a, b, D), SineBank.latency (read angle, ROM read, block-RAM
+    output register, sign), two adder levels; 1 pixel per clock.
     """
 
-    latency = ROM_LATENCY + 3          # read, output register, sign, two adder levels
+    latency = 1 + SineBank.latency + 2
 
     def __init__(self, cfg: Config):
         self.cfg = cfg
@@ -78,10 +100,12 @@ class Rotation:
     def build(self, m, i, o):
         cfg = self.cfg
         pipe = StallPipe(m, i, o, self.latency)
-        rom = _SineBank(m, pipe, cfg)
+        rom = SineBank(m, pipe, cfg)
         px, o = i.payload, o.payload
         t, bt, bp = px.n.theta, px.b.theta, px.b.phi
-        a, b = bt + bp, bt - bp
+        bits = cfg.angle_bits                  # input stage: a, b registered (mod 2**bits)
+        a, b = pipe.register((bt + bp)[:bits], "a"), pipe.register((bt - bp)[:bits], "b")
+        t, bt = pipe.register(t, "t"), pipe.register(bt, "bt")
         s = {f"s{n}": rom.sin(x, f"n_s{n}") for n, x in
              enumerate((a + t, a - t, b + t, b - t, t + bt, t - bt))}
         c = {f"c{n}": rom.cos(x, f"n_c{n}") for n, x in
@@ -96,13 +120,8 @@ class Rotation:
         for name, value in sums.items():
             m.d.comb += o.n[name].eq(reg(value, f"n_{name}"))
         for v in vectors(cfg):
-            th, d = px[v].theta, px[v].phi - px.n.phi
-            x, y = th + d, th - d
-            terms = {"p2": rom.sin(x, f"{v}_sx") + rom.sin(y, f"{v}_sy"),
-                     "y2": rom.cos(y, f"{v}_cy") - rom.cos(x, f"{v}_cx"),
-                     "z": rom.cos(th, f"{v}_cth")}
-            for name, value in terms.items():
-                m.d.comb += o[v][name].eq(pipe.delay(value, 2, f"{v}_{name}"))
+            for name, value in vector_terms(pipe, rom, px[v], px.n.phi, v, self.latency).items():
+                m.d.comb += o[v][name].eq(value)
         m.d.comb += o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
 
 

@@ -25,7 +25,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from .bumpfetch import BumpMapFetch, has_map
-from .exact import Rotation as ExactRotation, _SineBank, rotated_layout
+from .exact import Rotation as ExactRotation, SineBank, rotated_layout, vector_terms
 from .fixed import round_shift
 from .illumination import Illumination
 from .layouts import angle_shape, pixel_layout, polar_layout, shade_layout
@@ -46,9 +46,9 @@ def _vector_layout(cfg):
 class VectorTerms(wiring.Component):
     """The per-vector half of the exact rotation (DESIGN §3) for vectors ``names``:
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D, 2p = s(X) + s(Y), 2y = c(Y) - c(X),
-    z = c(th_A). Same arithmetic and latency (5) as ``exact.Rotation``'s vector terms, so it
-    runs in lock step beside it. Input {n_phi, <name>: polar, tag}; output {<name>: p2, y2,
-    z, tag}."""
+    z = c(th_A). Built by ``exact.vector_terms``, the function ``exact.Rotation`` uses, with
+    the same latency, so it runs in lock step beside it. Input {n_phi, <name>: polar, tag};
+    output {<name>: p2, y2, z, tag}."""
 
     latency = ExactRotation.latency
 
@@ -63,16 +63,11 @@ class VectorTerms(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency)
-        rom = _SineBank(m, pipe, self.cfg)
+        rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
         for v in self.names:
-            th, d = px[v].theta, px[v].phi - px.n_phi
-            x, y = th + d, th - d
-            terms = {"p2": rom.sin(x, f"{v}_sx") + rom.sin(y, f"{v}_sy"),
-                     "y2": rom.cos(y, f"{v}_cy") - rom.cos(x, f"{v}_cx"),
-                     "z": rom.cos(th, f"{v}_cth")}
-            for name, value in terms.items():
-                m.d.comb += out[v][name].eq(pipe.delay(value, 2, f"{v}_{name}"))
+            for name, value in vector_terms(pipe, rom, px[v], px.n_phi, v, self.latency).items():
+                m.d.comb += out[v][name].eq(value)
         m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
         return m
 

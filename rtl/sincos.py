@@ -9,7 +9,11 @@ from .config import Config
 from .pipe import ROM_LATENCY, StallPipe
 from .tables import quarter_sine
 
-__all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read"]
+__all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
+           "REGISTERED_SINE_LATENCY"]
+
+# sine_read(registered=True): angle register, ROM read, block-RAM output register, sign.
+REGISTERED_SINE_LATENCY = 1 + ROM_LATENCY + 1
 
 
 def quarter_wave_rom(cfg: Config):
@@ -27,16 +31,18 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
 def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
-    ROM_LATENCY + 1 stages later from a :class:`pipe.RegisteredROM` port with
-    ``registered`` (ROM read, block-RAM output register, then sign: the block RAM's
-    clock-to-out then does not share a cycle with the negation). ``cos(a)`` is
-    ``sin(a + 2**k)``.
+    REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
+    ``registered`` (the angle, ROM read, block-RAM output register, then sign: the angle's
+    adder, the mirrored address ``2**k - i`` and the block RAM's clock-to-out each get a
+    cycle of their own). ``cos(a)`` is ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
     """
     k = cfg.k
     a = angle[:cfg.angle_bits]
+    if registered:
+        a = pipe.register(a, f"{name}_angle")
     quadrant, index = a[k:], a[:k]
     m.d.comb += port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))
     if registered:
@@ -63,8 +69,8 @@ class SinCos(wiring.Component):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency ROM_LATENCY + 1 = 3 cycles (ROM read, block-RAM output register, sign);
-    throughput 1 angle per clock when not stalled.
+    Latency REGISTERED_SINE_LATENCY = 4 cycles (angle, ROM read, block-RAM output
+    register, sign); throughput 1 angle per clock when not stalled.
     """
 
     def __init__(self, cfg: Config):
@@ -83,7 +89,7 @@ class SinCos(wiring.Component):
 
     @property
     def latency(self):
-        return ROM_LATENCY + 1
+        return REGISTERED_SINE_LATENCY
 
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
