@@ -76,7 +76,26 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF):
     target = lpf_mhz(lpf)
     return {"unit": top, "device": device, **used,
             "fmax_mhz": round(fmax, 1) if fmax is not None else None,
-            "target_mhz": target, "met": fmax is not None and fmax >= target}
+            "target_mhz": target, "met": fmax is not None and fmax >= target,
+            "critical_path": critical_path(report)}
+
+
+def _cell(end):
+    """A netlist cell name without the suffixes Yosys/nextpnr add to mapped cells."""
+    name = re.sub(r"_(TRELLIS_FF|LUT4|CCU2C|TRELLIS_COMB)[^.]*$", "", end["cell"])
+    return f"{name}.{end['port']}"
+
+
+def critical_path(report):
+    """nextpnr's worst clk -> clk path: 'start -> end (logic ns + routing ns)', or None."""
+    paths = report.get("critical_paths") or []
+    if not paths or not paths[0].get("path"):
+        return None
+    steps = paths[0]["path"]
+    routing = sum(s["delay"] for s in steps if s["type"] == "routing")
+    logic = sum(s["delay"] for s in steps) - routing
+    return (f"{_cell(steps[0]['from'])} -> {_cell(steps[-1]['to'])} "
+            f"({logic:.2f} ns logic + {routing:.2f} ns routing)")
 
 
 def fpga_unit(name, cfg, device, work_dir, lpf=LPF):
@@ -115,6 +134,9 @@ def pipeline_component(cfg):
 
 def _component(design_method, row, cfg):
     from .units import build_unit
+    if row == "scene":              # the drop-in BumpPipeline of the default scene
+        from ..rtl.pipeline import BumpPipeline
+        return BumpPipeline("default")
     cfg = cfg.replace(method=design_method)
     if row == "pipeline":
         return pipeline_component(cfg)
@@ -160,6 +182,16 @@ def write_report(args, rows, acc):
                      f"{r['fmax_mhz']} | {'yes' if r['met'] else 'no'} | {a['max']} | {a['mean']:.4f} |")
     if _plot(rows, acc, plot):
         lines += ["", f"![LUT4 of the pipeline against diffuse error](img/{plot.name})"]
+    lines += ["", "## Critical paths", "",
+              "nextpnr's worst register-to-register path of each unit (start -> end cell.port):", ""]
+    lines += [f"- {r['unit']}: {r['critical_path']}" for r in rows]
+    target = [r for r in rows if r["unit"] == "exact_pipeline"]
+    if target:
+        r = target[0]
+        lines += ["", "## Notes", "",
+                  f"- Target of issue 7, the default exact pipeline at >= {r['target_mhz']:g} MHz "
+                  f"and 1 pixel per clock: {'met' if r['met'] else 'not met'} "
+                  f"({r['fmax_mhz']} MHz, speed grade 6, out of context)."]
     out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
     print(f"wrote {out}")
 
@@ -191,20 +223,34 @@ def _plot(rows, acc, path):
 
 
 FPGA_NOTES = """
-## Notes
-
-- The Fmax target of issue 7 (the default exact pipeline at >= 150 MHz) is not reached;
-  the numbers above are what nextpnr reports (speed grade 6, out of context).
-- The exact datapath was pipelined for this report: a plain register after every block-RAM
-  read (sine ROMs, specular table), two registered adder levels for n'', the Phong
-  products in their own stage, 255 x diffuse as a carry chain instead of a DSP block, and a
-  specular table of 2^10 + 1 entries that fits one DP16KD (`Config.spec_index_bits`). That
-  took the exact pipeline from 48.8 MHz to the figure above; the bits computed are the same
-  (the bit-exact tests read the latency from each unit).
-- What is left: the exact setup is bounded by the DP16KD clock-to-out itself (5.8 ns
-  without the block RAM's internal output register, which this Yosys flow does not infer)
-  plus routing into the next flip-flop; the illumination and pipeline paths are a 3-term
-  carry chain (the Phong sum or the dot's rounding) and its routing. The lee datapath was
-  not pipelined further (its setup runs ROM, multiply and ROM in few stages).
-- Units are placed out of context: no I/O buffers, ports are internal nets.
+- How the exact datapath was pipelined (every unit keeps 1 pixel per clock and its
+  bit-exact tests; each unit's `latency` property counts the stages): the input angle sums
+  (a, b, D) and every read angle are registered, so the mirrored quarter-wave address
+  `2**k - i` (`rtl/sincos.sine_read`) has a cycle of its own; the block RAMs use their
+  own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
+  about 1 ns clock-to-out instead of 5.8 ns; the 1025th word of the quarter-wave and
+  specular tables is kept in a flip-flop so each table is one 1024 x 18 block); every
+  product uses the DSP's input and output registers (`rtl/pipe.RegisteredProduct`:
+  MULT18X18D with REG_INPUTA/B and REG_OUTPUT, about 3.9 ns of DSP delay taken out of
+  the cycle); the n'' sums are two registered adder levels; the dot N'.A' and the Phong
+  sum of eq. 2 each run as two 2-operand carry-chain stages (the rounding half is folded
+  into an operand); 255 x diffuse is a shift-and-subtract.
+- Yosys `synth_ecp5` infers neither block-RAM output registers nor DSP registers, so
+  `report fpga` elaborates with the `rtl.pipe.ECP5` hint, which instantiates DP16KD and
+  MULT18X18D with those registers; every simulator (and `bumprtl emit`) runs the generic
+  form with the same registers. `tests/rtl/test_pipe.py` checks the generic form bit for
+  bit and the DP16KD contents against Yosys' own block-RAM mapping; neither Yosys nor
+  this repository has a simulation model of the two primitives, so the ECP5 form itself
+  is checked structurally only.
+- What limits Fmax now is in the critical-path list above (nextpnr reports the worst
+  path only; the next ones are not listed). The stall enable `adv = ~o.valid | o.ready` (`rtl/pipe.py`) still
+  fans out combinationally to every enable; it is not on a critical path at this target.
+- scene_default is the drop-in `BumpPipeline` of the default scene (fetch -> rotation
+  -> illumination, 64^2 bump map in block RAM). Its limit is `rtl/bumpfetch.py`'s
+  bump-map RAM read: an unregistered DP16KD (5.8 ns clock-to-out) feeding the rotation's
+  input adders in the same cycle; registering that read is the fetch unit's change.
+- The lee datapath was not pipelined further (its setup runs ROM, multiply and ROM in
+  few stages).
+- Units are placed out of context: no I/O buffers, ports are internal nets, so paths
+  from a unit's input ports are not timed (the pipelines time them between units).
 """
