@@ -28,20 +28,21 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
     return pipe.rom(quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
 
 
-def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False):
+def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
     ``registered`` (the angle, ROM read, block-RAM output register, then sign: the angle's
     adder, the mirrored address ``2**k - i`` and the block RAM's clock-to-out each get a
-    cycle of their own). ``cos(a)`` is ``sin(a + 2**k)``.
+    cycle of their own; ``angle_stage=False`` when the caller registered ``angle``
+    itself and counts that stage). ``cos(a)`` is ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
     """
     k = cfg.k
     a = angle[:cfg.angle_bits]
-    if registered:
+    if registered and angle_stage:
         a = pipe.register(a, f"{name}_angle")
     quadrant, index = a[k:], a[:k]
     m.d.comb += port.addr.eq(Mux(quadrant[0], (1 << k) - index, index))
@@ -96,9 +97,9 @@ class SinCos(wiring.Component):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency)
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
-        angle = self.i.payload.angle
+        angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
-                                   registered=True)
+                                   registered=True, angle_stage=False)
                    for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)))}
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),
