@@ -61,7 +61,8 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF):
     flag = check_device(device)
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(v_path, work_dir / f"{top}.in.v")      # YoWASP sees its cwd only
+    from .resources import strip_zero_init                # a zero-filled RAM: same cells
+    (work_dir / f"{top}.in.v").write_text(strip_zero_init(Path(v_path).read_text()))  # YoWASP sees its cwd only
     shutil.copyfile(lpf, work_dir / "clock.lpf")
     run_yosys(f"read_verilog {top}.in.v; synth_ecp5 -top {top} -json {top}.ecp5.json",
               f"{top}.synth.log", work_dir)
