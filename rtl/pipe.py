@@ -37,8 +37,11 @@ class RegisteredProduct(Elaboratable):
     REG_OUTPUT, so on ECP5 (``platform`` :class:`ECP5`) the whole product is one DSP block
     and the generic form (plain ``*`` between flip-flops) is what every simulator runs."""
 
-    def __init__(self, a_shape, b_shape, name):
-        self.a, self.b = Signal(a_shape, name=f"{name}_a"), Signal(b_shape, name=f"{name}_b")
+    def __init__(self, a_shape, b_shape, name, b_const=None):
+        """``b_const``: ``b`` is this constant (no operand register; a constant multiply
+        stays one in the netlist counts of gen/resources.py)."""
+        self.a = Signal(a_shape, name=f"{name}_a")
+        self.b = Signal(b_shape, name=f"{name}_b") if b_const is None else Const(b_const, b_shape)
         self.en = Signal(name=f"{name}_en")
         self.p = Signal((self.a * self.b).shape(), name=name)
 
@@ -63,9 +66,12 @@ class RegisteredProduct(Elaboratable):
                 i_SOURCEB=Const(0, 1), i_CLK0=ClockSignal(), i_CE0=self.en, i_RST0=Const(0, 1),
                 **ports)
             return m
-        a, b = Signal.like(self.a, name="a_r"), Signal.like(self.b, name="b_r")
+        a = Signal.like(self.a, name="a_r")
+        b = self.b if isinstance(self.b, Const) else Signal.like(self.b, name="b_r")
         with m.If(self.en):
-            m.d.sync += [a.eq(self.a), b.eq(self.b), self.p.eq(a * b)]
+            m.d.sync += [a.eq(self.a), self.p.eq(a * b)]
+            if b is not self.b:
+                m.d.sync += b.eq(self.b)
         return m
 
 
@@ -191,9 +197,12 @@ class StallPipe:
     def multiply(self, a, b, name):
         """``a * b`` PRODUCT_LATENCY ``adv`` stages later (:class:`RegisteredProduct`)."""
         a, b = Value.cast(a), Value.cast(b)
-        unit = RegisteredProduct(a.shape(), b.shape(), name)
+        const = b.value if isinstance(b, Const) else None
+        unit = RegisteredProduct(a.shape(), b.shape(), name, b_const=const)
         self.m.submodules[name] = unit
-        self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.adv)]
+        self.m.d.comb += [unit.a.eq(a), unit.en.eq(self.adv)]
+        if const is None:
+            self.m.d.comb += unit.b.eq(b)
         return unit.p
 
     def delay(self, value, stages, name):

@@ -65,6 +65,21 @@ def test_registered_product_is_the_product_two_enables_later(a_shape, b_shape):
         assert p == a * b, (a, b, p)
 
 
+def test_constant_operand_stays_a_constant():
+    """b_const (the Phong coefficients): same latency, and no operand register for b."""
+    dut = RegisteredProduct(unsigned(8), unsigned(8), "p", b_const=179)
+
+    def drive(ctx, rng):
+        a = int(rng.integers(0, 256))
+        ctx.set(dut.a, a)
+        return a
+
+    got = run_enabled(dut, drive, dut.p, PRODUCT_LATENCY - 1, 1000, seed=4)
+    assert len(got) > 300 and all(p == a * 179 for a, p in got)
+    text = verilog.convert(dut, name="p", ports=[dut.a, dut.en, dut.p], emit_src=False)
+    assert "b_r" not in text and "a_r" in text
+
+
 @pytest.mark.parametrize("ports", [1, 2])
 def test_registered_rom_reads_two_enables_later(ports):
     table = specular_table(Config()).tolist()            # 1025 words, the shade table
