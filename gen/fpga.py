@@ -226,8 +226,9 @@ def _plot(rows, acc, path):
 FPGA_NOTES = """
 - How the exact datapath was pipelined (every unit keeps 1 pixel per clock and its
   bit-exact tests; each unit's `latency` property counts the stages): the input angle sums
-  (a, b, D) and every read angle are registered, so the mirrored quarter-wave address
-  `2**k - i` (`rtl/sincos.sine_read`) has a cycle of its own; the block RAMs use their
+  (a, b, D), every read angle and every ROM address are registered, so the angle adders,
+  the mirrored quarter-wave address `2**k - i` (`rtl/sincos.sine_read`) and the route to
+  the block RAM's address pins each have a cycle of their own; the block RAMs use their
   own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
   about 1 ns clock-to-out instead of 5.8 ns; the 1025th word of the quarter-wave and
   specular tables is kept in a flip-flop so each table is one 1024 x 18 block); every

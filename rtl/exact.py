@@ -37,8 +37,8 @@ def rotated_layout(cfg: Config):
 
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
-    a value read appears ``latency`` ``adv`` stages after its angle (angle register, read,
-    block-RAM output register, sign)."""
+    a value read appears ``latency`` ``adv`` stages after its angle (angle register,
+    address register, read, block-RAM output register, sign)."""
 
     latency = REGISTERED_SINE_LATENCY
 
@@ -87,8 +87,8 @@ class Rotation:
       4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
-    Latency 7: the input sums (a, b, D), SineBank.latency (read angle, ROM read, block-RAM
-    output register, sign), two adder levels; 1 pixel per clock.
+    Latency 8: the input sums (a, b, D), SineBank.latency (read angle, ROM address, ROM
+    read, block-RAM output register, sign), two adder levels; 1 pixel per clock.
     """
 
     latency = 1 + SineBank.latency + 2
