@@ -44,3 +44,18 @@ def test_report_fpga_every_design(build_dir):
     for design in ("exact", "lee"):
         for row in ("setup", "illumination", "pipeline"):
             assert f"| {design}_{row} |" in text
+
+
+def test_critical_path_names_the_endpoints_and_splits_the_delay():
+    """nextpnr's report JSON -> 'start -> end (logic + routing)', mapped-cell suffixes cut."""
+    step = lambda cell, port, kind, delay: {"from": {"cell": cell, "port": port},
+                                            "to": {"cell": cell, "port": port},
+                                            "type": kind, "delay": delay}
+    report = {"critical_paths": [{"from": "posedge clk", "to": "posedge clk", "path": [
+        step("rotation.n_c4_angle_TRELLIS_FF_Q_3", "Q", "clk-to-q", 0.5),
+        step("rotation.x_LUT4_Z", "F", "routing", 1.25),
+        step("rotation.x_LUT4_Z", "F", "logic", 0.25),
+        step("rotation.sine_rom1.bram", "ADB13", "setup", 0.25)]}]}
+    assert fpga.critical_path(report) == ("rotation.n_c4_angle.Q -> rotation.sine_rom1.bram.ADB13 "
+                                          "(1.00 ns logic + 1.25 ns routing)")
+    assert fpga.critical_path({}) is None
