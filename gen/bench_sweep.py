@@ -193,23 +193,10 @@ def unit_cost(units, cfg, work):
 
 
 def fpga_cost(component_fn, label, cfg, device, work):
-    """Place a component on ``device`` (gen/fpga.py), cached per emitted Verilog; adds the
-    device's capacity."""
-    from amaranth.back import verilog
-    from .fpga import place_and_route
-    d = work / "fpga" / device / _tag(cfg)
-    d.mkdir(parents=True, exist_ok=True)
-    v = d / f"{label}.v"
-    v.write_text(verilog.convert(component_fn(cfg), name=label, emit_src=False))
-
-    def compute():
-        row = place_and_route(v, label, device, d)
-        report = json.loads((d / f"{label}.pnr.json").read_text())["utilization"]
-        row["available"] = {k: report.get(n, {}).get("available") for k, n in
-                            (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
-        return row
-
-    return _cached(work / "fpga" / device / f"{_tag(cfg)}_{label}_{_digest(v.read_text())}.json", compute)
+    """Place a component on ``device`` with gen/fpga.py's ECP5 form (DSP and block-RAM
+    registers, as ``report fpga``), cached per emitted Verilog in the cache both share."""
+    from .fpga import place_component
+    return place_component(component_fn(cfg), label, device)
 
 
 def _pipeline(cfg):

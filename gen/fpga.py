@@ -144,19 +144,42 @@ def _component(design_method, row, cfg):
     return build_unit({"setup": "rotation", "illumination": "illumination"}[row], cfg)[0]
 
 
+CACHE = Path("build/fpga_cache")
+
+
+def place_component(component, label, device, cache=CACHE, lpf=LPF):
+    """Elaborate ``component`` for ECP5 (the ``rtl.pipe.ECP5`` hint: DSP and block-RAM
+    registers) as module ``label`` and place it; the row is cached under ``cache`` by the
+    digest of the Verilog, the device and the constraints, so ``report fpga`` and
+    ``bench sweep --fpga`` share every placement and a changed datapath is placed anew."""
+    import hashlib
+    from amaranth.back import verilog
+    text = verilog.convert(component, name=label, platform=ECP5(), emit_src=False)
+    key = hashlib.sha256("\0".join((text, device, Path(lpf).read_text())).encode()).hexdigest()[:16]
+    work = Path(cache) / device / f"{label}_{key}"
+    row_path = work / "row.json"
+    if row_path.is_file():
+        return json.loads(row_path.read_text())
+    work.mkdir(parents=True, exist_ok=True)
+    v_path = work / f"{label}.v"
+    v_path.write_text(text)
+    row = place_and_route(v_path, label, device, work, lpf)
+    report = json.loads((work / f"{label}.pnr.json").read_text())["utilization"]
+    row["available"] = {k: report.get(n, {}).get("available") for k, n in
+                        (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
+    row_path.write_text(json.dumps(row, indent=1))
+    return row
+
+
 def fpga_report(cfg, args, units):
     """Place ``units`` ((label, design, row) triples of report.fpga_units) on ``args.device``
     and write ``args.out`` (markdown table + cost-against-error plot)."""
-    from amaranth.back import verilog
     from .report import DESIGNS, accuracy
     rows = []
     for label, design, row in units:
-        work = Path(args.work) / label
-        work.mkdir(parents=True, exist_ok=True)
-        v_path = work / f"{label}.v"
-        v_path.write_text(verilog.convert(_component(DESIGNS[design][2], row, cfg), name=label,
-                                          platform=ECP5(), emit_src=False))
-        rows.append({**place_and_route(v_path, label, args.device, work), "design": design, "row": row})
+        placed = place_component(_component(DESIGNS[design][2], row, cfg), label, args.device,
+                                 args.work)
+        rows.append({**placed, "design": design, "row": row})
         print(f"{label}: {rows[-1]}", flush=True)
     acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}
     write_report(args, rows, acc)

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..rtl.config import BumpError, Config
 
-__all__ = ["PAPER", "DESIGNS", "paper_multiplier_savings", "count_design", "accuracy",
+__all__ = ["PAPER", "DESIGNS", "paper_multiplier_savings", "netlist_multiplier_savings",
+           "count_design", "accuracy",
            "table1_markdown", "add_parser"]
 
 # Lee et al. 2003, Table 1 (per pixel, L and H). None = "Not Available" in the paper.
@@ -35,6 +36,9 @@ PAPER = {
 
 # Our designs: name -> (setup unit, illumination unit, Config method) in gen/units.py.
 DESIGNS = {
+    "peercy": ("rotation", "illumination", "peercy"),   # rtl/baselines/ (Table 1's columns)
+    "kim": ("rotation", "illumination", "kim"),
+    "ernst": ("rotation", "illumination", "ernst"),
     "lee": ("rotation", "illumination", "lee"),
     "exact": ("rotation", "illumination", "exact"),
 }
@@ -59,6 +63,16 @@ def paper_multiplier_savings():
             ours = lee["setup"]["multipliers"] + lee["illumination"]["multipliers"]
         out[name] = (theirs, ours, 1 - ours / theirs)
     return out
+
+
+def netlist_multiplier_savings(counts):
+    """Like :func:`paper_multiplier_savings` but from our Yosys counts:
+    ``{baseline: (baseline_total, lee_total, saving)}`` for every counted baseline."""
+    total = lambda d: sum(c.summary()["multipliers"] for c in counts[d].values())
+    if "lee" not in counts:
+        return {}
+    return {d: (total(d), total("lee"), 1 - total("lee") / total(d))
+            for d in counts if d not in ("lee", "exact") and total(d)}
 
 
 def count_design(name, cfg, work_dir):
@@ -139,6 +153,14 @@ def table1_markdown(cfg, counts, acc, command):
     if lee:
         lines += ["", f"Our lee netlists have {lee.get('setup')} + {lee.get('illumination')} = "
                       f"{sum(lee.values())} two-signal multipliers, the paper's 6 + 2."]
+    measured = netlist_multiplier_savings(counts)
+    if measured:
+        lines += ["", "The same comparison on our netlists (two-signal multipliers, setup + "
+                      "illumination, the same Config for every design):", "",
+                  "| baseline | baseline multipliers | lee multipliers | saving |", "|---|---|---|---|"]
+        lines += [f"| {n} | {t} | {o} | {100 * v:.1f} % |" for n, (t, o, v) in measured.items()]
+        top = max(measured, key=lambda n: measured[n][2])
+        lines += ["", f"Measured, the largest saving is against {top} ({100 * measured[top][2]:.1f} %)."]
     lines += ["", METHOD_NOTES]
     return "\n".join(lines) + "\n"
 
@@ -184,8 +206,31 @@ is classified cell by cell:
 - **exact**: DESIGN §3's exact angular method; same budget of 6 two-signal multipliers
   but 24 sin/cos reads from 12 dual-port quarter-wave ROMs, and no asin/atan/reciprocal
   tables.
-- **Peercy, Kim, Ernst RTL** (`rtl/baselines/`) and **Kugler** (3 MB of maps, not built)
-  are not in the counted rows yet: see the status line at the end of this file.
+- **peercy** (`rtl/baselines/peercy.py`): Cartesian inputs T, B, N, L, H, N' as a Phong
+  rasterizer interpolates them. Setup: two 3x3 transforms (18 multipliers, 12 adders) and
+  the normalization of the transformed L and H, per vector 3 squares, 2 adders, 1 square
+  root, 3 dividers. The paper's 27 multipliers / 9 division units / 3 SQRts / 18 adders
+  are three vectors' worth of that normalization unit; only L and H need normalizing (N'
+  comes unit-length from the bump map), so we build two: 24 multipliers, 6 dividers,
+  2 square roots, 16 adders. Signs and rounding of the quotient are constant adders.
+  Illumination: the paper has none ("Not Available"); we give Peercy Ernst's
+  straightforward Phong so that its output can be measured.
+- **ernst** (`rtl/baselines/ernst.py`): the same setup hardware as Peercy (Ernst et al.
+  differ in how the bump map is built, k = -1, a preprocessing step). Illumination: the
+  two dot products N'.L_n, N'.H_n (6 multipliers) and the Phong back end with the power
+  (specular) table; the paper's 7th multiplier is our `KD x diffuse` constant product, and
+  its 5 adders are the 4 of the dots plus the Phong sum.
+- **kim** (`rtl/baselines/kim.py`; Kim 2001 is known only through Lee's summary, so the
+  datapath is partly reconstructed and the module says which parts): polar -> Cartesian
+  (sin/cos ROM reads, 2 products), the matrix of N rebuilt per pixel (4 products) and
+  applied to L and H (8 products each), back to polar without divider or square root
+  (reciprocal ROM + atan ROM by octant, asin ROM; 3 products): 30 multipliers against
+  the paper's 31, 9 ROMs against 6 LUTs (one sin/cos ROM with several reads counts once
+  here) and 12 two-signal adders against 18 (octant and quadrant logic lands among the
+  comparators and constant adders). Illumination: eqs (3)/(4), 3 products per vector:
+  the paper's 6 multipliers.
+- **kugler** (IMEM, 1 + 2 maps of up to 3 MB) is not built: its cost is the maps, which
+  are memory chips rather than datapath; it appears with the paper's numbers only.
 """
 
 
@@ -212,18 +257,23 @@ def run_table1(args):
 STATUS = """
 ## Status
 
-Not built yet: the baselines' RTL (`rtl/baselines/` peercy, kim, ernst) and their
-fixed-point golden models (`sim/golden/fixed_baselines.py`), so Peercy, Kim and Ernst
-appear with the paper's numbers only; their float64 models (`sim/golden/peercy.py`,
-`kim.py`) agree with the Cartesian reference to rounding (`bumprtl bench float64`).
+Peercy, Ernst and Kim are real RTL (`rtl/baselines/`) with bit-exact golden models
+(`sim/golden/fixed_peercy.py`, `fixed_ernst.py`, `fixed_kim.py`), checked bit for bit in
+`tests/rtl/test_baselines_*.py` and under cocotb in `tests/sim/test_tb_datapath.py`.
 Kugler's scheme (3 MB of light maps) is taken from the paper's description only.
 """
 
 
+BASELINE_DESIGNS = ("peercy", "kim", "ernst")
+
+
 def fpga_units(cfg):
-    """What ``report fpga`` places: every design's two units and their pipeline, then the
-    BumpPipeline of the default scene (fetch -> rotation -> illumination, exact)."""
-    return ([(f"{d}_{row}", d, row) for d in DESIGNS for row in ("setup", "illumination", "pipeline")]
+    """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
+    pipeline (setup -> illumination; their combinational dividers and square roots take
+    synth_ecp5 10+ minutes per netlist, so not each unit again), then the BumpPipeline of
+    the default scene (fetch -> rotation -> illumination, exact)."""
+    rows = lambda d: ("pipeline",) if d in BASELINE_DESIGNS else ("setup", "illumination", "pipeline")
+    return ([(f"{d}_{row}", d, row) for d in DESIGNS for row in rows(d)]
             + [("scene_default", "exact", "scene")])
 
 
@@ -260,7 +310,9 @@ def add_parser(sub):
     f.add_argument("--device", default="LFE5U-85F", help="LFE5U-25F, LFE5U-45F or LFE5U-85F")
     f.add_argument("--unit", action="append", help="place only this unit (repeatable)")
     f.add_argument("--out", type=Path, default=Path("docs/report.md"))
-    f.add_argument("--work", type=Path, default=Path("build/report/fpga"))
+    f.add_argument("--work", type=Path, default=Path("build/fpga_cache"),
+                   help="placements, cached by Verilog digest (shared with bench sweep --fpga; "
+                        "default: build/fpga_cache)")
     f.add_argument("--samples", type=int, default=100_000)
     add_config_flags(f, ("angle_bits", "frac_bits", "specular"))
     f.set_defaults(func=run_fpga)

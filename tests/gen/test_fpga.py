@@ -44,6 +44,30 @@ def test_report_fpga_every_design(build_dir):
     for design in ("exact", "lee"):
         for row in ("setup", "illumination", "pipeline"):
             assert f"| {design}_{row} |" in text
+    for design in ("peercy", "kim", "ernst"):
+        assert f"| {design}_pipeline |" in text
+
+
+def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
+    """report fpga and bench sweep share placements: the same Verilog is placed once, a
+    different one (another config) again."""
+    import json
+    from bumprtl.gen.units import build_unit
+    from bumprtl.rtl.config import Config
+    calls = []
+
+    def fake(v_path, top, device, work, lpf=fpga.LPF):
+        calls.append(v_path.read_text())
+        (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
+        return {"unit": top, "fmax_mhz": 1.0}
+
+    monkeypatch.setattr(fpga, "place_and_route", fake)
+    unit = lambda b: build_unit("sincos", Config(angle_bits=6, frac_bits=b))[0]
+    first = fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path)
+    assert fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path) == first
+    assert len(calls) == 1
+    fpga.place_component(unit(6), "sincos", "LFE5U-25F", tmp_path)
+    assert len(calls) == 2 and calls[0] != calls[1]
 
 
 def test_critical_path_names_the_endpoints_and_splits_the_delay():

