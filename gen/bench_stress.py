@@ -42,6 +42,7 @@ def _fixed_row(px, cfg):
 
 def stress_rows(n, seed, configs=None, cases=None):
     """Rows ``(config, case, method, stats)`` for every combination."""
+    from ..rtl.config import ALL_METHODS
     from ..sim.golden.conventional import conventional
     from ..sim.golden.models import FLOAT_MODELS
     from ..sim.golden.stress import CASES, STRESS_CONFIGS, stress_case
@@ -55,7 +56,7 @@ def stress_rows(n, seed, configs=None, cases=None):
                 rows += [(cname, case, f"{m} (float64)", _float_row(f, px, cfg, ref))
                          for m, f in FLOAT_MODELS.items()]
             rows += [(cname, case, f"{m} (fixed)", _fixed_row(px, cfg.replace(method=m)))
-                     for m in ("exact", "lee")]
+                     for m in ALL_METHODS]
     return rows
 
 

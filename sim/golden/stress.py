@@ -147,14 +147,13 @@ def rotate_azimuth(px: PixelInputs, delta):
 def payload_fields(cfg: Config):
     """``{field: (width, signed)}`` of the rotation unit's output and the illumination
     unit's output for ``cfg.method``: the widths every model value must fit in."""
+    import importlib
     from ...gen.emit import layout_fields
+    from ...rtl.config import datapath_module
     from ...rtl.layouts import shade_layout
-    if cfg.method == "exact":
-        from ...rtl.exact import rotated_layout
-    else:
-        from ...rtl.lee import rotated_layout
+    methods = importlib.import_module(f"bumprtl.rtl.{datapath_module(cfg.method)}")
     out = {}
-    for layout in (rotated_layout(cfg), shade_layout(cfg)):
+    for layout in (methods.Rotation(cfg).out_layout, shade_layout(cfg)):
         out.update({k: (w, s) for k, (_, w, s) in layout_fields(layout).items() if k != "tag"})
     return out
 
