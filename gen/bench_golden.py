@@ -26,6 +26,7 @@ def _sim_rate(cfg, sim, unit, samples, work):
     from ..sim.golden.vectors import edge_codes
     from ..sim.tb.runner import run_cocotb
     from .units import emit_unit
+    work = Path(work).resolve()          # cocotb runs in its build directory
     v, j = emit_unit(unit, cfg, work / "rtl")
     run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", work / f"{sim}_{unit}",
                {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": samples})

@@ -164,3 +164,14 @@ def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
     monkeypatch.setattr(units, "canonical_command", lambda unit, c: "changed datapath")
     bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert len(calls) == 2
+
+
+def test_sim_rate_with_a_relative_work_dir(tmp_path, monkeypatch):
+    """--sim measures cocotb pixels/s; a relative --work (the CLI default) must work although
+    cocotb runs in its own build directory."""
+    from pathlib import Path
+    from bumprtl.gen.bench_golden import _sim_rate
+    monkeypatch.chdir(tmp_path)
+    rate, build_s = _sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))
+    assert rate > 0 and build_s >= 0
+    assert (tmp_path / "rel" / "rtl" / "rotation.json").is_file()
