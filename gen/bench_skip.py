@@ -57,19 +57,25 @@ def _golden(scene, size, flat_like=None):
 
 
 def _cost(scene, work):
+    """Yosys counts of the scene's BumpPipeline, cached by the digest of its Verilog (a
+    changed datapath is counted anew)."""
+    import hashlib
+    from amaranth.back import verilog
     from .bench_sweep import _cached
-    from .resources import count_component
+    from .resources import count_verilog
     from ..rtl.pipeline import BumpPipeline
+    text = verilog.convert(BumpPipeline(scene), name="pipeline", emit_src=False)
+    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    netlist = work / "netlist" / scene.name
 
     def compute():
-        c = count_component(BumpPipeline(scene), "pipeline", work / "netlist" / scene.name)
+        netlist.mkdir(parents=True, exist_ok=True)
+        (netlist / "pipeline.v").write_text(text)
+        c = count_verilog(netlist / "pipeline.v", "pipeline", netlist)
         s = c.summary()
         return {**{k: s[k] for k in ("multipliers", "adders", "table_bits", "register_bits")},
                 "ram_bits": sum(r["bits"] for r in c.rams)}
 
-    import hashlib
-    key = repr(sorted((k, v) for k, v in scene.to_dict().items() if k != "name"))
-    digest = hashlib.sha1(key.encode()).hexdigest()[:12]
     return _cached(work / "cost" / f"{scene.name}_{digest}.json", compute)
 
 
