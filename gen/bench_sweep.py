@@ -242,18 +242,20 @@ def perpixel_point(ctx, method, a, b, opts):
     return point
 
 
-FPGA_POINTS = ("diagonal", "all")
+FPGA_POINTS = ("default", "diagonal", "all")
 
 
 def fpga_selected(grid, a, b, opts, method="exact"):
-    """Which width points ``--fpga`` places: ``all``, or ``diagonal`` (the i-th angle width
-    with the i-th value width: cost against precision at a quarter of the flow time). With
-    ``diagonal`` the baselines are placed at the default widths only: their combinational
-    dividers and square roots take synth_ecp5 10+ minutes per point."""
-    if getattr(opts, "fpga_points", "all") == "all":
+    """Which width points ``--fpga`` places: ``all``; ``diagonal`` (the i-th angle width with
+    the i-th value width: cost against precision at a quarter of the flow time; baselines
+    at the default widths only, their combinational dividers and square roots take
+    synth_ecp5 10+ minutes per point); or ``default`` (the default widths of every method,
+    the placements ``report fpga`` shares). Palette sizes are always placed."""
+    from ..rtl.config import Config
+    mode = getattr(opts, "fpga_points", "all")
+    if mode == "all":
         return True
-    if method in BASELINES:
-        from ..rtl.config import Config
+    if mode == "default" or method in BASELINES:
         return (a, b) == (Config().angle_bits, Config().frac_bits)
     ia, ib = grid.angle_bits.index(a), grid.frac_bits.index(b)
     return ia == ib
@@ -268,7 +270,13 @@ def map_bits_per_texel(cfg):
 def _hardware(point, cfg, component_fn, label, ctx, opts):
     if not opts.fpga:
         return
-    row = fpga_cost(component_fn, f"{point['method']}_{label}", cfg, opts.device, ctx.work)
+    from .fpga import FpgaError
+    from .resources import SynthesisError
+    try:
+        row = fpga_cost(component_fn, f"{point['method']}_{label}", cfg, opts.device, ctx.work)
+    except (FpgaError, SynthesisError) as e:      # e.g. does not fit: recorded, not fatal
+        point["cost"]["fpga_error"] = str(e).splitlines()[0][:300]
+        return
     point["cost"]["fpga"] = row
     if row.get("fmax_mhz"):
         point["speed"]["hw_pix_s"] = row["fmax_mhz"] * 1e6     # 1 pixel per clock (DESIGN §5)
@@ -399,6 +407,10 @@ def markdown(data, command, plot_paths=()):
     if other:
         lines += ["", "Not measured:", ""]
         lines += [f"- {point_label(p)}: **{p['status']}** — {p['reason']}" for p in other]
+    failed = [p for p in pts if p["cost"].get("fpga_error")]
+    if failed:
+        lines += ["", "FPGA flow failed (the point keeps its other columns):", ""]
+        lines += [f"- {point_label(p)}: {p['cost']['fpga_error']}" for p in failed]
     lines += [""] + [f"![{name}](img/{Path(path).name})" for name, path in plot_paths]
     return "\n".join(lines)
 
@@ -497,10 +509,10 @@ def add_parser(sub):
     p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
     p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
     p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
-    p.add_argument("--fpga-points", default="diagonal", choices=FPGA_POINTS,
-                   help="with --fpga: place every width point (all) or the i-th angle width with "
-                        "the i-th value width only (diagonal, default; baselines at the default "
-                        "widths only); palette sizes always")
+    p.add_argument("--fpga-points", default="default", choices=FPGA_POINTS,
+                   help="with --fpga: which width points to place: the default widths of every "
+                        "method (default), the i-th angle width with the i-th value width "
+                        "(diagonal; baselines at the default widths), or all; palette sizes always")
     p.add_argument("--sim", action="store_true",
                    help="cocotb/Verilator pixels/s for the points at the default widths")
     p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))

@@ -146,6 +146,9 @@ def test_fpga_points_diagonal_and_all():
     assert chosen == list(zip(grid.angle_bits, grid.frac_bits))
     assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
             if bench_sweep.fpga_selected(grid, a, b, diag, "peercy")] == [(12, 13)]
+    default = SimpleNamespace(fpga_points="default")
+    assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
+            if bench_sweep.fpga_selected(grid, a, b, default, "lee")] == [(12, 13)]
     every = SimpleNamespace(fpga_points="all")
     assert all(bench_sweep.fpga_selected(grid, a, b, every)
                for a in grid.angle_bits for b in grid.frac_bits)
