@@ -155,11 +155,14 @@ def place_component(component, label, device, cache=CACHE, lpf=LPF):
     import hashlib
     from amaranth.back import verilog
     text = verilog.convert(component, name=label, platform=ECP5(), emit_src=False)
-    key = hashlib.sha256("\0".join((text, device, Path(lpf).read_text())).encode()).hexdigest()[:16]
-    work = Path(cache) / device / f"{label}_{key}"
+    # The key ignores the module name: the same hardware under another label (Ernst's
+    # datapath is Peercy's, rtl/baselines/ernst.py) is placed once.
+    key = hashlib.sha256("\0".join((text.replace(label, "\0top"), device,
+                                     Path(lpf).read_text())).encode()).hexdigest()[:16]
+    work = Path(cache) / device / key
     row_path = work / "row.json"
     if row_path.is_file():
-        return json.loads(row_path.read_text())
+        return {**json.loads(row_path.read_text()), "unit": label}
     work.mkdir(parents=True, exist_ok=True)
     v_path = work / f"{label}.v"
     v_path.write_text(text)

@@ -68,6 +68,8 @@ def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
     assert len(calls) == 1
     fpga.place_component(unit(6), "sincos", "LFE5U-25F", tmp_path)
     assert len(calls) == 2 and calls[0] != calls[1]
+    renamed = fpga.place_component(unit(5), "other_name", "LFE5U-25F", tmp_path)
+    assert len(calls) == 2 and renamed["unit"] == "other_name"    # same hardware, placed once
 
 
 def test_critical_path_names_the_endpoints_and_splits_the_delay():
