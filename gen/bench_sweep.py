@@ -270,8 +270,11 @@ def map_bits_per_texel(cfg):
 def _hardware(point, cfg, component_fn, label, ctx, opts):
     if not opts.fpga:
         return
-    from .fpga import FpgaError
+    from .fpga import NOT_PLACED, FpgaError
     from .resources import SynthesisError
+    if point["method"] in NOT_PLACED:
+        point["cost"]["fpga_error"] = NOT_PLACED[point["method"]]
+        return
     try:
         row = fpga_cost(component_fn, f"{point['method']}_{label}", cfg, opts.device, ctx.work)
     except (FpgaError, SynthesisError) as e:      # e.g. does not fit: recorded, not fatal

@@ -272,8 +272,9 @@ def fpga_units(cfg):
     pipeline (setup -> illumination; their combinational dividers and square roots take
     synth_ecp5 10+ minutes per netlist, so not each unit again), then the BumpPipeline of
     the default scene (fetch -> rotation -> illumination, exact)."""
+    from .fpga import NOT_PLACED
     rows = lambda d: ("pipeline",) if d in BASELINE_DESIGNS else ("setup", "illumination", "pipeline")
-    return ([(f"{d}_{row}", d, row) for d in DESIGNS for row in rows(d)]
+    return ([(f"{d}_{row}", d, row) for d in DESIGNS if d not in NOT_PLACED for row in rows(d)]
             + [("scene_default", "exact", "scene")])
 
 
