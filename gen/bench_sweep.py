@@ -70,12 +70,14 @@ def error_lsb(point):
 
 def cost_key(point, device=None):
     """What "cheaper" means: on ``device`` (FPGA numbers) DSP, block RAM, then LUT4;
-    otherwise ROM+RAM bits, then multipliers, then adders."""
+    otherwise the arithmetic units (multipliers + dividers + square roots), then ROM+RAM
+    bits, then adders: a divider or a multiplier costs more than a few kbit of table."""
     cost = point["cost"]
     if device:
         f = cost["fpga"]
         return (f["DSP"], f["BRAM"], f["LUT4"])
-    return (cost["table_bits"] + cost["ram_bits"], cost["multipliers"], cost["adders"])
+    units = cost["multipliers"] + cost.get("dividers", 0) + cost.get("sqrts", 0)
+    return (units, cost["table_bits"] + cost["ram_bits"], cost["adders"])
 
 
 def pareto_front(points, x, y):

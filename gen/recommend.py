@@ -86,7 +86,8 @@ def _flags(p):
 def run(args):
     data = _load(args.sweep)
     best, meeting = recommend(data, args.max_error_lsb, args.device)
-    order = "DSP, block RAM, LUT4 on " + args.device if args.device else "ROM+RAM bits, multipliers, adders"
+    order = ("DSP, block RAM, LUT4 on " + args.device if args.device else
+             "multipliers + dividers + square roots, then ROM+RAM bits, then adders")
     print(f"cheapest configuration with worst measured error <= {args.max_error_lsb} LSB "
           f"(cheapest by {order}):\n")
     print(f"  {point_label(best)}: {_flags(best)}")

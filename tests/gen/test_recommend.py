@@ -44,9 +44,13 @@ def test_picks_cheapest_meeting_bound():
     assert recommend(TOY, 4)[0]["angle_bits"] == 10
 
 
-def test_ties_on_memory_broken_by_multipliers():
+def test_arithmetic_units_before_memory():
     data = {"points": [_point((12, 13), 1, 1000, mult=8), _point((12, 12), 1, 1000, mult=6)]}
     assert recommend(data, 1)[0]["frac_bits"] == 12
+    divider_heavy = _point((8, 9), 1, 4_000, mult=30)
+    divider_heavy["cost"].update(dividers=6, sqrts=2)
+    data = {"points": [divider_heavy, _point((12, 13), 1, 180_000, mult=6)]}
+    assert recommend(data, 1)[0]["angle_bits"] == 12      # 6 multipliers beat 30 + 6 + 2
 
 
 def test_none_meets_bound_names_smallest_error():
