@@ -59,13 +59,12 @@ def _golden(scene, size, flat_like=None):
 def _cost(scene, work):
     """Yosys counts of the scene's BumpPipeline, cached by the digest of its Verilog (a
     changed datapath is counted anew)."""
-    import hashlib
     from amaranth.back import verilog
-    from .bench_sweep import _cached
+    from .bench_sweep import _cached, _digest
     from .resources import count_verilog
     from ..rtl.pipeline import BumpPipeline
     text = verilog.convert(BumpPipeline(scene), name="pipeline", emit_src=False)
-    digest = hashlib.sha256(text.encode()).hexdigest()[:12]
+    digest = _digest(text)
     netlist = work / "netlist" / scene.name
 
     def compute():

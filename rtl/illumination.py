@@ -5,8 +5,8 @@ intensities and the Phong sum of eq. (2); it is shared by every method and mirro
 operation for operation by ``sim/golden/fixed_common.shade_fixed``.
 """
 
-from amaranth.hdl import Module, Mux, unsigned
-from amaranth.lib import stream, wiring
+from amaranth.hdl import Module, Mux, signed, unsigned
+from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from .config import BumpError, Config
@@ -90,10 +90,45 @@ class IlluminationDatapath:
                      o.payload.tag.eq(pipe.delay(i.payload.tag, self.latency, "tag"))]
 
 
-class MethodUnit(wiring.Component):
-    """A unit whose datapath is chosen by ``cfg.method``: the datapath object (from
-    rtl/exact.py or rtl/lee.py) gives the payload layouts and latency and elaborates straight
-    into this component's module, so the emitted Verilog is one module per unit."""
+class BackEnd(IlluminationDatapath):
+    """The shared back end of eq. (2) alone: N'.L' and N'.H' arrive on the stream (signed,
+    ``frac_bits`` fractional bits) and take one register; what a method's illumination adds
+    to it is its count minus this one's (tests/rtl/test_baselines_*.py)."""
+
+    dot_latency = 1
+
+    def __init__(self, cfg: Config):
+        b = cfg.frac_bits
+        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
+                                                 "tag": unsigned(cfg.tag_bits)}))
+
+    def dots(self, m, pipe, payload):
+        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
+
+
+class DatapathUnit(wiring.Component):
+    """A component around a datapath object (layouts, ``latency``, ``build``): the datapath
+    elaborates straight into this component's module, so the emitted Verilog is one module
+    per unit."""
+
+    def __init__(self, datapath):
+        self.datapath = datapath
+        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
+                          "o": Out(stream.Signature(datapath.out_layout))})
+
+    @property
+    def latency(self):
+        return self.datapath.latency
+
+    def elaborate(self, platform):
+        m = Module()
+        self.datapath.build(m, self.i, self.o)
+        return m
+
+
+class MethodUnit(DatapathUnit):
+    """A unit whose datapath is chosen by ``cfg.method`` (rtl/exact.py, rtl/lee.py or
+    rtl/baselines/<method>.py)."""
 
     _unit = None       # "Rotation" or "Illumination": the datapath class name
 
@@ -106,18 +141,7 @@ class MethodUnit(wiring.Component):
         except ModuleNotFoundError:
             raise BumpError(f"method {cfg.method!r}: rtl/{datapath_module(cfg.method).replace('.', '/')}"
                             f".py is not built in this checkout") from None
-        self.datapath = getattr(methods, self._unit)(cfg)
-        super().__init__({"i": In(stream.Signature(self.datapath.in_layout)),
-                          "o": Out(stream.Signature(self.datapath.out_layout))})
-
-    @property
-    def latency(self):
-        return self.datapath.latency
-
-    def elaborate(self, platform):
-        m = Module()
-        self.datapath.build(m, self.i, self.o)
-        return m
+        super().__init__(getattr(methods, self._unit)(cfg))
 
 
 class Illumination(MethodUnit):

@@ -10,7 +10,8 @@ import random
 from amaranth.lib import data
 from amaranth.sim import Simulator
 
-__all__ = ["PATTERNS", "simulate_stream", "assert_bit_exact"]
+__all__ = ["PATTERNS", "simulate_stream", "assert_bit_exact", "check_rotation",
+           "check_illumination", "check_datapath"]
 
 # name -> (probability of an input gap, probability of output backpressure)
 PATTERNS = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4)}
@@ -84,3 +85,38 @@ def assert_bit_exact(out, golden, inputs):
             bad = [n for n, (g, e) in enumerate(zip(got, golden[field])) if g != e]
             assert not bad, (f"{field}: {len(bad)} mismatches, first at {bad[0]}: RTL {got[bad[0]]} "
                              f"golden {golden[field][bad[0]]} (input {inputs[bad[0]]})")
+
+
+def check_rotation(cfg, codes, pattern="no_stall", seed=0):
+    """``VectorRotation(cfg)`` on the input ``codes``, bit for bit against the golden model
+    (sim/golden/fixed.py); returns ``(latency, cycles)``."""
+    from ..rtl.rotation import VectorRotation
+    from .golden.fixed import rotation_fixed
+    from .golden.vectors import as_payloads
+    inputs = as_payloads(codes, cfg)
+    dut = VectorRotation(cfg)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
+    assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
+    return dut.latency, cycles
+
+
+def check_illumination(cfg, codes, pattern="no_stall", seed=0):
+    """``Illumination(cfg)`` on the golden rotation output of ``codes``, bit for bit against
+    the golden model; returns ``(latency, cycles)``."""
+    from ..rtl.illumination import Illumination
+    from .golden.fixed import illumination_fixed, rotation_fixed
+    from .golden.vectors import as_payloads
+    rot = rotation_fixed(codes, cfg)
+    inputs = as_payloads(rot, cfg)
+    dut = Illumination(cfg)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
+    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
+    return dut.latency, cycles
+
+
+def check_datapath(cfg, codes, pattern="no_stall", seed=0):
+    """Both units bit-exact (the illumination on the golden rotation output); returns
+    ``cycles - latency`` of each (the pixel count when nothing stalls)."""
+    rot = check_rotation(cfg, codes, pattern, seed)
+    ill = check_illumination(cfg, codes, pattern, seed + 1)
+    return rot[1] - rot[0], ill[1] - ill[0]

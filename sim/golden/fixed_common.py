@@ -10,7 +10,8 @@ from ...rtl.fixed import round_shift
 from ...rtl.tables import phong_coefficients, specular_index_bits, specular_table
 from .common import PixelInputs
 
-__all__ = ["angle_codes", "quantize_pixels", "shade_fixed"]
+__all__ = ["angle_codes", "quantize_pixels", "shade_fixed", "polar_rotation_fixed",
+           "polar_illumination_fixed"]
 
 
 def angle_codes(angle_rad, cfg: Config):
@@ -46,3 +47,27 @@ def shade_fixed(ndotl, ndoth, cfg: Config):
     ka, kd, ks = phong_coefficients(cfg)
     color = np.clip(round_shift(ka + kd * diffuse + ks * specular, 8), 0, 255)
     return {"diffuse": diffuse, "specular": specular, "color": color}
+
+
+def polar_rotation_fixed(rotate, codes, cfg: Config):
+    """The rotation unit of a polar method (lee, kim): ``rotate(a_phi, a_theta, n_phi,
+    n_theta, cfg) -> (ph_A', th_A')`` for L (and H with specular), N' passed through."""
+    from .fixed_exact import vectors
+    out = {}
+    for v in vectors(cfg):
+        out[f"{v}.phi"], out[f"{v}.theta"] = rotate(
+            codes[f"{v}.phi"], codes[f"{v}.theta"], codes["n.phi"], codes["n.theta"], cfg)
+    out["b.phi"] = np.asarray(codes["b.phi"], dtype=np.int64)
+    out["b.theta"] = np.asarray(codes["b.theta"], dtype=np.int64)
+    return out
+
+
+def polar_illumination_fixed(illuminate, rot, cfg: Config):
+    """The illumination unit of a polar method: ``illuminate(a_phi, a_theta, b_phi, b_theta,
+    cfg) -> N'.A'`` per vector, then the shared back end (ndotl, ndoth, 8-bit shades)."""
+    from .fixed_exact import vectors
+    dots = {v: illuminate(rot[f"{v}.phi"], rot[f"{v}.theta"], rot["b.phi"], rot["b.theta"], cfg)
+            for v in vectors(cfg)}
+    ndotl = dots["l"]
+    ndoth = dots.get("h", np.zeros_like(ndotl))
+    return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}

@@ -26,8 +26,7 @@ from ...rtl.lee import (below_horizon, magnitude, phi_quadrant, prop_address, qu
                         ratio_index, theta_from_prop)
 from ...rtl.tables import (cos_lookup, lee_asin_index_bits, lee_asin_table, lee_atan_table,
                            lee_prop_table, lee_reciprocal_table, sin_lookup)
-from .fixed_common import shade_fixed
-from .fixed_exact import vectors
+from .fixed_common import polar_illumination_fixed, polar_rotation_fixed
 
 __all__ = ["rotate_fixed", "illuminate_fixed", "lee_rotation_fixed", "lee_illumination_fixed",
            "lee_fixed_model"]
@@ -75,22 +74,12 @@ def illuminate_fixed(a_phi, a_theta, b_phi, b_theta, cfg: Config):
 
 def lee_rotation_fixed(codes, cfg: Config):
     """VectorRotation (lee): the output payload fields L', H' and the passed-through N'."""
-    out = {}
-    for v in vectors(cfg):
-        out[f"{v}.phi"], out[f"{v}.theta"] = rotate_fixed(
-            codes[f"{v}.phi"], codes[f"{v}.theta"], codes["n.phi"], codes["n.theta"], cfg)
-    out["b.phi"] = np.asarray(codes["b.phi"], dtype=np.int64)
-    out["b.theta"] = np.asarray(codes["b.theta"], dtype=np.int64)
-    return out
+    return polar_rotation_fixed(rotate_fixed, codes, cfg)
 
 
 def lee_illumination_fixed(rot, cfg: Config):
     """Illumination (lee): ndotl, ndoth and the 8-bit diffuse, specular and color."""
-    dots = {v: illuminate_fixed(rot[f"{v}.phi"], rot[f"{v}.theta"], rot["b.phi"], rot["b.theta"], cfg)
-            for v in vectors(cfg)}
-    ndotl = dots["l"]
-    ndoth = dots.get("h", np.zeros_like(ndotl))
-    return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
+    return polar_illumination_fixed(illuminate_fixed, rot, cfg)
 
 
 def lee_fixed_model(codes, cfg: Config):

@@ -7,7 +7,7 @@ from ...rtl.config import Config
 from .common import PixelInputs
 from .fixed_common import quantize_pixels
 
-__all__ = ["edge_codes", "random_codes", "as_payloads"]
+__all__ = ["edge_codes", "random_codes", "as_payloads", "concat_codes"]
 
 KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
 
@@ -47,3 +47,8 @@ def as_payloads(codes, cfg: Config, keys=None):
     mask = (1 << cfg.tag_bits) - 1
     cols = {k: np.asarray(codes[k]).tolist() for k in keys}
     return [{**{k: cols[k][i] for k in keys}, "tag": i & mask} for i in range(n)]
+
+
+def concat_codes(*codes):
+    """Code dicts with the same keys, one after the other."""
+    return {k: np.concatenate([np.asarray(c[k]) for c in codes]) for k in codes[0]}

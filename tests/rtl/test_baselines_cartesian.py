@@ -11,9 +11,6 @@ import sys
 
 import numpy as np
 import pytest
-from amaranth.hdl import Module, signed, unsigned
-from amaranth.lib import data, stream, wiring
-from amaranth.lib.wiring import In, Out
 from amaranth.sim import Simulator
 
 from bumprtl.gen.emit import lint
@@ -21,28 +18,24 @@ from bumprtl.gen.resources import count_component, count_verilog
 from bumprtl.gen.units import build_unit, emit_unit
 from bumprtl.rtl.baselines.peercy import PeercySqrt
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.illumination import IlluminationDatapath, Illumination
+from bumprtl.rtl.illumination import BackEnd, DatapathUnit
 from bumprtl.rtl.pipe import PRODUCT_LATENCY
-from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
 from bumprtl.sim.golden import fixed_peercy
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
-from bumprtl.sim.golden.vectors import as_payloads, edge_codes
+from bumprtl.sim.golden.vectors import concat_codes, edge_codes
 
 METHODS = ["peercy", "ernst"]
 NARROW = Config(method="peercy", angle_bits=8, frac_bits=9, tag_bits=12, spec_exponent=3)
 
 
-def concat(*codes):
-    return {k: np.concatenate([np.asarray(c[k]) for c in codes]) for k in codes[0]}
 
 
 def stimulus(cfg, n, seed):
     """The shared polar edge cases as Cartesian codes, then ``n`` random valid pixels."""
     edges = fixed_peercy.from_angle_codes(edge_codes(cfg), cfg)
     rand = fixed_peercy.encode(PixelInputs.random(n, np.random.default_rng(seed)), cfg)
-    return concat(edges, rand)
+    return concat_codes(edges, rand)
 
 
 def full_range_codes(cfg, n, seed):
@@ -57,21 +50,8 @@ def full_range_codes(cfg, n, seed):
     return codes
 
 
-def run_rotation(cfg, codes, pattern):
-    inputs = as_payloads(codes, cfg)
-    dut = VectorRotation(cfg)
-    out, cycles = simulate_stream(dut, inputs, pattern)
-    assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
-    return dut.latency, cycles
 
 
-def run_illumination(cfg, codes, pattern):
-    rot = rotation_fixed(codes, cfg)
-    inputs = as_payloads(rot, cfg)
-    dut = Illumination(cfg)
-    out, cycles = simulate_stream(dut, inputs, pattern)
-    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
-    return dut.latency, cycles
 
 
 # --- bit-exact in the Amaranth simulator -----------------------------------------------------
@@ -82,7 +62,7 @@ def test_bit_exact_no_stall_one_pixel_per_clock(method, n):
     cfg = Config(method=method)
     codes = stimulus(cfg, n, seed=1)
     total = len(codes["l.x"])
-    for run in (run_rotation, run_illumination):
+    for run in (check_rotation, check_illumination):
         latency, cycles = run(cfg, codes, "no_stall")
         assert cycles == total + latency
 
@@ -91,16 +71,16 @@ def test_bit_exact_no_stall_one_pixel_per_clock(method, n):
 def test_bit_exact_under_stalls(pattern):
     cfg = Config(method="peercy")
     codes = stimulus(cfg, 400, seed=2)
-    run_rotation(cfg, codes, pattern)
-    run_illumination(cfg, codes, pattern)
+    check_rotation(cfg, codes, pattern)
+    check_illumination(cfg, codes, pattern)
 
 
 def test_bit_exact_on_full_range_and_degenerate_inputs():
     """Non-unit, zero and extreme vectors: r = 0 gives a zero quotient in both models."""
     cfg = Config(method="peercy")
     codes = full_range_codes(cfg, 600, seed=3)
-    run_rotation(cfg, codes, "backpressure")
-    run_illumination(cfg, codes, "no_stall")
+    check_rotation(cfg, codes, "backpressure")
+    check_illumination(cfg, codes, "no_stall")
 
 
 @pytest.mark.parametrize("specular", [True, False])
@@ -108,9 +88,9 @@ def test_narrow_and_wide_configurations(specular):
     for cfg in (NARROW.replace(specular=specular),
                 Config(method="ernst", angle_bits=14, frac_bits=20, specular=specular,
                        spec_exponent=128)):
-        codes = concat(stimulus(cfg, 100, seed=4), full_range_codes(cfg, 60, seed=5))
-        run_rotation(cfg, codes, "input_gaps")
-        run_illumination(cfg, codes, "backpressure")
+        codes = concat_codes(stimulus(cfg, 100, seed=4), full_range_codes(cfg, 60, seed=5))
+        check_rotation(cfg, codes, "input_gaps")
+        check_illumination(cfg, codes, "backpressure")
 
 
 def test_latencies_follow_the_structure():
@@ -220,30 +200,6 @@ def test_setup_counts_match_the_structure(specular, build_dir):
     assert c.tables == [] and c.const_multipliers == []
 
 
-class _ShadeOnly(IlluminationDatapath):
-    """The shared back end alone: the dot products come in on the stream, one register."""
-    dot_latency = 1
-
-    def __init__(self, cfg):
-        b = cfg.frac_bits
-        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
-                                                 "tag": unsigned(cfg.tag_bits)}))
-
-    def dots(self, m, pipe, payload):
-        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
-
-
-class _Unit(wiring.Component):
-    def __init__(self, datapath):
-        self.datapath = datapath
-        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
-                          "o": Out(stream.Signature(datapath.out_layout))})
-
-    def elaborate(self, platform):
-        m = Module()
-        self.datapath.build(m, self.i, self.o)
-        return m
-
 
 def test_illumination_counts_are_the_back_end_plus_two_dots(build_dir):
     """N'.L_n and N'.H_n: 3 products of signed(B + 2) values and 2 adders each; the rest
@@ -252,7 +208,7 @@ def test_illumination_counts_are_the_back_end_plus_two_dots(build_dir):
     q = cfg.frac_bits + 2
     v_path, _ = emit_unit("illumination", cfg, build_dir)
     c = count_verilog(v_path, "illumination", build_dir / "yosys")
-    shade = count_component(_Unit(_ShadeOnly(cfg)), "shade_only", build_dir / "shade")
+    shade = count_component(DatapathUnit(BackEnd(cfg)), "shade_only", build_dir / "shade")
     assert _pairs(c.multipliers) == _pairs(shade.multipliers + [f"{q}x{q}"] * 6)
     assert len(c.adders) == len(shade.adders) + 4
     assert c.tables == shade.tables and len(c.tables) == 1          # the power (cos^n) table

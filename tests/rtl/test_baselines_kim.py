@@ -10,9 +10,6 @@ import sys
 
 import numpy as np
 import pytest
-from amaranth.hdl import Module, signed, unsigned
-from amaranth.lib import data, stream, wiring
-from amaranth.lib.wiring import In, Out
 
 from bumprtl.gen.emit import lint
 from bumprtl.gen.resources import count_component, count_verilog
@@ -20,34 +17,18 @@ from bumprtl.gen.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.baselines.kim import Rotation as KimRotation
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.illumination import Illumination, IlluminationDatapath
-from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
-from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
+from bumprtl.rtl.illumination import BackEnd, DatapathUnit
+from bumprtl.sim.amaranth_stream import check_datapath
 from bumprtl.sim.golden.fixed_kim import predicted_error_bound_lsb
 from bumprtl.sim.golden.stress import stress_codes
-from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+from bumprtl.sim.golden.vectors import concat_codes, edge_codes, random_codes
 
 DEFAULT = Config(method="kim")
 NARROW = Config(method="kim", angle_bits=8, frac_bits=9)
 
 
-def concat(*codes):
-    return {k: np.concatenate([np.asarray(c[k]) for c in codes]) for k in codes[0]}
 
 
-def run_both(cfg, codes, pattern, seed=0):
-    """Rotation on ``codes``, then illumination on the golden rotation output, both bit-exact;
-    returns (cycles - latency) of each."""
-    inputs = as_payloads(codes, cfg)
-    rot_dut, ill_dut = VectorRotation(cfg), Illumination(cfg)
-    out, rot_cycles = simulate_stream(rot_dut, inputs, pattern, seed=seed)
-    rot = rotation_fixed(codes, cfg)
-    assert_bit_exact(out, rot, inputs)
-    inputs = as_payloads(rot, cfg)
-    out, ill_cycles = simulate_stream(ill_dut, inputs, pattern, seed=seed + 1)
-    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
-    return rot_cycles - rot_dut.latency, ill_cycles - ill_dut.latency
 
 
 # --- bit-exact against the golden model -----------------------------------------------------
@@ -59,8 +40,8 @@ def test_bit_exact_random_and_edges(pattern, n):
     cycles)."""
     codes = random_codes(n, DEFAULT, seed=len(pattern))
     if pattern == "no_stall":
-        codes = concat(edge_codes(DEFAULT), codes)
-    rot, ill = run_both(DEFAULT, codes, pattern)
+        codes = concat_codes(edge_codes(DEFAULT), codes)
+    rot, ill = check_datapath(DEFAULT, codes, pattern)
     total = len(codes["n.phi"])
     if pattern == "no_stall":
         assert rot == ill == total
@@ -72,13 +53,13 @@ def test_bit_exact_stress_cases_at_the_widest_widths():
     """angle_bits 16, frac_bits 24: the widest products (M A: 26 x 26 bits, three summed)
     and the 25 x 25 bit divide must stay inside int64 in the golden model."""
     cfg = Config(method="kim", angle_bits=16, frac_bits=24, spec_index_bits=16)
-    run_both(cfg, stress_codes(240, cfg, seed=3), "backpressure")
+    check_datapath(cfg, stress_codes(240, cfg, seed=3), "backpressure")
 
 
 def test_bit_exact_narrow_without_specular():
     """8-bit angles, B = 9, no H path (its ROMs and multipliers are not built)."""
     cfg = NARROW.replace(specular=False)
-    run_both(cfg, random_codes(300, cfg, seed=4), "input_gaps")
+    check_datapath(cfg, random_codes(300, cfg, seed=4), "input_gaps")
 
 
 def test_bit_exact_tiny_config():
@@ -89,7 +70,7 @@ def test_bit_exact_tiny_config():
     a, b, c = idx & 15, (idx >> 4) & 15, idx >> 8
     codes = {"n.phi": (3 * c) & 15, "n.theta": a, "l.theta": b, "l.phi": (5 * c + a) & 15,
              "h.theta": (a + b) & 15, "h.phi": (7 * b + c) & 15, "b.phi": (a + c) & 15, "b.theta": b}
-    run_both(cfg, codes, "no_stall")
+    check_datapath(cfg, codes, "no_stall")
 
 
 # --- tables and structure --------------------------------------------------------------------
@@ -197,30 +178,6 @@ def test_rotation_counts_match_the_structure(build_dir):
     assert sorted(map(_table, c.tables)) == sorted(want)
 
 
-class _ShadeOnly(IlluminationDatapath):
-    """The shared back end alone: the dot products come in on the stream, one register."""
-    dot_latency = 1
-
-    def __init__(self, cfg):
-        b = cfg.frac_bits
-        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
-                                                 "tag": unsigned(cfg.tag_bits)}))
-
-    def dots(self, m, pipe, payload):
-        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
-
-
-class _Unit(wiring.Component):
-    def __init__(self, datapath):
-        self.datapath = datapath
-        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
-                          "o": Out(stream.Signature(datapath.out_layout))})
-
-    def elaborate(self, platform):
-        m = Module()
-        self.datapath.build(m, self.i, self.o)
-        return m
-
 
 def test_illumination_counts_are_the_back_end_plus_eqs_3_and_4(build_dir):
     """Eqs (3)/(4) per vector: cos cos, sin sin, (sin sin) cos(dph): 3 products of Q1.B
@@ -230,7 +187,7 @@ def test_illumination_counts_are_the_back_end_plus_eqs_3_and_4(build_dir):
     b = cfg.frac_bits
     v_path, _ = emit_unit("illumination", cfg, build_dir)
     c = count_verilog(v_path, "illumination", build_dir / "yosys")
-    shade = count_component(_Unit(_ShadeOnly(cfg)), "shade_only", build_dir / "shade")
+    shade = count_component(DatapathUnit(BackEnd(cfg)), "shade_only", build_dir / "shade")
     q = b + 2
     assert _pairs(c.multipliers) == _pairs(shade.multipliers + [f"{q}x{q}"] * 6)
     assert len(c.adders) == len(shade.adders) + 4

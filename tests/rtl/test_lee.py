@@ -15,7 +15,7 @@ from bumprtl.gen.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
-from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
 from bumprtl.sim.golden.fixed_lee import lee_illumination_fixed, lee_rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, random_codes
 
@@ -23,18 +23,6 @@ DEFAULT = Config(method="lee")
 TINY = Config(method="lee", angle_bits=4, frac_bits=4, tag_bits=16)
 
 
-def run_both(cfg, codes, pattern, seed=0):
-    """Rotation on ``codes``, then illumination on the golden rotation output; returns the
-    cycles each took minus its latency."""
-    inputs = as_payloads(codes, cfg)
-    duts = LeeRotation(cfg), LeeIllumination(cfg)
-    out, rot_cycles = simulate_stream(duts[0], inputs, pattern, seed=seed)
-    rot = lee_rotation_fixed(codes, cfg)
-    assert_bit_exact(out, rot, inputs)
-    inputs = as_payloads(rot, cfg)
-    out, ill_cycles = simulate_stream(duts[1], inputs, pattern, seed=seed + 1)
-    assert_bit_exact(out, lee_illumination_fixed(rot, cfg), inputs)
-    return rot_cycles - duts[0].latency, ill_cycles - duts[1].latency
 
 
 # --- ROM contents (tables.py, Lee section) ----------------------------------------------------
@@ -99,7 +87,7 @@ def test_latency_and_one_pixel_per_clock():
     """Without stalls N pixels take N cycles plus the latency property."""
     cfg = DEFAULT
     codes = random_codes(300, cfg, seed=5)
-    rot_cycles, ill_cycles = run_both(cfg, codes, "no_stall")
+    rot_cycles, ill_cycles = check_datapath(cfg, codes, "no_stall")
     assert rot_cycles == ill_cycles == 300
 
 
@@ -166,4 +154,4 @@ def test_widest_config_bit_exact_on_stress_cases():
     grid extremes included (the IndexError of docs/stability.md's first run)."""
     from bumprtl.sim.golden.stress import stress_codes
     cfg = Config(method="lee", angle_bits=16, frac_bits=24, spec_index_bits=16)
-    run_both(cfg, stress_codes(180, cfg, seed=3), "no_stall")
+    check_datapath(cfg, stress_codes(180, cfg, seed=3), "no_stall")

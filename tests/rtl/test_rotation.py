@@ -5,33 +5,16 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.amaranth_stream import assert_bit_exact, PATTERNS, simulate_stream
-from bumprtl.sim.golden.fixed import illumination_fixed, rotation_fixed
-from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+from bumprtl.sim.amaranth_stream import PATTERNS, check_illumination, check_rotation
+from bumprtl.sim.golden.vectors import concat_codes, edge_codes, random_codes
 
 METHODS = ["exact", "lee"]
 
 
-def concat(*codes):
-    return {k: np.concatenate([c[k] for c in codes]) for k in codes[0]}
 
 
-def run_rotation(cfg, codes, pattern):
-    inputs = as_payloads(codes, cfg)
-    dut = VectorRotation(cfg)
-    out, cycles = simulate_stream(dut, inputs, pattern)
-    assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
-    return dut.latency, cycles
 
 
-def run_illumination(cfg, codes, pattern):
-    rot = rotation_fixed(codes, cfg)
-    inputs = as_payloads(rot, cfg)
-    out, cycles = simulate_stream(Illumination(cfg), inputs, pattern)
-    assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
-    return cycles
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -40,9 +23,9 @@ def test_rotation_and_illumination_bit_exact(method, pattern):
     """20 000 random vectors plus the edge cases without stalls; 4 000 under stalls."""
     cfg = Config(method=method)
     n = 20_000 if pattern == "no_stall" else 4_000
-    codes = concat(edge_codes(cfg), random_codes(n, cfg, seed=hash(pattern) % 1000))
-    latency, cycles = run_rotation(cfg, codes, pattern)
-    run_illumination(cfg, codes, pattern)
+    codes = concat_codes(edge_codes(cfg), random_codes(n, cfg, seed=hash(pattern) % 1000))
+    latency, cycles = check_rotation(cfg, codes, pattern)
+    check_illumination(cfg, codes, pattern)
     total = len(codes["n.phi"])
     if pattern == "no_stall":                 # 1 pixel per clock: latency + N cycles
         assert cycles == total + latency
@@ -61,8 +44,8 @@ def test_tiny_config_exhaustive_per_output_support(method):
     d1, d2, d3 = idx & 15, (idx >> 4) & 15, idx >> 8
     codes = {"n.theta": d1, "b.phi": d2, "b.theta": d3, "n.phi": (d3 * 5) & 15,
              "l.theta": d1, "l.phi": (d2 + d3 * 5) & 15, "h.theta": d2, "h.phi": (d1 + d3 * 5) & 15}
-    run_rotation(cfg, codes, "no_stall")
-    run_illumination(cfg, codes, "no_stall")
+    check_rotation(cfg, codes, "no_stall")
+    check_illumination(cfg, codes, "no_stall")
 
 
 @pytest.mark.parametrize("specular", [True, False])
@@ -70,6 +53,6 @@ def test_configurations(specular):
     """Narrow and wide widths, specular on and off."""
     for cfg in (Config(angle_bits=8, frac_bits=9, specular=specular, spec_exponent=3),
                 Config(angle_bits=14, frac_bits=16, specular=specular, spec_exponent=128)):
-        codes = concat(edge_codes(cfg), random_codes(600, cfg, seed=3))
-        run_rotation(cfg, codes, "backpressure")
-        run_illumination(cfg, codes, "input_gaps")
+        codes = concat_codes(edge_codes(cfg), random_codes(600, cfg, seed=3))
+        check_rotation(cfg, codes, "backpressure")
+        check_illumination(cfg, codes, "input_gaps")
