@@ -15,11 +15,11 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from .fixed import Q, saturate
-from .layouts import polar_layout
-from .palette import index_bits
-from .pipe import StallPipe
-from .scene import SceneConfig
+from bumprtl.rtl.fixed import Q, saturate
+from bumprtl.rtl.layouts import polar_layout
+from bumprtl.rtl.palette import index_bits
+from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.scene import SceneConfig
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
            "level_bits", "texel_shape", "fetched_field", "fetched_fields", "has_map",
@@ -145,7 +145,7 @@ class BumpMapFetch(wiring.Component):
     latency = 2
 
     def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None):
-        from .texture import rgb_layout
+        from bumprtl.rtl.texture import rgb_layout
         self.scene, self.cfg = scene, scene.config
         self.fetched = fetched_fields(scene)
         if not self.fetched:

@@ -9,12 +9,12 @@ Bit-exact with ``sim/golden/fixed_exact.py``.
 from amaranth.hdl import signed
 from amaranth.lib import data
 
-from .config import Config
-from .fixed import round_shift
-from .illumination import IlluminationDatapath
-from .layouts import pixel_layout
-from .pipe import PRODUCT_LATENCY, StallPipe
-from .sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.illumination import IlluminationDatapath
+from bumprtl.rtl.layouts import pixel_layout
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
 
 __all__ = ["Rotation", "Illumination", "SineBank", "rotated_layout", "vector_terms"]
 

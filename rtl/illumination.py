@@ -9,11 +9,11 @@ from amaranth.hdl import Module, Mux, signed, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from .config import BumpError, Config
-from .fixed import round_shift
-from .layouts import shade_layout
-from .pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
-from .tables import phong_coefficients, specular_index_bits, specular_table
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.layouts import shade_layout
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
+from bumprtl.rtl.tables import phong_coefficients, specular_index_bits, specular_table
 
 __all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
 
@@ -135,7 +135,7 @@ class MethodUnit(DatapathUnit):
     def __init__(self, cfg: Config):
         self.cfg = cfg
         import importlib
-        from .config import datapath_module
+        from bumprtl.rtl.config import datapath_module
         try:
             methods = importlib.import_module(f".{datapath_module(cfg.method)}", __package__)
         except ModuleNotFoundError:

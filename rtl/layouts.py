@@ -3,7 +3,7 @@
 from amaranth.hdl import unsigned
 from amaranth.lib import data
 
-from .config import Config
+from bumprtl.rtl.config import Config
 
 __all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout"]
 

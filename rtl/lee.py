@@ -38,15 +38,15 @@ from amaranth.hdl import Mux, Value, ValueCastable, unsigned
 from amaranth.lib import data
 from amaranth.lib.memory import Memory
 
-from .config import Config
-from .exact import vectors
-from .fixed import round_shift
-from .illumination import Illumination as _Illumination, IlluminationDatapath
-from .layouts import pixel_layout, polar_layout
-from .pipe import StallPipe
-from .rotation import VectorRotation
-from .sincos import quarter_wave_rom, sine_read
-from .tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.exact import vectors
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.illumination import Illumination as _Illumination, IlluminationDatapath
+from bumprtl.rtl.layouts import pixel_layout, polar_layout
+from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
+from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
                      lee_atan_ratio_bits, lee_atan_table, lee_prop_index_bits, lee_prop_table,
                      lee_reciprocal_bits, lee_reciprocal_table)
 

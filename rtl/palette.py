@@ -16,9 +16,9 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from .config import Config
-from .fixed import Q, mul_round, round_shift, saturate
-from .pipe import StallPipe
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.fixed import Q, mul_round, round_shift, saturate
+from bumprtl.rtl.pipe import StallPipe
 
 __all__ = ["PaletteLUT", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
 
@@ -86,7 +86,7 @@ class PaletteLUT(wiring.Component):
     o : Out(stream.Signature({color: rgba, oor: 1, tag}))
         ``color`` is the table entry, or with ``palette_blend`` eq. 2:
         ``r = ro * ai + (1 - ro) * ri`` (products rounded to nearest, see
-        :mod:`bumprtl.sim.golden.palette_lut`), ``a = ao``.
+        :mod:`bumprtl.sim.golden.fixed.palette_lut`), ``a = ao``.
         ``oor`` = 1 when ``index >= sN``: the entry then reads as all zeros (defined,
         never X). Only possible when sN is not a power of two.
     w_en, w_addr, w_data : In

@@ -24,17 +24,17 @@ from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from .bumpfetch import BumpMapFetch, has_map
-from .exact import Rotation as ExactRotation, SineBank, rotated_layout, vector_terms
-from .fixed import round_shift
-from .illumination import Illumination
-from .layouts import angle_shape, pixel_layout, polar_layout, shade_layout
-from .palette import PaletteLUT
-from .pipe import StallPipe
-from .rotation import VectorRotation
-from .scene import SceneConfig, light_fields, load_scene_config
-from .tables import phong_coefficients
-from .texture import TexelDelay, TextureBlend, rgb_layout
+from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
+from bumprtl.rtl.exact import Rotation as ExactRotation, SineBank, rotated_layout, vector_terms
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.layouts import angle_shape, pixel_layout, polar_layout, shade_layout
+from bumprtl.rtl.palette import PaletteLUT
+from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config
+from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout
 
 __all__ = ["BumpPipeline", "VectorTerms", "LightSum", "light_fields"]
 

@@ -1,6 +1,6 @@
 """Vector rotation unit (Lee Sec. 3.1, Fig. 7), method chosen by ``cfg.method``."""
 
-from .illumination import MethodUnit
+from bumprtl.rtl.illumination import MethodUnit
 
 __all__ = ["VectorRotation"]
 

@@ -10,7 +10,7 @@ import tomllib
 from dataclasses import dataclass, fields, asdict
 from pathlib import Path
 
-from .config import BumpError, Config, METHODS
+from bumprtl.rtl.config import BumpError, Config, METHODS
 
 __all__ = ["SceneConfig", "SceneError", "BUILTIN", "load_scene_config", "ADDRESSING",
            "BUMP_MAPS", "SHADINGS", "ROTATIONS", "light_fields"]

@@ -5,9 +5,9 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from .config import Config
-from .pipe import ROM_LATENCY, StallPipe
-from .tables import quarter_sine
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe
+from bumprtl.rtl.tables import quarter_sine
 
 __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
            "REGISTERED_SINE_LATENCY"]

@@ -8,7 +8,7 @@ import functools
 
 import numpy as np
 
-from .config import Config
+from bumprtl.rtl.config import Config
 
 __all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits", "specular_table",
            "phong_coefficients", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",

@@ -27,11 +27,11 @@ from amaranth.hdl import Module, Mux, Value, ValueCastable, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from .config import Config
-from .fixed import round_shift
-from .palette import mul8
-from .pipe import StallPipe
-from .tables import phong_coefficients
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.palette import mul8
+from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.tables import phong_coefficients
 
 __all__ = ["RGB", "rgb_layout", "texture_blend", "blend_error_bound_lsb", "TextureBlend",
            "TexelDelay", "BLEND_LATENCY"]

@@ -90,9 +90,9 @@ def assert_bit_exact(out, golden, inputs):
 def check_rotation(cfg, codes, pattern="no_stall", seed=0):
     """``VectorRotation(cfg)`` on the input ``codes``, bit for bit against the golden model
     (sim/golden/fixed.py); returns ``(latency, cycles)``."""
-    from ..rtl.rotation import VectorRotation
-    from .golden.fixed import rotation_fixed
-    from .golden.vectors import as_payloads
+    from bumprtl.rtl.rotation import VectorRotation
+    from bumprtl.sim.golden.fixed.dispatch import rotation_fixed
+    from bumprtl.sim.golden.vectors import as_payloads
     inputs = as_payloads(codes, cfg)
     dut = VectorRotation(cfg)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
@@ -103,9 +103,9 @@ def check_rotation(cfg, codes, pattern="no_stall", seed=0):
 def check_illumination(cfg, codes, pattern="no_stall", seed=0):
     """``Illumination(cfg)`` on the golden rotation output of ``codes``, bit for bit against
     the golden model; returns ``(latency, cycles)``."""
-    from ..rtl.illumination import Illumination
-    from .golden.fixed import illumination_fixed, rotation_fixed
-    from .golden.vectors import as_payloads
+    from bumprtl.rtl.illumination import Illumination
+    from bumprtl.sim.golden.fixed.dispatch import illumination_fixed, rotation_fixed
+    from bumprtl.sim.golden.vectors import as_payloads
     rot = rotation_fixed(codes, cfg)
     inputs = as_payloads(rot, cfg)
     dut = Illumination(cfg)

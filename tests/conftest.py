@@ -4,7 +4,7 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-from bumprtl.gen.toolchain import tool_env
+from bumprtl.gen.flow.toolchain import tool_env
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build" / "test"

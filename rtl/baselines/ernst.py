@@ -15,7 +15,7 @@ products, rtl/illumination.py), 4 dot adders plus the back end's Phong sum, agai
 paper's 7 and 5.
 """
 
-from .peercy import Illumination as _PeercyIllumination, Rotation as _PeercyRotation
+from bumprtl.rtl.baselines.peercy import Illumination as _PeercyIllumination, Rotation as _PeercyRotation
 
 __all__ = ["Rotation", "Illumination"]
 

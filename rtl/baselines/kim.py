@@ -64,15 +64,15 @@ import numpy as np
 from amaranth.hdl import C, Cat, Mux, Value, ValueCastable, unsigned
 from amaranth.lib.memory import Memory
 
-from ..config import Config
-from ..exact import vectors
-from ..fixed import round_shift
-from ..illumination import IlluminationDatapath
-from ..layouts import pixel_layout
-from ..lee import ratio_index, rotated_layout
-from ..pipe import PRODUCT_LATENCY, StallPipe
-from ..sincos import quarter_wave_rom, sine_read
-from ..tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.exact import vectors
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.illumination import IlluminationDatapath
+from bumprtl.rtl.layouts import pixel_layout
+from bumprtl.rtl.lee import ratio_index, rotated_layout
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
+from bumprtl.rtl.tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
                       lee_asin_table, lee_atan_table)
 
 __all__ = ["Rotation", "Illumination", "rotated_layout", "matrix_entries", "cartesian",

@@ -50,10 +50,10 @@ The paper gives no illumination row for Peercy ("Not Available"); this is Ernst'
 from amaranth.hdl import Cat, Const, Elaboratable, Module, Mux, Signal, signed, unsigned
 from amaranth.lib import data
 
-from ..config import Config
-from ..fixed import round_shift
-from ..illumination import IlluminationDatapath
-from ..pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.illumination import IlluminationDatapath
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
 
 __all__ = ["Rotation", "Illumination", "PeercySqrt", "vectors", "cartesian_layout",
            "setup_input_layout", "setup_output_layout", "component_width", "square_bits",

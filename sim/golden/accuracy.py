@@ -5,10 +5,10 @@ from dataclasses import fields
 
 import numpy as np
 
-from ...rtl.config import Config
-from .common import PixelInputs, to_8bit
-from .conventional import conventional
-from .fixed import encode_pixels
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.common import PixelInputs, to_8bit
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.fixed.dispatch import encode_pixels
 
 __all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "ANGLES_OF_NDOTL"]
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ...rtl.config import BumpError, Config
+from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["PixelInputs", "Result", "polar_to_cartesian", "cartesian_to_polar",
            "tangent_rotation", "shade", "to_8bit"]

@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from ...rtl.config import BumpError, Config
-from .common import PixelInputs, polar_to_cartesian
-from .conventional import conventional
-from .models import FLOAT_MODELS
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
 
 __all__ = ["angle_error_deg", "compare", "error_stats", "error_by_theta_n", "error_at_theta_n",
            "proportion_worst_case_deg", "random_pixels", "worst_pixel"]

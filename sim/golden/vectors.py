@@ -3,9 +3,9 @@ flattened input payloads the RTL takes (binary-angle codes)."""
 
 import numpy as np
 
-from ...rtl.config import Config
-from .common import PixelInputs
-from .fixed_common import quantize_pixels
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.fixed.common import quantize_pixels
 
 __all__ = ["edge_codes", "random_codes", "as_payloads", "concat_codes"]
 

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...rtl.config import BumpError
-from ..golden.common import PixelInputs, cartesian_to_polar
-from .heightfields import HEIGHTFIELDS, height_to_normals
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar
+from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS, height_to_normals
 
 __all__ = ["SCENES", "GEOMETRIES", "Scene", "load_scene", "light_direction"]
 

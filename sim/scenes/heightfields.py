@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ...rtl.config import BumpError
+from bumprtl.rtl.config import BumpError
 
 __all__ = ["HEIGHTFIELDS", "height_to_normals", "normals_from_gradient", "smooth_noise"]
 

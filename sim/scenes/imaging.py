@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..golden.common import to_8bit
+from bumprtl.sim.golden.common import to_8bit
 
 __all__ = ["compose", "psnr", "max_diff", "panel", "save_png"]
 

@@ -1,7 +1,7 @@
 """Build and run a cocotb testbench on emitted Verilog with ``cocotb_tools.runner``.
 
 One build directory per (unit, configuration, simulator). A missing simulator raises
-:class:`bumprtl.gen.toolchain.ToolMissing`: the suite fails, it never skips.
+:class:`bumprtl.gen.flow.toolchain.ToolMissing`: the suite fails, it never skips.
 """
 
 import os
@@ -10,7 +10,7 @@ from pathlib import Path
 
 from cocotb_tools.runner import get_results, get_runner
 
-from ...gen.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.gen.flow.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["SIMULATORS", "run_cocotb"]
 

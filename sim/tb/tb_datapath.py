@@ -7,17 +7,17 @@ valid pixels (BUMPRTL_SAMPLES of them); the golden model is sim/golden/fixed.py.
 import cocotb
 import numpy as np
 
-from ...rtl.config import Config
-from ..golden.fixed import illumination_fixed, rotation_fixed
-from ..golden.vectors import as_payloads, edge_codes, random_codes
-from .stream import PATTERNS, load_sidecar, run_stream, samples
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.fixed.dispatch import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, run_stream, samples
 
 
 def _stimulus(unit, cfg, n, seed):
     edges, rand = edge_codes(cfg), random_codes(n, cfg, seed=seed)
     codes = {k: np.concatenate([edges[k], rand[k]]) for k in edges}
     if cfg.method in ("peercy", "ernst"):      # Cartesian inputs: the same directions
-        from ..golden.fixed_peercy import from_angle_codes
+        from bumprtl.sim.golden.fixed.peercy import from_angle_codes
         codes = from_angle_codes(codes, cfg)
     if unit == "rotation":
         return as_payloads(codes, cfg), lambda acc: _golden(acc, cfg, rotation_fixed)

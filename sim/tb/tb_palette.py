@@ -9,10 +9,10 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from ...rtl.config import Config
-from ...rtl.palette import CHANNELS, index_bits
-from ..golden.palette_lut import PaletteLUTModel, host_op
-from .stream import PATTERNS, load_sidecar, pack, samples, unpack
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.palette import CHANNELS, index_bits
+from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op
+from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, samples, unpack
 
 log = logging.getLogger("bumprtl.tb")
 

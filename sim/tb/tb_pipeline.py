@@ -17,7 +17,7 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from .stream import PATTERNS, load_sidecar, pack, unpack
+from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, unpack
 
 
 async def _host_setup(dut, meta, stim):

@@ -3,9 +3,9 @@
 import cocotb
 import numpy as np
 
-from ...rtl.config import Config
-from ...rtl.tables import cos_lookup, sin_lookup
-from .stream import PATTERNS, load_sidecar, run_stream, samples
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.tables import cos_lookup, sin_lookup
+from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, run_stream, samples
 
 
 def model(cfg):

@@ -13,15 +13,15 @@ import numpy as np
 import pytest
 from amaranth.sim import Simulator
 
-from bumprtl.gen.emit import lint
-from bumprtl.gen.resources import count_component, count_verilog
-from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.flow.resources import count_component, count_verilog
+from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.baselines.peercy import PeercySqrt
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import BackEnd, DatapathUnit
 from bumprtl.rtl.pipe import PRODUCT_LATENCY
 from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
-from bumprtl.sim.golden import fixed_peercy
+from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.vectors import concat_codes, edge_codes
 
@@ -160,7 +160,7 @@ def test_ernst_emits_the_same_setup_hardware(build_dir):
 
 
 def test_cli_emit_rotation_method_peercy(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
                         "peercy", "--out", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "rotation.v").read_text().startswith(
@@ -170,7 +170,7 @@ def test_cli_emit_rotation_method_peercy(tmp_path):
     assert meta["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
     assert sorted(meta["ports"]["i__payload"]["fields"]) == sorted(
         fixed_peercy.input_keys(Config()) + ["tag"])
-    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
                           "peercy", "--frac-bits", "40", "--out", str(tmp_path)],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr

@@ -11,15 +11,15 @@ import sys
 import numpy as np
 import pytest
 
-from bumprtl.gen.emit import lint
-from bumprtl.gen.resources import count_component, count_verilog
-from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.flow.resources import count_component, count_verilog
+from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.baselines.kim import Rotation as KimRotation
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import BackEnd, DatapathUnit
 from bumprtl.sim.amaranth_stream import check_datapath
-from bumprtl.sim.golden.fixed_kim import predicted_error_bound_lsb
+from bumprtl.sim.golden.fixed.kim import predicted_error_bound_lsb
 from bumprtl.sim.golden.stress import stress_codes
 from bumprtl.sim.golden.vectors import concat_codes, edge_codes, random_codes
 
@@ -121,7 +121,7 @@ def test_emission_lint_clean_and_deterministic(unit, build_dir):
 
 
 def test_cli_emit_rotation_method_kim(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
                         "kim", "--out", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "rotation.v").read_text().startswith(
@@ -129,7 +129,7 @@ def test_cli_emit_rotation_method_kim(tmp_path):
     meta = json.loads((tmp_path / "rotation.json").read_text())
     assert meta["method"] == "kim" and meta["latency"] == KimRotation(DEFAULT).latency
     assert meta["error_bound_lsb"] == predicted_error_bound_lsb(DEFAULT)
-    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli", "emit", "rotation", "--method",
+    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
                           "kim", "--frac-bits", "40", "--out", str(tmp_path)],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr

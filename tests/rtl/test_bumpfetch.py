@@ -7,7 +7,7 @@ import pytest
 from bumprtl.rtl.bumpfetch import BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.sim.amaranth_stream import PATTERNS, assert_bit_exact, simulate_stream
-from bumprtl.sim.golden.fixed_pipeline import fetch_fixed, random_inputs, random_map
+from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, random_inputs, random_map
 
 
 def reference_word(words, u, v, level, scene):
@@ -99,7 +99,7 @@ def test_init_of_the_wrong_size_is_rejected():
 def test_texture_ram_read_at_the_same_address(keys):
     """The colour texture is read beside the map at the same (u, v, level); a flat map
     keeps only the texture RAM (no map port). Against the independent reference."""
-    from bumprtl.sim.golden.fixed_pipeline import random_texture
+    from bumprtl.sim.golden.fixed.pipeline import random_texture
     scene = load_scene_config({"texture_size": 16, **keys})
     rng = np.random.default_rng(11)
     words = random_map(scene, rng) if scene.bump_map == "varying" else None
@@ -126,7 +126,7 @@ def test_texture_words_need_a_textured_scene():
 @pytest.mark.parametrize("name, outputs", [("default", ["b"]), ("palette", ["index"]),
                                            ("textured", ["b", "texel"])])
 def test_fetch_sidecar_lists_every_output(name, outputs):
-    from bumprtl.gen.units import build_unit
+    from bumprtl.gen.flow.units import build_unit
     from bumprtl.rtl.scene import load_scene_config
     dut, sidecar, _ = build_unit("fetch", load_scene_config(name))
     dut._MustUse__silence = True                   # only its ports are read

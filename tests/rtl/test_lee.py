@@ -10,13 +10,13 @@ tests/sim/test_tb_datapath.py (cocotb on the emitted Verilog, Icarus and Verilat
 import numpy as np
 import pytest
 
-from bumprtl.gen.emit import lint
-from bumprtl.gen.units import build_unit, emit_unit
+from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
 from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
-from bumprtl.sim.golden.fixed_lee import lee_illumination_fixed, lee_rotation_fixed
+from bumprtl.sim.golden.fixed.lee import lee_illumination_fixed, lee_rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, random_codes
 
 DEFAULT = Config(method="lee")

@@ -13,7 +13,7 @@ from amaranth.hdl import Fragment, Instance, Module, signed, unsigned
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
-from bumprtl.gen.toolchain import require, tool_env
+from bumprtl.gen.flow.toolchain import require, tool_env
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
 from bumprtl.rtl.tables import quarter_sine, specular_table

@@ -10,16 +10,16 @@ from amaranth.hdl import Module, Signal
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 
-from bumprtl.gen.emit import lint
-from bumprtl.gen.units import emit_unit
+from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
-from bumprtl.sim.golden.fixed_pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
+from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
                                                random_inputs, random_map, random_texture,
                                                unpack_rgb)
-from bumprtl.sim.golden.palette_lut import PaletteLUTModel
+from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel
 
 SWITCHES = {"lights": (1, 2), "specular": (True, False), "bump_map": ("varying", "flat"),
             "shading": ("per-pixel", "palette"), "addressing": ("wrap", "clamp"),

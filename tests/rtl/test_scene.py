@@ -2,7 +2,7 @@
 
 import pytest
 
-from bumprtl.gen.cli import main
+from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.scene import BUILTIN, SceneConfig, load_scene_config
 

@@ -8,12 +8,12 @@ from hypothesis import given, settings, strategies as st
 
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
-from bumprtl.sim.golden.conventional import conventional
-from bumprtl.sim.golden.exact import exact
-from bumprtl.sim.golden.fixed import datapath_fixed
-from bumprtl.sim.golden.fixed_common import quantize_pixels
-from bumprtl.sim.golden.fixed_exact import predicted_error_bound_lsb
-from bumprtl.sim.golden.lee import lee_fixed, lee_printed
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.exact import exact
+from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+from bumprtl.sim.golden.fixed.common import quantize_pixels
+from bumprtl.sim.golden.fixed.exact import predicted_error_bound_lsb
+from bumprtl.sim.golden.float.lee import lee_fixed, lee_printed
 from bumprtl.sim.golden.stress import (CASES, check_fixed, float_stats, payload_fields,
                                        rotate_azimuth, stress_case)
 
@@ -130,7 +130,7 @@ def test_pipeline_stimulus_reaches_the_datapath():
     """The pipeline golden model on the stress stimulus equals the datapath model on the
     same codes: every N' went through the map to its pixel."""
     from bumprtl.rtl.scene import load_scene_config
-    from bumprtl.sim.golden.fixed_pipeline import pipeline_fixed
+    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus, stress_codes
     scene = load_scene_config("default")
     n = scene.texture_size ** 2 + 100
@@ -148,9 +148,9 @@ def test_pipeline_stimulus_reaches_the_datapath():
 def test_pipeline_1e6_stress_vectors_verilator(build_dir):
     """10^6 stress vectors (all cases) through the emitted pipeline on Verilator, 250k per
     traffic pattern, bit-exact against the pipeline golden model, in order."""
-    from bumprtl.gen.render_rtl import run_pipeline
+    from bumprtl.gen.render.rtl import run_pipeline
     from bumprtl.rtl.scene import load_scene_config
-    from bumprtl.sim.golden.fixed_pipeline import pipeline_fixed
+    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus
     scene = load_scene_config("default")
     inputs, words = pipeline_stimulus(scene, 250_000, seed=9)

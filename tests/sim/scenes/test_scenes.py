@@ -5,8 +5,8 @@ import pytest
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import polar_to_cartesian
-from bumprtl.sim.golden.conventional import conventional
-from bumprtl.sim.golden.exact import exact
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.exact import exact
 from bumprtl.sim.scenes import SCENES, light_direction, load_scene
 from bumprtl.sim.scenes.heightfields import height_to_normals, smooth_noise
 from bumprtl.sim.scenes.imaging import compose, psnr

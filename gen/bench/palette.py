@@ -1,0 +1,148 @@
+"""``bumprtl bench palette``: the palette method (Tarini et al.) against per-pixel shading.
+
+``speed``: per-frame cost = colour table (sN shading evaluations) + per-pixel lookup,
+against direct per-pixel shading with the same lighting function, side by side in one run
+(the sizes of the paper's Table 1). ``accuracy``: PSNR / max difference of palette renders
+against the conventional per-pixel reference. ``images``: palette renders of the demo scenes.
+"""
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+SPEED_SIZES = (256, 512, 1024, 2048)
+SPEED_PALETTES = (256, 2048, 16384)
+ACC_PALETTES = (16, 64, 256, 1024, 4096, 16384)
+ACC_SCENES = ("wood", "bumps", "gravel", "globe")
+
+
+def _best(fn, repeats=3):
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def speed(cfg, sizes, palettes):
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.float.palette import color_table
+    rng = np.random.default_rng(0)
+    l, v = np.array([[0.4, -0.7, 0.6]]), np.array([[0.0, -1.0, 0.0]])
+    shade8 = lambda normals: to_8bit(color_table(normals, "phong", l, v, cfg))
+    print("| image | sN | colour table ms | lookup ms | palette frame ms | per-pixel ms | ratio |")
+    print("|---|---|---|---|---|---|---|")
+    for size in sizes:
+        for sn in palettes:
+            table = rng.normal(size=(sn, 3))
+            table /= np.linalg.norm(table, axis=1, keepdims=True)
+            idx = rng.integers(0, sn, (size, size))
+            per_pixel_normals = table[idx]
+            t_table = _best(lambda: shade8(table))
+            colors = shade8(table)
+            t_lookup = _best(lambda: colors[idx])
+            t_direct = _best(lambda: shade8(per_pixel_normals.reshape(-1, 3)))
+            frame = t_table + t_lookup
+            print(f"| {size}² | {sn} | {t_table * 1e3:.2f} | {t_lookup * 1e3:.2f} | {frame * 1e3:.2f} "
+                  f"| {t_direct * 1e3:.1f} | {t_direct / frame:.1f}x |", flush=True)
+
+
+def accuracy(cfg, scenes, palettes, size, plot=None):
+    from bumprtl.rtl.config import BumpError
+    from bumprtl.sim.golden.float.conventional import conventional
+    from bumprtl.sim.golden.float.palette import render_palette
+    from bumprtl.sim.scenes import load_scene
+    from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
+    print("| scene | quantizer | " + " | ".join(f"sN={s}" for s in palettes) + " |")
+    print("|---|---|" + "---|" * len(palettes))
+    curves = {}
+    for name in scenes:
+        scene = load_scene(name, size=size)
+        ref = compose(scene, conventional(scene.px, cfg).color)
+        for quantizer in ("median-cut", "kmeans"):
+            cells, curve = [], []
+            for sn in palettes:
+                try:
+                    img = compose(scene, render_palette(scene, cfg, sn, quantizer).color)
+                except BumpError:          # sN > distinct normals of this map
+                    cells.append("—")
+                    continue
+                p = psnr(ref, img)
+                curve.append((sn, p))
+                cells.append(f"{p:.1f} dB / {max_diff(ref, img)}")
+            curves[(name, quantizer)] = curve
+            print(f"| {name} | {quantizer} | " + " | ".join(cells) + " |", flush=True)
+    if plot:
+        _plot(curves, plot, size)
+
+
+def _plot(curves, path, size):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.6), dpi=80)
+    for n, ((name, quantizer), curve) in enumerate(sorted(curves.items())):
+        if curve:
+            xs, ys = zip(*curve)
+            ax.semilogx(xs, ys, "-o" if quantizer == "kmeans" else "--x", base=2,
+                        color=f"C{sorted({k[0] for k in curves}).index(name)}", label=f"{name} {quantizer}")
+    ax.set_xlabel("palette size sN")
+    ax.set_ylabel("PSNR vs per-pixel (dB)")
+    ax.set_title(f"Palette method accuracy, {size}x{size}")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    print(f"plot -> {path}")
+
+
+def images(cfg, out_dir, size):
+    from bumprtl.sim.golden.float.conventional import conventional
+    from bumprtl.sim.golden.float.palette import palette_rgb
+    from bumprtl.sim.scenes import load_scene
+    from bumprtl.sim.scenes.imaging import compose, panel, save_png
+    from bumprtl.sim.golden.common import to_8bit
+    for name, sn, lighting, dither in (("bricks", 16, "phong", False), ("globe", 256, "phong", False),
+                                       ("globe", 64, "phong", True), ("globe", 1024, "chrome", False),
+                                       ("wood", 256, "toon", False)):
+        scene = load_scene(name, size=size)
+        rgb, _ = palette_rgb(scene, cfg, sn, "kmeans", lighting, dither)
+        if lighting == "phong":
+            ref = compose(scene, conventional(scene.px, cfg).color)
+            img = panel(ref, compose(scene, rgb.mean(-1)))
+        else:
+            img = np.where(scene.mask[..., None], to_8bit(rgb), 0).astype(np.uint8)
+        tag = f"{name}_{lighting}_{sn}" + ("_dither" if dither else "")
+        print(f"{tag} -> {save_png(Path(out_dir) / f'palette_{tag}.png', img)}")
+
+
+def run(args):
+    from bumprtl.rtl.config import Config
+    cfg = Config()
+    print(f"bumprtl bench palette --what {' '.join(args.what)}")
+    if "speed" in args.what:
+        print("\nPer-frame cost, numpy, best of 3 (Phong, one light):\n")
+        speed(cfg, args.sizes, args.palettes)
+    if "accuracy" in args.what:
+        print(f"\nPSNR / max difference (8-bit) against conventional, {args.size}x{args.size}:\n")
+        accuracy(cfg, args.scenes, ACC_PALETTES, args.size, args.plot)
+    if "images" in args.what:
+        images(cfg, args.images_dir, args.size)
+    return 0
+
+
+def add_parser(sub):
+    p = sub.add_parser("palette", help="palette method: per-frame cost and accuracy vs per-pixel",
+                       description="Palette method of Tarini et al.: colour table + lookup against "
+                                   "per-pixel shading (speed), PSNR vs sN (accuracy), demo renders.")
+    p.add_argument("--what", nargs="+", default=["speed", "accuracy"], choices=["speed", "accuracy", "images"])
+    p.add_argument("--sizes", nargs="+", type=int, default=list(SPEED_SIZES), help="speed: image sizes")
+    p.add_argument("--palettes", nargs="+", type=int, default=list(SPEED_PALETTES), help="speed: sN values")
+    p.add_argument("--scenes", nargs="+", default=list(ACC_SCENES), help="accuracy: scenes")
+    p.add_argument("--size", type=int, default=256, help="accuracy/images: image size (default 256)")
+    p.add_argument("--plot", type=Path, default=None, help="accuracy: write the PSNR plot here")
+    p.add_argument("--images-dir", type=Path, default=Path("build/palette"), help="images: output dir")
+    p.set_defaults(func=run)

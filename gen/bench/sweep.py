@@ -1,0 +1,530 @@
+"""``bumprtl bench sweep``: error against cost against run time for every method and width.
+
+For each method (``exact`` and ``lee`` over a grid of angle bits and value bits,
+``palette`` over palette sizes, the Table 1 baselines) one *point* records
+
+* **error** against float64 (``conventional``): max / mean diffuse LSB of the bit-exact
+  model on random valid and adversarial vectors (unquantized inputs), and PSNR / max LSB
+  of the shaded image on the scenes. ``error_lsb`` = the worst max LSB over all of them:
+  the number ``bumprtl recommend --max-error-lsb`` compares;
+* **cost** from the Yosys netlist of the method's per-pixel units (gen/resources.py:
+  multipliers, ROM bits, RAM bits, adders) and, with ``--fpga``, ECP5 LUT4/FF/DSP/BRAM and
+  Fmax of the unit(s) placed by gen/fpga.py;
+* **speed**: golden-model Mpix/s (numpy, best of 3, measured in this run), cocotb
+  simulation pixels/s with ``--sim`` and hardware pixels/s = Fmax x 1 pixel/clock with
+  ``--fpga``.
+
+A width the Config rejects is recorded as ``invalid`` with the Config's message; a method
+whose model or RTL is missing as ``not available`` with the reason. Nothing is estimated.
+Output: ``build/bench/sweep.json`` (``--out``), Pareto plots and a markdown table.
+"""
+
+import json
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot"]
+
+
+@dataclass(frozen=True)
+class Grid:
+    angle_bits: tuple
+    frac_bits: tuple
+    palette_sizes: tuple
+    samples: int          # random vectors per point
+    scenes: tuple
+    size: int             # scene images are size x size
+
+
+GRIDS = {
+    "quick": Grid((10, 12), (11, 13), (16, 256), 20_000, ("bricks",), 64),
+    "default": Grid((8, 10, 12, 14), (9, 11, 13, 16), (16, 64, 256, 1024, 4096, 16384),
+                    100_000, ("bricks", "wood", "globe"), 128),
+}
+PER_PIXEL = ("exact", "lee")
+BASELINES = ("peercy", "ernst", "kim")     # Lee Table 1's designs as RTL (rtl/baselines/)
+COST_FIELDS = ("multipliers", "const_multipliers", "dividers", "sqrts", "adders", "table_bits", "ram_bits",
+               "register_bits")
+
+
+def _best_time(fn, repeats=3):
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def error_lsb(point):
+    """Worst max LSB over every error set the point measured (None if it measured none)."""
+    err = point.get("error") or {}
+    maxima = [err[k]["max"] for k in ("random", "adversarial") if k in err]
+    maxima += [s["max_lsb"] for s in err.get("scenes", {}).values() if "max_lsb" in s]
+    return max(maxima) if maxima else None
+
+
+def cost_key(point, device=None):
+    """What "cheaper" means: on ``device`` (FPGA numbers) DSP, block RAM, then LUT4;
+    otherwise the arithmetic units (multipliers + dividers + square roots), then ROM+RAM
+    bits, then adders: a divider or a multiplier costs more than a few kbit of table."""
+    cost = point["cost"]
+    if device:
+        f = cost["fpga"]
+        return (f["DSP"], f["BRAM"], f["LUT4"])
+    units = cost["multipliers"] + cost.get("dividers", 0) + cost.get("sqrts", 0)
+    return (units, cost["table_bits"] + cost["ram_bits"], cost["adders"])
+
+
+def pareto_front(points, x, y):
+    """Indices of the points no other point beats in both ``x(p)`` and ``y(p)`` (both
+    minimized; ties kept once, the first). Points where either is None are skipped."""
+    vals = [(i, x(p), y(p)) for i, p in enumerate(points)]
+    vals = [(i, a, b) for i, a, b in vals if a is not None and b is not None]
+    front = []
+    for i, a, b in vals:
+        dominated = any((a2 <= a and b2 <= b) and ((a2, b2) != (a, b) or j < i)
+                        for j, a2, b2 in vals if j != i)
+        if not dominated:
+            front.append(i)
+    return front
+
+
+# ---------------------------------------------------------------- measurement context
+
+class Context:
+    """Inputs shared by every point of one run (same vectors, same scenes)."""
+
+    def __init__(self, grid, seed, work):
+        from bumprtl.sim.golden.common import PixelInputs
+        from bumprtl.sim.golden.float.conventional import conventional
+        from bumprtl.sim.scenes import load_scene
+        from bumprtl.sim.scenes.imaging import compose
+        from bumprtl.rtl.config import Config
+        self.grid, self.work = grid, Path(work)
+        self.px = PixelInputs.random(grid.samples, np.random.default_rng(seed))
+        self.scenes = {name: load_scene(name, size=grid.size) for name in grid.scenes}
+        self.refs = {name: compose(s, conventional(s.px, Config()).color) for name, s in self.scenes.items()}
+        self._adversarial = {}
+
+    def adversarial(self, cfg):
+        """Adversarial vectors depend on the angle grid only: one set per angle_bits."""
+        from bumprtl.sim.golden.accuracy import adversarial_pixels
+        if cfg.angle_bits not in self._adversarial:
+            self._adversarial[cfg.angle_bits] = adversarial_pixels(cfg)
+        return self._adversarial[cfg.angle_bits]
+
+
+def _stats(err):
+    return {"max": int(err.max()), "mean": round(float(err.mean()), 5), "n": int(err.size)}
+
+
+def _scene_stats(ctx, name, img):
+    from bumprtl.sim.scenes.imaging import max_diff, psnr
+    p = psnr(ctx.refs[name], img)
+    return {"psnr_db": None if p == float("inf") else round(p, 2), "max_lsb": max_diff(ctx.refs[name], img)}
+
+
+def perpixel_error(ctx, cfg):
+    from bumprtl.sim.golden.accuracy import diffuse_error_lsb
+    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+    from bumprtl.sim.golden.fixed.dispatch import encode_pixels
+    from bumprtl.sim.scenes.imaging import compose
+    out = {"random": _stats(diffuse_error_lsb(datapath_fixed, ctx.px, cfg)),
+           "adversarial": _stats(diffuse_error_lsb(datapath_fixed, ctx.adversarial(cfg), cfg)),
+           "scenes": {}}
+    for name, scene in ctx.scenes.items():
+        color = datapath_fixed(encode_pixels(scene.px, cfg), cfg)["color"] / 255.0
+        out["scenes"][name] = _scene_stats(ctx, name, compose(scene, color))
+    return out
+
+
+def perpixel_speed(ctx, cfg):
+    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+    from bumprtl.sim.golden.fixed.dispatch import encode_pixels
+    codes = encode_pixels(ctx.px, cfg)
+    return {"golden_mpix_s": round(len(ctx.px) / _best_time(lambda: datapath_fixed(codes, cfg)) / 1e6, 3)}
+
+
+def _cached(path, compute):
+    if path.is_file():
+        return json.loads(path.read_text())
+    value = compute()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(value, indent=1))
+    return value
+
+
+def _tag(cfg):
+    return f"{cfg.method}_a{cfg.angle_bits}_b{cfg.frac_bits}_p{cfg.palette_size}_s{int(cfg.specular)}"
+
+
+def _summary(counts):
+    s = counts.summary()
+    return {**{k: s[k] for k in COST_FIELDS if k in s}, "ram_bits": sum(r["bits"] for r in counts.rams)}
+
+
+def _digest(*texts):
+    """Cache key of generated Verilog: a changed datapath never reuses an old count."""
+    import hashlib
+    h = hashlib.sha256()
+    for t in texts:
+        h.update(t.encode())
+    return h.hexdigest()[:12]
+
+
+def unit_cost(units, cfg, work):
+    """Yosys counts of ``units`` (gen/units.py names) summed, cached per emitted Verilog."""
+    from bumprtl.gen.flow.resources import count_verilog
+    from bumprtl.gen.flow.units import emit_unit
+    paths = {u: emit_unit(u, cfg, work / "netlists" / _tag(cfg) / u)[0] for u in units}
+
+    def compute():
+        total = None
+        for u, v in paths.items():
+            c = count_verilog(v, u, v.parent)
+            total = c if total is None else total + c
+        return _summary(total)
+
+    key = _digest(*(v.read_text() for v in paths.values()))
+    return _cached(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}_{key}.json", compute)
+
+
+def fpga_cost(component_fn, label, cfg, device, work):
+    """Place a component on ``device`` with gen/fpga.py's ECP5 form (DSP and block-RAM
+    registers, as ``report fpga``), cached per emitted Verilog in the cache both share."""
+    from bumprtl.gen.flow.fpga import place_component
+    return place_component(component_fn(cfg), label, device)
+
+
+def _pipeline(cfg):
+    from bumprtl.gen.flow.fpga import pipeline_component
+    return pipeline_component(cfg)
+
+
+def _palette_unit(cfg):
+    from bumprtl.gen.flow.units import build_unit
+    return build_unit("palette", cfg)[0]
+
+
+def sim_rate(cfg, work):
+    """cocotb pixels/s on Verilator of the rotation and illumination units (scoreboard
+    included), the slower of the two (gen/bench_golden.py's measurement)."""
+    from bumprtl.gen.bench.golden import _sim_rate
+    rates = [_sim_rate(cfg, "verilator", u, 2000, work / "sim" / _tag(cfg))[0]
+             for u in ("rotation", "illumination")]
+    return round(min(rates))
+
+
+# ---------------------------------------------------------------- points
+
+def _invalid(method, params, e):
+    return {"method": method, **params, "status": "invalid", "reason": str(e)}
+
+
+def perpixel_point(ctx, method, a, b, opts):
+    from bumprtl.rtl.config import Config, ConfigError
+    params = {"angle_bits": a, "frac_bits": b}
+    try:
+        cfg = Config(method=method, angle_bits=a, frac_bits=b)
+    except ConfigError as e:
+        return _invalid(method, params, e)
+    point = {"method": method, **params, "status": "ok", "config": cfg.to_dict(),
+             "error": perpixel_error(ctx, cfg), "speed": perpixel_speed(ctx, cfg),
+             "cost": {**unit_cost(("rotation", "illumination"), cfg, ctx.work),
+                      "map_bits_per_texel": map_bits_per_texel(cfg)}}
+    if fpga_selected(ctx.grid, a, b, opts, method):
+        _hardware(point, cfg, _pipeline, "pipeline", ctx, opts)
+    if opts.sim and (a, b) == (Config().angle_bits, Config().frac_bits):
+        point["speed"]["sim_pix_s"] = sim_rate(cfg, ctx.work)
+    return point
+
+
+FPGA_POINTS = ("default", "diagonal", "all")
+
+
+def fpga_selected(grid, a, b, opts, method="exact"):
+    """Which width points ``--fpga`` places: ``all``; ``diagonal`` (the i-th angle width with
+    the i-th value width: cost against precision at a quarter of the flow time; baselines
+    at the default widths only, their combinational dividers and square roots take
+    synth_ecp5 10+ minutes per point); or ``default`` (the default widths of every method,
+    the placements ``report fpga`` shares). Palette sizes are always placed."""
+    from bumprtl.rtl.config import Config
+    mode = getattr(opts, "fpga_points", "all")
+    if mode == "all":
+        return True
+    if mode == "default" or method in BASELINES:
+        return (a, b) == (Config().angle_bits, Config().frac_bits)
+    ia, ib = grid.angle_bits.index(a), grid.frac_bits.index(b)
+    return ia == ib
+
+
+def map_bits_per_texel(cfg):
+    """Bump-map bits per texel: N' as two binary angles (polar methods) or three signed
+    components of B + 2 bits (Peercy, Ernst: Cartesian N')."""
+    return 3 * (cfg.frac_bits + 2) if cfg.method in ("peercy", "ernst") else 2 * cfg.angle_bits
+
+
+def _hardware(point, cfg, component_fn, label, ctx, opts):
+    if not opts.fpga:
+        return
+    from bumprtl.gen.flow.fpga import NOT_PLACED, FpgaError
+    from bumprtl.gen.flow.resources import SynthesisError
+    if point["method"] in NOT_PLACED:
+        point["cost"]["fpga_error"] = NOT_PLACED[point["method"]]
+        return
+    try:
+        row = fpga_cost(component_fn, f"{point['method']}_{label}", cfg, opts.device, ctx.work)
+    except (FpgaError, SynthesisError) as e:      # e.g. does not fit: recorded, not fatal
+        point["cost"]["fpga_error"] = str(e).splitlines()[0][:300]
+        return
+    point["cost"]["fpga"] = row
+    if row.get("fmax_mhz"):
+        point["speed"]["hw_pix_s"] = row["fmax_mhz"] * 1e6     # 1 pixel per clock (DESIGN §5)
+
+
+def palette_point(ctx, size, opts):
+    from bumprtl.rtl.config import BumpError, Config
+    from bumprtl.sim.golden.float.palette import palette_rgb, quantize_normal_map, world_normal_map
+    from bumprtl.sim.scenes.imaging import compose
+    cfg = Config(palette_size=size)
+    scenes, speeds = {}, []
+    for name, scene in ctx.scenes.items():
+        normals, counts = world_normal_map(scene)
+        try:
+            qmap = quantize_normal_map(normals, size, "median-cut", weights=counts)
+        except BumpError as e:         # sN above the map's distinct normals
+            scenes[name] = {"reason": str(e)}
+            continue
+        rgb, _ = palette_rgb(scene, cfg, qmap=qmap)
+        scenes[name] = _scene_stats(ctx, name, compose(scene, rgb.mean(-1)))
+        speeds.append(scene.mask.size / _best_time(lambda: palette_rgb(scene, cfg, qmap=qmap)))
+    if not speeds:
+        return _invalid("palette", {"palette_size": size}, "; ".join(s["reason"] for s in scenes.values()))
+    point = {"method": "palette", "palette_size": size, "status": "ok", "config": cfg.to_dict(),
+             "error": {"scenes": scenes, "note": "a palette shades a normal map: scenes only, "
+                                                  "no independent random/adversarial vectors"},
+             "speed": {"golden_mpix_s": round(min(speeds) / 1e6, 3),
+                       "golden_note": "per frame: colour table of sN normals + per-pixel lookup"},
+             "cost": {**unit_cost(("palette",), cfg, ctx.work),
+                      "map_bits_per_texel": (size - 1).bit_length()}}   # a palette index
+    _hardware(point, cfg, _palette_unit, "palette", ctx, opts)
+    return point
+
+
+def sweep(grid, opts, work, seed=11, progress=True):
+    """Every point of ``grid``; ``opts`` has ``fpga``, ``device``, ``sim``, ``methods``."""
+    from tqdm import tqdm
+    ctx = Context(grid, seed, work)
+    methods = [m for m in PER_PIXEL if m in opts.methods]
+    methods += list(BASELINES) if "baselines" in opts.methods else []
+    jobs = [(perpixel_point, (m, a, b, opts)) for m in methods
+            for a in grid.angle_bits for b in grid.frac_bits]
+    if "palette" in opts.methods:
+        jobs += [(palette_point, (s, opts)) for s in grid.palette_sizes]
+    points = []
+    with tqdm(jobs, desc="sweep", unit="point", disable=not progress, file=sys.stderr) as bar:
+        for fn, args in bar:
+            bar.set_postfix_str(" ".join(map(str, args[:-1])))
+            points.append(fn(ctx, *args))
+    reference = len(ctx.px) / _best_time(lambda: _conventional(ctx)) / 1e6
+    return {"grid": grid.__dict__, "seed": seed, "float64_conventional_mpix_s": round(reference, 3),
+            "points": points}
+
+
+def _conventional(ctx):
+    from bumprtl.rtl.config import Config
+    from bumprtl.sim.golden.float.conventional import conventional
+    return conventional(ctx.px, Config())
+
+
+# ---------------------------------------------------------------- output
+
+def ok_points(data):
+    return [p for p in data["points"] if p["status"] == "ok"]
+
+
+def _ns_per_pixel(p):
+    return 1e3 / p["speed"]["golden_mpix_s"]
+
+
+def _memory_bits(p):
+    return p["cost"]["table_bits"] + p["cost"]["ram_bits"]
+
+
+def point_label(p):
+    if p["method"] == "palette":
+        return f"palette sN={p['palette_size']}"
+    return f"{p['method']} a{p['angle_bits']} b{p['frac_bits']}" if "angle_bits" in p else p["method"]
+
+
+def _fmt(x, spec="{}"):
+    return "—" if x is None else spec.format(x)
+
+
+def _row(p, front):
+    err, cost, speed = p.get("error", {}), p.get("cost", {}), p.get("speed", {})
+    scenes = [s for s in err.get("scenes", {}).values() if "max_lsb" in s]
+    psnrs = [s["psnr_db"] for s in scenes]
+    psnr = None if not scenes else ("inf" if all(v is None for v in psnrs) else
+                                    f"{min(v for v in psnrs if v is not None):.1f}")
+    rnd, adv = err.get("random"), err.get("adversarial")
+    f = cost.get("fpga", {})
+    hw = speed.get("hw_pix_s")
+    return (f"| {point_label(p)} | {_fmt(rnd and rnd['max'])} / {_fmt(rnd and rnd['mean'], '{:.3f}')} "
+            f"| {_fmt(adv and adv['max'])} / {_fmt(adv and adv['mean'], '{:.3f}')} "
+            f"| {_fmt(psnr)} / {_fmt(max((s['max_lsb'] for s in scenes), default=None))} "
+            f"| **{error_lsb(p)}** | {cost['multipliers']} | {cost.get('dividers', 0)} / {cost.get('sqrts', 0)} "
+            f"| {cost['adders']} | {cost['table_bits']} "
+            f"| {cost['ram_bits']} | {cost['map_bits_per_texel']} | {_fmt(f.get('LUT4'))} | {_fmt(f.get('DSP'))} | {_fmt(f.get('BRAM'))} "
+            f"| {_fmt(f.get('fmax_mhz'))} | {speed['golden_mpix_s']:.2f} | {_fmt(speed.get('sim_pix_s'), '{:,}')} "
+            f"| {_fmt(hw and hw / 1e6, '{:.1f}')} | {'yes' if id(p) in front else ''} |")
+
+
+def markdown(data, command, plot_paths=()):
+    """The sweep section of docs/bench.md."""
+    pts = ok_points(data)
+    front = {id(pts[i]) for i in pareto_front(pts, _memory_bits, error_lsb)}
+    g = data["grid"]
+    lines = [f"Generated by `{command}` (grid: angle bits {g['angle_bits']}, frac bits "
+             f"{g['frac_bits']}, palette sizes {g['palette_sizes']}; {g['samples']} random valid "
+             f"vectors, seed {data['seed']}; adversarial vectors of sim/golden/accuracy.py per "
+             f"angle width; scenes {', '.join(g['scenes'])} at {g['size']}x{g['size']}).", "",
+             "Errors are 8-bit LSB against float64 `conventional` on unquantized inputs: diffuse "
+             "max / mean on the vectors, colour-image PSNR (worst scene, dB) / max LSB on the "
+             "scenes. **error** = the worst max over all sets (what `bumprtl recommend` uses). "
+             "Cost: Yosys coarse netlist of the per-pixel units (rotation + illumination, or the "
+             "palette LUT; gen/resources.py); the bump map itself is not in it: `map bits` per texel is "
+             "2 x angle bits for N' angles, 3 x (frac bits + 2) for Peercy's and Ernst's Cartesian N', "
+             "log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
+             f"of 3; float64 `conventional` ran at {data['float64_conventional_mpix_s']:.2f} Mpix/s "
+             "on the same vectors). `pareto` = on the front of error against ROM+RAM bits.", "",
+             "| point | random max / mean | adversarial max / mean | scenes PSNR / max | error "
+             "| mult | div / sqrt | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM | Fmax MHz "
+             "| golden Mpix/s | sim pix/s | hw Mpix/s | pareto |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [_row(p, front) for p in pts]
+    other = [p for p in data["points"] if p["status"] != "ok"]
+    if other:
+        lines += ["", "Not measured:", ""]
+        lines += [f"- {point_label(p)}: **{p['status']}** — {p['reason']}" for p in other]
+    failed = [p for p in pts if p["cost"].get("fpga_error")]
+    if failed:
+        lines += ["", "FPGA flow failed (the point keeps its other columns):", ""]
+        lines += [f"- {point_label(p)}: {p['cost']['fpga_error']}" for p in failed]
+    lines += [""] + [f"![{name}](img/{Path(path).name})" for name, path in plot_paths]
+    return "\n".join(lines)
+
+
+def plot(data, path):
+    """Two panels: error against ROM+RAM bits and against golden-model ns/pixel, each
+    with its Pareto front."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    pts = ok_points(data)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for ax, x, xlabel in ((axes[0], _memory_bits, "ROM + RAM bits"),
+                          (axes[1], _ns_per_pixel, "golden model ns / pixel (numpy)")):
+        for n, method in enumerate(sorted({p["method"] for p in pts})):
+            sel = [p for p in pts if p["method"] == method]
+            ax.scatter([x(p) for p in sel], [max(error_lsb(p), 0.5) for p in sel], label=method,
+                       color=f"C{n}")
+        front = sorted((x(pts[i]), max(error_lsb(pts[i]), 0.5)) for i in pareto_front(pts, x, error_lsb))
+        if front:
+            ax.step(*zip(*front), where="post", color="k", lw=0.8, label="Pareto front")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("worst error, 8-bit LSB (0 shown as 0.5)")
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def write_section(path, name, text):
+    """Replace the ``name`` section of a generated markdown file (between its markers),
+    appending it when absent; other sections stay as they are."""
+    path = Path(path)
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    old = path.read_text() if path.is_file() else "# Benchmarks\n"
+    block = f"{begin}\n{text}\n{end}"
+    if begin in old and end in old:
+        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
+    else:
+        new = old.rstrip("\n") + "\n\n" + block + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(new)
+
+
+def command_line(args):
+    parts = ["bumprtl bench sweep"] + (["--quick"] if args.quick else [])
+    if set(args.methods) != set(METHOD_CHOICES):
+        parts += ["--methods", *args.methods]
+    if args.fpga:
+        parts += ["--fpga", "--device", args.device, "--fpga-points", args.fpga_points]
+    if args.sim:
+        parts.append("--sim")
+    return " ".join(parts)
+
+
+METHOD_CHOICES = ("exact", "lee", "palette", "baselines")
+
+
+def run(args):
+    from bumprtl.gen.flow.fpga import check_device
+    if args.fpga:
+        check_device(args.device)
+    grid = GRIDS["quick" if args.quick else "default"]
+    command = command_line(args)
+    print(command)
+    data = sweep(grid, args, args.work, progress=not args.no_progress)
+    data["command"] = command
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(data, indent=1))
+    print(f"wrote {args.out}")
+    if args.docs:
+        img = args.docs.parent / "img"
+        plots = [("error against cost and run time", plot(data, img / "bench_pareto.png"))]
+        write_section(args.docs, "sweep", "## Error, cost and speed sweep\n\n" + markdown(data, command, plots))
+        if args.data_copy:
+            args.data_copy.parent.mkdir(parents=True, exist_ok=True)
+            args.data_copy.write_text(json.dumps(data, indent=1))
+        print(f"wrote {args.docs}")
+    else:
+        print(markdown(data, command))
+    return 0
+
+
+def add_parser(sub):
+    p = sub.add_parser("sweep", help="error against cost against run time over widths and methods",
+                       description="For exact/lee over angle and value widths, the palette over "
+                                   "palette sizes, and the baselines: error vs float64, Yosys cost "
+                                   "(optionally ECP5), golden/simulation/hardware speed. JSON, "
+                                   "Pareto plot, markdown table.")
+    p.add_argument("--quick", action="store_true", help="small grid (angle 10,12 x frac 11,13; sN 16,256)")
+    p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
+    p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
+    p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
+    p.add_argument("--fpga-points", default="default", choices=FPGA_POINTS,
+                   help="with --fpga: which width points to place: the default widths of every "
+                        "method (default), the i-th angle width with the i-th value width "
+                        "(diagonal; baselines at the default widths), or all; palette sizes always")
+    p.add_argument("--sim", action="store_true",
+                   help="cocotb/Verilator pixels/s for the points at the default widths")
+    p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
+    p.add_argument("--work", type=Path, default=Path("build/bench/sweep"),
+                   help="netlists and cached cost per config")
+    p.add_argument("--docs", type=Path, default=None, help="write the sweep section of this markdown file "
+                                                           "(docs/bench.md) and docs/img/bench_pareto.png")
+    p.add_argument("--data-copy", type=Path, default=None, help="also copy the JSON here (docs/data/)")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=run)

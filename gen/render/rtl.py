@@ -1,0 +1,249 @@
+"""Rendering through the RTL (``bumprtl render --rtl``): emit the scene's pipeline, stream
+every pixel through it with cocotb (Icarus or Verilator), collect the image.
+
+The same stimulus gives the fixed-point golden render (sim/golden/fixed_pipeline.py); the
+two must agree byte for byte. Per pixel the stimulus carries the texel coordinates (u, v),
+world N, L and H as binary angles and a tag (the pixel index); the bump map (N' angles of
+every texel, or palette indices) is the fetch unit's block-RAM initial contents, and with
+``texture = true`` the scene's albedo (8-bit RGB per texel, :func:`scene_texels`) is the
+colour texture's; the pipeline then outputs RGB itself.
+"""
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config
+
+__all__ = ["RtlRender", "scene_stimulus", "scene_texels", "golden_render", "render_rtl"]
+
+LIGHT_AZIMUTH_STEP = 120.0        # light j sits 120 degrees further round than light j - 1
+
+
+@dataclass
+class RtlRender:
+    image: np.ndarray              # 8-bit (H, W, 3) image through the RTL
+    golden: np.ndarray             # the fixed-point golden render of the same stimulus
+    cycles: int
+    seconds: float                 # wall time of the simulation run (not the build)
+    build_seconds: float
+
+
+def _sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
+    from bumprtl.sim.scenes import load_scene
+    return load_scene(scene.image, size=size, texture_size=scene.texture_size,
+                      light_azimuth=azimuth, **light)
+
+
+def _levels(level0, scene):
+    """Mip levels of a word map: point-sampled (every 2**l-th texel); renders read level 0."""
+    return [level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)]
+
+
+def scene_stimulus(scene: SceneConfig, size, **light):
+    """Per-pixel input arrays, memory words, polygon registers and palette table (or None)
+    of one frame of ``scene`` at ``size`` x ``size``; and the sim scene."""
+    from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
+    from bumprtl.sim.golden.fixed.pipeline import map_words, polygon_fixed
+    from bumprtl.rtl.bumpfetch import pack_texels
+    cfg = scene.config
+    base = _sim_scene(scene, size, **light)
+    inputs, words, polygon, table = {}, None, None, None
+    if scene.bump_map == "varying" or scene.shading == "palette" or scene.texture:
+        inputs["u"], inputs["v"] = base.u, base.v
+        if scene.mip_levels > 1:
+            inputs["level"] = np.zeros_like(base.u)
+    if scene.shading == "palette":
+        words, table = _palette_maps(base, scene)
+    else:
+        codes = quantize_pixels(base.px, cfg)
+        if scene.bump_map == "varying":
+            inputs["n.phi"], inputs["n.theta"] = codes["n.phi"], codes["n.theta"]
+            level0 = pack_texels(scene, angle_codes(base.b_phi_map, cfg), angle_codes(base.b_theta_map, cfg))
+            words = map_words(_levels(level0, scene), scene)
+        else:
+            if np.ptp(codes["n.phi"]) or np.ptp(codes["n.theta"]):
+                raise BumpError(f"bump_map = 'flat' renders one polygon: image {scene.image!r} "
+                                f"is not a plane (its normal varies); use a plane scene")
+            polygon = polygon_fixed(codes["n.phi"].flat[0], codes["n.theta"].flat[0], 0, 0, scene)
+        for j, names in enumerate(light_fields(scene)):
+            lit = quantize_pixels(_sim_scene(scene, size, 30.0 + LIGHT_AZIMUTH_STEP * j, **light).px, cfg)
+            for std, name in zip(("l", "h"), names):
+                inputs[f"{name}.phi"], inputs[f"{name}.theta"] = lit[f"{std}.phi"], lit[f"{std}.theta"]
+    inputs = {k: np.asarray(v, np.int64).ravel() for k, v in inputs.items()}
+    inputs["tag"] = np.arange(size * size, dtype=np.int64) & ((1 << scene.tag_bits) - 1)
+    return inputs, words, polygon, table, base
+
+
+def scene_texels(scene: SceneConfig, base):
+    """The colour-texture memory of a textured scene (None without a texture): the sim
+    scene's albedo as 8-bit RGB words, mip levels point-sampled like the bump map."""
+    if not scene.texture:
+        return None
+    if base.albedo is None:
+        from bumprtl.sim.scenes import SCENES
+        have = [n for n, v in SCENES.items() if v[0] in ("bricks", "wood")]
+        raise BumpError(f"texture = true needs an image with a colour texture ({', '.join(have)}), "
+                        f"got image {scene.image!r}")
+    from bumprtl.rtl.bumpfetch import pack_rgb
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.fixed.pipeline import map_words
+    return map_words(_levels(pack_rgb(to_8bit(base.albedo)), scene), scene)
+
+
+def _palette_maps(base, scene):
+    """Index map words (mip levels by Tarini Sec. 5.2) and the 8-bit RGBA colour table."""
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.fixed.pipeline import map_words
+    from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
+                                      quantize_normal_map, world_normal_map)
+    from bumprtl.sim.golden.fixed.palette_lut import pack_rgba
+    normals, counts = world_normal_map(base)
+    qmap = quantize_normal_map(normals, scene.palette_size, weights=counts)
+    l, v = frame_directions(base)
+    table8 = to_8bit(color_table(qmap.table, "phong", l, v, scene.config))
+    levels = mipmap_indices(qmap)[:scene.mip_levels]
+    return map_words(levels, scene), pack_rgba(table8, scene.config)
+
+
+def _image(base, pixels, scene):
+    """Output fields (flat arrays) -> 8-bit RGB image: grey shading times the albedo, or the
+    pipeline's own RGB (palette colour, or the colour-texture blend); black outside the
+    geometry."""
+    from bumprtl.sim.scenes.imaging import compose
+    size = base.size
+    if "color.r" in pixels:
+        rgb = np.stack([pixels[f"color.{c}"] for c in "rgb"], -1).reshape(size, size, 3)
+        return np.where(base.mask[..., None], rgb, 0).astype(np.uint8)
+    return compose(base, np.asarray(pixels["color"]).reshape(size, size) / 255.0)
+
+
+def golden_render(scene, size, **light):
+    """The fixed-point golden image of ``scene``: 8-bit RGB."""
+    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+    from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, unpack_rgba
+    scene = load_scene_config(scene)
+    inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
+    out = pipeline_fixed(inputs, scene, words, polygon, scene_texels(scene, base))
+    if scene.shading == "palette":
+        entry = unpack_rgba(table[out["index"]], scene.config)
+        if scene.texture:                  # Tarini eq. 2, the texel as the base colour
+            rgb = unpack_rgba(out["texel"] | (255 << 24), scene.config)
+            entry = blend_eq2(entry, rgb, scene.config)
+        out = {f"color.{c}": v for c, v in entry.items()}
+    return _image(base, out, scene)
+
+
+def write_stimulus(path, inputs, polygon, table):
+    arrays = {f"in.{k}": v for k, v in inputs.items()}
+    arrays.update({f"polygon.{k}": np.array(v) for k, v in (polygon or {}).items()})
+    if table is not None:
+        arrays["lut"] = np.asarray(table, np.int64)
+    np.savez(path, **arrays)
+
+
+def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, patterns=("no_stall",),
+                 progress=True, texels=None, rtl_dir=None):
+    """Emit BumpPipeline(scene) with ``words`` in its map (and ``texels`` in its colour
+    texture), run ``inputs`` through it under each traffic pattern; returns
+    ({pattern: {field: array}}, {pattern: cycles}, times). The Verilog goes to ``rtl_dir``
+    (default ``<build_dir>/rtl``)."""
+    from bumprtl.rtl.pipeline import BumpPipeline
+    from bumprtl.sim.tb.runner import run_cocotb
+    from bumprtl.gen.flow.emit import emit
+    from bumprtl.gen.flow.units import build_unit, canonical_command, UNITS
+    build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
+    dut = BumpPipeline(scene, init=words, texture=texels)
+    sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
+    rtl_dir = build_dir / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
+    v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), rtl_dir,
+                sidecar, flatten=True)
+    build_dir.mkdir(parents=True, exist_ok=True)
+    stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
+    write_stimulus(stim, inputs, polygon, table)
+    run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
+               {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
+                "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
+    res = dict(np.load(result))
+    outs = {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".") and
+                not k.endswith(".cycles")} for p in patterns}
+    return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run_cocotb.last_times
+
+
+def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl", progress=True,
+               rtl_dir=None, **light):
+    """Render ``scene`` (SceneConfig, name or TOML path) through the emitted RTL; returns an
+    :class:`RtlRender` with the RTL image and the golden image of the same stimulus."""
+    scene = load_scene_config(scene)
+    inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
+    outs, cycles, times = run_pipeline(scene, inputs, words, polygon, table, simulator,
+                                       build_dir, progress=progress,
+                                       texels=scene_texels(scene, base), rtl_dir=rtl_dir)
+    pixels = outs["no_stall"]
+    if not np.array_equal(pixels["tag"], inputs["tag"]):
+        raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
+    return RtlRender(_image(base, pixels, scene), golden_render(scene, size, **light),
+                     cycles["no_stall"], times["run_s"], times["build_s"])
+
+
+def cli_render(args):
+    """``bumprtl render --rtl``: the scene class ``--pipeline`` (built-in name or TOML)
+    rendering image ``--scene``; writes the RTL image, checks it against the golden render."""
+    from bumprtl.sim.scenes.imaging import save_png
+    scene = load_scene_config(args.pipeline)
+    keys = {"image": args.scene}
+    if args.texture_size is not None:
+        keys["texture_size"] = args.texture_size
+    scene = load_scene_config({**scene.to_dict(), **keys, "rotation": None})
+    light = {"light_elevation": args.light_elevation, "light": args.light}
+    t0 = time.perf_counter()
+    r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / scene.name,
+                   progress=True, **light)
+    out = save_png(args.out, r.image)
+    same = r.image.tobytes() == r.golden.tobytes()
+    print(f"rtl ({args.simulator}): {args.size}x{args.size} {args.scene} with pipeline "
+          f"{scene.name}: {r.cycles} cycles, simulation {r.seconds:.2f} s "
+          f"({args.size ** 2 / r.seconds:.0f} pix/s), build {r.build_seconds:.1f} s, "
+          f"total {time.perf_counter() - t0:.1f} s -> {out}")
+    print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
+    return 0 if same else 1
+
+
+
+SCENES_TABLE_SIZE = 256
+
+
+def _built_units(scene):
+    from bumprtl.rtl.pipeline import BumpPipeline
+    dut = BumpPipeline(scene)
+    for unit in (dut, *dut.units.values()):        # only the plan is read, never elaborated
+        unit._MustUse__silence = True
+    return ", ".join(u["unit"] for u in dut.built)
+
+
+def scenes_table(work_dir="build/scenes"):
+    """The table of docs/scenes.md: per built-in scene class, the units
+    built, multipliers, ROM and RAM bits and adders of the emitted pipeline (Yosys netlist,
+    gen/resources.py) and the golden render time at SCENES_TABLE_SIZE^2."""
+    from bumprtl.rtl.scene import BUILTIN
+    from bumprtl.gen.flow.resources import count_unit
+    rows = ["| scene class | units built | multipliers | ROM bits | RAM bits | adders | "
+            f"golden render {SCENES_TABLE_SIZE}² (s) | command |", "|---" * 8 + "|"]
+    for name in BUILTIN:
+        scene = load_scene_config(name)
+        netlist = count_unit("pipeline", scene, Path(work_dir) / name)
+        counts, ram = netlist.summary(), sum(r["bits"] for r in netlist.rams)
+        t0 = time.perf_counter()
+        golden_render(scene, SCENES_TABLE_SIZE)
+        seconds = time.perf_counter() - t0
+        rows.append(f"| {name} | {_built_units(scene)} | {counts['multipliers']} | "
+                    f"{counts['table_bits']} | {ram} | {counts['adders']} | {seconds:.2f} | "
+                    f"`bumprtl emit pipeline --scene {name}` |")
+    return "\n".join(rows)
+
+
+if __name__ == "__main__":            # python -m bumprtl.gen.render.rtl > build/scenes.md
+    print(scenes_table())

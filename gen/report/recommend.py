@@ -1,0 +1,111 @@
+"""``bumprtl recommend --max-error-lsb E [--device D]``: the cheapest configuration whose
+measured error meets the bound, from the sweep data (``bumprtl bench sweep``), with the
+evidence: its error sets, its cost, its speed, the runners-up and the command that made
+the numbers. Nothing is re-measured or estimated here.
+"""
+
+import json
+from pathlib import Path
+
+from bumprtl.rtl.config import BumpError
+from bumprtl.gen.bench.sweep import point_label, cost_key, error_lsb, ok_points
+
+__all__ = ["recommend", "add_parser"]
+
+
+def _load(path):
+    path = Path(path)
+    if not path.is_file():
+        raise BumpError(f"sweep data {path} does not exist: run `bumprtl bench sweep` first "
+                        f"(or pass --sweep FILE)")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise BumpError(f"sweep data {path} is not valid JSON ({e})") from None
+    if not isinstance(data, dict) or not isinstance(data.get("points"), list):
+        raise BumpError(f"sweep data {path} has no 'points' list: not a `bumprtl bench sweep` output")
+    return data
+
+
+def _fits(point, device):
+    f = point["cost"].get("fpga")
+    if not f or f.get("device") != device:
+        return False
+    avail = f.get("available") or {}
+    return all(avail.get(k) is None or f[k] <= avail[k] for k in ("LUT4", "DSP", "BRAM"))
+
+
+def recommend(data, max_error_lsb, device=None):
+    """``(best, candidates)``: the points meeting the bound (and fitting ``device``), cheapest
+    first by :func:`cost_key`; raises BumpError when none does."""
+    if isinstance(max_error_lsb, bool) or not isinstance(max_error_lsb, (int, float)) or max_error_lsb < 0:
+        raise BumpError(f"max_error_lsb must be a number >= 0, got {max_error_lsb!r}")
+    points = [p for p in ok_points(data) if error_lsb(p) is not None]
+    if device:
+        placed = [p for p in points if p["cost"].get("fpga", {}).get("device") == device]
+        if not placed:
+            raise BumpError(f"the sweep has no FPGA numbers for device {device}: run "
+                            f"`bumprtl bench sweep --fpga --device {device}` first")
+        points = [p for p in placed if _fits(p, device)]
+    meeting = sorted((p for p in points if error_lsb(p) <= max_error_lsb),
+                     key=lambda p: (cost_key(p, device), error_lsb(p)))
+    if not meeting:
+        best = min((error_lsb(p) for p in points), default=None)
+        raise BumpError(f"no configuration in the sweep meets max_error_lsb = {max_error_lsb}"
+                        f"{' on ' + device if device else ''}: the smallest measured error is "
+                        f"{best} LSB (allowed bounds: >= {best})")
+    return meeting[0], meeting
+
+
+def _evidence(p):
+    err, cost, speed = p["error"], p["cost"], p["speed"]
+    lines = [f"  error (8-bit LSB vs float64): worst {error_lsb(p)}"]
+    for k in ("random", "adversarial"):
+        if k in err:
+            lines.append(f"    {k}: max {err[k]['max']}, mean {err[k]['mean']} over {err[k]['n']} vectors")
+    for name, s in err.get("scenes", {}).items():
+        if "max_lsb" in s:
+            lines.append(f"    scene {name}: PSNR {s['psnr_db']} dB, max {s['max_lsb']}")
+    lines.append(f"  cost: {cost['multipliers']} multipliers, {cost['adders']} adders, "
+                 f"{cost['table_bits']} ROM bits, {cost['ram_bits']} RAM bits")
+    if "fpga" in cost:
+        f = cost["fpga"]
+        lines.append(f"    {f['device']}: {f['LUT4']} LUT4, {f['DSP']} DSP, {f['BRAM']} BRAM, "
+                     f"Fmax {f['fmax_mhz']} MHz")
+    lines.append("  speed: " + ", ".join(f"{k} {v}" for k, v in speed.items() if not k.endswith("note")))
+    return lines
+
+
+def _flags(p):
+    c = p["config"]
+    if p["method"] == "palette":
+        return f"--palette-size {c['palette_size']}"
+    return f"--method {c['method']} --angle-bits {c['angle_bits']} --frac-bits {c['frac_bits']}"
+
+
+def run(args):
+    data = _load(args.sweep)
+    best, meeting = recommend(data, args.max_error_lsb, args.device)
+    order = ("DSP, block RAM, LUT4 on " + args.device if args.device else
+             "multipliers + dividers + square roots, then ROM+RAM bits, then adders")
+    print(f"cheapest configuration with worst measured error <= {args.max_error_lsb} LSB "
+          f"(cheapest by {order}):\n")
+    print(f"  {point_label(best)}: {_flags(best)}")
+    print("\n".join(_evidence(best)))
+    if len(meeting) > 1:
+        print("\nnext cheapest meeting the bound:")
+        for p in meeting[1:4]:
+            print(f"  {point_label(p)}: error {error_lsb(p)}, cost key {cost_key(p, args.device)}")
+    print(f"\nevidence from {args.sweep}, made by `{data.get('command', 'bumprtl bench sweep')}`")
+    return 0
+
+
+def add_parser(sub):
+    p = sub.add_parser("recommend", help="cheapest configuration meeting an error bound (from the sweep)",
+                       description="Reads the `bumprtl bench sweep` JSON and prints the cheapest "
+                                   "configuration whose worst measured error is within the bound, "
+                                   "with the evidence. Exits 2 when none meets it.")
+    p.add_argument("--max-error-lsb", type=float, required=True, help="bound on the worst error, 8-bit LSB")
+    p.add_argument("--device", default=None, help="rank by ECP5 cost on this device (needs sweep --fpga)")
+    p.add_argument("--sweep", type=Path, default=Path("build/bench/sweep.json"), help="sweep JSON")
+    p.set_defaults(func=run)

@@ -1,0 +1,179 @@
+"""Bit-exact int64 model of BumpMapFetch and of the BumpPipeline a SceneConfig builds.
+
+It skips the same work the generator skips: no H terms without specular, the N' rotation
+once per polygon for a flat bump map, m lights dotted with one rotated normal, only a table
+lookup with palette shading. Inputs and outputs are dicts of arrays keyed like the flattened
+payloads (``"u"``, ``"n.phi"``, ``"l1.theta"``, ...).
+
+Several lights (DESIGN §6; eq. 2 of Lee et al. summed over lights): each light j gives
+diffuse_j and specular_j (8 bits, rtl/illumination.shade_stages); the pipeline outputs
+  diffuse  = min(255, sum diffuse_j),  specular = min(255, sum specular_j),
+  color    = clamp(round((KA + KD sum diffuse_j + KS sum specular_j) / 256), 0, 255).
+
+Colour texture (``texture = true``): the RGB texel at the same (u, v, level) as the bump map
+(``texels``: the texture memory) and :func:`rtl.texture.texture_blend`, the very function the
+RTL's TextureBlend elaborates: per channel
+  color.c  = clamp(tex_c min(1, ka + kd sum d_j) + ks sum s_j)   (rounded as in rtl/texture.py);
+palette shading returns the texel word beside the index (PaletteLUT's eq. 2 base colour).
+"""
+
+import numpy as np
+
+from bumprtl.rtl.bumpfetch import has_map, level_bases, pack_texels, texel_address
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.scene import SceneConfig, light_fields
+from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.texture import RGB, texture_blend
+from bumprtl.sim.golden.fixed.exact import exact_rotation_fixed
+from bumprtl.sim.golden.fixed.dispatch import illumination_fixed, rotation_fixed
+
+__all__ = ["light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
+           "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
+           "random_inputs", "as_payload_list", "unpack_rgb"]
+
+
+def unpack_rgb(words):
+    """Texture words (r low) -> {r, g, b} 8-bit arrays."""
+    w = np.asarray(words, np.int64)
+    return {c: (w >> (8 * n)) & 0xFF for n, c in enumerate(RGB)}
+
+
+def fetch_fixed(u, v, level, words, scene: SceneConfig):
+    """BumpMapFetch: the stored word of each (u, v, level); levels past the last read the
+    last (``level`` None means level 0)."""
+    u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
+    level = np.zeros_like(u) if level is None else np.minimum(np.asarray(level), scene.mip_levels - 1)
+    addr = np.zeros_like(u)
+    for n in range(scene.mip_levels):
+        addr = np.where(level == n, texel_address(u, v, n, scene), addr)
+    return np.asarray(words, np.int64)[addr]
+
+
+def unpack_texels(words, scene: SceneConfig):
+    """Texel words -> ``{"b.phi", "b.theta"}`` angle codes, or ``{"index"}``."""
+    w = np.asarray(words, np.int64)
+    if scene.shading == "palette":
+        return {"index": w}
+    mask = (1 << scene.angle_bits) - 1
+    return {"b.phi": w & mask, "b.theta": (w >> scene.angle_bits) & mask}
+
+
+def map_words(levels, scene: SceneConfig):
+    """The memory image: per-level (T_l, T_l) word maps, row v, column u, one after the
+    other at :func:`level_bases`."""
+    if len(levels) != scene.mip_levels:
+        raise ValueError(f"{len(levels)} levels given, the scene has {scene.mip_levels}")
+    words = np.concatenate([np.asarray(lv, np.int64).ravel() for lv in levels])
+    assert len(words) == level_bases(scene)[-1] + levels[-1].size
+    return words
+
+
+def _light_codes(codes, names):
+    """The codes of one light renamed to the ``l``/``h`` keys the unit models read."""
+    out = {k: codes[k] for k in ("n.phi", "n.theta", "b.phi", "b.theta") if k in codes}
+    for std, name in zip(("l", "h"), names):
+        out[f"{std}.phi"], out[f"{std}.theta"] = codes[f"{name}.phi"], codes[f"{name}.theta"]
+    return out
+
+
+def polygon_fixed(n_phi, n_theta, b_phi, b_theta, scene: SceneConfig):
+    """The once-per-polygon rotation of a flat bump map's N' (polygon normal N): the n''
+    terms x4, y2, z4 and ph_N (``n_phi``), which the per-pixel vector terms need; keyed
+    like the pipeline's ``poly`` port."""
+    codes = {"n.phi": n_phi, "n.theta": n_theta, "b.phi": b_phi, "b.theta": b_theta,
+             "l.phi": 0, "l.theta": 0, "h.phi": 0, "h.theta": 0}
+    rot = exact_rotation_fixed({k: np.asarray(c, np.int64) for k, c in codes.items()}, scene.config)
+    return {"n_phi": int(n_phi), **{k: int(rot[k]) for k in ("n.x4", "n.y2", "n.z4")}}
+
+
+def combine_lights_fixed(shades, scene: SceneConfig):
+    """Several lights' diffuse/specular -> the pipeline output (module docstring)."""
+    cfg = scene.config
+    d = sum(np.asarray(s["diffuse"], np.int64) for s in shades)
+    s = sum(np.asarray(s["specular"], np.int64) for s in shades)
+    ka, kd, ks = phong_coefficients(cfg)
+    color = np.clip(round_shift(ka + kd * d + ks * s, 8), 0, 255)
+    return {"diffuse": np.minimum(d, 255), "specular": np.minimum(s, 255), "color": color}
+
+
+def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=None):
+    """The outputs of BumpPipeline(scene) for the input payload arrays ``inputs``.
+
+    ``words``: the bump map memory (varying map); ``polygon``: the per-polygon n'' terms
+    (flat map, :func:`polygon_fixed`); ``texels``: the colour-texture memory (texture =
+    true). Palette shading returns the ``index`` of each pixel (and the ``texel`` word with
+    a texture; the colour is PaletteLUT's: ``sim/golden/palette_lut.py``).
+    """
+    cfg = scene.config
+    codes = dict(inputs)
+    fetch = lambda mem: fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"), mem, scene)
+    if has_map(scene):
+        codes.update(unpack_texels(fetch(words), scene))
+    tex = fetch(texels) if scene.texture else None
+    if scene.shading == "palette":
+        return {"index": codes["index"], **({"texel": tex} if scene.texture else {})}
+    shades = []
+    for names in light_fields(scene):
+        light = _light_codes(codes, names)
+        if polygon is None:
+            rot = rotation_fixed(light, cfg)
+        else:                                      # n'' once per polygon, terms per pixel
+            shape = light["l.phi"].shape
+            poly = {k: np.full(shape, v, np.int64) for k, v in polygon.items()}
+            zero = np.zeros(shape, np.int64)
+            rot = {**exact_rotation_fixed({**light, "n.phi": poly.pop("n_phi"), "n.theta": zero,
+                                           "b.phi": zero, "b.theta": zero}, cfg), **poly}
+        shades.append(illumination_fixed(rot, cfg))
+    if scene.texture:
+        color, d, s = texture_blend([sh["diffuse"] for sh in shades],
+                                    [sh["specular"] for sh in shades], unpack_rgb(tex), cfg)
+        return {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
+    if len(shades) == 1:
+        return {k: shades[0][k] for k in ("diffuse", "specular", "color")}
+    return combine_lights_fixed(shades, scene)
+
+
+def random_map(scene: SceneConfig, rng):
+    """A random memory image: N' in the upper tangent hemisphere, or palette indices."""
+    from bumprtl.rtl.bumpfetch import memory_depth, pack_texels
+    from bumprtl.rtl.palette import index_bits
+    n, full = memory_depth(scene), 1 << scene.angle_bits
+    if scene.shading == "palette":
+        return pack_texels(scene, index=rng.integers(0, 1 << index_bits(scene.config), n))
+    return pack_texels(scene, phi=rng.integers(0, full, n), theta=rng.integers(0, full // 4 + 1, n))
+
+
+def random_texture(scene: SceneConfig, rng):
+    """A random colour-texture memory image (24-bit RGB words), or None without a texture."""
+    from bumprtl.rtl.bumpfetch import memory_depth
+    return rng.integers(0, 1 << 24, memory_depth(scene)) if scene.texture else None
+
+
+def random_inputs(scene: SceneConfig, n, rng):
+    """``n`` random input payloads (dict of arrays): texel coordinates over the whole signed
+    port range (so wrap/clamp are exercised), levels past the last, random angles."""
+    from bumprtl.rtl.bumpfetch import coord_bits, level_bits
+    from bumprtl.sim.golden.vectors import random_codes
+    out = {}
+    if has_map(scene) or scene.texture:
+        half = 1 << (coord_bits(scene) - 1)
+        out["u"], out["v"] = rng.integers(-half, half, n), rng.integers(-half, half, n)
+        if scene.mip_levels > 1:
+            out["level"] = rng.integers(0, 1 << level_bits(scene), n)
+    if scene.shading == "per-pixel":
+        for j, names in enumerate(light_fields(scene)):
+            codes = random_codes(n, scene.config, seed=int(rng.integers(1 << 30)))
+            if j == 0 and scene.bump_map == "varying":
+                out["n.phi"], out["n.theta"] = codes["n.phi"], codes["n.theta"]
+            for std, name in zip(("l", "h"), names):
+                out[f"{name}.phi"], out[f"{name}.theta"] = codes[f"{std}.phi"], codes[f"{std}.theta"]
+    mask = (1 << scene.tag_bits) - 1
+    out["tag"] = np.arange(n) & mask
+    return {k: np.asarray(v, np.int64) for k, v in out.items()}
+
+
+def as_payload_list(inputs):
+    """Dict of arrays -> list of payload dicts (for the stream drivers)."""
+    cols = {k: np.asarray(v).tolist() for k, v in inputs.items()}
+    n = len(next(iter(cols.values())))
+    return [{k: c[i] for k, c in cols.items()} for i in range(n)]

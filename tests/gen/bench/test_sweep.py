@@ -1,0 +1,180 @@
+"""bench sweep: Pareto front on toy sets, and one tiny sweep through the real models
+(errors re-derived from the models, invalid widths recorded, missing baselines reported)."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from bumprtl.gen.bench import sweep as bench_sweep
+from bumprtl.gen.bench.sweep import Grid, error_lsb, pareto_front, sweep, write_section
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.accuracy import diffuse_error_lsb
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+
+
+def _front(pairs):
+    pts = [{"x": x, "y": y} for x, y in pairs]
+    return sorted(pareto_front(pts, lambda p: p["x"], lambda p: p["y"]))
+
+
+def test_pareto_toy():
+    #            0       1       2       3 (dominated by 1)  4 (None: skipped)
+    assert _front([(1, 10), (2, 3), (5, 1), (3, 4)]) == [0, 1, 2]
+    assert _front([(1, 1), (2, 2), (3, 3)]) == [0]
+
+
+def test_pareto_duplicates_and_none():
+    pts = [{"x": 1, "y": 1}, {"x": 1, "y": 1}, {"x": None, "y": 0}, {"x": 0, "y": 5}]
+    assert sorted(pareto_front(pts, lambda p: p["x"], lambda p: p["y"])) == [0, 3]
+
+
+def test_pareto_random_against_brute_force():
+    rng = np.random.default_rng(3)
+    pairs = [tuple(v) for v in rng.integers(0, 20, (60, 2))]
+    front = _front(pairs)
+    for i, (x, y) in enumerate(pairs):
+        better = any(x2 <= x and y2 <= y and (x2, y2) != (x, y) for x2, y2 in pairs)
+        assert (i in front) == (not better and pairs.index((x, y)) == i)
+
+
+def test_error_lsb_is_worst_of_sets():
+    p = {"error": {"random": {"max": 2}, "adversarial": {"max": 5},
+                   "scenes": {"a": {"max_lsb": 7}, "b": {"reason": "skipped"}}}}
+    assert error_lsb(p) == 7
+    assert error_lsb({"error": {}}) is None
+
+
+def test_write_section_keeps_other_sections(tmp_path):
+    doc = tmp_path / "bench.md"
+    write_section(doc, "sweep", "one")
+    write_section(doc, "skip", "two")
+    write_section(doc, "sweep", "three")
+    text = doc.read_text()
+    assert "three" in text and "two" in text and "one" not in text
+    assert text.index("three") < text.index("two")
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    grid = Grid(angle_bits=(6, 14), frac_bits=(5,), palette_sizes=(16,), samples=300,
+                scenes=("bumps",), size=16)
+    opts = SimpleNamespace(methods=("exact", "palette", "baselines"), fpga=False, sim=False,
+                           device="LFE5U-85F")
+    work = tmp_path_factory.mktemp("sweep")
+    return sweep(grid, opts, work, seed=4, progress=False)
+
+
+def test_tiny_sweep_points(tiny):
+    by = {(p["method"], p.get("angle_bits"), p.get("palette_size")): p for p in tiny["points"]}
+    exact6 = by[("exact", 6, None)]
+    assert exact6["status"] == "ok"
+    # the same vectors through the model directly give the same numbers
+    cfg = Config(angle_bits=6, frac_bits=5)
+    err = diffuse_error_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)
+    assert exact6["error"]["random"]["max"] == err.max()
+    assert error_lsb(exact6) >= err.max()
+    assert exact6["cost"]["multipliers"] > 0 and exact6["cost"]["table_bits"] > 0
+    assert exact6["speed"]["golden_mpix_s"] > 0
+
+
+def test_tiny_sweep_invalid_and_missing(tiny):
+    by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
+    invalid = by[("exact", 14)]                       # B = 5 < k - 1 = 11
+    assert invalid["status"] == "invalid" and "frac_bits" in invalid["reason"]
+    for name in ("peercy", "ernst", "kim"):             # baselines: real points at valid widths
+        point = by[(name, 6)]
+        assert point["status"] == "ok" and point["cost"]["multipliers"] > 0
+        cfg = Config(method=name, angle_bits=6, frac_bits=5)
+        err = diffuse_error_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)
+        assert point["error"]["random"]["max"] == err.max()
+        assert by[(name, 14)]["status"] == "invalid"
+    assert by[("peercy", 6)]["cost"]["dividers"] > 0 and by[("peercy", 6)]["cost"]["sqrts"] > 0
+    assert by[("kim", 6)]["cost"]["dividers"] == 0 == by[("exact", 6)]["cost"]["sqrts"]
+    palette = by[("palette", None)]
+    assert palette["status"] == "ok" and "random" not in palette["error"]
+    assert palette["error"]["scenes"]["bumps"]["max_lsb"] == error_lsb(palette)
+    json.dumps(tiny)                                  # the sweep is JSON-serializable
+
+
+def test_markdown_and_plot(tiny, tmp_path):
+    text = bench_sweep.markdown(tiny, "bumprtl bench sweep --test")
+    assert "`bumprtl bench sweep --test`" in text
+    assert "exact a6 b5" in text and "invalid" in text
+    png = bench_sweep.plot(tiny, tmp_path / "p.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_stress_rows_and_markdown():
+    from bumprtl.gen.bench.stress import _float_row, markdown, stress_rows
+    rows = stress_rows(200, 0, configs=["default"], cases=["below_horizon"])
+    by = {r[2]: r[3] for r in rows}
+    assert by["lee_printed (float64)"]["nan"] > 0
+    assert by["exact (fixed)"]["overflow"] == 0 and by["exact (fixed)"]["diffuse_max_lsb"] <= 1
+
+    def boom(px, cfg):
+        raise ZeroDivisionError("model fell over")
+
+    crash = _float_row(boom, None, Config(), None)
+    text = markdown(rows + [("default", "below_horizon", "boom (float64)", crash)], "bumprtl bench stress --x", 200)
+    assert "`bumprtl bench stress --x`" in text
+    assert "**crash**: `ZeroDivisionError: model fell over`" in text
+    assert "**crashes** in 1: default / below_horizon" in text
+
+
+def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
+    """Skipping must not change the picture: the unskipped diffuse and flat scenes give the
+    same colour bytes; so does the full scene (texture, two lights, mipmaps)."""
+    from bumprtl.gen.bench import skip as bench_skip
+    from bumprtl.rtl.scene import load_scene_config
+    monkeypatch.setattr(bench_skip, "_cost", lambda scene, work: {"multipliers": 0})
+    rows = {r["scene"]: r for r in bench_skip.skip_rows(["diffuse", "flat", "full"], 16, tmp_path)}
+    assert rows["diffuse"]["same_image"] and rows["flat"]["same_image"]
+    assert "H path + specular table" in rows["diffuse"]["skipped"]
+    assert rows["full"]["status"] == "ok" and rows["full"]["same_image"]   # textured, 2 lights
+    off = bench_skip.unskipped(load_scene_config("flat"))
+    assert (off.bump_map, off.shading, off.specular) == ("varying", "per-pixel", True)
+
+
+def test_fpga_points_diagonal_and_all():
+    grid = bench_sweep.GRIDS["default"]
+    diag = SimpleNamespace(fpga_points="diagonal")
+    chosen = [(a, b) for a in grid.angle_bits for b in grid.frac_bits
+              if bench_sweep.fpga_selected(grid, a, b, diag)]
+    assert chosen == list(zip(grid.angle_bits, grid.frac_bits))
+    assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
+            if bench_sweep.fpga_selected(grid, a, b, diag, "peercy")] == [(12, 13)]
+    default = SimpleNamespace(fpga_points="default")
+    assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
+            if bench_sweep.fpga_selected(grid, a, b, default, "lee")] == [(12, 13)]
+    every = SimpleNamespace(fpga_points="all")
+    assert all(bench_sweep.fpga_selected(grid, a, b, every)
+               for a in grid.angle_bits for b in grid.frac_bits)
+
+
+def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
+    """The cost cache is keyed by the emitted Verilog: a different datapath is counted anew."""
+    from bumprtl.gen.flow import resources
+    calls = []
+    real = resources.count_verilog
+    monkeypatch.setattr(resources, "count_verilog", lambda *a, **k: calls.append(a) or real(*a, **k))
+    cfg = Config(angle_bits=6, frac_bits=5)
+    first = bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
+    assert bench_sweep.unit_cost(("sincos",), cfg, tmp_path) == first and len(calls) == 1
+    from bumprtl.gen.flow import units          # same Config, different Verilog text: counted anew
+    monkeypatch.setattr(units, "canonical_command", lambda unit, c: "changed datapath")
+    bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
+    assert len(calls) == 2
+
+
+def test_sim_rate_with_a_relative_work_dir(tmp_path, monkeypatch):
+    """--sim measures cocotb pixels/s; a relative --work (the CLI default) must work although
+    cocotb runs in its own build directory."""
+    from pathlib import Path
+    from bumprtl.gen.bench.golden import _sim_rate
+    monkeypatch.chdir(tmp_path)
+    rate, build_s = _sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))
+    assert rate > 0 and build_s >= 0
+    assert (tmp_path / "rel" / "rtl" / "rotation.json").is_file()

@@ -1,0 +1,88 @@
+"""The ECP5 flow: one small unit in make test, every design behind `make fpga`."""
+
+import pytest
+
+from bumprtl.gen.flow import fpga
+from bumprtl.gen.cli.main import main
+from bumprtl.gen.flow.resources import count_unit
+from bumprtl.rtl.config import Config
+
+
+def test_sincos_places_on_the_smallest_device(build_dir):
+    cfg = Config()
+    row = fpga.fpga_unit("sincos", cfg, "LFE5U-25F", build_dir)
+    coarse = count_unit("sincos", cfg, build_dir / "coarse")
+    assert row["FF"] == coarse.register_bits          # every register bit becomes one FF
+    assert row["DSP"] == 0                            # no multiplier in sincos
+    assert row["BRAM"] >= 1                           # the quarter-wave ROM stays a block RAM
+    assert row["LUT4"] > 0 and row["fmax_mhz"] > 0
+    assert row["target_mhz"] == fpga.lpf_mhz() == 150
+
+
+def test_unknown_device_names_the_choices(build_dir):
+    with pytest.raises(fpga.FpgaError, match="device must be one of LFE5U-25F, LFE5U-45F, LFE5U-85F"):
+        fpga.fpga_unit("sincos", Config(), "LFE5U-12F", build_dir)
+
+
+def test_nextpnr_error_is_shown(build_dir):
+    # a 64k x 18 RAM needs 64 DP16KD; the LFE5U-25F has 56: nextpnr cannot place it
+    big = build_dir / "big.v"
+    big.write_text("module big(input clk, input [15:0] a, output reg [17:0] d);\n"
+                   "  reg [17:0] mem [0:65535];\n"
+                   "  always @(posedge clk) begin mem[a] <= {a, 2'b01}; d <= mem[a ^ 16'h5555]; end\n"
+                   "endmodule\n")
+    with pytest.raises(fpga.FpgaError, match="nextpnr-ecp5 failed.*ERROR.*DP16KD"):
+        fpga.place_and_route(big, "big", "LFE5U-25F", build_dir)
+
+
+@pytest.mark.fpga
+def test_report_fpga_every_design(build_dir):
+    out = build_dir / "report.md"
+    assert main(["report", "fpga", "--device", "LFE5U-85F", "--samples", "2000",
+                 "--out", str(out), "--work", str(build_dir / "work")]) == 0
+    text = out.read_text()
+    for design in ("exact", "lee"):
+        for row in ("setup", "illumination", "pipeline"):
+            assert f"| {design}_{row} |" in text
+    assert "| kim_pipeline |" in text
+    for design in fpga.NOT_PLACED:                  # said why, never a silent gap
+        assert f"| {design}_pipeline |" not in text and design in text.split("## Notes")[1]
+
+
+def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
+    """report fpga and bench sweep share placements: the same Verilog is placed once, a
+    different one (another config) again."""
+    import json
+    from bumprtl.gen.flow.units import build_unit
+    from bumprtl.rtl.config import Config
+    calls = []
+
+    def fake(v_path, top, device, work, lpf=fpga.LPF):
+        calls.append(v_path.read_text())
+        (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
+        return {"unit": top, "fmax_mhz": 1.0}
+
+    monkeypatch.setattr(fpga, "place_and_route", fake)
+    unit = lambda b: build_unit("sincos", Config(angle_bits=6, frac_bits=b))[0]
+    first = fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path)
+    assert fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path) == first
+    assert len(calls) == 1
+    fpga.place_component(unit(6), "sincos", "LFE5U-25F", tmp_path)
+    assert len(calls) == 2 and calls[0] != calls[1]
+    renamed = fpga.place_component(unit(5), "other_name", "LFE5U-25F", tmp_path)
+    assert len(calls) == 2 and renamed["unit"] == "other_name"    # same hardware, placed once
+
+
+def test_critical_path_names_the_endpoints_and_splits_the_delay():
+    """nextpnr's report JSON -> 'start -> end (logic + routing)', mapped-cell suffixes cut."""
+    step = lambda cell, port, kind, delay: {"from": {"cell": cell, "port": port},
+                                            "to": {"cell": cell, "port": port},
+                                            "type": kind, "delay": delay}
+    report = {"critical_paths": [{"from": "posedge clk", "to": "posedge clk", "path": [
+        step("rotation.n_c4_angle_TRELLIS_FF_Q_3", "Q", "clk-to-q", 0.5),
+        step("rotation.x_LUT4_Z", "F", "routing", 1.25),
+        step("rotation.x_LUT4_Z", "F", "logic", 0.25),
+        step("rotation.sine_rom1.bram", "ADB13", "setup", 0.25)]}]}
+    assert fpga.critical_path(report) == ("rotation.n_c4_angle.Q -> rotation.sine_rom1.bram.ADB13 "
+                                          "(1.00 ns logic + 1.25 ns routing)")
+    assert fpga.critical_path({}) is None

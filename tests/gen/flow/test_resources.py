@@ -1,0 +1,127 @@
+"""The resource counter on hand-written Amaranth modules whose contents are known."""
+
+import pytest
+from amaranth.hdl import Module, signed, unsigned
+from amaranth.lib import wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from bumprtl.gen.flow.resources import SynthesisError, count_component, count_verilog
+from bumprtl.rtl.config import BumpError
+
+
+class Known(wiring.Component):
+    """One 9x7 multiplier, two adders (one a subtractor), one 100 x 12 ROM, one comparator,
+    a constant multiply by 3 and one by 4 (a shift); every result registered."""
+
+    a: In(signed(9))
+    b: In(signed(7))
+    c: In(unsigned(10))
+    d: In(unsigned(10))
+    addr: In(unsigned(7))
+    prod: Out(signed(16))
+    total: Out(unsigned(11))
+    lt: Out(1)
+    rom_data: Out(unsigned(12))
+    scaled: Out(unsigned(13))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.rom = rom = Memory(shape=unsigned(12), depth=100,
+                                        init=[(i * 37) % 4096 for i in range(100)])
+        port = rom.read_port()
+        m.d.comb += port.addr.eq(self.addr)
+        m.d.sync += [self.prod.eq(self.a * self.b),
+                     self.total.eq((self.c + self.d) - self.addr),
+                     self.lt.eq(self.c < self.d),
+                     self.scaled.eq(self.c * 3 + self.d * 4),
+                     self.rom_data.eq(port.data)]
+        return m
+
+
+@pytest.fixture(scope="module")
+def known(tmp_path_factory):
+    return count_component(Known(), "known", tmp_path_factory.mktemp("known"))
+
+
+def test_multipliers_by_operand_widths(known):
+    assert known.multipliers == ["9x7"]
+    assert len(known.const_multipliers) == 1      # c * 3; d * 4 is a shift
+
+
+def test_adders_and_comparators(known):
+    # (c + d) - addr is two adders; c * 3 + d * 4 adds a third (the constant product's sum)
+    assert len(known.adders) == 3
+    assert known.comparators and len(known.comparators) == 1
+    assert known.dividers == [] and known.sqrts == 0
+
+
+def test_rom_depth_width_bits(known):
+    assert [(t["depth"], t["width"], t["bits"], t["read_ports"]) for t in known.tables] == \
+        [(100, 12, 1200, 1)]
+    assert known.rams == []
+
+
+def test_register_bits(known):
+    # the five registered outputs (prod, total, lt, scaled, rom_data); the ROM's own read
+    # register stays inside the $mem_v2 and is not counted
+    assert known.register_bits == 16 + 11 + 1 + 13 + 12
+
+
+class Single(wiring.Component):
+    """Exactly one multiplier, two adders and one ROM, nothing else (the issue's module)."""
+
+    x: In(unsigned(8))
+    y: In(unsigned(8))
+    z: In(unsigned(8))
+    o: Out(unsigned(24))
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.rom = rom = Memory(shape=unsigned(8), depth=256, init=range(256))
+        port = rom.read_port(domain="comb")
+        m.d.comb += [port.addr.eq(self.z), self.o.eq(self.x * self.y + self.z + port.data)]
+        return m
+
+
+def test_one_multiplier_two_adders_one_rom(build_dir):
+    c = count_component(Single(), "single", build_dir)
+    s = c.summary()
+    assert (s["multipliers"], s["adders"], s["tables"], s["table_bits"]) == (1, 2, 1, 256 * 8)
+    assert (s["const_multipliers"], s["comparators"], s["register_bits"]) == (0, 0, 0)
+
+
+def test_missing_file_is_one_line_error(build_dir):
+    with pytest.raises(BumpError, match="does not exist"):
+        count_verilog(build_dir / "nope.v", "nope")
+
+
+def test_yosys_error_is_shown(build_dir):
+    bad = build_dir / "bad.v"
+    bad.write_text("module bad(input a, output b); assign b = a +; endmodule\n")
+    with pytest.raises(SynthesisError, match="yosys failed.*ERROR"):
+        count_verilog(bad, "bad", build_dir)
+
+
+def test_unknown_top_shows_yosys_message(build_dir):
+    ok = build_dir / "ok.v"
+    ok.write_text("module ok(input a, output b); assign b = a; endmodule\n")
+    with pytest.raises(SynthesisError, match="ERROR.*nothere"):
+        count_verilog(ok, "nothere", build_dir)
+
+
+def test_zero_initialised_ram_counts_the_same_without_its_init(tmp_path):
+    """strip_zero_init drops only all-zero memory inits: the palette RAM is still counted as
+    its 2 x sN x 32 bits (double-buffered), and a ROM's non-zero contents are kept."""
+    from bumprtl.gen.flow.resources import strip_zero_init
+    from bumprtl.gen.flow.units import emit_unit
+    from bumprtl.rtl.config import Config
+    v, _ = emit_unit("palette", Config(palette_size=64), tmp_path / "pal")
+    text = v.read_text()
+    stripped = strip_zero_init(text)
+    init = "\\table [127] = 32'd0;"                  # the last zero of the init block
+    assert init in text and init not in stripped
+    counts = count_verilog(v, "palette", tmp_path / "a")
+    assert counts.rams == [{"name": "table", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
+    rom, _ = emit_unit("sincos", Config(angle_bits=6, frac_bits=5), tmp_path / "rom")
+    assert strip_zero_init(rom.read_text()) == rom.read_text()       # non-zero contents stay

@@ -1,0 +1,109 @@
+import subprocess
+import sys
+import types
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from bumprtl.gen.render import images as render
+from bumprtl.gen.cli.main import main
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
+from bumprtl.sim.scenes import load_scene
+
+CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
+PALETTE_MODULE = "bumprtl.sim.golden.float.palette"
+
+
+def test_render_compare_writes_panel_and_prints_psnr(tmp_path):
+    out = tmp_path / "lee.png"
+    r = subprocess.run(CLI + ["render", "--scene", "bumps", "--method", "lee_fixed", "--size", "64",
+                              "--out", str(out), "--compare"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "PSNR" in r.stdout and "max difference" in r.stdout
+    img = np.asarray(Image.open(out))
+    panel = np.asarray(Image.open(tmp_path / "lee_compare.png"))
+    assert img.shape == (64, 64, 3)
+    assert panel.shape == (64, 3 * 64 + 8, 3)
+    assert np.array_equal(panel[:, 68:132], img)
+    assert panel[:, 136:].any()                         # lee_fixed differs: |diff| is not black
+
+
+@pytest.mark.parametrize("scene", ["globe", "cylinder"])
+def test_render_exact_equals_conventional(tmp_path, scene):
+    for method in ("exact", "conventional"):
+        assert main(["render", "--scene", scene, "--method", method, "--size", "64",
+                     "--light", "point", "--out", str(tmp_path / f"{method}.png")]) == 0
+    a, b = (np.asarray(Image.open(tmp_path / f"{m}.png")) for m in ("exact", "conventional"))
+    assert np.array_equal(a, b)
+
+
+def test_shade_scene_chunks_match_one_call():
+    """Row chunks (and the progress bar) must not change a pixel."""
+    s = load_scene("wood", size=128)
+    assert s.size > render.ROWS_PER_CHUNK
+    assert np.array_equal(render.shade_scene(s, "conventional", Config()),
+                          conventional(s.px, Config()).color)
+
+
+def test_progress_bar_on_long_renders(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(render, "PROGRESS_PIXELS", 64 * 64)
+    assert main(["render", "--size", "64", "--out", str(tmp_path / "a.png")]) == 0
+    assert "pix" in capsys.readouterr().err               # tqdm's unit on stderr
+    monkeypatch.setattr(render, "PROGRESS_PIXELS", 64 * 64 + 1)
+    assert main(["render", "--size", "64", "--out", str(tmp_path / "b.png")]) == 0
+    assert "pix" not in capsys.readouterr().err
+
+
+def test_palette_flags_reach_render_palette(tmp_path, monkeypatch):
+    """--method palette calls sim.golden.palette.render_palette(scene, cfg, palette_size=...,
+    quantizer=..., lighting=...) and writes its .color (a stand-in module here)."""
+    calls = []
+
+    def render_palette(scene, cfg, **kwargs):
+        calls.append((scene.name, cfg.kd, kwargs))
+        return types.SimpleNamespace(color=np.full(scene.mask.shape, 0.5))
+
+    monkeypatch.setitem(sys.modules, PALETTE_MODULE, types.SimpleNamespace(render_palette=render_palette))
+    out = tmp_path / "p.png"
+    assert main(["render", "--scene", "moon", "--method", "palette", "--size", "32", "--kd", "0.5",
+                 "--palette-size", "64", "--quantizer", "kmeans", "--lighting", "lambert",
+                 "--out", str(out)]) == 0
+    assert calls == [("moon", 0.5, {"palette_size": 64, "quantizer": "kmeans", "lighting": "lambert"})]
+    assert np.all(np.asarray(Image.open(out)) == 128)     # 0.5 -> 127.5 -> 128
+
+
+def test_palette_missing_is_a_clear_error(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, PALETTE_MODULE, None)    # import fails
+    assert main(["render", "--method", "palette", "--size", "16", "--out", str(tmp_path / "p.png")]) == 2
+    err = capsys.readouterr().err
+    assert "palette" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_methods_are_the_registry_plus_palette():
+    assert render.render_methods() == [*FLOAT_MODELS, "palette"]
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--scene", "marble"], "--scene"),
+    (["--size", "100"], "size"),
+    (["--size", "8192"], "size"),
+    (["--texture-size", "24"], "texture_size"),
+    (["--method", "cordic"], "--method"),
+    (["--light-elevation", "100"], "light_elevation"),
+    (["--light-azimuth", "-400"], "light_azimuth"),
+    (["--light", "spot"], "--light"),
+    (["--kd", "2"], "kd"),
+    (["--palette-size", "8", "--method", "palette"], "palette_size"),
+    (["--quantizer", "kmeans"], "--quantizer"),
+    (["--quantizer", "octree", "--method", "palette"], "--quantizer"),
+    (["--lighting", "sunset", "--method", "palette", "--size", "32"], "lighting"),
+])
+def test_render_bad_input_exit_2_one_line(tmp_path, argv, word):
+    r = subprocess.run(CLI + ["render", "--out", str(tmp_path / "x.png")] + argv,
+                       capture_output=True, text=True)
+    assert r.returncode == 2, (argv, r.stderr)
+    assert word in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "x.png").exists()

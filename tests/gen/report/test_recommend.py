@@ -1,0 +1,102 @@
+"""bumprtl recommend on toy sweep data: the cheapest point meeting the bound, with evidence;
+exit 2 with a one-line message when none does."""
+
+import json
+
+import pytest
+
+from bumprtl.gen.cli.main import main
+from bumprtl.gen.report.recommend import recommend
+from bumprtl.rtl.config import BumpError
+
+
+def _point(name, err, rom, mult=6, adders=30, fpga=None):
+    cost = {"multipliers": mult, "adders": adders, "table_bits": rom, "ram_bits": 0,
+            "map_bits_per_texel": 24}
+    if fpga:
+        cost["fpga"] = fpga
+    a, b = name
+    return {"method": "exact", "angle_bits": a, "frac_bits": b, "status": "ok",
+            "config": {"method": "exact", "angle_bits": a, "frac_bits": b},
+            "error": {"random": {"max": err, "mean": 0.1, "n": 10},
+                      "adversarial": {"max": err - 1, "mean": 0.5, "n": 13}},
+            "cost": cost, "speed": {"golden_mpix_s": 10.0}}
+
+
+def _fpga(lut, dsp, bram, device="LFE5U-25F", avail=(24000, 28, 56)):
+    return {"device": device, "LUT4": lut, "DSP": dsp, "BRAM": bram, "fmax_mhz": 100.0,
+            "available": dict(zip(("LUT4", "DSP", "BRAM"), avail))}
+
+
+TOY = {"command": "bumprtl bench sweep --toy", "points": [
+    _point((12, 13), 1, 180_000),
+    _point((12, 11), 1, 150_000),
+    _point((10, 11), 4, 45_000),
+    _point((14, 16), 1, 900_000),
+    {"method": "exact", "angle_bits": 14, "frac_bits": 9, "status": "invalid", "reason": "frac_bits"},
+]}
+
+
+def test_picks_cheapest_meeting_bound():
+    best, meeting = recommend(TOY, 1)
+    assert (best["angle_bits"], best["frac_bits"]) == (12, 11)
+    assert len(meeting) == 3
+    assert recommend(TOY, 4)[0]["angle_bits"] == 10
+
+
+def test_arithmetic_units_before_memory():
+    data = {"points": [_point((12, 13), 1, 1000, mult=8), _point((12, 12), 1, 1000, mult=6)]}
+    assert recommend(data, 1)[0]["frac_bits"] == 12
+    divider_heavy = _point((8, 9), 1, 4_000, mult=30)
+    divider_heavy["cost"].update(dividers=6, sqrts=2)
+    data = {"points": [divider_heavy, _point((12, 13), 1, 180_000, mult=6)]}
+    assert recommend(data, 1)[0]["angle_bits"] == 12      # 6 multipliers beat 30 + 6 + 2
+
+
+def test_none_meets_bound_names_smallest_error():
+    with pytest.raises(BumpError, match=r"smallest measured error is 1 LSB"):
+        recommend(TOY, 0.5)
+
+
+def test_device_ranking_uses_fpga_and_capacity():
+    data = {"points": [
+        _point((12, 13), 1, 100, fpga=_fpga(3000, 8, 25)),
+        _point((12, 11), 1, 50, fpga=_fpga(2000, 40, 10)),       # 40 DSP > 28: does not fit
+        _point((11, 11), 1, 900, fpga=_fpga(9000, 2, 30)),
+    ]}
+    best, meeting = recommend(data, 1, "LFE5U-25F")
+    assert (best["angle_bits"], best["frac_bits"]) == (11, 11)       # fewest DSP among those that fit
+    assert all(p["cost"]["fpga"]["DSP"] <= 28 for p in meeting)
+    with pytest.raises(BumpError, match="no FPGA numbers for device LFE5U-85F"):
+        recommend(data, 1, "LFE5U-85F")
+
+
+@pytest.mark.parametrize("bad", [-1, True, "1"])
+def test_bad_bound(bad):
+    with pytest.raises(BumpError, match="max_error_lsb"):
+        recommend(TOY, bad)
+
+
+def test_cli_prints_evidence(tmp_path, capsys):
+    path = tmp_path / "sweep.json"
+    path.write_text(json.dumps(TOY))
+    assert main(["recommend", "--max-error-lsb", "1", "--sweep", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "--angle-bits 12 --frac-bits 11" in out
+    assert "adversarial: max 0" in out and "150000 ROM bits" in out
+    assert "bumprtl bench sweep --toy" in out
+
+
+@pytest.mark.parametrize("content, message", [
+    (json.dumps(TOY), "no configuration in the sweep meets"),
+    ("{not json", "not valid JSON"),
+    ("[1, 2]", "no 'points' list"),
+    (None, "does not exist"),
+])
+def test_cli_exits_2_with_one_line(tmp_path, capsys, content, message):
+    path = tmp_path / "sweep.json"
+    if content is not None:
+        path.write_text(content)
+    assert main(["recommend", "--max-error-lsb", "0", "--sweep", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1

@@ -1,0 +1,199 @@
+"""Golden model of the palette method (Tarini et al.): preprocessing, colour tables, renders."""
+
+import numpy as np
+import pytest
+
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import shade
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.palette import (Material, color_table, displacement_to_normals, lookup,
+                                        mipmap_indices, quantize_normal_map, render_palette,
+                                        world_normal_map)
+from bumprtl.sim.golden.float.palette_quantize import QUANTIZERS
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
+
+
+def random_normals(t, seed=0, spread=0.6):
+    rng = np.random.default_rng(seed)
+    n = np.concatenate([rng.normal(0, spread, (t, t, 2)), np.ones((t, t, 1))], -1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def sse(normals, qmap):
+    return float(np.sum((normals - qmap.table[qmap.indices]) ** 2))
+
+
+# --- Sec. 4.1: displacement -> normal map --------------------------------------------------
+
+def test_least_squares_cross_is_central_difference():
+    rng = np.random.default_rng(1)
+    h = rng.uniform(0, 1, (16, 16))
+    n = displacement_to_normals(h, scale=3.0)
+    d_row = 3.0 * (np.roll(h, -1, 0) - np.roll(h, 1, 0)) / 2
+    d_col = 3.0 * (np.roll(h, -1, 1) - np.roll(h, 1, 1)) / 2
+    ref = np.stack([-d_row, -d_col, np.ones_like(h)], -1)
+    assert np.allclose(n, ref / np.linalg.norm(ref, axis=-1, keepdims=True), atol=1e-12)
+
+
+def test_least_squares_plane_is_exact_with_3x3_stencil():
+    r, c = np.indices((32, 32), dtype=float)
+    h = 0.2 * r - 0.1 * c                     # a plane: interior normals all the same
+    stencil = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1)]
+    n = displacement_to_normals(h, offsets=stencil)[2:-2, 2:-2]
+    want = np.array([-0.2, 0.1, 1.0]) / np.linalg.norm([-0.2, 0.1, 1.0])
+    assert np.allclose(n, want, atol=1e-12)
+
+
+# --- Sec. 4: quantization -------------------------------------------------------------------
+
+@pytest.mark.parametrize("quantizer", list(QUANTIZERS))
+def test_quantizer_gives_table_and_nearest_indices(quantizer):
+    n = random_normals(24)
+    q = quantize_normal_map(n, 64, quantizer)
+    assert q.table.shape == (64, 3) and q.indices.shape == (24, 24)
+    assert np.allclose(np.linalg.norm(q.table, axis=1), 1)
+    d = np.linalg.norm(n[:, :, None, :] - q.table[None, None], axis=-1)   # brute force
+    assert np.allclose(d[np.arange(24)[:, None], np.arange(24), q.indices], d.min(-1))
+    assert len(np.unique(q.indices)) > 48        # the table is used, not a few entries
+
+
+def test_kmeans_never_worse_than_median_cut_and_error_falls_with_size():
+    n = random_normals(32, seed=2)
+    errs = {s: sse(n, quantize_normal_map(n, s, "median-cut")) for s in (16, 64, 256)}
+    assert errs[16] > errs[64] > errs[256]
+    for s in (16, 64):
+        assert sse(n, quantize_normal_map(n, s, "kmeans")) <= errs[s]
+
+
+def test_palette_as_large_as_distinct_normals_is_lossless():
+    base = random_normals(4, seed=3).reshape(-1, 3)           # 16 distinct normals
+    n = base[np.random.default_rng(0).integers(0, 16, (20, 20))]
+    q = quantize_normal_map(n, 16, "kmeans")
+    assert np.allclose(q.table[q.indices], n, atol=1e-12)
+
+
+def test_dithering_keeps_block_means_closer():
+    """Ordered dithering trades per-texel error for a better local average (Fig. 4)."""
+    t = 32
+    phi = np.linspace(0, 0.8, t)[None, :].repeat(t, 0)
+    n = np.stack([np.sin(phi), np.zeros_like(phi), np.cos(phi)], -1)   # a smooth ramp
+    n[..., 1] = np.linspace(-0.3, 0.3, t)[:, None]
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+
+    def block_error(q):
+        rec = q.table[q.indices].reshape(8, 4, 8, 4, 3).mean((1, 3))
+        return np.abs(rec - n.reshape(8, 4, 8, 4, 3).mean((1, 3))).mean()
+    plain = quantize_normal_map(n, 16, "median-cut")
+    dith = quantize_normal_map(n, 16, "median-cut", dither=True)
+    assert not np.array_equal(plain.indices, dith.indices)
+    assert block_error(dith) < block_error(plain)
+
+
+def test_materials_never_share_an_entry():
+    n = random_normals(16, seed=4)
+    mats = (np.arange(16)[:, None] + np.zeros(16, int)) // 8          # top half 0, bottom 1
+    q = quantize_normal_map(n, 32, "median-cut", materials=mats)
+    assert np.array_equal(q.materials[q.indices], mats)
+    assert np.all(np.diff(q.materials) >= 0)                           # sorted: intervals
+
+
+def test_mipmap_levels_pick_nearest_to_mean():
+    n = random_normals(8, seed=5)
+    q = quantize_normal_map(n, 16, "median-cut")
+    levels = mipmap_indices(q)
+    assert [lv.shape[0] for lv in levels] == [8, 4, 2, 1]
+    mean = q.table[q.indices[:2, :2]].reshape(-1, 3).mean(0)
+    mean /= np.linalg.norm(mean)
+    assert levels[1][0, 0] == np.argmin(np.linalg.norm(q.table - mean, axis=1))
+
+
+# --- Sec. 5.1 / 6 / 7.3: colour tables ---------------------------------------------------------
+
+def test_phong_table_is_the_per_pixel_shade_of_the_table_normals():
+    cfg = Config()
+    table = random_normals(4, seed=6).reshape(-1, 3)
+    l = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+    v = np.array([0.0, 0.0, 1.0])
+    h = (l + v) / np.linalg.norm(l + v)
+    c = color_table(table, "phong", l, v, cfg)
+    assert np.allclose(c[:, 0], shade(table @ l, table @ h, cfg).color)
+    assert np.allclose(c[:, 3], np.clip(cfg.ka + cfg.kd * np.clip(table @ l, 0, 1), 0, 1))
+
+
+def test_lambert_several_lights_add_up():
+    cfg = Config()
+    table = random_normals(4, seed=7).reshape(-1, 3)
+    lights = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 0.6, 0.8]])
+    c = color_table(table, "lambert", lights, [0, 0, 1.0], cfg)
+    want = cfg.ka + cfg.kd * sum(np.clip(table @ l, 0, 1) for l in lights)
+    assert np.allclose(c[:, 0], np.clip(want, 0, 1))
+
+
+def test_chrome_reflects_the_viewer_and_toon_has_few_levels():
+    table = np.array([[0, -1.0, 0], [0, -0.6, 0.8], [0, -0.6, -0.8]])
+    view = np.array([0, -1.0, 0])
+    chrome = color_table(table, "chrome", [0, -1.0, 0], view)
+    assert chrome[1, 2] > chrome[1, 0] and chrome[2, 0] > chrome[2, 2]   # sky above, ground below
+    toon = color_table(random_normals(16, seed=8).reshape(-1, 3), "toon", [0, 0, 1.0], [0, 0, 1.0])
+    assert len(np.unique(toon[:, 0])) <= 4
+
+
+def test_colour_as_material_sec_7_3():
+    table = random_normals(4, seed=9).reshape(-1, 3)
+    mats = np.repeat([0, 1], 8)
+    red = Material(color=(1.0, 0.0, 0.0), ks=0.0)
+    blue = Material(color=(0.0, 0.0, 1.0), ks=0.5, spec_exponent=8)
+    c = color_table(table, "phong", [0, 0, 1.0], [0, 0, 1.0], materials=mats, material_params=[red, blue])
+    assert np.all(c[:8, 1:3] == 0) and np.all(c[8:, 2] >= c[8:, 0])
+    assert np.allclose(c[:8, 0], np.clip(red.ka + red.kd * np.clip(table[:8, 2], 0, 1), 0, 1))
+
+
+# --- bad input ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("normals, size, match", [
+    (random_normals(8)[:, :6], 16, "square"),
+    (np.zeros((0, 0, 3)), 16, "square"),
+    (np.where(np.arange(64).reshape(8, 8, 1) == 5, np.nan, random_normals(8)), 16, "NaN"),
+    (np.where(np.arange(64).reshape(8, 8, 1) == 5, 0.0, random_normals(8)), 16, "zero-length"),
+    (random_normals(8), 8, "palette_size"),
+    (random_normals(8), 20000, "palette_size"),
+    (random_normals(2).repeat(4, 0).repeat(4, 1), 16, "distinct normals"),
+])
+def test_bad_input_names_the_parameter(normals, size, match):
+    with pytest.raises(BumpError, match=match):
+        quantize_normal_map(normals, size)
+
+
+def test_bad_names_and_indices():
+    with pytest.raises(BumpError, match="quantizer"):
+        quantize_normal_map(random_normals(8), 16, "octree")
+    with pytest.raises(BumpError, match="lighting"):
+        color_table(np.eye(3), "cel", [0, 0, 1.0], [0, 0, 1.0])
+    with pytest.raises(BumpError, match="outside the table"):
+        lookup(np.array([[0, 3]]), np.zeros((3, 4)))
+    with pytest.raises(BumpError, match="height"):
+        displacement_to_normals(np.zeros((4, 5)))
+
+
+# --- renders against the per-pixel reference ---------------------------------------------------
+
+def test_palette_psnr_grows_with_size_on_a_small_scene():
+    cfg = Config()
+    scene = load_scene("wood", size=64)
+    ref = compose(scene, conventional(scene.px, cfg).color)
+    scores = [psnr(ref, compose(scene, render_palette(scene, cfg, s, "kmeans").color))
+              for s in (16, 64, 256, 1024)]
+    assert all(a < b for a, b in zip(scores, scores[1:])), scores
+
+
+def test_plane_is_exact_up_to_quantization():
+    """With as many palette entries as distinct normals, a plane under a directional light
+    renders like the per-pixel reference up to the 8-bit rounding of the table (1 LSB)."""
+    cfg = Config()
+    scene = load_scene("bumps", size=32)
+    normals, counts = world_normal_map(scene)
+    n_distinct = len(np.unique(normals[counts > 0], axis=0))
+    r = render_palette(scene, cfg, n_distinct, "median-cut")
+    ref = compose(scene, conventional(scene.px, cfg).color)
+    assert max_diff(ref, compose(scene, r.color)) <= 1
