@@ -6,7 +6,7 @@ the other. With a colour texture (``texture = true``) a second block RAM of the 
 geometry holds the RGB texels (8 bits per channel, r low) and is read at the same address
 in the same cycle (``texel`` field). A flat bump map with a texture keeps only that memory.
 :func:`texel_address` is the addressing arithmetic; it runs on Amaranth values here and on
-int64 arrays in ``sim/golden/fixed_pipeline.py``, so both address alike.
+int64 arrays in ``sim/golden/fixed/pipeline.py``, so both address alike.
 """
 
 import numpy as np
@@ -20,6 +20,7 @@ from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import StallPipe
 from bumprtl.rtl.scene import SceneConfig
+from bumprtl.rtl.texture import rgb_layout
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
            "level_bits", "texel_shape", "fetched_field", "fetched_fields", "has_map",
@@ -125,6 +126,8 @@ class BumpMapFetch(wiring.Component):
     texture : sequence of int, optional
         Initial colour-texture words (:func:`pack_rgb`, same level layout); only with
         ``scene.texture``.
+    target : None or pipe.ECP5
+        Elaboration target (None: the generic form every simulator runs).
 
     Members
     -------
@@ -144,9 +147,8 @@ class BumpMapFetch(wiring.Component):
 
     latency = 2
 
-    def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None):
-        from bumprtl.rtl.texture import rgb_layout
-        self.scene, self.cfg = scene, scene.config
+    def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None, target=None):
+        self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
         self.fetched = fetched_fields(scene)
         if not self.fetched:
             self._MustUse__silence = True
@@ -188,15 +190,16 @@ class BumpMapFetch(wiring.Component):
     def elaborate(self, platform):
         scene = self.scene
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        self.memories = pipe.memories
         mems = {}                                   # output field -> (memory, host port prefix)
         if has_map(scene):
-            m.submodules.map = mem = Memory(shape=unsigned(self.word_bits), depth=self.depth,
-                                            init=self.init)
+            mem = pipe.memory("map", Memory(shape=unsigned(self.word_bits), depth=self.depth,
+                                            init=self.init))
             mems[fetched_field(scene)] = mem, ""
         if scene.texture:
-            m.submodules.texture = mem = Memory(shape=unsigned(TEXEL_BITS), depth=self.depth,
-                                                init=self.texture)
+            mem = pipe.memory("texture", Memory(shape=unsigned(TEXEL_BITS), depth=self.depth,
+                                                init=self.texture))
             mems["texel"] = mem, "tex_"
         for mem, prefix in mems.values():
             wp = mem.write_port()

@@ -1,7 +1,7 @@
 """The single source of truth for every width, table size and method choice.
 
 The RTL, the golden models, the testbenches, the emitter and the reports all read a
-:class:`Config`; nothing else holds a width. Number formats (DESIGN.md §4):
+:class:`Config`; nothing else holds a width. Number formats (docs/architecture.md, Number formats):
 
 * angles are unsigned binary angles of ``angle_bits = k + 2`` bits: the full circle is
   ``2**angle_bits`` steps, so sums wrap for free;
@@ -12,14 +12,12 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 
 from dataclasses import dataclass, fields, asdict
 
-__all__ = ["Config", "ConfigError", "BumpError", "METHODS", "BASELINES", "ALL_METHODS",
-           "datapath_module"]
+__all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES"]
 
-METHODS = ("exact", "lee")              # the per-pixel methods scenes and pipelines use
-# Lee et al. Table 1's comparison designs, built as real RTL for the cost comparison only
-# (rtl/baselines/<name>.py, golden model sim/golden/fixed_<name>.py).
-BASELINES = ("peercy", "ernst", "kim")
-ALL_METHODS = METHODS + BASELINES
+# The names of the method registry (rtl/methods.py: what each method is and builds), in its
+# order. Config validates ``method`` against them here because the registry imports the
+# datapaths, which import Config; rtl/methods.py refuses to load if its keys differ.
+METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
 
 
 class BumpError(ValueError):
@@ -55,17 +53,21 @@ class Config:
     frac_bits : int
         Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24.
     method : str
-        ``"exact"`` (exact angular method, DESIGN §3) or ``"lee"`` (Lee et al., errata fixed).
+        A name of the method registry (rtl/methods.py, :data:`METHOD_NAMES`): ``"exact"``
+        (the exact angular method of docs/architecture.md), ``"lee"`` (Lee et al., errata
+        fixed) or a Table 1 baseline, ``"peercy"``, ``"ernst"``, ``"kim"`` (cost comparison
+        only, not in scenes).
     tag_bits : int
         Width of the side-band tag that rides along with every pixel; 0 to 32.
     out_bits : int
-        Width of the clamped output intensities; 8 (DESIGN §4).
+        Width of the clamped output intensities; always 8 (8-bit outputs).
     spec_exponent : int
         Phong exponent ``n`` of the specular table ``cos^n``; 1 to 1024.
     spec_index_bits : int
         Address bits of the specular table (at most ``frac_bits`` are used); 4 to 16. 10 (the
-        default) fits one ECP5 block RAM; 12 halves the specular error for 2 block RAMs and
-        a slower table read (docs/fixed_point.md).
+        default) fits one ECP5 block RAM; more bits lower the specular error at the cost of more
+        block RAM and a slower table read (docs/fixed_point.md has the measured comparison,
+        ``bumprtl bench accuracy --spec-index-bits N``).
     ka, kd, ks : float
         Ambient, diffuse and specular coefficients of eq. (2), each in [0, 1].
     lights : int
@@ -102,10 +104,10 @@ class Config:
         _check_int("frac_bits", self.frac_bits, max(4, k - 1), 24,
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
                    f"half an LSB; B <= 24 keeps every product inside 64 bits")
-        if self.method not in ALL_METHODS:
-            raise ConfigError(f"method must be one of {', '.join(ALL_METHODS)}, got {self.method!r}")
+        if self.method not in METHOD_NAMES:
+            raise ConfigError(f"method must be one of {', '.join(METHOD_NAMES)}, got {self.method!r}")
         _check_int("tag_bits", self.tag_bits, 0, 32)
-        _check_int("out_bits", self.out_bits, 8, 8, "DESIGN §4 fixes 8-bit outputs")
+        _check_int("out_bits", self.out_bits, 8, 8, "outputs are 8-bit intensities")
         _check_int("spec_exponent", self.spec_exponent, 1, 1024)
         _check_int("spec_index_bits", self.spec_index_bits, 4, 16)
         for name in ("ka", "kd", "ks"):
@@ -153,8 +155,3 @@ class Config:
     def to_dict(self):
         return asdict(self)
 
-
-def datapath_module(method):
-    """Dotted module (relative to ``bumprtl.rtl``) holding ``method``'s Rotation (the
-    setup) and Illumination datapaths."""
-    return method if method in METHODS else f"baselines.{method}"

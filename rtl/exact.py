@@ -1,9 +1,9 @@
-"""The exact angular method in hardware (DESIGN §3): rotate N' once, not L and H.
+"""The exact angular method in hardware (docs/architecture.md): rotate N' once, not L and H.
 
 N'.(M A) = (R_y(th_N) n') . A_z with A_z = R_z(-ph_N) A. Everything is a sum of sines and
 cosines of angle sums read from quarter-wave ROMs (product-to-sum), then 3 multiplies per
 vector: 6 multipliers, 24 sin/cos reads and no division or inverse trig per pixel.
-Bit-exact with ``sim/golden/fixed_exact.py``.
+Bit-exact with ``sim/golden/fixed/exact.py``.
 """
 
 from amaranth.hdl import signed
@@ -11,12 +11,13 @@ from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.illumination import IlluminationDatapath
 from bumprtl.rtl.layouts import pixel_layout
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
+from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
 
-__all__ = ["Rotation", "Illumination", "SineBank", "rotated_layout", "vector_terms"]
+__all__ = ["ExactRotation", "ExactIllumination", "SineBank", "rotated_layout", "vector_terms",
+           "vectors"]
 
 
 def vectors(cfg: Config):
@@ -64,7 +65,7 @@ def vector_terms(pipe, bank, vec, n_phi, name, latency):
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A)
     read from ``bank`` (a :class:`SineBank`) and delayed to ``latency`` ``adv`` stages
-    after the input. Shared by :class:`Rotation` and ``pipeline.VectorTerms``, so units
+    after the input. Shared by :class:`ExactRotation` and ``pipeline.VectorTerms``, so units
     built from it run in lock step."""
     bits = bank.cfg.angle_bits                          # binary angles wrap (mod 2**bits)
     d = pipe.register((vec.phi - n_phi)[:bits], f"{name}_d")             # input stage
@@ -77,8 +78,9 @@ def vector_terms(pipe, bank, vec, n_phi, name, latency):
             for k, v in terms.items()}
 
 
-class Rotation:
-    """VectorRotation datapath, exact method (elaborated into ``rotation.VectorRotation``).
+class ExactRotation(PipeUnit):
+    """VectorRotation datapath, exact method (``rotation.VectorRotation`` with
+    ``method = "exact"``; a ``wiring.Component``, rtl/methods.py's registry entry).
 
     Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. With a = th_N' + ph_N',
     b = th_N' - ph_N', t = th_N:
@@ -93,15 +95,13 @@ class Rotation:
 
     latency = 1 + SineBank.latency + 2
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = pixel_layout(cfg), rotated_layout(cfg)
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
 
-    def build(self, m, i, o):
+    def build(self, m, pipe):
         cfg = self.cfg
-        pipe = StallPipe(m, i, o, self.latency)
         rom = SineBank(m, pipe, cfg)
-        px, o = i.payload, o.payload
+        px, o = self.i.payload, self.o.payload
         t, bt, bp = px.n.theta, px.b.theta, px.b.phi
         bits = cfg.angle_bits                  # input stage: a, b registered (mod 2**bits)
         a, b = pipe.register((bt + bp)[:bits], "a"), pipe.register((bt - bp)[:bits], "b")
@@ -125,7 +125,7 @@ class Rotation:
         m.d.comb += o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
 
 
-class Illumination(IlluminationDatapath):
+class ExactIllumination(IlluminationDatapath):
     """Illumination datapath, exact method: N'.A' = (x4 p2 + 2 y2 y2 + 2 z4 z) / 8, rounded
     once, then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
 
@@ -136,8 +136,8 @@ class Illumination(IlluminationDatapath):
 
     dot_latency = PRODUCT_LATENCY + 2
 
-    def __init__(self, cfg: Config):
-        super().__init__(cfg, rotated_layout(cfg))
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, rotated_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
         n, dots = payload.n, {}

@@ -5,7 +5,7 @@ numpy int64 arrays (in ``sim/golden``), so the two cannot drift apart:
 
 * :func:`round_shift` is round-to-nearest (ties toward +inf): add half an LSB of the
   result, then shift right arithmetically. ``>>`` floors in Amaranth and numpy alike, so
-  rounding has to be written out (DESIGN §4).
+  rounding has to be written out (docs/architecture.md, Number formats).
 * :func:`saturate` clamps into a :class:`Q` format; hardware never wraps silently.
 """
 

@@ -1,156 +1,24 @@
-"""Illumination unit (Lee Sec. 3.2, Fig. 8) and its shared back end.
+"""The Illumination unit (Lee Sec. 3.2, Fig. 8): the rotation unit's output in, 8-bit
+shading out, for the method ``cfg.method`` names.
 
-The back end turns the dot products N'.L' and N'.H' into 8-bit diffuse and specular
-intensities and the Phong sum of eq. (2); it is shared by every method and mirrored
-operation for operation by ``sim/golden/fixed_common.shade_fixed``.
+:func:`Illumination` is the entry point the pipeline, the emitter and the tests use: it
+builds the method's illumination class from the registry (rtl/methods.py), e.g.
+``exact.ExactIllumination`` or ``lee.LeeIllumination``. Every such class is a
+``wiring.Component`` on the shared back end of rtl/shade.py.
 """
 
-from amaranth.hdl import Module, Mux, signed, unsigned
-from amaranth.lib import data, stream, wiring
-from amaranth.lib.wiring import In, Out
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.methods import get
 
-from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.layouts import shade_layout
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, StallPipe
-from bumprtl.rtl.tables import phong_coefficients, specular_index_bits, specular_table
-
-__all__ = ["Illumination", "IlluminationDatapath", "MethodUnit", "SHADE_LATENCY", "shade_stages"]
-
-# Registers of shade_stages: clamp, round (diffuse, table index), table read and table
-# output register (ROM_LATENCY), Phong products (operand and product registers,
-# PRODUCT_LATENCY), Phong sum, rounding and clamp.
-SHADE_LATENCY = 4 + ROM_LATENCY + PRODUCT_LATENCY
+__all__ = ["Illumination"]
 
 
-def _clamp01(x, cfg):
-    """clamp(x, 0, 1.0) of a signed value with frac_bits fractional bits, as unsigned B+1."""
-    return Mux(x[-1], 0, Mux(x > cfg.one, cfg.one, x))[:cfg.frac_bits + 1]
+def Illumination(cfg: Config, target=None):
+    """The illumination datapath of ``cfg.method``: an instance of
+    ``methods.get(cfg.method).illumination`` (a ``wiring.Component``).
 
-
-def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
-    """Eq. (2) from the dot products; returns (diffuse, specular, color), SHADE_LATENCY
-    ``adv`` stages after ``ndotl``/``ndoth`` (signed, ``frac_bits`` fractional bits).
-
-    diffuse  = round(255 clamp(N'.L))                    (constant multiply)
-    specular = cos^n table[round(clamp(N'.H) 2**s)]      (block-RAM table, Fig. 8)
-    color    = clamp(round((KA + KD diffuse + KS specular) / 256), 0, 255)
-    """
-    b = cfg.frac_bits
-    d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
-    # 255 d as (d << 8) - d: a carry chain instead of a DSP block (same integers as d * 255).
-    diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage 2
-    if cfg.specular:
-        s_bits = specular_index_bits(cfg)
-        h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
-        index = pipe.register(round_shift(h, b - s_bits), "spec_index")           # stage 2
-        rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8), "specular_table", ports=1)
-        m.d.comb += rom.ports[0].addr.eq(index)                                   # stage 2
-        specular = rom.ports[0].data                                              # 2 + ROM
-    else:
-        specular = 0
-    diffuse = pipe.delay(diffuse, ROM_LATENCY, "diffuse_d")                       # 2 + ROM
-    ka, kd, ks = phong_coefficients(cfg)
-    kd_term = pipe.multiply(diffuse, kd, "kd_diffuse")                            # + PRODUCT
-    ks_term = pipe.multiply(specular, ks, "ks_specular") if cfg.specular else 0
-    # round_shift(KA + kd + ks, 8) as two 2-operand stages: KA and the rounding half are
-    # one constant added in the second.
-    terms = pipe.register(kd_term + ks_term, "phong_terms")                       # + 1
-    total = (terms + (ka + 128)) >> 8
-    color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 2
-    diffuse = pipe.delay(diffuse, PRODUCT_LATENCY + 2, "diffuse_out")
-    specular = pipe.delay(specular, PRODUCT_LATENCY + 2, "specular_out") if cfg.specular else 0
-    return diffuse, specular, color
-
-
-class IlluminationDatapath:
-    """The shell every method's illumination datapath shares: the method's ``dots`` gives
-    N'.L' and N'.H' (signed, ``frac_bits`` fractional bits) ``dot_latency`` stages after the
-    input, :func:`shade_stages` does eq. (2), and the tag rides along.
-
-    Subclasses set ``dot_latency`` and implement ``dots(m, pipe, payload) -> {"l": .., "h": ..}``.
-    """
-
-    dot_latency = None
-
-    def __init__(self, cfg: Config, in_layout):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = in_layout, shade_layout(cfg)
-
-    @property
-    def latency(self):
-        return self.dot_latency + SHADE_LATENCY
-
-    def build(self, m, i, o):
-        pipe = StallPipe(m, i, o, self.latency)
-        dots = self.dots(m, pipe, i.payload)
-        diffuse, specular, color = shade_stages(m, pipe, self.cfg, dots["l"], dots.get("h", 0))
-        m.d.comb += [o.payload.diffuse.eq(diffuse), o.payload.specular.eq(specular),
-                     o.payload.color.eq(color),
-                     o.payload.tag.eq(pipe.delay(i.payload.tag, self.latency, "tag"))]
-
-
-class BackEnd(IlluminationDatapath):
-    """The shared back end of eq. (2) alone: N'.L' and N'.H' arrive on the stream (signed,
-    ``frac_bits`` fractional bits) and take one register; what a method's illumination adds
-    to it is its count minus this one's (tests/rtl/test_baselines_*.py)."""
-
-    dot_latency = 1
-
-    def __init__(self, cfg: Config):
-        b = cfg.frac_bits
-        super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
-                                                 "tag": unsigned(cfg.tag_bits)}))
-
-    def dots(self, m, pipe, payload):
-        return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}
-
-
-class DatapathUnit(wiring.Component):
-    """A component around a datapath object (layouts, ``latency``, ``build``): the datapath
-    elaborates straight into this component's module, so the emitted Verilog is one module
-    per unit."""
-
-    def __init__(self, datapath):
-        self.datapath = datapath
-        super().__init__({"i": In(stream.Signature(datapath.in_layout)),
-                          "o": Out(stream.Signature(datapath.out_layout))})
-
-    @property
-    def latency(self):
-        return self.datapath.latency
-
-    def elaborate(self, platform):
-        m = Module()
-        self.datapath.build(m, self.i, self.o)
-        return m
-
-
-class MethodUnit(DatapathUnit):
-    """A unit whose datapath is chosen by ``cfg.method`` (rtl/exact.py, rtl/lee.py or
-    rtl/baselines/<method>.py)."""
-
-    _unit = None       # "Rotation" or "Illumination": the datapath class name
-
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
-        import importlib
-        from bumprtl.rtl.config import datapath_module
-        try:
-            methods = importlib.import_module(f".{datapath_module(cfg.method)}", __package__)
-        except ModuleNotFoundError:
-            raise BumpError(f"method {cfg.method!r}: rtl/{datapath_module(cfg.method).replace('.', '/')}"
-                            f".py is not built in this checkout") from None
-        super().__init__(getattr(methods, self._unit)(cfg))
-
-
-class Illumination(MethodUnit):
-    """Per-pixel illumination: the rotation unit's output in, 8-bit shading out.
-
-    ``cfg.method`` picks the datapath: ``exact`` (rtl/exact.py) or ``lee`` (rtl/lee.py).
     Input payload: the matching rotation unit's output layout; output payload:
-    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, tag).
-    Throughput 1 pixel per clock; ``latency`` depends on the method.
+    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, tag). ``latency`` depends on
+    the method; 1 pixel per clock. ``target``: None (generic) or ``pipe.ECP5()``.
     """
-
-    _unit = "Illumination"
+    return get(cfg.method).illumination(cfg, target=target)

@@ -1,15 +1,15 @@
-"""Stream payload layouts shared by the units (DESIGN §5), all derived from a Config."""
+"""Stream payload layouts shared by the units (docs/architecture.md, Interfaces), all derived from a Config."""
 
-from amaranth.hdl import unsigned
+from amaranth.hdl import Shape, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 
-__all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout"]
+__all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout", "layout_fields"]
 
 
 def angle_shape(cfg: Config):
-    """A binary angle: full circle = 2**angle_bits (DESIGN §4)."""
+    """A binary angle: full circle = 2**angle_bits (docs/architecture.md, Number formats)."""
     return unsigned(cfg.angle_bits)
 
 
@@ -34,3 +34,21 @@ def shade_layout(cfg: Config):
     out = unsigned(cfg.out_bits)
     return data.StructLayout({"diffuse": out, "specular": out, "color": out,
                               "tag": unsigned(cfg.tag_bits)})
+
+
+def layout_fields(layout, prefix=""):
+    """Bit fields of a payload layout, flattened: ``{name: [offset, width, signed]}``.
+
+    Nested layouts get dotted names (``"l.phi"``). Testbenches pack and unpack payloads
+    from this table, so they never hard-code a bit position.
+    """
+    out = {}
+    for name, field in layout:
+        shape = field.shape
+        if isinstance(shape, data.Layout):
+            for sub, (off, width, sgn) in layout_fields(shape, f"{prefix}{name}.").items():
+                out[sub] = [field.offset + off, width, sgn]
+        else:
+            s = Shape.cast(shape)
+            out[f"{prefix}{name}"] = [field.offset, s.width, s.signed]
+    return out

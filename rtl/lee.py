@@ -1,7 +1,8 @@
 """Lee et al. 2003 in hardware: the vector rotation of Fig. 7 and the illumination of Fig. 8,
-errata 1-6 and 8 of DESIGN §3 repaired (elaborated into ``rotation.VectorRotation`` and
-``illumination.Illumination`` when ``cfg.method == "lee"``). Bit-exact with
-``sim/golden/fixed_lee.py``, which calls the small helpers below on int64 arrays where the
+errata 1-6 and 8 repaired (docs/architecture.md, Errata of Lee et al.): :class:`LeeRotation` and
+:class:`LeeIllumination`, what ``rotation.VectorRotation`` and ``illumination.Illumination``
+build when ``cfg.method == "lee"`` (rtl/methods.py). Bit-exact with
+``sim/golden/fixed/lee.py``, which calls the small helpers below on int64 arrays where the
 RTL calls them on Amaranth values, so both do the same arithmetic.
 
 Mapping to the paper (Sec. 4 and Table 1), per vector A in {L, H}:
@@ -29,7 +30,7 @@ Illumination per vector: three cosine tables (``{a}_cos_plus_rom``, ``{a}_cos_mi
 ``{a}_cos_phi_rom``), six adders (th_A' + th_N', th_A' - th_N', ph_A' - ph_N', the two
 brackets, the sum) and one multiplier: Table 1's 6 cosine tables and 2 multipliers; adders
 12 here against the paper's 11 (Table 1) or 13 (Sec. 4.2, erratum 9). The diffuse and
-specular tables of Fig. 8 are the shared back end of rtl/illumination.py (diffuse there is a
+specular tables of Fig. 8 are the shared back end of rtl/shade.py (diffuse there is a
 constant multiply by 255, specular the cos^n block-RAM table).
 """
 
@@ -41,21 +42,20 @@ from amaranth.lib.memory import Memory
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.illumination import Illumination as _Illumination, IlluminationDatapath
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
-from bumprtl.rtl.pipe import StallPipe
-from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.pipe import PipeUnit
+from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
                      lee_atan_ratio_bits, lee_atan_table, lee_prop_index_bits, lee_prop_table,
                      lee_reciprocal_bits, lee_reciprocal_table)
 
-__all__ = ["Rotation", "Illumination", "LeeRotation", "LeeIllumination", "rotated_layout",
+__all__ = ["LeeRotation", "LeeIllumination", "rotated_layout",
            "below_horizon", "quarter_address", "ratio_index", "prop_address", "phi_quadrant",
            "magnitude", "theta_from_prop"]
 
 
-# --- Arithmetic shared with sim/golden/fixed_lee.py (Amaranth values or int64 arrays) -------
+# --- Arithmetic shared with sim/golden/fixed/lee.py (Amaranth values or int64 arrays) -------
 
 def _select(cond, a, b):
     if isinstance(cond, (Value, ValueCastable)):
@@ -128,9 +128,8 @@ def rotated_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-def _rom(m, name, table, width):
-    m.submodules[name] = rom = Memory(shape=unsigned(width), depth=len(table), init=table.tolist())
-    return rom
+def _rom(pipe, name, table, width):
+    return pipe.memory(name, Memory(shape=unsigned(width), depth=len(table), init=table.tolist()))
 
 
 def _read(m, pipe, rom, address):
@@ -140,8 +139,9 @@ def _read(m, pipe, rom, address):
     return port.data
 
 
-class Rotation:
-    """VectorRotation datapath, lee method (Fig. 7 once per vector; see the module table).
+class LeeRotation(PipeUnit):
+    """VectorRotation datapath, lee method (Fig. 7 once per vector; see the module table),
+    whatever ``cfg.method`` says; a ``wiring.Component``.
 
     Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Stages per vector:
     1-2 sin/cos X, Y; 3 asin; 4 1/sin Z, 1/cos Z; 5 products; 6 atan, T_prop; 7 ph', th'.
@@ -150,29 +150,27 @@ class Rotation:
 
     latency = 7
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = pixel_layout(cfg), rotated_layout(cfg)
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
 
-    def build(self, m, i, o):
-        pipe = StallPipe(m, i, o, self.latency)
-        px = i.payload
+    def build(self, m, pipe):
+        px, o = self.i.payload, self.o.payload
         for v in vectors(self.cfg):
             phi, theta = self._rotate(m, pipe, v, px[v], px.n)
-            m.d.comb += [o.payload[v].phi.eq(phi), o.payload[v].theta.eq(theta)]
-        m.d.comb += [o.payload.b.eq(pipe.delay(px.b, self.latency, "b")),
-                     o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
+            m.d.comb += [o[v].phi.eq(phi), o[v].theta.eq(theta)]
+        m.d.comb += [o.b.eq(pipe.delay(px.b, self.latency, "b")),
+                     o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
 
     def _rotate(self, m, pipe, v, a, n):
         cfg, k, b = self.cfg, self.cfg.k, self.cfg.frac_bits
         d = a.phi - n.phi                                                  # adder 1
         x, y = a.theta + d, a.theta - d                                    # adders 2, 3 (eq. 6)
-        m.submodules[f"{v}_sincos_rom"] = sincos = quarter_wave_rom(cfg)
+        sincos = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
         sx, sy, cx, cy = (sine_read(m, pipe, sincos.read_port(domain="sync"), angle, cfg, f"{v}_{nm}")
                           for nm, angle in (("sin_x", x), ("sin_y", y),
                                             ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k))))
         s2 = sx + sy                                                       # adder 4: 2 s (eq. 7)
-        asin_rom = _rom(m, f"{v}_asin_rom", lee_asin_table(cfg), k + 1)
+        asin_rom = _rom(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1)
         asin = _read(m, pipe, asin_rom, round_shift(abs(s2), b + 1 - lee_asin_index_bits(cfg)))
         s_negative = pipe.register(s2[-1], f"{v}_s_negative")              # stage 3
         y2 = pipe.register(cy - cx, f"{v}_y2")                             # adder 5: 2 sin th sin D
@@ -183,17 +181,17 @@ class Rotation:
         z = _wrap(theta_x - theta_n, cfg)                                  # adder 6: Z
         inv = lee_reciprocal_table(cfg)
         width = lee_reciprocal_bits(cfg)
-        inv_sin = _read(m, pipe, _rom(m, f"{v}_inv_sin_rom", inv, width), quarter_address(z, cfg))
-        inv_cos = _read(m, pipe, _rom(m, f"{v}_inv_cos_rom", inv, width),
+        inv_sin = _read(m, pipe, _rom(pipe, f"{v}_inv_sin_rom", inv, width), quarter_address(z, cfg))
+        inv_cos = _read(m, pipe, _rom(pipe, f"{v}_inv_cos_rom", inv, width),
                         quarter_address(z + (1 << k), cfg))                # stage 4
         z = pipe.register(z, f"{v}_z")
         y2 = pipe.register(y2, f"{v}_y2_4")
         ay2 = abs(y2)
         ratio = pipe.register(ay2 * inv_sin, f"{v}_ratio") >> (2 * b + 1 - k)   # stage 5
         product = pipe.register(ay2 * inv_cos, f"{v}_yk_product")
-        atan = _read(m, pipe, _rom(m, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
+        atan = _read(m, pipe, _rom(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
                      ratio_index(ratio, cfg))
-        prop = _read(m, pipe, _rom(m, f"{v}_prop_rom", lee_prop_table(cfg), b + 1),
+        prop = _read(m, pipe, _rom(pipe, f"{v}_prop_rom", lee_prop_table(cfg), b + 1),
                      prop_address(product, cfg))                            # stage 6
         z = pipe.delay(z, 2, f"{v}_z")
         y_negative = pipe.delay(y2[-1], 2, f"{v}_y_negative")
@@ -203,8 +201,8 @@ class Rotation:
         return phi, theta                                                   # stage 7
 
 
-class Illumination(IlluminationDatapath):
-    """Illumination datapath, lee method (Fig. 8): eq. 24 with erratum 2 per vector,
+class LeeIllumination(IlluminationDatapath):
+    """Illumination datapath, lee method (Fig. 8), whatever ``cfg.method`` says: eq. 24 with erratum 2 per vector,
     N'.A' = ((c- + c+) 2**B + (c- - c+) c_phi) / 2**(B+1), one rounding, where
     c+- = cos(th_A' +- th_N') and c_phi = cos(ph_A' - ph_N'); then the shared back end.
 
@@ -214,8 +212,8 @@ class Illumination(IlluminationDatapath):
 
     dot_latency = 4
 
-    def __init__(self, cfg: Config):
-        super().__init__(cfg, rotated_layout(cfg))
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, rotated_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
         return {v: self._dot(m, pipe, v, payload[v], payload.b) for v in vectors(self.cfg)}
@@ -225,24 +223,10 @@ class Illumination(IlluminationDatapath):
         angles = {"plus": a.theta + n.theta, "minus": a.theta - n.theta, "phi": a.phi - n.phi}
         c = {}
         for name, angle in angles.items():                                 # 3 cosine tables
-            m.submodules[f"{v}_cos_{name}_rom"] = rom = quarter_wave_rom(cfg)
+            rom = pipe.memory(f"{v}_cos_{name}_rom", quarter_wave_rom(cfg))
             c[name] = sine_read(m, pipe, rom.read_port(domain="sync"), angle + (1 << cfg.k), cfg,
                                 f"{v}_cos_{name}")                          # stage 2
         first = pipe.register(c["minus"] + c["plus"], f"{v}_first")       # stage 3
         second = pipe.register((c["minus"] - c["plus"]) * c["phi"], f"{v}_second")
         return pipe.register(round_shift((first << cfg.frac_bits) + second, cfg.frac_bits + 1),
                              f"{v}_dot")                                    # stage 4
-
-
-class LeeRotation(VectorRotation):
-    """``VectorRotation`` with the lee datapath, whatever ``cfg.method`` says."""
-
-    def __init__(self, cfg: Config):
-        super().__init__(cfg.replace(method="lee"))
-
-
-class LeeIllumination(_Illumination):
-    """``Illumination`` with the lee datapath, whatever ``cfg.method`` says."""
-
-    def __init__(self, cfg: Config):
-        super().__init__(cfg.replace(method="lee"))

@@ -1,6 +1,6 @@
 """PaletteLUT: the per-pixel half of Tarini et al.'s palette method (Sec. 5, step 2).
 
-Blend arithmetic shared with the golden model (``sim/golden/palette_lut.py``): 8-bit
+Blend arithmetic shared with the golden model (``sim/golden/fixed/palette_lut.py``): 8-bit
 channels (``cfg.color_bits``, 255 = 1.0); a product of two channel values is
 ``x * a / 255`` rounded to nearest, exactly, by the divide-by-255 identity
 ``round(t / 255) = round_shift(t + round_shift(t, 8), 8)`` for ``t = x * a <= 255**2``
@@ -78,6 +78,8 @@ class PaletteLUT(wiring.Component):
     ----------
     cfg : Config
         Reads ``palette_size`` (sN), ``color_bits``, ``palette_blend`` and ``tag_bits``.
+    target : None or pipe.ECP5
+        Elaboration target (None: the generic form every simulator runs).
 
     Members
     -------
@@ -105,8 +107,8 @@ class PaletteLUT(wiring.Component):
     pixel per clock when not stalled.
     """
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
+    def __init__(self, cfg: Config, target=None):
+        self.cfg, self.target, self.memories = cfg, target, {}
         ib = index_bits(cfg)
         fields = {"index": unsigned(ib)}
         if cfg.palette_blend:
@@ -134,8 +136,9 @@ class PaletteLUT(wiring.Component):
     def elaborate(self, platform):
         cfg, size = self.cfg, self.cfg.palette_size
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
-        m.submodules.table = table = Memory(shape=unsigned(4 * cfg.color_bits), depth=2 * size, init=[])
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        table = pipe.memory("table", Memory(shape=unsigned(4 * cfg.color_bits), depth=2 * size, init=[]))
+        self.memories = pipe.memories
         front = Signal(name="front")
         with m.If(self.swap):
             m.d.sync += front.eq(~front)

@@ -1,4 +1,4 @@
-"""Stall-safe pipeline bookkeeping shared by every unit (DESIGN §5).
+"""Stall-safe pipeline bookkeeping shared by every unit (docs/architecture.md, Interfaces).
 
 The whole pipe advances when the output is empty or being taken,
 ``adv = ~o.valid | o.ready``; every register, including the ROM read ports, is enabled by
@@ -8,9 +8,11 @@ from a register and never depends on ``o.ready`` (stream rule 1).
 
 from amaranth.hdl import (ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
                           Value, signed)
-from amaranth.lib.memory import Memory
+from amaranth.lib import stream, wiring
+from amaranth.lib.memory import Memory, ReadPort
+from amaranth.lib.wiring import In, Out
 
-__all__ = ["StallPipe", "RegisteredProduct", "RegisteredROM", "PRODUCT_LATENCY",
+__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "RegisteredROM", "read_port", "PRODUCT_LATENCY",
            "ROM_LATENCY", "ECP5"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
@@ -20,10 +22,12 @@ ROM_LATENCY = 2
 
 
 class ECP5:
-    """Elaboration hint passed as ``platform`` by the ECP5 flow (gen/fpga.py): products
+    """The ECP5 target, passed as ``target=ECP5()`` to a unit's constructor by the ECP5 flow
+    (gen/flow/fpga.py) and threaded down to its StallPipe, RegisteredROM and
+    RegisteredProduct (``target=None``, the default, is the generic form): products
     become MULT18X18D blocks with their own input and output registers, which Yosys
     ``synth_ecp5`` does not infer from the generic netlist (a DSP block used without its
-    registers costs ~3.9 ns of its own). Every other flow elaborates the generic form."""
+    registers adds its own delay to the cycle). Every other flow elaborates the generic form."""
     dsp = "MULT18X18D"
     dsp_width = 18
     bram = "DP16KD"
@@ -34,12 +38,13 @@ class ECP5:
 class RegisteredProduct(Elaboratable):
     """``p = a * b`` two ``en`` cycles after ``a``/``b`` (operand registers, product
     register): exactly the registers of an ECP5 MULT18X18D with REG_INPUTA/B and
-    REG_OUTPUT, so on ECP5 (``platform`` :class:`ECP5`) the whole product is one DSP block
+    REG_OUTPUT, so on ECP5 (``target`` :class:`ECP5`) the whole product is one DSP block
     and the generic form (plain ``*`` between flip-flops) is what every simulator runs."""
 
-    def __init__(self, a_shape, b_shape, name, b_const=None):
+    def __init__(self, a_shape, b_shape, name, b_const=None, target=None):
         """``b_const``: ``b`` is this constant (no operand register; a constant multiply
-        stays one in the netlist counts of gen/resources.py)."""
+        stays one in the netlist counts of gen/flow/resources.py)."""
+        self.target = target               # None (generic) or ECP5
         self.a = Signal(a_shape, name=f"{name}_a")
         self.b = Signal(b_shape, name=f"{name}_b") if b_const is None else Const(b_const, b_shape)
         self.en = Signal(name=f"{name}_en")
@@ -51,7 +56,8 @@ class RegisteredProduct(Elaboratable):
 
     def elaborate(self, platform):
         m = Module()
-        if getattr(platform, "dsp", None) == "MULT18X18D" and self._fits(platform.dsp_width):
+        target = self.target
+        if getattr(target, "dsp", None) == "MULT18X18D" and self._fits(target.dsp_width):
             a, b, p = Signal(signed(18)), Signal(signed(18)), Signal(signed(36))
             m.d.comb += [a.eq(self.a), b.eq(self.b), self.p.eq(p)]       # sign/zero-extend
             ports = {f"i_A{n}": a[n] for n in range(18)}
@@ -75,37 +81,46 @@ class RegisteredProduct(Elaboratable):
         return m
 
 
-class _ReadPort:
-    def __init__(self, addr_bits, shape, name):
-        self.addr = Signal(addr_bits, name=f"{name}_addr")
-        self.data = Signal(shape, name=f"{name}_data")
+def read_port(addr_bits, shape, name):
+    """One read port of a :class:`RegisteredROM`: an interface of
+    ``amaranth.lib.memory.ReadPort.Signature`` (``addr`` in, ``data`` out, as a Memory's read
+    port; its ``en`` is unused, the ROM's own ``en`` enables every port) whose signals are
+    named ``{name}_addr`` and ``{name}_data``."""
+    signature = ReadPort.Signature(addr_width=addr_bits, shape=shape)
+    port = wiring.PureInterface(signature, path=(name,))
+    port.addr = Signal(addr_bits, name=f"{name}_addr")
+    port.data = Signal(shape, name=f"{name}_data")
+    assert signature.is_compliant(port)
+    return port
 
 
 class RegisteredROM(Elaboratable):
-    """A ROM whose ``ports`` read ports give ``data`` ROM_LATENCY ``en`` cycles after
-    ``addr`` (synchronous read, then an output register). On ECP5 (``platform``
+    """A ROM whose ``ports`` read ports (:func:`read_port`) give ``data`` ROM_LATENCY ``en`` cycles after
+    ``addr`` (synchronous read, then an output register). On ECP5 (``target``
     :class:`ECP5`) that is one DP16KD with both ports and its own output registers
-    (REGMODE OUTREG: the 5.8 ns clock-to-out of an unregistered block RAM leaves the
+    (REGMODE OUTREG: the clock-to-out of an unregistered block RAM leaves the
     cycle); a table of 2**n + 1 words whose word 0 is 0 keeps its last word in a flip-flop
-    (the address wraps to word 0 and the word is OR'ed in). Elsewhere: an Amaranth Memory
-    and a register."""
+    (the address wraps to word 0 and the word is OR'ed in). Elsewhere (``target=None``): an
+    Amaranth Memory and a register. ``depth`` and ``width`` are the table's size."""
 
-    def __init__(self, init, shape, ports, name):
-        self.init, self.shape, self.name = [int(x) for x in init], shape, name
+    def __init__(self, init, shape, ports, name, target=None):
+        self.init, self.shape, self.name, self.target = [int(x) for x in init], shape, name, target
+        self.depth, self.width = len(self.init), Shape.cast(shape).width
         addr_bits = max(1, (len(self.init) - 1).bit_length())
         self.en = Signal(name=f"{name}_en")
-        self.ports = [_ReadPort(addr_bits, shape, f"{name}_p{n}") for n in range(ports)]
+        self.ports = [read_port(addr_bits, shape, f"{name}_p{n}") for n in range(ports)]
 
-    def _fits(self, platform):
-        words, width = len(self.init), Shape.cast(self.shape).width
-        spill = words == platform.bram_words + 1 and self.init[0] == 0
-        return (len(self.ports) <= 2 and width <= platform.bram_width
-                and (words <= platform.bram_words or spill))
+    def _fits(self, target):
+        words, width = self.depth, self.width
+        spill = words == target.bram_words + 1 and self.init[0] == 0
+        return (len(self.ports) <= 2 and width <= target.bram_width
+                and (words <= target.bram_words or spill))
 
     def elaborate(self, platform):
         m = Module()
-        if getattr(platform, "bram", None) == "DP16KD" and self._fits(platform):
-            self._dp16kd(m, platform)
+        target = self.target
+        if getattr(target, "bram", None) == "DP16KD" and self._fits(target):
+            self._dp16kd(m, target)
             return m
         m.submodules.mem = mem = Memory(shape=self.shape, depth=len(self.init), init=self.init)
         for port in self.ports:
@@ -115,8 +130,8 @@ class RegisteredROM(Elaboratable):
                 m.d.sync += port.data.eq(read.data)
         return m
 
-    def _dp16kd(self, m, platform):
-        words = platform.bram_words
+    def _dp16kd(self, m, target):
+        words = target.bram_words
         slots = [0] * words
         for n, x in enumerate(self.init[:words]):
             slots[n] = x & ((1 << 18) - 1)
@@ -162,13 +177,21 @@ class StallPipe:
     i, o : stream interfaces of the enclosing component (``i`` flipped, ``o`` not)
     depth : int
         Number of register stages between ``i`` and ``o`` (the latency).
+    target : None or ECP5
+        Passed to every RegisteredROM and RegisteredProduct built through the pipe.
+
+    ``memories`` records every memory built through the pipe (:meth:`rom`, :meth:`memory`):
+    name -> {depth, width, bits}. A unit keeps it as its own ``memories`` when it elaborates
+    (the ROM sizes of gen/flow/units.py's sidecar).
     """
 
-    def __init__(self, m, i, o, depth):
+    def __init__(self, m, i, o, depth, target=None):
         if depth < 1:
             raise ValueError(f"pipeline depth must be >= 1, got {depth}")
         self.m = m
         self.depth = depth
+        self.target = target
+        self.memories = {}
         self.adv = Signal(name="adv")
         m.d.comb += [self.adv.eq(~o.valid | o.ready), i.ready.eq(self.adv)]
         self.valid = [i.valid]
@@ -187,18 +210,28 @@ class StallPipe:
             self.m.d.sync += reg.eq(value)
         return reg
 
+    def _record(self, name, depth, width):
+        self.memories[name] = {"depth": depth, "width": width, "bits": depth * width}
+
     def rom(self, init, shape, name, ports=2):
         """A :class:`RegisteredROM` with ``ports`` read ports enabled by ``adv``."""
-        unit = RegisteredROM(init, shape, ports, name)
+        unit = RegisteredROM(init, shape, ports, name, target=self.target)
         self.m.submodules[name] = unit
         self.m.d.comb += unit.en.eq(self.adv)
+        self._record(name, unit.depth, unit.width)
         return unit
+
+    def memory(self, name, memory):
+        """Add an Amaranth ``Memory`` as submodule ``name`` and record its size."""
+        self.m.submodules[name] = memory
+        self._record(name, memory.depth, Shape.cast(memory.shape).width)
+        return memory
 
     def multiply(self, a, b, name):
         """``a * b`` PRODUCT_LATENCY ``adv`` stages later (:class:`RegisteredProduct`)."""
         a, b = Value.cast(a), Value.cast(b)
         const = b.value if isinstance(b, Const) else None
-        unit = RegisteredProduct(a.shape(), b.shape(), name, b_const=const)
+        unit = RegisteredProduct(a.shape(), b.shape(), name, b_const=const, target=self.target)
         self.m.submodules[name] = unit
         self.m.d.comb += [unit.a.eq(a), unit.en.eq(self.adv)]
         if const is None:
@@ -210,3 +243,37 @@ class StallPipe:
         for n in range(stages):
             value = self.register(value, f"{name}_d{n + 1}")
         return value
+
+
+class PipeUnit(wiring.Component):
+    """A unit that is one :class:`StallPipe` from stream ``i`` to stream ``o``: the base of
+    every method's datapath (rtl/exact.py, rtl/lee.py, rtl/baselines/).
+
+    Parameters
+    ----------
+    cfg : Config
+    in_layout, out_layout : data.Layout
+        Payloads of ``i`` and ``o``.
+    target : None or ECP5
+        Elaboration target of the pipe's ROMs and products (None: the generic form).
+
+    Members: ``i`` In(stream.Signature(in_layout)), ``o`` Out(stream.Signature(out_layout)).
+    Subclasses give ``latency`` (the pipe's depth) and ``build(m, pipe)``. After elaboration
+    ``memories`` holds the pipe's record of the memories built (name -> depth, width, bits).
+    1 pixel per clock when not stalled.
+    """
+
+    def __init__(self, cfg, in_layout, out_layout, target=None):
+        self.cfg, self.target, self.memories = cfg, target, {}
+        super().__init__({"i": In(stream.Signature(in_layout)),
+                          "o": Out(stream.Signature(out_layout))})
+
+    def build(self, m, pipe):
+        raise NotImplementedError
+
+    def elaborate(self, platform):
+        m = Module()
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        self.build(m, pipe)
+        self.memories = pipe.memories
+        return m

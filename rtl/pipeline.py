@@ -1,10 +1,11 @@
-"""BumpPipeline: the per-pixel system a scene needs, generated from a SceneConfig (DESIGN §6).
+"""BumpPipeline: the per-pixel system a scene needs, generated from a SceneConfig
+(docs/architecture.md, Scenes decide what is built).
 
 texel coordinates + world N, L, H in; shaded pixels out. Only what the scene needs is built:
 
 * varying bump map: BumpMapFetch -> VectorRotation -> Illumination (``wiring.connect``);
 * flat bump map: no map and no per-pixel N' rotation: n'' is rotated once per polygon
-  (``sim/golden/fixed_pipeline.polygon_fixed``) and written to the polygon registers, per
+  (``sim/golden/fixed/pipeline.polygon_fixed``) and written to the polygon registers, per
   pixel only the light terms (:class:`VectorTerms`) and the dots remain;
 * palette shading: BumpMapFetch (indices) -> PaletteLUT, no rotation at all;
 * m lights share the one rotated normal n'' (exact method): light 0 rides in VectorRotation,
@@ -25,7 +26,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
-from bumprtl.rtl.exact import Rotation as ExactRotation, SineBank, rotated_layout, vector_terms
+from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, vector_terms
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import angle_shape, pixel_layout, polar_layout, shade_layout
@@ -44,16 +45,16 @@ def _vector_layout(cfg):
 
 
 class VectorTerms(wiring.Component):
-    """The per-vector half of the exact rotation (DESIGN §3) for vectors ``names``:
+    """The per-vector half of the exact rotation (docs/architecture.md, The exact angular method) for vectors ``names``:
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D, 2p = s(X) + s(Y), 2y = c(Y) - c(X),
-    z = c(th_A). Built by ``exact.vector_terms``, the function ``exact.Rotation`` uses, with
+    z = c(th_A). Built by ``exact.vector_terms``, the function ``exact.ExactRotation`` uses, with
     the same latency, so it runs in lock step beside it. Input {n_phi, <name>: polar, tag};
     output {<name>: p2, y2, z, tag}."""
 
     latency = ExactRotation.latency
 
-    def __init__(self, cfg, names):
-        self.cfg, self.names = cfg, tuple(names)
+    def __init__(self, cfg, names, target=None):
+        self.cfg, self.names, self.target, self.memories = cfg, tuple(names), target, {}
         fields_in = {"n_phi": angle_shape(cfg), **{v: polar_layout(cfg) for v in names},
                      "tag": unsigned(cfg.tag_bits)}
         fields_out = {**{v: _vector_layout(cfg) for v in names}, "tag": unsigned(cfg.tag_bits)}
@@ -62,7 +63,8 @@ class VectorTerms(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        self.memories = pipe.memories
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
         for v in self.names:
@@ -73,27 +75,27 @@ class VectorTerms(wiring.Component):
 
 
 class LightSum(wiring.Component):
-    """m lights' 8-bit diffuse and specular -> the pixel (eq. 2 summed over the lights):
+    """m lights' 8-bit diffuse and specular -> the pixel (eq. 2 summed over the lights).
+    Input {d, s: ArrayLayout(unsigned(8), m) (light j's d_j, s_j at index j), tag}:
     diffuse = min(255, sum d_j), specular = min(255, sum s_j),
     color = clamp(round((KA + KD sum d_j + KS sum s_j) / 256), 0, 255).
-    Latency 3 (sums, products, clamp); bit-exact with ``fixed_pipeline.combine_lights_fixed``."""
+    Latency 3 (sums, products, clamp); bit-exact with ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
 
     latency = 3
 
-    def __init__(self, scene: SceneConfig):
-        self.cfg, self.lights = scene.config, scene.lights
-        u8 = unsigned(8)
-        fields = {**{f"d{j}": u8 for j in range(self.lights)},
-                  **{f"s{j}": u8 for j in range(self.lights)}, "tag": unsigned(self.cfg.tag_bits)}
+    def __init__(self, scene: SceneConfig, target=None):
+        self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
+        per_light = data.ArrayLayout(unsigned(8), self.lights)      # light j's 8-bit value
+        fields = {"d": per_light, "s": per_light, "tag": unsigned(self.cfg.tag_bits)}
         super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
                           "o": Out(stream.Signature(shade_layout(self.cfg)))})
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
         px = self.i.payload
-        d = pipe.register(sum(px[f"d{j}"] for j in range(self.lights)), "diffuse_sum")
-        s = pipe.register(sum(px[f"s{j}"] for j in range(self.lights)), "specular_sum")
+        d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
+        s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
         ka, kd, ks = phong_coefficients(self.cfg)
         kd_term, ks_term = pipe.register(d * kd, "kd_sum"), pipe.register(s * ks, "ks_sum")
         total = round_shift(ka + kd_term + ks_term, 8)
@@ -125,6 +127,8 @@ class BumpPipeline(wiring.Component):
         Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
     texture : sequence of int, optional
         Colour-texture words (``bumpfetch.pack_rgb``, same level layout as the map).
+    target : None or pipe.ECP5
+        Elaboration target of every unit (None: the generic form every simulator runs).
 
     Members
     -------
@@ -146,12 +150,14 @@ class BumpPipeline(wiring.Component):
         Palette: PaletteLUT's host port.
 
     ``latency`` is the sum of the units' latencies; 1 pixel per clock when not stalled.
-    ``built`` lists the units and why each was built.
+    ``built`` lists the units and why each was built; after elaboration ``memories`` lists
+    every unit's memories (``unit.name`` -> depth, width, bits).
     """
 
-    def __init__(self, scene, init=None, texture=None):
+    def __init__(self, scene, init=None, texture=None, target=None):
         self.scene = scene = load_scene_config(scene)
         self.cfg = cfg = scene.config
+        self.target = target
         self.units, self.built = {}, []
         self._texture = texture
         ports = {}
@@ -197,12 +203,12 @@ class BumpPipeline(wiring.Component):
                                             "tag": out_layout["tag"].shape})
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
             (["texture = true: the RGB colour texel"] if s.texture else [])
-        self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture),
+        self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target),
                   f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):
-        lut = PaletteLUT(self.cfg)
+        lut = PaletteLUT(self.cfg, self.target)
         self._fetch(lut.i.payload.shape(), init, "a palette index")
         if self.scene.texture:
             self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
@@ -223,7 +229,7 @@ class BumpPipeline(wiring.Component):
             tag = fields.pop("tag")
             self._fetch(data.StructLayout({**fields, **{v: polar_layout(cfg) for v in extra},
                                            "tag": tag}), init, "N' (polar angles)")
-            self._add("rotation", VectorRotation(cfg),
+            self._add("rotation", VectorRotation(cfg, self.target),
                       f"rotation = 'per-pixel': N' rotated into N's frame every pixel ({spec})")
             rot_layer.append("rotation")
             term_names = extra
@@ -236,29 +242,31 @@ class BumpPipeline(wiring.Component):
             why = ("bump_map = 'flat': n'' written once per polygon, per pixel only the light "
                    "terms" if s.rotation == "per-polygon" else
                    f"lights = {s.lights}: lights 1..{s.lights - 1} share light 0's rotated normal")
-            self._add("terms", VectorTerms(cfg, term_names), why)
+            self._add("terms", VectorTerms(cfg, term_names, self.target), why)
             rot_layer.append("terms")
         ill = []
         for j in range(s.lights):
-            self._add(f"illumination{j}" if s.lights > 1 else "illumination", Illumination(cfg),
+            self._add(f"illumination{j}" if s.lights > 1 else "illumination",
+                      Illumination(cfg, self.target),
                       f"light {j}: N'.L' (and N'.H') and the shade of eq. 2 ({spec})")
             ill.append(self.built[-1]["unit"])
         if s.texture:                          # the texel rides beside both layers
             for name, layer in (("texel_r", rot_layer), ("texel_i", ill)):
                 latency = self.units[layer[0]].latency
-                self._add(name, TexelDelay(cfg, latency),
+                self._add(name, TexelDelay(cfg, latency, self.target),
                           f"texture = true: the texel waits {latency} stages beside {layer[0]}")
                 layer.append(name)
         self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
         self._rot_layer, self._ill_layer = rot_layer, ill
         if s.texture:
-            self._add("blend", TextureBlend(cfg, s.lights),
+            self._add("blend", TextureBlend(cfg, s.lights, self.target),
                       "texture = true: out_c = tex_c min(1, ka + kd d) + ks s (Lee eq. 2 with a "
                       "textured albedo, Tarini eq. 2's shape)" +
                       (f", summed over the {s.lights} lights" if s.lights > 1 else ""))
             self._layers.append(["blend"])
         elif s.lights > 1:
-            self._add("lightsum", LightSum(s), f"lights = {s.lights}: eq. 2 summed over the lights")
+            self._add("lightsum", LightSum(s, self.target),
+                      f"lights = {s.lights}: eq. 2 summed over the lights")
             self._layers.append(["lightsum"])
         self._first, self._last = self._layers[0][0], self._layers[-1][0]
 
@@ -289,6 +297,12 @@ class BumpPipeline(wiring.Component):
     @property
     def latency(self):
         return sum(self.units[layer[0]].latency for layer in self._layers)
+
+    @property
+    def memories(self):
+        """Every unit's memories, ``unit.name`` -> {depth, width, bits} (after elaboration)."""
+        return {f"{unit}.{name}": size for unit, u in self.units.items()
+                for name, size in u.memories.items()}
 
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
@@ -372,8 +386,8 @@ class BumpPipeline(wiring.Component):
         total = u["blend"] if s.texture else u["lightsum"]
         _lockstep(m, lead, [total.i])
         for j, n in enumerate(ill_layer[:s.lights]):
-            m.d.comb += [total.i.payload[f"d{j}"].eq(u[n].o.payload.diffuse),
-                         total.i.payload[f"s{j}"].eq(u[n].o.payload.specular)]
+            m.d.comb += [total.i.payload.d[j].eq(u[n].o.payload.diffuse),
+                         total.i.payload.s[j].eq(u[n].o.payload.specular)]
         if s.texture:
             m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)

@@ -1,4 +1,5 @@
-"""What a scene needs, and so what the generator builds (DESIGN §6).
+"""What a scene needs, and so what the generator builds (docs/architecture.md, "Scenes
+decide what is built").
 
 A :class:`SceneConfig` comes from a TOML file (``bumprtl emit pipeline --scene FILE``) or a
 built-in name (:data:`BUILTIN`). Every key is checked at load time; a bad one raises a
@@ -10,7 +11,8 @@ import tomllib
 from dataclasses import dataclass, fields, asdict
 from pathlib import Path
 
-from bumprtl.rtl.config import BumpError, Config, METHODS
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.methods import PER_PIXEL
 
 __all__ = ["SceneConfig", "SceneError", "BUILTIN", "load_scene_config", "ADDRESSING",
            "BUMP_MAPS", "SHADINGS", "ROTATIONS", "light_fields"]
@@ -110,8 +112,8 @@ class SceneConfig:
             self.config
         except BumpError as e:
             raise SceneError(f"scene {self.name!r}: {e}") from None
-        if self.method not in METHODS:
-            raise SceneError(f"method must be one of {', '.join(METHODS)} in a scene (the "
+        if self.method not in PER_PIXEL:
+            raise SceneError(f"method must be one of {', '.join(PER_PIXEL)} in a scene (the "
                              f"baselines are built for the cost comparison only), got {self.method!r}")
         self._check_rotation()
         if self.rotation == "per-polygon" and self.method != "exact":

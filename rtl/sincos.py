@@ -1,4 +1,4 @@
-"""Quarter-wave sine/cosine unit: the toolchain vertical slice (DESIGN §4)."""
+"""Quarter-wave sine/cosine unit: the toolchain vertical slice (docs/architecture.md, Number formats)."""
 
 from amaranth.hdl import Module, Mux, signed, unsigned
 from amaranth.lib import data, stream, wiring
@@ -64,6 +64,8 @@ class SinCos(wiring.Component):
     ----------
     cfg : Config
         Reads ``angle_bits`` (k + 2), ``frac_bits`` (B) and ``tag_bits``.
+    target : None or pipe.ECP5
+        Elaboration target (None: the generic form every simulator runs).
 
     Members
     -------
@@ -76,8 +78,8 @@ class SinCos(wiring.Component):
     output register, sign); throughput 1 angle per clock when not stalled.
     """
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
+    def __init__(self, cfg: Config, target=None):
+        self.cfg, self.target, self.memories = cfg, target, {}
         super().__init__({
             "i": In(stream.Signature(data.StructLayout({
                 "angle": unsigned(cfg.angle_bits),
@@ -97,8 +99,9 @@ class SinCos(wiring.Component):
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
+        self.memories = pipe.memories
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
                                    registered=True, angle_stage=False)

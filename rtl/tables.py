@@ -18,7 +18,7 @@ __all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_
 
 
 def quarter_sine(cfg: Config) -> np.ndarray:
-    """Quarter-wave sine ROM (DESIGN §4).
+    """Quarter-wave sine ROM (docs/architecture.md, Number formats).
 
     Entry ``i`` (0 <= i <= 2**k) holds ``round(sin(i * 90deg / 2**k) * 2**B)``: the sine of
     ``i`` binary-angle steps, rounded to nearest, so ``rom[0] == 0`` and
@@ -40,7 +40,7 @@ def sine_circle(cfg: Config) -> np.ndarray:
     index = a & ((1 << cfg.k) - 1)
     mirrored = (quadrant & 1) == 1          # quadrants 1 and 3 read the ROM backwards
     value = rom[np.where(mirrored, (1 << cfg.k) - index, index)]
-    # int32: the values need B + 2 <= 26 bits, and int32 gathers are 2-3x faster.
+    # int32: the values need B + 2 <= 26 bits, and int32 gathers are faster than int64 ones.
     table = np.where(quadrant >= 2, -value, value).astype(np.int32)  # quadrants 2, 3 negative
     table.flags.writeable = False
     return table
@@ -89,7 +89,7 @@ def phong_coefficients(cfg: Config):
 # --- Lee et al. 2003: the vector-rotation ROMs of Fig. 7 (rtl/lee.py) -----------------------
 # Angles out of these tables are binary-angle codes (full circle = 2**(k+2)); fractions carry
 # frac_bits = B fractional bits. Each table is indexed by a magnitude; signs, quadrants and
-# the errata's branch fixes are logic in rtl/lee.py and sim/golden/fixed_lee.py.
+# the errata's branch fixes are logic in rtl/lee.py and sim/golden/fixed/lee.py.
 
 def _angle_code(rad, cfg: Config):
     return np.rint(rad * (cfg.full_circle / (2 * np.pi))).astype(np.int64)

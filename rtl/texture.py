@@ -1,4 +1,4 @@
-"""The colour-texture blend: Phong shading with a textured albedo (DESIGN §6, ``texture = true``).
+"""The colour-texture blend: Phong shading with a textured albedo (``texture = true``).
 
 Per colour channel c, with the texel colour tex_c fetched from block RAM at the same
 (u, v[, level]) as the bump map (rtl/bumpfetch.py), summed over the m lights (Lee eq. 2):
@@ -14,7 +14,7 @@ specular term), and the product is the palette blend's own :func:`rtl.palette.mu
 (x * a / 255 rounded to nearest, exactly), so the two blends share one arithmetic.
 
 :func:`texture_blend` runs on Amaranth values (with ``reg`` = a pipeline register) and on
-int64 arrays (``reg`` = identity) in ``sim/golden/fixed_pipeline.py``: one function, so the
+int64 arrays (``reg`` = identity) in ``sim/golden/fixed/pipeline.py``: one function, so the
 RTL and the golden model cannot drift apart.
 
 Error against float64 (same d_j, s_j, tex_c): three roundings of half an LSB each (lit,
@@ -100,28 +100,29 @@ def blend_error_bound_lsb(cfg: Config, lights=1):
 class TextureBlend(wiring.Component):
     """m lights' diffuse and specular and the texel colour -> the RGB pixel.
 
-    Input {d0.., s0.. (8-bit per light), texel: rgb, tag}; output {diffuse, specular,
+    Input {d, s: ArrayLayout(unsigned(8), lights) (light j's diffuse and specular at index
+    j), texel: rgb, tag}; output {diffuse, specular,
     color: rgb, tag} (diffuse, specular = the saturated light sums). Latency
     ``BLEND_LATENCY``; 1 pixel per clock; bit-exact with ``texture_blend`` on int arrays.
     """
 
     latency = BLEND_LATENCY
 
-    def __init__(self, cfg: Config, lights=1):
-        self.cfg, self.lights = cfg, lights
+    def __init__(self, cfg: Config, lights=1, target=None):
+        self.cfg, self.lights, self.target, self.memories = cfg, lights, target, {}
         u8, tag = unsigned(8), unsigned(cfg.tag_bits)
-        fields = {**{f"d{j}": u8 for j in range(lights)}, **{f"s{j}": u8 for j in range(lights)},
-                  "texel": rgb_layout(cfg), "tag": tag}
+        per_light = data.ArrayLayout(u8, lights)
+        fields = {"d": per_light, "s": per_light, "texel": rgb_layout(cfg), "tag": tag}
         out = {"diffuse": u8, "specular": u8, "color": rgb_layout(cfg), "tag": tag}
         super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
                           "o": Out(stream.Signature(data.StructLayout(out)))})
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
         px = self.i.payload
-        color, d, s = texture_blend([px[f"d{j}"] for j in range(self.lights)],
-                                    [px[f"s{j}"] for j in range(self.lights)],
+        color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
+                                    [px.s[j] for j in range(self.lights)],
                                     {c: px.texel[c] for c in RGB}, self.cfg, pipe.register)
         o = self.o.payload
         m.d.comb += [o.color[c].eq(color[c]) for c in RGB]
@@ -136,13 +137,13 @@ class TexelDelay(wiring.Component):
     illumination) in lock step, so it meets that pixel's shade at the blend.
     Input/output {texel: rgb}."""
 
-    def __init__(self, cfg: Config, latency):
-        self.cfg, self.latency = cfg, latency
+    def __init__(self, cfg: Config, latency, target=None):
+        self.cfg, self.latency, self.target, self.memories = cfg, latency, target, {}
         layout = data.StructLayout({"texel": rgb_layout(cfg)})
         super().__init__({"i": In(stream.Signature(layout)), "o": Out(stream.Signature(layout))})
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
         m.d.comb += self.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))
         return m

@@ -1,8 +1,10 @@
-"""Amaranth-simulator stream helpers shared by every unit test (tier 1 of STYLE.md).
+"""Amaranth-simulator stream helpers shared by every unit test (the Amaranth-simulator
+tests of docs/architecture.md, Data flow).
 
 ``simulate_stream`` pushes a list of payload dicts through a component's ``i`` stream and
-collects the ``o`` stream under one of the traffic patterns of :data:`PATTERNS`,
-then returns the received payload dicts (with nested layouts flattened to dotted names).
+collects the ``o`` stream under one of the traffic patterns of :data:`PATTERNS`
+(sim/traffic.py, shared with the cocotb testbenches), then returns the received payload
+dicts (with nested layouts flattened to dotted names).
 """
 
 import random
@@ -10,17 +12,21 @@ import random
 from amaranth.lib import data
 from amaranth.sim import Simulator
 
+from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.vectors import as_payloads
+from bumprtl.sim.traffic import PATTERNS
+
 __all__ = ["PATTERNS", "simulate_stream", "assert_bit_exact", "check_rotation",
            "check_illumination", "check_datapath"]
 
-# name -> (probability of an input gap, probability of output backpressure)
-PATTERNS = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4)}
-
 
 def _flatten(value, prefix=""):
+    """A payload View -> {dotted name: Value}; an ArrayLayout's elements are ``name.j``."""
     out = {}
     for name, _ in value.shape():
-        v = getattr(value, name)
+        v = value[name]
         if isinstance(v, data.View):
             out.update(_flatten(v, f"{prefix}{name}."))
         else:
@@ -89,10 +95,7 @@ def assert_bit_exact(out, golden, inputs):
 
 def check_rotation(cfg, codes, pattern="no_stall", seed=0):
     """``VectorRotation(cfg)`` on the input ``codes``, bit for bit against the golden model
-    (sim/golden/fixed.py); returns ``(latency, cycles)``."""
-    from bumprtl.rtl.rotation import VectorRotation
-    from bumprtl.sim.golden.fixed.dispatch import rotation_fixed
-    from bumprtl.sim.golden.vectors import as_payloads
+    (sim/golden/fixed/); returns ``(latency, cycles)``."""
     inputs = as_payloads(codes, cfg)
     dut = VectorRotation(cfg)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
@@ -103,9 +106,6 @@ def check_rotation(cfg, codes, pattern="no_stall", seed=0):
 def check_illumination(cfg, codes, pattern="no_stall", seed=0):
     """``Illumination(cfg)`` on the golden rotation output of ``codes``, bit for bit against
     the golden model; returns ``(latency, cycles)``."""
-    from bumprtl.rtl.illumination import Illumination
-    from bumprtl.sim.golden.fixed.dispatch import illumination_fixed, rotation_fixed
-    from bumprtl.sim.golden.vectors import as_payloads
     rot = rotation_fixed(codes, cfg)
     inputs = as_payloads(rot, cfg)
     dut = Illumination(cfg)

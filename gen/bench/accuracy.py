@@ -2,13 +2,14 @@
 
 import numpy as np
 
+from bumprtl.rtl.config import Config, ConfigError
+from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb, term_errors_lsb
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.gen.flow.units import build_unit
+
 
 def run(args):
-    from bumprtl.rtl.config import Config, ConfigError
-    from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb, term_errors_lsb
-    from bumprtl.sim.golden.common import PixelInputs
-    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
-    from bumprtl.gen.flow.units import build_unit
     print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} "
           f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
           f"--spec-index-bits {args.spec_index_bits}")
@@ -39,7 +40,7 @@ def add_parser(sub):
                        description="Max and mean diffuse error (8-bit LSB) of the bit-exact golden "
                                    "model against float64 on random and adversarial inputs, beside "
                                    "the sidecar's predicted bound.")
-    p.add_argument("--method", default="exact", choices=["exact", "lee"])
+    p.add_argument("--method", default="exact", choices=PER_PIXEL)
     p.add_argument("--samples", type=int, default=1_000_000)
     p.add_argument("--angle-bits", type=int, nargs="+", default=[10, 11, 12, 13])
     p.add_argument("--frac-bits", type=int, nargs="+", default=[10, 13, 16])

@@ -2,14 +2,19 @@
 
 import time
 
+import numpy as np
+
+from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
+from bumprtl.sim.golden.measure import (compare, error_at_theta_n, error_by_theta_n,
+                                        proportion_worst_case_deg, random_pixels, worst_pixel)
+
 
 def _cols(s):
     return f"{s['mean']:.3g} | {s['p99']:.3g} | {s['max']:.3g}"
 
 
 def _model_table(px, cfg):
-    from bumprtl.sim.golden.measure import compare
-    from bumprtl.sim.golden.float.models import FLOAT_MODELS
     print("| method | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max | NaN | Mpix/s |")
     print("|---|---|---|---|---|---|---|---|---|")
     ref = FLOAT_MODELS["conventional"](px, cfg)
@@ -23,34 +28,29 @@ def _model_table(px, cfg):
 
 
 def _theta_n_table(args, cfg):
-    from bumprtl.sim.golden.measure import error_by_theta_n
-    print("\nlee_fixed by theta_N (the rigid circle of Lee Sec. 3.1.2 is exact at theta_N = 0)\n")
+    print("\nlee_corrected by theta_N (the rigid circle of Lee Sec. 3.1.2 is exact at theta_N = 0)\n")
     print("| theta_N (deg) | pixels | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max |")
     print("|---|---|---|---|---|---|---|---|")
-    for lo, hi, count, s in error_by_theta_n("lee_fixed", args.samples, args.seed, 15, cfg):
+    for lo, hi, count, s in error_by_theta_n("lee_corrected", args.samples, args.seed, 15, cfg):
         print(f"| {lo}-{hi} | {count} | {_cols(s['l_prime_deg'])} | {_cols(s['diffuse_lsb'])} |")
 
 
 def _approximations(args, cfg):
-    import numpy as np
-    from bumprtl.sim.golden.measure import error_at_theta_n, proportion_worst_case_deg, worst_pixel
-    at = {deg: error_at_theta_n("lee_fixed", np.radians(deg), args.samples, args.seed, cfg)
+    at = {deg: error_at_theta_n("lee_corrected", np.radians(deg), args.samples, args.seed, cfg)
           for deg in (0, 90, 180)}
     print(f"\nlinear proportion (eqs 10-13) alone, closed-form worst case: "
           f"{proportion_worst_case_deg():.3g} deg")
-    print("lee_fixed max L' error (deg) / max diffuse error (LSB) with theta_N fixed at "
+    print("lee_corrected max L' error (deg) / max diffuse error (LSB) with theta_N fixed at "
           + ", ".join(f"{deg} deg: {s['l_prime_deg']['max']:.3g} / {s['diffuse_lsb']['max']:.3g}"
                       for deg, s in at.items()))
-    w = worst_pixel("lee_fixed", args.samples, args.seed, cfg)
+    w = worst_pixel("lee_corrected", args.samples, args.seed, cfg)
     pair = lambda key: f"({w[key][0]:.1f}, {w[key][1]:.1f})"
-    print(f"lee_fixed worst L' pixel (phi, theta in deg): N {pair('N')}, L {pair('L')}, D = {w['D']:.1f}; "
-          f"L' {pair('l_prime_ref')}, lee_fixed gives {pair('l_prime')}: {w['l_prime_deg']:.3g} deg, "
+    print(f"lee_corrected worst L' pixel (phi, theta in deg): N {pair('N')}, L {pair('L')}, D = {w['D']:.1f}; "
+          f"L' {pair('l_prime_ref')}, lee_corrected gives {pair('l_prime')}: {w['l_prime_deg']:.3g} deg, "
           f"{w['diffuse_lsb']:.3g} LSB")
 
 
 def run(args):
-    from bumprtl.rtl.config import Config
-    from bumprtl.sim.golden.measure import random_pixels
     cfg = Config()
     px = random_pixels(args.samples, args.seed)
     print(f"bumprtl bench float64 --samples {args.samples} --seed {args.seed}")
@@ -66,7 +66,7 @@ def add_parser(sub):
                        description="Mean, p99 and max of the L' angle error (degrees) and of the "
                                    "diffuse error (8-bit LSB) of every float64 model against the "
                                    "Cartesian reference, and each model's speed, in one run; "
-                                   "then lee_fixed's errors binned by theta_N.")
+                                   "then lee_corrected's errors binned by theta_N.")
     p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
     p.add_argument("--seed", type=int, default=1)
     p.set_defaults(func=run)

@@ -6,10 +6,14 @@ from pathlib import Path
 
 import numpy as np
 
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.sim.golden.vectors import edge_codes, random_codes
+from bumprtl.sim.tb.runner import run_cocotb, SIMULATORS
+from bumprtl.gen.flow.units import emit_unit
+
 
 def _golden_rate(cfg, n, repeats=3):
-    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
-    from bumprtl.sim.golden.vectors import random_codes
     codes = random_codes(n, cfg, seed=5)
     datapath_fixed({k: v[:16] for k, v in codes.items()}, cfg)        # warm the table caches
     best = min(_timed(lambda: datapath_fixed(codes, cfg)) for _ in range(repeats))
@@ -23,20 +27,15 @@ def _timed(fn):
 
 
 def _sim_rate(cfg, sim, unit, samples, work):
-    from bumprtl.sim.golden.vectors import edge_codes
-    from bumprtl.sim.tb.runner import run_cocotb
-    from bumprtl.gen.flow.units import emit_unit
     work = Path(work).resolve()          # cocotb runs in its build directory
     v, j = emit_unit(unit, cfg, work / "rtl")
-    run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", work / f"{sim}_{unit}",
-               {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": samples})
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", work / f"{sim}_{unit}",
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": samples})
     pixels = 4 * (samples + len(edge_codes(cfg)["n.phi"]))          # 4 traffic patterns
-    return pixels / run_cocotb.last_times["run_s"], run_cocotb.last_times["build_s"]
+    return pixels / run.run_s, run.build_s
 
 
 def run(args):
-    from bumprtl.rtl.config import Config
-    from bumprtl.sim.tb.runner import SIMULATORS
     print(f"bumprtl bench golden --pixels {args.pixels} --sim-samples {args.sim_samples}")
     print("\nFixed-point golden model (numpy, one process, best of 3):\n")
     print("| method | pixels | Mpix/s |")
@@ -70,5 +69,5 @@ def add_parser(sub):
     p.add_argument("--pixels", type=int, default=1_000_000, help="golden-model batch (default: 10^6)")
     p.add_argument("--sim-samples", type=int, default=5000,
                    help="random vectors per traffic pattern in the simulations (default: 5000)")
-    p.add_argument("--methods", nargs="+", default=["exact", "lee"], choices=["exact", "lee"])
+    p.add_argument("--methods", nargs="+", default=list(PER_PIXEL), choices=PER_PIXEL)
     p.set_defaults(func=run)

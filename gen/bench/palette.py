@@ -9,7 +9,17 @@ against the conventional per-pixel reference. ``images``: palette renders of the
 import time
 from pathlib import Path
 
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
 import numpy as np
+
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import to_8bit
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.palette import color_table, palette_rgb, render_palette
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 
 SPEED_SIZES = (256, 512, 1024, 2048)
 SPEED_PALETTES = (256, 2048, 16384)
@@ -27,8 +37,6 @@ def _best(fn, repeats=3):
 
 
 def speed(cfg, sizes, palettes):
-    from bumprtl.sim.golden.common import to_8bit
-    from bumprtl.sim.golden.float.palette import color_table
     rng = np.random.default_rng(0)
     l, v = np.array([[0.4, -0.7, 0.6]]), np.array([[0.0, -1.0, 0.0]])
     shade8 = lambda normals: to_8bit(color_table(normals, "phong", l, v, cfg))
@@ -50,11 +58,6 @@ def speed(cfg, sizes, palettes):
 
 
 def accuracy(cfg, scenes, palettes, size, plot=None):
-    from bumprtl.rtl.config import BumpError
-    from bumprtl.sim.golden.float.conventional import conventional
-    from bumprtl.sim.golden.float.palette import render_palette
-    from bumprtl.sim.scenes import load_scene
-    from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
     print("| scene | quantizer | " + " | ".join(f"sN={s}" for s in palettes) + " |")
     print("|---|---|" + "---|" * len(palettes))
     curves = {}
@@ -79,9 +82,6 @@ def accuracy(cfg, scenes, palettes, size, plot=None):
 
 
 def _plot(curves, path, size):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=80)
     for n, ((name, quantizer), curve) in enumerate(sorted(curves.items())):
         if curve:
@@ -100,11 +100,6 @@ def _plot(curves, path, size):
 
 
 def images(cfg, out_dir, size):
-    from bumprtl.sim.golden.float.conventional import conventional
-    from bumprtl.sim.golden.float.palette import palette_rgb
-    from bumprtl.sim.scenes import load_scene
-    from bumprtl.sim.scenes.imaging import compose, panel, save_png
-    from bumprtl.sim.golden.common import to_8bit
     for name, sn, lighting, dither in (("bricks", 16, "phong", False), ("globe", 256, "phong", False),
                                        ("globe", 64, "phong", True), ("globe", 1024, "chrome", False),
                                        ("wood", 256, "toon", False)):
@@ -120,7 +115,6 @@ def images(cfg, out_dir, size):
 
 
 def run(args):
-    from bumprtl.rtl.config import Config
     cfg = Config()
     print(f"bumprtl bench palette --what {' '.join(args.what)}")
     if "speed" in args.what:

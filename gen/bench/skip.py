@@ -1,16 +1,17 @@
-"""``bumprtl bench skip``: what scene skipping (DESIGN §6) saves, per scene class.
+"""``bumprtl bench skip``: what scene skipping saves, per scene class (docs/architecture.md,
+"Scenes decide what is built").
 
 For each built-in scene class (rtl/scene.py BUILTIN) two pipelines, side by side in one run:
 
 * **on**: the scene as it is: BumpPipeline builds only what the scene needs and the golden
-  model (sim/golden/fixed_pipeline.py) skips the same work;
+  model (sim/golden/fixed/pipeline.py) skips the same work;
 * **off**: the same scene with nothing skipped: per-pixel shading with a per-pixel bump map
   and the H path + specular table (lights and widths unchanged). A scene without specular
   gets ks = 0, a flat map becomes a map of the same constant N', so the off pipeline
   computes the same image the long way; ``same image`` says whether it did. A textured
   scene keeps its colour texture (and blend) in both.
 
-Golden-model time (best of 3, one frame) and Yosys cost (gen/resources.py) of each. The
+Golden-model time (best of 3, one frame) and Yosys cost (gen/flow/resources.py) of each. The
 section goes into docs/bench.md.
 """
 
@@ -18,6 +19,16 @@ import time
 from pathlib import Path
 
 import numpy as np
+from amaranth.back import verilog
+
+from bumprtl.rtl.bumpfetch import pack_texels
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import BUILTIN, load_scene_config
+from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed
+from bumprtl.gen.bench.sweep import _cached, _digest, write_section
+from bumprtl.gen.flow.resources import count_verilog
+from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
 
 __all__ = ["unskipped", "skip_rows", "markdown", "add_parser"]
 
@@ -32,9 +43,6 @@ def unskipped(scene):
 
 def _stimulus(scene, size, flat_like=None):
     """scene_stimulus; for the off-version of a flat scene, the map holds the flat N'."""
-    from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
-    from bumprtl.rtl.bumpfetch import pack_texels
-    from bumprtl.sim.golden.fixed.pipeline import map_words
     inputs, words, polygon, _, base = scene_stimulus(scene, size)
     texels = scene_texels(scene, base)
     if flat_like is not None:
@@ -45,7 +53,6 @@ def _stimulus(scene, size, flat_like=None):
 
 
 def _golden(scene, size, flat_like=None):
-    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     inputs, words, polygon, texels = _stimulus(scene, size, flat_like)
     out = pipeline_fixed(inputs, scene, words, polygon, texels)
     best = float("inf")
@@ -59,10 +66,6 @@ def _golden(scene, size, flat_like=None):
 def _cost(scene, work):
     """Yosys counts of the scene's BumpPipeline, cached by the digest of its Verilog (a
     changed datapath is counted anew)."""
-    from amaranth.back import verilog
-    from bumprtl.gen.bench.sweep import _cached, _digest
-    from bumprtl.gen.flow.resources import count_verilog
-    from bumprtl.rtl.pipeline import BumpPipeline
     text = verilog.convert(BumpPipeline(scene), name="pipeline", emit_src=False)
     digest = _digest(text)
     netlist = work / "netlist" / scene.name
@@ -85,7 +88,6 @@ def skip_rows(names, size, work):
 
 def _skipped(scene):
     """The units the scene's pipeline skips (asked of a pipeline that is never elaborated)."""
-    from bumprtl.rtl.pipeline import BumpPipeline
     pipeline = BumpPipeline(scene)
     for unit in (pipeline, *pipeline.units.values()):
         unit._MustUse__silence = True
@@ -93,8 +95,6 @@ def _skipped(scene):
 
 
 def _row(name, size, work):
-    from bumprtl.rtl.config import BumpError
-    from bumprtl.rtl.scene import load_scene_config
     scene = load_scene_config(name)
     off = unskipped(scene).replace(name=f"{name}-noskip")
     try:
@@ -120,8 +120,8 @@ def markdown(rows, command, size):
              "generated (**on**) beside the same scene with nothing skipped (**off**: per-pixel "
              "shading, per-pixel bump map, H path + specular table; ks = 0 when the scene has no "
              "specular, the flat N' stored in the map), measured in one run. Golden = "
-             f"sim/golden/fixed_pipeline.py on one {size}x{size} frame (numpy, best of 3). Cost = "
-             "Yosys coarse netlist of BumpPipeline (gen/resources.py). `same image`: the off "
+             f"sim/golden/fixed/pipeline.py on one {size}x{size} frame (numpy, best of 3). Cost = "
+             "Yosys coarse netlist of BumpPipeline (gen/flow/resources.py). `same image`: the off "
              "pipeline produced identical colour outputs (palette shading cannot: it quantizes normals). "
              "The palette's golden time covers the index fetch only (the per-frame colour table "
              "and lookup are in the sweep above). Where on and off build the same pipeline (nothing "
@@ -145,8 +145,6 @@ def markdown(rows, command, size):
 
 
 def run(args):
-    from bumprtl.gen.bench.sweep import write_section
-    from bumprtl.rtl.scene import BUILTIN
     command = f"bumprtl bench skip --size {args.size}"
     print(command)
     rows = skip_rows(args.scenes or list(BUILTIN), args.size, args.work)

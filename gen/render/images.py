@@ -6,20 +6,25 @@ import time
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
+from bumprtl.sim.scenes import load_scene, SCENES
+from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
+from bumprtl.gen.cli.flags import add_config_flags, config_from_args
+from bumprtl.gen.render.rtl import cli_render
 
 __all__ = ["PALETTE", "render_methods", "shade_scene", "add_parser"]
 
 ROWS_PER_CHUNK = 32
 PROGRESS_PIXELS = 1 << 20          # show a progress bar from 1024 x 1024 pixels on
-PALETTE = "palette"                # Tarini et al.'s quantized normal map (sim/golden/palette.py)
+PALETTE = "palette"                # Tarini et al.'s quantized normal map (sim/golden/float/palette.py)
 QUANTIZERS = ("median-cut", "kmeans")
 
 
 def render_methods():
     """Every method ``render`` accepts: the float64 golden models, then ``palette``."""
-    from bumprtl.sim.golden.float.models import FLOAT_MODELS
     return [*FLOAT_MODELS, PALETTE]
 
 
@@ -40,12 +45,10 @@ def shade_scene(scene, method, cfg, progress=True, **palette_opts):
     renders; ``palette`` shades the whole bump map at once (``palette_opts``: ``quantizer``,
     ``lighting``, passed through to ``render_palette``).
     """
-    from bumprtl.sim.golden.float.models import FLOAT_MODELS
     if method == PALETTE:
         return _render_palette(scene, cfg, palette_opts)
     if method not in FLOAT_MODELS:
         raise BumpError(f"method must be one of {', '.join(render_methods())}, got {method!r}")
-    from tqdm import tqdm
     model, size = FLOAT_MODELS[method], scene.size
     out = np.zeros((size, size))
     with tqdm(total=size * size, unit="pix", unit_scale=True, desc=method, leave=False,
@@ -65,11 +68,7 @@ def _palette_opts(args):
 
 
 def run(args):
-    from bumprtl.sim.scenes import load_scene
-    from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
-    from bumprtl.gen.cli.flags import config_from_args
-    if args.rtl:                                   # through the emitted pipeline (gen/render_rtl.py)
-        from bumprtl.gen.render.rtl import cli_render
+    if args.rtl:                                   # through the emitted pipeline (gen/render/rtl.py)
         return cli_render(args)
     cfg, palette_opts = config_from_args(args), _palette_opts(args)
     scene = load_scene(args.scene, size=args.size, light_elevation=args.light_elevation,
@@ -90,8 +89,6 @@ def run(args):
 
 
 def add_parser(sub):
-    from bumprtl.sim.scenes import SCENES
-    from bumprtl.gen.cli.flags import add_config_flags
     methods = render_methods()
     scenes = "\n".join(f"  {k:<12} {v[3]}" for k, v in SCENES.items())
     p = sub.add_parser("render", help="render a scene to PNG with one method",
@@ -115,11 +112,14 @@ def add_parser(sub):
     p.add_argument("--quantizer", default=None, choices=QUANTIZERS,
                    help="palette method only (default: the palette model's)")
     p.add_argument("--lighting", default=None, metavar="NAME",
-                   help="palette method only: a lighting model of sim/golden/palette.py "
+                   help="palette method only: a lighting model of sim/golden/float/palette.py "
                         "(Tarini Sec. 5.1; a bad name lists them)")
     p.add_argument("--rtl", action="store_true",
                    help="render through the emitted BumpPipeline with cocotb; checks it equals the golden render")
     p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"], help="with --rtl")
+    p.add_argument("--per-cycle", action="store_true",
+                   help="with --rtl: drive every pixel from cocotb, clock by clock, instead of the "
+                        "bulk path (sim/tb/bulk.py: arrays in, arrays out, cached build)")
     p.add_argument("--pipeline", default="default", metavar="FILE|NAME",
                    help="with --rtl: the scene class (rtl/scene.py built-in or TOML) to build")
     add_config_flags(p, fields=("spec_exponent", "ka", "kd", "ks", "specular", "palette_size"))

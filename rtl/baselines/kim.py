@@ -1,5 +1,5 @@
 """Kim, Lee and Park 2001 (Lee et al. ref. 9) as real RTL at the same Config widths: the
-polar-coordinate baseline of Lee et al. Table 1, bit-exact with ``sim/golden/fixed_kim.py``
+polar-coordinate baseline of Lee et al. Table 1, bit-exact with ``sim/golden/fixed/kim.py``
 (which calls the helpers below on int64 arrays where the RTL calls them on Amaranth values).
 
 Kim 2001 is known here only through the Lee paper: its setup does "transformation
@@ -12,7 +12,7 @@ N'.A = cos th_A cos th_N' + sin th_A sin th_N' cos(ph_A - ph_N'), with 6 multipl
   matrix of N, M = R_y(-th_N) R_z(-ph_N) (sim/golden/common.tangent_rotation; a matrix
   rebuilt per pixel, as Lee Sec. 4.3 says of ref. 9), and brought back to polar angles
   (ph_A', th_A'); the illumination is eqs (3)/(4) per vector and the diffuse/specular
-  tables of eq. (2) (the shared back end, rtl/illumination.py, as for every method).
+  tables of eq. (2) (the shared back end, rtl/shade.py, as for every method).
 * **Guessed** (the paper gives no datapath): how the polar angles are recovered without a
   divider or square root, since Table 1 lists neither for Kim. ph_A' = atan2(y', x') by
   octant: the smaller of |x'|, |y'| over the larger through a reciprocal ROM on the
@@ -27,7 +27,7 @@ Poles (th_A' = 0 or 180 deg, where ph_A' is undefined): x' = y' = 0 gives p = q 
 and ph_A' = 0 exactly; any tiny (x', y') gives some definite azimuth, and the product
 sin th_A' sin th_N' cos(ph_A' - ph_N') of eq. (3) makes its value irrelevant there.
 
-Setup (``Rotation``, Table 1's "illumination environment setup"), per pixel:
+Setup (:class:`KimRotation`, Table 1's "illumination environment setup"), per pixel:
 
 ======================  =====================================================================
 element                 hardware here
@@ -67,21 +67,21 @@ from amaranth.lib.memory import Memory
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.illumination import IlluminationDatapath
 from bumprtl.rtl.layouts import pixel_layout
 from bumprtl.rtl.lee import ratio_index, rotated_layout
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
+from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
 from bumprtl.rtl.tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
                       lee_asin_table, lee_atan_table)
 
-__all__ = ["Rotation", "Illumination", "rotated_layout", "matrix_entries", "cartesian",
+__all__ = ["KimRotation", "KimIllumination", "rotated_layout", "matrix_entries", "cartesian",
            "transform", "octant", "normalize", "reciprocal_address", "ratio_of",
            "phi_from_octant", "rho_of", "theta_select", "asin_address", "theta_from_octant",
            "dot_terms", "dot_sum"]
 
 
-# --- Arithmetic shared with sim/golden/fixed_kim.py (Amaranth values or int64 arrays) -------
+# --- Arithmetic shared with sim/golden/fixed/kim.py (Amaranth values or int64 arrays) -------
 
 def _hdl(x):
     return isinstance(x, (Value, ValueCastable))
@@ -231,9 +231,8 @@ def _read(m, pipe, rom, address):
     return port.data
 
 
-def _rom(m, name, table, width):
-    m.submodules[name] = rom = Memory(shape=unsigned(width), depth=len(table), init=table.tolist())
-    return rom
+def _rom(pipe, name, table, width):
+    return pipe.memory(name, Memory(shape=unsigned(width), depth=len(table), init=table.tolist()))
 
 
 def _multiplier(pipe, prefix):
@@ -246,9 +245,9 @@ def _multiplier(pipe, prefix):
 P = PRODUCT_LATENCY
 
 
-class Rotation:
-    """VectorRotation datapath, kim method (the module table): polar -> Cartesian, M, back
-    to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
+class KimRotation(PipeUnit):
+    """VectorRotation datapath, kim method (the module table; a ``wiring.Component``): polar ->
+    Cartesian, M, back to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
     through, polar binary angles, as rtl/lee.py).
 
     Stages (P = PRODUCT_LATENCY, every product a RegisteredProduct as in rtl/exact.py):
@@ -259,15 +258,13 @@ class Rotation:
 
     latency = 12 + 4 * P
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = pixel_layout(cfg), rotated_layout(cfg)
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
 
-    def build(self, m, i, o):
+    def build(self, m, pipe):
         cfg, k = self.cfg, self.cfg.k
-        pipe = StallPipe(m, i, o, self.latency)
-        px = i.payload
-        m.submodules.n_sincos_rom = rom = quarter_wave_rom(cfg)
+        px, o = self.i.payload, self.o.payload
+        rom = pipe.memory("n_sincos_rom", quarter_wave_rom(cfg))
         read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg, name)
         n = (read(px.n.theta, "n_sin_theta"), read(px.n.theta + (1 << k), "n_cos_theta"),
              read(px.n.phi, "n_sin_phi"), read(px.n.phi + (1 << k), "n_cos_phi"))   # 2
@@ -276,15 +273,15 @@ class Rotation:
         n = tuple(pipe.delay(e, P + 1, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp")))
         for v in vectors(cfg):                                                      # 3 + P
             phi, theta = self._vector(m, pipe, v, px[v], mat, n)
-            m.d.comb += [o.payload[v].phi.eq(phi), o.payload[v].theta.eq(theta)]
-        m.d.comb += [o.payload.b.eq(pipe.delay(px.b, self.latency, "b")),
-                     o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
+            m.d.comb += [o[v].phi.eq(phi), o[v].theta.eq(theta)]
+        m.d.comb += [o.b.eq(pipe.delay(px.b, self.latency, "b")),
+                     o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
 
     def _vector(self, m, pipe, v, a, mat, n):
         cfg, k = self.cfg, self.cfg.k
         reg, delay = pipe.register, pipe.delay
         mul = _multiplier(pipe, v)
-        m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
+        rom = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
         read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg,
                                              f"{v}_{name}")
         st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
@@ -297,10 +294,10 @@ class Rotation:
         swap, p, q = reg(swap, f"{v}_swap"), reg(p, f"{v}_p"), reg(q, f"{v}_q")     # 5 + 2P
         x_neg, y_neg = reg(xp < 0, f"{v}_x_negative"), reg(yp < 0, f"{v}_y_negative")
         pn, qn = normalize(p, q, cfg)
-        recip = _read(m, pipe, _rom(m, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1),
+        recip = _read(m, pipe, _rom(pipe, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1),
                       reciprocal_address(pn, cfg))                                  # 6 + 2P
         product = mul(reg(qn, f"{v}_qn"), recip)                                    # 6 + 3P
-        a0 = _read(m, pipe, _rom(m, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
+        a0 = _read(m, pipe, _rom(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
                    ratio_index(ratio_of(product, cfg), cfg))                        # 7 + 3P
         phi = reg(phi_from_octant(a0, delay(swap, P + 2, f"{v}_swap"), delay(x_neg, P + 2, f"{v}_x_neg"),
                                   delay(y_neg, P + 2, f"{v}_y_neg"), cfg), f"{v}_phi")  # 8 + 3P
@@ -309,14 +306,14 @@ class Rotation:
         rho = reg(rho_of(delay(p, P + 4, f"{v}_p"), delay(q, P + 4, f"{v}_q"), ca0, sa0, cfg, mul),
                   f"{v}_rho")                                                       # 10 + 4P
         use_rho, z_neg, val = theta_select(rho, delay(zp, 2 * P + 6, f"{v}_z_rot"), cfg)
-        asin = _read(m, pipe, _rom(m, f"{v}_asin_rom", lee_asin_table(cfg), k + 1),
+        asin = _read(m, pipe, _rom(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1),
                      asin_address(val, cfg))                                        # 11 + 4P
         theta = reg(theta_from_octant(asin, reg(use_rho, f"{v}_use_rho"), reg(z_neg, f"{v}_z_negative"),
                                       cfg), f"{v}_theta")                           # 12 + 4P
         return delay(phi, P + 4, f"{v}_phi"), theta
 
 
-class Illumination(IlluminationDatapath):
+class KimIllumination(IlluminationDatapath):
     """Illumination datapath, kim method: Lee eqs (3)/(4) per vector,
     N'.A' = cos th_A' cos th_N' + round(sin th_A' sin th_N') cos(ph_A' - ph_N'), rounded once
     to B bits (:func:`dot_terms`, :func:`dot_sum`), then the shared back end.
@@ -328,20 +325,20 @@ class Illumination(IlluminationDatapath):
 
     dot_latency = 4 + 2 * P
 
-    def __init__(self, cfg: Config):
-        super().__init__(cfg, rotated_layout(cfg))
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, rotated_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
         cfg, k = self.cfg, self.cfg.k
         b = payload.b
-        m.submodules.b_sincos_rom = rom = quarter_wave_rom(cfg)
+        rom = pipe.memory("b_sincos_rom", quarter_wave_rom(cfg))
         st_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta, cfg, "b_sin_theta")
         ct_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta + (1 << k), cfg, "b_cos_theta")
         dots = {}
         for v in vectors(cfg):
             a = payload[v]
             mul = _multiplier(pipe, f"{v}_dot")
-            m.submodules[f"{v}_sincos_rom"] = rom = quarter_wave_rom(cfg)
+            rom = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
             read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle,
                                                  cfg, f"{v}_{name}")
             st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")

@@ -1,13 +1,13 @@
 """Peercy, Airey and Cabral 1997 in hardware: the Cartesian reference-space baseline of Lee
 et al. Table 1 (first column), at the same Config widths as ours. Bit-exact with
-``sim/golden/fixed_peercy.py``.
+``sim/golden/fixed/peercy.py``.
 
 Inputs are Cartesian, as a Phong rasterizer's interpolators deliver them: the tangent frame
 rows T, B, N, the light vector L, the halfway vector H (with ``cfg.specular``) and the
 stored perturbed normal N' from the bump map, every component signed with ``frac_bits`` = B
-fractional bits in ``B + 2`` bits (the sin/cos format of DESIGN §4, range [-2, 2)).
+fractional bits in ``B + 2`` bits (the sin/cos format of docs/architecture.md, Number formats; range [-2, 2)).
 
-Setup (:class:`Rotation`, Table 1's "illumination environment setup"), per vector A in {L, H}:
+Setup (:class:`PeercyRotation`, Table 1's "illumination environment setup"), per vector A in {L, H}:
 
 1. transform into the tangent space, A_t = (T.A, B.A, N.A): 9 multipliers, 6 adders, one
    rounding back to B fractional bits per component;
@@ -40,9 +40,9 @@ root and the dividers are combinational, each alone between two registers: Yosys
 ``$div`` cell to count a divider, so they are not hand-pipelined, and they set this unit's
 Fmax, which is part of the baseline's cost.
 
-Illumination (:class:`Illumination`): N'.L_n and N'.H_n (6 multipliers, 4 adders, one
+Illumination (:class:`PeercyIllumination`): N'.L_n and N'.H_n (6 multipliers, 4 adders, one
 rounding each), then the shared Phong back end of eq. (2) with the same cos^n specular
-(power) table as ours (rtl/illumination.py ``shade_stages``), so outputs are comparable.
+(power) table as ours (rtl/shade.py ``shade_stages``), so outputs are comparable.
 The paper gives no illumination row for Peercy ("Not Available"); this is Ernst's
 "straightforward Phong" (rtl/baselines/ernst.py), used for Peercy too.
 """
@@ -52,10 +52,10 @@ from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.illumination import IlluminationDatapath
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, StallPipe
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
+from bumprtl.rtl.shade import IlluminationDatapath
 
-__all__ = ["Rotation", "Illumination", "PeercySqrt", "vectors", "cartesian_layout",
+__all__ = ["PeercyRotation", "PeercyIllumination", "PeercySqrt", "vectors", "cartesian_layout",
            "setup_input_layout", "setup_output_layout", "component_width", "square_bits",
            "ROTATION_LATENCY", "DOT_LATENCY"]
 
@@ -65,7 +65,7 @@ FRAME = ("t", "b", "n")       # tangent, binormal, normal: the rows of the 3x3 t
 # DSP block on ECP5), transformed sums, squares (PRODUCT_LATENCY; |a| rides along),
 # |A_t|**2, square root, quotient, signed result.
 ROTATION_LATENCY = 2 * PRODUCT_LATENCY + 5
-DOT_LATENCY = PRODUCT_LATENCY + 1     # products, sum (then rtl/illumination.SHADE_LATENCY)
+DOT_LATENCY = PRODUCT_LATENCY + 1     # products, sum (then rtl/shade.SHADE_LATENCY)
 
 
 def vectors(cfg: Config):
@@ -106,7 +106,7 @@ class PeercySqrt(Elaboratable):
     """Integer square root, ``root = floor(sqrt(radicand))``, combinational, restoring
     (one bit of the root per step: try (root << 2) | 1 against the remainder).
 
-    Its Amaranth submodule name ends in ``sqrt`` so that gen/resources.py keeps it as a
+    Its Amaranth submodule name ends in ``sqrt`` so that gen/flow/resources.py keeps it as a
     black box and counts it as one square root (Table 1's "SQRt").
     """
 
@@ -135,8 +135,9 @@ class PeercySqrt(Elaboratable):
         return m
 
 
-class Rotation:
-    """Setup datapath, Peercy (elaborated into ``rotation.VectorRotation``).
+class PeercyRotation(PipeUnit):
+    """Setup datapath, Peercy (``rotation.VectorRotation`` with ``method = "peercy"``; a
+    ``wiring.Component``).
 
     Input :func:`setup_input_layout`; output :func:`setup_output_layout` (L_n, H_n in tangent
     space, N' passed through). Latency :data:`ROTATION_LATENCY` (2 PRODUCT_LATENCY + 5 = 9);
@@ -145,15 +146,13 @@ class Rotation:
 
     latency = ROTATION_LATENCY
 
-    def __init__(self, cfg: Config):
-        self.cfg = cfg
-        self.in_layout, self.out_layout = setup_input_layout(cfg), setup_output_layout(cfg)
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target)
 
-    def build(self, m, i, o):
+    def build(self, m, pipe):
         cfg, b = self.cfg, self.cfg.frac_bits
-        pipe = StallPipe(m, i, o, self.latency)
         reg = pipe.register
-        px, out = i.payload, o.payload
+        px, out = self.i.payload, self.o.payload
         cw = component_width(cfg)
         for v in vectors(cfg):
             a = px[v]
@@ -183,7 +182,7 @@ class Rotation:
         m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
 
 
-class Illumination(IlluminationDatapath):
+class PeercyIllumination(IlluminationDatapath):
     """Illumination datapath, Peercy (and Ernst): N'.A_n = round((N'.A_n) / 2**B) per
     vector (3 multipliers, 2 adders), then the shared back end (diffuse, cos^n specular
     table, Phong sum of eq. 2).
@@ -195,8 +194,8 @@ class Illumination(IlluminationDatapath):
 
     dot_latency = DOT_LATENCY
 
-    def __init__(self, cfg: Config):
-        super().__init__(cfg, setup_output_layout(cfg))
+    def __init__(self, cfg: Config, target=None):
+        super().__init__(cfg, setup_output_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
         n, dots = payload.np, {}

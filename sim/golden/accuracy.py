@@ -8,7 +8,7 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.fixed.dispatch import encode_pixels
+from bumprtl.rtl.methods import encode_pixels
 
 __all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "ANGLES_OF_NDOTL"]
 

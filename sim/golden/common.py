@@ -1,6 +1,6 @@
 """The one signature every float64 golden model shares.
 
-Inputs are per-pixel arrays of polar angles in radians (DESIGN §3): theta from +z in
+Inputs are per-pixel arrays of polar angles in radians (docs/algorithms.md): theta from +z in
 [0, pi], phi the azimuth in [0, 2*pi]. N, L and H are in world angles; the bump normal
 N' (``b_phi``, ``b_theta``) is in tangent space. The tangent frame is the one the Lee
 paper's two rotations define (Sec. 3.1.1, Figs 1-2): rotate by -phi_N about z, then by
@@ -138,7 +138,7 @@ def shade(ndotl, ndoth, cfg: Config, l_prime=None):
 
 
 def to_8bit(x):
-    """[0, 1] -> 0..255, rounded to nearest (outputs are 8-bit, DESIGN §4). NaN (where the
+    """[0, 1] -> 0..255, rounded to nearest (outputs are 8-bit: docs/architecture.md, Number formats). NaN (where the
     printed Lee equations have no value) becomes 0, i.e. black."""
     x = np.nan_to_num(np.asarray(x, dtype=np.float64), nan=0.0)
     return np.clip(np.rint(x * 255.0), 0, 255).astype(np.uint8)

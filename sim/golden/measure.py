@@ -58,7 +58,7 @@ def error_stats(method, n=100_000, seed=1, cfg=Config()):
     return {"method": method, "n": n, **compare(FLOAT_MODELS[method](px, cfg), conventional(px, cfg))}
 
 
-def error_by_theta_n(method="lee_fixed", n=100_000, seed=1, step_deg=15, cfg=Config()):
+def error_by_theta_n(method="lee_corrected", n=100_000, seed=1, step_deg=15, cfg=Config()):
     """Errors of ``method`` binned by th_N: where the rigid-circle approximation of Lee
     Sec. 3.1.2 (exact at th_N = 0) costs most. Rows (lo_deg, hi_deg, count, summaries)."""
     if not isinstance(step_deg, int) or step_deg < 1 or 180 % step_deg:

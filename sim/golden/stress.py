@@ -11,8 +11,13 @@ from dataclasses import fields
 
 import numpy as np
 
+from bumprtl.rtl.bumpfetch import pack_texels
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.layouts import layout_fields, shade_layout
+from bumprtl.rtl.methods import encode_pixels, get
 from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, tangent_rotation, to_8bit
+from bumprtl.sim.golden.fixed.common import quantize_pixels
+from bumprtl.sim.golden.fixed.pipeline import map_words
 from bumprtl.sim.golden.float.conventional import conventional
 
 __all__ = ["CASES", "STRESS_CONFIGS", "stress_case", "rotate_azimuth", "check_fixed",
@@ -147,13 +152,8 @@ def rotate_azimuth(px: PixelInputs, delta):
 def payload_fields(cfg: Config):
     """``{field: (width, signed)}`` of the rotation unit's output and the illumination
     unit's output for ``cfg.method``: the widths every model value must fit in."""
-    import importlib
-    from bumprtl.gen.flow.emit import layout_fields
-    from bumprtl.rtl.config import datapath_module
-    from bumprtl.rtl.layouts import shade_layout
-    methods = importlib.import_module(f"bumprtl.rtl.{datapath_module(cfg.method)}")
     out = {}
-    for layout in (methods.Rotation(cfg).out_layout, shade_layout(cfg)):
+    for layout in (get(cfg.method).rotated_layout(cfg), shade_layout(cfg)):
         out.update({k: (w, s) for k, (_, w, s) in layout_fields(layout).items() if k != "tag"})
     return out
 
@@ -168,7 +168,6 @@ def check_fixed(model, px: PixelInputs, cfg: Config):
     """Run a bit-exact model on ``px`` quantized for ``cfg``: per pixel the diffuse and
     colour error against float64 (8-bit LSB), and the overflow count (pixels with some
     field outside its payload width, :func:`payload_fields`; fields per name)."""
-    from bumprtl.sim.golden.fixed.dispatch import encode_pixels
     out = model(encode_pixels(px, cfg), cfg)
     ref = conventional(px, cfg)
     overflow = {k: int((~_fits(out[k], w, s)).sum()) for k, (w, s) in payload_fields(cfg).items()
@@ -201,7 +200,6 @@ def float_stats(result, ref):
 
 def stress_codes(n, cfg: Config, seed=0):
     """``n`` pixels cycling through every case of :data:`CASES`, quantized for ``cfg``."""
-    from bumprtl.sim.golden.fixed.common import quantize_pixels
     per = -(-n // len(CASES))
     parts = [quantize_pixels(stress_case(name, per, seed + i), cfg) for i, name in enumerate(CASES)]
     order = np.arange(per * len(CASES)).reshape(len(CASES), per).T.ravel()[:n]   # interleave
@@ -212,8 +210,6 @@ def pipeline_stimulus(scene, n, seed=0):
     """Stress vectors for BumpPipeline(scene) (varying map, per-pixel shading): ``(inputs,
     words)``. Pixel i reads texel i mod T^2, and the map holds the N' of the first T^2
     stress pixels, so every case's N' reaches the datapath through the fetch unit."""
-    from bumprtl.rtl.bumpfetch import pack_texels
-    from bumprtl.sim.golden.fixed.pipeline import map_words
     t = scene.texture_size
     codes = stress_codes(max(n, t * t), scene.config, seed)
     texel = np.arange(n) % (t * t)

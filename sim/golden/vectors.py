@@ -7,9 +7,13 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 
-__all__ = ["edge_codes", "random_codes", "as_payloads", "concat_codes"]
+__all__ = ["TINY", "edge_codes", "random_codes", "as_payloads", "concat_codes"]
 
 KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
+
+# The tiny configuration of the exhaustive walks: k = 2 (4-bit angles, 16 codes each), B = 4,
+# and 16-bit tags, so up to 16^4 vectors are numbered each once. ``TINY.replace(method=...)``.
+TINY = Config(angle_bits=4, frac_bits=4, tag_bits=16)
 
 
 def random_codes(n, cfg: Config, seed=0):

@@ -1,6 +1,8 @@
 """Height fields (T x T, values in [0, 1]) and displacement -> tangent-space normals."""
 
 import numpy as np
+import skimage.data
+from PIL import Image, ImageDraw, ImageFilter, ImageFont
 
 from bumprtl.rtl.config import BumpError
 
@@ -51,7 +53,6 @@ def bumps(t):
 
 def text(t):
     """Engraved text: 'BUMP RTL' cut into a flat face, edges softened by a small blur."""
-    from PIL import Image, ImageDraw, ImageFilter, ImageFont
     img = Image.new("L", (t, t), 255)
     draw = ImageDraw.Draw(img)
     try:
@@ -66,8 +67,6 @@ def text(t):
 
 def _skimage(name):
     def load(t):
-        from PIL import Image
-        import skimage.data
         img = getattr(skimage.data, name)()
         if img.ndim == 3:
             img = img[..., :3].mean(axis=-1)

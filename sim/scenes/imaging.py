@@ -3,6 +3,7 @@
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from bumprtl.sim.golden.common import to_8bit
 
@@ -36,7 +37,6 @@ def panel(ref, img, gain=10):
 
 
 def save_png(path, img):
-    from PIL import Image
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     Image.fromarray(np.asarray(img, np.uint8)).save(path, optimize=False)

@@ -2,7 +2,8 @@
 
 Payloads are packed and unpacked from the bit-field table of the sidecar
 (``ports[...]["fields"]``), so no testbench hard-codes a bit position. Traffic patterns
-follow verilog-axis: no stall, random input gaps, random output backpressure.
+are sim/traffic.py's (after verilog-axis: no stall, random input gaps, random output
+backpressure, both).
 """
 
 import json
@@ -14,11 +15,9 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
-__all__ = ["PATTERNS", "load_sidecar", "pack", "unpack", "run_stream", "samples"]
+from bumprtl.sim.traffic import PATTERNS
 
-# name -> (probability of an input gap, probability of output backpressure)
-PATTERNS = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4),
-            "both": (0.3, 0.3)}
+__all__ = ["PATTERNS", "load_sidecar", "pack", "unpack", "run_stream", "samples"]
 
 log = logging.getLogger("bumprtl.tb")
 

@@ -2,11 +2,11 @@
 comes out.
 
 Environment: BUMPRTL_SIDECAR (pipeline.json), BUMPRTL_STIMULUS (npz written by
-``gen/render_rtl.write_stimulus``: input payload arrays ``in.<field>``, optional ``polygon.*``
+``gen/render/rtl.write_stimulus``: input payload arrays ``in.<field>``, optional ``polygon.*``
 and ``lut``), BUMPRTL_RESULT (npz to write: ``<pattern>.<field>`` output arrays and
 ``<pattern>.cycles``), BUMPRTL_PATTERNS (comma-separated traffic patterns of
 sim/tb/stream.py; default no_stall). Checking is done by the caller against
-sim/golden/fixed_pipeline.py, so the same run serves the render and the tests.
+sim/golden/fixed/pipeline.py, so the same run serves the render and the tests.
 """
 
 import os
@@ -16,6 +16,7 @@ import cocotb
 import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
+from tqdm import tqdm
 
 from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, unpack
 
@@ -53,7 +54,6 @@ async def _reset(dut, meta):
 
 
 def _progress(total):
-    from tqdm import tqdm
     return tqdm(total=total, unit="pix", unit_scale=True, desc="rtl", mininterval=0.5,
                 disable=os.environ.get("BUMPRTL_PROGRESS", "1") == "0")
 

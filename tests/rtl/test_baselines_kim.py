@@ -1,5 +1,5 @@
 """The kim baseline datapaths (rtl/baselines/kim.py): bit for bit against
-sim/golden/fixed_kim.py in the Amaranth simulator (random, edge, stress and tiny-width vectors,
+sim/golden/fixed/kim.py in the Amaranth simulator (random, edge, stress and tiny-width vectors,
 with and without stalls), the reciprocal ROM against float64, emission (lint-clean,
 deterministic, ``bumprtl emit rotation --method kim``) and the Yosys counts implied by the
 structure in the module docstring (Lee Table 1's Kim column)."""
@@ -12,36 +12,33 @@ import numpy as np
 import pytest
 
 from bumprtl.gen.flow.emit import lint
-from bumprtl.gen.flow.resources import count_component, count_verilog
+from bumprtl.gen.flow.resources import count_component, count_verilog, multiplier_pairs
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
-from bumprtl.rtl.baselines.kim import Rotation as KimRotation
+from bumprtl.rtl.baselines.kim import KimRotation
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.illumination import BackEnd, DatapathUnit
+from bumprtl.rtl.shade import BackEnd
 from bumprtl.sim.amaranth_stream import check_datapath
 from bumprtl.sim.golden.fixed.kim import predicted_error_bound_lsb
 from bumprtl.sim.golden.stress import stress_codes
-from bumprtl.sim.golden.vectors import concat_codes, edge_codes, random_codes
+from bumprtl.sim.golden.vectors import TINY, concat_codes, edge_codes, random_codes
+from bumprtl.sim.traffic import PATTERNS
 
-DEFAULT = Config(method="kim")
 NARROW = Config(method="kim", angle_bits=8, frac_bits=9)
-
-
-
-
 
 
 # --- bit-exact against the golden model -----------------------------------------------------
 
-@pytest.mark.parametrize("pattern,n", [("no_stall", 800), ("input_gaps", 300), ("backpressure", 300)])
-def test_bit_exact_random_and_edges(pattern, n):
-    """Random valid pixels, and without stalls also the edge cases (poles, azimuth wrap,
-    L = N, grazing, below the horizon); without stalls one pixel per clock (N + latency
-    cycles)."""
-    codes = random_codes(n, DEFAULT, seed=len(pattern))
+@pytest.mark.parametrize("pattern", list(PATTERNS))
+def test_bit_exact_random_and_edges(pattern):
+    """800 random valid pixels and the edge cases (poles, azimuth wrap, L = N, grazing,
+    below the horizon) without stalls, one pixel per clock (N + latency cycles); 300 random
+    pixels under each stalling pattern."""
+    cfg = Config(method="kim")
+    codes = random_codes(800 if pattern == "no_stall" else 300, cfg, seed=len(pattern))
     if pattern == "no_stall":
-        codes = concat_codes(edge_codes(DEFAULT), codes)
-    rot, ill = check_datapath(DEFAULT, codes, pattern)
+        codes = concat_codes(edge_codes(cfg), codes)
+    rot, ill = check_datapath(cfg, codes, pattern)
     total = len(codes["n.phi"])
     if pattern == "no_stall":
         assert rot == ill == total
@@ -65,7 +62,7 @@ def test_bit_exact_narrow_without_specular():
 def test_bit_exact_tiny_config():
     """k = 2 (4-bit angles, B = 4, so the asin address is shifted left): 2048 vectors; L walks
     all 16^2 (th_N, th_L) for 8 azimuth pairs (ph_N, ph_L), H and N' move too."""
-    cfg = Config(method="kim", angle_bits=4, frac_bits=4, tag_bits=12)
+    cfg = TINY.replace(method="kim")
     idx = np.arange(2048, dtype=np.int64)
     a, b, c = idx & 15, (idx >> 4) & 15, idx >> 8
     codes = {"n.phi": (3 * c) & 15, "n.theta": a, "l.theta": b, "l.phi": (5 * c + a) & 15,
@@ -75,7 +72,8 @@ def test_bit_exact_tiny_config():
 
 # --- tables and structure --------------------------------------------------------------------
 
-@pytest.mark.parametrize("cfg", [DEFAULT, NARROW, Config(method="kim", angle_bits=16, frac_bits=24)])
+@pytest.mark.parametrize("cfg", [Config(method="kim"), NARROW,
+                                 Config(method="kim", angle_bits=16, frac_bits=24)])
 def test_reciprocal_table_against_float(cfg):
     """Every divisor P in [1, 2) whose mantissa selects entry i gets 1/P within a relative
     2**-(R+1) (the middle of the interval) plus the entry's rounding."""
@@ -97,24 +95,24 @@ def test_roms():
     """Setup: N's sin & cos ROM, and per vector sin & cos, reciprocal, atan, asin ROMs;
     illumination: N' and per-vector sin & cos ROMs plus the specular table. Without specular
     the H path is not built."""
+    cfg = Config(method="kim")
     per_vector = ("sincos", "recip", "atan", "asin")
-    assert sorted(_roms("rotation", DEFAULT)) == sorted(
+    assert sorted(_roms("rotation", cfg)) == sorted(
         ["n_sincos_rom"] + [f"{v}_{kind}_rom" for v in "lh" for kind in per_vector])
-    assert sorted(_roms("rotation", DEFAULT.replace(specular=False))) == sorted(
+    assert sorted(_roms("rotation", cfg.replace(specular=False))) == sorted(
         ["n_sincos_rom"] + [f"l_{kind}_rom" for kind in per_vector])
-    ill = _roms("illumination", DEFAULT)
+    ill = _roms("illumination", cfg)
     assert sorted(n for n in ill if not n.startswith("specular")) == sorted(
         ["b_sincos_rom", "l_sincos_rom", "h_sincos_rom"])
     assert len(ill) == 4                              # + the back end's specular table
-
 
 
 # --- emission ------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("unit", ["rotation", "illumination"])
 def test_emission_lint_clean_and_deterministic(unit, build_dir):
-    v1, j1 = emit_unit(unit, DEFAULT, build_dir / "a")
-    v2, j2 = emit_unit(unit, DEFAULT, build_dir / "b")
+    v1, j1 = emit_unit(unit, Config(method="kim"), build_dir / "a")
+    v2, j2 = emit_unit(unit, Config(method="kim"), build_dir / "b")
     assert v1.read_bytes() == v2.read_bytes() and j1.read_bytes() == j2.read_bytes()
     assert "--method kim" in v1.read_text().splitlines()[0]
     assert lint(v1) == []
@@ -127,8 +125,9 @@ def test_cli_emit_rotation_method_kim(tmp_path):
     assert (tmp_path / "rotation.v").read_text().startswith(
         "// Generated by: bumprtl emit rotation --method kim --angle-bits 12 --frac-bits 13")
     meta = json.loads((tmp_path / "rotation.json").read_text())
-    assert meta["method"] == "kim" and meta["latency"] == KimRotation(DEFAULT).latency
-    assert meta["error_bound_lsb"] == predicted_error_bound_lsb(DEFAULT)
+    cfg = Config(method="kim")
+    assert meta["method"] == "kim" and meta["latency"] == KimRotation.latency
+    assert meta["error_bound_lsb"] == predicted_error_bound_lsb(cfg)
     bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
                           "kim", "--frac-bits", "40", "--out", str(tmp_path)],
                          capture_output=True, text=True)
@@ -136,10 +135,6 @@ def test_cli_emit_rotation_method_kim(tmp_path):
 
 
 # --- Yosys counts against the structure (module docstring) -----------------------------------
-
-def _pairs(mults):
-    return sorted(tuple(sorted(int(w) for w in m.split("x"))) for m in mults)
-
 
 def _table(t):
     return (t["name"], t["depth"], t["width"], t["read_ports"])
@@ -164,7 +159,7 @@ def test_rotation_counts_match_the_structure(build_dir):
     q = b + 2                                                   # a signed Q1.B value
     expected = [(q, q)] * (4 + len(vs) * 10)
     expected += [(b + 1, b + 1), (q + 1, q), (q, b + 1)] * len(vs)
-    assert _pairs(c.multipliers) == _pairs(f"{x}x{y}" for x, y in expected)
+    assert multiplier_pairs(c.multipliers) == multiplier_pairs(f"{x}x{y}" for x, y in expected)
     assert len(c.adders) == 6 * len(vs)
     assert c.dividers == [] and c.sqrts == 0
     roms = {"sincos": tables.quarter_sine(cfg), "recip": tables.kim_reciprocal_table(cfg),
@@ -187,9 +182,10 @@ def test_illumination_counts_are_the_back_end_plus_eqs_3_and_4(build_dir):
     b = cfg.frac_bits
     v_path, _ = emit_unit("illumination", cfg, build_dir)
     c = count_verilog(v_path, "illumination", build_dir / "yosys")
-    shade = count_component(DatapathUnit(BackEnd(cfg)), "shade_only", build_dir / "shade")
+    shade = count_component(BackEnd(cfg), "shade_only", build_dir / "shade")
     q = b + 2
-    assert _pairs(c.multipliers) == _pairs(shade.multipliers + [f"{q}x{q}"] * 6)
+    assert multiplier_pairs(c.multipliers) == multiplier_pairs(
+        shade.multipliers + [f"{q}x{q}"] * 6)
     assert len(c.adders) == len(shade.adders) + 4
     sincos = len(tables.quarter_sine(cfg))
     want = sorted(map(_table, shade.tables)) + [("b_sincos_rom", sincos, b + 1, 2),

@@ -6,8 +6,9 @@ import pytest
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.scene import load_scene_config
-from bumprtl.sim.amaranth_stream import PATTERNS, assert_bit_exact, simulate_stream
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, random_inputs, random_map
+from bumprtl.sim.traffic import PATTERNS
 
 
 def reference_word(words, u, v, level, scene):

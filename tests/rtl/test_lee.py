@@ -1,10 +1,10 @@
 """The lee datapaths (rtl/lee.py): ROM contents, structure against the paper's counts,
-latency, a tiny configuration walked exhaustively against sim/golden/fixed_lee.py, emission.
+latency, a tiny configuration walked exhaustively against sim/golden/fixed/lee.py, emission.
 
 The method-parametrized suites run the rest for lee as well, so it is not repeated here:
-tests/rtl/test_rotation.py (20 000 random vectors + the edge cases without stalls, 4 000
-under input gaps and under backpressure, other widths, specular off) and
-tests/sim/test_tb_datapath.py (cocotb on the emitted Verilog, Icarus and Verilator;
+tests/rtl/test_rotation.py (the edge cases and 1 000 random vectors under every traffic
+pattern, the tiny configuration, other widths, specular off) and
+tests/sim/tb/test_tb_datapath.py (cocotb on the emitted Verilog, Icarus and Verilator;
 10^6 vectors on Verilator in `make regress`)."""
 
 import numpy as np
@@ -16,18 +16,14 @@ from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
 from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
-from bumprtl.sim.golden.fixed.lee import lee_illumination_fixed, lee_rotation_fixed
-from bumprtl.sim.golden.vectors import as_payloads, random_codes
-
-DEFAULT = Config(method="lee")
-TINY = Config(method="lee", angle_bits=4, frac_bits=4, tag_bits=16)
-
-
+from bumprtl.sim.golden.fixed import lee as fixed_lee
+from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
 
 
 # --- ROM contents (tables.py, Lee section) ----------------------------------------------------
 
-@pytest.mark.parametrize("cfg", [DEFAULT, TINY, Config(angle_bits=14, frac_bits=20)])
+@pytest.mark.parametrize("cfg", [Config(method="lee"), TINY.replace(method="lee"),
+                                 Config(angle_bits=14, frac_bits=20)])
 def test_tables_against_float(cfg):
     step = 2 * np.pi / cfg.full_circle                      # one binary-angle step, radians
     a = tables.lee_asin_index_bits(cfg)
@@ -45,7 +41,8 @@ def test_tables_against_float(cfg):
     assert np.all(np.abs(prop - (1 - np.arccos(y) / (np.pi / 2))) <= 0.5 / cfg.one + 1e-12)
 
 
-@pytest.mark.parametrize("cfg", [DEFAULT, TINY, Config(angle_bits=8, frac_bits=7)])
+@pytest.mark.parametrize("cfg", [Config(method="lee"), TINY.replace(method="lee"),
+                                 Config(angle_bits=8, frac_bits=7)])
 def test_atan_address_and_table(cfg):
     """Every ratio p < 2**W (k fractional bits) gets an address whose entry is atan(p / 2**k)
     within half an angle step plus the mantissa's error 2**-(M+2) rad; the address is
@@ -73,19 +70,20 @@ def _memories(unit, cfg):
 def test_rom_count_matches_table_1():
     """Fig. 7: six tables per vector (sin & cos, asin, 1/sin, 1/cos, atan, T_prop) -> Table 1's
     12 for L and H; Fig. 8: six cosine tables plus the specular table. Without specular the
-    H sub-datapaths (and their tables) are not built (DESIGN §6)."""
-    roms = _memories("rotation", DEFAULT)
+    H sub-datapaths (and their tables) are not built."""
+    cfg = Config(method="lee")
+    roms = _memories("rotation", cfg)
     kinds = ("sincos", "asin", "inv_sin", "inv_cos", "atan", "prop")
     assert sorted(roms) == sorted(f"{v}_{kind}_rom" for v in "lh" for kind in kinds)
-    assert len(_memories("rotation", DEFAULT.replace(specular=False))) == 6
-    ill = _memories("illumination", DEFAULT)
+    assert len(_memories("rotation", cfg.replace(specular=False))) == 6
+    ill = _memories("illumination", cfg)
     cosines = [name for name in ill if "_cos_" in name]
     assert len(cosines) == 6 and len(ill) == 7
 
 
 def test_latency_and_one_pixel_per_clock():
     """Without stalls N pixels take N cycles plus the latency property."""
-    cfg = DEFAULT
+    cfg = Config(method="lee")
     codes = random_codes(300, cfg, seed=5)
     rot_cycles, ill_cycles = check_datapath(cfg, codes, "no_stall")
     assert rot_cycles == ill_cycles == 300
@@ -95,7 +93,7 @@ def test_latency_and_one_pixel_per_clock():
 
 def _class_walk(cfg):
     """4 096 vectors: each vector's rotation output depends on (th_N, ph_A - ph_N, th_A) only
-    (tests/sim/golden/test_fixed_lee.py checks that on all 16^4 inputs), and L and H walk all
+    (tests/sim/golden/fixed/test_lee.py checks that on all 16^4 inputs), and L and H walk all
     16^3 such triples at once; N' walks all 16^2 values."""
     idx = np.arange(16 ** 3, dtype=np.int64)
     t, u, w = idx & 15, (idx >> 4) & 15, idx >> 8
@@ -107,43 +105,45 @@ def _class_walk(cfg):
 def test_tiny_config_exhaustive_classes():
     """k = 2: rotation over every (th_N, D, th_A) of both vectors, and illumination over every
     (th_A', th_N', ph_A' - ph_N') of both vectors (inputs fed directly, not only reachable ones)."""
-    codes = _class_walk(TINY)
-    inputs = as_payloads(codes, TINY)
-    out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
-    assert_bit_exact(out, lee_rotation_fixed(codes, TINY), inputs)
+    cfg = TINY.replace(method="lee")
+    codes = _class_walk(cfg)
+    inputs = as_payloads(codes, cfg)
+    out, _ = simulate_stream(LeeRotation(cfg), inputs, "no_stall")
+    assert_bit_exact(out, fixed_lee.rotation_fixed(codes, cfg), inputs)
     idx = np.arange(16 ** 3, dtype=np.int64)
     t, u, w = idx & 15, (idx >> 4) & 15, idx >> 8
     b_phi = (idx * 5 + t) & 15
     rot = {"l.phi": (b_phi + u) & 15, "l.theta": w, "h.phi": (b_phi + w) & 15, "h.theta": u,
            "b.phi": b_phi, "b.theta": t}
-    inputs = as_payloads(rot, TINY)
-    out, _ = simulate_stream(LeeIllumination(TINY), inputs, "backpressure")
-    assert_bit_exact(out, lee_illumination_fixed(rot, TINY), inputs)
+    inputs = as_payloads(rot, cfg)
+    out, _ = simulate_stream(LeeIllumination(cfg), inputs, "backpressure")
+    assert_bit_exact(out, fixed_lee.illumination_fixed(rot, cfg), inputs)
 
 
 @pytest.mark.regress
 def test_tiny_config_exhaustive_all_inputs():
     """k = 2: all 16^4 (ph_N, th_N, ph_A, th_A) for L (H and N' permuted), no equivalence
     argument needed; and all 16^4 (ph_A', th_A', ph_N', th_N') of the illumination."""
+    cfg = TINY.replace(method="lee")
     idx = np.arange(16 ** 4, dtype=np.int64)
     d = [(idx >> (4 * j)) & 15 for j in range(4)]
     codes = {"n.phi": d[0], "n.theta": d[1], "l.phi": d[2], "l.theta": d[3],
              "h.phi": d[3], "h.theta": d[0], "b.phi": d[2], "b.theta": d[1]}
-    inputs = as_payloads(codes, TINY)
-    out, _ = simulate_stream(LeeRotation(TINY), inputs, "no_stall")
-    assert_bit_exact(out, lee_rotation_fixed(codes, TINY), inputs)
+    inputs = as_payloads(codes, cfg)
+    out, _ = simulate_stream(LeeRotation(cfg), inputs, "no_stall")
+    assert_bit_exact(out, fixed_lee.rotation_fixed(codes, cfg), inputs)
     rot = {"l.phi": d[0], "l.theta": d[1], "h.phi": d[1], "h.theta": d[2], "b.phi": d[2],
            "b.theta": d[3]}
-    inputs = as_payloads(rot, TINY)
-    out, _ = simulate_stream(LeeIllumination(TINY), inputs, "no_stall")
-    assert_bit_exact(out, lee_illumination_fixed(rot, TINY), inputs)
+    inputs = as_payloads(rot, cfg)
+    out, _ = simulate_stream(LeeIllumination(cfg), inputs, "no_stall")
+    assert_bit_exact(out, fixed_lee.illumination_fixed(rot, cfg), inputs)
 
 
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------
 
 @pytest.mark.parametrize("unit", ["rotation", "illumination"])
 def test_emitted_verilog_lint_clean(unit, build_dir):
-    v, j = emit_unit(unit, DEFAULT, build_dir)
+    v, j = emit_unit(unit, Config(method="lee"), build_dir)
     assert lint(v) == []
     assert v.read_text().splitlines()[0].find("--method lee") > 0   # the command that made it
 

@@ -1,5 +1,5 @@
 """PaletteLUT in the Amaranth simulator: bit-exact against the cycle model, with host writes
-racing lookups and swaps at random times (also under backpressure), three traffic patterns."""
+racing lookups and swaps at random times (also under backpressure), every traffic pattern."""
 
 import random
 
@@ -11,8 +11,8 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import CHANNELS, PaletteLUT, blend_eq1, blend_eq2, index_bits, mul8
-from bumprtl.sim.amaranth_stream import PATTERNS
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, unpack_rgba
+from bumprtl.sim.traffic import PATTERNS
 
 CONFIGS = [Config(palette_size=200, tag_bits=8),                       # indices 200..255 out of range
            Config(palette_size=100, palette_blend=True, tag_bits=8)]

@@ -13,7 +13,7 @@ from amaranth.hdl import Fragment, Instance, Module, signed, unsigned
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
-from bumprtl.gen.flow.toolchain import require, tool_env
+from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
 from bumprtl.rtl.tables import quarter_sine, specular_table
@@ -123,9 +123,9 @@ def test_ecp5_rom_contents_match_yosys_block_ram_mapping(build_dir):
         generic, name="generic", ports=[port.addr, port.data], emit_src=False))
     _yosys("read_verilog generic.v; synth_ecp5 -top generic -json generic.json", build_dir)
 
-    ours = RegisteredROM(words, shape, 2, "rom")
+    ours = RegisteredROM(words, shape, 2, "rom", target=ECP5())
     (build_dir / "ours.v").write_text(verilog.convert(
-        ours, name="ours", platform=ECP5(), emit_src=False,
+        ours, name="ours", emit_src=False,
         ports=[ours.en] + [s for p in ours.ports for s in (p.addr, p.data)]))
     _yosys("read_verilog -lib +/ecp5/cells_bb.v; read_verilog ours.v; hierarchy -top ours; "
            "write_json ours.json", build_dir)
@@ -138,8 +138,8 @@ def test_ecp5_rom_contents_match_yosys_block_ram_mapping(build_dir):
     assert mine["parameters"]["REGMODE_A"] == mine["parameters"]["REGMODE_B"] == "OUTREG"
 
 
-def _instances(dut, platform):
-    frag = Fragment.get(dut, platform)
+def _instances(dut):
+    frag = Fragment.get(dut, None)
     found = []
 
     def walk(f):
@@ -152,22 +152,22 @@ def _instances(dut, platform):
 
 
 def test_ecp5_product_uses_the_dsp_registers():
-    dut = RegisteredProduct(signed(18), signed(16), "p")
-    (dsp,) = _instances(dut, ECP5())
+    dut = RegisteredProduct(signed(18), signed(16), "p", target=ECP5())
+    (dsp,) = _instances(dut)
     assert dsp.type == "MULT18X18D"
     for reg in ("INPUTA", "INPUTB", "OUTPUT"):
         assert dsp.parameters[f"REG_{reg}_CLK"] == "CLK0"
         assert dsp.parameters[f"REG_{reg}_CE"] == "CE0"
-    assert not _instances(RegisteredProduct(signed(18), signed(16), "p"), None)
+    assert not _instances(RegisteredProduct(signed(18), signed(16), "p"))
 
 
 def test_ecp5_forms_only_where_the_block_fits():
     """Operands wider than 18 bits (signed) and tables deeper than 1025 words or wider than
     18 bits keep the generic form (Yosys then splits them as before)."""
-    assert not _instances(RegisteredProduct(signed(19), signed(4), "p"), ECP5())
-    assert not _instances(RegisteredProduct(unsigned(18), signed(4), "p"), ECP5())
-    assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p"), ECP5())) == 1
-    assert not _instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r"), ECP5())  # word 0 != 0
-    assert not _instances(RegisteredROM(range(2049), unsigned(12), 2, "r"), ECP5())
-    assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r"), ECP5())
-    assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r"), ECP5())) == 1
+    assert not _instances(RegisteredProduct(signed(19), signed(4), "p", target=ECP5()))
+    assert not _instances(RegisteredProduct(unsigned(18), signed(4), "p", target=ECP5()))
+    assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p", target=ECP5()))) == 1
+    assert not _instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r", target=ECP5()))  # word 0 != 0
+    assert not _instances(RegisteredROM(range(2049), unsigned(12), 2, "r", target=ECP5()))
+    assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r", target=ECP5()))
+    assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r", target=ECP5()))) == 1

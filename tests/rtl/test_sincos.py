@@ -5,7 +5,8 @@ import pytest
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.amaranth_stream import PATTERNS, simulate_stream
+from bumprtl.sim.amaranth_stream import simulate_stream
+from bumprtl.sim.traffic import PATTERNS
 
 
 def _check_exhaustive(cfg, pattern):

@@ -7,6 +7,7 @@ import pytest
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.texture import RGB, TextureBlend, blend_error_bound_lsb, texture_blend
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.traffic import PATTERNS
 
 
 def float_blend(d, s, tex, cfg):
@@ -47,15 +48,15 @@ def test_white_texel_gives_the_grey_shade_black_gives_the_highlight():
     assert black["g"][0] > 40 and black["g"][-1] == 0          # only the highlight is left
 
 
-@pytest.mark.parametrize("pattern", ["no_stall", "backpressure", "input_gaps"])
+@pytest.mark.parametrize("pattern", list(PATTERNS))
 def test_unit_bit_exact(pattern):
     cfg, lights, n = Config(lights=2), 2, 300
     rng = np.random.default_rng(9)
-    inputs = [{**{f"d{j}": int(rng.integers(256)) for j in range(lights)},
-               **{f"s{j}": int(rng.integers(256)) for j in range(lights)},
+    inputs = [{**{f"d.{j}": int(rng.integers(256)) for j in range(lights)},
+               **{f"s.{j}": int(rng.integers(256)) for j in range(lights)},
                **{f"texel.{c}": int(rng.integers(256)) for c in RGB}, "tag": t} for t in range(n)]
     col = lambda k: np.array([p[k] for p in inputs])
-    color, d, s = texture_blend([col("d0"), col("d1")], [col("s0"), col("s1")],
+    color, d, s = texture_blend([col("d.0"), col("d.1")], [col("s.0"), col("s.1")],
                                 {c: col(f"texel.{c}") for c in RGB}, cfg)
     golden = {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
     dut = TextureBlend(cfg, lights)

@@ -1,11 +1,12 @@
 """Shared pieces of the bit-exact (int64) golden models: input quantization and the
-illumination back end, mirrored operation for operation by ``rtl/illumination.py``."""
+illumination back end, mirrored operation for operation by ``rtl/shade.py``."""
 
 from dataclasses import fields
 
 import numpy as np
 
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import phong_coefficients, specular_index_bits, specular_table
 from bumprtl.sim.golden.common import PixelInputs
@@ -15,7 +16,7 @@ __all__ = ["angle_codes", "quantize_pixels", "shade_fixed", "polar_rotation_fixe
 
 
 def angle_codes(angle_rad, cfg: Config):
-    """Radians -> binary-angle codes of ``angle_bits`` bits, rounded to nearest (DESIGN §4);
+    """Radians -> binary-angle codes of ``angle_bits`` bits, rounded to nearest (docs/architecture.md, Number formats);
     the full circle wraps to 0. int32 (angle sums of a few codes never overflow it)."""
     steps = np.rint(np.asarray(angle_rad, dtype=np.float64) * (cfg.full_circle / (2 * np.pi)))
     return steps.astype(np.int32) & np.int32(cfg.full_circle - 1)
@@ -52,7 +53,6 @@ def shade_fixed(ndotl, ndoth, cfg: Config):
 def polar_rotation_fixed(rotate, codes, cfg: Config):
     """The rotation unit of a polar method (lee, kim): ``rotate(a_phi, a_theta, n_phi,
     n_theta, cfg) -> (ph_A', th_A')`` for L (and H with specular), N' passed through."""
-    from bumprtl.sim.golden.fixed.exact import vectors
     out = {}
     for v in vectors(cfg):
         out[f"{v}.phi"], out[f"{v}.theta"] = rotate(
@@ -65,7 +65,6 @@ def polar_rotation_fixed(rotate, codes, cfg: Config):
 def polar_illumination_fixed(illuminate, rot, cfg: Config):
     """The illumination unit of a polar method: ``illuminate(a_phi, a_theta, b_phi, b_theta,
     cfg) -> N'.A'`` per vector, then the shared back end (ndotl, ndoth, 8-bit shades)."""
-    from bumprtl.sim.golden.fixed.exact import vectors
     dots = {v: illuminate(rot[f"{v}.phi"], rot[f"{v}.theta"], rot["b.phi"], rot["b.theta"], cfg)
             for v in vectors(cfg)}
     ndotl = dots["l"]

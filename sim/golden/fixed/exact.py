@@ -1,7 +1,7 @@
 """Bit-exact int64 model of the ``exact`` datapath (rtl/exact.py), vectorized.
 
 Scales (all integers carry ``frac_bits`` = B fractional bits; no rounding until the dot):
-  n.x4 = 4 n''x, n.y2 = 2 n''y, n.z4 = 4 n''z     (DESIGN §3, product-to-sum sums)
+  n.x4 = 4 n''x, n.y2 = 2 n''y, n.z4 = 4 n''z     (product-to-sum sums, docs/architecture.md)
   a.p2 = 2 p, a.y2 = 2 y, a.z = cos th_A          per vector A in {L, H}
   N'.A' = (n.x4 a.p2 + 2 n.y2 a.y2 + 2 n.z4 a.z) / 8, one rounding back to B bits.
 """
@@ -9,20 +9,16 @@ Scales (all integers carry ``frac_bits`` = B fractional bits; no rounding until 
 import numpy as np
 
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
 from bumprtl.sim.golden.fixed.common import shade_fixed
 
-__all__ = ["exact_rotation_fixed", "exact_illumination_fixed", "exact_dot_fixed", "exact_fixed",
-           "vectors", "predicted_error_bound_lsb"]
+__all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors",
+           "predicted_error_bound_lsb"]
 
 
-def vectors(cfg: Config):
-    """The vectors whose dot products with N' the datapath forms: L, and H with specular."""
-    return ("l", "h") if cfg.specular else ("l",)
-
-
-def exact_rotation_fixed(codes, cfg: Config):
+def rotation_fixed(codes, cfg: Config):
     """VectorRotation (exact): n'' of the bump normal and p, y, cos th of L and H."""
     s, c = (lambda a: sin_lookup(cfg, a)), (lambda a: cos_lookup(cfg, a))
     t, bt, bp = codes["n.theta"], codes["b.theta"], codes["b.phi"]
@@ -41,7 +37,7 @@ def exact_rotation_fixed(codes, cfg: Config):
     return out
 
 
-def exact_dot_fixed(rot, v, cfg: Config):
+def dot_fixed(rot, v, cfg: Config):
     """N'.A' with B fractional bits: (x4 p2 + 2 y2 y2 + 2 z4 z) / 8 / 2**B, rounded once."""
     wide = lambda key: rot[key].astype(np.int64)          # products need up to 2B + 8 bits
     acc = (wide("n.x4") * rot[f"{v}.p2"] + 2 * wide("n.y2") * rot[f"{v}.y2"]
@@ -49,18 +45,11 @@ def exact_dot_fixed(rot, v, cfg: Config):
     return round_shift(acc, cfg.frac_bits + 3)
 
 
-def exact_illumination_fixed(rot, cfg: Config):
+def illumination_fixed(rot, cfg: Config):
     """Illumination (exact): ndotl, ndoth and 8-bit diffuse, specular, color."""
-    ndotl = exact_dot_fixed(rot, "l", cfg)
-    ndoth = exact_dot_fixed(rot, "h", cfg) if cfg.specular else np.zeros_like(ndotl)
+    ndotl = dot_fixed(rot, "l", cfg)
+    ndoth = dot_fixed(rot, "h", cfg) if cfg.specular else np.zeros_like(ndotl)
     return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
-
-
-def exact_fixed(codes, cfg: Config):
-    """The whole exact datapath: dict with the rotation terms, ndotl, ndoth and 8-bit
-    diffuse, specular and color."""
-    rot = exact_rotation_fixed(codes, cfg)
-    return {**rot, **exact_illumination_fixed(rot, cfg)}
 
 
 def predicted_error_bound_lsb(cfg: Config):
@@ -77,7 +66,7 @@ def predicted_error_bound_lsb(cfg: Config):
       (p, y, cos th_A) by sqrt(3)/2 u, and the dot's final rounding adds u/2 (1.3 u**2 covers
       the product of the two errors);
     * the 8-bit rounding turns an error e before it into at most floor(e) + 1 after it.
-    Measured maxima stay under the bound (tests/sim/golden/test_fixed_exact.py).
+    Measured maxima stay under the bound (tests/sim/golden/fixed/test_exact.py).
     """
     delta = np.pi / (1 << (cfg.k + 2))
     u = 2.0 ** -cfg.frac_bits

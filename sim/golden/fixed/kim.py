@@ -28,7 +28,7 @@ from bumprtl.rtl.tables import (cos_lookup, kim_reciprocal_bits, kim_reciprocal_
 from bumprtl.sim.golden.fixed.common import polar_illumination_fixed, polar_rotation_fixed
 
 __all__ = ["rotate_fixed", "to_polar_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
-           "kim_fixed", "predicted_error_bound_lsb", "direction_error_bound"]
+           "predicted_error_bound_lsb", "direction_error_bound"]
 
 
 def _sincos(angle, cfg: Config):
@@ -86,13 +86,6 @@ def illumination_fixed(rot, cfg: Config):
     return polar_illumination_fixed(illuminate_fixed, rot, cfg)
 
 
-def kim_fixed(codes, cfg: Config):
-    """The whole kim datapath from input angle codes: L', H' codes, ndotl, ndoth, diffuse,
-    specular, color."""
-    rot = rotation_fixed(codes, cfg)
-    return {**rot, **illumination_fixed(rot, cfg)}
-
-
 def predicted_error_bound_lsb(cfg: Config):
     """Worst-case |diffuse8 - round(255 * clamp(N'.L))| of the kim datapath, in 8-bit LSB,
     against float64 on unquantized inputs.
@@ -101,7 +94,7 @@ def predicted_error_bound_lsb(cfg: Config):
     R = kim_reciprocal_bits and M = lee_atan_mantissa_bits; first order, a few u**2 ignored:
 
     * input rounding: the same N'.A' on quantized angles moves by at most
-      2 sqrt(5) delta + 14 delta**2 (fixed_exact.predicted_error_bound_lsb's argument: it is a
+      2 sqrt(5) delta + 14 delta**2 (exact.predicted_error_bound_lsb's argument: it is a
       property of the inputs, not of the method);
     * A' = M A: the ROM values are off by u/2; the four product entries of M and x, y by
       u/2 + u/2 + u/2 = 1.5 u, so |dM|_F <= sqrt(4 (1.5u)**2 + 4 (u/2)**2) = sqrt(10) u and
@@ -124,7 +117,7 @@ def predicted_error_bound_lsb(cfg: Config):
     * eqs (3)/(4): four ROM values (|cos| + |sin| <= sqrt(2) per angle) and cos(dph) off by
       u/2, the rounding of sin sin and of the sum: (sqrt(2) + 1.5) u;
     * the 8-bit rounding turns an error E before it into at most floor(255 E) + 1 after it.
-    Measured maxima stay under the bound (tests/sim/golden/test_fixed_kim.py).
+    Measured maxima stay under the bound (tests/sim/golden/fixed/test_kim.py).
     """
     delta = np.pi / (1 << (cfg.k + 2))
     u = 2.0 ** -cfg.frac_bits

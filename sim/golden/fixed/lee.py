@@ -1,9 +1,9 @@
 """Bit-exact int64 model of the ``lee`` datapath (rtl/lee.py), vectorized.
 
-Lee et al. 2003, Figs 7 and 8, with errata 1-6 and 8 of DESIGN §3 repaired; the method's
+Lee et al. 2003, Figs 7 and 8, with errata 1-6 and 8 repaired (docs/architecture.md); the method's
 own approximations (rigid circle, linear proportion; erratum 7) are kept, so this model
-tracks the float64 ``sim/golden/lee.lee_fixed`` and, like it, is ~200 LSB from the exact
-reference. Angles are binary-angle codes (full circle 2**(k+2)); values carry B = frac_bits
+tracks the float64 ``sim/golden/float/lee.lee_corrected`` and, like it, stays far from the exact
+reference at every width (docs/lee_method.md, ``bumprtl bench lee-widths``). Angles are binary-angle codes (full circle 2**(k+2)); values carry B = frac_bits
 fractional bits. Per vector A in {L, H} (Fig. 7, ``rotate_fixed``):
 
   D = ph_A - ph_N, X = th_A + D, Y = th_A - D            eq. 6, erratum 1 (no /2)
@@ -28,8 +28,8 @@ from bumprtl.rtl.tables import (cos_lookup, lee_asin_index_bits, lee_asin_table,
                            lee_prop_table, lee_reciprocal_table, sin_lookup)
 from bumprtl.sim.golden.fixed.common import polar_illumination_fixed, polar_rotation_fixed
 
-__all__ = ["rotate_fixed", "illuminate_fixed", "lee_rotation_fixed", "lee_illumination_fixed",
-           "lee_fixed_model"]
+__all__ = ["rotate_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
+           "predicted_error_bound_lsb"]
 
 
 def _reciprocal(angle, cfg: Config):
@@ -72,18 +72,20 @@ def illuminate_fixed(a_phi, a_theta, b_phi, b_theta, cfg: Config):
     return round_shift(acc, cfg.frac_bits + 1)
 
 
-def lee_rotation_fixed(codes, cfg: Config):
+def rotation_fixed(codes, cfg: Config):
     """VectorRotation (lee): the output payload fields L', H' and the passed-through N'."""
     return polar_rotation_fixed(rotate_fixed, codes, cfg)
 
 
-def lee_illumination_fixed(rot, cfg: Config):
+def illumination_fixed(rot, cfg: Config):
     """Illumination (lee): ndotl, ndoth and the 8-bit diffuse, specular and color."""
     return polar_illumination_fixed(illuminate_fixed, rot, cfg)
 
 
-def lee_fixed_model(codes, cfg: Config):
-    """The whole lee datapath from input angle codes: L', H' codes, ndotl, ndoth, diffuse,
-    specular, color."""
-    rot = lee_rotation_fixed(codes, cfg)
-    return {**rot, **lee_illumination_fixed(rot, cfg)}
+def predicted_error_bound_lsb(cfg: Config):
+    """The diffuse error bound of the lee datapath against float64, in 8-bit LSB: the whole
+    8-bit range (255) at every width. The rigid-circle and proportion approximations are the
+    method itself (erratum 7) and are geometric, so no width bounds the error below it; the
+    measured maxima are in docs/algorithms.md and docs/lee_method.md (``bumprtl bench
+    float64``, ``bench lee-widths``)."""
+    return 255

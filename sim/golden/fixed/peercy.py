@@ -23,7 +23,7 @@ from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import shade_fixed
 from bumprtl.sim.golden.float.peercy import tbn_frame
 
-__all__ = ["rotation_fixed", "illumination_fixed", "datapath_fixed", "encode",
+__all__ = ["rotation_fixed", "illumination_fixed", "encode",
            "from_angle_codes", "isqrt", "input_keys", "predicted_error_bound_lsb"]
 
 
@@ -124,11 +124,6 @@ def illumination_fixed(rot, cfg: Config):
     return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
 
 
-def datapath_fixed(codes, cfg: Config):
-    rot = rotation_fixed(codes, cfg)
-    return {**rot, **illumination_fixed(rot, cfg)}
-
-
 def predicted_error_bound_lsb(cfg: Config):
     """Worst-case |diffuse8 - round(255 clamp(N'.L'))| against float64 ``conventional`` on
     unquantized inputs (:func:`encode`), in 8-bit LSB. With u = 2**-B, to first order:
@@ -144,7 +139,7 @@ def predicted_error_bound_lsb(cfg: Config):
     Total e = (3/2 + sqrt 3 + 1/2 + sqrt 3 / 2 + sqrt 3 / 2 + 1/2) u = (5/2 + 2 sqrt 3) u
     (+ 2 u**2 for the second-order terms); the 8-bit rounding of both sides turns an error
     e before it into at most floor(255 e) + 1 after it. Measured maxima stay under it
-    (tests/sim/golden/test_fixed_cartesian.py).
+    (tests/sim/golden/fixed/test_cartesian.py).
     """
     u = 2.0 ** -cfg.frac_bits
     before = 255.0 * ((2.5 + 2 * np.sqrt(3)) * u + 2 * u * u)

@@ -5,8 +5,8 @@ once per polygon for a flat bump map, m lights dotted with one rotated normal, o
 lookup with palette shading. Inputs and outputs are dicts of arrays keyed like the flattened
 payloads (``"u"``, ``"n.phi"``, ``"l1.theta"``, ...).
 
-Several lights (DESIGN §6; eq. 2 of Lee et al. summed over lights): each light j gives
-diffuse_j and specular_j (8 bits, rtl/illumination.shade_stages); the pipeline outputs
+Several lights (eq. 2 of Lee et al. summed over lights): each light j gives
+diffuse_j and specular_j (8 bits, rtl/shade.shade_stages); the pipeline outputs
   diffuse  = min(255, sum diffuse_j),  specular = min(255, sum specular_j),
   color    = clamp(round((KA + KD sum diffuse_j + KS sum specular_j) / 256), 0, 255).
 
@@ -19,13 +19,16 @@ palette shading returns the texel word beside the index (PaletteLUT's eq. 2 base
 
 import numpy as np
 
-from bumprtl.rtl.bumpfetch import has_map, level_bases, pack_texels, texel_address
+from bumprtl.rtl.bumpfetch import (has_map, level_bases, pack_texels, texel_address, coord_bits,
+                                   level_bits, memory_depth)
 from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.scene import SceneConfig, light_fields
 from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.texture import RGB, texture_blend
-from bumprtl.sim.golden.fixed.exact import exact_rotation_fixed
-from bumprtl.sim.golden.fixed.dispatch import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.fixed import exact
+from bumprtl.sim.golden.vectors import random_codes
 
 __all__ = ["light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
            "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
@@ -82,7 +85,7 @@ def polygon_fixed(n_phi, n_theta, b_phi, b_theta, scene: SceneConfig):
     like the pipeline's ``poly`` port."""
     codes = {"n.phi": n_phi, "n.theta": n_theta, "b.phi": b_phi, "b.theta": b_theta,
              "l.phi": 0, "l.theta": 0, "h.phi": 0, "h.theta": 0}
-    rot = exact_rotation_fixed({k: np.asarray(c, np.int64) for k, c in codes.items()}, scene.config)
+    rot = exact.rotation_fixed({k: np.asarray(c, np.int64) for k, c in codes.items()}, scene.config)
     return {"n_phi": int(n_phi), **{k: int(rot[k]) for k in ("n.x4", "n.y2", "n.z4")}}
 
 
@@ -102,7 +105,7 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
     ``words``: the bump map memory (varying map); ``polygon``: the per-polygon n'' terms
     (flat map, :func:`polygon_fixed`); ``texels``: the colour-texture memory (texture =
     true). Palette shading returns the ``index`` of each pixel (and the ``texel`` word with
-    a texture; the colour is PaletteLUT's: ``sim/golden/palette_lut.py``).
+    a texture; the colour is PaletteLUT's: ``sim/golden/fixed/palette_lut.py``).
     """
     cfg = scene.config
     codes = dict(inputs)
@@ -121,8 +124,8 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
             shape = light["l.phi"].shape
             poly = {k: np.full(shape, v, np.int64) for k, v in polygon.items()}
             zero = np.zeros(shape, np.int64)
-            rot = {**exact_rotation_fixed({**light, "n.phi": poly.pop("n_phi"), "n.theta": zero,
-                                           "b.phi": zero, "b.theta": zero}, cfg), **poly}
+            rot = {**exact.rotation_fixed({**light, "n.phi": poly.pop("n_phi"), "n.theta": zero,
+                                             "b.phi": zero, "b.theta": zero}, cfg), **poly}
         shades.append(illumination_fixed(rot, cfg))
     if scene.texture:
         color, d, s = texture_blend([sh["diffuse"] for sh in shades],
@@ -135,8 +138,6 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
 
 def random_map(scene: SceneConfig, rng):
     """A random memory image: N' in the upper tangent hemisphere, or palette indices."""
-    from bumprtl.rtl.bumpfetch import memory_depth, pack_texels
-    from bumprtl.rtl.palette import index_bits
     n, full = memory_depth(scene), 1 << scene.angle_bits
     if scene.shading == "palette":
         return pack_texels(scene, index=rng.integers(0, 1 << index_bits(scene.config), n))
@@ -145,15 +146,12 @@ def random_map(scene: SceneConfig, rng):
 
 def random_texture(scene: SceneConfig, rng):
     """A random colour-texture memory image (24-bit RGB words), or None without a texture."""
-    from bumprtl.rtl.bumpfetch import memory_depth
     return rng.integers(0, 1 << 24, memory_depth(scene)) if scene.texture else None
 
 
 def random_inputs(scene: SceneConfig, n, rng):
     """``n`` random input payloads (dict of arrays): texel coordinates over the whole signed
     port range (so wrap/clamp are exercised), levels past the last, random angles."""
-    from bumprtl.rtl.bumpfetch import coord_bits, level_bits
-    from bumprtl.sim.golden.vectors import random_codes
     out = {}
     if has_map(scene) or scene.texture:
         half = 1 << (coord_bits(scene) - 1)

@@ -1,4 +1,4 @@
-"""The exact angular method (DESIGN §3), float64.
+"""The exact angular method (docs/architecture.md), float64.
 
 Instead of rotating L and H into the tangent frame (Lee Sec. 3.1), rotate N' once per
 pixel: N'.(M A) = (R_y(th_N) n') . A_z, where A_z = R_z(-ph_N) A. Everything is sums of

@@ -1,9 +1,9 @@
-"""Lee, Park, Lee, Han and Yang 2003, float64: the printed equations and the fixed ones.
+"""Lee, Park, Lee, Han and Yang 2003, float64: the printed equations and the corrected ones.
 
 Vector rotation (Sec. 3.1, eqs 5-21) turns a world vector A = (ph_A, th_A) into the
 tangent frame of N = (ph_N, th_N) by angles alone; illumination (Sec. 3.2, eqs 22-25)
 takes N'.A' by the law of cosines. ``lee_printed`` follows the equations exactly as
-printed; ``lee_fixed`` repairs errata 1-6 of DESIGN §3 and keeps the two geometric
+printed; ``lee_corrected`` repairs errata 1-6 (docs/architecture.md) and keeps the two geometric
 approximations that are the method itself (the "rigid circle" of Sec. 3.1.2 and the
 linear "proportion" of eqs 10-13).
 
@@ -16,7 +16,7 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs, shade
 
-__all__ = ["ALL_ERRATA", "rotate", "illuminate", "lee_printed", "lee_fixed"]
+__all__ = ["ALL_ERRATA", "rotate", "illuminate", "lee_printed", "lee_corrected"]
 
 ALL_ERRATA = frozenset({1, 2, 3, 4, 5, 6})
 QUARTER = np.pi / 2        # the papers' "90" (degrees) in radians
@@ -91,6 +91,6 @@ def lee_printed(px: PixelInputs, cfg: Config = Config()):
     return _lee(px, cfg, frozenset())
 
 
-def lee_fixed(px: PixelInputs, cfg: Config = Config()):
+def lee_corrected(px: PixelInputs, cfg: Config = Config()):
     """Errata 1-6 repaired; the rigid-circle and proportion approximations kept."""
     return _lee(px, cfg, ALL_ERRATA)

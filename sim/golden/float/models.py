@@ -4,7 +4,7 @@ from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.ernst import ernst
 from bumprtl.sim.golden.float.exact import exact
 from bumprtl.sim.golden.float.kim import kim
-from bumprtl.sim.golden.float.lee import lee_fixed, lee_printed
+from bumprtl.sim.golden.float.lee import lee_corrected, lee_printed
 from bumprtl.sim.golden.float.peercy import peercy
 
 __all__ = ["FLOAT_MODELS"]
@@ -15,6 +15,6 @@ FLOAT_MODELS = {
     "kim": kim,
     "ernst": ernst,
     "lee_printed": lee_printed,
-    "lee_fixed": lee_fixed,
+    "lee_corrected": lee_corrected,
     "exact": exact,
 }

@@ -16,6 +16,7 @@ position are considered to be constant all over the object").
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.common import (Result, cartesian_to_polar, polar_to_cartesian, shade, tangent_rotation,
@@ -100,7 +101,6 @@ def _dithered(vectors, table):
 
 def nearest_spacing(table):
     """Distance from every table entry to its nearest other entry (the local cell size)."""
-    from scipy.spatial import cKDTree
     dist, _ = cKDTree(table).query(table, k=2)
     return dist[:, 1]
 

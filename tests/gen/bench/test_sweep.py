@@ -12,7 +12,7 @@ from bumprtl.gen.bench.sweep import Grid, error_lsb, pareto_front, sweep, write_
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+from bumprtl.rtl.methods import BASELINES, datapath_fixed
 
 
 def _front(pairs):
@@ -84,7 +84,7 @@ def test_tiny_sweep_invalid_and_missing(tiny):
     by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
     invalid = by[("exact", 14)]                       # B = 5 < k - 1 = 11
     assert invalid["status"] == "invalid" and "frac_bits" in invalid["reason"]
-    for name in ("peercy", "ernst", "kim"):             # baselines: real points at valid widths
+    for name in BASELINES:                              # real points at valid widths
         point = by[(name, 6)]
         assert point["status"] == "ok" and point["cost"]["multipliers"] > 0
         cfg = Config(method=name, angle_bits=6, frac_bits=5)
@@ -156,10 +156,9 @@ def test_fpga_points_diagonal_and_all():
 
 def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
     """The cost cache is keyed by the emitted Verilog: a different datapath is counted anew."""
-    from bumprtl.gen.flow import resources
     calls = []
-    real = resources.count_verilog
-    monkeypatch.setattr(resources, "count_verilog", lambda *a, **k: calls.append(a) or real(*a, **k))
+    real = bench_sweep.count_verilog             # the name unit_cost calls
+    monkeypatch.setattr(bench_sweep, "count_verilog", lambda *a, **k: calls.append(a) or real(*a, **k))
     cfg = Config(angle_bits=6, frac_bits=5)
     first = bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert bench_sweep.unit_cost(("sincos",), cfg, tmp_path) == first and len(calls) == 1

@@ -6,6 +6,8 @@ from bumprtl.gen.flow import fpga
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.rtl.pipe import ECP5
 
 
 def test_sincos_places_on_the_smallest_device(build_dir):
@@ -41,7 +43,7 @@ def test_report_fpga_every_design(build_dir):
     assert main(["report", "fpga", "--device", "LFE5U-85F", "--samples", "2000",
                  "--out", str(out), "--work", str(build_dir / "work")]) == 0
     text = out.read_text()
-    for design in ("exact", "lee"):
+    for design in PER_PIXEL:
         for row in ("setup", "illumination", "pipeline"):
             assert f"| {design}_{row} |" in text
     assert "| kim_pipeline |" in text
@@ -63,7 +65,7 @@ def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
         return {"unit": top, "fmax_mhz": 1.0}
 
     monkeypatch.setattr(fpga, "place_and_route", fake)
-    unit = lambda b: build_unit("sincos", Config(angle_bits=6, frac_bits=b))[0]
+    unit = lambda b: build_unit("sincos", Config(angle_bits=6, frac_bits=b), ECP5())[0]
     first = fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path)
     assert fpga.place_component(unit(5), "sincos", "LFE5U-25F", tmp_path) == first
     assert len(calls) == 1

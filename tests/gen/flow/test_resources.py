@@ -6,7 +6,8 @@ from amaranth.lib import wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
-from bumprtl.gen.flow.resources import SynthesisError, count_component, count_verilog
+from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_verilog,
+                                        multiplier_pairs)
 from bumprtl.rtl.config import BumpError
 
 
@@ -47,6 +48,8 @@ def known(tmp_path_factory):
 def test_multipliers_by_operand_widths(known):
     assert known.multipliers == ["9x7"]
     assert len(known.const_multipliers) == 1      # c * 3; d * 4 is a shift
+    assert multiplier_pairs(known.multipliers) == [(7, 9)]
+    assert multiplier_pairs(["18x2", "9x7", "7x9"]) == [(2, 18), (7, 9), (7, 9)]  # operand order
 
 
 def test_adders_and_comparators(known):
@@ -69,7 +72,7 @@ def test_register_bits(known):
 
 
 class Single(wiring.Component):
-    """Exactly one multiplier, two adders and one ROM, nothing else (the issue's module)."""
+    """Exactly one multiplier, two adders and one ROM, nothing else."""
 
     x: In(unsigned(8))
     y: In(unsigned(8))

@@ -19,7 +19,7 @@ PALETTE_MODULE = "bumprtl.sim.golden.float.palette"
 
 def test_render_compare_writes_panel_and_prints_psnr(tmp_path):
     out = tmp_path / "lee.png"
-    r = subprocess.run(CLI + ["render", "--scene", "bumps", "--method", "lee_fixed", "--size", "64",
+    r = subprocess.run(CLI + ["render", "--scene", "bumps", "--method", "lee_corrected", "--size", "64",
                               "--out", str(out), "--compare"], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "PSNR" in r.stdout and "max difference" in r.stdout
@@ -28,7 +28,7 @@ def test_render_compare_writes_panel_and_prints_psnr(tmp_path):
     assert img.shape == (64, 64, 3)
     assert panel.shape == (64, 3 * 64 + 8, 3)
     assert np.array_equal(panel[:, 68:132], img)
-    assert panel[:, 136:].any()                         # lee_fixed differs: |diff| is not black
+    assert panel[:, 136:].any()                         # lee_corrected differs: |diff| is not black
 
 
 @pytest.mark.parametrize("scene", ["globe", "cylinder"])

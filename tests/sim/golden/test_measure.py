@@ -22,7 +22,7 @@ def test_compare_counts_nan_instead_of_averaging_it():
 
 
 def test_theta_n_bins_partition_the_pixels():
-    rows = error_by_theta_n("lee_fixed", n=5000, seed=3, step_deg=30)
+    rows = error_by_theta_n("lee_corrected", n=5000, seed=3, step_deg=30)
     assert [r[0] for r in rows] == list(range(0, 180, 30))
     assert sum(r[2] for r in rows) == 5000
 

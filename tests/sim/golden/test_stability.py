@@ -10,12 +10,13 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.exact import exact
-from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.exact import predicted_error_bound_lsb
-from bumprtl.sim.golden.float.lee import lee_fixed, lee_printed
+from bumprtl.sim.golden.float.lee import lee_corrected, lee_printed
 from bumprtl.sim.golden.stress import (CASES, check_fixed, float_stats, payload_fields,
                                        rotate_azimuth, stress_case)
+from bumprtl.sim.traffic import PATTERNS
 
 N = 400
 cases = st.sampled_from(sorted(CASES))
@@ -51,7 +52,7 @@ def test_exact_and_conventional_never_nan_or_out_of_range(case, seed, n):
     cfg = Config(spec_exponent=n)
     px = stress_case(case, N, seed)
     ref = conventional(px, cfg)
-    for model in (conventional, exact, lee_fixed):
+    for model in (conventional, exact, lee_corrected):
         stats = float_stats(model(px, cfg), ref)
         assert stats["nan"] == 0 and stats["overflow"] == 0, (model.__name__, stats)
 
@@ -72,7 +73,7 @@ def test_azimuth_rotation_changes_exact_by_at_most_1_lsb(case, seed, delta):
 
 
 @FEW
-@given(case=cases, seed=seeds, steps=st.integers(0, 4095), method=st.sampled_from(["exact", "lee"]))
+@given(case=cases, seed=seeds, steps=st.integers(0, 4095), method=st.sampled_from(PER_PIXEL))
 def test_azimuth_rotation_by_whole_steps_is_bit_exact_invariant(case, seed, steps, method):
     """Only D = ph_A - ph_N enters (eqs 5-6): turning every azimuth by whole angle steps
     must leave every output bit of the fixed-point models unchanged."""
@@ -97,13 +98,13 @@ def test_fixed_exact_no_overflow_and_within_bound(case, seed, n):
 @FEW
 @given(case=cases, seed=seeds)
 def test_fixed_lee_no_overflow(case, seed):
-    """lee's error is geometric (DESIGN §3 item 7), but no field may leave its width."""
+    """lee's error is geometric (erratum 7), but no field may leave its width."""
     res = check_fixed(datapath_fixed, stress_case(case, N, seed), Config(method="lee"))
     assert sum(res["overflow"].values()) == 0, res["overflow"]
     assert res["diffuse_lsb"].max() <= 255
 
 
-@pytest.mark.parametrize("method", ["exact", "lee"])
+@pytest.mark.parametrize("method", PER_PIXEL)
 def test_overflow_check_can_fail(method):
     """check_fixed flags a value outside its payload width (a model that overflows)."""
     cfg = Config(method=method)
@@ -154,7 +155,7 @@ def test_pipeline_1e6_stress_vectors_verilator(build_dir):
     from bumprtl.sim.golden.stress import pipeline_stimulus
     scene = load_scene_config("default")
     inputs, words = pipeline_stimulus(scene, 250_000, seed=9)
-    patterns = ("no_stall", "input_gaps", "backpressure", "both")
+    patterns = list(PATTERNS)
     outs, _, _ = run_pipeline(scene, inputs, words, None, None, "verilator", build_dir,
                               patterns=patterns, progress=False)
     want = pipeline_fixed(inputs, scene, words)

@@ -5,9 +5,11 @@ import pytest
 
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.methods import PER_PIXEL
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
+from bumprtl.sim.traffic import PATTERNS
 
-METHODS = ["exact", "lee"]
+METHODS = list(PER_PIXEL)              # exact, lee
 
 
 @pytest.mark.parametrize("sim", SIMULATORS)
@@ -15,9 +17,9 @@ METHODS = ["exact", "lee"]
 @pytest.mark.parametrize("method", METHODS)
 def test_datapath_cocotb(sim, unit, method, build_dir):
     v, j = emit_unit(unit, Config(method=method), build_dir / "rtl")
-    tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
-                                 {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 1500})
-    assert (tests, failures) == (4, 0)
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 1500})
+    assert (run.tests, run.failures) == (len(PATTERNS), 0)
 
 
 # Table 1 baselines: one short run per simulator (edge cases + 200 random pixels per pattern),
@@ -28,9 +30,9 @@ def test_datapath_cocotb(sim, unit, method, build_dir):
                                              ("verilator", "illumination", "peercy")])
 def test_baseline_cocotb(sim, unit, method, build_dir):
     v, j = emit_unit(unit, Config(method=method), build_dir / "rtl")
-    tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
-                                 {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 200})
-    assert (tests, failures) == (4, 0)
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", build_dir / sim,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 200})
+    assert (run.tests, run.failures) == (len(PATTERNS), 0)
 
 
 @pytest.mark.regress

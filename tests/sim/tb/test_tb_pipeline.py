@@ -9,8 +9,7 @@ from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline, sce
                                     scene_texels)
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
-
-PATTERNS = ("no_stall", "backpressure", "both")
+from bumprtl.sim.traffic import PATTERNS
 
 
 @pytest.mark.parametrize("sim, name", [("verilator", "full"), ("icarus", "default")])
@@ -20,7 +19,7 @@ def test_pipeline_stream_cocotb(sim, name, build_dir):
     inputs, words, polygon, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
     outs, cycles, _ = run_pipeline(scene, inputs, words, polygon, table, sim, build_dir,
-                                   patterns=PATTERNS, progress=False, texels=texels)
+                                   patterns=list(PATTERNS), progress=False, texels=texels)
     golden = pipeline_fixed(inputs, scene, words, polygon, texels)
     assert ("color.r" in golden) == scene.texture
     n = len(inputs["tag"])

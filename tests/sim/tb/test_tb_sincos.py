@@ -5,20 +5,21 @@ import pytest
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import Config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
+from bumprtl.sim.traffic import PATTERNS
 
 
 @pytest.mark.parametrize("sim", SIMULATORS)
 @pytest.mark.parametrize("angle_bits, frac_bits", [(12, 13), (8, 8)])
 def test_sincos_cocotb(sim, angle_bits, frac_bits, build_dir):
     v, j = emit_unit("sincos", Config(angle_bits=angle_bits, frac_bits=frac_bits), build_dir / "rtl")
-    tests, failures = run_cocotb(sim, v, "bumprtl.sim.tb.tb_sincos", build_dir / sim,
-                                 {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 600})
-    assert (tests, failures) == (4, 0)
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_sincos", build_dir / sim,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 600})
+    assert (run.tests, run.failures) == (len(PATTERNS), 0)
 
 
 def test_missing_simulator_fails_with_install_hint(monkeypatch, tmp_path):
     """A simulator that is not on PATH is an error naming the install command, never a skip."""
-    from bumprtl.gen.flow import toolchain
+    from bumprtl.sim import toolchain
     monkeypatch.setattr(toolchain.shutil, "which", lambda *a, **k: None)
     v, _ = emit_unit("sincos", Config(angle_bits=8, frac_bits=8), tmp_path)
     with pytest.raises(toolchain.ToolMissing, match="apt-get install -y iverilog"):

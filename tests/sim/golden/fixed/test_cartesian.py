@@ -1,4 +1,4 @@
-"""The Peercy/Ernst fixed-point golden model (sim/golden/fixed_peercy.py) against float64:
+"""The Peercy/Ernst fixed-point golden model (sim/golden/fixed/peercy.py) against float64:
 the stated error bound (predicted_error_bound_lsb and its first-order dot-product bound),
 the encoder, the integer square root, and width/symmetry properties of the normalization
 over the whole input range (Hypothesis)."""
@@ -15,10 +15,8 @@ from bumprtl.sim.golden.fixed import ernst as fixed_ernst
 from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.fixed.dispatch import datapath_fixed
+from bumprtl.rtl.methods import datapath_fixed
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
-
-DEFAULT = Config(method="peercy")
 
 
 def _errors(cfg, samples=20_000, seed=11):
@@ -30,8 +28,9 @@ def _errors(cfg, samples=20_000, seed=11):
     return diffuse, ndotl_u
 
 
-@pytest.mark.parametrize("cfg", [DEFAULT, DEFAULT.replace(angle_bits=8, frac_bits=8),
-                                 DEFAULT.replace(frac_bits=20)], ids=["B13", "B8", "B20"])
+@pytest.mark.parametrize("cfg", [Config(method="peercy"),
+                                 Config(method="peercy", angle_bits=8, frac_bits=8),
+                                 Config(method="peercy", frac_bits=20)], ids=["B13", "B8", "B20"])
 def test_diffuse_within_the_predicted_bound(cfg):
     """20 000 random valid pixels: |diffuse8 - round(255 clamp(N'.L'))| <= the bound of the
     docstring, and N'.L' itself within its first-order (5/2 + 2 sqrt 3) u + 2 u**2."""
@@ -43,7 +42,7 @@ def test_diffuse_within_the_predicted_bound(cfg):
 
 def test_the_bound_is_not_vacuous_at_narrow_widths():
     """At B = 8 the bound is several LSB and the datapath does err by more than 1 LSB."""
-    cfg = DEFAULT.replace(angle_bits=8, frac_bits=8)
+    cfg = Config(method="peercy", angle_bits=8, frac_bits=8)
     diffuse, _ = _errors(cfg)
     assert 1 < diffuse.max() <= fixed_peercy.predicted_error_bound_lsb(cfg) < 255
 
@@ -52,7 +51,8 @@ def test_ernst_is_peercy_per_pixel():
     px = PixelInputs.random(500, np.random.default_rng(3))
     cfg = Config(method="ernst")
     a = datapath_fixed(fixed_ernst.encode(px, cfg), cfg)
-    b = datapath_fixed(fixed_peercy.encode(px, DEFAULT), DEFAULT)
+    peercy = Config(method="peercy")
+    b = datapath_fixed(fixed_peercy.encode(px, peercy), peercy)
     assert all(np.array_equal(a[k], b[k]) for k in b)
     ref, ern = conventional(px, cfg), FLOAT_MODELS["ernst"](px, cfg)
     assert np.abs(ern.ndotl - ref.ndotl).max() < 1e-12
@@ -61,8 +61,9 @@ def test_ernst_is_peercy_per_pixel():
 
 def test_encode_rounds_each_component_to_nearest():
     px = PixelInputs.random(300, np.random.default_rng(4))
-    codes = fixed_peercy.encode(px, DEFAULT)
-    b = DEFAULT.frac_bits
+    cfg = Config(method="peercy")
+    codes = fixed_peercy.encode(px, cfg)
+    b = cfg.frac_bits
     exact = polar_to_cartesian(px.l_phi, px.l_theta) * 2.0 ** b
     for i, a in enumerate("xyz"):
         assert np.abs(codes[f"l.{a}"] - exact[..., i]).max() <= 0.5
@@ -70,12 +71,13 @@ def test_encode_rounds_each_component_to_nearest():
     assert np.array_equal(codes["n.z"], np.rint(np.cos(px.n_theta) * 2.0 ** b))
     assert np.array_equal(codes["b.x"], np.rint(-np.sin(px.n_phi) * 2.0 ** b))
     assert not np.any(codes["b.z"])
-    assert "h.x" not in fixed_peercy.encode(px, DEFAULT.replace(specular=False))
+    assert "h.x" not in fixed_peercy.encode(px, cfg.replace(specular=False))
 
 
 def test_from_angle_codes_gives_exact_axes():
     """theta 0 and 90 degrees and phi 0 are exact in Cartesian codes."""
-    cfg, q = DEFAULT, DEFAULT.full_circle // 4
+    cfg = Config(method="peercy")
+    q = cfg.full_circle // 4
     z = np.zeros(1, np.int64)
     codes = {"n.phi": z, "n.theta": z, "l.phi": z, "l.theta": z + q, "h.phi": z + q,
              "h.theta": z + q, "b.phi": z, "b.theta": z}
@@ -97,7 +99,8 @@ def test_isqrt_is_floor_sqrt():
 
 # --- properties of the normalization over any input code -------------------------------------
 
-B = DEFAULT.frac_bits
+PEERCY = Config(method="peercy")            # the widths the Hypothesis properties draw from
+B = PEERCY.frac_bits
 CODE = st.integers(-(1 << (B + 1)), (1 << (B + 1)) - 1)
 
 
@@ -113,10 +116,10 @@ def test_widths_hold_every_input(values):
     |A_n| components fit signed(B + 2)."""
     frame = [values[0:3], values[3:6], values[6:9]]
     at = _transformed(frame, values[9:12])
-    assert all(abs(int(x)) < 1 << (component_width(DEFAULT) - 1) for x in at)
+    assert all(abs(int(x)) < 1 << (component_width(PEERCY) - 1) for x in at)
     s = sum(int(x) ** 2 for x in at)
-    assert s < 1 << square_bits(DEFAULT)
-    an = fixed_peercy.normalize_fixed([np.array([x]) for x in at], DEFAULT)
+    assert s < 1 << square_bits(PEERCY)
+    an = fixed_peercy.normalize_fixed([np.array([x]) for x in at], PEERCY)
     assert all(-(1 << (B + 1)) <= int(x[0]) < 1 << (B + 1) for x in an)
 
 
@@ -125,8 +128,8 @@ def test_normalization_is_odd_and_unit_length(at):
     """Negating A_t negates A_n (round half away from zero); for |A_t| >= 1/2 the result
     has length 1 within the floored root (relative 2**-(B+1) / |A_t| <= u) and the three
     quotient roundings (sqrt 3 / 2 u): 2 u in all."""
-    pos = fixed_peercy.normalize_fixed([np.array([x]) for x in at], DEFAULT)
-    neg = fixed_peercy.normalize_fixed([np.array([-x]) for x in at], DEFAULT)
+    pos = fixed_peercy.normalize_fixed([np.array([x]) for x in at], PEERCY)
+    neg = fixed_peercy.normalize_fixed([np.array([-x]) for x in at], PEERCY)
     assert [int(p[0]) for p in pos] == [-int(n[0]) for n in neg]
     if sum(x * x for x in at) >= (1 << (2 * B)) // 4:
         length = math.sqrt(sum(int(p[0]) ** 2 for p in pos))

@@ -1,4 +1,4 @@
-"""The bit-exact kim baseline model (sim/golden/fixed_kim.py) against float64: the diffuse
+"""The bit-exact kim baseline model (sim/golden/fixed/kim.py) against float64: the diffuse
 error stays within the derived bound (predicted_error_bound_lsb) on random valid, adversarial
 and stress inputs; the rotated directions stay within direction_error_bound of the float64
 Kim model; the polar recovery is exact on the axes and at the poles (where ph is undefined
@@ -11,13 +11,14 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import quantize_pixels
-from bumprtl.sim.golden.fixed.kim import (direction_error_bound, kim_fixed,
-                                          predicted_error_bound_lsb, rotate_fixed,
-                                          to_polar_fixed)
+from bumprtl.rtl.methods import METHODS
+from bumprtl.sim.golden.fixed.kim import (direction_error_bound, predicted_error_bound_lsb,
+                                          rotate_fixed, to_polar_fixed)
 from bumprtl.sim.golden.float.kim import kim
 from bumprtl.sim.golden.stress import CASES, stress_case
 
 CFG = Config(method="kim")
+kim_fixed = METHODS["kim"].datapath_fixed           # rotation then illumination, bit-exact
 
 
 def dequantize(codes, cfg):
@@ -31,7 +32,7 @@ def directions(phi_codes, theta_codes, cfg):
 
 
 def test_diffuse_error_within_bound_on_20000_random_valid():
-    """The issue's measurement: 20 000 random valid pixels at the default widths."""
+    """20 000 random valid pixels at the default widths stay within the predicted bound."""
     px = PixelInputs.random(20_000, np.random.default_rng(11))
     err = diffuse_error_lsb(kim_fixed, px, CFG)
     bound = predicted_error_bound_lsb(CFG)

@@ -1,4 +1,4 @@
-"""The exact angular method (DESIGN §3): every identity against explicit 3x3 rotation
+"""The exact angular method (docs/architecture.md): every identity against explicit 3x3 rotation
 matrices, agreement with the Cartesian reference on 10^5 random inputs and on the edges."""
 
 import numpy as np

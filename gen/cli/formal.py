@@ -1,0 +1,15 @@
+"""``bumprtl formal``: SymbiYosys proofs of the stream contract (sim/formal/, docs/formal.md)."""
+
+from bumprtl.sim.formal.run import add_arguments, execute
+
+
+def add_parser(sub):
+    p = sub.add_parser("formal", help="prove the stream contract of every unit and scene pipeline",
+                       description="k-induction (BMC where it does not close) of the stream "
+                                   "contract with SymbiYosys: payload held under stall, every "
+                                   "pixel once and in order, latency without bubbles, i.ready "
+                                   "while the output is empty, no output without input, the "
+                                   "palette's double buffer; broken units must fail. Prints the "
+                                   "proof table; exit 1 and the counterexample trace on failure.")
+    add_arguments(p)
+    p.set_defaults(func=execute)

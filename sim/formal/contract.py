@@ -1,0 +1,313 @@
+"""The stream contract as Amaranth properties, in a formal-only wrapper around a unit.
+
+:class:`StreamContract` elaborates a unit (a ``wiring.Component`` with ``i``/``o``
+``amaranth.lib.stream`` ports and a ``tag`` payload field) inside a top that drives nothing:
+every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports, ``rst``) is a
+free input of the model, so the solver plays every producer, consumer and host there is.
+One wrapper checks one property (:data:`PROPERTIES`):
+
+``hold``     o.payload and o.valid are held while ``o.valid & ~o.ready`` (stream rule 2);
+``ready``    ``i.ready`` is high while ``o.valid`` is low: a slow consumer never stops the
+             pipe from filling (the mutation ``adv = o.ready`` of rtl/pipe.py fails it);
+``order``    every accepted input comes out exactly once and in order: the inputs carry
+             consecutive tags (assumed), the n-th output must carry tag n;
+``quiet``    no output without an input: with nothing in flight (accepted minus delivered
+             is 0, counted from reset) ``o.valid`` is low;
+``latency``  with ``o.ready`` held high the output is the input ``latency`` cycles later,
+             valid for valid and tag for tag (no bubble added, none removed);
+``cover``    vacuity check: a transfer, a stall and a transfer after a stall are reachable.
+``bank``     PaletteLUT's double buffer (units with ``swap``/``w_*``/``bank`` ports): a pixel
+             reads the entry of the bank that was in front in the cycle it was accepted,
+             whatever the host writes or swaps while it is in flight or stalled. The swap
+             strobe is the frame boundary (the host strobes it between frames; PaletteLUT
+             has no frame signal of its own), so all pixels of a frame read one bank and a
+             swap strobed while the last pixels of a frame are still in the pipe takes
+             effect only for the pixels accepted after it. A symbolic entry (any address,
+             fixed for the trace) is shadowed in both banks and one symbolic pixel reading
+             it is followed to the output.
+
+k-induction needs the contract to be inductive, so the wrapper also asserts *lemmas* about
+the unit's own pipeline registers: the number of valid stages equals the pixels in flight,
+the tag held in each valid stage is the one the order says, and units that run in lock step
+have equal valid chains. It finds those registers by observing
+:class:`bumprtl.rtl.pipe.StallPipe` while the unit elaborates (:func:`observe_pipes`:
+the valid chain and the ``tag`` delay line of every pipe, keyed by its input valid), so no
+unit carries formal-only code. ``lemmas=False`` leaves them out (plain BMC, and the broken
+units of :mod:`bumprtl.sim.formal.mutants`, whose failure must be the property itself).
+"""
+
+import contextlib
+import re
+
+from amaranth.hdl import (Assert, Assume, Const, Cover, Elaboratable, Fragment, Module, Mux,
+                          Signal, Value, ValueCastable)
+from amaranth.lib import wiring
+
+from bumprtl.rtl.pipe import StallPipe
+
+__all__ = ["PROPERTIES", "StreamContract", "observe_pipes", "pipeline_layers"]
+
+PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
+
+_TAG_REG = re.compile(r"tag_d(\d+)$")
+
+
+@contextlib.contextmanager
+def observe_pipes():
+    """Record every :class:`StallPipe` built while the block runs: yields a dict
+    ``id(input valid signal) -> {"valid": [i.valid, stage1, ...], "adv": adv,
+    "tags": {n: tag register of stage n}}``. StallPipe itself is restored afterwards."""
+    seen = {}
+    init, register = StallPipe.__init__, StallPipe.register
+
+    def observed_init(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        self._formal = {"valid": list(self.valid), "adv": self.adv, "tags": {}}
+        seen[id(self.valid[0])] = self._formal
+
+    def observed_register(self, value, name, *args, **kwargs):
+        reg = register(self, value, name, *args, **kwargs)
+        match = _TAG_REG.match(str(name))
+        if match and hasattr(self, "_formal"):
+            self._formal["tags"][int(match.group(1))] = reg
+        return reg
+
+    StallPipe.__init__, StallPipe.register = observed_init, observed_register
+    try:
+        yield seen
+    finally:
+        StallPipe.__init__, StallPipe.register = init, register
+
+
+def pipeline_layers(dut):
+    """The lock-step layers of a :class:`~bumprtl.rtl.pipeline.BumpPipeline` (first unit
+    of each layer carries the tag), or ``[[dut]]`` for a single unit."""
+    layers = getattr(dut, "_layers", None)
+    if layers is None or not hasattr(dut, "units"):
+        return [[dut]]
+    return [[dut.units[name] for name in layer] for layer in layers]
+
+
+class _Built(Elaboratable):
+    """An already elaborated fragment as a submodule."""
+
+    def __init__(self, fragment):
+        self.fragment = fragment
+
+    def elaborate(self, platform):
+        return self.fragment
+
+
+class StreamContract(Elaboratable):
+    """Formal wrapper: ``dut`` and the properties of ``prop`` (one of :data:`PROPERTIES`).
+
+    Parameters
+    ----------
+    dut : wiring.Component with ``i``/``o`` streams whose payloads have a ``tag`` field.
+    prop : str
+    latency : int, optional
+        Defaults to ``dut.latency``.
+    layers : list of lists of units, optional
+        The lock-step layers the pixels pass (default :func:`pipeline_layers`).
+    lemmas : bool
+        Assert the pipeline-register lemmas that make the property k-inductive.
+    """
+
+    def __init__(self, dut, prop, latency=None, layers=None, lemmas=True):
+        if prop not in PROPERTIES:
+            raise ValueError(f"property must be one of {', '.join(PROPERTIES)}, got {prop!r}")
+        self.dut, self.prop, self.lemmas = dut, prop, lemmas
+        self.latency = dut.latency if latency is None else latency
+        self.layers = layers if layers is not None else pipeline_layers(dut)
+        self.lemma_count = 0
+        self.messages = {}
+        self._free = []
+        if prop == "bank":
+            if getattr(dut, "cfg", None) is None or dut.cfg.palette_blend:
+                raise ValueError("bank: a PaletteLUT without the blend stage")
+            self.watch_addr = Signal(len(dut.w_addr), name="watch_addr")   # any constant
+            self.watch_pick = Signal(name="watch_pick")                    # any sequence
+            self._free = [self.watch_addr, self.watch_pick]
+
+    # --- the unit's pipeline registers ------------------------------------------------------
+    def _stages(self, pipes):
+        """Chain stages input -> output: ``[(valid, tag or None)]``, and the lock-step pairs
+        ``[(lead valid, other valid)]``."""
+        stages, lockstep = [], []
+        for layer in self.layers:
+            recs = [pipes.get(id(unit.i.valid)) for unit in layer]
+            lead = recs[0]
+            if lead is None:             # not built on a StallPipe: no lemmas (BMC only)
+                return [], []
+            for n in range(1, len(lead["valid"])):
+                stages.append((lead["valid"][n], lead["tags"].get(n)))
+            for rec in recs[1:]:
+                if rec is not None:
+                    lockstep += list(zip(lead["valid"][1:], rec["valid"][1:]))
+        return stages, lockstep
+
+    def free_inputs(self):
+        """Every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports) and
+        the clock and reset: the model's free inputs, chosen by the solver in every cycle."""
+        ports = []
+        for _path, member, value in self.dut.signature.flatten(self.dut):
+            if member.flow == wiring.In:
+                ports.append(value.as_value() if isinstance(value, ValueCastable) else Value.cast(value))
+        return ports + self._free
+
+    def _check(self, m, test, message, src_loc_at=1):
+        """``Assert(test)``; sby names a failed one by its source line, ``messages`` maps
+        that line back to ``message``."""
+        check = Assert(test, message, src_loc_at=src_loc_at)
+        self.messages[f"{check.src_loc[0]}:{check.src_loc[1]}"] = message
+        m.d.comb += check
+
+    def _lemma(self, m, test, what):
+        self.lemma_count += 1
+        self._check(m, test, f"lemma ({what})", src_loc_at=2)
+
+    def describe(self, location):
+        """The message of the assertion sby reports at ``location`` (``file:line ...``)."""
+        return self.messages.get(location.split(" ")[0], location)
+
+    def elaborate(self, platform):
+        m = Module()
+        dut = self.dut
+        with observe_pipes() if self.lemmas else contextlib.nullcontext({}) as pipes:
+            fragment = Fragment.get(dut, platform)
+        m.submodules.dut = _Built(fragment)
+        i, o = dut.i, dut.o
+        take_in = i.valid & i.ready
+        take_out = o.valid & o.ready
+        stages, lockstep = self._stages(pipes) if self.lemmas else ([], [])
+        if self.lemmas:
+            for lead, other in lockstep:
+                self._lemma(m, lead == other, "lock-step units have equal valid chains")
+        getattr(self, f"_{self.prop}")(m, i, o, take_in, take_out, stages)
+        return m
+
+    # --- the properties ---------------------------------------------------------------------
+    def _hold(self, m, i, o, take_in, take_out, stages):
+        """Rule 2: a pending output keeps its valid and payload until it is taken (a reset
+        in between may clear it)."""
+        stalled = Signal(name="past_stalled")
+        payload = Signal(len(o.payload.as_value()), name="past_payload")
+        m.d.sync += [stalled.eq(o.valid & ~o.ready), payload.eq(o.payload.as_value())]
+        # ``stalled`` is reset with the unit: a reset in the stalled cycle clears the check.
+        self._check(m, ~stalled | (o.valid & (o.payload.as_value() == payload)),
+                           "hold: o.valid/o.payload changed while stalled")
+
+    def _ready(self, m, i, o, take_in, take_out, stages):
+        self._check(m, o.valid | i.ready, "ready: i.ready low while o.valid low")
+
+    def _ahead(self, m, width, stages):
+        """``ahead[j]``: valid stages downstream of stage ``j``, as comb signals summed from
+        the output backwards (linear in the stages); and their total."""
+        if hasattr(self, "_ahead_sums"):
+            return self._ahead_sums
+        ahead, run = [None] * len(stages), Const(0, width)
+        for j in reversed(range(len(stages))):
+            ahead[j] = run
+            nxt = Signal(width, name=f"valid_from_stage{j + 1}")
+            m.d.comb += nxt.eq(run + stages[j][0])
+            run = nxt
+        self._ahead_sums = ahead, run
+        return self._ahead_sums
+
+    def _occupancy(self, m, take_in, take_out, stages):
+        width = (len(stages) + 1).bit_length() + 1
+        occ = Signal(width, name="in_flight")
+        m.d.sync += occ.eq(occ + take_in - take_out)
+        if self.lemmas and stages:
+            _ahead, total = self._ahead(m, width, stages)
+            self._lemma(m, occ == total, "valid stages = pixels in flight")
+        return occ
+
+    def _quiet(self, m, i, o, take_in, take_out, stages):
+        occ = self._occupancy(m, take_in, take_out, stages)
+        self._check(m, ~o.valid | (occ != 0), "quiet: o.valid with nothing in flight")
+
+    def _order(self, m, i, o, take_in, take_out, stages):
+        bits = len(i.payload.tag)
+        n_in, n_out = Signal(bits, name="tag_in"), Signal(bits, name="tag_out")
+        m.d.sync += [n_in.eq(n_in + take_in), n_out.eq(n_out + take_out)]
+        m.d.comb += Assume(~i.valid | (i.payload.tag == n_in))
+        self._check(m, ~o.valid | (o.payload.tag == n_out), "order: output tag out of sequence")
+        if self.lemmas and stages:
+            # Consecutive valid stages hold consecutive tags, the one nearest the output
+            # holds n_out and the next input gets one past the youngest: a chain of muxes
+            # from the output backwards (no counting, which SAT solvers find hard).
+            expect = n_out
+            for j in reversed(range(len(stages))):
+                valid, tag = stages[j]
+                if tag is None:
+                    return
+                self._lemma(m, ~valid | (tag == expect), "valid stages hold consecutive tags")
+                nxt = Signal(bits, name=f"tag_after_stage{j + 1}")
+                m.d.comb += nxt.eq(Mux(valid, tag + 1, expect))
+                expect = nxt
+            self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
+
+    def _latency(self, m, i, o, take_in, take_out, stages):
+        """o.ready held high: the valid chain and the tags are a plain delay line."""
+        m.d.comb += Assume(o.ready)
+        self._check(m, i.ready, "latency: i.ready low with o.ready held high")
+        valid, tag = [i.valid], [i.payload.tag]
+        for n in range(1, self.latency + 1):
+            v, t = Signal(name=f"ref_valid{n}"), Signal.like(i.payload.tag, name=f"ref_tag{n}")
+            m.d.sync += [v.eq(valid[-1]), t.eq(tag[-1])]
+            valid.append(v)
+            tag.append(t)
+        self._check(m, o.valid == valid[-1], "latency: o.valid is not i.valid delayed by latency")
+        self._check(m, ~o.valid | (o.payload.tag == tag[-1]),
+                           "latency: o.tag is not i.tag delayed by latency")
+        if self.lemmas and len(stages) == self.latency:
+            for n, (v, t) in enumerate(stages, start=1):
+                self._lemma(m, v == valid[n], "stage n valid = i.valid n cycles ago")
+                if t is not None:
+                    self._lemma(m, ~v | (t == tag[n]), "stage n tag = i.tag n cycles ago")
+
+    def _cover(self, m, i, o, take_in, take_out, stages):
+        stalled = Signal(name="was_stalled")
+        m.d.sync += stalled.eq(o.valid & ~o.ready)
+        m.d.comb += [Cover(take_out), Cover(o.valid & ~o.ready), Cover(stalled & take_out),
+                     Cover(take_in & take_out)]
+
+    def _bank(self, m, i, o, take_in, take_out, stages):
+        dut, size = self.dut, self.dut.cfg.palette_size
+        sel, pick = self.watch_addr, self.watch_pick
+        sel_q, first = Signal.like(sel, reset_less=True), Signal(init=1, reset_less=True)
+        m.d.sync += [sel_q.eq(sel), first.eq(0)]
+        m.d.comb += [Assume(first | (sel == sel_q)), Assume(sel < size)]
+        front = Signal(name="ref_front")                 # reset with the unit, like its bank
+        with m.If(dut.swap):
+            m.d.sync += front.eq(~front)
+        self._check(m, dut.bank == front, "bank: the bank output is not the front bank")
+        word = len(dut.w_data.as_value())
+        # The watched entry in bank 0 and bank 1 (memory is not reset, neither are these).
+        shadow = [Signal(word, name=f"ref_bank{b}_entry", reset_less=True) for b in (0, 1)]
+        with m.If(dut.w_en & (dut.w_addr == sel)):
+            with m.If(front):
+                m.d.sync += shadow[0].eq(dut.w_data.as_value())
+            with m.Else():
+                m.d.sync += shadow[1].eq(dut.w_data.as_value())
+        occ = self._occupancy(m, take_in, take_out, stages)
+        watching, ahead = Signal(name="watching"), Signal.like(occ, name="watch_ahead")
+        expected = Signal(word, name="watch_expected")
+        start = take_in & (i.payload.index == sel) & ~watching & pick
+        deliver = watching & take_out & (ahead == 0)
+        with m.If(start):
+            m.d.sync += [watching.eq(1), ahead.eq(occ - take_out),
+                         expected.eq(Mux(front, shadow[1], shadow[0]))]
+        with m.Elif(deliver):
+            m.d.sync += watching.eq(0)
+        with m.Elif(watching & take_out):
+            m.d.sync += ahead.eq(ahead - 1)
+        self._check(m, ~deliver | (o.payload.color.as_value() == expected),
+                           "bank: a pixel read another bank than the one in front when it was accepted")
+        swapped = Signal(name="swapped_in_flight")
+        with m.If(start):
+            m.d.sync += swapped.eq(0)
+        with m.Elif(watching & dut.swap):
+            m.d.sync += swapped.eq(1)
+        m.d.comb += Cover(deliver & swapped & (shadow[0] != shadow[1]))

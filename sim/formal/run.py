@@ -1,0 +1,204 @@
+"""Run the formal checks of :mod:`bumprtl.sim.formal.targets` and print the proof table.
+
+``python -m bumprtl.sim.formal.run`` or ``bumprtl formal`` (``make formal`` runs all of it
+and writes docs/formal.md). Each (unit, property) is one sby job under ``build/formal/``:
+k-induction (``mode prove``) first; a property whose induction does not close at the
+induction depth is checked by BMC to ``latency + BMC_MARGIN`` instead and reported as
+*bounded*. A failed property prints its message and the counterexample trace and the run
+exits 1. The broken units of :mod:`bumprtl.sim.formal.mutants` must each fail theirs.
+"""
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from bumprtl.sim.formal.contract import StreamContract
+from bumprtl.sim.formal.mutants import MUTANTS
+from bumprtl.sim.formal.sby import run_sby
+from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
+
+__all__ = ["Row", "check", "check_mutant", "run", "table", "main", "INDUCTION_DEPTH"]
+
+INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
+BMC_MARGIN = 6               # BMC depth = latency + this (every pixel reaches the output)
+BANK_DEPTH = 8               # the palette bank check: write, swap, accept, stall, swap, deliver
+
+
+@dataclass
+class Row:
+    unit: str
+    prop: str
+    result: str              # proved | bounded | covered | FAIL | ...
+    depth: int
+    seconds: float
+    latency: int
+    lemmas: int = 0
+    detail: str = ""
+    trace: str = ""
+
+    @property
+    def ok(self):
+        return self.result in ("proved", "bounded", "covered", "fails as expected")
+
+
+def _job(top, workdir, name, mode, depth, script=()):
+    return run_sby(top, workdir, name, mode=mode, depth=depth, script=script)
+
+
+def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
+    """One (target, property): returns a :class:`Row`."""
+    workdir = Path(root) / target.name
+    t0 = time.perf_counter()
+    if prop == "cover":
+        dut = target.unit()
+        top = StreamContract(dut, prop, lemmas=False)
+        res = _job(top, workdir, prop, "cover", dut.latency + BMC_MARGIN)
+        result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
+        return _row(target, prop, result, res, top, dut, t0)
+    if prop == "bank":
+        dut = target.unit()
+        top = StreamContract(dut, prop, lemmas=False)
+        res = _job(top, workdir, prop, "bmc", BANK_DEPTH, script=("memory_map", "opt -fast"))
+        return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
+    dut = target.unit()
+    top = StreamContract(dut, prop)
+    res = _job(top, workdir, prop, "prove", induction_depth)
+    if res.passed:
+        return _row(target, prop, "proved", res, top, dut, t0)
+    if res.status == "UNKNOWN" or (res.status == "FAIL" and not res.trace):
+        # induction did not close: fall back to BMC without the lemmas
+        dut = target.unit()
+        top = StreamContract(dut, prop, lemmas=False)
+        res = _job(top, workdir, f"{prop}_bmc", "bmc", dut.latency + BMC_MARGIN)
+        return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
+    return _row(target, prop, res.status, res, top, dut, t0)
+
+
+def _row(target, prop, result, res, top, dut, t0):
+    detail = "; ".join(top.describe(f) for f in res.failed) if not res.passed else ""
+    if res.status == "ERROR" and not detail:
+        detail = res.log.strip().splitlines()[-1] if res.log.strip() else "sby error"
+    return Row(target.name, prop, result, res.depth, time.perf_counter() - t0, dut.latency,
+               top.lemma_count, detail, str(res.trace or ""))
+
+
+def check_mutant(name, root, cfg=None):
+    """A broken unit against the property it breaks (BMC): the row says whether it failed."""
+    cls, prop = MUTANTS[name]
+    cfg = cfg or Config(**SMALL)
+    dut = cls(cfg)
+    top = StreamContract(dut, prop, lemmas=False)
+    t0 = time.perf_counter()
+    depth = BANK_DEPTH if prop == "bank" else dut.latency + BMC_MARGIN
+    script = ("memory_map", "opt -fast") if prop == "bank" else ()
+    res = run_sby(top, Path(root) / "mutants", name, mode="bmc", depth=depth, script=script)
+    result = "fails as expected" if res.status == "FAIL" and res.trace else \
+        ("NOT CAUGHT" if res.passed else res.status)
+    detail = "; ".join(top.describe(f) for f in res.failed)
+    return Row(f"mutant {name}", prop, result, depth, time.perf_counter() - t0, dut.latency,
+               0, detail, str(res.trace or ""))
+
+
+def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print):
+    """Every requested check; returns the rows (in order)."""
+    names = list(names or TARGETS)
+    jobs_list = []
+    for name in names:
+        target = TARGETS[name]
+        for prop in target.props:
+            if props is None or prop in props:
+                jobs_list.append(lambda t=target, p=prop: check(t, p, root))
+    if mutants:
+        for name, (_cls, prop) in MUTANTS.items():
+            if props is None or prop in props:
+                jobs_list.append(lambda n=name: check_mutant(n, root))
+    rows = []
+
+    def one(job):
+        row = job()
+        log(f"{row.unit:<24} {row.prop:<8} {row.result:<18} depth {row.depth:<3} "
+            f"{row.seconds:6.1f} s {row.detail}")
+        return row
+
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        rows = list(pool.map(one, jobs_list))
+    return rows
+
+
+def table(rows):
+    """The proof table as Markdown."""
+    lines = ["| unit | property | result | depth | latency | lemmas | seconds |",
+             "| --- | --- | --- | ---: | ---: | ---: | ---: |"]
+    for r in rows:
+        lines.append(f"| {r.unit} | {r.prop} | {r.result} | {r.depth} | {r.latency} | "
+                     f"{r.lemmas} | {r.seconds:.1f} |")
+    return "\n".join(lines)
+
+
+def failures(rows):
+    return [r for r in rows if not r.ok]
+
+
+def report_failures(rows, out=sys.stderr):
+    bad = failures(rows)
+    for r in bad:
+        print(f"FAILED: {r.unit} property {r.prop}: {r.result}"
+              + (f" ({r.detail})" if r.detail else ""), file=out)
+        if r.trace:
+            print(f"  counterexample: {r.trace}", file=out)
+    return bad
+
+
+def add_arguments(p):
+    p.add_argument("units", nargs="*", metavar="UNIT",
+                   help=f"targets to check (default: all): {', '.join(TARGETS)}")
+    p.add_argument("--prop", action="append", dest="props", metavar="PROP",
+                   help="only these properties (repeatable)")
+    p.add_argument("--no-mutants", dest="mutants", action="store_false",
+                   help="skip the broken units that must fail")
+    p.add_argument("--quick", action="store_true", help="leave out the slow targets (baselines, pipelines)")
+    p.add_argument("-j", "--jobs", type=int, default=1, help="sby jobs in parallel (default 1)")
+    p.add_argument("--out", type=Path, default=Path("build/formal"), help="work directory")
+    p.add_argument("--from-results", action="store_true",
+                   help="do not run: reprint (and --doc) the table of OUT/results.json")
+    p.add_argument("--doc", type=Path, default=None,
+                   help="write the table into this Markdown file (docs/formal.md)")
+
+
+def execute(args):
+    unknown = [u for u in args.units if u not in TARGETS]
+    if unknown:
+        print(f"error: unknown formal target {unknown[0]!r}: allowed {', '.join(TARGETS)}",
+              file=sys.stderr)
+        return 2
+    names = args.units or [n for n, t in TARGETS.items() if not (args.quick and t.slow)]
+    t0 = time.perf_counter()
+    if args.from_results:
+        rows = [Row(**r) for r in json.loads((args.out / "results.json").read_text())]
+    else:
+        rows = run(names, args.props, args.mutants, args.out, args.jobs)
+        args.out.mkdir(parents=True, exist_ok=True)
+        (args.out / "results.json").write_text(json.dumps([asdict(r) for r in rows], indent=1))
+    print()
+    print(table(rows))
+    print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")
+    if args.doc is not None:
+        from bumprtl.sim.formal.doc import write_doc
+        write_doc(args.doc, rows, " ".join(sys.argv[1:]))
+        print(f"wrote {args.doc}")
+    return 1 if report_failures(rows) else 0
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python -m bumprtl.sim.formal.run", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(p)
+    return execute(p.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

