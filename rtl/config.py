@@ -22,7 +22,13 @@ METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
 
 class BumpError(ValueError):
     """Bad input to bumprtl. The message is one line that names the parameter and its
-    allowed range; the CLI prints it and exits with status 2, never a traceback."""
+    allowed range; the CLI prints it and exits with status 2, never a traceback. ``field``
+    is the parameter's name (None when the error is not about one parameter), so tests and
+    callers can tell which value was refused without parsing the wording."""
+
+    def __init__(self, message, field=None):
+        super().__init__(message)
+        self.field = field
 
 
 class ConfigError(BumpError):
@@ -31,15 +37,15 @@ class ConfigError(BumpError):
 
 def _check_int(name, value, lo, hi, why=""):
     if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}")
+        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}", name)
     if not lo <= value <= hi:
         extra = f" ({why})" if why else ""
-        raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}")
+        raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}", name)
 
 
 def _check_unit(name, value):
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 1.0:
-        raise ConfigError(f"{name} must be a number in [0, 1], got {value!r}")
+        raise ConfigError(f"{name} must be a number in [0, 1], got {value!r}", name)
 
 
 @dataclass(frozen=True)
@@ -105,7 +111,8 @@ class Config:
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
                    f"half an LSB; B <= 24 keeps every product inside 64 bits")
         if self.method not in METHOD_NAMES:
-            raise ConfigError(f"method must be one of {', '.join(METHOD_NAMES)}, got {self.method!r}")
+            raise ConfigError(f"method must be one of {', '.join(METHOD_NAMES)}, got {self.method!r}",
+                              "method")
         _check_int("tag_bits", self.tag_bits, 0, 32)
         _check_int("out_bits", self.out_bits, 8, 8, "outputs are 8-bit intensities")
         _check_int("spec_exponent", self.spec_exponent, 1, 1024)
@@ -114,11 +121,12 @@ class Config:
             _check_unit(name, getattr(self, name))
         _check_int("lights", self.lights, 1, 8)
         if not isinstance(self.specular, bool):
-            raise ConfigError(f"specular must be true or false, got {self.specular!r}")
+            raise ConfigError(f"specular must be true or false, got {self.specular!r}", "specular")
         _check_int("palette_size", self.palette_size, 16, 16384)
         _check_int("color_bits", self.color_bits, 8, 8)
         if not isinstance(self.palette_blend, bool):
-            raise ConfigError(f"palette_blend must be true or false, got {self.palette_blend!r}")
+            raise ConfigError(f"palette_blend must be true or false, got {self.palette_blend!r}",
+                              "palette_blend")
 
     # Derived facts: read-only, never stored.
     @property
@@ -149,7 +157,8 @@ class Config:
         """A copy with some fields changed (validated again)."""
         unknown = set(changes) - {f.name for f in fields(self)}
         if unknown:
-            raise ConfigError(f"unknown Config field(s): {', '.join(sorted(unknown))}")
+            raise ConfigError(f"unknown Config field(s): {', '.join(sorted(unknown))}",
+                              sorted(unknown)[0])
         return Config(**{**asdict(self), **changes})
 
     def to_dict(self):

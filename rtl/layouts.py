@@ -4,6 +4,7 @@ from amaranth.hdl import Shape, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.tables import SPEC_FRAC_BITS
 
 __all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout", "layout_fields"]
 
@@ -29,11 +30,18 @@ def pixel_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-def shade_layout(cfg: Config):
-    """Per-pixel outputs of the illumination unit: 8-bit diffuse, specular and Phong sum."""
+def shade_layout(cfg: Config, fine=True):
+    """Per-pixel outputs of the illumination unit: 8-bit diffuse, specular and Phong sum,
+    and (``fine``) the unrounded terms the light sum and the texture blend take:
+    ``diffuse_fine`` = clamp(N'.L', 0, 1) with B fractional bits and ``specular_fine`` =
+    255 (N'.H')^n with SPEC_FRAC_BITS (rtl/shade.py). A light sum's output has no fine
+    terms (``fine=False``)."""
     out = unsigned(cfg.out_bits)
-    return data.StructLayout({"diffuse": out, "specular": out, "color": out,
-                              "tag": unsigned(cfg.tag_bits)})
+    fields = {"diffuse": out, "specular": out, "color": out}
+    if fine:
+        fields["diffuse_fine"] = unsigned(cfg.frac_bits + 1)
+        fields["specular_fine"] = unsigned(cfg.out_bits + SPEC_FRAC_BITS)
+    return data.StructLayout({**fields, "tag": unsigned(cfg.tag_bits)})
 
 
 def layout_fields(layout, prefix=""):

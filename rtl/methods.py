@@ -80,7 +80,8 @@ class Method:
     cartesian : bool
         The inputs (and a bump map's N') are Cartesian components, not binary angles.
     predicted_error_bound_lsb : callable
-        ``cfg -> int``: the diffuse error bound against float64, 8-bit LSB.
+        ``(cfg, channel="diffuse", lights=1) -> int``: the proven error bound of one output
+        channel (``diffuse``, ``specular``, ``color``, ``blend``) against float64, 8-bit LSB.
     error_note : str
         What the bound means and where it is proved or measured (the emitter's sidecar).
     reference : callable or None
@@ -120,7 +121,7 @@ def _same_codes(codes, cfg: Config):
     return codes
 
 
-_UNQUANTIZED = "diffuse vs float64 on unquantized inputs"
+_UNQUANTIZED = "diffuse (error_bound_lsb; every channel in error_bounds_lsb) vs float64 on unquantized inputs"
 _CARTESIAN_NOTE = (f"{_UNQUANTIZED}, Cartesian input codes from "
                    "sim/golden/fixed/peercy.encode "
                    "(proof: sim/golden/fixed/peercy.predicted_error_bound_lsb)")

@@ -12,13 +12,15 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory, ReadPort
 from amaranth.lib.wiring import In, Out
 
-__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "RegisteredROM", "read_port", "PRODUCT_LATENCY",
-           "ROM_LATENCY", "ECP5"]
+__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "RegisteredROM", "RegisteredRAM", "read_port",
+           "PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2
 # Stages of a RegisteredROM read: the synchronous read, the output register.
 ROM_LATENCY = 2
+# Stages of a RegisteredRAM read: the same two.
+RAM_LATENCY = 2
 
 
 class ECP5:
@@ -168,6 +170,104 @@ class RegisteredROM(Elaboratable):
         m.submodules.bram = Instance("DP16KD", **params)
 
 
+# DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
+DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))
+
+
+def dp16kd_initvals(words, width):
+    """INITVAL_00..3F of one DP16KD in ``width`` mode holding ``words`` (word w at address w):
+    the array is 1024 rows of 18 bits, an x18 word a row, an x9 word half a row (low half
+    first), an x4/x2/x1 word in the low 8 bits of 9-bit unit w / (8 / width); each INITVAL
+    holds 16 rows in 20-bit slots (sim/ecp5/dp16kd.v models the same layout; Yosys' own
+    block-RAM mapping agrees, tests/sim/ecp5/test_postsynth.py)."""
+    flat = 0
+    for w, x in enumerate(words):
+        x = int(x) & ((1 << width) - 1)
+        if width in (18, 9):
+            pos = w * width
+        else:
+            per = 8 // width
+            pos = (w // per) * 9 + width * (w % per)
+        flat |= x << pos
+    params = {}
+    for row in range(64):
+        value = 0
+        for n in range(16):
+            value |= ((flat >> (18 * (row * 16 + n))) & ((1 << 18) - 1)) << (20 * n)
+        params[f"p_INITVAL_{row:02X}"] = Const(value, 320)
+    return params
+
+
+class RegisteredRAM(Elaboratable):
+    """A RAM with one host write port (``w_en``, ``w_addr``, ``w_data``) and one read port
+    whose ``r_data`` comes RAM_LATENCY ``en`` cycles after ``r_addr`` (synchronous read, then
+    an output register), as :class:`RegisteredROM`. A read in the cycle of a write to the
+    same word returns the old word. On ECP5 (``target`` :class:`ECP5`, depth <= 16384) it is
+    DP16KD blocks in the widest mode (:data:`DP16KD_MODES`) that holds ``depth`` words, side
+    by side for the width: port A writes, port B reads with its output register (REGMODE_B
+    OUTREG); elsewhere an Amaranth Memory and a register."""
+
+    def __init__(self, depth, shape, name, init=None, target=None):
+        self.depth, self.shape, self.name, self.target = depth, shape, name, target
+        self.width = Shape.cast(shape).width
+        self.init = [int(x) for x in init] if init is not None else []
+        self.en = Signal(name=f"{name}_en")
+        self.r_addr = Signal(range(depth), name=f"{name}_r_addr")
+        self.r_data = Signal(shape, name=f"{name}_r_data")
+        self.w_en = Signal(name=f"{name}_w_en")
+        self.w_addr = Signal(range(depth), name=f"{name}_w_addr")
+        self.w_data = Signal(shape, name=f"{name}_w_data")
+
+    def mode(self):
+        """(data width, depth, address shift) of the DP16KD mode used on ECP5, or None."""
+        return next((m for m in DP16KD_MODES if m[1] >= self.depth), None)
+
+    def elaborate(self, platform):
+        m = Module()
+        mode = self.mode() if getattr(self.target, "bram", None) == "DP16KD" else None
+        if mode is not None:
+            self._dp16kd(m, *mode)
+            return m
+        m.submodules.mem = mem = Memory(shape=self.shape, depth=self.depth, init=self.init)
+        wp = mem.write_port()
+        m.d.comb += [wp.en.eq(self.w_en), wp.addr.eq(self.w_addr), wp.data.eq(self.w_data)]
+        rp = mem.read_port(domain="sync")
+        m.d.comb += [rp.en.eq(self.en), rp.addr.eq(self.r_addr)]
+        with m.If(self.en):
+            m.d.sync += self.r_data.eq(rp.data)
+        return m
+
+    def _dp16kd(self, m, bits, words, shift):
+        zero, one = Const(0, 1), Const(1, 1)
+        w_addr, r_addr = Signal(14, name=f"{self.name}_ada"), Signal(14, name=f"{self.name}_adb")
+        m.d.comb += [w_addr[shift:].eq(self.w_addr), r_addr[shift:].eq(self.r_addr)]
+        if bits == 18:
+            m.d.comb += w_addr[:2].eq(0b11)            # x18 mode: AD[1:0] are the byte enables
+        w_data, r_data = Value.cast(self.w_data), Signal(self.width)
+        m.d.comb += self.r_data.eq(r_data)
+        for col in range(-(-self.width // bits)):
+            lo, hi = col * bits, min(self.width, (col + 1) * bits)
+            dout = Signal(18, name=f"{self.name}_do{col}")
+            din = Signal(18, name=f"{self.name}_di{col}")
+            m.d.comb += [din.eq(w_data[lo:hi]), r_data[lo:hi].eq(dout[:hi - lo])]
+            init = [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init]
+            params = dp16kd_initvals(init, bits)
+            params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="NOREG",
+                          p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
+                          p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
+                          p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+            params.update(i_CLKA=ClockSignal(), i_CEA=self.w_en, i_OCEA=one, i_WEA=self.w_en,
+                          i_RSTA=zero, i_CLKB=ClockSignal(), i_CEB=self.en, i_OCEB=self.en,
+                          i_WEB=zero, i_RSTB=zero)
+            for side, addr in (("A", w_addr), ("B", r_addr)):
+                params.update({f"i_CS{side}{n}": zero for n in range(3)})
+                params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
+            params.update({f"i_DIA{n}": din[n] for n in range(18)})
+            params.update({f"i_DIB{n}": zero for n in range(18)})
+            params.update({f"o_DOB{n}": dout[n] for n in range(18)})
+            m.submodules[f"bram{col}"] = Instance("DP16KD", **params)
+
+
 class StallPipe:
     """Valid chain and delay lines of a ``depth``-stage pipe from stream ``i`` to ``o``.
 
@@ -219,6 +319,15 @@ class StallPipe:
         self.m.submodules[name] = unit
         self.m.d.comb += unit.en.eq(self.adv)
         self._record(name, unit.depth, unit.width)
+        return unit
+
+    def ram(self, name, depth, shape, init=None):
+        """A :class:`RegisteredRAM` whose read is enabled by ``adv``; the caller drives its
+        ``r_addr`` and write port and reads ``r_data`` RAM_LATENCY stages later."""
+        unit = RegisteredRAM(depth, shape, name, init, target=self.target)
+        self.m.submodules[name] = unit
+        self.m.d.comb += unit.en.eq(self.adv)
+        self._record(name, depth, unit.width)
         return unit
 
     def memory(self, name, memory):

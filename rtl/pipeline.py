@@ -34,7 +34,8 @@ from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import StallPipe
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config
-from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
+                                phong_coefficients)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout
 
 __all__ = ["BumpPipeline", "VectorTerms", "LightSum", "light_fields"]
@@ -75,34 +76,41 @@ class VectorTerms(wiring.Component):
 
 
 class LightSum(wiring.Component):
-    """m lights' 8-bit diffuse and specular -> the pixel (eq. 2 summed over the lights).
-    Input {d, s: ArrayLayout(unsigned(8), m) (light j's d_j, s_j at index j), tag}:
-    diffuse = min(255, sum d_j), specular = min(255, sum s_j),
-    color = clamp(round((KA + KD sum d_j + KS sum s_j) / 256), 0, 255).
+    """m lights' unrounded diffuse and specular terms -> the pixel (eq. 2 summed over the
+    lights, rounded once). Input {d: ArrayLayout(unsigned(B + 1), m), s: ArrayLayout(
+    unsigned(8 + F), m) (light j's ``diffuse_fine``, ``specular_fine`` at index j), tag};
+    with D = sum d_j, S = sum s_j:
+    diffuse = min(255, round(255 D)), specular = min(255, round(S / 2**F)),
+    color = min(255, round((KA + floor(KD D / 2**B) + floor(KS S / 2**16)) / 2**G))
+    (rtl/shade.py's Phong sum). Output ``shade_layout(cfg, fine=False)``.
     Latency 3 (sums, products, clamp); bit-exact with ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
 
     latency = 3
 
     def __init__(self, scene: SceneConfig, target=None):
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
-        per_light = data.ArrayLayout(unsigned(8), self.lights)      # light j's 8-bit value
-        fields = {"d": per_light, "s": per_light, "tag": unsigned(self.cfg.tag_bits)}
+        fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
+                  "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), self.lights),
+                  "tag": unsigned(self.cfg.tag_bits)}
         super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
-                          "o": Out(stream.Signature(shade_layout(self.cfg)))})
+                          "o": Out(stream.Signature(shade_layout(self.cfg, fine=False)))})
 
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
-        px = self.i.payload
+        px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
         ka, kd, ks = phong_coefficients(self.cfg)
         kd_term, ks_term = pipe.register(d * kd, "kd_sum"), pipe.register(s * ks, "ks_sum")
-        total = round_shift(ka + kd_term + ks_term, 8)
         sat = lambda x: Mux(x > 255, 255, x)[:8]
+        d8 = pipe.register(sat(round_shift((d << 8) - d, b)), "diffuse8")
+        s8 = pipe.register(sat(round_shift(s, SPEC_FRAC_BITS)), "specular8")
+        terms = (kd_term >> (KD_FRAC_BITS + b - g)) + (ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - g))
+        total = (terms + (ka + (1 << (g - 1)))) >> g
         m.d.comb += [self.o.payload.color.eq(pipe.register(sat(total), "color")),
-                     self.o.payload.diffuse.eq(pipe.delay(sat(d), 2, "diffuse")),
-                     self.o.payload.specular.eq(pipe.delay(sat(s), 2, "specular")),
+                     self.o.payload.diffuse.eq(pipe.register(d8, "diffuse")),
+                     self.o.payload.specular.eq(pipe.register(s8, "specular")),
                      self.o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
         return m
 
@@ -137,7 +145,8 @@ class BumpPipeline(wiring.Component):
         {[u, v, [level] with a texture], l, [h], ..., tag}; palette: {u, v, [level], tag}.
         Angles are binary angles.
     o : Out(stream.Signature(...))
-        ``shade_layout`` (diffuse, specular, color, tag); with a texture TextureBlend's
+        ``shade_layout`` (diffuse, specular, color, diffuse_fine, specular_fine, tag; with
+        m > 1 lights LightSum's, without the fine terms); with a texture TextureBlend's
         {diffuse, specular, color: rgb, tag}; or PaletteLUT's {color: rgba, oor, tag} with
         palette shading.
     map_w_en, map_w_addr, map_w_data : In
@@ -386,8 +395,8 @@ class BumpPipeline(wiring.Component):
         total = u["blend"] if s.texture else u["lightsum"]
         _lockstep(m, lead, [total.i])
         for j, n in enumerate(ill_layer[:s.lights]):
-            m.d.comb += [total.i.payload.d[j].eq(u[n].o.payload.diffuse),
-                         total.i.payload.s[j].eq(u[n].o.payload.specular)]
+            m.d.comb += [total.i.payload.d[j].eq(u[n].o.payload.diffuse_fine),
+                         total.i.payload.s[j].eq(u[n].o.payload.specular_fine)]
         if s.texture:
             m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)

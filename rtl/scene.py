@@ -7,20 +7,24 @@ built-in name (:data:`BUILTIN`). Every key is checked at load time; a bad one ra
 widths follows from the scene (:meth:`SceneConfig.config`).
 """
 
+import math
 import tomllib
 from dataclasses import dataclass, fields, asdict
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.sim.scenes import GEOMETRIES, SCENES
+from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE, map_size
 
 __all__ = ["SceneConfig", "SceneError", "BUILTIN", "load_scene_config", "ADDRESSING",
-           "BUMP_MAPS", "SHADINGS", "ROTATIONS", "light_fields"]
+           "BUMP_MAPS", "SHADINGS", "ROTATIONS", "MAP_KEYS", "light_fields", "flag_name"]
 
 ADDRESSING = ("wrap", "clamp")
 BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
 SHADINGS = ("per-pixel", "palette")      # Lee/exact per-pixel rotation, or Tarini's palette
 ROTATIONS = ("per-pixel", "per-polygon", "none")
+MAP_KEYS = ("height_map", "normal_map")  # a user's map file instead of a procedural image
 _CONFIG_KEYS = ("method", "angle_bits", "frac_bits", "tag_bits", "spec_exponent",
                 "spec_index_bits", "ka", "kd", "ks", "lights", "specular", "palette_size")
 
@@ -37,8 +41,23 @@ class SceneConfig:
     ----------
     name : str
         Label of the scene class (sidecar, docs/scenes.md).
-    image : str
-        The procedural scene of ``bumprtl.sim.scenes`` rendered with it (``bumprtl render``).
+    image : str or None
+        The procedural scene of ``bumprtl.sim.scenes`` (``SCENES``) whose bump map the
+        pipeline holds and ``bumprtl render`` draws; None with a user's map.
+    height_map, normal_map : str or None
+        A user's map file instead of ``image`` (at most one; sim/scenes/usermap.py): an 8- or
+        16-bit greyscale PNG or a ``.npy`` of heights, or an 8-bit RGB tangent-space normal
+        map PNG. In a TOML file a relative path is relative to the TOML file. The map's
+        side becomes ``texture_size`` (a power of two in [16, 4096]).
+    normal_convention : str
+        ``opengl`` (green = +Y up the image, the default) or ``directx`` (green = +Y down).
+    geometry : str or None
+        ``plane``, ``sphere`` or ``cylinder``; None: the image's own (a user map: plane).
+    height_scale : float
+        Texels of relief for height 1.0 (white) of a height map (default 4).
+    resample : bool
+        Resample a map whose size is not allowed (or not ``texture_size``) instead of
+        refusing it; a map is never cropped.
     lights : int
         Number of lights, 1 to 8; they share one rotated normal.
     specular : bool
@@ -66,7 +85,7 @@ class SceneConfig:
     """
 
     name: str = "default"
-    image: str = "bricks"
+    image: str | None = "bricks"
     lights: int = 1
     specular: bool = True
     bump_map: str = "varying"
@@ -86,32 +105,39 @@ class SceneConfig:
     kd: float = 0.7
     ks: float = 0.2
     palette_size: int = 256
+    height_map: str | None = None
+    normal_map: str | None = None
+    normal_convention: str = "opengl"
+    geometry: str | None = None
+    height_scale: float = DEFAULT_HEIGHT_SCALE
+    resample: bool = False
 
     def __post_init__(self):
-        for key in ("name", "image"):
-            if not isinstance(getattr(self, key), str):
-                raise SceneError(f"{key} must be a string, got {getattr(self, key)!r}")
+        if not isinstance(self.name, str):
+            raise SceneError(f"name must be a string, got {self.name!r}")
+        self._check_picture()
         for key, allowed in (("bump_map", BUMP_MAPS), ("shading", SHADINGS),
                              ("addressing", ADDRESSING)):
             _choice(key, getattr(self, key), allowed)
-        for key in ("specular", "texture"):
+        for key in ("specular", "texture", "resample"):
             if not isinstance(getattr(self, key), bool):
-                raise SceneError(f"{key} must be true or false, got {getattr(self, key)!r}")
+                raise SceneError(f"{key} must be true or false, got {getattr(self, key)!r}", key)
         if isinstance(self.lights, int) and not isinstance(self.lights, bool) and self.lights < 1:
-            raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])")
+            raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])",
+                             "lights")
         t = self.texture_size
         if isinstance(t, bool) or not isinstance(t, int) or not 16 <= t <= 4096 or t & (t - 1):
             raise SceneError(f"texture_size must be a power of two in [16, 4096] (texel "
-                             f"addressing by bit slicing), got {t!r}")
+                             f"addressing by bit slicing), got {t!r}", "texture_size")
         top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
         if isinstance(self.mip_levels, bool) or not isinstance(self.mip_levels, int) \
                 or not 1 <= self.mip_levels <= top:
             raise SceneError(f"mip_levels must be an integer in [1, {top}] for texture_size "
-                             f"{t}, got {self.mip_levels!r}")
+                             f"{t}, got {self.mip_levels!r}", "mip_levels")
         try:
             self.config
         except BumpError as e:
-            raise SceneError(f"scene {self.name!r}: {e}") from None
+            raise SceneError(f"scene {self.name!r}: {e}", e.field) from None
         if self.method not in PER_PIXEL:
             raise SceneError(f"method must be one of {', '.join(PER_PIXEL)} in a scene (the "
                              f"baselines are built for the cost comparison only), got {self.method!r}")
@@ -122,6 +148,44 @@ class SceneConfig:
         if self.lights > 1 and self.method != "exact" and self.shading == "per-pixel":
             raise SceneError(f"lights = {self.lights} needs method = 'exact' (lights share the one "
                              f"rotated normal n''; the lee method rotates each light instead)")
+
+    def _check_picture(self):
+        """image, or one user map (then image is None), and the keys that go with them."""
+        maps = [k for k in MAP_KEYS if getattr(self, k) is not None]
+        for key in maps:
+            if not isinstance(getattr(self, key), str) or not getattr(self, key):
+                raise SceneError(f"{key} must be a file path (a string), got {getattr(self, key)!r}")
+        if len(maps) > 1:
+            raise SceneError("give height_map or normal_map, not both: a height map becomes "
+                             "normals by the plane fit, a normal map already is one")
+        if maps:
+            object.__setattr__(self, "image", None)
+        elif not isinstance(self.image, str) or self.image not in SCENES:
+            raise SceneError(f"image must be one of {', '.join(SCENES)} (or give height_map "
+                             f"or normal_map for your own map), got {self.image!r}")
+        _choice("normal_convention", self.normal_convention, CONVENTIONS)
+        if self.geometry is not None:
+            _choice("geometry", self.geometry, GEOMETRIES)
+        h = self.height_scale
+        if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < math.inf:
+            raise SceneError(f"height_scale must be a positive finite number (texels of relief "
+                             f"for height 1.0), got {h!r}")
+        if maps and self.bump_map == "flat" and self.shading != "palette":
+            raise SceneError(f"{maps[0]} needs bump_map = 'varying': a flat bump map (one N' "
+                             f"per polygon) stores no map")
+
+    @property
+    def map_file(self):
+        """``(key, path)`` of the user's map, or None."""
+        for key in MAP_KEYS:
+            if getattr(self, key) is not None:
+                return key, getattr(self, key)
+        return None
+
+    @property
+    def picture(self):
+        """What the bump map shows: the user's map file or the procedural image's name."""
+        return self.map_file[1] if self.map_file else self.image
 
     def _check_rotation(self):
         derived = self.derived_rotation
@@ -174,7 +238,12 @@ def light_fields(scene: SceneConfig):
 
 def _choice(key, value, allowed):
     if value not in allowed:
-        raise SceneError(f"{key} must be one of {', '.join(allowed)}, got {value!r}")
+        raise SceneError(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+
+
+def flag_name(key):
+    """The command-line flag of scene key ``key``."""
+    return "--" + key.replace("_", "-")
 
 
 _KEYS = tuple(f.name for f in fields(SceneConfig))
@@ -191,27 +260,83 @@ BUILTIN = {
 }
 
 
-def load_scene_config(source) -> SceneConfig:
-    """A SceneConfig from a built-in name, a TOML path, or a dict of keys."""
-    if isinstance(source, SceneConfig):
-        return source
+_PICTURE_KEYS = ("image", *MAP_KEYS)       # what the map shows: one of them
+
+
+def _source_keys(source):
+    """``(keys, where)`` of a built-in name, a TOML path or a dict; map paths of a TOML file
+    made relative to the file's directory."""
     if isinstance(source, dict):
-        keys, where = dict(source), "scene"
-    elif str(source) in BUILTIN:
-        keys, where = dict(BUILTIN[str(source)]), f"built-in scene {source!r}"
-    else:
-        path = Path(source)
-        if not path.is_file():
-            raise SceneError(f"scene must be a TOML file or one of {', '.join(BUILTIN)}, "
-                             f"got {str(source)!r}")
-        try:
-            keys = tomllib.loads(path.read_text())
-        except tomllib.TOMLDecodeError as e:
-            raise SceneError(f"scene file {path}: not valid TOML ({e})") from None
-        keys.setdefault("name", str(path))      # names the file in the emit command line
-        where = f"scene file {path}"
+        return dict(source), "scene"
+    if str(source) in BUILTIN:
+        return dict(BUILTIN[str(source)]), f"built-in scene {source!r}"
+    path = Path(source)
+    if not path.is_file():
+        raise SceneError(f"scene must be a TOML file or one of {', '.join(BUILTIN)}, "
+                         f"got {str(source)!r}")
+    try:
+        keys = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise SceneError(f"scene file {path}: not valid TOML ({e})") from None
+    keys.setdefault("name", str(path))          # names the file in the emit command line
+    for key in MAP_KEYS:
+        if isinstance(keys.get(key), str):
+            keys[key] = str(path.parent / keys[key]) if not Path(keys[key]).is_absolute() \
+                else keys[key]
+    return keys, f"scene file {path}"
+
+
+def _merge(keys, where, overrides, flags):
+    """``keys`` plus the command-line ``overrides``; a flag that contradicts a key the source
+    sets is an error naming both (never a silent override)."""
+    flags = flags or {}
+    for key, value in overrides.items():
+        flag = flags.get(key, flag_name(key))
+        if key in _PICTURE_KEYS:
+            clash = [k for k in _PICTURE_KEYS if k != key and keys.get(k) is not None]
+            if clash:
+                raise SceneError(f"{flag} {value} contradicts {clash[0]} = {keys[clash[0]]!r} in "
+                                 f"{where}: give the picture once")
+        if key in keys and keys[key] is not None and keys[key] != value:
+            raise SceneError(f"{flag} {value} contradicts {key} = {keys[key]!r} in {where}: "
+                             f"drop one")
+    return {**keys, **overrides}
+
+
+def load_scene_config(source, overrides=None, flags=None, defaults=None) -> SceneConfig:
+    """A SceneConfig from a built-in name, a TOML path, or a dict of keys.
+
+    ``overrides``: scene keys given on the command line (``{key: value}``; ``flags`` names
+    their flags for messages). A key the source sets to another value is an error naming
+    both. ``defaults``: keys used when neither sets them (``texture_size`` not with a map).
+    With a user map (``height_map``/``normal_map``) ``texture_size`` is the map's side (or,
+    given, must equal it unless ``resample``) and ``image`` is not allowed."""
+    if isinstance(source, SceneConfig):
+        if not overrides:
+            return source
+        source = {**source.to_dict(), "rotation": None}
+    keys, where = _source_keys(source)
     unknown = sorted(set(keys) - set(_KEYS))
     if unknown:
         raise SceneError(f"unknown key {unknown[0]!r} in {where}: allowed keys are {', '.join(_KEYS)}")
-    keys = {k: v for k, v in keys.items() if v is not None}
+    keys = _merge({k: v for k, v in keys.items() if v is not None}, where,
+                  {k: v for k, v in (overrides or {}).items() if v is not None}, flags)
+    maps = [k for k in MAP_KEYS if k in keys]
+    for key, value in (defaults or {}).items():
+        if key not in keys and value is not None and not (maps and key == "texture_size"):
+            keys[key] = value
+    if maps:
+        if "image" in keys:
+            raise SceneError(f"image = {keys['image']!r} and {maps[0]} in {where}: give the "
+                             f"picture once")
+        defaults = SceneConfig()
+        extra = [k for k, need in (("height_scale", "height_map"), ("normal_convention",
+                 "normal_map")) if keys.get(k, getattr(defaults, k)) != getattr(defaults, k)
+                 and need not in keys]
+        if extra:
+            raise SceneError(f"{extra[0]} applies to a {'height' if extra[0] == 'height_scale' else 'normal'}"
+                             f" map, but {where} gives {maps[0]}")
+        if len(maps) == 1 and isinstance(keys[maps[0]], str):
+            resample = keys.get("resample", False) is True
+            keys["texture_size"] = map_size(keys[maps[0]], resample, keys.get("texture_size"))
     return SceneConfig(**keys)

@@ -15,14 +15,18 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import shade_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
-from bumprtl.rtl.tables import phong_coefficients, specular_index_bits, specular_table
+from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
+                                phong_coefficients, specular_base, specular_index_bits,
+                                specular_step_bits, specular_table)
 
 __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp, round (diffuse, table index), table read and table
-# output register (ROM_LATENCY), Phong products (operand and product registers,
-# PRODUCT_LATENCY), Phong sum, rounding and clamp.
-SHADE_LATENCY = 4 + ROM_LATENCY + PRODUCT_LATENCY
+# Registers of shade_stages: clamp, table address (and the 8-bit diffuse), table read and
+# table output register (ROM_LATENCY), the word difference, the interpolation product
+# (PRODUCT_LATENCY), the interpolated specular, the Phong product KS s (PRODUCT_LATENCY; KD d
+# runs beside the table), the Phong sum, its rounding and clamp.
+FINE_STAGE = 2 + ROM_LATENCY + 1 + PRODUCT_LATENCY + 1     # specular_fine's register
+SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 
 
 def _clamp01(x, cfg):
@@ -31,38 +35,61 @@ def _clamp01(x, cfg):
 
 
 def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
-    """Eq. (2) from the dot products; returns (diffuse, specular, color), SHADE_LATENCY
-    ``adv`` stages after ``ndotl``/``ndoth`` (signed, ``frac_bits`` fractional bits).
+    """Eq. (2) from the dot products; returns {diffuse, specular, color, diffuse_fine,
+    specular_fine}, SHADE_LATENCY ``adv`` stages after ``ndotl``/``ndoth`` (signed,
+    ``frac_bits`` fractional bits). With d = clamp(N'.L), h = clamp(N'.H) (B fractional bits):
 
-    diffuse  = round(255 clamp(N'.L))                    (constant multiply)
-    specular = cos^n table[round(clamp(N'.H) 2**s)]      (block-RAM table, Fig. 8)
-    color    = clamp(round((KA + KD diffuse + KS specular) / 256), 0, 255)
+    diffuse_fine  = d                                                    (B fractional bits)
+    specular_fine = T[j] + floor((T[j+1] - T[j]) f / 2**r),  h - x0 = j 2**r + f
+                    (the cos^n table of rtl/tables.py, F = SPEC_FRAC_BITS fractional bits,
+                    linear interpolation with the r = B - t bits below its step; 0 below x0)
+    diffuse       = round(255 d),   specular = round(specular_fine / 2**F)   (8-bit ports)
+    color         = min(255, round((KA + floor(KD d / 2**B) + floor(KS s / 2**16)) / 2**G))
+    The Phong sum takes the unrounded terms and rounds once (G = COLOR_FRAC_BITS).
     """
-    b = cfg.frac_bits
+    b, f, g = cfg.frac_bits, SPEC_FRAC_BITS, COLOR_FRAC_BITS
+    ka, kd, ks = phong_coefficients(cfg)
     d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
     # 255 d as (d << 8) - d: a carry chain instead of a DSP block (same integers as d * 255).
     diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage 2
+    kd_term = pipe.multiply(d, kd, "kd_diffuse")                                 # 1 + PRODUCT
+    kd_term = pipe.delay(kd_term, SHADE_LATENCY - 3 - PRODUCT_LATENCY, "kd_diffuse_d")
     if cfg.specular:
-        s_bits = specular_index_bits(cfg)
+        s_bits, r = specular_index_bits(cfg), b - specular_step_bits(cfg)
+        x0 = specular_base(cfg)
         h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
-        index = pipe.register(round_shift(h, b - s_bits), "spec_index")           # stage 2
-        rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8), "specular_table", ports=1)
-        m.d.comb += rom.ports[0].addr.eq(index)                                   # stage 2
-        specular = rom.ports[0].data                                              # 2 + ROM
+        # h - x0, or 0 below x0 (word 0 of the table is 0 there)
+        above = pipe.register(Mux(h < x0, 0, h - x0)[:b + 1], "spec_offset")    # stage 2
+        rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8 + f), "specular_table", ports=2)
+        j = above[r:]
+        # word j + 1; at j = 2**s (h = 1, so the fraction is 0) any word will do: j's low
+        # s bits + 1 = word 1 keeps the address inside the table.
+        m.d.comb += [rom.ports[0].addr.eq(j), rom.ports[1].addr.eq(j[:s_bits] + 1)]
+        t0 = rom.ports[0].data                                                   # 2 + ROM
+        if r:
+            frac = pipe.delay(above[:r], ROM_LATENCY + 1, "spec_frac")
+            step = pipe.register(rom.ports[1].data - t0, "spec_step")             # + 1
+            product = pipe.multiply(step, frac, "spec_interp")                    # + PRODUCT
+            t0 = pipe.delay(t0, 1 + PRODUCT_LATENCY, "spec_word")
+            fine = pipe.register((t0 + (product >> r))[:8 + f], "specular_fine")  # + 1
+        else:
+            fine = pipe.delay(t0, 2 + PRODUCT_LATENCY, "specular_fine")
+        specular = pipe.register(round_shift(fine, f)[:8], "specular")          # + 1
+        ks_term = pipe.multiply(fine, ks, "ks_specular")                          # + PRODUCT
+        ks_term = ks_term >> (KS_FRAC_BITS + f - g)
+        specular = pipe.delay(specular, SHADE_LATENCY - FINE_STAGE - 1, "specular_out")
+        fine = pipe.delay(fine, SHADE_LATENCY - FINE_STAGE, "specular_fine_out")
     else:
-        specular = 0
-    diffuse = pipe.delay(diffuse, ROM_LATENCY, "diffuse_d")                       # 2 + ROM
-    ka, kd, ks = phong_coefficients(cfg)
-    kd_term = pipe.multiply(diffuse, kd, "kd_diffuse")                            # + PRODUCT
-    ks_term = pipe.multiply(specular, ks, "ks_specular") if cfg.specular else 0
-    # round_shift(KA + kd + ks, 8) as two 2-operand stages: KA and the rounding half are
+        ks_term, specular, fine = 0, 0, 0
+    # round_shift(KA + kd + ks, G) as two 2-operand stages: KA and the rounding half are
     # one constant added in the second.
-    terms = pipe.register(kd_term + ks_term, "phong_terms")                       # + 1
-    total = (terms + (ka + 128)) >> 8
+    terms = pipe.register((kd_term >> (KD_FRAC_BITS + b - g)) + ks_term, "phong_terms")  # + 1
+    total = (terms + (ka + (1 << (g - 1)))) >> g
     color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 2
-    diffuse = pipe.delay(diffuse, PRODUCT_LATENCY + 2, "diffuse_out")
-    specular = pipe.delay(specular, PRODUCT_LATENCY + 2, "specular_out") if cfg.specular else 0
-    return diffuse, specular, color
+    return {"diffuse": pipe.delay(diffuse, SHADE_LATENCY - 2, "diffuse_out"),
+            "specular": specular, "color": color,
+            "diffuse_fine": pipe.delay(d, SHADE_LATENCY - 1, "diffuse_fine_out"),
+            "specular_fine": fine}
 
 
 class IlluminationDatapath(PipeUnit):
@@ -88,9 +115,9 @@ class IlluminationDatapath(PipeUnit):
     def build(self, m, pipe):
         i, o = self.i.payload, self.o.payload
         dots = self.dots(m, pipe, i)
-        diffuse, specular, color = shade_stages(m, pipe, self.cfg, dots["l"], dots.get("h", 0))
-        m.d.comb += [o.diffuse.eq(diffuse), o.specular.eq(specular), o.color.eq(color),
-                     o.tag.eq(pipe.delay(i.tag, self.latency, "tag"))]
+        shade = shade_stages(m, pipe, self.cfg, dots["l"], dots.get("h", 0))
+        m.d.comb += [o[k].eq(v) for k, v in shade.items()]
+        m.d.comb += o.tag.eq(pipe.delay(i.tag, self.latency, "tag"))
 
 
 class BackEnd(IlluminationDatapath):

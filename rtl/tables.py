@@ -10,8 +10,10 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 
-__all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits", "specular_table",
-           "phong_coefficients", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",
+__all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits",
+           "specular_step_bits", "specular_base", "specular_table", "specular_table_error_lsb",
+           "SPEC_FRAC_BITS", "COLOR_FRAC_BITS", "KD_FRAC_BITS", "KS_FRAC_BITS", "LIT_FRAC_BITS",
+           "phong_coefficients", "blend_coefficients", "coefficient_error_lsb", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",
            "lee_reciprocal_table", "lee_atan_mantissa_bits", "lee_atan_ratio_bits", "lee_atan_depth",
            "lee_atan_table", "lee_prop_index_bits", "lee_prop_table", "kim_reciprocal_bits",
            "kim_reciprocal_table"]
@@ -64,26 +66,103 @@ def cos_lookup(cfg: Config, angle) -> np.ndarray:
 
 
 # --- Illumination back end (Lee Sec. 3.2 / Fig. 8: diffuse and specular tables) -------------
+# Eq. (2) is carried with extra fractional bits and rounded once, at the end (rtl/shade.py):
+# the specular term as 255 (N'.H)^n with SPEC_FRAC_BITS fractional bits, the diffuse term as
+# clamp(N'.L) with B, the Phong sum with COLOR_FRAC_BITS; only the 8-bit output ports round.
+
+SPEC_FRAC_BITS = 9      # F: fractional bits of the specular table (8 + F = 17 bits a word)
+COLOR_FRAC_BITS = 9     # G: fractional bits (of an 8-bit LSB) of eq. 2's Phong sum
+KD_FRAC_BITS = 9        # KD = 255 kd 2**9: <= 17 bits, one DSP operand with clamp(N'.L)
+KS_FRAC_BITS = 16       # KS = ks 2**16: <= 17 bits, one DSP operand with the 17-bit specular
+LIT_FRAC_BITS = 16      # the texture blend's lit = min(1, ka + kd D) (rtl/texture.py)
+
 
 def specular_index_bits(cfg: Config) -> int:
-    """Address bits of the specular table: the clamped N'.H' with ``spec_index_bits``
-    fractional bits (at most ``frac_bits``). At the default 10, 2**10 + 1 entries x 8 bits
-    fit one ECP5 DP16KD (2048 x 9), so the read has no multiplexer between block RAMs."""
+    """Address bits s of the specular table: 2**s + 1 words (at most ``frac_bits``). At the
+    default 10, 1025 words x 17 bits are one ECP5 DP16KD (1024 x 18, the last word in a
+    flip-flop: rtl/pipe.RegisteredROM), read through both of its ports."""
     return min(cfg.frac_bits, cfg.spec_index_bits)
 
 
+def _spec_scale():
+    return 255 * (1 << SPEC_FRAC_BITS)
+
+
+def specular_step_bits(cfg: Config) -> int:
+    """t: the table's step is 2**-t in N'.H (s <= t <= B). The table covers
+    [x0, 1] = [1 - 2**(s - t), 1] in 2**s steps and is interpolated linearly between them
+    with the B - t bits of N'.H below its step; t is the largest for which everything below
+    x0 rounds to 0 (255 x0**n 2**F < 1/2), so a large exponent n, whose cos^n is non-zero
+    only near N'.H = 1, gets a finer step there (an index finer near 1)."""
+    s, b, n = specular_index_bits(cfg), cfg.frac_bits, cfg.spec_exponent
+    best = s
+    for t in range(s + 1, b + 1):
+        if _spec_scale() * (1.0 - 2.0 ** (s - t)) ** n < 0.5:
+            best = t
+    return best
+
+
+def specular_base(cfg: Config) -> int:
+    """x0 with B fractional bits: the table's word 0 stands for N'.H = x0 (0 when t = s)."""
+    s, t = specular_index_bits(cfg), specular_step_bits(cfg)
+    return cfg.one - (1 << (cfg.frac_bits - t + s))
+
+
 def specular_table(cfg: Config) -> np.ndarray:
-    """``cos^n`` table (eq. 2's (N'.H)^n): entry i = round(255 * (i / 2**s)**n), i = 0..2**s."""
-    s = specular_index_bits(cfg)
-    x = np.arange((1 << s) + 1, dtype=np.float64) / (1 << s)
-    return np.rint(255.0 * x ** cfg.spec_exponent).astype(np.int64)
+    """``cos^n`` table (eq. 2's (N'.H)^n): word j = round(255 (x0 + j 2**-t)**n 2**F),
+    j = 0 .. 2**s, with F = SPEC_FRAC_BITS fractional bits; word 0 is 0 and word 2**s (N'.H =
+    1) is 255 2**F. rtl/shade.py reads words j and j + 1 and interpolates."""
+    s, t = specular_index_bits(cfg), specular_step_bits(cfg)
+    x = specular_base(cfg) / cfg.one + np.arange((1 << s) + 1, dtype=np.float64) / (1 << t)
+    return np.rint(_spec_scale() * x ** cfg.spec_exponent).astype(np.int64)
+
+
+def specular_table_error_lsb(cfg: Config) -> float:
+    """Bound on |specular_fine / 2**F - 255 x**n| (8-bit LSB) for N'.H = x in [0, 1] on the
+    grid of B fractional bits: the words' rounding 2**-(F+1); linear interpolation of the
+    convex x**n, whose chord lies above it by at most h**2 / 8 max f'' = 2**-2t 255 n (n - 1)
+    / 8 (f'' is largest at x = 1); the floor of the interpolation product, 2**-F; below x0 the
+    table gives 0 where 255 x**n < 2**-(F+1) (specular_step_bits)."""
+    n, t, f = cfg.spec_exponent, specular_step_bits(cfg), SPEC_FRAC_BITS
+    chord = 255.0 * n * (n - 1) / 8 * 4.0 ** -t if cfg.frac_bits > t else 0.0
+    return 2.0 ** -(f + 1) + chord + (2.0 ** -f if cfg.frac_bits > t else 0.0)
 
 
 def phong_coefficients(cfg: Config):
-    """(KA, KD, KS): eq. (2)'s ka, kd, ks as integers. color8 = (KA + KD d8 + KS s8) / 256,
-    so KA = round(255 * 256 * ka) and KD, KS = round(256 * k) (8 fractional bits)."""
-    return (int(round(255 * 256 * cfg.ka)), int(round(256 * cfg.kd)),
-            int(round(256 * cfg.ks)) if cfg.specular else 0)
+    """(KA, KD, KS): eq. (2)'s ka, kd, ks as integers for the Phong sum of rtl/shade.py, in
+    8-bit LSB with G = COLOR_FRAC_BITS fractional bits:
+    KA = round(255 ka 2**G), KD = round(255 kd 2**KD_FRAC_BITS) (times clamp(N'.L) with B
+    fractional bits), KS = round(ks 2**KS_FRAC_BITS) (times the specular with F; 0 without
+    specular)."""
+    return (int(round(255 * cfg.ka * (1 << COLOR_FRAC_BITS))),
+            int(round(255 * cfg.kd * (1 << KD_FRAC_BITS))),
+            int(round(cfg.ks * (1 << KS_FRAC_BITS))) if cfg.specular else 0)
+
+
+def blend_coefficients(cfg: Config):
+    """(KA, KD, KS) of the texture blend (rtl/texture.py): lit = min(1, ka + kd D) with
+    LIT_FRAC_BITS fractional bits, KA = round(ka 2**16), KD = round(kd 2**16) (times D with B
+    fractional bits), KS as in :func:`phong_coefficients`."""
+    return (int(round(cfg.ka * (1 << LIT_FRAC_BITS))), int(round(cfg.kd * (1 << LIT_FRAC_BITS))),
+            phong_coefficients(cfg)[2])
+
+
+def coefficient_error_lsb(cfg: Config, lights=1, blend=False):
+    """Bound (8-bit LSB) on what the integer Phong sum (``blend``: the texture blend) adds to
+    255 (ka + kd D + ks S) for exact D = sum clamp(N'.L_j), S = sum cos^n: the coefficients'
+    rounding at their largest inputs (D, S <= m) and the floor of each product (2**-G each,
+    2**-LIT_FRAC_BITS in lit, which a texel of 255 scales by 255)."""
+    ks = cfg.ks if cfg.specular else 0.0
+    ka_i, kd_i, ks_i = phong_coefficients(cfg)
+    e_ks = lights * 255 * abs(ks_i / (1 << KS_FRAC_BITS) - ks)
+    if not blend:
+        g = 2.0 ** -COLOR_FRAC_BITS
+        return (abs(ka_i * g - 255 * cfg.ka) + lights * abs(kd_i / (1 << KD_FRAC_BITS) - 255 * cfg.kd)
+                + e_ks + 2 * g)
+    ka_l, kd_l, _ = blend_coefficients(cfg)
+    g = 2.0 ** -LIT_FRAC_BITS
+    lit = abs(ka_l * g - cfg.ka) + lights * abs(kd_l * g - cfg.kd) + g
+    return 255 * lit + e_ks + g
 
 
 # --- Lee et al. 2003: the vector-rotation ROMs of Fig. 7 (rtl/lee.py) -----------------------

@@ -1,25 +1,27 @@
 """The colour-texture blend: Phong shading with a textured albedo (``texture = true``).
 
 Per colour channel c, with the texel colour tex_c fetched from block RAM at the same
-(u, v[, level]) as the bump map (rtl/bumpfetch.py), summed over the m lights (Lee eq. 2):
+(u, v[, level]) as the bump map (rtl/bumpfetch.py), summed over the m lights (Lee eq. 2),
+from the illumination units' unrounded terms d_j = clamp(N'.L_j) (B fractional bits) and
+s_j = 255 (N'.H_j)^n (SPEC_FRAC_BITS fractional bits; rtl/shade.py):
 
-    lit    = clamp(round((KA + KD sum d_j) / 256), 0, 255)       ambient + diffuse intensity
-    spec   = clamp(round((KS sum s_j) / 256), 0, 255)            specular intensity
-    out_c  = clamp(tex_c * lit / 255 + spec, 0, 255)             (tex_c * lit / 255 rounded)
+    lit    = min(1, ka + kd sum d_j)                  with LIT_FRAC_BITS fractional bits
+    spec   = ks sum s_j                               8-bit LSB, LIT_FRAC_BITS fractional bits
+    out_c  = min(255, round(tex_c lit + spec))        rounded once, at the end
 
-i.e. out_c = ka tex_c + kd diffuse tex_c + ks specular: the base colour modulates the
+i.e. out_c = tex_c (ka + kd diffuse) + ks specular: the base colour modulates the
 Lambertian term and the highlight is added on top. This is the shape of Tarini et al.'s
 eq. 2 (Sec. 7.2, ``r = ro ai + (1 - ro) ri``, base colour times the Lambertian shade plus a
-specular term), and the product is the palette blend's own :func:`rtl.palette.mul8`
-(x * a / 255 rounded to nearest, exactly), so the two blends share one arithmetic.
+specular term); with tex_c / 255 as the albedo, tex_c lit is the albedo times 255 lit with
+no division. The 8-bit diffuse and specular outputs are the light sums rounded once,
+min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)).
 
 :func:`texture_blend` runs on Amaranth values (with ``reg`` = a pipeline register) and on
 int64 arrays (``reg`` = identity) in ``sim/golden/fixed/pipeline.py``: one function, so the
 RTL and the golden model cannot drift apart.
 
-Error against float64 (same d_j, s_j, tex_c): three roundings of half an LSB each (lit,
-spec, the product) plus the coefficient quantization of KA, KD, KS: see
-:func:`blend_error_bound_lsb`.
+Error against float64 (same d_j, s_j, tex_c): the one rounding at the end plus the
+coefficients' quantization and the floors of the products: :func:`blend_error_bound_lsb`.
 """
 
 import numpy as np
@@ -29,17 +31,17 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.palette import mul8
 from bumprtl.rtl.pipe import StallPipe
-from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.tables import (KS_FRAC_BITS, LIT_FRAC_BITS, SPEC_FRAC_BITS, blend_coefficients,
+                                coefficient_error_lsb)
 
 __all__ = ["RGB", "rgb_layout", "texture_blend", "blend_error_bound_lsb", "TextureBlend",
            "TexelDelay", "BLEND_LATENCY"]
 
 RGB = ("r", "g", "b")
 
-# Registers of texture_blend: light sums, coefficient products, lit/spec rounding, the
-# texel product (mul8), the output sum.
+# Registers of texture_blend: light sums, coefficient products, lit/spec, the texel
+# product, the output sum and its rounding.
 BLEND_LATENCY = 5
 
 
@@ -65,45 +67,46 @@ def _sat(x, top):
 def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity):
     """The blend of the module docstring for m lights.
 
-    ``diffuse``, ``specular``: lists of the lights' 8-bit intensities (Illumination's
-    outputs); ``texel``: {r, g, b} 8-bit. ``reg(value, name)`` is called after each stage
-    (a pipeline register in the RTL, identity in the golden model). Returns ``(out, d, s)``:
-    {r, g, b} and the light sums min(255, sum d_j), min(255, sum s_j).
+    ``diffuse``, ``specular``: lists of the lights' unrounded terms (Illumination's
+    ``diffuse_fine``, ``specular_fine``); ``texel``: {r, g, b} 8-bit. ``reg(value, name)`` is
+    called after each stage (a pipeline register in the RTL, identity in the golden model).
+    Returns ``(out, diffuse8, specular8)``: {r, g, b} and the light sums rounded to 8 bits,
+    min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)).
     """
-    u8 = (1 << cfg.color_bits) - 1
-    ka, kd, ks = phong_coefficients(cfg)
+    u8, b, gl = (1 << cfg.color_bits) - 1, cfg.frac_bits, LIT_FRAC_BITS
+    ka, kd, ks = blend_coefficients(cfg)
     d = reg(sum(diffuse[1:], diffuse[0]), "diffuse_sum")                        # stage 1
     s = reg(sum(specular[1:], specular[0]), "specular_sum")
     tex = {c: reg(texel[c], f"texel_{c}_d1") for c in RGB}
     kd_term, ks_term = reg(d * kd, "kd_sum"), reg(s * ks, "ks_sum")             # stage 2
+    d8 = reg(_sat(round_shift((d << 8) - d, b), u8), "diffuse8")
+    s8 = reg(_sat(round_shift(s, SPEC_FRAC_BITS), u8), "specular8")
     tex = {c: reg(tex[c], f"texel_{c}_d2") for c in RGB}
-    lit = reg(_sat(round_shift(ka + kd_term, 8), u8), "lit")               # stage 3
-    spec = reg(_sat(round_shift(ks_term, 8), u8), "spec")
+    lit = reg(_sat(ka + (kd_term >> b), 1 << gl), "lit")                        # stage 3
+    spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
     tex = {c: reg(tex[c], f"texel_{c}_d3") for c in RGB}
-    prod = {c: reg(mul8(tex[c], lit, cfg), f"albedo_{c}") for c in RGB}         # stage 4
+    prod = {c: reg(tex[c] * lit, f"albedo_{c}") for c in RGB}                   # stage 4
     spec = reg(spec, "spec_d4")
-    out = {c: reg(_sat(prod[c] + spec, u8), f"color_{c}") for c in RGB}    # stage 5
-    return out, _sat(d, u8), _sat(s, u8)
+    out = {c: reg(_sat(round_shift(prod[c] + spec, gl), u8), f"color_{c}") for c in RGB}  # 5
+    return out, d8, s8
 
 
 def blend_error_bound_lsb(cfg: Config, lights=1):
-    """Bound on |out_c - float64(ka tex + kd D tex + ks S)| in 8-bit LSB for diffuse and
-    specular sums D, S (before any clamp): 0.5 per rounding (lit, spec, product) plus the
-    quantization of KA, KD, KS at their largest inputs (sums up to 255 m)."""
-    ka, kd, ks = phong_coefficients(cfg)
-    top = 255 * lights
-    coeff = (abs(ka / 256 - 255 * cfg.ka) + abs(kd / 256 - cfg.kd) * top +
-             abs(ks / 256 - (cfg.ks if cfg.specular else 0)) * top)
-    return 1.5 + coeff
+    """Bound on |out_c - 255 clamp(tex_c / 255 min(1, ka + kd D) + ks S)| in 8-bit LSB, for
+    the unrounded sums D = sum d_j, S = sum s_j / (255 2**F) given exactly (before any
+    clamp): the final rounding (1/2) plus the coefficients' quantization and the products'
+    floors (rtl/tables.coefficient_error_lsb; a texel scales lit's error by at most 255)."""
+    return 0.5 + coefficient_error_lsb(cfg, lights, blend=True)
 
 
 class TextureBlend(wiring.Component):
-    """m lights' diffuse and specular and the texel colour -> the RGB pixel.
+    """m lights' diffuse and specular terms and the texel colour -> the RGB pixel.
 
-    Input {d, s: ArrayLayout(unsigned(8), lights) (light j's diffuse and specular at index
-    j), texel: rgb, tag}; output {diffuse, specular,
-    color: rgb, tag} (diffuse, specular = the saturated light sums). Latency
-    ``BLEND_LATENCY``; 1 pixel per clock; bit-exact with ``texture_blend`` on int arrays.
+    Input {d: ArrayLayout(unsigned(B + 1), lights), s: ArrayLayout(unsigned(8 + F), lights)
+    (light j's ``diffuse_fine`` and ``specular_fine`` at index j), texel: rgb, tag}; output
+    {diffuse, specular, color: rgb, tag} (diffuse, specular = the light sums rounded to 8
+    bits). Latency ``BLEND_LATENCY``; 1 pixel per clock; bit-exact with ``texture_blend`` on
+    int arrays.
     """
 
     latency = BLEND_LATENCY
@@ -111,8 +114,9 @@ class TextureBlend(wiring.Component):
     def __init__(self, cfg: Config, lights=1, target=None):
         self.cfg, self.lights, self.target, self.memories = cfg, lights, target, {}
         u8, tag = unsigned(8), unsigned(cfg.tag_bits)
-        per_light = data.ArrayLayout(u8, lights)
-        fields = {"d": per_light, "s": per_light, "texel": rgb_layout(cfg), "tag": tag}
+        fields = {"d": data.ArrayLayout(unsigned(cfg.frac_bits + 1), lights),
+                  "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), lights),
+                  "texel": rgb_layout(cfg), "tag": tag}
         out = {"diffuse": u8, "specular": u8, "color": rgb_layout(cfg), "tag": tag}
         super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
                           "o": Out(stream.Signature(data.StructLayout(out)))})
@@ -126,8 +130,8 @@ class TextureBlend(wiring.Component):
                                     {c: px.texel[c] for c in RGB}, self.cfg, pipe.register)
         o = self.o.payload
         m.d.comb += [o.color[c].eq(color[c]) for c in RGB]
-        m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - 1, "diffuse")),
-                     o.specular.eq(pipe.delay(s, self.latency - 1, "specular")),
+        m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - 2, "diffuse")),
+                     o.specular.eq(pipe.delay(s, self.latency - 2, "specular")),
                      o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
         return m
 

@@ -34,12 +34,16 @@ def _flatten(value, prefix=""):
     return out
 
 
-def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None):
+def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None,
+                    pipe_handshake=False):
     """Drive ``inputs`` into ``dut.i``; return ``(outputs, cycles)`` from ``dut.o``.
 
     Each input is a dict ``{field: int}`` (dotted names for nested layouts). Outputs come
     back as dicts of ints in the same naming. Valid never waits on ready; the payload is held
-    until it is taken (stream rules).
+    until it is taken (stream rules). ``pipe_handshake``: also assert, every cycle, the
+    handshake of a StallPipe (rtl/pipe.py) or a chain of them, ``i.ready == ~o.valid |
+    o.ready``: the pipe stalls only while its output is held, a bubble never stalls it (a
+    stall enable of ``o.ready`` alone is bit-exact and fails only this check).
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
@@ -62,6 +66,10 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
             ctx.set(dut.o.ready, rng.random() >= bp_p)
             _, _, i_ready, o_valid, o_ready, *o_vals = await ctx.tick().sample(
                 dut.i.ready, dut.o.valid, dut.o.ready, *out_fields.values())
+            if pipe_handshake:
+                assert i_ready == (not o_valid or o_ready), (
+                    f"cycle {state['cycles']}: i.ready {i_ready} with o.valid {o_valid}, "
+                    f"o.ready {o_ready} (a pipe must advance when its output is empty or taken)")
             if offered is not None and i_ready:
                 offered = None
             if o_valid and o_ready:
@@ -98,7 +106,7 @@ def check_rotation(cfg, codes, pattern="no_stall", seed=0):
     (sim/golden/fixed/); returns ``(latency, cycles)``."""
     inputs = as_payloads(codes, cfg)
     dut = VectorRotation(cfg)
-    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed, pipe_handshake=True)
     assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
     return dut.latency, cycles
 
@@ -109,7 +117,7 @@ def check_illumination(cfg, codes, pattern="no_stall", seed=0):
     rot = rotation_fixed(codes, cfg)
     inputs = as_payloads(rot, cfg)
     dut = Illumination(cfg)
-    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed, pipe_handshake=True)
     assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
     return dut.latency, cycles
 

@@ -3,7 +3,8 @@
 Each kind lives in its own module with ``add_parser(subparsers)``; register it in BENCHES.
 """
 
-from bumprtl.gen.bench import accuracy, float64, golden, lee_widths, palette, skip, stress, sweep
+from bumprtl.gen.bench import (accuracy, float64, golden, lee_widths, palette, rtl_sim, skip,
+                                stress, sweep)
 
 # kind -> module of gen/bench/ providing add_parser(subparsers); each benchmark module adds
 # its own line here.
@@ -16,6 +17,7 @@ BENCHES = {
     "sweep": sweep,
     "stress": stress,
     "skip": skip,
+    "rtl-sim": rtl_sim,
 }
 
 

@@ -1,27 +1,44 @@
-"""``bumprtl emit UNIT``: write ``UNIT.v`` and its ``UNIT.json`` sidecar."""
+"""``bumprtl emit UNIT``: write ``UNIT.v`` and its ``UNIT.json`` sidecar (and, for
+``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
+import json
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.scene import load_scene_config
-from bumprtl.gen.cli.flags import add_config_flags, config_from_args
+from bumprtl.gen.cli.flags import (add_config_flags, add_map_flags, config_from_args, map_overrides,
+                                   scene_from_args)
 from bumprtl.gen.flow.axis import emit_axis
 from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.flow.fusesoc import write_core
+from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, DEVICE_BRAM, LOADS, emit_scene_unit,
+                                       memory_images, scene_command)
+from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, emit_unit
 
 
 def run(args):
-    cfg = config_from_args(args)
+    hexes = []
     if args.unit in SCENE_UNITS:                     # built from a SceneConfig, not flags
-        cfg = load_scene_config(args.scene)
+        cfg = scene_from_args(args, args.scene)
+    else:
+        given = map_overrides(args)
+        if given or args.load is not None or args.device is not None:
+            flag = next(iter([*given, *(["load"] if args.load else []), "device"]))
+            raise BumpError(f"--{flag.replace('_', '-')} applies to emit pipeline|fetch (a "
+                            f"scene's memories), not to {args.unit}")
+        cfg = config_from_args(args)
     if args.interface == "axis":
         v_path, j_path = emit_axis(args.unit, cfg, args.out, args.tdata_width)
     elif args.tdata_width is not None:
         raise BumpError("--tdata-width needs --interface axis")
+    elif args.unit in SCENE_UNITS:
+        v_path, j_path, hexes = _emit_scene(args.unit, cfg, args)
     else:
         v_path, j_path = emit_unit(args.unit, cfg, args.out)
-    print(f"wrote {v_path}")
-    print(f"wrote {j_path}")
+    for path in (v_path, j_path, *hexes):
+        print(f"wrote {path}")
+    if args.fusesoc:
+        print(f"wrote {write_core(v_path, json.loads(j_path.read_text())['command'])}")
     if args.lint:
         problems = lint(v_path)
         for line in problems:
@@ -29,6 +46,15 @@ def run(args):
         print(f"lint: {'clean' if not problems else f'{len(problems)} problem(s)'}")
         return 1 if problems else 0
     return 0
+
+
+def _emit_scene(unit, scene, args):
+    """The scene unit with its memory contents: built in, or for the host write port."""
+    load = args.load or "initial"
+    words, texels, table = scene_memories(scene)
+    images = memory_images(unit, scene, words, texels, table, load)
+    return emit_scene_unit(unit, scene, args.out, images, args.device or DEFAULT_DEVICE,
+                           scene_command(unit, scene, load))
 
 
 def add_parser(sub):
@@ -51,5 +77,16 @@ def add_parser(sub):
     p.add_argument("--tdata-width", type=int, default=None, metavar="BITS",
                    help="axis: width of both tdata buses, a multiple of 8 (default: the wider "
                         "payload rounded up to whole bytes); too narrow is refused")
+    p.add_argument("--fusesoc", action="store_true",
+                   help="also write UNIT.core, a FuseSoC CAPI2 core (targets default, lint, sim)")
+    p.add_argument("--load", default=None, choices=LOADS,
+                   help="pipeline/fetch: initial = the map (and texture) are the Verilog's "
+                        "built-in initial contents, the same words as UNIT_map.hex; port = the "
+                        "memories start at zero and the host writes UNIT_*.hex through the write "
+                        "port before the first pixel (default: initial)")
+    p.add_argument("--device", default=None, choices=sorted(DEVICE_BRAM),
+                   help=f"pipeline/fetch: refuse memories that do not fit this ECP5's block RAM "
+                        f"(default: {DEFAULT_DEVICE})")
+    add_map_flags(p)
     add_config_flags(p)
     p.set_defaults(func=run)

@@ -4,12 +4,13 @@ Each kind lives in its own module of gen/report/ with ``add_parser(subparsers)``
 it in REPORTS.
 """
 
-from bumprtl.gen.report import fpga, table1
+from bumprtl.gen.report import fpga, table1, timing
 
 # kind -> module of gen/report/ providing add_parser(subparsers), in `--help` order.
 REPORTS = {
     "table1": table1,
     "fpga": fpga,
+    "timing": timing,
 }
 
 

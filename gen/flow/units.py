@@ -19,7 +19,8 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 
-__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command"]
+__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command",
+           "error_bounds"]
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,22 @@ def _method_sidecar(cfg, dut):
     method = get(cfg.method)
     return {"latency": dut.latency, "throughput": 1, "method": cfg.method, "roms": _roms(dut),
             "error_bound_lsb": method.predicted_error_bound_lsb(cfg),
+            "error_bounds_lsb": error_bounds(cfg),
             "error_note": method.error_note}
+
+
+def error_bounds(cfg, lights=1, texture=False):
+    """The method's proven bound per output channel (8-bit LSB vs float64 on unquantized
+    inputs; the registry's ``predicted_error_bound_lsb``, proofs in its docstring): diffuse,
+    specular (0 without specular) and color (the texture blend's with ``texture``), summed
+    over ``lights``. A Config whose widths cannot reach 1 LSB still emits: its sidecar states
+    the larger bound."""
+    bound = get(cfg.method).predicted_error_bound_lsb
+    out = {c: bound(cfg, c, lights) for c in ("diffuse", "specular")}
+    if not cfg.specular:
+        out["specular"] = 0
+    out["color"] = bound(cfg, "blend" if texture else "color", lights)
+    return out
 
 
 def _roms(dut):
@@ -64,8 +80,11 @@ def _palette_sidecar(cfg, dut):
 
 def _pipeline_sidecar(scene, dut):
     """Which units were built and why, which were skipped, latency, memories."""
-    return {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
-            "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
+    out = {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
+           "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
+    if scene.shading == "per-pixel":
+        out["error_bounds_lsb"] = error_bounds(scene.config, scene.lights, scene.texture)
+    return out
 
 
 def _fetch_sidecar(scene, dut):

@@ -1,12 +1,17 @@
 """``bumprtl demo``: the main job on the default scene, PNGs plus a short text report.
 
-1. The demo scenes with every float64 model (and palette), PSNR against ``conventional``.
-2. Unless ``--no-rtl``: the pipeline of the default scene class (rtl/scene.py) emitted to
-   ``<out>/pipeline/pipeline.v`` + ``pipeline.json`` (with the scene's bump map in its RAM),
-   rendered through the simulator with cocotb (gen/render/rtl.py), written as ``rtl.png``
+1. The demo scenes with every float64 model (and palette), PSNR against ``conventional``,
+   and beside it the PSNR of the method's bit-exact fixed-point model (the picture the
+   hardware makes; ``bumprtl render --model fixed``) where the method has hardware.
+2. Unless ``--no-rtl``: the pipeline of the default scene class (rtl/scene.py) with the
+   largest bump map (at most the image size) that fits the block RAM of DEMO_DEVICE, emitted
+   to ``<out>/pipeline/pipeline.v`` + ``pipeline.json`` + ``pipeline_map.hex`` (the map's
+   ``$readmemh`` file, written through the host write port before the first pixel),
+   rendered through the simulator on the bulk path (gen/render/rtl.py), written as ``rtl.png``
    beside the fixed-point golden render ``golden.png`` and ``diff.png`` (|rtl - golden|
-   x DIFF_GAIN); the report gets the resource summary (Yosys, gen/flow/resources.py), the latency
-   and the cycles per pixel measured in the simulation. A different RTL image fails the demo.
+   x DIFF_GAIN); the report gets the RTL image's PSNR against float64 ``conventional``, the
+   resource summary (Yosys, gen/flow/resources.py), the latency and the cycles per pixel
+   measured in the simulation. A different RTL image fails the demo.
 """
 
 import importlib.util
@@ -17,17 +22,21 @@ from pathlib import Path
 
 import numpy as np
 
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
+from bumprtl.gen.flow.memories import DEFAULT_DEVICE, check_scene_fits
 from bumprtl.gen.flow.resources import count_verilog
-from bumprtl.gen.render.images import PALETTE, render_methods, shade_scene
+from bumprtl.gen.render.images import (FIXED_METHODS, PALETTE, fixed_image, float_image,
+                                       render_methods, shade_scene)
 from bumprtl.gen.render.rtl import render_rtl
 
 DEMO_SCENES = ("bricks", "globe")
 REFERENCE = "conventional"
 DEMO_PIPELINE = "default"          # the scene class rendered through the RTL
+DEMO_DEVICE = DEFAULT_DEVICE       # its bump map must fit this FPGA's block RAM
+DEMO_LOAD = "port"                 # the map goes in through the host write port
 DIFF_GAIN = 64
 
 
@@ -40,8 +49,10 @@ def demo_methods():
 
 
 def _render_scene(name, size, methods, cfg, out):
-    """Render one scene with every method; yields one report line per method."""
+    """Render one scene with every method, by its float64 model and by its fixed-point
+    model; yields one report line per method (fixed-point columns '-' without hardware)."""
     scene = load_scene(name, size=size)
+    fixed_scene = load_scene_config({"name": name, "image": name, "texture_size": size})
     ref = None
     for method in methods:
         t0 = time.perf_counter()
@@ -52,8 +63,29 @@ def _render_scene(name, size, methods, cfg, out):
             ref = img
         else:
             save_png(out / f"{name}_{method}_compare.png", panel(ref, img))
+        fixed = "-", "-"
+        if method in FIXED_METHODS:
+            f = fixed_image(fixed_scene, method, size)
+            save_png(out / f"{name}_{method}_fixed.png", f)
+            fixed = f"{psnr(ref, f):.2f}", str(max_diff(ref, f))
         yield (f"{name:<8} {method:<13} {psnr(ref, img):>8.2f} {max_diff(ref, img):>9d} "
-               f"{seconds:>8.3f} {size * size / seconds / 1e6:>8.2f}  {path.name}")
+               f"{fixed[0]:>9} {fixed[1]:>9} {seconds:>8.3f} {size * size / seconds / 1e6:>8.2f}  "
+               f"{path.name}")
+
+
+def demo_map_size(size, device=DEMO_DEVICE, scene=DEMO_PIPELINE):
+    """The largest power-of-two map side, at most ``size``, whose pipeline fits ``device``'s
+    block RAM (gen/flow/memories.check_scene_fits)."""
+    t = size
+    while True:
+        candidate = load_scene_config(scene).replace(texture_size=t)
+        try:
+            check_scene_fits(candidate, device)
+            return t
+        except BumpError:
+            if t <= 16:
+                raise
+            t //= 2
 
 
 def rtl_mismatch(rtl, golden):
@@ -70,12 +102,15 @@ def rtl_mismatch(rtl, golden):
 
 def _rtl_section(args, out):
     """Emit, render through the simulator, compare, count. Returns (report lines, error)."""
-    scene = load_scene_config(DEMO_PIPELINE)
+    t = demo_map_size(args.size)
+    scene = load_scene_config(DEMO_PIPELINE).replace(texture_size=t)
+    blocks, have = check_scene_fits(scene, DEMO_DEVICE)
     n = args.size * args.size
-    print(f"rtl: rendering {args.size}x{args.size} {scene.image} through the emitted pipeline "
-          f"of scene {scene.name!r} on {args.simulator}", flush=True)
+    print(f"rtl: rendering {args.size}x{args.size} {scene.image} ({t}^2 map) through the emitted "
+          f"pipeline of scene {scene.name!r} on {args.simulator}", flush=True)
     r = render_rtl(scene, args.size, args.simulator, out / "sim", progress=True,
-                   rtl_dir=out / "pipeline")
+                   rtl_dir=out / "pipeline", load=DEMO_LOAD)
+    reference, _ = float_image(scene, "conventional", args.size, progress=False)
     save_png(out / "rtl.png", r.image)
     save_png(out / "golden.png", r.golden)
     diff = np.abs(r.image.astype(int) - r.golden.astype(int))
@@ -84,10 +119,13 @@ def _rtl_section(args, out):
     meta = json.loads((out / "pipeline" / "pipeline.json").read_text())
     counts = count_verilog(out / "pipeline" / "pipeline.v", "pipeline", out / "pipeline" / "yosys")
     c = counts.summary()
-    lines = ["", f"RTL render: scene class {scene.name!r} (`bumprtl emit pipeline --scene "
-                 f"{scene.name}`, with the {scene.image} bump map in its RAM) -> "
-                 f"{out / 'pipeline' / 'pipeline.v'} + pipeline.json",
-             f"  image {scene.image} {args.size}x{args.size}, simulator {args.simulator} (cocotb), "
+    lines = ["", f"RTL render: scene class {scene.name!r} (`{meta['command']}`, the "
+                 f"{scene.image} bump map at {t}x{t} texels written through the host write port "
+                 f"from pipeline_map.hex) -> {out / 'pipeline' / 'pipeline.v'} + pipeline.json",
+             f"  map {t}x{t} x {2 * scene.angle_bits} bits: {blocks} of {have} DP16KD on "
+             f"{DEMO_DEVICE} with the pipeline's tables (the largest power-of-two map up to the "
+             f"image size that fits)",
+             f"  image {scene.image} {args.size}x{args.size}, simulator {args.simulator} (cocotb, bulk path), "
              f"same stimulus as the fixed-point golden render (sim/golden/fixed/pipeline.py)",
              "  units built: " + "; ".join(f"{b['unit']} ({b['class']}, latency {b['latency']})"
                                           for b in meta["built"]),
@@ -98,11 +136,14 @@ def _rtl_section(args, out):
              f"RAM bits {sum(x['bits'] for x in counts.rams)}, register bits {c['register_bits']}",
              f"  latency {meta['latency']} cycles; {n} pixels in {r.cycles} cycles without stalls "
              f"= {r.cycles / n:.4f} cycles per pixel (the pipe fills once, then 1 pixel per clock)",
-             f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {args.simulator} "
-             f"(build {r.build_seconds:.1f} s)",
+             f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {args.simulator}, "
+             f"streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:.0f} pixels/s "
+             f"(build {r.build_seconds:.1f} s{', cached' if r.cached else ''})",
              f"  rtl.png vs golden.png: " + ("identical bytes, max |difference| 0" if error is None
                                              else error) +
-             f"; diff.png = |rtl - golden| x {DIFF_GAIN}"]
+             f"; diff.png = |rtl - golden| x {DIFF_GAIN}",
+             f"  rtl.png vs float64 conventional (same scene and map): PSNR "
+             f"{psnr(reference, r.image):.2f} dB, max difference {max_diff(reference, r.image)}"]
     for line in lines:
         print(line, flush=True)
     return lines, error
@@ -118,15 +159,19 @@ def run(args):
              + ("" if args.rtl else " --no-rtl") +
              (f" --simulator {args.simulator}" if args.rtl and args.simulator != "verilator" else ""),
              "",
-             f"{'scene':<8} {'method':<13} {'PSNR dB':>8} {'max diff':>9} {'seconds':>8} "
-             f"{'Mpix/s':>8}  file"]
+             f"{'scene':<8} {'method':<13} {'PSNR dB':>8} {'max diff':>9} {'fixed dB':>9} "
+             f"{'fixed max':>9} {'seconds':>8} {'Mpix/s':>8}  file"]
     for name in DEMO_SCENES:
         for line in _render_scene(name, args.size, methods, cfg, out):
             lines.append(line)
             print(line, flush=True)
-    lines += ["", f"PSNR and max difference (8-bit RGB) are against '{REFERENCE}'; "
-              f"*_compare.png panels: {REFERENCE} | method | |difference| x10."]
-    error, pngs = None, len(DEMO_SCENES) * (2 * len(methods) - 1)
+    fixed = [m for m in methods if m in FIXED_METHODS]
+    lines += ["", f"PSNR and max difference (8-bit RGB) are against float64 '{REFERENCE}': "
+              f"'PSNR dB' of the method's float64 model, 'fixed dB' of its bit-exact fixed-point "
+              f"model (`bumprtl render --model fixed`, the picture the hardware makes; '-': no "
+              f"hardware); *_compare.png panels: {REFERENCE} | method | |difference| x10; "
+              f"*_fixed.png the fixed-point renders."]
+    error, pngs = None, len(DEMO_SCENES) * (2 * len(methods) - 1 + len(fixed))
     if args.rtl:
         rtl_lines, error = _rtl_section(args, out)
         lines += rtl_lines

@@ -1,4 +1,7 @@
-"""``bumprtl render``: render a scene with one method; ``--compare`` against conventional."""
+"""``bumprtl render``: render a scene (a procedural image or your own height or normal map)
+with one method, by its float64 model or by the bit-exact fixed-point model of the hardware
+(``--model fixed``: the picture the RTL makes, without a simulator), or through the RTL
+itself (``--rtl``); ``--compare`` against float64 ``conventional``."""
 
 import argparse
 import importlib
@@ -9,18 +12,30 @@ import numpy as np
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed, encode_pixels
+from bumprtl.rtl.scene import SceneConfig
+from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
-from bumprtl.sim.scenes import load_scene, SCENES
+from bumprtl.sim.scenes import SCENES
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
-from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.gen.render.rtl import cli_render
+from bumprtl.gen.cli.flags import add_config_flags, add_map_flags, scene_from_args
+from bumprtl.gen.flow.memories import DEFAULT_DEVICE, DEVICE_BRAM, LOADS
+from bumprtl.gen.render.rtl import cli_render, golden_render, scene_stimulus, sim_scene
 
-__all__ = ["PALETTE", "render_methods", "shade_scene", "add_parser"]
+__all__ = ["PALETTE", "MODELS", "FIXED_METHODS", "render_methods", "shade_scene", "fixed_image",
+           "float_image", "render_scene", "add_parser"]
 
 ROWS_PER_CHUNK = 32
 PROGRESS_PIXELS = 1 << 20          # show a progress bar from 1024 x 1024 pixels on
 PALETTE = "palette"                # Tarini et al.'s quantized normal map (sim/golden/float/palette.py)
 QUANTIZERS = ("median-cut", "kmeans")
+MODELS = ("float64", "fixed")
+# render method -> the registry method (rtl/methods.py) whose bit-exact model renders it with
+# --model fixed; palette: the pipeline's PaletteLUT. conventional and lee_printed have no
+# hardware.
+FIXED_METHODS = {"exact": "exact", "lee_corrected": "lee", "peercy": "peercy", "kim": "kim",
+                 "ernst": "ernst", PALETTE: PALETTE}
 
 
 def render_methods():
@@ -62,45 +77,141 @@ def shade_scene(scene, method, cfg, progress=True, **palette_opts):
 
 def _palette_opts(args):
     opts = {k: getattr(args, k) for k in ("quantizer", "lighting") if getattr(args, k) is not None}
-    if opts and args.model != PALETTE:
-        raise BumpError(f"--{next(iter(opts))} applies to --method palette only, not {args.model}")
+    if opts and (args.render_method != PALETTE or args.model != "float64" or args.rtl):
+        raise BumpError(f"--{next(iter(opts))} applies to --method palette with --model float64 "
+                        f"only, not {args.render_method} ({'rtl' if args.rtl else args.model})")
     return opts
+
+
+def _light(args):
+    return {"azimuth": args.light_azimuth, "light_elevation": args.light_elevation,
+            "light": args.light}
+
+
+def float_image(scene: SceneConfig, method, size, progress=True, azimuth=30.0, **light):
+    """8-bit image of ``scene`` at ``size`` x ``size`` by the float64 model ``method`` (or the
+    float palette); returns ``(image, sim scene)``."""
+    base = sim_scene(scene, size, azimuth, **light)
+    return compose(base, shade_scene(base, method, scene.config, progress)), base
+
+
+def fixed_image(scene: SceneConfig, method, size, azimuth=30.0, **light):
+    """8-bit image of ``scene`` by the bit-exact fixed-point model of ``method`` (a key of
+    :data:`FIXED_METHODS`): for exact and lee the pipeline's golden render (byte for byte the
+    RTL's picture, gen/render/rtl.golden_render); for the Table 1 baselines their datapath's
+    model on the same pixels; for palette the pipeline's PaletteLUT colour (the mean of its
+    RGB, shown like the float64 palette: times the scene's albedo)."""
+    if method not in FIXED_METHODS:
+        raise BumpError(f"--method {method} has no fixed-point model; with --model fixed the "
+                        f"method must be one of {', '.join(FIXED_METHODS)}")
+    name = FIXED_METHODS[method]
+    if name in PER_PIXEL:
+        return golden_render(scene.replace(method=name), size, azimuth=azimuth, **light)
+    if name == PALETTE:
+        s = scene.replace(shading="palette")
+        if s.texture:
+            return golden_render(s, size, azimuth=azimuth, **light)
+        inputs, words, polygon, table, base = scene_stimulus(s, size, azimuth, **light)
+        rgba = unpack_rgba(table[pipeline_fixed(inputs, s, words, polygon)["index"]], s.config)
+        grey = (rgba["r"] + rgba["g"] + rgba["b"]) / 3.0
+        return compose(base, grey.reshape(size, size) / 255.0)
+    base = sim_scene(scene, size, azimuth, **light)          # a Table 1 baseline datapath
+    cfg = scene.config.replace(method=name)
+    color = datapath_fixed(encode_pixels(base.px, cfg), cfg)["color"]
+    return compose(base, np.asarray(color, np.float64).reshape(size, size) / 255.0)
+
+
+def render_scene(args, rtl=False) -> SceneConfig:
+    """The scene a render draws: ``--pipeline`` (a scene class or TOML) or ``--scene`` (an
+    image name, or a TOML file), with the map, method and Config flags that were given; a
+    flag that contradicts the TOML is an error naming both. Without ``rtl`` the map is
+    image-sized unless the scene, the map or a flag says otherwise."""
+    source, extra = args.pipeline, {}
+    if args.scene is not None:
+        if Path(args.scene).suffix.lower() == ".toml":
+            if source is not None:
+                raise BumpError(f"--scene {args.scene} and --pipeline {source}: give the scene "
+                                f"TOML once")
+            source = args.scene
+        elif args.scene in SCENES:
+            extra["image"] = args.scene
+        elif Path(args.scene).suffix.lower() in (".png", ".npy"):
+            raise BumpError(f"--scene {args.scene}: a map file goes to --height-map FILE "
+                            f"(greyscale heights) or --normal-map FILE (RGB normals)")
+        else:
+            raise BumpError(f"--scene must be one of {', '.join(SCENES)} or a scene TOML file, "
+                            f"got {args.scene!r}")
+    if args.render_method is not None and (rtl or args.model == "fixed"):
+        name = FIXED_METHODS.get(args.render_method)
+        if name in PER_PIXEL:
+            extra["method"] = name
+        elif name == PALETTE:
+            extra["shading"] = "palette"
+        elif rtl:
+            raise BumpError(f"--method {args.render_method} with --rtl: a scene pipeline is built for "
+                            f"exact, lee_corrected (lee) or palette")
+    defaults = None if rtl else {"texture_size": args.size}
+    return scene_from_args(args, source or "default", extra, defaults)
 
 
 def run(args):
     if args.rtl:                                   # through the emitted pipeline (gen/render/rtl.py)
-        return cli_render(args)
-    cfg, palette_opts = config_from_args(args), _palette_opts(args)
-    scene = load_scene(args.scene, size=args.size, light_elevation=args.light_elevation,
-                       light_azimuth=args.light_azimuth, light=args.light,
-                       texture_size=args.texture_size)
+        if args.model != "float64":
+            raise BumpError("--rtl renders through the hardware; --model applies without --rtl")
+        return cli_render(args, render_scene(args, rtl=True))
+    if args.load is not None or args.device is not None or args.per_cycle:
+        raise BumpError("--load, --device and --per-cycle apply to --rtl only")
+    palette_opts = _palette_opts(args)
+    scene = render_scene(args)
     t0 = time.perf_counter()
-    img = compose(scene, shade_scene(scene, args.model, cfg, **palette_opts))
+    if args.model == "fixed":
+        args.render_method = args.render_method or "exact"
+        img = fixed_image(scene, args.render_method, args.size, **_light(args))
+        base = sim_scene(scene, args.size, args.light_azimuth,
+                         light_elevation=args.light_elevation, light=args.light)
+    else:
+        args.render_method = args.render_method or "exact"
+        if args.render_method not in render_methods():
+            raise BumpError(f"--method must be one of {', '.join(render_methods())}, got {args.render_method!r}")
+        base = sim_scene(scene, args.size, args.light_azimuth,
+                         light_elevation=args.light_elevation, light=args.light)
+        img = compose(base, shade_scene(base, args.render_method, scene.config, **palette_opts))
     elapsed = time.perf_counter() - t0
     out = save_png(args.out, img)
-    print(f"{args.model}: {args.size}x{args.size} {args.scene} in {elapsed:.2f} s "
+    print(f"{args.render_method} ({args.model}): {args.size}x{args.size} {scene.picture} (map "
+          f"{scene.texture_size}^2, {base.geometry}) in {elapsed:.2f} s "
           f"({args.size ** 2 / elapsed / 1e6:.2f} Mpix/s) -> {out}")
     if args.compare:
-        ref = compose(scene, shade_scene(scene, "conventional", cfg))
+        ref = compose(base, shade_scene(base, "conventional", scene.config))
         cmp_path = save_png(out.with_name(out.stem + "_compare.png"), panel(ref, img))
-        print(f"vs conventional: PSNR {psnr(ref, img):.2f} dB, max difference "
-              f"{max_diff(ref, img)} (8-bit); panel reference | {args.model} | |diff| x10 -> {cmp_path}")
+        print(f"vs conventional (float64): PSNR {psnr(ref, img):.2f} dB, max difference "
+              f"{max_diff(ref, img)} (8-bit); panel reference | {args.render_method} | |diff| x10 -> {cmp_path}")
     return 0
 
 
 def add_parser(sub):
     methods = render_methods()
     scenes = "\n".join(f"  {k:<12} {v[3]}" for k, v in SCENES.items())
-    p = sub.add_parser("render", help="render a scene to PNG with one method",
-                       description=f"Render a bump-mapped scene with a golden model.\n\nscenes:\n{scenes}",
+    p = sub.add_parser("render", help="render a scene or your own bump map to PNG",
+                       description=f"Render a bump-mapped scene: a procedural image or your own "
+                                   f"height or normal map (--height-map / --normal-map), by a "
+                                   f"float64 model, by the bit-exact fixed-point model of the "
+                                   f"hardware (--model fixed) or through the RTL (--rtl).\n\n"
+                                   f"scenes:\n{scenes}",
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--scene", default="bricks", choices=list(SCENES), metavar="NAME",
-                   help="scene name (default: bricks)")
-    p.add_argument("--method", dest="model", default="exact", choices=methods, metavar="METHOD",
-                   help=f"one of {', '.join(methods)} (default: exact)")
+    p.add_argument("--scene", default=None, metavar="NAME|FILE.toml",
+                   help="procedural image (default: bricks) or a scene TOML file")
+    p.add_argument("--method", dest="render_method", default=None, metavar="METHOD",
+                   help=f"one of {', '.join(methods)} (default: exact); with --model fixed one "
+                        f"of {', '.join(FIXED_METHODS)}")
+    p.add_argument("--model", default="float64", choices=MODELS,
+                   help="float64: the method's float64 reference (default); fixed: its bit-exact "
+                        "fixed-point model, the picture the hardware makes (rtl/methods.py, "
+                        "sim/golden/fixed/)")
     p.add_argument("--size", type=int, default=512, help="image size, power of two in [16, 4096] (default: 512)")
     p.add_argument("--texture-size", type=int, default=None, metavar="T",
-                   help="bump map size, power of two in [16, 4096] (default: the image size)")
+                   help="bump map size, power of two in [16, 4096] (default: your map's size, "
+                        "else the scene's with --rtl, else the image size)")
     p.add_argument("--light-elevation", type=float, default=45.0, metavar="DEG",
                    help="light elevation above the screen plane, [-90, 90] (default: 45)")
     p.add_argument("--light-azimuth", type=float, default=30.0, metavar="DEG",
@@ -120,7 +231,15 @@ def add_parser(sub):
     p.add_argument("--per-cycle", action="store_true",
                    help="with --rtl: drive every pixel from cocotb, clock by clock, instead of the "
                         "bulk path (sim/tb/bulk.py: arrays in, arrays out, cached build)")
-    p.add_argument("--pipeline", default="default", metavar="FILE|NAME",
-                   help="with --rtl: the scene class (rtl/scene.py built-in or TOML) to build")
+    p.add_argument("--pipeline", default=None, metavar="FILE|NAME",
+                   help="the scene class (rtl/scene.py built-in or TOML) to build with --rtl and "
+                        "to model with --model fixed (default: default)")
+    p.add_argument("--load", default=None, choices=LOADS,
+                   help="with --rtl: the map as the Verilog's initial contents, or written "
+                        "through the host write port before the first pixel (default: initial)")
+    p.add_argument("--device", default=None, choices=sorted(DEVICE_BRAM),
+                   help=f"with --rtl: refuse a map that does not fit this ECP5's block RAM "
+                        f"(default: {DEFAULT_DEVICE})")
+    add_map_flags(p)
     add_config_flags(p, fields=("spec_exponent", "ka", "kd", "ks", "specular", "palette_size"))
     p.set_defaults(func=run)

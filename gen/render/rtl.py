@@ -4,9 +4,11 @@ every pixel through it with cocotb (Icarus or Verilator), collect the image.
 The same stimulus gives the fixed-point golden render (sim/golden/fixed/pipeline.py); the
 two must agree byte for byte. Per pixel the stimulus carries the texel coordinates (u, v),
 world N, L and H as binary angles and a tag (the pixel index); the bump map (N' angles of
-every texel, or palette indices) is the fetch unit's block-RAM initial contents, and with
+every texel, or palette indices) is the fetch unit's block-RAM initial contents (or, with
+``load = "port"``, written through its host write port before the first pixel), and with
 ``texture = true`` the scene's albedo (8-bit RGB per texel, :func:`scene_texels`) is the
-colour texture's; the pipeline then outputs RGB itself.
+colour texture's; the pipeline then outputs RGB itself. The bump map is the scene's
+procedural image or the user's map file (``height_map``/``normal_map``, sim/scenes/usermap.py).
 """
 
 import json
@@ -27,14 +29,18 @@ from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, polygon
 from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
                                               quantize_normal_map, world_normal_map)
 from bumprtl.sim.scenes import load_scene, SCENES
+from bumprtl.sim.scenes.usermap import load_bump_map
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.sim.tb.bulk import run_bulk, setup_writes
 from bumprtl.sim.tb.runner import run_cocotb
 from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
+                                       host_writes, memory_images)
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.gen.flow.units import build_unit, canonical_command, UNITS
 
-__all__ = ["RtlRender", "scene_stimulus", "scene_texels", "golden_render", "render_rtl"]
+__all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
+           "render_rtl", "sim_scene"]
 
 LIGHT_AZIMUTH_STEP = 120.0        # light j sits 120 degrees further round than light j - 1
 
@@ -50,9 +56,17 @@ class RtlRender:
     cached: bool = False           # bulk path: the simulator build came from build/sim_cache
 
 
-def _sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
+def sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
+    """The sim scene (bumprtl.sim.scenes.Scene) of ``scene`` at ``size`` x ``size`` pixels:
+    its procedural image or its user map, on its geometry, at its texture size."""
+    bump = None
+    if scene.map_file is not None:
+        key, path = scene.map_file
+        bump = load_bump_map(path, "height" if key == "height_map" else "normal",
+                             scene.normal_convention, scene.height_scale, scene.texture_size,
+                             scene.resample)
     return load_scene(scene.image, size=size, texture_size=scene.texture_size,
-                      light_azimuth=azimuth, **light)
+                      light_azimuth=azimuth, bump=bump, geometry=scene.geometry, **light)
 
 
 def _levels(level0, scene):
@@ -60,11 +74,12 @@ def _levels(level0, scene):
     return [level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)]
 
 
-def scene_stimulus(scene: SceneConfig, size, **light):
+def scene_stimulus(scene: SceneConfig, size, azimuth=30.0, **light):
     """Per-pixel input arrays, memory words, polygon registers and palette table (or None)
-    of one frame of ``scene`` at ``size`` x ``size``; and the sim scene."""
+    of one frame of ``scene`` at ``size`` x ``size``; and the sim scene. Light 0 sits at
+    ``azimuth`` degrees, light j LIGHT_AZIMUTH_STEP * j further round."""
     cfg = scene.config
-    base = _sim_scene(scene, size, **light)
+    base = sim_scene(scene, size, azimuth, **light)
     inputs, words, polygon, table = {}, None, None, None
     if scene.bump_map == "varying" or scene.shading == "palette" or scene.texture:
         inputs["u"], inputs["v"] = base.u, base.v
@@ -76,20 +91,46 @@ def scene_stimulus(scene: SceneConfig, size, **light):
         codes = quantize_pixels(base.px, cfg)
         if scene.bump_map == "varying":
             inputs["n.phi"], inputs["n.theta"] = codes["n.phi"], codes["n.theta"]
-            level0 = pack_texels(scene, angle_codes(base.b_phi_map, cfg), angle_codes(base.b_theta_map, cfg))
-            words = map_words(_levels(level0, scene), scene)
+            words = _bump_words(base, scene)
         else:
             if np.ptp(codes["n.phi"]) or np.ptp(codes["n.theta"]):
-                raise BumpError(f"bump_map = 'flat' renders one polygon: image {scene.image!r} "
-                                f"is not a plane (its normal varies); use a plane scene")
+                raise BumpError(f"bump_map = 'flat' renders one polygon: {scene.picture!r} is "
+                                f"not on a plane (its normal varies); use a plane scene")
             polygon = polygon_fixed(codes["n.phi"].flat[0], codes["n.theta"].flat[0], 0, 0, scene)
         for j, names in enumerate(light_fields(scene)):
-            lit = quantize_pixels(_sim_scene(scene, size, 30.0 + LIGHT_AZIMUTH_STEP * j, **light).px, cfg)
+            turn = azimuth if j == 0 else (azimuth + LIGHT_AZIMUTH_STEP * j) % 360
+            lit = quantize_pixels(sim_scene(scene, size, turn, **light).px, cfg)
             for std, name in zip(("l", "h"), names):
                 inputs[f"{name}.phi"], inputs[f"{name}.theta"] = lit[f"{std}.phi"], lit[f"{std}.theta"]
     inputs = {k: np.asarray(v, np.int64).ravel() for k, v in inputs.items()}
     inputs["tag"] = np.arange(size * size, dtype=np.int64) & ((1 << scene.tag_bits) - 1)
     return inputs, words, polygon, table, base
+
+
+def _bump_words(base, scene):
+    """The bump vector map memory: N' of every texel as binary angles, levels point-sampled."""
+    cfg = scene.config
+    level0 = pack_texels(scene, angle_codes(base.b_phi_map, cfg), angle_codes(base.b_theta_map, cfg))
+    return map_words(_levels(level0, scene), scene)
+
+
+MEMORY_FRAME_MAX = 1024
+
+
+def scene_memories(scene):
+    """``(map words, texture words, palette table)`` (each None when the scene has no such
+    memory) of ``scene``'s pipeline, as ``bumprtl emit`` writes them. The bump map and the
+    texture depend on the map only; the palette's index map and colour table on a frame too:
+    the default light, T x T pixels (at most MEMORY_FRAME_MAX^2)."""
+    scene = load_scene_config(scene)
+    palette = scene.shading == "palette"
+    base = sim_scene(scene, min(scene.texture_size, MEMORY_FRAME_MAX) if palette else 16)
+    words, table = None, None
+    if palette:
+        words, table = _palette_maps(base, scene)
+    elif scene.bump_map == "varying":
+        words = _bump_words(base, scene)
+    return words, scene_texels(scene, base), table
 
 
 def scene_texels(scene: SceneConfig, base):
@@ -100,7 +141,7 @@ def scene_texels(scene: SceneConfig, base):
     if base.albedo is None:
         have = [n for n, v in SCENES.items() if v[0] in ("bricks", "wood")]
         raise BumpError(f"texture = true needs an image with a colour texture ({', '.join(have)}), "
-                        f"got image {scene.image!r}")
+                        f"got {'image ' if scene.map_file is None else ''}{scene.picture!r}")
     return map_words(_levels(pack_rgb(to_8bit(base.albedo)), scene), scene)
 
 
@@ -139,25 +180,30 @@ def golden_render(scene, size, **light):
     return _image(base, out, scene)
 
 
-def write_stimulus(path, inputs, polygon, table):
+def write_stimulus(path, inputs, polygon, table, setup=()):
+    """The npz tb_pipeline.py reads; ``setup``: host cycles (``{port: value}`` per clock,
+    e.g. the map written through its port) as ``setup.<port>`` arrays, one entry a clock."""
     arrays = {f"in.{k}": v for k, v in inputs.items()}
     arrays.update({f"polygon.{k}": np.array(v) for k, v in (polygon or {}).items()})
     if table is not None:
         arrays["lut"] = np.asarray(table, np.int64)
+    for port in sorted({p for cycle in setup for p in cycle}):
+        arrays[f"setup.{port}"] = np.array([c.get(port, 0) for c in setup], np.int64)
     np.savez(path, **arrays)
 
 
 def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, patterns=("no_stall",),
-                 progress=True, texels=None, rtl_dir=None):
+                 progress=True, texels=None, rtl_dir=None, load="initial"):
     """Emit BumpPipeline(scene) with ``words`` in its map (and ``texels`` in its colour
     texture), run ``inputs`` through it under each traffic pattern; returns
     ({pattern: {field: array}}, {pattern: cycles}, run), ``run`` the :class:`CocotbRun` with
-    the build and run wall times. The Verilog goes to ``rtl_dir`` (default ``<build_dir>/rtl``)."""
+    the build and run wall times. The Verilog goes to ``rtl_dir`` (default ``<build_dir>/rtl``).
+    ``load = "port"``: the memories start at zero and the host writes them before the pixels."""
     build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
-    v, j = _emit_pipeline(scene, words, texels, build_dir, rtl_dir)
+    v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
     build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
-    write_stimulus(stim, inputs, polygon, table)
+    write_stimulus(stim, inputs, polygon, table, writes)
     run = run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
                       "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
@@ -167,44 +213,58 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run
 
 
-def _emit_pipeline(scene, words, texels, build_dir, rtl_dir):
-    dut = BumpPipeline(scene, init=words, texture=texels)
-    sidecar = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
+def emit_pipeline(scene, words, texels, build_dir, rtl_dir, table=None, load="initial"):
+    """Write pipeline.v, pipeline.json and the $readmemh files of its memories
+    (gen/flow/memories.py); ``load``: the contents built in (``initial``) or left to the
+    host write port (``port``). Returns the .v and .json paths."""
+    images = memory_images("pipeline", scene, words, texels, table, load)
     rtl_dir = Path(build_dir) / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
-    return emit(dut, "pipeline", canonical_command(UNITS["pipeline"], scene), rtl_dir,
-                sidecar, flatten=True)
+    v, j, _ = emit_scene_unit("pipeline", scene, rtl_dir, images, device=None)
+    return v, j
+
+
+def _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load):
+    """emit_pipeline, plus the host cycles that load the memories when ``load = "port"``."""
+    v, j = emit_pipeline(scene, words, texels, build_dir, rtl_dir, table, load)
+    images = memory_images("pipeline", scene, words, texels, None, load)
+    return v, j, host_writes(images, json.loads(Path(j).read_text()))
 
 
 def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir,
-                      patterns=("no_stall",), texels=None, rtl_dir=None, expected=None):
+                      patterns=("no_stall",), texels=None, rtl_dir=None, expected=None,
+                      clock="verilog", load="initial"):
     """:func:`run_pipeline` on the bulk path (sim/tb/bulk.py): the pixels travel as arrays
     and the clock runs in the simulator; the build is cached under build/sim_cache by the
-    Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel.
+    Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel;
+    ``clock="cocotb"`` drives the clock with cocotb's Clock instead of the wrapper's own.
+    ``load = "port"``: the memories are written through the host ports in the set-up.
     Returns ({pattern: {field: array}}, {pattern: cycles}, :class:`BulkResult`)."""
     build_dir = Path(build_dir).resolve()
-    v, j = _emit_pipeline(scene, words, texels, build_dir, rtl_dir)
+    v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
     meta = json.loads(Path(j).read_text())
     r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
-                 expected=expected, setup=setup_writes(meta, polygon, table))
+                 expected=expected, setup=writes + setup_writes(meta, polygon, table), clock=clock)
     return r.outputs, r.cycles, r
 
 
 def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl", progress=True,
-               rtl_dir=None, per_cycle=False, **light):
+               rtl_dir=None, per_cycle=False, load="initial", **light):
     """Render ``scene`` (SceneConfig, name or TOML path) through the emitted RTL; returns an
     :class:`RtlRender` with the RTL image and the golden image of the same stimulus. The
-    bulk path by default; ``per_cycle`` drives every pixel from cocotb (tb_pipeline.py)."""
+    bulk path by default; ``per_cycle`` drives every pixel from cocotb (tb_pipeline.py).
+    ``load = "port"``: the Verilog has no map contents; the host write port loads them."""
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
     texels = scene_texels(scene, base)
     if per_cycle:
         outs, cycles, run = run_pipeline(scene, inputs, words, polygon, table, simulator,
                                          build_dir, progress=progress, texels=texels,
-                                         rtl_dir=rtl_dir)
+                                         rtl_dir=rtl_dir, load=load)
         times = (run.run_s, run.build_s, None, False)
     else:
         outs, cycles, run = run_pipeline_bulk(scene, inputs, words, polygon, table, simulator,
-                                              build_dir, texels=texels, rtl_dir=rtl_dir)
+                                              build_dir, texels=texels, rtl_dir=rtl_dir,
+                                              load=load)
         times = (run.run_s, run.build_s, run.sim_s["no_stall"], run.cached)
     pixels = outs["no_stall"]
     if not np.array_equal(pixels["tag"], inputs["tag"]):
@@ -213,19 +273,20 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
                      cycles["no_stall"], *times)
 
 
-def cli_render(args):
-    """``bumprtl render --rtl``: the scene class ``--pipeline`` (built-in name or TOML)
-    rendering image ``--scene``; writes the RTL image, checks it against the golden render."""
-    scene = load_scene_config(args.pipeline)
-    keys = {"image": args.scene}
-    if args.texture_size is not None:
-        keys["texture_size"] = args.texture_size
-    scene = load_scene_config({**scene.to_dict(), **keys, "rotation": None})
-    light = {"light_elevation": args.light_elevation, "light": args.light}
+def cli_render(args, scene=None):
+    """``bumprtl render --rtl``: the scene (``--pipeline``, a built-in scene class or TOML,
+    with the flags that were given: ``gen/render/images.render_scene``) rendered through its
+    emitted pipeline; writes the RTL image and checks it against the golden render. A map
+    that does not fit ``--device``'s block RAM is refused before anything is built."""
+    scene = load_scene_config(args.pipeline or "default") if scene is None else scene
+    check_scene_fits(scene, getattr(args, "device", None) or DEFAULT_DEVICE)
+    light = {"azimuth": args.light_azimuth, "light_elevation": args.light_elevation,
+             "light": args.light}
     t0 = time.perf_counter()
     per_cycle = getattr(args, "per_cycle", False)
-    r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / scene.name,
-                   progress=True, per_cycle=per_cycle, **light)
+    load = getattr(args, "load", None) or "initial"
+    r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / _dir_name(scene),
+                   progress=True, per_cycle=per_cycle, load=load, **light)
     out = save_png(args.out, r.image)
     same = r.image.tobytes() == r.golden.tobytes()
     n = args.size ** 2
@@ -234,12 +295,17 @@ def cli_render(args):
              f"build cached (took {r.build_seconds:.1f} s once)")
     stream = "" if r.stream_seconds is None else \
         f"; streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:,.0f} pix/s"
-    print(f"rtl ({args.simulator}, {path}): {args.size}x{args.size} {args.scene} with pipeline "
-          f"{scene.name}: {r.cycles} cycles; {build}; simulation {r.seconds:.2f} s = "
-          f"{n / r.seconds:,.0f} pix/s{stream}; total {time.perf_counter() - t0:.1f} s -> {out}")
+    print(f"rtl ({args.simulator}, {path}, map load {load}): {args.size}x{args.size} "
+          f"{scene.picture} ({scene.texture_size}^2 map) with pipeline {scene.name}: {r.cycles} "
+          f"cycles; {build}; simulation {r.seconds:.2f} s = {n / r.seconds:,.0f} pix/s{stream}; "
+          f"total {time.perf_counter() - t0:.1f} s -> {out}")
     print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
     return 0 if same else 1
 
+
+def _dir_name(scene):
+    """A build directory name for ``scene`` (a TOML path's stem, not its directories)."""
+    return Path(scene.name).stem or "scene"
 
 
 SCENES_TABLE_SIZE = 256

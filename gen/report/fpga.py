@@ -7,19 +7,24 @@ the accuracy of each design's bit-exact golden model (:func:`.table1.accuracy`),
 critical paths and a cost-against-error plot.
 """
 
+import argparse
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import BUILTIN
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, check_device, lpf_mhz,
-                                   pipeline_component, place_component)
+from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, check_device,
+                                   lpf_mhz, pipeline_component, place_component)
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 
@@ -30,10 +35,10 @@ def fpga_units(cfg):
     """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
     pipeline (setup -> illumination; their combinational dividers and square roots make
     synth_ecp5 slow on every netlist, so not each unit again), then the BumpPipeline of
-    the default scene (fetch -> rotation -> illumination, exact)."""
+    every built-in scene class (row ``scene:<name>``)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
     return ([(f"{d}_{row}", d, row) for d in TABLE1_ORDER if d not in NOT_PLACED for row in rows(d)]
-            + [("scene_default", "exact", "scene")])
+            + [(f"scene_{s.replace('-', '_')}", "exact", f"scene:{s}") for s in BUILTIN])
 
 
 def run_fpga(args):
@@ -51,8 +56,8 @@ def run_fpga(args):
 def _component(design, row, cfg):
     """The ECP5 form (``target=ECP5()``) of row ``row`` of ``design`` (a method name)."""
     target = ECP5()
-    if row == "scene":              # the drop-in BumpPipeline of the default scene
-        return BumpPipeline("default", target=target)
+    if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
+        return BumpPipeline(row.split(":", 1)[1], target=target)
     cfg = cfg.replace(method=design)
     if row == "pipeline":
         return pipeline_component(cfg, target)
@@ -62,26 +67,54 @@ def _component(design, row, cfg):
 def fpga_report(cfg, args, units):
     """Place ``units`` ((label, design, row) triples of :func:`fpga_units`) on ``args.device``
     and write ``args.out`` (markdown table + cost-against-error plot)."""
+    seeds = list(getattr(args, "seeds", None) or [1])
+    jobs = max(1, getattr(args, "jobs", None) or 1)
+    tasks = [(u, seed) for u in units for seed in seeds]
+    placed = {}
+    with ProcessPoolExecutor(jobs) as pool:
+        futures = {pool.submit(_place, u, cfg, args.device, args.work, seed): (u, seed)
+                   for u, seed in tasks}
+        for fut in tqdm(as_completed(futures), total=len(futures), desc="place", unit="run",
+                        disable=os.environ.get("BUMPRTL_PROGRESS", "1") == "0"):
+            placed[futures[fut]] = fut.result()
     rows = []
     for label, design, row in units:
-        placed = place_component(_component(design, row, cfg), label, args.device,
-                                 args.work)
-        rows.append({**placed, "design": design, "row": row})
+        runs = [placed[((label, design, row), s)] for s in seeds]
+        ok = [r for r in runs if "error" not in r]
+        if not ok:
+            rows.append({"unit": label, "design": design, "row": row, "error": runs[0]["error"]})
+        else:
+            worst = min(ok, key=lambda r: r["fmax_mhz"] or 0)
+            rows.append({**worst, "unit": label, "design": design, "row": row,
+                         "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}})
         print(f"{label}: {rows[-1]}", flush=True)
     acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}
     write_report(args, rows, acc)
+
+
+def _place(unit, cfg, device, work, seed):
+    """One placement (a worker process): the row, or {"error": reason} when the tools fail."""
+    label, design, row = unit
+    try:
+        return {**place_component(_component(design, row, cfg), label, device, work, seed=seed),
+                "seed": seed}
+    except FpgaError as e:
+        return {"error": str(e), "seed": seed}
 
 
 def write_report(args, rows, acc):
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot = out.parent / "img" / "cost_vs_error.png"
+    seeds = list(getattr(args, "seeds", None) or [1])
     command = (f"bumprtl report fpga --device {args.device} --samples {args.samples}"
+               + (f" --seeds {','.join(map(str, seeds))}" if seeds != [1] else "")
                + "".join(f" --unit {u}" for u in args.unit or ()))
     lines = ["# FPGA cost of every design", "",
              f"Generated by `{command}`: Yosys `synth_ecp5`, then `nextpnr-ecp5` "
              f"{DEVICES[args.device]} --package {PACKAGE} --out-of-context with "
-             f"`constraints/ecp5.lpf` ({lpf_mhz():g} MHz clock target), seed 1. LUT4 = "
+             f"`constraints/ecp5.lpf` ({lpf_mhz():g} MHz clock target), nextpnr seed(s) "
+             f"{', '.join(map(str, seeds))}: Fmax is the minimum over the seeds. LUT4 = "
              "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
              "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
              f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
@@ -89,13 +122,16 @@ def write_report(args, rows, acc):
              "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         a = acc[r["design"]]
+        if "error" in r:
+            lines.append(f"| {r['unit']} | not placed: {r['error']} | | | | | | {a['max']} | {a['mean']:.4f} |")
+            continue
         lines.append(f"| {r['unit']} | {r['LUT4']} | {r['FF']} | {r['DSP']} | {r['BRAM']} | "
                      f"{r['fmax_mhz']} | {'yes' if r['met'] else 'no'} | {a['max']} | {a['mean']:.4f} |")
     if _plot(rows, acc, plot):
         lines += ["", f"![LUT4 of the pipeline against diffuse error](img/{plot.name})"]
     lines += ["", "## Critical paths", "",
               "nextpnr's worst register-to-register path of each unit (start -> end cell.port):", ""]
-    lines += [f"- {r['unit']}: {r['critical_path']}" for r in rows]
+    lines += [f"- {r['unit']}: {r['critical_path']}" for r in rows if "error" not in r]
     target = [r for r in rows if r["unit"] == "exact_pipeline"]
     if target:
         r = target[0]
@@ -115,7 +151,7 @@ def _plot(rows, acc, path):
     """LUT4 of each design's pipeline (or its units' sum) against its max and mean error."""
     cost = {}
     for r in rows:
-        if r["row"] == "pipeline":
+        if r["row"] == "pipeline" and "error" not in r:
             cost[r["design"]] = r["LUT4"]
     if not cost:
         return False
@@ -151,22 +187,42 @@ FPGA_NOTES = """
 - Yosys `synth_ecp5` infers neither block-RAM output registers nor DSP registers, so
   `report fpga` elaborates with the `rtl.pipe.ECP5` hint, which instantiates DP16KD and
   MULT18X18D with those registers; every simulator (and `bumprtl emit`) runs the generic
-  form with the same registers. `tests/rtl/test_pipe.py` checks the generic form bit for
-  bit and the DP16KD contents against Yosys' own block-RAM mapping; neither Yosys nor
-  this repository has a simulation model of the two primitives, so the ECP5 form itself
-  is checked structurally only.
+  form with the same registers. The ECP5 form is simulated too: `sim/ecp5/dp16kd.v` and
+  `sim/ecp5/mult18x18d.v` are behavioural models written from Lattice's memory and sysDSP
+  usage guides (Yosys ships DP16KD as a blackbox and no MULT18X18D model);
+  `tests/sim/ecp5/` runs RegisteredROM (every word, the spill word included),
+  RegisteredProduct and RegisteredRAM in their ECP5 form against the generic form under a
+  random enable, checks that Yosys' own block-RAM mapping reads back through the DP16KD
+  model (x4, x9, x2 modes), and (`make fpga`) simulates the `synth_ecp5` netlists of the
+  exact pipeline and of the default scene's BumpPipeline with Yosys' `cells_sim.v` and the
+  two models, bit-exact against the golden model on 10^4 pixels under random
+  backpressure and input gaps.
 - What limits Fmax now is in the critical-path list above (nextpnr reports the worst
-  path only; the next ones are not listed). The stall enable `adv = ~o.valid | o.ready` (`rtl/pipe.py`) still
-  fans out combinationally to every enable; it is not on a critical path at this target.
-- scene_default is the drop-in `BumpPipeline` of the default scene (fetch -> rotation
-  -> illumination, 64^2 bump map in block RAM). Its limit is `rtl/bumpfetch.py`'s
-  bump-map RAM read: an unregistered DP16KD (5.8 ns clock-to-out) feeding the rotation's
-  input adders in the same cycle; registering that read is the fetch unit's change.
+  path only; the next ones are not listed).
+- scene_* rows are the drop-in `BumpPipeline` of each built-in scene class (fetch ->
+  rotation -> illumination, 64^2 bump map in block RAM). The bump-map and colour-texture
+  reads are registered like the ROMs (`rtl/pipe.RegisteredRAM`: DP16KD blocks with the
+  write port on port A and REGMODE OUTREG on the read port; the fetch's latency is 3).
+  With that read registered, the limit of scene_default is the stall enable
+  `adv = ~o.valid | o.ready` (`rtl/pipe.py`): it fans out combinationally from the last
+  unit's `o.valid` to every register, ROM and RAM clock enable of the whole pipeline
+  (mostly routing delay); cutting it needs a registered ready per unit (a skid buffer
+  between units), which is not built.
 - The lee datapath was not pipelined further (its setup runs ROM, multiply and ROM in
   few stages).
 - Units are placed out of context: no I/O buffers, ports are internal nets, so paths
   from a unit's input ports are not timed (the pipelines time them between units).
 """
+
+
+def _seeds(text):
+    try:
+        seeds = [int(s) for s in text.split(",")]
+    except ValueError:
+        seeds = []
+    if not seeds or any(s < 1 for s in seeds):
+        raise argparse.ArgumentTypeError(f"must be comma-separated positive integers, got {text!r}")
+    return seeds
 
 
 def add_parser(kinds):
@@ -179,5 +235,9 @@ def add_parser(kinds):
                    help="placements, cached by Verilog digest (shared with bench sweep --fpga; "
                         "default: build/fpga_cache)")
     f.add_argument("--samples", type=int, default=100_000)
+    f.add_argument("--seeds", type=_seeds, default=[1],
+                   help="nextpnr seeds, comma-separated (default 1); Fmax is their minimum")
+    f.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="placements run in parallel (default: the number of cores)")
     add_config_flags(f, ("angle_bits", "frac_bits", "specular"))
     f.set_defaults(func=run_fpga)

@@ -1,7 +1,9 @@
 """``bumprtl recommend --max-error-lsb E [--device D]``: the cheapest configuration whose
 measured error meets the bound, from the sweep data (``bumprtl bench sweep``), with the
 evidence: its error sets, its cost, its speed, the runners-up and the command that made
-the numbers. Nothing is re-measured or estimated here.
+the numbers. Nothing is re-measured or estimated here. Without ``--sweep`` and without a local
+sweep (``build/bench/sweep.json``), it reads the sweep that ships in ``docs/data/sweep.json``
+(the one docs/bench.md shows) and says so.
 """
 
 import json
@@ -10,7 +12,25 @@ from pathlib import Path
 from bumprtl.rtl.config import BumpError
 from bumprtl.gen.bench.sweep import point_label, cost_key, error_lsb, ok_points
 
-__all__ = ["recommend", "add_parser"]
+__all__ = ["recommend", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path"]
+
+LOCAL_SWEEP = Path("build/bench/sweep.json")          # what `bumprtl bench sweep` writes
+# The sweep docs/bench.md was made from, in the checkout (gen/report/ -> the repository root).
+SHIPPED_SWEEP = Path(__file__).resolve().parents[2] / "docs" / "data" / "sweep.json"
+
+
+def sweep_path(given=None):
+    """``(path, note)``: ``given``, else the local sweep, else the shipped one (the note
+    says which and why)."""
+    if given is not None:
+        return Path(given), None
+    if LOCAL_SWEEP.is_file():
+        return LOCAL_SWEEP, None
+    if SHIPPED_SWEEP.is_file():
+        return SHIPPED_SWEEP, (f"no local sweep ({LOCAL_SWEEP}): reading the sweep that ships "
+                               f"with bumprtl, {SHIPPED_SWEEP} (run `bumprtl bench sweep` to "
+                               f"measure your own)")
+    return LOCAL_SWEEP, None
 
 
 def _load(path):
@@ -84,7 +104,11 @@ def _flags(p):
 
 
 def run(args):
-    data = _load(args.sweep)
+    path, note = sweep_path(args.sweep)
+    if note:
+        print(note + "\n")
+    args.sweep = path
+    data = _load(path)
     best, meeting = recommend(data, args.max_error_lsb, args.device)
     order = ("DSP, block RAM, LUT4 on " + args.device if args.device else
              "multipliers + dividers + square roots, then ROM+RAM bits, then adders")
@@ -107,5 +131,7 @@ def add_parser(sub):
                                    "with the evidence. Exits 2 when none meets it.")
     p.add_argument("--max-error-lsb", type=float, required=True, help="bound on the worst error, 8-bit LSB")
     p.add_argument("--device", default=None, help="rank by ECP5 cost on this device (needs sweep --fpga)")
-    p.add_argument("--sweep", type=Path, default=Path("build/bench/sweep.json"), help="sweep JSON")
+    p.add_argument("--sweep", type=Path, default=None,
+                   help=f"sweep JSON (default: {LOCAL_SWEEP}, else the sweep shipped in "
+                        f"docs/data/sweep.json)")
     p.set_defaults(func=run)

@@ -310,4 +310,4 @@ class StreamContract(Elaboratable):
             m.d.sync += swapped.eq(0)
         with m.Elif(watching & dut.swap):
             m.d.sync += swapped.eq(1)
-        m.d.comb += Cover(deliver & swapped & (shadow[0] != shadow[1]))
+        m.d.comb += Cover(deliver & swapped & (shadow[0] != shadow[1]) & (expected != 0))

@@ -2,18 +2,27 @@
 
 from pathlib import Path
 
-from bumprtl.sim.formal.run import table
-
-__all__ = ["write_doc"]
+__all__ = ["write_doc", "table"]
 
 BEGIN, END = "<!-- formal table: begin -->", "<!-- formal table: end -->"
+
+
+def table(rows):
+    """The proof table as Markdown (rows: sim/formal/run.py's Row)."""
+    lines = ["| unit | property | result | depth | latency | lemmas | seconds |",
+             "| --- | --- | --- | ---: | ---: | ---: | ---: |"]
+    for r in rows:
+        lines.append(f"| {r.unit} | {r.prop} | {r.result} | {r.depth} | {r.latency} | "
+                     f"{r.lemmas} | {r.seconds:.1f} |")
+    return "\n".join(lines)
 
 
 def write_doc(path, rows, args=""):
     """Replace the table between the markers of ``path`` (the prose around it stays)."""
     path = Path(path)
-    command = f"make formal   (python -m bumprtl.sim.formal.run {args})".rstrip()
-    block = f"{BEGIN}\nProduced by `{command.strip()}`:\n\n{table(rows)}\n{END}"
+    block = (f"{BEGIN}\nProduced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
+             f"--doc docs/formal.md`; `bumprtl formal` is the same command):\n\n"
+             f"{table(rows)}\n{END}")
     text = path.read_text() if path.exists() else f"# Formal proofs\n\n{BEGIN}\n{END}\n"
     if BEGIN in text and END in text:
         head, rest = text.split(BEGIN, 1)

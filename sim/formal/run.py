@@ -11,12 +11,14 @@ exits 1. The broken units of :mod:`bumprtl.sim.formal.mutants` must each fail th
 import argparse
 import json
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from bumprtl.sim.formal.contract import StreamContract
+from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
 from bumprtl.sim.formal.sby import run_sby
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
@@ -25,6 +27,7 @@ __all__ = ["Row", "check", "check_mutant", "run", "table", "main", "INDUCTION_DE
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
 BMC_MARGIN = 6               # BMC depth = latency + this (every pixel reaches the output)
+PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
 BANK_DEPTH = 8               # the palette bank check: write, swap, accept, stall, swap, deliver
 
 
@@ -45,8 +48,8 @@ class Row:
         return self.result in ("proved", "bounded", "covered", "fails as expected")
 
 
-def _job(top, workdir, name, mode, depth, script=()):
-    return run_sby(top, workdir, name, mode=mode, depth=depth, script=script)
+def _job(top, workdir, name, mode, depth, script=(), timeout=3600):
+    return run_sby(top, workdir, name, mode=mode, depth=depth, script=script, timeout=timeout)
 
 
 def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
@@ -59,6 +62,12 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         res = _job(top, workdir, prop, "cover", dut.latency + BMC_MARGIN)
         result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
         return _row(target, prop, result, res, top, dut, t0)
+    if prop == "bank_cover":         # the bank check's trace of interest is reachable
+        dut = target.unit()
+        top = StreamContract(dut, "bank", lemmas=False)
+        res = _job(top, workdir, prop, "cover", BANK_DEPTH + 2, script=("memory_map", "opt -fast"))
+        result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
+        return _row(target, prop, result, res, top, dut, t0)
     if prop == "bank":
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
@@ -66,10 +75,10 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
     dut = target.unit()
     top = StreamContract(dut, prop)
-    res = _job(top, workdir, prop, "prove", induction_depth)
+    res = _job(top, workdir, prop, "prove", induction_depth, timeout=PROVE_TIMEOUT)
     if res.passed:
         return _row(target, prop, "proved", res, top, dut, t0)
-    if res.status == "UNKNOWN" or (res.status == "FAIL" and not res.trace):
+    if res.status == "UNKNOWN" or (res.status == "FAIL" and not res.trace) or res.timed_out:
         # induction did not close: fall back to BMC without the lemmas
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
@@ -103,47 +112,50 @@ def check_mutant(name, root, cfg=None):
                0, detail, str(res.trace or ""))
 
 
-def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print):
-    """Every requested check; returns the rows (in order)."""
+def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print, save=None):
+    """Every requested check; returns the rows (in order). ``save(rows_so_far)`` is called
+    after each check (results.json is written as the run goes). A check that raises (a unit
+    that does not elaborate) is an ERROR row, not the end of the run."""
     names = list(names or TARGETS)
     jobs_list = []
     for name in names:
         target = TARGETS[name]
         for prop in target.props:
             if props is None or prop in props:
-                jobs_list.append(lambda t=target, p=prop: check(t, p, root))
+                jobs_list.append((name, prop, lambda t=target, p=prop: check(t, p, root)))
     if mutants:
         for name, (_cls, prop) in MUTANTS.items():
             if props is None or prop in props:
-                jobs_list.append(lambda n=name: check_mutant(n, root))
-    rows = []
+                jobs_list.append((f"mutant {name}", prop, lambda n=name: check_mutant(n, root)))
+    done, lock = {}, threading.Lock()
 
-    def one(job):
-        row = job()
-        log(f"{row.unit:<24} {row.prop:<8} {row.result:<18} depth {row.depth:<3} "
+    def one(n_job):
+        n, (unit, prop, job) = n_job
+        t0 = time.perf_counter()
+        try:
+            row = job()
+        except Exception as e:          # noqa: BLE001 - reported as a failed row
+            row = Row(unit, prop, "ERROR", 0, time.perf_counter() - t0, 0, 0,
+                      f"{type(e).__name__}: {e}")
+        log(f"{row.unit:<24} {row.prop:<10} {row.result:<18} depth {row.depth:<3} "
             f"{row.seconds:6.1f} s {row.detail}")
+        with lock:
+            done[n] = row
+            if save is not None:
+                save([done[k] for k in sorted(done)])
         return row
 
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        rows = list(pool.map(one, jobs_list))
+        rows = list(pool.map(one, enumerate(jobs_list)))
     return rows
-
-
-def table(rows):
-    """The proof table as Markdown."""
-    lines = ["| unit | property | result | depth | latency | lemmas | seconds |",
-             "| --- | --- | --- | ---: | ---: | ---: | ---: |"]
-    for r in rows:
-        lines.append(f"| {r.unit} | {r.prop} | {r.result} | {r.depth} | {r.latency} | "
-                     f"{r.lemmas} | {r.seconds:.1f} |")
-    return "\n".join(lines)
 
 
 def failures(rows):
     return [r for r in rows if not r.ok]
 
 
-def report_failures(rows, out=sys.stderr):
+def report_failures(rows, out=None):
+    out = out or sys.stderr
     bad = failures(rows)
     for r in bad:
         print(f"FAILED: {r.unit} property {r.prop}: {r.result}"
@@ -163,6 +175,8 @@ def add_arguments(p):
     p.add_argument("--quick", action="store_true", help="leave out the slow targets (baselines, pipelines)")
     p.add_argument("-j", "--jobs", type=int, default=1, help="sby jobs in parallel (default 1)")
     p.add_argument("--out", type=Path, default=Path("build/formal"), help="work directory")
+    p.add_argument("--merge", action="store_true",
+                   help="update the rows of OUT/results.json that this run checked, keep the rest")
     p.add_argument("--from-results", action="store_true",
                    help="do not run: reprint (and --doc) the table of OUT/results.json")
     p.add_argument("--doc", type=Path, default=None,
@@ -177,17 +191,26 @@ def execute(args):
         return 2
     names = args.units or [n for n, t in TARGETS.items() if not (args.quick and t.slow)]
     t0 = time.perf_counter()
-    if args.from_results:
-        rows = [Row(**r) for r in json.loads((args.out / "results.json").read_text())]
-    else:
-        rows = run(names, args.props, args.mutants, args.out, args.jobs)
+    results = args.out / "results.json"
+    base = [Row(**r) for r in json.loads(results.read_text())] \
+        if (args.merge or args.from_results) and results.exists() else []
+
+    def merged(rows):
+        new = {(r.unit, r.prop): r for r in rows}
+        return [new.pop((r.unit, r.prop), r) for r in base] + list(new.values())
+
+    def save(rows):
         args.out.mkdir(parents=True, exist_ok=True)
-        (args.out / "results.json").write_text(json.dumps([asdict(r) for r in rows], indent=1))
+        results.write_text(json.dumps([asdict(r) for r in merged(rows)], indent=1) + "\n")
+
+    if args.from_results:
+        rows = base
+    else:
+        rows = merged(run(names, args.props, args.mutants, args.out, args.jobs, save=save))
     print()
     print(table(rows))
     print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")
     if args.doc is not None:
-        from bumprtl.sim.formal.doc import write_doc
         write_doc(args.doc, rows, " ".join(sys.argv[1:]))
         print(f"wrote {args.doc}")
     return 1 if report_failures(rows) else 0

@@ -9,6 +9,7 @@ The tools are looked up beside this interpreter first, then on PATH; a missing o
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -60,6 +61,7 @@ class FormalResult:
     trace: Path | None = None           # counterexample (VCD) on failure
     failed: list = field(default_factory=list)   # messages / locations of failed asserts
     log: str = ""
+    timed_out: bool = False
 
     @property
     def passed(self):
@@ -100,13 +102,17 @@ def run_sby(top, workdir, name, mode="prove", depth=10, engine="smtbmc z3", scri
             str(sby_file)]
     tool("z3")
     t0 = time.perf_counter()
+    # Own process group: on a timeout sby, smtbmc and z3 all go (not only sby).
+    proc = subprocess.Popen(argv, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, env=formal_env(), start_new_session=True)
     try:
-        out = subprocess.run(argv, cwd=workdir, capture_output=True, text=True,
-                             env=formal_env(), timeout=timeout)
-        log, rc = out.stdout + out.stderr, out.returncode
-    except subprocess.TimeoutExpired as e:
-        log, rc = (e.stdout or b"").decode() if isinstance(e.stdout, bytes) else (e.stdout or ""), -1
-        log += f"\ntimeout after {timeout} s"
+        log, _ = proc.communicate(timeout=timeout)
+        timed_out = False
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        log, _ = proc.communicate()
+        log = (log or "") + f"\ntimeout after {timeout} s"
+        timed_out = True
     seconds = time.perf_counter() - t0
     run_dir = workdir / name
     match = re.search(r"DONE \((\w+), rc=\d+\)", log)
@@ -119,4 +125,4 @@ def run_sby(top, workdir, name, mode="prove", depth=10, engine="smtbmc z3", scri
     trace = None
     if traces and status != "PASS":
         trace = (run_dir / traces[-1]).resolve()
-    return FormalResult(name, mode, depth, status, seconds, run_dir, trace, failed, log)
+    return FormalResult(name, mode, depth, status, seconds, run_dir, trace, failed, log, timed_out)

@@ -9,9 +9,16 @@ or duplicated pixel always shows in the order check.
 from dataclasses import dataclass, field
 from typing import Callable
 
+from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.methods import BASELINES, PER_PIXEL
+from bumprtl.rtl.palette import PaletteLUT
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import BUILTIN, load_scene_config
+from bumprtl.rtl.sincos import SinCos
+from bumprtl.rtl.texture import TextureBlend
 
 __all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "target"]
 
@@ -53,27 +60,23 @@ def _cfg(bits, **kw):
 
 
 def _sincos(bits):
-    from bumprtl.rtl.sincos import SinCos
     return SinCos(_cfg(bits))
 
 
 def _rotation(method):
     def build(bits):
-        from bumprtl.rtl.rotation import VectorRotation
         return VectorRotation(_cfg(bits, method=method))
     return build
 
 
 def _illumination(method):
     def build(bits):
-        from bumprtl.rtl.illumination import Illumination
         return Illumination(_cfg(bits, method=method))
     return build
 
 
 def _palette(blend):
     def build(bits):
-        from bumprtl.rtl.palette import PaletteLUT
         return PaletteLUT(_cfg(bits, palette_blend=blend))
     return build
 
@@ -84,18 +87,15 @@ def _scene(name, bits):
 
 
 def _fetch(bits):
-    from bumprtl.rtl.bumpfetch import BumpMapFetch
     return BumpMapFetch(_scene("default", bits))
 
 
 def _texture_blend(bits):
-    from bumprtl.rtl.texture import TextureBlend
     return TextureBlend(_cfg(bits), lights=2)
 
 
 def _pipeline(name):
     def build(bits):
-        from bumprtl.rtl.pipeline import BumpPipeline
         return BumpPipeline(_scene(name, bits))
     return build
 
@@ -109,7 +109,7 @@ def _targets():
         out.append(Target(f"rotation_{method}", _rotation(method), slow=True, note="baseline"))
         out.append(Target(f"illumination_{method}", _illumination(method), slow=True,
                           note="baseline"))
-    out.append(Target("palette", _palette(False), STREAM + ("bank",)))
+    out.append(Target("palette", _palette(False), STREAM + ("bank", "bank_cover")))
     out.append(Target("palette_blend", _palette(True)))
     out.append(Target("fetch", _fetch))
     out.append(Target("texture_blend", _texture_blend))

@@ -5,15 +5,24 @@ from dataclasses import fields
 
 import numpy as np
 
-from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.common import PixelInputs, to_8bit
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.texture import texture_blend
+from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to_cartesian,
+                                       tangent_rotation, to_8bit)
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.rtl.methods import encode_pixels
 
-__all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "ANGLES_OF_NDOTL"]
+__all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "arithmetic_pixels",
+           "highlight_pixels", "reference_blend", "scene_error", "ANGLES_OF_NDOTL", "ANGLES_OF",
+           "CHANNELS"]
 
 # The six input angles N'.L' depends on.
 ANGLES_OF_NDOTL = ("n_phi", "n_theta", "l_phi", "l_theta", "b_phi", "b_theta")
+# The output channels and the input angles each depends on.
+CHANNELS = ("diffuse", "specular", "color")
+ANGLES_OF = {"diffuse": ANGLES_OF_NDOTL,
+             "specular": ("n_phi", "n_theta", "h_phi", "h_theta", "b_phi", "b_theta"),
+             "color": ANGLES_OF_NDOTL + ("h_phi", "h_theta")}
 
 
 def diffuse_error_lsb(model, px: PixelInputs, cfg: Config):
@@ -31,6 +40,45 @@ def term_errors_lsb(model, px: PixelInputs, cfg: Config):
             for k in ("diffuse", "specular", "color")}
 
 
+def reference_blend(refs, texel, cfg: Config):
+    """float64 of the texture blend (rtl/texture.py) for lights ``refs`` (float64 Results)
+    and 8-bit texels {r, g, b}: 255 clamp(tex / 255 min(1, ka + kd sum d_j) + ks sum s_j),
+    rounded to 8 bits."""
+    d = sum(np.clip(r.ndotl, 0.0, 1.0) for r in refs)
+    s = sum(r.specular for r in refs)
+    lit = np.minimum(1.0, cfg.ka + cfg.kd * d)
+    ks = cfg.ks if cfg.specular else 0.0
+    return {c: to_8bit(np.clip(np.asarray(texel[c], np.float64) / 255 * lit + ks * s, 0.0, 1.0))
+            for c in texel}
+
+
+def scene_error(scene, cfg: Config, model, blend=False):
+    """PSNR (dB, None when identical) and max |difference| (8-bit LSB) over the pixels the
+    geometry covers of a scene's shading by ``model`` (a fixed-point golden model, e.g.
+    rtl/methods.datapath_fixed) against float64 ``conventional`` on the unquantized inputs.
+
+    The image is what the datapath outputs, eq. 2's 8-bit colour; with ``blend`` (a scene
+    with a colour texture) the texture blend of rtl/texture.py on the scene's 8-bit albedo
+    texels, against :func:`reference_blend` of the same texels. (Multiplying the 8-bit
+    colour by the albedo in float afterwards would round twice on the measuring side: the
+    exact colour rounded to 8 bits then reaches only about 57 dB.)"""
+    ref = conventional(scene.px, cfg)
+    out = model(encode_pixels(scene.px, cfg), cfg)
+    m = scene.mask
+    if blend:
+        tex = {c: to_8bit(scene.albedo[scene.v, scene.u][..., n]).astype(np.int64)
+               for n, c in enumerate("rgb")}
+        got = texture_blend([out["diffuse_fine"]], [out["specular_fine"]], tex, cfg)[0]
+        want = reference_blend([ref], tex, cfg)
+        got = np.stack([got[c][m] for c in "rgb"]).astype(np.float64)
+        want = np.stack([want[c][m] for c in "rgb"]).astype(np.float64)
+    else:
+        got, want = out["color"][m].astype(np.float64), to_8bit(ref.color)[m].astype(np.float64)
+    mse = float(np.mean((got - want) ** 2))
+    return {"psnr_db": None if mse == 0 else round(float(10 * np.log10(255.0 ** 2 / mse)), 2),
+            "max_lsb": int(np.abs(got - want).max())}
+
+
 def _with(px, **changes):
     return PixelInputs(**{**{f.name: getattr(px, f.name) for f in fields(px)}, **changes})
 
@@ -40,42 +88,142 @@ def _clip_angles(name, x):
     return np.clip(x, 0.0, hi)
 
 
-def adversarial_pixels(cfg: Config, candidates=200_000, keep=1_000, seed=7):
-    """Inputs that push the quantized datapath hardest.
+def _target(channel, ref):
+    """255 x the float64 channel, and where its value is not clamped (its slope is 0 there)."""
+    if channel == "diffuse":
+        return 255 * ref.ndotl, (ref.ndotl > 0.02) & (ref.ndotl < 0.98)
+    value = 255 * getattr(ref, channel)
+    return value, (value > 0.5) & (value < 254.5)
 
-    1. Start where 255 N'.L' is most sensitive to the input angles: among ``candidates``
-       random valid pixels with 0 < N'.L' < 1 (unclamped), keep the ``keep`` with the
-       largest sum of |d(255 N'.L')/d angle| (central differences).
-    2. Put each of the six angles half a grid step off on the worse side: at the grid point
+
+def _world_bump_normal(px):
+    """N' in world coordinates: M^T b, M = R_y(-th_N) R_z(-ph_N) (common.tangent_rotation)."""
+    m = tangent_rotation(px.n_phi, px.n_theta)
+    return np.einsum("...ji,...j->...i", m, polar_to_cartesian(px.b_phi, px.b_theta))
+
+
+def highlight_pixels(n, rng, cfg: Config):
+    """``n`` random pixels whose H lies near N' (angle between them uniform in [0, 4 /
+    sqrt(exponent)] rad, where cos^n still has a slope), the region random H seldom reaches."""
+    px = PixelInputs.random(n, rng)
+    nw = _world_bump_normal(px)
+    helper = np.where(np.abs(nw[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    e1 = np.cross(nw, helper)
+    e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
+    e2 = np.cross(nw, e1)
+    turn = rng.uniform(0, 2 * np.pi, n)[:, None]
+    angle = rng.uniform(0, min(np.pi / 2, 4 / np.sqrt(cfg.spec_exponent)), n)[:, None]
+    h = np.cos(angle) * nw + np.sin(angle) * (np.cos(turn) * e1 + np.sin(turn) * e2)
+    h_phi, h_theta = cartesian_to_polar(h)
+    return _with(px, h_phi=h_phi, h_theta=h_theta)
+
+
+def adversarial_pixels(cfg: Config, candidates=200_000, keep=1_000, seed=7, channel="diffuse"):
+    """Inputs that push the quantized datapath hardest on one output ``channel``.
+
+    1. Start where 255 x the channel (N'.L' for diffuse, cos^n N'.H' for specular, eq. 2's
+       colour) is most sensitive to the input angles it depends on (:data:`ANGLES_OF`):
+       among ``candidates`` random valid pixels (for specular and colour half of them with H
+       near N', :func:`highlight_pixels`) where it is not clamped, keep the ``keep`` with the
+       largest sum of |d(255 channel)/d angle| (central differences).
+    2. Put each of those angles half a grid step off on the worse side: at the grid point
        plus 0.4999 step times the sign of its derivative, so rounding to the grid moves every
        angle against the output at once.
     3. Scan neighbouring grid points: the same construction around the grid point one step
-       below and above in each angle in turn (1 + 2 x 6 variants per pixel).
-    Returns PixelInputs of keep x 13 pixels.
+       below and above in each angle in turn (1 + 2 x len(angles) variants per pixel).
+    Returns PixelInputs of keep x (1 + 2 x len(angles)) pixels.
     """
+    if channel not in CHANNELS:
+        raise BumpError(f"channel must be one of {', '.join(CHANNELS)}, got {channel!r}")
+    angles = ANGLES_OF[channel]
     rng = np.random.default_rng(seed)
     px = PixelInputs.random(candidates, rng)
-    base = conventional(px, cfg).ndotl
-    px = px.subset((base > 0.02) & (base < 0.98))
+    if channel != "diffuse":
+        near = highlight_pixels(candidates // 2, rng, cfg)
+        px = PixelInputs(**{f.name: np.concatenate([getattr(px, f.name)[candidates // 2:],
+                                                    getattr(near, f.name)]) for f in fields(px)})
+    px = px.subset(_target(channel, conventional(px, cfg))[1])
     step = 2 * np.pi / cfg.full_circle
     h = 1e-6
     grads = {}
-    for name in ANGLES_OF_NDOTL:
+    for name in angles:
         x = getattr(px, name)
-        up = conventional(_with(px, **{name: _clip_angles(name, x + h)}), cfg).ndotl
-        dn = conventional(_with(px, **{name: _clip_angles(name, x - h)}), cfg).ndotl
-        grads[name] = 255 * (up - dn) / (2 * h)
+        up = _target(channel, conventional(_with(px, **{name: _clip_angles(name, x + h)}), cfg))[0]
+        dn = _target(channel, conventional(_with(px, **{name: _clip_angles(name, x - h)}), cfg))[0]
+        grads[name] = (up - dn) / (2 * h)
     sensitivity = sum(np.abs(g) for g in grads.values())
-    px = px.subset(np.argsort(sensitivity)[-keep:])
-    grads = {k: g[np.argsort(sensitivity)[-keep:]] for k, g in grads.items()}
-    variants = [(None, 0)] + [(name, d) for name in ANGLES_OF_NDOTL for d in (-1, 1)]
+    top = np.argsort(sensitivity)[-keep:]
+    px = px.subset(top)
+    grads = {k: g[top] for k, g in grads.items()}
+    variants = [(None, 0)] + [(name, d) for name in angles for d in (-1, 1)]
     out = []
     for moved, delta in variants:
         changes = {}
-        for name in ANGLES_OF_NDOTL:
+        for name in angles:
             grid = np.rint(getattr(px, name) / step) + (delta if name == moved else 0)
             # rounding back to `grid` moves the angle by -0.4999 step * sign(grad): worst side
             changes[name] = _clip_angles(name, (grid + 0.4999 * np.sign(grads[name])) * step)
         out.append(_with(px, **changes))
     return PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in out])
+                          for f in fields(px)})
+
+
+def arithmetic_pixels(model, cfg: Config, candidates=400_000, keep=2_000, seed=5, reach=3):
+    """Inputs where the datapath's own arithmetic error in N'.H' is largest near N'.H' = 1,
+    where the specular slope 255 n is steepest, with the input rounding added on top: the
+    search aimed at the specular term's arithmetic part.
+
+    1. ``candidates`` random N, N' on the angle grid with H the grid point nearest N' in
+       world coordinates and its four neighbours; the model's N'.H' against float64 of the
+       same angles; keep the ``keep`` with the largest mean error over the five (the error
+       of this N' that stays whatever H: its ROM errors adding up along N').
+    2. For those, every H within ``reach`` grid steps in theta and phi ((2 reach + 1)**2
+       variants), where N'.H' runs from 1 down the highlight's slope.
+    3. Each of those again with its six angles of N'.H' put 0.4999 step off the grid on the
+       side where rounding moves N'.H' the same way as the arithmetic error (the sign of
+       the model's error times the sign of d N'.H' / d angle), so both add up.
+    ``model(codes, cfg)`` is a fixed-point golden model (rtl/methods.datapath_fixed).
+    Returns PixelInputs: the on-grid set of step 2, then the shifted set of step 3 (L = H)."""
+    rng = np.random.default_rng(seed)
+    full = cfg.full_circle
+    step = 2 * np.pi / full
+    codes = {"n_phi": rng.integers(0, full, candidates), "n_theta": rng.integers(0, full // 2 + 1, candidates),
+             "b_phi": rng.integers(0, full, candidates), "b_theta": rng.integers(0, full // 4 + 1, candidates)}
+    px = PixelInputs(**{k: v * step for k, v in codes.items()},
+                     **{f"{v}_{a}": np.zeros(candidates) for v in "lh" for a in ("phi", "theta")})
+    h_phi, h_theta = cartesian_to_polar(_world_bump_normal(px))
+    codes["h_phi"], codes["h_theta"] = np.rint(h_phi / step) % full, np.rint(h_theta / step)
+
+    def on_grid(c):
+        ang = {k: np.clip(v * step, 0, np.pi if k.endswith("theta") else 2 * np.pi) for k, v in c.items()}
+        return PixelInputs(**ang, l_phi=ang["h_phi"], l_theta=ang["h_theta"])
+
+    def dot_error(p):
+        return model(encode_pixels(p, cfg), cfg)["ndoth"] / cfg.one - conventional(p, cfg).ndoth
+
+    # the error that stays when H moves (N''s ROM errors), not one H's luck: the mean over H
+    # and its four grid neighbours
+    moves = ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1))
+    persistent = sum(dot_error(on_grid(dict(codes, h_theta=np.clip(codes["h_theta"] + dt, 0, full // 2),
+                                            h_phi=(codes["h_phi"] + dp) % full))) for dt, dp in moves)
+    worst = np.argsort(np.abs(persistent))[-keep:]
+    codes = {k: v[worst] for k, v in codes.items()}
+    grid = []
+    for dt in range(-reach, reach + 1):
+        for dp in range(-reach, reach + 1):
+            grid.append(on_grid(dict(codes, h_theta=np.clip(codes["h_theta"] + dt, 0, full // 2),
+                                     h_phi=(codes["h_phi"] + dp) % full)))
+    grid = PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in grid])
+                          for f in fields(px)})
+    sign = np.sign(dot_error(grid))
+    shifted = {}
+    for name in ANGLES_OF["specular"]:
+        x = getattr(grid, name)
+        up = conventional(_with(grid, **{name: _clip_angles(name, x + 1e-6)}), cfg).ndoth
+        dn = conventional(_with(grid, **{name: _clip_angles(name, x - 1e-6)}), cfg).ndoth
+        # the true angle on the side where N'.H' is off from the grid's by -sign: rounding
+        # then moves it by +sign, the way the arithmetic already does
+        shifted[name] = _clip_angles(name, x - 0.4999 * step * sign * np.sign(up - dn))
+    shifted = _with(grid, **shifted, l_phi=shifted["h_phi"], l_theta=shifted["h_theta"])
+    return PixelInputs(**{f.name: np.concatenate([getattr(grid, f.name), getattr(shifted, f.name)])
                           for f in fields(px)})

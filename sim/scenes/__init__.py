@@ -16,11 +16,16 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar
 from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS, height_to_normals
 
-__all__ = ["SCENES", "GEOMETRIES", "Scene", "load_scene", "light_direction"]
+__all__ = ["SCENES", "GEOMETRIES", "REFERENCE_TEXTURE_SIZE", "Scene", "load_scene",
+           "light_direction", "bump_strength"]
 
 GEOMETRIES = ("plane", "sphere", "cylinder")
+# The map size the scenes' bump strengths were chosen at (the render default). A larger map
+# of the same scene keeps the same slopes: heights are scaled by T / 512 (bump_strength).
+REFERENCE_TEXTURE_SIZE = 512
 
-# name -> (height field, geometry, bump strength, description)
+# name -> (height field, geometry, bump strength: texels of relief for height 1.0 at maps up
+# to REFERENCE_TEXTURE_SIZE, description)
 SCENES = {
     "bricks": ("bricks", "plane", 6.0, "procedural brick wall on a plane (the default)"),
     "wood": ("wood", "plane", 3.0, "wood-grain rings on a plane (like the paper's Fig. 9)"),
@@ -47,7 +52,7 @@ class Scene:
     mask: np.ndarray
     u: np.ndarray
     v: np.ndarray
-    height: np.ndarray
+    height: np.ndarray | None          # None for a user's normal map (no height field)
     b_phi_map: np.ndarray
     b_theta_map: np.ndarray
     albedo: np.ndarray | None
@@ -58,7 +63,7 @@ class Scene:
 
     @property
     def texture_size(self):
-        return self.height.shape[0]
+        return self.b_phi_map.shape[0]
 
 
 def _power_of_two(name, value, lo, hi):
@@ -112,14 +117,29 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
+def bump_strength(name, texture_size):
+    """Texels of relief for height 1.0 of scene ``name`` on a T x T map: the scene's
+    strength up to :data:`REFERENCE_TEXTURE_SIZE`, scaled by T / 512 above it (so that a
+    4096^2 map shows the slopes of the 512^2 one instead of an 8x flatter surface)."""
+    return SCENES[name][2] * max(1.0, texture_size / REFERENCE_TEXTURE_SIZE)
+
+
 def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
-               light="directional", texture_size=None):
-    """Build scene ``name`` at ``size`` x ``size`` pixels (see :data:`SCENES`)."""
-    if name not in SCENES:
+               light="directional", texture_size=None, bump=None, geometry=None):
+    """Build scene ``name`` at ``size`` x ``size`` pixels (see :data:`SCENES`).
+
+    ``bump``: a user's bump map (:class:`bumprtl.sim.scenes.usermap.BumpMap`) instead of the
+    scene's height field (``name`` is then ignored; no colour texture); ``geometry``
+    overrides the scene's (a user map defaults to ``plane``)."""
+    if bump is None and name not in SCENES:
         raise BumpError(f"scene must be one of {', '.join(SCENES)}, got {name!r}")
+    if geometry is not None and geometry not in GEOMETRIES:
+        raise BumpError(f"geometry must be one of {', '.join(GEOMETRIES)}, got {geometry!r}")
     _power_of_two("size", size, 16, 4096)
-    tex = size if texture_size is None else texture_size
+    tex = (size if bump is None else bump.size) if texture_size is None else texture_size
     _power_of_two("texture_size", tex, 16, 4096)
+    if bump is not None and tex != bump.size:
+        raise BumpError(f"texture_size = {tex} but the map {bump.label} has {bump.size}x{bump.size} texels")
     for pname, val, lo, hi in (("light_elevation", light_elevation, -90, 90),
                                ("light_azimuth", light_azimuth, -360, 360)):
         if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
@@ -128,9 +148,14 @@ def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
     if light not in ("directional", "point"):
         raise BumpError(f"light must be directional or point, got {light!r}")
 
-    field, geometry, strength, _ = SCENES[name]
-    height = HEIGHTFIELDS[field](tex)
-    b_phi_map, b_theta_map = height_to_normals(height, strength)
+    if bump is None:
+        field, own_geometry, _, _ = SCENES[name]
+        height = HEIGHTFIELDS[field](tex)
+        b_phi_map, b_theta_map = height_to_normals(height, bump_strength(name, tex))
+    else:
+        field, own_geometry, name = None, "plane", bump.label
+        height, b_phi_map, b_theta_map = bump.height, bump.b_phi_map, bump.b_theta_map
+    geometry = geometry or own_geometry
     p, n, u, v, mask = _geometry(geometry, size, tex)
 
     ldir = light_direction(light_elevation, light_azimuth)

@@ -25,19 +25,69 @@ def smooth_noise(t, cells=16, seed=0):
     return (fine - fine.mean()) / fine.std()
 
 
+BRICK_COURSES, BRICKS_PER_COURSE = 8, 4
+BRICK_BEVEL = 0.12          # width of a groove's bevel, in sixteenths of the map (T/16 texels)
+
+
+def brick_lines(t):
+    """Where the mortar lines of :func:`bricks` lie on a T x T map, in texel coordinates
+    (texel centres at integers): course lines at rows k T/8 - 1/2 (between two texel rows)
+    and, in course k, joints at columns (j + k/2) T/4 - 1/2; on a narrow map (the bevel
+    at most half a texel, T <= 64) every line sits half a texel further, on a texel row or
+    column (k T/8, (j + k/2) T/4). Returns ``(rows, joints)``: the 8 row positions and per
+    course the 4 joint positions."""
+    offset = 0.0 if _narrow(t) else -0.5
+    rows = [k * t / BRICK_COURSES + offset for k in range(BRICK_COURSES)]
+    joints = [[((j + 0.5 * (k % 2)) * t / BRICKS_PER_COURSE + offset) % t
+               for j in range(BRICKS_PER_COURSE)] for k in range(BRICK_COURSES)]
+    return rows, joints
+
+
+def _narrow(t):
+    """The bevel is at most half a texel wide: texel centres (half a texel either side of a
+    line between two texels) would miss the groove entirely."""
+    return BRICK_BEVEL * t / 16 <= 0.5
+
+
 def bricks(t):
-    """Running-bond bricks: 8 courses, mortar grooves with bevelled edges, slightly rough
-    faces (so that the map has many distinct normals, as a real one has)."""
-    u, v = _grid(t)
-    rows = 8
-    row = np.floor(v * rows)
-    fu = np.mod(u * 4 + 0.5 * (row % 2), 1.0)
-    fv = np.mod(v * rows, 1.0)
+    """Running-bond bricks: 8 courses of 4 bricks, mortar grooves with bevelled edges,
+    slightly rough faces (so that the map has many distinct normals, as a real one has).
+
+    The bevel is 0.12 / 16 of the map wide (3.8 texels at 512). On a map where that is at
+    most half a texel (T <= 64) every texel centre would miss the groove and the wall would
+    show no bricks, so there the lines move half a texel onto texel centres and the bevel
+    widens to one texel: every allowed size shows its 8 courses (:func:`brick_lines`)."""
+    if _narrow(t):
+        c = np.arange(t) / t                         # texel centres on the lines
+        u, v = np.meshgrid(c, c)
+        bevel = 16 / t                               # one texel, in sixteenths of the map
+    else:
+        (u, v), bevel = _grid(t), BRICK_BEVEL
+    row = np.floor(v * BRICK_COURSES)
+    fu = np.mod(u * BRICKS_PER_COURSE + 0.5 * (row % 2), 1.0)
+    fv = np.mod(v * BRICK_COURSES, 1.0)
     edge = np.minimum(np.minimum(fu, 1 - fu) * 4, np.minimum(fv, 1 - fv) * 2)
-    face = np.clip(edge / 0.12, 0, 1)            # 0 in the mortar, 1 on the brick face
+    face = np.clip(edge / bevel, 0, 1)           # 0 in the mortar, 1 on the brick face
     return np.clip(face * (0.9 + 0.03 * smooth_noise(t)), 0, 1)
 
 
+SMALLEST_DRAWN = 64         # finer fields are drawn at this size and box-filtered down
+
+
+def _band_limited(draw):
+    """``draw(t)`` for t >= SMALLEST_DRAWN; below, ``draw(SMALLEST_DRAWN)`` averaged over
+    blocks of (64 / t)^2 texels, so that detail finer than a texel of the small map is
+    averaged out instead of aliasing into a pattern the scene does not have."""
+    def field(t):
+        if t >= SMALLEST_DRAWN:
+            return draw(t)
+        k = SMALLEST_DRAWN // t
+        return draw(SMALLEST_DRAWN).reshape(t, k, t, k).mean(axis=(1, 3))
+    field.__name__, field.__doc__ = draw.__name__, draw.__doc__
+    return field
+
+
+@_band_limited
 def wood(t):
     """Wood-grain rings: concentric rings around an off-centre axis, slightly wavy."""
     u, v = _grid(t)
@@ -51,6 +101,7 @@ def bumps(t):
     return 0.5 + 0.5 * np.sin(2 * np.pi * 6 * u) * np.sin(2 * np.pi * 6 * v)
 
 
+@_band_limited
 def text(t):
     """Engraved text: 'BUMP RTL' cut into a flat face, edges softened by a small blur."""
     img = Image.new("L", (t, t), 255)

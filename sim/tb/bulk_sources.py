@@ -5,7 +5,8 @@ memory at once.
 A source is ``{"kind": name, ...}`` in the job; :func:`make_source` turns it into
 ``(setup, chunks)``: host set-up cycles (``[{port: int}]``, driven after reset) and an
 iterator of ``(inputs, expected)`` dicts of int64 arrays, ``expected`` None when only
-the outputs are wanted (the render checks its image itself).
+the outputs are wanted. Stimulus arrays from a file are sim/tb/tb_bulk.py's own source;
+these generators run under sim/tb/tb_bulk_gen.py, which alone pays for their imports.
 """
 
 import numpy as np
@@ -31,20 +32,6 @@ def _counts(n, chunk):
 
 def _tags(n, start, bits):
     return (np.arange(start, start + n, dtype=np.int64)) & ((1 << bits) - 1)
-
-
-def _arrays(meta, spec, chunk):
-    """The stimulus (and golden outputs, if any) in an npz: ``in.<field>``, ``expect.<field>``."""
-    data = np.load(spec["path"])
-    ins = {k[3:]: data[k] for k in data.files if k.startswith("in.")}
-    exp = {k[7:]: data[k] for k in data.files if k.startswith("expect.")}
-    n = len(next(iter(ins.values())))
-
-    def chunks():
-        for s in range(0, n, chunk):
-            yield ({k: v[s:s + chunk] for k, v in ins.items()},
-                   {k: v[s:s + chunk] for k, v in exp.items()} or None)
-    return [], chunks()
 
 
 def _out_fields(meta):
@@ -177,7 +164,7 @@ def _pipeline(meta, spec, chunk):
     return [], chunks()
 
 
-SOURCES = {"arrays": _arrays, "datapath": _datapath, "sincos": _sincos, "palette": _palette,
+SOURCES = {"datapath": _datapath, "sincos": _sincos, "palette": _palette,
            "pipeline": _pipeline}
 
 

@@ -42,10 +42,12 @@ def _tool_environ():
         os.environ.update(saved)
 
 
-def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None):
+def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None, sources=(),
+               includes=()):
     """Compile ``v_path`` for ``sim`` and run ``test_module`` on it.
 
-    The top level is the file's stem. ``extra_env`` reaches the cocotb side (sample
+    The top level is the file's stem; ``sources`` and ``includes`` are further Verilog files
+    and include directories (a synthesized netlist's cell models). ``extra_env`` reaches the cocotb side (sample
     count, sidecar path, traffic pattern). ``WAVES=1`` in the environment writes waveforms.
     Returns a :class:`CocotbRun` (test count and the build and run wall times) and raises
     AssertionError when a test failed or none ran.
@@ -61,7 +63,8 @@ def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None):
     with _tool_environ():                 # the runner looks the simulator up on PATH
         runner = get_runner(sim)
         t0 = time.perf_counter()
-        runner.build(sources=[v_path], hdl_toplevel=top, build_dir=build_dir,
+        runner.build(sources=[v_path, *[Path(s).resolve() for s in sources]],
+                     includes=[Path(d).resolve() for d in includes], hdl_toplevel=top, build_dir=build_dir,
                      timescale=("1ns", "1ps"), build_args=build_args, waves=waves, always=True)
         t1 = time.perf_counter()
         results = runner.test(hdl_toplevel=top, test_module=test_module, build_dir=build_dir,

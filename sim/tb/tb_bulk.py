@@ -1,12 +1,16 @@
-"""cocotb side of the bulk path (sim/tb/bulk.py): one test that streams chunks of stimulus
-through the bulk wrapper and compares the outputs with the golden model.
+"""cocotb side of the bulk path (sim/tb/bulk.py): stream chunks of stimulus through the
+bulk wrapper and compare the outputs with the golden model.
 
-Per chunk it writes ``bulk_in.hex``, sets the count, the traffic seeds and densities,
+Per chunk it writes ``bulk_in.bin``, sets the count, the traffic seeds and densities,
 raises ``start`` and sleeps (a cocotb Timer) until ``done``: the clock runs inside the
-simulator meanwhile, and Python wakes up a few times per chunk, never per clock. Environment: BUMPRTL_BULK_JOB, the
-job JSON that :func:`bumprtl.sim.tb.bulk.run_bulk` writes (sidecar, patterns, traffic,
-set-up cycles, source, result and summary paths). The summary JSON (pixels, cycles and
-seconds per pattern, or the error) is written even when the test fails.
+simulator meanwhile, and Python wakes up a few times per chunk, never per clock. Then it
+reads ``bulk_out.bin`` back as arrays and checks them: every tag once and in order, and
+every field bit for bit against the golden outputs when the source has them.
+
+Environment: BUMPRTL_BULK_JOB, the job JSON that :func:`bumprtl.sim.tb.bulk.run_bulk`
+writes (sidecar, patterns, traffic, set-up cycles, source, result and summary paths). The
+summary JSON (pixels, cycles and seconds per pattern, or the error) is written even when
+the test fails, so the caller can raise with the message.
 """
 
 import json
@@ -19,10 +23,10 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import Timer
 
-from bumprtl.sim.tb.bulk import DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, decode_words, encode_words
+from bumprtl.sim.tb.bulk import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, decode_words,
+                                 encode_words)
 
 DENSITY_ONE = 1 << DENSITY_BITS
-from bumprtl.sim.tb.bulk_sources import make_source
 
 # A guard in case the wrapper itself never raises done (its idle limit ends a deadlock):
 # clock cycles per pixel, and fixed.
@@ -92,7 +96,7 @@ def _compare(pattern, k, got, want, inputs):
                 f"differ in this field)")
 
 
-async def _run(dut, job, meta, summary):
+async def _run(dut, job, meta, summary, make_source):
     fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
     iw, ow = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
     patterns = job["patterns"]
@@ -136,7 +140,8 @@ async def _run(dut, job, meta, summary):
             while int(dut.done.value):           # the wrapper clears done at the next edge
                 await _cycle()
             got = decode_words(fout, ow, Path(OUT_FILE).read_bytes())
-            assert len(got["tag"]) == n, f"pattern {pattern} chunk {k}: {len(got['tag'])} words in {OUT_FILE}, {n} expected"
+            assert len(got["tag"]) == n, \
+                f"pattern {pattern} chunk {k}: {len(got['tag'])} words in {OUT_FILE}, {n} expected"
             _compare(pattern, k, got, {"tag": inputs["tag"]}, inputs)      # each once, in order
             if expected is not None:
                 _compare(pattern, k, got, expected, inputs)
@@ -145,8 +150,7 @@ async def _run(dut, job, meta, summary):
             s["cycles"] += cycles
             if job["keep"]:
                 kept[pattern].append(got)
-        if job["progress"]:
-            dut._log.info("chunk %d: %d pixels x %d patterns", k, n, len(patterns))
+        dut._log.info("chunk %d: %d pixels x %d patterns", k, n, len(patterns))
     if job["keep"]:
         result = {}
         for p in patterns:
@@ -156,17 +160,41 @@ async def _run(dut, job, meta, summary):
         np.savez(job["result"], **result)
 
 
-@cocotb.test()
-async def bulk_stream(dut):
+def array_source(meta, spec, chunk):
+    """The stimulus (and golden outputs, if any) from an npz: ``in.<field>``,
+    ``expect.<field>``; no set-up of its own (the job's ``setup`` cycles drive the host ports)."""
+    data = np.load(spec["path"])
+    ins = {k[3:]: data[k] for k in data.files if k.startswith("in.")}
+    exp = {k[7:]: data[k] for k in data.files if k.startswith("expect.")}
+    n = len(next(iter(ins.values())))
+
+    def chunks():
+        for s in range(0, n, chunk):
+            yield ({k: v[s:s + chunk] for k, v in ins.items()},
+                   {k: v[s:s + chunk] for k, v in exp.items()} or None)
+    return [], chunks()
+
+
+async def run_job(dut, make_source):
+    """The whole job of BUMPRTL_BULK_JOB: reset, set-up, every chunk under every pattern.
+    ``make_source(meta, spec, chunk)`` -> ``(setup cycles, iterator of (inputs, expected))``.
+    The summary JSON is written whatever happens."""
     job = json.loads(Path(os.environ["BUMPRTL_BULK_JOB"]).read_text())
     meta = json.loads(Path(job["sidecar"]).read_text())
-    summary = {"patterns": {p: {"pixels": 0, "cycles": 0, "sim_s": 0.0, "sim_cpu_s": 0.0} for p in job["patterns"]},
+    summary = {"patterns": {p: {"pixels": 0, "cycles": 0, "sim_s": 0.0, "sim_cpu_s": 0.0}
+                            for p in job["patterns"]},
                "finished": False, "checked": False, "timeout": False, "error": None}
     try:
-        await _run(dut, job, meta, summary)
+        await _run(dut, job, meta, summary, make_source)
         summary["finished"] = True
     except AssertionError as e:
         summary["error"] = str(e)
         raise
     finally:
         Path(job["summary"]).write_text(json.dumps(summary, indent=1) + "\n")
+
+
+@cocotb.test()
+async def bulk_stream(dut):
+    """Stimulus arrays from the job's npz (the render, the small tests)."""
+    await run_job(dut, array_source)

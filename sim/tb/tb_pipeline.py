@@ -22,8 +22,17 @@ from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, unpack
 
 
 async def _host_setup(dut, meta, stim):
-    """Polygon registers (flat map) and the palette colour table, before the first pixel."""
+    """Host cycles of the stimulus (``setup.<port>`` arrays: e.g. the map written through
+    its port), the polygon registers (flat map) and the palette colour table, before the
+    first pixel."""
     ports = meta["ports"]
+    setup = {k[len("setup."):]: v.tolist() for k, v in stim.items() if k.startswith("setup.")}
+    for i in range(len(next(iter(setup.values()), []))):
+        for port, values in setup.items():
+            getattr(dut, port).value = int(values[i])
+        await RisingEdge(dut.clk)
+    for port in setup:
+        getattr(dut, port).value = 0
     if "poly" in ports:
         dut.poly.value = pack(ports["poly"]["fields"],
                               {k[len("polygon."):]: int(v) for k, v in stim.items()

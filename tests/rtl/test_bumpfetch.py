@@ -52,7 +52,7 @@ def test_fetch_streams_bit_exact(keys, pattern):
     payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
                 for n in range(500)]
     dut = BumpMapFetch(scene, init=words)
-    out, cycles = simulate_stream(dut, payloads, pattern)
+    out, cycles = simulate_stream(dut, payloads, pattern, pipe_handshake=True)
     want = fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"), words, scene)
     flat = {"b": lambda o: o["b.phi"] | (o["b.theta"] << scene.angle_bits), "index": lambda o: o["index"]}
     assert_bit_exact([{"word": flat[field](o), "tag": o["tag"]} for o in out], {"word": want}, payloads)
@@ -110,7 +110,7 @@ def test_texture_ram_read_at_the_same_address(keys):
                 for n in range(300)]
     dut = BumpMapFetch(scene, init=words, texture=texels)
     assert ("w_en" in dut.signature.members) == (words is not None)
-    out, _ = simulate_stream(dut, payloads, "backpressure")
+    out, _ = simulate_stream(dut, payloads, "backpressure", pipe_handshake=True)
     got = [o["texel.r"] | (o["texel.g"] << 8) | (o["texel.b"] << 16) for o in out]
     want = [reference_word(texels, p["u"], p["v"], p.get("level", 0), scene) for p in payloads]
     assert got == want and [o["tag"] for o in out] == [p["tag"] for p in payloads]

@@ -1,3 +1,5 @@
+import math
+
 import pytest
 
 from bumprtl.rtl.config import Config, ConfigError
@@ -32,3 +34,47 @@ def test_replace_validates_and_rejects_unknown_fields():
         Config().replace(frac_bits=2)
     with pytest.raises(ConfigError, match="unknown Config field"):
         Config().replace(bits=3)
+
+
+# Config's documented ranges (its docstring), as (field, lo, hi, other fields that set the
+# range): each is refused one step outside on both sides, naming the field (BumpError.field,
+# not the wording), and accepted at both ends. frac_bits's lower end follows k = angle_bits - 2.
+RANGES = [
+    ("angle_bits", 4, 16, {}),
+    ("frac_bits", 9, 24, {}),                                   # k = 10: B >= k - 1
+    ("frac_bits", 4, 24, {"angle_bits": 4}),                    # k = 2: B >= 4
+    ("frac_bits", 13, 24, {"angle_bits": 16}),                  # k = 14: B >= 13
+    ("tag_bits", 0, 32, {}),
+    ("out_bits", 8, 8, {}),
+    ("spec_exponent", 1, 1024, {}),
+    ("spec_index_bits", 4, 16, {}),
+    ("lights", 1, 8, {}),
+    ("palette_size", 16, 16384, {}),
+    ("color_bits", 8, 8, {}),
+    ("ka", 0.0, 1.0, {}),
+    ("kd", 0.0, 1.0, {}),
+    ("ks", 0.0, 1.0, {}),
+]
+
+
+@pytest.mark.parametrize("field, lo, hi, base", RANGES,
+                         ids=[f"{r[0]}-{r[1]}-{r[2]}" for r in RANGES])
+def test_every_range_is_checked_on_both_sides(field, lo, hi, base):
+    for value in (lo, hi):
+        assert getattr(Config(**base, **{field: value}), field) == value
+    outside = [lo - 1, hi + 1]
+    if isinstance(lo, float):                                   # the nearest floats outside too
+        outside += [math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf)]
+    for value in outside:
+        with pytest.raises(ConfigError) as e:
+            Config(**base, **{field: value})
+        assert e.value.field == field, (value, str(e.value))
+
+
+@pytest.mark.parametrize("field, value", [("method", "cordic"), ("specular", 1),
+                                          ("palette_blend", "yes"), ("angle_bits", 12.0),
+                                          ("lights", True)])
+def test_bad_type_or_choice_names_the_field(field, value):
+    with pytest.raises(ConfigError) as e:
+        Config(**{field: value})
+    assert e.value.field == field

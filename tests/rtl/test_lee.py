@@ -116,7 +116,7 @@ def test_tiny_config_exhaustive_classes():
     rot = {"l.phi": (b_phi + u) & 15, "l.theta": w, "h.phi": (b_phi + w) & 15, "h.theta": u,
            "b.phi": b_phi, "b.theta": t}
     inputs = as_payloads(rot, cfg)
-    out, _ = simulate_stream(LeeIllumination(cfg), inputs, "backpressure")
+    out, _ = simulate_stream(LeeIllumination(cfg), inputs, "backpressure", pipe_handshake=True)
     assert_bit_exact(out, fixed_lee.illumination_fixed(rot, cfg), inputs)
 
 

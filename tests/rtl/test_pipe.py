@@ -1,7 +1,10 @@
 """rtl/pipe.py's registered primitives: RegisteredProduct and RegisteredROM give the value
 of their inputs PRODUCT_LATENCY / ROM_LATENCY enabled cycles later (checked in the
 Amaranth simulator with a random enable), and their ECP5 form is the block the generic
-form stands for (DP16KD contents compared with Yosys' own block-RAM mapping)."""
+form stands for (DP16KD contents compared with Yosys' own block-RAM mapping). The stall
+rule ``adv = ~o.valid | o.ready`` of StallPipe is checked as a throughput property on the
+units built from it: a pipe fills while its output waits, and under traffic on both sides
+the cycle count stays within the bound derived in :func:`test_cycles_within_the_stall_bound`."""
 
 import json
 import subprocess
@@ -15,8 +18,17 @@ from amaranth.sim import Simulator
 
 from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.bumpfetch import BumpMapFetch
+from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
+from bumprtl.rtl.pipeline import BumpPipeline, LightSum
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.tables import quarter_sine, specular_table
+from bumprtl.rtl.texture import TextureBlend
+from bumprtl.sim.traffic import PATTERNS
 
 
 def run_enabled(dut, drive, sample, latency, n, seed):
@@ -83,7 +95,7 @@ def test_constant_operand_stays_a_constant():
 @pytest.mark.parametrize("ports", [1, 2])
 def test_registered_rom_reads_two_enables_later(ports):
     table = specular_table(Config()).tolist()            # 1025 words, the shade table
-    dut = RegisteredROM(table, unsigned(8), ports, "t")
+    dut = RegisteredROM(table, unsigned(max(table).bit_length()), ports, "t")
 
     def drive(ctx, rng):
         addrs = [int(rng.integers(0, len(table))) for _ in dut.ports]
@@ -171,3 +183,83 @@ def test_ecp5_forms_only_where_the_block_fits():
     assert not _instances(RegisteredROM(range(2049), unsigned(12), 2, "r", target=ECP5()))
     assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r", target=ECP5()))
     assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r", target=ECP5()))) == 1
+
+
+# --- the stall rule as a throughput property ---------------------------------------------------
+
+UNITS = {
+    "sincos": lambda: SinCos(Config()),
+    "rotation-lee": lambda: VectorRotation(Config(method="lee")),
+    "illumination-exact": lambda: Illumination(Config()),
+    "fetch": lambda: BumpMapFetch(load_scene_config({"name": "t", "texture_size": 16})),
+    "palette-blend": lambda: PaletteLUT(Config(palette_size=16, palette_blend=True)),
+    "texture": lambda: TextureBlend(Config(), lights=2),
+    "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2})),
+    "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16})),
+}
+
+
+def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
+    """Offer ``n`` (all-zero) payloads to ``dut.i`` with input gaps of probability ``gap_p``
+    and hold ``dut.o.ready`` low with probability ``bp_p`` (valid never waits on ready);
+    returns the per-cycle samples ``(i.valid, i.ready, o.valid, o.ready)`` of every cycle
+    until the n-th output is taken, or of ``max_cycles`` cycles."""
+    rng = np.random.default_rng(seed)
+    samples = []
+
+    async def bench(ctx):
+        pending, taken, offered = n, 0, False
+        for _ in range(max_cycles):
+            if not offered and pending and rng.random() >= gap_p:
+                offered = True
+            ctx.set(dut.i.valid, offered)
+            ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
+            _, _, i_valid, i_ready, o_valid, o_ready = await ctx.tick().sample(
+                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready)
+            samples.append((bool(i_valid), bool(i_ready), bool(o_valid), bool(o_ready)))
+            if i_valid and i_ready:
+                offered, pending = False, pending - 1
+            if o_valid and o_ready:
+                taken += 1
+                if taken == n:
+                    return
+
+    sim = Simulator(dut)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    return samples
+
+
+@pytest.mark.parametrize("unit", list(UNITS))
+def test_pipe_fills_while_its_output_waits(unit):
+    """o.ready low from reset, a pixel offered every cycle: the pipe accepts exactly
+    ``latency`` pixels (one per stage; a chain of pipes, its total latency) and then holds.
+    With ``adv = o.ready`` it would accept none: nothing moves while the consumer waits."""
+    dut = UNITS[unit]()
+    samples = run_traffic(dut, dut.latency + 20, 0.0, 1.0, 0, max_cycles=dut.latency + 20)
+    accepted = sum(v and r for v, r, _, _ in samples)
+    assert accepted == dut.latency, (unit, accepted, dut.latency)
+    assert samples[-1][2] and not any(o_valid for _, _, o_valid, _ in samples[:dut.latency])
+
+
+@pytest.mark.parametrize("unit", list(UNITS))
+def test_cycles_within_the_stall_bound(unit):
+    """Traffic on both sides (sim/traffic.py ``both``). Every cycle either hands over an
+    output (N of them), or holds an output that is not taken (S: o.valid, not o.ready), or
+    has no output (E: not o.valid). With ``adv = ~o.valid | o.ready`` a cycle without output
+    advances the pipe and drops one bubble off its end; the bubbles ahead of the last pixel
+    are the L stages empty at reset plus one per cycle without input before the last pixel
+    is taken (G), so E <= L + G and the whole run takes at most N + L + S + G cycles. A pipe
+    that does not advance while empty and not ready breaks it."""
+    gap_p, bp_p = PATTERNS["both"]
+    dut = UNITS[unit]()
+    n = 200
+    samples = run_traffic(dut, n, gap_p, bp_p, seed=list(UNITS).index(unit),
+                          max_cycles=20 * (n + dut.latency))
+    taken = sum(o_valid and o_ready for _, _, o_valid, o_ready in samples)
+    assert taken == n, (unit, taken)
+    last_in = max(c for c, (v, r, _, _) in enumerate(samples) if v and r)
+    held = sum(o_valid and not o_ready for _, _, o_valid, o_ready in samples)
+    gaps = sum(not v for v, _, _, _ in samples[:last_in])
+    assert len(samples) <= n + dut.latency + held + gaps, (unit, len(samples), held, gaps)

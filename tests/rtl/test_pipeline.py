@@ -3,6 +3,8 @@ for every combination of the SceneConfig switches; lint of the emitted Verilog; 
 and backpressure (tags in order, each once)."""
 
 import itertools
+import json
+import re
 
 import numpy as np
 import pytest
@@ -176,3 +178,31 @@ def test_textured_scene_the_texture_reaches_the_output():
         assert_bit_exact(out, golden, payloads)
         colors[name] = np.array([o["color.g"] for o in out])
     assert (colors["black"] <= golden["specular"]).all() and colors["white"].mean() > 80
+
+
+@pytest.mark.parametrize("method", ["exact", "lee"])
+def test_no_specular_builds_no_h_path_and_no_table(method, build_dir):
+    """specular = false checked on the elaborated design (not on the built/skipped lists,
+    which are computed from the SceneConfig): the emitted pipeline's memories and Verilog have
+    no specular table and no H path (no signal of the rotation or illumination named h_...),
+    and the ROMs are those of the L path alone. Counts from the datapaths' structure, per
+    vector V built: exact rotation, n'' takes 6 sines and 8 cosines and each vector 2 sines
+    and 3 cosines, two reads per dual-port ROM: ceil((14 + 5 V) / 2) ROMs (10 with L, 12 with
+    L and H), no ROM in its illumination but the specular table; lee (Fig. 7 and 8): 6 ROMs
+    per vector in the rotation, 3 cosine ROMs per vector in the illumination."""
+    for specular in (False, True):
+        scene = load_scene_config({"name": "t", "texture_size": 16, "specular": specular,
+                                   "method": method, "angle_bits": 8, "frac_bits": 9})
+        v, sidecar = emit_unit("pipeline", scene, build_dir / f"specular_{specular}")
+        text, roms = v.read_text(), json.loads(sidecar.read_text())["roms"]
+        assert any(name.endswith("specular_table") for name in roms) == specular, roms
+        assert ("specular_table" in text) == specular
+        assert bool(re.search(r"\\(rotation|illumination)\.h_", text)) == specular
+        vectors = 2 if specular else 1
+        rotation = [r for r in roms if r.startswith("rotation.")]
+        illumination = [r for r in roms if r.startswith("illumination.")
+                        and not r.endswith("specular_table")]
+        if method == "exact":
+            assert len(rotation) == -(-(14 + 5 * vectors) // 2) and illumination == []
+        else:
+            assert len(rotation) == 6 * vectors and len(illumination) == 3 * vectors

@@ -62,3 +62,39 @@ def test_derived_rotation():
     assert SceneConfig(bump_map="flat").rotation == "per-polygon"
     assert SceneConfig(shading="palette").rotation == "none"
     assert SceneConfig().rotation == "per-pixel"
+
+
+# SceneConfig's ranges (its docstring), each refused one step outside on both sides with the
+# key named (BumpError.field, not the wording) and accepted at both ends; the Config keys a
+# scene passes on keep their names. texture_size is a power of two, so its neighbours
+# outside are also the next powers of two; mip_levels runs to log2(T) + 1.
+SCENE_RANGES = [
+    ("lights", 1, 8, [0, 9], {}),
+    ("texture_size", 16, 4096, [15, 4097, 8, 8192], {}),
+    ("mip_levels", 1, 7, [0, 8], {"texture_size": 64}),
+    ("mip_levels", 1, 5, [0, 6], {"texture_size": 16}),
+    ("angle_bits", 4, 16, [3, 17], {}),
+    ("spec_index_bits", 4, 16, [3, 17], {}),
+    ("spec_exponent", 1, 1024, [0, 1025], {}),
+    ("palette_size", 16, 16384, [15, 16385], {}),
+]
+
+
+@pytest.mark.parametrize("key, lo, hi, outside, base", SCENE_RANGES,
+                         ids=[f"{r[0]}-{r[1]}-{r[2]}" for r in SCENE_RANGES])
+def test_every_scene_range_is_checked_on_both_sides(key, lo, hi, outside, base):
+    for value in (lo, hi):
+        assert getattr(load_scene_config({"name": "t", **base, key: value}), key) == value
+    for value in outside:
+        with pytest.raises(BumpError) as e:
+            load_scene_config({"name": "t", **base, key: value})
+        assert e.value.field == key, (value, str(e.value))
+
+
+@pytest.mark.parametrize("key, value", [("bump_map", "bumpy"), ("shading", "flat"),
+                                        ("addressing", "mirror"), ("specular", "yes"),
+                                        ("texture", 1), ("rotation", "sideways")])
+def test_bad_choice_names_the_key(key, value):
+    with pytest.raises(BumpError) as e:
+        load_scene_config({"name": "t", key: value})
+    assert e.value.field == key

@@ -1,8 +1,12 @@
+import math
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.tables import cos_lookup, quarter_sine, sin_lookup
+from bumprtl.rtl.tables import (blend_coefficients, cos_lookup, phong_coefficients, quarter_sine,
+                                sin_lookup, specular_step_bits, specular_table)
 
 
 @pytest.mark.parametrize("angle_bits, frac_bits", [(8, 8), (12, 13), (14, 16)])
@@ -29,3 +33,56 @@ def test_lookup_wraps_like_binary_angles():
     cfg = Config()
     a = np.arange(-5, 5)
     assert np.array_equal(sin_lookup(cfg, a), sin_lookup(cfg, a + 3 * cfg.full_circle))
+
+
+# --- independent float64 oracles of the tables the RTL and the golden model share ------------
+# rtl/tables.py feeds both the RTL's ROMs and the golden model, so the bit-exact tests cannot
+# see a wrong entry: each table is checked here against its definition, computed entry by
+# entry with exact rationals (fractions) or math, never by calling the function under test.
+
+@pytest.mark.parametrize("spec_index_bits, frac_bits, exponent", [
+    (10, 13, 16), (4, 13, 1), (6, 9, 3), (13, 13, 2), (8, 13, 1024), (10, 16, 128)])
+def test_specular_table_is_cos_n_rounded_to_nearest(spec_index_bits, frac_bits, exponent):
+    """Eq. (2)'s (N'.H)^n with F = 9 fractional bits: word j = 255 2**9 (x0 + j 2**-t)**n
+    rounded to nearest, j = 0 .. 2**s, s = min(B, spec_index_bits), within half an LSB of the
+    exact rational; the step 2**-t (s <= t <= B) is the finest at which every word below
+    x0 = 1 - 2**(s - t) would round to 0 (so word 0 is 0), and word 2**s is N'.H = 1."""
+    cfg = Config(frac_bits=frac_bits, spec_index_bits=spec_index_bits, spec_exponent=exponent)
+    s, scale = min(frac_bits, spec_index_bits), 255 * 2 ** 9
+    below = lambda t: scale * (1 - Fraction(1, 2 ** (t - s))) ** exponent < Fraction(1, 2)
+    t = max([s] + [t for t in range(s + 1, frac_bits + 1) if below(t)])
+    table = specular_table(cfg)
+    assert specular_step_bits(cfg) == t
+    assert len(table) == (1 << s) + 1 and table[0] == 0 and table[-1] == scale
+    x0 = 1 - Fraction(1, 2 ** (t - s))
+    for j, got in enumerate(table.tolist()):
+        exact = scale * (x0 + Fraction(j, 2 ** t)) ** exponent
+        assert abs(got - exact) <= Fraction(1, 2), (j, got, float(exact))
+
+
+@pytest.mark.parametrize("ka, kd, ks", [(0.1, 0.7, 0.2), (0.0, 1.0, 1.0), (0.33, 0.47, 0.61),
+                                        (0.999, 0.0039, 0.0059), (1.0, 0.5, 0.0)])
+@pytest.mark.parametrize("specular", [True, False])
+def test_phong_coefficients_round_to_nearest(ka, kd, ks, specular):
+    """Eq. (2)'s ka, kd, ks for the Phong sum in 8-bit LSB with 9 fractional bits: KA =
+    255 ka 2**9, KD = 255 kd 2**9 (times clamp(N'.L) with B fractional bits), KS = ks 2**16
+    (times the 17-bit specular, 0 without specular); the blend's KA = ka 2**16, KD = kd 2**16;
+    each within half an LSB."""
+    cfg = Config(ka=ka, kd=kd, ks=ks, specular=specular)
+    got = phong_coefficients(cfg) + blend_coefficients(cfg)[:2]
+    exact = (255 * 512 * Fraction(ka), 255 * 512 * Fraction(kd),
+             65536 * Fraction(ks) if specular else 0, 65536 * Fraction(ka), 65536 * Fraction(kd))
+    for g, e in zip(got, exact):
+        assert isinstance(g, int) and abs(g - e) <= Fraction(1, 2), (got, exact)
+
+
+@pytest.mark.parametrize("angle_bits, frac_bits", [(4, 4), (8, 9), (12, 13), (16, 24)])
+def test_quarter_sine_entries_from_math_sin(angle_bits, frac_bits):
+    """Entry i = sin(i 90 deg / 2**k) 2**B rounded to nearest, i = 0 .. 2**k, from math.sin
+    per entry (ties cannot occur: sin of a non-zero rational multiple of pi/2 below 1 is
+    irrational)."""
+    cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
+    k = angle_bits - 2
+    want = [math.floor(math.sin(i * (math.pi / 2) / (1 << k)) * (1 << frac_bits) + 0.5)
+            for i in range((1 << k) + 1)]
+    assert quarter_sine(cfg).tolist() == want

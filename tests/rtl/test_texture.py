@@ -1,50 +1,64 @@
-"""The colour-texture blend (rtl/texture.py): the integer blend against float64 within its
-stated bound, and the TextureBlend unit bit for bit against it under stalls."""
+"""The colour-texture blend (rtl/texture.py): the integer blend of the unrounded terms
+against float64 within its stated bound, and the TextureBlend unit bit for bit against it
+under stalls."""
 
 import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import RGB, TextureBlend, blend_error_bound_lsb, texture_blend
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.traffic import PATTERNS
 
 
 def float_blend(d, s, tex, cfg):
-    """float64: out_c = clamp(tex_c min(1, ka + kd D / 255) + ks S, 0, 255), D, S = sums."""
-    D, S = sum(np.asarray(x, float) for x in d), sum(np.asarray(x, float) for x in s)
-    lit = np.minimum(1.0, cfg.ka + cfg.kd * D / 255)
+    """float64: out_c = clamp(tex_c min(1, ka + kd D) + ks S, 0, 255), D = sum d_j / 2**B,
+    S = sum s_j / 2**F (the unrounded terms: clamp(N'.L) and 255 cos^n)."""
+    D = sum(np.asarray(x, float) for x in d) / (1 << cfg.frac_bits)
+    S = sum(np.asarray(x, float) for x in s) / (1 << SPEC_FRAC_BITS)
+    lit = np.minimum(1.0, cfg.ka + cfg.kd * D)
     ks = cfg.ks if cfg.specular else 0.0
     return {c: np.clip(np.asarray(tex[c], float) * lit + ks * S, 0, 255) for c in RGB}
+
+
+def random_terms(rng, cfg, lights, n):
+    """Light j's diffuse_fine in [0, 2**B] and specular_fine in [0, 255 2**F]."""
+    d = [rng.integers(0, cfg.one + 1, n) for _ in range(lights)]
+    s = [rng.integers(0, 255 * (1 << SPEC_FRAC_BITS) + 1, n) for _ in range(lights)]
+    return d, s
 
 
 @pytest.mark.parametrize("lights", [1, 3])
 @pytest.mark.parametrize("k", [(0.1, 0.7, 0.2), (0.33, 0.45, 0.61), (0.0, 1.0, 0.0)])
 def test_blend_within_its_bound_of_float64(lights, k):
+    """One rounding at the end: within 1/2 LSB plus the coefficients' quantization."""
     cfg = Config(ka=k[0], kd=k[1], ks=k[2], lights=lights)
     rng = np.random.default_rng(lights)
     n = 200_000
-    d = [rng.integers(0, 256, n) for _ in range(lights)]
-    s = [rng.integers(0, 256, n) for _ in range(lights)]
+    d, s = random_terms(rng, cfg, lights, n)
     tex = {c: rng.integers(0, 256, n) for c in RGB}
     got, dsum, ssum = texture_blend(d, s, tex, cfg)
     want = float_blend(d, s, tex, cfg)
     bound = blend_error_bound_lsb(cfg, lights)
-    assert bound < 3
+    assert bound < 0.52
     for c in RGB:
         assert got[c].min() >= 0 and got[c].max() <= 255
         assert np.abs(got[c] - want[c]).max() <= bound, c
-    assert np.array_equal(dsum, np.minimum(sum(d), 255)) and np.array_equal(ssum, np.minimum(sum(s), 255))
+    D, S = sum(d) / cfg.one, sum(s) / (1 << SPEC_FRAC_BITS)
+    assert np.abs(dsum - np.minimum(255 * D, 255)).max() <= 0.5
+    assert np.abs(ssum - np.minimum(S, 255)).max() <= 0.5
 
 
 def test_white_texel_gives_the_grey_shade_black_gives_the_highlight():
     cfg = Config()
-    d, s = np.arange(256), np.arange(256)[::-1]
+    d = np.arange(256) * cfg.one // 255
+    s = np.arange(256)[::-1] << SPEC_FRAC_BITS
     white = texture_blend([d], [s], {c: np.full(256, 255) for c in RGB}, cfg)[0]
     black = texture_blend([d], [s], {c: np.zeros(256, int) for c in RGB}, cfg)[0]
-    grey = np.clip(np.floor((0.1 * 255 + 0.7 * d + 0.2 * s) + 0.5), 0, 255)
-    assert np.abs(white["r"] - grey).max() <= 1
-    assert np.abs(black["g"] - 0.2 * s).max() <= 0.5 + 255 * abs(round(0.2 * 256) / 256 - 0.2)
+    grey = np.floor(0.1 * 255 + 0.7 * 255 * d / cfg.one + 0.2 * np.arange(256)[::-1] + 0.5)
+    assert np.abs(white["r"] - np.clip(grey, 0, 255)).max() <= 1
+    assert np.abs(black["g"] - 0.2 * np.arange(256)[::-1]).max() <= 0.51
     assert black["g"][0] > 40 and black["g"][-1] == 0          # only the highlight is left
 
 
@@ -52,15 +66,15 @@ def test_white_texel_gives_the_grey_shade_black_gives_the_highlight():
 def test_unit_bit_exact(pattern):
     cfg, lights, n = Config(lights=2), 2, 300
     rng = np.random.default_rng(9)
-    inputs = [{**{f"d.{j}": int(rng.integers(256)) for j in range(lights)},
-               **{f"s.{j}": int(rng.integers(256)) for j in range(lights)},
+    inputs = [{**{f"d.{j}": int(rng.integers(cfg.one + 1)) for j in range(lights)},
+               **{f"s.{j}": int(rng.integers(255 << SPEC_FRAC_BITS)) for j in range(lights)},
                **{f"texel.{c}": int(rng.integers(256)) for c in RGB}, "tag": t} for t in range(n)]
     col = lambda k: np.array([p[k] for p in inputs])
     color, d, s = texture_blend([col("d.0"), col("d.1")], [col("s.0"), col("s.1")],
                                 {c: col(f"texel.{c}") for c in RGB}, cfg)
     golden = {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
     dut = TextureBlend(cfg, lights)
-    out, cycles = simulate_stream(dut, inputs, pattern, seed=2)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=2, pipe_handshake=True)
     assert_bit_exact(out, golden, inputs)
     if pattern == "no_stall":
         assert cycles <= n + dut.latency + 1

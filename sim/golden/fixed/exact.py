@@ -12,9 +12,9 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.golden.fixed.common import shade_fixed
+from bumprtl.sim.golden.fixed.common import channel_bound, input_angle_error, shade_fixed
 
-__all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors",
+__all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors", "dot_error_bound",
            "predicted_error_bound_lsb"]
 
 
@@ -52,24 +52,37 @@ def illumination_fixed(rot, cfg: Config):
     return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
 
 
-def predicted_error_bound_lsb(cfg: Config):
-    """Worst-case |diffuse8 - round(255 * clamp(N'.L))| of the exact datapath, in 8-bit LSB,
-    against float64 on unquantized inputs.
-
-    With delta = pi / 2**(k+2) rad (half an angle step) and u = 2**-B:
-    * input rounding: N' moves by at most sqrt(5) delta (th_N, th_N', ph_N' through
-      Cauchy-Schwarz) and A by at most sqrt(5) delta (th_A, and ph_A, ph_N which move it
-      along one direction, worth 2 sin th_A), so N'.A' moves by at most 2 sqrt(5) delta to
-      first order, plus at most 14 delta**2;
-    * arithmetic: the ROM values are off by at most u/2 each, so n'' (4 values / 4 + 2 / 2,
-      2 / 2, 4 / 4 + 2 / 2) is off by at most sqrt(1 + 1/4 + 1) u = 1.5 u, the vector terms
-      (p, y, cos th_A) by sqrt(3)/2 u, and the dot's final rounding adds u/2 (1.3 u**2 covers
-      the product of the two errors);
-    * the 8-bit rounding turns an error e before it into at most floor(e) + 1 after it.
-    Measured maxima stay under the bound (tests/sim/golden/fixed/test_exact.py).
-    """
-    delta = np.pi / (1 << (cfg.k + 2))
+def dot_error_bound(cfg: Config):
+    """|N'.A' computed - exact N'.A' of the same (rounded) angles| <= (1.5 + sqrt(3)/2 + 1/2
+    + 1.3 u) u, u = 2**-B: the ROM values are off by at most u/2 each, so n'' (4 values / 4 +
+    2 / 2, 2 / 2, 4 / 4 + 2 / 2) is off by at most sqrt(1 + 1/4 + 1) u = 1.5 u, the vector
+    terms (p, y, cos th_A) by sqrt(3)/2 u; both exact vectors are unit vectors, so the dot
+    moves by at most the sum (Cauchy-Schwarz), 1.3 u**2 covers the product of the two errors,
+    and the dot's one rounding adds u/2."""
     u = 2.0 ** -cfg.frac_bits
-    before = 255.0 * (2 * np.sqrt(5) * delta + 14 * delta ** 2
-                      + (1.5 + np.sqrt(3) / 2 + 0.5 + 1.3 * u) * u)
-    return int(np.floor(before)) + 1
+    return (1.5 + np.sqrt(3) / 2 + 0.5 + 1.3 * u) * u
+
+
+def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):
+    """Proven worst case of one output ``channel`` (``diffuse``, ``specular``, ``color``, or
+    ``blend``, the texture blend's colour) of the exact datapath against float64 on
+    unquantized inputs, in 8-bit LSB (|8-bit output - round(255 x float64)|), summed over
+    ``lights`` lights for the light sum and the blend.
+
+    * input rounding: the angle alpha between N' and A (A = L or H) moves by at most
+      D = 2 sqrt(5) delta, delta = pi / 2**(k+2) (common.input_angle_error: exact, not only
+      first order), so N'.A' of the rounded angles lies in [cos(alpha + D), cos(alpha - D)];
+    * arithmetic: the computed dot is within E = :func:`dot_error_bound` of that;
+    * so the unrounded terms 255 clamp(x) and 255 clamp(x)**n are off by at most the largest
+      change of those functions over that interval, maximized over alpha on a fine grid of
+      intervals (common.term_bounds_lsb, rigorous because both are monotone); the specular
+      term adds its table's rounding and interpolation (rtl/tables.specular_table_error_lsb);
+    * eq. 2's colour and the blend take the unrounded terms and round once: kd and ks times
+      those errors plus the coefficients' quantization (common.channel_bounds_lsb);
+    * the 8-bit rounding of both sides turns an error e before it into at most floor(e) + 1.
+    Where the widths make 1 LSB impossible (the specular term of a large n: its slope 255 n
+    times the angle grid's and the ROMs' error) this is the larger bound, and the sidecar
+    states it. Measured maxima stay under it and reach at least half of it
+    (tests/sim/golden/fixed/test_exact.py, test_channels.py).
+    """
+    return channel_bound(cfg, channel, input_angle_error(cfg), dot_error_bound(cfg), lights)

@@ -25,7 +25,8 @@ from bumprtl.rtl.lee import ratio_index
 from bumprtl.rtl.tables import (cos_lookup, kim_reciprocal_bits, kim_reciprocal_table,
                            lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
                            lee_atan_table, sin_lookup)
-from bumprtl.sim.golden.fixed.common import polar_illumination_fixed, polar_rotation_fixed
+from bumprtl.sim.golden.fixed.common import (channel_bound, input_angle_error,
+                                             polar_illumination_fixed, polar_rotation_fixed)
 
 __all__ = ["rotate_fixed", "to_polar_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
            "predicted_error_bound_lsb", "direction_error_bound"]
@@ -86,9 +87,12 @@ def illumination_fixed(rot, cfg: Config):
     return polar_illumination_fixed(illuminate_fixed, rot, cfg)
 
 
-def predicted_error_bound_lsb(cfg: Config):
+def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):
     """Worst-case |diffuse8 - round(255 * clamp(N'.L))| of the kim datapath, in 8-bit LSB,
-    against float64 on unquantized inputs.
+    against float64 on unquantized inputs; for ``channel`` = ``specular``, ``color`` or
+    ``blend`` the shared back end's bound (common.channel_bounds_lsb) for a dot product
+    within the input angle error 2 sqrt(5) delta and then direction_error_bound +
+    (sqrt(2) + 1.5) u (the two arithmetic items below) of the true one.
 
     With delta = pi / 2**(k+2) rad (half an angle step), u = 2**-B, a = lee_asin_index_bits,
     R = kim_reciprocal_bits and M = lee_atan_mantissa_bits; first order, a few u**2 ignored:
@@ -121,6 +125,9 @@ def predicted_error_bound_lsb(cfg: Config):
     """
     delta = np.pi / (1 << (cfg.k + 2))
     u = 2.0 ** -cfg.frac_bits
+    if channel != "diffuse" or lights != 1:
+        return channel_bound(cfg, channel, input_angle_error(cfg),
+                             direction_error_bound(cfg) + (np.sqrt(2) + 1.5) * u, lights)
     before = (2 * np.sqrt(5) * delta + 14 * delta ** 2 + direction_error_bound(cfg)
               + (np.sqrt(2) + 1.5) * u)
     return int(np.floor(255.0 * before)) + 1

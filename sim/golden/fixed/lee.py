@@ -26,7 +26,8 @@ from bumprtl.rtl.lee import (below_horizon, magnitude, phi_quadrant, prop_addres
                         ratio_index, theta_from_prop)
 from bumprtl.rtl.tables import (cos_lookup, lee_asin_index_bits, lee_asin_table, lee_atan_table,
                            lee_prop_table, lee_reciprocal_table, sin_lookup)
-from bumprtl.sim.golden.fixed.common import polar_illumination_fixed, polar_rotation_fixed
+from bumprtl.sim.golden.fixed.common import (check_channel, polar_illumination_fixed,
+                                             polar_rotation_fixed)
 
 __all__ = ["rotate_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
            "predicted_error_bound_lsb"]
@@ -82,10 +83,11 @@ def illumination_fixed(rot, cfg: Config):
     return polar_illumination_fixed(illuminate_fixed, rot, cfg)
 
 
-def predicted_error_bound_lsb(cfg: Config):
-    """The diffuse error bound of the lee datapath against float64, in 8-bit LSB: the whole
-    8-bit range (255) at every width. The rigid-circle and proportion approximations are the
+def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):
+    """The error bound of the lee datapath against float64, in 8-bit LSB, for every channel
+    (diffuse, specular, color, blend): the whole 8-bit range (255) at every width. The rigid-circle and proportion approximations are the
     method itself (erratum 7) and are geometric, so no width bounds the error below it; the
     measured maxima are in docs/algorithms.md and docs/lee_method.md (``bumprtl bench
     float64``, ``bench lee-widths``)."""
+    check_channel(channel)
     return 255

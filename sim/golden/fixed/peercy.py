@@ -20,7 +20,7 @@ from bumprtl.rtl.baselines.peercy import AXES, FRAME, vectors
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q, round_shift
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian
-from bumprtl.sim.golden.fixed.common import shade_fixed
+from bumprtl.sim.golden.fixed.common import channel_bound, shade_fixed
 from bumprtl.sim.golden.float.peercy import tbn_frame
 
 __all__ = ["rotation_fixed", "illumination_fixed", "encode",
@@ -124,9 +124,11 @@ def illumination_fixed(rot, cfg: Config):
     return {"ndotl": ndotl, "ndoth": ndoth, **shade_fixed(ndotl, ndoth, cfg)}
 
 
-def predicted_error_bound_lsb(cfg: Config):
+def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):
     """Worst-case |diffuse8 - round(255 clamp(N'.L'))| against float64 ``conventional`` on
-    unquantized inputs (:func:`encode`), in 8-bit LSB. With u = 2**-B, to first order:
+    unquantized inputs (:func:`encode`), in 8-bit LSB; for ``channel`` = ``specular``,
+    ``color`` or ``blend`` the shared back end's bound (common.channel_bounds_lsb) for a dot
+    product within e (below) of the true one. With u = 2**-B, to first order:
 
     * inputs: every component is rounded to nearest, so |dL|, |dN'| <= (sqrt 3 / 2) u and the
       frame matrix M = (T; B; N) is off by at most 3/2 u in Frobenius norm;
@@ -142,5 +144,7 @@ def predicted_error_bound_lsb(cfg: Config):
     (tests/sim/golden/fixed/test_cartesian.py).
     """
     u = 2.0 ** -cfg.frac_bits
-    before = 255.0 * ((2.5 + 2 * np.sqrt(3)) * u + 2 * u * u)
-    return int(np.floor(before)) + 1
+    e = (2.5 + 2 * np.sqrt(3)) * u + 2 * u * u
+    if channel != "diffuse" or lights != 1:
+        return channel_bound(cfg, channel, 0.0, e, lights)
+    return int(np.floor(255.0 * e)) + 1

@@ -5,10 +5,12 @@ once per polygon for a flat bump map, m lights dotted with one rotated normal, o
 lookup with palette shading. Inputs and outputs are dicts of arrays keyed like the flattened
 payloads (``"u"``, ``"n.phi"``, ``"l1.theta"``, ...).
 
-Several lights (eq. 2 of Lee et al. summed over lights): each light j gives
-diffuse_j and specular_j (8 bits, rtl/shade.shade_stages); the pipeline outputs
-  diffuse  = min(255, sum diffuse_j),  specular = min(255, sum specular_j),
-  color    = clamp(round((KA + KD sum diffuse_j + KS sum specular_j) / 256), 0, 255).
+Several lights (eq. 2 of Lee et al. summed over lights): each light j gives the unrounded
+terms d_j = clamp(N'.L_j) and s_j = 255 (N'.H_j)^n with F fractional bits
+(rtl/shade.shade_stages' diffuse_fine, specular_fine); with D = sum d_j, S = sum s_j the
+pipeline outputs
+  diffuse  = min(255, round(255 D)),  specular = min(255, round(S / 2**F)),
+  color    = the Phong sum of D and S rounded once (common.phong_sum_fixed).
 
 Colour texture (``texture = true``): the RGB texel at the same (u, v, level) as the bump map
 (``texels``: the texture memory) and :func:`rtl.texture.texture_blend`, the very function the
@@ -24,13 +26,17 @@ from bumprtl.rtl.bumpfetch import (has_map, level_bases, pack_texels, texel_addr
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.scene import SceneConfig, light_fields
-from bumprtl.rtl.tables import phong_coefficients
+from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.fixed import exact
+from bumprtl.sim.golden.fixed.common import phong_sum_fixed
 from bumprtl.sim.golden.vectors import random_codes
 
-__all__ = ["light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
+# The outputs of one Illumination unit (rtl/layouts.shade_layout) a single-light pipeline has.
+SHADE_OUTPUTS = ("diffuse", "specular", "color", "diffuse_fine", "specular_fine")
+
+__all__ = ["SHADE_OUTPUTS", "light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
            "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
            "random_inputs", "as_payload_list", "unpack_rgb"]
 
@@ -90,13 +96,13 @@ def polygon_fixed(n_phi, n_theta, b_phi, b_theta, scene: SceneConfig):
 
 
 def combine_lights_fixed(shades, scene: SceneConfig):
-    """Several lights' diffuse/specular -> the pipeline output (module docstring)."""
+    """Several lights' unrounded terms -> the pipeline output (module docstring)."""
     cfg = scene.config
-    d = sum(np.asarray(s["diffuse"], np.int64) for s in shades)
-    s = sum(np.asarray(s["specular"], np.int64) for s in shades)
-    ka, kd, ks = phong_coefficients(cfg)
-    color = np.clip(round_shift(ka + kd * d + ks * s, 8), 0, 255)
-    return {"diffuse": np.minimum(d, 255), "specular": np.minimum(s, 255), "color": color}
+    d = sum(np.asarray(s["diffuse_fine"], np.int64) for s in shades)
+    s = sum(np.asarray(s["specular_fine"], np.int64) for s in shades)
+    return {"diffuse": np.minimum(round_shift(255 * d, cfg.frac_bits), 255),
+            "specular": np.minimum(round_shift(s, SPEC_FRAC_BITS), 255),
+            "color": phong_sum_fixed(d, s, cfg)}
 
 
 def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=None):
@@ -128,11 +134,11 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
                                              "b.phi": zero, "b.theta": zero}, cfg), **poly}
         shades.append(illumination_fixed(rot, cfg))
     if scene.texture:
-        color, d, s = texture_blend([sh["diffuse"] for sh in shades],
-                                    [sh["specular"] for sh in shades], unpack_rgb(tex), cfg)
+        color, d, s = texture_blend([sh["diffuse_fine"] for sh in shades],
+                                    [sh["specular_fine"] for sh in shades], unpack_rgb(tex), cfg)
         return {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
     if len(shades) == 1:
-        return {k: shades[0][k] for k in ("diffuse", "specular", "color")}
+        return {k: shades[0][k] for k in SHADE_OUTPUTS}
     return combine_lights_fixed(shades, scene)
 
 

@@ -7,12 +7,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from bumprtl.gen.bench import skip as bench_skip
 from bumprtl.gen.bench import sweep as bench_sweep
 from bumprtl.gen.bench.sweep import Grid, error_lsb, pareto_front, sweep, write_section
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.rtl.methods import BASELINES, datapath_fixed
+from bumprtl.rtl.scene import load_scene_config
 
 
 def _front(pairs):
@@ -136,6 +138,24 @@ def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
     assert rows["full"]["status"] == "ok" and rows["full"]["same_image"]   # textured, 2 lights
     off = bench_skip.unskipped(load_scene_config("flat"))
     assert (off.bump_map, off.shading, off.specular) == ("varying", "per-pixel", True)
+
+
+def test_skip_cost_is_measured_on_the_netlists(tmp_path):
+    """bench skip's cost, measured for real once (the test above stands it in): a small
+    scene without specular against its unskipped version, both synthesized by Yosys.
+    Expected from the exact datapath's structure: 3 two-signal multipliers per vector dotted
+    (x4 p2, y2 y2, z4 z), so 3 on and 6 off; the rotation's dual-port sine ROMs,
+    ceil((14 + 5 V) / 2) for V vectors (10 on, 12 off), plus the specular table off; every
+    sine ROM (2**k + 1) x (B + 1) bits."""
+    scene = load_scene_config({"name": "tiny-diffuse", "specular": False, "texture_size": 16,
+                               "angle_bits": 6, "frac_bits": 5})
+    off = bench_skip.unskipped(scene).replace(name="tiny-off")
+    on_cost, off_cost = bench_skip._cost(scene, tmp_path), bench_skip._cost(off, tmp_path)
+    assert (on_cost["multipliers"], off_cost["multipliers"]) == (3, 6)
+    cfg = scene.config
+    assert on_cost["table_bits"] == 10 * cfg.sincos_depth * (cfg.frac_bits + 1)
+    assert off_cost["table_bits"] > 12 * cfg.sincos_depth * (cfg.frac_bits + 1)   # + the table
+    assert on_cost["ram_bits"] == off_cost["ram_bits"] == 16 * 16 * 2 * cfg.angle_bits  # the map
 
 
 def test_fpga_points_diagonal_and_all():

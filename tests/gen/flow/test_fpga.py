@@ -59,7 +59,7 @@ def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
     from bumprtl.rtl.config import Config
     calls = []
 
-    def fake(v_path, top, device, work, lpf=fpga.LPF):
+    def fake(v_path, top, device, work, lpf=fpga.LPF, seed=1):
         calls.append(v_path.read_text())
         (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
         return {"unit": top, "fmax_mhz": 1.0}
@@ -88,3 +88,27 @@ def test_critical_path_names_the_endpoints_and_splits_the_delay():
     assert fpga.critical_path(report) == ("rotation.n_c4_angle.Q -> rotation.sine_rom1.bram.ADB13 "
                                           "(1.00 ns logic + 1.25 ns routing)")
     assert fpga.critical_path({}) is None
+
+
+def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
+    """--seeds: each row's Fmax is the minimum over the seeds; a placement that fails is
+    written on its row with the reason, the other rows still placed (worker processes
+    inherit the patched flow through fork)."""
+    from bumprtl.gen.report import fpga as report
+    from bumprtl.gen.report import table1
+
+    def fake(component, label, device, work, seed=1):
+        if label == "exact_setup":
+            raise fpga.FpgaError("nextpnr-ecp5 failed (status 1): ERROR: no room")
+        return {"unit": label, "LUT4": 1, "FF": 2, "DSP": 0, "BRAM": 0, "fmax_mhz": 100.0 + seed,
+                "target_mhz": 150.0, "met": False, "critical_path": f"a -> b seed {seed}"}
+
+    monkeypatch.setattr(report, "place_component", fake)
+    monkeypatch.setattr(report, "accuracy", lambda d, cfg, n: {"max": 1, "mean": 0.1})
+    out = tmp_path / "report.md"
+    assert main(["report", "fpga", "--seeds", "3,2", "--unit", "exact_setup", "--unit",
+                 "exact_pipeline", "--out", str(out), "--work", str(tmp_path), "--jobs", "2"]) == 0
+    text = out.read_text()
+    assert "| exact_pipeline | 1 | 2 | 0 | 0 | 102.0 |" in text          # min over seeds 2, 3
+    assert "| exact_setup | not placed: nextpnr-ecp5 failed (status 1): ERROR: no room |" in text
+    assert "--seeds 3,2" in text and "a -> b seed 2" in text

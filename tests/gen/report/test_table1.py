@@ -35,11 +35,72 @@ def test_lee_counts_agree_with_the_paper_where_they_should(table1):
     assert setup["multipliers"] == paper["setup"]["multipliers"]            # 6
     assert setup["tables"] == paper["setup"]["tables"]                      # 12 ROMs
     assert illum["multipliers"] == paper["illumination"]["multipliers"]     # 2
-    # Sec. 4.2's 13 (not Table 1's 11), plus the (d << 8) - d that replaces the diffuse table
-    assert illum["adders"] == 13 + 1
+    # Sec. 4.2: 6 adders per vector (th_A' +- th_N', ph_A' - ph_N', the two brackets, the sum)
+    # and the Phong sum = 13 (not Table 1's 11), plus the (d << 8) - d that replaces the
+    # diffuse table
+    assert illum["adders"] == 2 * 6 + 1 + 1
     # Sec. 4.1: 8 adders per vector, one of which (90 deg - |Z|) has a constant operand
-    assert setup["adders"] == paper["setup"]["adders"] - 2
+    assert setup["adders"] == 2 * (8 - 1) and paper["setup"]["adders"] == 2 * 8
     assert setup["dividers"] == setup["sqrts"] == 0
+
+
+# Every row of docs/table1.md, pinned to the count its datapath's equations give (V = 2 vectors,
+# L and H; the shared back end of rtl/shade.py adds to every illumination row 2 adders, the
+# 255 d = (d << 8) - d and the Phong sum of eq. 2, 2 constant products, KD d and KS s, and 1
+# table, the cos^n one, read once):
+EXPECTED = {
+    # Product-to-sum: no multiplier. Sine reads: 14 for n'' (s(a +- t), s(b +- t),
+    # s(t +- th_N'), c(a), c(b), c(a +- t), c(b +- t), c(th_N' +- t)) + 5 per vector (s(X), s(Y),
+    # c(X), c(Y), c(th_A)) = 24, two per dual-port ROM: 12 ROMs. Adders: a, b (2); the distinct
+    # angle sums a +- t, b +- t, t +- th_N', th_N' - t (7); x4: 3 pair sums + 2 (5); y2 (1);
+    # z4: 3 + 2 (5); per vector D, X, Y, 2p, 2y (5 V = 10): 30.
+    ("exact", "setup"): {"multipliers": 0, "const_multipliers": 0, "dividers": 0, "sqrts": 0,
+                         "tables": 12, "table_reads": 24, "adders": 30},
+    # N'.A' = (x4 p2 + 2 y2 y2 + 2 z4 z) / 8: 3 products and 2 adders per vector (the rounding
+    # half rides on 2 z4 z, a constant adder), then the back end.
+    ("exact", "illumination"): {"multipliers": 3 * 2, "const_multipliers": 2, "dividers": 0,
+                                "sqrts": 0, "tables": 1, "table_reads": 1, "adders": 2 * 2 + 2},
+    # Sec. 4.1 per vector: 3 multipliers, 6 tables (the sin & cos ROM read 4 times, asin, 1/sin,
+    # 1/cos, atan, T_prop: 9 reads), 8 adders of which 90 deg - |Z| has a constant operand.
+    ("lee", "setup"): {"multipliers": 3 * 2, "const_multipliers": 0, "dividers": 0, "sqrts": 0,
+                       "tables": 6 * 2, "table_reads": 9 * 2, "adders": 7 * 2},
+    # Eq. 24 per vector: (c- - c+) c_phi (1 multiplier), 3 cosine ROMs, 6 adders (th_A' +-
+    # th_N', ph_A' - ph_N', c- + c+, c- - c+, the sum); then the back end.
+    ("lee", "illumination"): {"multipliers": 1 * 2, "const_multipliers": 2, "dividers": 0,
+                              "sqrts": 0, "tables": 3 * 2 + 1, "table_reads": 3 * 2 + 1,
+                              "adders": 6 * 2 + 2},
+    # Per vector: T, B, N rows times A (9 products, 2 adders per row) and the normalization
+    # (3 squares, 2 adders, 1 square root, 3 dividers); no table.
+    ("peercy", "setup"): {"multipliers": (9 + 3) * 2, "const_multipliers": 0, "dividers": 3 * 2,
+                          "sqrts": 1 * 2, "tables": 0, "table_reads": 0, "adders": (3 * 2 + 2) * 2},
+    # N'.A_n per vector: 3 products, 2 adders; then the back end.
+    ("peercy", "illumination"): {"multipliers": 3 * 2, "const_multipliers": 2, "dividers": 0,
+                                 "sqrts": 0, "tables": 1, "table_reads": 1, "adders": 2 * 2 + 2},
+    # N's matrix M: 4 products (ct cp, ct sp, st cp, st sp). Per vector: polar -> Cartesian 2,
+    # M A 8 (5 adders), q x 1/p 1, rho = p cos a0 + q sin a0 2 (1 adder): 13. ROMs: N's sin &
+    # cos (4 reads), per vector sin & cos (6 reads), reciprocal, atan, asin.
+    ("kim", "setup"): {"multipliers": 4 + 13 * 2, "const_multipliers": 0, "dividers": 0, "sqrts": 0,
+                       "tables": 1 + 4 * 2, "table_reads": 4 + 9 * 2, "adders": (5 + 1) * 2},
+    # Eqs (3)/(4) per vector: cos cos, sin sin, (sin sin) cos(ph_A' - ph_N') (3 products), its
+    # sin & cos ROM (3 reads), 2 adders (ph_A' - ph_N', the sum); N''s sin & cos ROM (2 reads);
+    # then the back end.
+    ("kim", "illumination"): {"multipliers": 3 * 2, "const_multipliers": 2, "dividers": 0,
+                              "sqrts": 0, "tables": 1 + 2 + 1, "table_reads": 2 + 3 * 2 + 1,
+                              "adders": 2 * 2 + 2},
+}
+EXPECTED[("ernst", "setup")] = EXPECTED[("peercy", "setup")]      # the same setup hardware
+EXPECTED[("ernst", "illumination")] = EXPECTED[("peercy", "illumination")]   # the two dots
+
+
+def test_every_row_is_the_count_its_equations_give(table1):
+    rows = {tuple(c.strip() for c in ln.strip("|").split("|")[:2]) for ln in table1.splitlines()
+            if re.match(r"^\| \w+ \| (setup|illumination) \|", ln)}
+    assert rows == set(EXPECTED)
+    for (design, row), want in EXPECTED.items():
+        got = _row(table1, design, row)
+        line = next(ln for ln in table1.splitlines() if ln.startswith(f"| {design} | {row} |"))
+        got["table_reads"] = int(re.search(r"\((\d+) reads\)", line).group(1))
+        assert {k: got[k] for k in want} == want, (design, row)
 
 
 def test_exact_method_has_no_division_or_inverse_trig(table1):

@@ -148,16 +148,16 @@ def test_pipeline_stimulus_reaches_the_datapath():
 @pytest.mark.regress
 def test_pipeline_1e6_stress_vectors_verilator(build_dir):
     """10^6 stress vectors (all cases) through the emitted pipeline on Verilator, 250k per
-    traffic pattern, bit-exact against the pipeline golden model, in order."""
-    from bumprtl.gen.render.rtl import run_pipeline
+    traffic pattern, bit-exact against the pipeline golden model, in order (bulk path)."""
+    from bumprtl.gen.render.rtl import run_pipeline_bulk
     from bumprtl.rtl.scene import load_scene_config
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus
     scene = load_scene_config("default")
     inputs, words = pipeline_stimulus(scene, 250_000, seed=9)
     patterns = list(PATTERNS)
-    outs, _, _ = run_pipeline(scene, inputs, words, None, None, "verilator", build_dir,
-                              patterns=patterns, progress=False)
+    outs, _, _ = run_pipeline_bulk(scene, inputs, words, None, None, "verilator", build_dir,
+                                   patterns=patterns)
     want = pipeline_fixed(inputs, scene, words)
     for pattern in patterns:
         assert np.array_equal(outs[pattern]["tag"], inputs["tag"]), pattern

@@ -1,0 +1,205 @@
+"""Block-RAM contents of a scene's pipeline (or fetch unit) as ``$readmemh`` files, the
+word layout of each memory, and whether the memories fit a device's block RAM.
+
+``bumprtl emit pipeline|fetch`` writes, beside ``<unit>.v`` and ``<unit>.json``, one file
+per memory: ``<unit>_map.hex`` (the bump vector map or palette index map), with a colour
+texture ``<unit>_texture.hex``, with palette shading ``<unit>_lut.hex`` (the colour table of
+one frame). Each file holds one word per line in hexadecimal, without address markers or
+comments, word 0 first: what Verilog's ``$readmemh`` (and every FPGA flow's memory
+initialisation) reads. The sidecar's ``memory_images`` gives each file's depth, width,
+word layout and host write port. The Verilog takes the contents either as its built-in
+initial contents (``load = "initial"``, the same words as the file) or through the host
+write port (``load = "port"``: the memory starts at zero and the host writes word ``a`` of
+the file at address ``a``, one per clock, before the first pixel).
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.palette import index_bits
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.fpga import DEVICES
+from bumprtl.gen.flow.units import UNITS
+
+__all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks",
+           "check_fits", "check_scene_fits", "hex_text", "memory_images", "emit_scene_unit", "host_writes",
+           "scene_command"]
+
+LOADS = ("initial", "port")
+DEFAULT_DEVICE = "LFE5U-85F"
+# ECP5 block RAM: DP16KD blocks of 18 kbit per device (Lattice ECP5 family data sheet,
+# "EBR SRAM blocks"; nextpnr-ecp5's utilization report lists the same counts).
+DEVICE_BRAM = {"LFE5U-25F": 56, "LFE5U-45F": 108, "LFE5U-85F": 208}
+BRAM_BITS = 18 * 1024
+BRAM_SHAPES = ((16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36))  # depth x width
+if set(DEVICE_BRAM) != set(DEVICES):
+    raise ImportError("gen/flow/memories.py DEVICE_BRAM must list the devices of gen/flow/fpga.py")
+
+# memory name (last part of the sidecar's ``roms`` key) -> host write port prefix, per unit
+_PORTS = {"pipeline": {"map": "map_", "texture": "tex_", "lut": "lut_"},
+          "fetch": {"map": "", "texture": "tex_"}}
+
+
+def bram_blocks(depth, width):
+    """DP16KD blocks a ``depth`` x ``width`` memory needs: the cheapest tiling by one of
+    the block's aspect ratios (:data:`BRAM_SHAPES`)."""
+    return min(math.ceil(depth / d) * math.ceil(width / w) for d, w in BRAM_SHAPES)
+
+
+def _is_map(name):
+    return name.split(".")[-1] in ("map", "texture")
+
+
+def check_fits(roms, device, what):
+    """Raise a BumpError (naming ``what``, the bits it needs and the device's block RAM) when
+    the maps of ``roms`` (the sidecar's memories) and one block per other memory do not fit
+    ``device``. Returns ``(blocks needed, blocks available)``."""
+    if device not in DEVICE_BRAM:
+        raise BumpError(f"device must be one of {', '.join(DEVICE_BRAM)}, got {device!r}")
+    maps = {k: v for k, v in roms.items() if _is_map(k)}
+    map_bits = sum(v["bits"] for v in maps.values())
+    map_blocks = sum(bram_blocks(v["depth"], v["width"]) for v in maps.values())
+    other = len(roms) - len(maps)                 # tables: at least one block each
+    have = DEVICE_BRAM[device]
+    if map_blocks + other > have:
+        raise BumpError(f"{what}: the map needs {map_bits:,} bits of block RAM ({map_blocks} "
+                        f"DP16KD of 18 kbit) beside {other} for the pipeline's tables; "
+                        f"{device} has {have} DP16KD of 18 kbit ({have * BRAM_BITS:,} bits)")
+    return map_blocks + other, have
+
+
+def check_scene_fits(scene, device, unit="pipeline"):
+    """:func:`check_fits` for the memories of ``scene``'s pipeline (or fetch unit)."""
+    build = BumpPipeline if unit == "pipeline" else BumpMapFetch
+    dut = build(scene)
+    return check_fits(UNITS[unit].sidecar(scene, dut)["roms"], device, scene.picture or scene.name)
+
+
+def hex_text(words, width):
+    """``$readmemh`` text: one word per line, ``ceil(width / 4)`` hex digits, word 0 first."""
+    digits = max(1, (width + 3) // 4)
+    return "".join(f"{int(w):0{digits}x}\n" for w in np.asarray(words, np.int64).tolist())
+
+
+def _layout(name, scene):
+    a, lv = scene.angle_bits, level_bases(scene)
+    where = (f"texel (u, v) of mip level l at word level_bases[l] + v * (T >> l) + u, "
+             f"T = {scene.texture_size}, level_bases = {lv}")
+    if name == "map" and scene.shading == "palette":
+        return f"palette index of the texel's quantized normal (Tarini Sec. 4), {index_bits(scene.config)} bits; {where}"
+    if name == "map":
+        return (f"N' of the texel as binary angles (Lee Sec. 2, bump vector map): phi in bits "
+                f"[{a - 1}:0], theta in bits [{2 * a - 1}:{a}] (full circle = 2^{a}); {where}")
+    if name == "texture":
+        return f"RGB colour texel, r in bits [7:0], g [15:8], b [23:16]; {where}"
+    return (f"colour-table entry i (palette normal i shaded for one frame): r [7:0], g [15:8], "
+            f"b [23:16], a [31:24] (Lambert intensity, Tarini Sec. 5.1); written through lut_w_*, "
+            f"then lut_swap (double-buffered), never initial contents")
+
+
+def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
+    """``{name: {"words", "width", "file", "layout", "port", "load"}}`` of the unit's memories
+    (``unit``: ``pipeline`` or ``fetch``)."""
+    if load not in LOADS:
+        raise BumpError(f"load must be one of {', '.join(LOADS)}, got {load!r}")
+    ports = _PORTS[unit]
+    out = {}
+    if words is not None:
+        width = index_bits(scene.config) if scene.shading == "palette" else 2 * scene.angle_bits
+        out["map"] = (words, width)
+    if texels is not None:
+        out["texture"] = (texels, TEXEL_BITS)
+    if table is not None and "lut" in ports:
+        out["lut"] = (table, 4 * scene.config.color_bits)
+    images = {}
+    for name, (w, width) in out.items():
+        w = np.asarray(w, np.int64)
+        depth = memory_depth(scene) if name != "lut" else len(w)
+        if len(w) != depth:
+            raise BumpError(f"{name} has {len(w)} words, the memory holds {depth}")
+        p = ports[name]
+        images[name] = {"words": w, "width": width, "depth": depth,
+                        "file": f"{unit}_{name}.hex", "layout": _layout(name, scene),
+                        "port": [f"{p}w_en", f"{p}w_addr", f"{p}w_data"] +
+                                (["lut_swap"] if name == "lut" else []),
+                        "load": "port" if name == "lut" else load}
+    return images
+
+
+def host_writes(images, meta):
+    """Host set-up cycles (``{port: value}`` per clock) that write the map and texture
+    images with ``load = "port"`` through their write ports, word ``a`` at address ``a``.
+    (The palette colour table belongs to a frame: its set-up writes it.)"""
+    cycles = []
+    for name, img in images.items():
+        if img["load"] != "port" or name == "lut":
+            continue
+        en, addr, data = img["port"][:3]
+        if en not in meta["ports"]:
+            raise BumpError(f"the emitted unit has no {en} port for the {name} image")
+        cycles += [{en: 1, addr: a, data: int(w)} for a, w in enumerate(img["words"].tolist())]
+    return cycles
+
+
+# Scene keys with a command-line flag of ``bumprtl emit`` (gen/cli/flags.py), in this order.
+_FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",
+              "resample", "texture_size", "method", "angle_bits", "frac_bits", "tag_bits",
+              "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights", "specular",
+              "palette_size")
+
+
+def scene_command(unit, scene, load="initial"):
+    """The ``bumprtl emit`` line that reproduces ``unit`` of ``scene``: ``--scene NAME`` plus
+    a flag for every key with a flag that differs from the named scene's."""
+    parts = ["bumprtl", "emit", unit, "--scene", scene.name]
+    try:
+        base = load_scene_config(scene.name)
+    except BumpError:                                  # a scene built in code: no source
+        base = None
+    for key in _FLAG_KEYS if base is not None else ():
+        value = getattr(scene, key)
+        if value == getattr(base, key) or value is None:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if isinstance(value, bool):
+            parts.append(flag if value else "--no-" + key.replace("_", "-"))
+        else:
+            parts += [flag, str(value)]
+    if load != "initial":
+        parts += ["--load", load]
+    return " ".join(parts)
+
+
+def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command=None):
+    """Build ``unit`` (``pipeline`` or ``fetch``) of ``scene`` with the ``images`` of
+    :func:`memory_images` (built-in initial contents where ``load = "initial"``), check its
+    memories fit ``device`` (``None``: no check), then write ``<unit>.v``, ``<unit>.json``
+    (with ``memory_images``) and one ``$readmemh`` file per image. Returns the paths
+    ``(v, json, [hex...])``; nothing is written when a check fails."""
+    init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
+    spec = UNITS[unit]
+    build = BumpPipeline if unit == "pipeline" else BumpMapFetch
+    dut = build(scene, init=init("map"), texture=init("texture"))
+    sidecar = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
+    if device is not None:
+        blocks, have = check_fits(sidecar["roms"], device, scene.picture or scene.name)
+        sidecar["block_ram"] = {"device": device, "dp16kd_needed": blocks, "dp16kd_available": have,
+                                "note": "maps tiled into DP16KD shapes, one block per other table"}
+    sidecar["memory_images"] = {n: {k: v for k, v in img.items() if k != "words"}
+                                for n, img in images.items()}
+    texts = {img["file"]: hex_text(img["words"], img["width"]) for img in images.values()}
+    load = images["map"]["load"] if "map" in images else "initial"
+    v, j = emit(dut, unit, command or scene_command(unit, scene, load), out_dir, sidecar,
+                flatten=True)
+    paths = []
+    for name, text in texts.items():
+        path = Path(out_dir) / name
+        path.write_text(text)
+        paths.append(path)
+    return v, j, paths

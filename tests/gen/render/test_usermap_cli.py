@@ -1,0 +1,227 @@
+"""Your own map on the command line: ``bumprtl render`` and ``bumprtl emit pipeline|fetch``
+with --height-map/--normal-map or a scene TOML, the $readmemh files beside the Verilog,
+flags that contradict a TOML, maps too large for the device, bad input (one line, exit 2,
+nothing written) and ``recommend`` without a local sweep."""
+
+import json
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from bumprtl.gen.cli.main import main
+from bumprtl.gen.flow.emit import lint
+from bumprtl.gen.render import images, rtl
+from bumprtl.gen.render.images import fixed_image
+from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.report import recommend as rec
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.golden.common import polar_to_cartesian
+from bumprtl.sim.scenes.usermap import load_bump_map, normals_to_rgb, write_png
+
+CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
+
+
+def craters(t, seed=11, n=10):
+    """An unseen height map: random craters (bowl and rim), fixed seed, tiling."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:t, 0:t] + 0.5
+    h = np.zeros((t, t))
+    for _ in range(n):
+        cx, cy = rng.uniform(0, t, 2)
+        r = rng.uniform(0.08, 0.25) * t
+        d = np.hypot((x - cx + t / 2) % t - t / 2, (y - cy + t / 2) % t - t / 2) / r
+        h += np.where(d < 1, d ** 2 - 1, 0.3 * np.exp(-((d - 1) / 0.3) ** 2))
+    return (h - h.min()) / np.ptp(h)
+
+
+def _png(path, h):
+    Image.fromarray(np.rint(h * 255).astype(np.uint8)).save(path)
+    return path
+
+
+def _one_line_exit_2(capsys, argv, *words):
+    assert main(argv) == 2, argv
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in err[0], err
+    assert all(w in err[0] for w in words), (words, err[0])
+    return err[0]
+
+
+def test_render_height_map_float64_and_fixed(tmp_path, capsys):
+    path = _png(tmp_path / "c.png", craters(64))
+    out = tmp_path / "f.png"
+    assert main(["render", "--height-map", str(path), "--size", "64", "--out", str(out)]) == 0
+    img = np.asarray(Image.open(out))
+    assert img.shape == (64, 64, 3) and img.std() > 5
+    fixed = tmp_path / "x.png"
+    assert main(["render", "--height-map", str(path), "--size", "64", "--model", "fixed",
+                 "--compare", "--out", str(fixed)]) == 0
+    text = capsys.readouterr().out
+    assert "exact (fixed)" in text and "PSNR" in text
+    scene = load_scene_config("default", {"height_map": str(path)})
+    want = fixed_image(scene, "exact", 64, light_elevation=45.0, light="directional")
+    assert np.array_equal(np.asarray(Image.open(fixed)), want)
+    assert not np.array_equal(want, img)                   # fixed point is not float64
+
+
+def test_render_scene_png_points_to_the_map_flags(tmp_path, capsys):
+    path = _png(tmp_path / "my_map.png", craters(32))
+    _one_line_exit_2(capsys, ["render", "--scene", str(path), "--out", str(tmp_path / "o.png")],
+                     "my_map.png", "--height-map", "--normal-map")
+    toml = tmp_path / "s.toml"
+    toml.write_text('image = "my_map.npy"\n')
+    _one_line_exit_2(capsys, ["emit", "pipeline", "--scene", str(toml), "--out", str(tmp_path / "e")],
+                     "image", "my_map.npy", "height_map")
+    assert not (tmp_path / "e").exists() and not (tmp_path / "o.png").exists()
+
+
+def _initial_contents(v_text, mem="fetch.map.mem"):
+    pat = re.compile(r"\\" + re.escape(mem) + r" \[(\d+)\] = \d+'h([0-9a-f]+);")
+    return {int(a): int(w, 16) for a, w in pat.findall(v_text)}
+
+
+def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
+    """Paths in a TOML are relative to it; the map file is the Verilog's initial contents
+    word for word (load initial) or absent from it (load port); lint-clean, deterministic."""
+    (tmp_path / "maps").mkdir()
+    _png(tmp_path / "maps" / "c.png", craters(32))
+    toml = tmp_path / "maps" / "scene.toml"
+    toml.write_text('height_map = "c.png"\nheight_scale = 3.0\ngeometry = "sphere"\n')
+    out = tmp_path / "a"
+    assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(out)]) == 0
+    scene = load_scene_config(toml)
+    assert scene.texture_size == 32 and scene.height_map == str(tmp_path / "maps" / "c.png")
+    words = scene_memories(scene)[0]
+    hexwords = [int(x, 16) for x in (out / "pipeline_map.hex").read_text().split()]
+    assert hexwords == words.tolist() and len(hexwords) == 32 * 32
+    assert all(len(x) == 6 for x in (out / "pipeline_map.hex").read_text().split())   # 24 bits
+    v = (out / "pipeline.v").read_text()
+    init = _initial_contents(v)
+    assert [init.get(a, 0) for a in range(len(words))] == words.tolist()
+    meta = json.loads((out / "pipeline.json").read_text())
+    img = meta["memory_images"]["map"]
+    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 24
+    assert "phi in bits [11:0], theta in bits [23:12]" in img["layout"]
+    assert img["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
+    assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
+    assert meta["block_ram"]["device"] == "LFE5U-85F"
+    assert lint(out / "pipeline.v") == []
+    port = tmp_path / "b"
+    assert main(["emit", "pipeline", "--scene", str(toml), "--load", "port", "--out", str(port)]) == 0
+    pv = (port / "pipeline.v").read_text()
+    assert not any(_initial_contents(pv).values())          # no map in the Verilog
+    assert pv.splitlines()[0].endswith(f"--scene {toml} --load port")
+    assert (port / "pipeline_map.hex").read_text() == (out / "pipeline_map.hex").read_text()
+    again = tmp_path / "c"
+    assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(again)]) == 0
+    for name in ("pipeline.v", "pipeline_map.hex"):
+        assert (again / name).read_bytes() == (out / name).read_bytes()
+
+
+def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsys):
+    bm = load_bump_map(_png(tmp_path / "c.png", craters(32)), "height")
+    write_png(tmp_path / "n.png", normals_to_rgb(polar_to_cartesian(bm.b_phi_map, bm.b_theta_map)))
+    assert main(["emit", "fetch", "--normal-map", str(tmp_path / "n.png"), "--out",
+                 str(tmp_path / "f")]) == 0
+    meta = json.loads((tmp_path / "f" / "fetch.json").read_text())
+    assert meta["memory_images"]["map"]["port"] == ["w_en", "w_addr", "w_data"]
+    assert len((tmp_path / "f" / "fetch_map.hex").read_text().split()) == 32 * 32
+    _one_line_exit_2(capsys, ["emit", "fetch", "--scene", "flat", "--out", str(tmp_path / "g")],
+                     "flat", "nothing to fetch")
+    assert not (tmp_path / "g").exists()
+
+
+def test_a_map_too_large_for_the_device_says_bits_needed_and_available(tmp_path, capsys):
+    path = _png(tmp_path / "big.png", craters(512, n=40))
+    line = _one_line_exit_2(capsys, ["emit", "pipeline", "--height-map", str(path), "--out",
+                                     str(tmp_path / "o")],
+                            "big.png", "6,291,456 bits", "LFE5U-85F has 208 DP16KD of 18 kbit")
+    assert "3,833,856 bits" in line
+    _one_line_exit_2(capsys, ["render", "--rtl", "--height-map", str(path), "--device", "LFE5U-25F",
+                              "--out", str(tmp_path / "r.png")], "big.png", "LFE5U-25F has 56 DP16KD")
+    assert not (tmp_path / "o").exists() and not (tmp_path / "r.png").exists()
+    small = _png(tmp_path / "s.png", craters(256, n=20))         # 96 + 13 blocks: fits
+    assert main(["emit", "pipeline", "--height-map", str(small), "--device", "LFE5U-85F",
+                 "--load", "port", "--out", str(tmp_path / "p")]) == 0
+
+
+def test_flags_that_contradict_the_toml_name_both(tmp_path, capsys):
+    toml = tmp_path / "wood.toml"
+    toml.write_text('image = "wood"\ntexture_size = 32\nangle_bits = 12\n')
+    out = str(tmp_path / "x.png")
+    _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--scene", "bricks",
+                              "--out", out], "--image bricks", "image = 'wood'", "wood.toml")
+    _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--texture-size", "64",
+                              "--out", out], "--texture-size 64", "texture_size = 32")
+    _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--height-map", "x.png",
+                              "--out", out], "--height-map x.png", "image = 'wood'")
+    _one_line_exit_2(capsys, ["emit", "pipeline", "--scene", str(toml), "--angle-bits", "10",
+                              "--out", str(tmp_path / "e")], "--angle-bits 10", "angle_bits = 12")
+    _one_line_exit_2(capsys, ["emit", "pipeline", "--scene", str(toml), "--out-bits", "8",
+                              "--out", str(tmp_path / "e")], "--out-bits", "does not apply")
+    assert not (tmp_path / "e").exists() and not (tmp_path / "x.png").exists()
+
+
+def test_render_rtl_uses_the_toml(tmp_path, monkeypatch):
+    """The TOML's image and map size reach the RTL render; a flag it does not set applies."""
+    toml = tmp_path / "wood.toml"
+    toml.write_text('image = "wood"\ntexture_size = 32\n')
+    seen = []
+
+    def fake_render(scene, size, simulator, build_dir, **kw):
+        seen.append((scene, size, kw["load"], kw["azimuth"]))
+        img = np.zeros((size, size, 3), np.uint8)
+        return rtl.RtlRender(img, img, size * size, 1.0, 1.0)
+
+    monkeypatch.setattr(rtl, "render_rtl", fake_render)
+    assert main(["render", "--rtl", "--pipeline", str(toml), "--size", "16", "--light-azimuth",
+                 "60", "--kd", "0.5", "--load", "port", "--out", str(tmp_path / "r.png")]) == 0
+    scene, size, load, azimuth = seen[0]
+    assert (scene.image, scene.texture_size, scene.kd, size, load, azimuth) == \
+        ("wood", 32, 0.5, 16, "port", 60.0)
+    assert main(["render", "--rtl", "--scene", str(toml), "--size", "16",
+                 "--out", str(tmp_path / "s.png")]) == 0
+    assert seen[1][0].image == "wood" and seen[1][2] == "initial"
+
+
+def test_bad_maps_on_the_command_line_one_line_exit_2_nothing_written(tmp_path):
+    (tmp_path / "junk.png").write_bytes(b"\x89PNG\r\n\x1a\n" + b"\0" * 5)
+    nan = craters(32)
+    nan[1, 2] = np.nan
+    np.save(tmp_path / "nan.npy", nan)
+    np.save(tmp_path / "flat.npy", np.zeros((32, 32)))
+    _png(tmp_path / "odd.png", craters(40))
+    cases = [(["--height-map", str(tmp_path / "none.png")], ["none.png", "no such file"]),
+             (["--height-map", str(tmp_path / "junk.png")], ["junk.png", "truncated"]),
+             (["--height-map", str(tmp_path / "nan.npy")], ["nan.npy", "NaN"]),
+             (["--height-map", str(tmp_path / "flat.npy")], ["flat.npy", "all-flat"]),
+             (["--height-map", str(tmp_path / "odd.png")], ["odd.png", "32x32", "--resample"]),
+             (["--normal-map", str(tmp_path / "odd.png")], ["odd.png", "RGB"]),
+             (["--height-map", str(tmp_path / "odd.png"), "--height-scale", "-1"], ["height_scale"])]
+    for flags, words in cases:
+        for cmd in (["render"], ["render", "--model", "fixed"], ["render", "--rtl"],
+                    ["emit", "pipeline"]):
+            out = tmp_path / "out"
+            argv = [*cmd, *flags, "--out", str(out if cmd[0] == "emit" else out / "x.png")]
+            r = subprocess.run(CLI + argv, capture_output=True, text=True)
+            lines = r.stderr.strip().splitlines()
+            assert r.returncode == 2 and len(lines) == 1 and "Traceback" not in r.stderr, (argv, r.stderr)
+            assert all(w in lines[0] for w in words), (argv, lines)
+            assert not out.exists(), argv
+
+
+def test_recommend_without_a_local_sweep_reads_the_shipped_one(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["recommend", "--max-error-lsb", "2"]) == 0
+    text = capsys.readouterr().out
+    assert "no local sweep" in text and "docs/data/sweep.json" in text
+    assert rec.SHIPPED_SWEEP.is_file()
+    local = tmp_path / "build" / "bench" / "sweep.json"
+    local.parent.mkdir(parents=True)
+    local.write_text(json.dumps({"command": "toy", "points": []}))
+    assert main(["recommend", "--max-error-lsb", "2"]) == 2          # the local one, empty
+    assert "no local sweep" not in capsys.readouterr().out

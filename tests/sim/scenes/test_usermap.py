@@ -1,0 +1,207 @@
+"""A user's height or normal map (sim/scenes/usermap.py): decoding, the two green-channel
+conventions, resampling, every bad input refused with one line naming the file, and the
+normal-map round trip held to a bound derived from the PNG's 8-bit quantization."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import polar_to_cartesian
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.palette import displacement_to_normals
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.imaging import compose
+from bumprtl.sim.scenes.usermap import (load_bump_map, map_size, nearest_allowed_size,
+                                        normals_to_rgb, read_height, read_normals, write_png)
+
+
+def hex_tiles(t, seed=3, tiles=6):
+    """An unseen height map: hexagonal tiles of random heights with bevelled grout."""
+    rng = np.random.default_rng(seed)
+    y, x = (np.mgrid[0:t, 0:t] + 0.5) / t * tiles
+    r = np.array([1.0, np.sqrt(3)])
+    p = np.stack([x, y], -1)
+    a, b = np.mod(p, r) - r / 2, np.mod(p - r / 2, r) - r / 2
+    g = np.where(((a ** 2).sum(-1) < (b ** 2).sum(-1))[..., None], a, b)
+    q = np.abs(g)
+    edge = np.maximum(q[..., 0] * 0.5 + q[..., 1] * np.sqrt(3) / 2, q[..., 0])
+    keys = np.round((p - g) * 1000).astype(np.int64)
+    _, tile = np.unique(keys[..., 0] * 10 ** 7 + keys[..., 1], return_inverse=True)
+    top = rng.uniform(0.5, 1.0, tile.max() + 1)[tile.reshape(t, t)]
+    return top * np.clip((0.5 - edge) / 0.1, 0, 1)
+
+
+def _grey_png(path, h, bits=8):
+    scale = 255 if bits == 8 else 65535
+    Image.fromarray(np.rint(h * scale).astype(np.uint8 if bits == 8 else np.uint16)).save(path)
+    return path
+
+
+def test_height_map_png_8_and_16_bit_and_npy_give_the_plane_fit(tmp_path):
+    h = hex_tiles(64)
+    for path, q in ((_grey_png(tmp_path / "h8.png", h), 255), (_grey_png(tmp_path / "h16.png", h, 16), 65535)):
+        got = read_height(path)
+        assert np.array_equal(got, np.rint(h * q) / q)
+    np.save(tmp_path / "h.npy", h)
+    bm = load_bump_map(tmp_path / "h.npy", "height", height_scale=3.0)
+    want = displacement_to_normals(h, 3.0)                      # Tarini Sec. 4.1
+    assert np.allclose(polar_to_cartesian(bm.b_phi_map, bm.b_theta_map), want, atol=1e-12)
+    assert bm.size == 64 and bm.kind == "height" and np.array_equal(bm.height, h)
+
+
+def test_normal_map_axes_and_conventions(tmp_path):
+    """A texel whose normal leans to the right of the image (red > 128) and up the image
+    (green > 128 in OpenGL) is N' = (-up, right, z) in the bump map's frame (tangent x down
+    the rows); DirectX's green points down, so the flipped file decodes to the same map."""
+    rng = np.random.default_rng(5)
+    n = rng.normal(size=(32, 32, 3))
+    n[..., 2] = np.abs(n[..., 2]) + 0.5
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    rgb = normals_to_rgb(n, "opengl")
+    write_png(tmp_path / "gl.png", rgb)
+    write_png(tmp_path / "dx.png", np.stack([rgb[..., 0], 255 - rgb[..., 1], rgb[..., 2]], -1))
+    gl = read_normals(tmp_path / "gl.png", "opengl")
+    assert np.allclose(gl, read_normals(tmp_path / "dx.png", "directx"), atol=1e-15, rtol=0)
+    assert np.abs(normals_to_rgb(n, "directx").astype(int) - rgb * [1, -1, 1] - [0, 255, 0]).max() <= 1
+    assert not np.allclose(gl, read_normals(tmp_path / "dx.png", "opengl"))   # the flag matters
+    rgb = np.asarray(Image.open(tmp_path / "gl.png"), float)
+    right, up = 2 * rgb[..., 0] / 255 - 1, 2 * rgb[..., 1] / 255 - 1
+    assert np.all(np.sign(gl[..., 1]) == np.sign(right)) and np.all(np.sign(gl[..., 0]) == -np.sign(up))
+    assert np.allclose(np.linalg.norm(gl, axis=-1), 1, atol=1e-12)             # re-normalized
+
+
+def test_normal_map_matches_the_height_map_lighting(tmp_path):
+    """Height rising to the right (dh/du > 0) leans the normal left: an OpenGL normal map of
+    that surface has red < 128 and renders like the height map (sign conventions agree)."""
+    t = 32
+    h = np.tile(np.arange(t) / t, (t, 1))
+    n = displacement_to_normals(h, 4.0)
+    rgb = normals_to_rgb(n)
+    assert rgb[5, 5, 0] < 128 and abs(int(rgb[5, 5, 1]) - 128) <= 1
+
+
+def test_power_of_two_refused_with_nearest_size_or_resampled(tmp_path):
+    h = hex_tiles(96)                       # 96 x 96: not a power of two
+    path = _grey_png(tmp_path / "h96.png", h)
+    with pytest.raises(BumpError, match=r"h96\.png: 96x96 .*nearest allowed size is 128x128"):
+        read_height(path)
+    with pytest.raises(BumpError, match="nearest allowed size is 128x128"):
+        map_size(path)
+    assert map_size(path, resample=True) == 128
+    got = read_height(path, resample=True)
+    assert got.shape == (128, 128)                          # resampled, never cropped
+    assert abs(got.mean() - h.mean()) < 0.01
+    wide = _grey_png(tmp_path / "wide.png", hex_tiles(64)[:, :48])
+    with pytest.raises(BumpError, match="48x64 .*nearest allowed size is 64x64"):
+        read_height(wide)
+    assert nearest_allowed_size(2800) == 2048 and nearest_allowed_size(3000) == 4096   # by ratio
+    assert nearest_allowed_size(5) == 16 and nearest_allowed_size(9000) == 4096
+    with pytest.raises(BumpError, match="texture_size = 32"):
+        map_size(_grey_png(tmp_path / "h64.png", hex_tiles(64)), texture_size=32)
+
+
+def _truncated(tmp_path):
+    good = _grey_png(tmp_path / "good.png", hex_tiles(64))
+    raw = good.read_bytes()
+    (tmp_path / "cut.png").write_bytes(raw[:len(raw) // 2])
+    return tmp_path / "cut.png"
+
+
+def _bad_inputs(tmp_path):
+    """(function, args, words in the message) of every bad input."""
+    h = hex_tiles(32)
+    rgb = normals_to_rgb(displacement_to_normals(h, 4.0))
+    (tmp_path / "junk.png").write_bytes(b"not a png at all")
+    nan = h.copy()
+    nan[3, 4] = np.nan
+    np.save(tmp_path / "nan.npy", nan)
+    inf = h.copy()
+    inf[0, 0] = np.inf
+    np.save(tmp_path / "inf.npy", inf)
+    np.save(tmp_path / "flat.npy", np.full((32, 32), 0.5))
+    write_png(tmp_path / "rgb16.png", rgb.astype(np.uint16) * 257, bit_depth=16)
+    write_png(tmp_path / "rgb.png", rgb)
+    Image.fromarray(np.rint(h * 255).astype(np.uint8)).convert("LA").save(tmp_path / "la.png")
+    _grey_png(tmp_path / "grey.png", h)
+    write_png(tmp_path / "flatn.png", np.full((32, 32, 3), [128, 128, 255], np.uint8))
+    inward = rgb.copy()
+    inward[7, 9] = [128, 128, 20]
+    write_png(tmp_path / "inward.png", inward)
+    (tmp_path / "h.txt").write_text("1 2 3")
+    np.save(tmp_path / "cplx.npy", h.astype(complex))
+    return [
+        ("missing.png", "height", ["missing.png", "no such file"]),
+        ("junk.png", "height", ["junk.png", "not a PNG"]),
+        (_truncated(tmp_path).name, "height", ["cut.png", "truncated"]),
+        ("rgb.png", "height", ["rgb.png", "3 channel", "greyscale", "--normal-map"]),
+        ("la.png", "height", ["la.png", "2 channel"]),
+        ("grey.png", "normal", ["grey.png", "1 channel", "RGB", "--height-map"]),
+        ("rgb16.png", "normal", ["rgb16.png", "16-bit", "8 bits"]),
+        ("nan.npy", "height", ["nan.npy", "NaN", "(3, 4)"]),
+        ("inf.npy", "height", ["inf.npy", "infinity"]),
+        ("flat.npy", "height", ["flat.npy", "all-flat"]),
+        ("flatn.png", "normal", ["flatn.png", "all-flat"]),
+        ("inward.png", "normal", ["inward.png", "into the surface", "row 7, column 9"]),
+        ("h.txt", "height", ["h.txt", ".png or .npy"]),
+        ("cplx.npy", "height", ["cplx.npy", "complex"]),
+    ]
+
+
+def test_every_bad_map_is_one_line_naming_the_file(tmp_path):
+    for name, kind, words in _bad_inputs(tmp_path):
+        with pytest.raises(BumpError) as e:
+            load_bump_map(tmp_path / name, kind)
+        msg = str(e.value)
+        assert "\n" not in msg and all(w in msg for w in words), (name, msg)
+    with pytest.raises(BumpError, match="height_scale"):
+        load_bump_map(tmp_path / "grey.png", "height", height_scale=-1)
+
+
+def test_user_map_scene_uses_its_map_and_geometry(tmp_path):
+    h = hex_tiles(64)
+    bm = load_bump_map(_grey_png(tmp_path / "h.png", h), "height")
+    s = load_scene(None, size=32, bump=bm, geometry="sphere")
+    assert s.geometry == "sphere" and s.texture_size == 64 and s.albedo is None
+    assert np.array_equal(s.px.b_phi, bm.b_phi_map[s.v, s.u])
+    assert load_scene(None, size=32, bump=bm).geometry == "plane"
+    with pytest.raises(BumpError, match="texture_size = 32"):
+        load_scene(None, size=32, bump=bm, texture_size=32)
+
+
+def _round_trip_bound(cfg):
+    """The largest 8-bit difference between renders of the same normals, one decoded from an
+    8-bit normal-map PNG. Each stored component c in [-1, 1] becomes round((c + 1) 255 / 2),
+    decoded as 2 q / 255 - 1: off by at most 1/255 per component, |dn| <= sqrt(3)/255, so
+    after re-normalizing the direction turns by alpha <= asin(sqrt(3)/255). The angle of N'
+    to L (and to H) then changes by at most alpha: diffuse cos changes by at most alpha, the
+    specular cos^p by at most alpha * max|d cos^p/d theta| = alpha sqrt(p) ((p-1)/p)^((p-1)/2)
+    (at tan^2 theta = 1/(p-1)); clamping to [0, 1] and the albedo (<= 1) only shrink it. So the
+    colour moves by delta <= (kd + ks g(p)) alpha, and two 8-bit roundings by at most
+    floor(255 delta + 1)."""
+    alpha = np.arcsin(np.sqrt(3) / 255)
+    p = cfg.spec_exponent
+    g = np.sqrt(p) * ((p - 1) / p) ** ((p - 1) / 2) if p > 1 else 1.0
+    return int(np.floor(255 * (cfg.kd + cfg.ks * g) * alpha + 1))
+
+
+def test_normal_map_round_trip_within_the_png_quantization(tmp_path):
+    """height map -> normals (plane fit) -> 8-bit normal-map PNG -> --normal-map renders the
+    height map's picture within the derived bound; the measured error is printed."""
+    cfg = Config()
+    bound = _round_trip_bound(cfg)
+    assert bound == 3                                        # for the default Config
+    h = hex_tiles(64)
+    hmap = load_bump_map(_grey_png(tmp_path / "h.png", h), "height", height_scale=4.0)
+    n = polar_to_cartesian(hmap.b_phi_map, hmap.b_theta_map)
+    write_png(tmp_path / "n.png", normals_to_rgb(n))
+    nmap = load_bump_map(tmp_path / "n.png", "normal")
+    worst = 0
+    for geometry in ("plane", "sphere"):
+        for az in (30.0, 200.0):
+            a, b = (load_scene(None, size=128, bump=m, geometry=geometry, light_azimuth=az)
+                    for m in (hmap, nmap))
+            ia, ib = (compose(s, conventional(s.px, cfg).color).astype(int) for s in (a, b))
+            worst = max(worst, int(np.abs(ia - ib).max()))
+    print(f"normal-map round trip: max |difference| {worst} LSB (bound {bound})")
+    assert 0 < worst <= bound

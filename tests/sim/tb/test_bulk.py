@@ -1,0 +1,175 @@
+"""The bulk path (sim/tb/bulk.py): stimulus and outputs as arrays, the clock inside the
+simulator, the build cached by the Verilog's digest.
+
+`make test`: a small frame of the default pipeline on both simulators under every traffic
+pattern, byte-exact against the golden model; a second run starts from the cached build;
+a wrong golden value fails; bad stimulus is refused before the build; a deadlock ends in
+a timeout that counts the pixels in and out. `make regress`: >= 10^7 vectors through each
+emitted unit and the default pipeline under every traffic pattern on Verilator (this
+replaces the per-cycle 10^6-vector runs, keeping their units, methods, patterns and the
+pipeline's stress cases).
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline_bulk,
+                                    scene_stimulus, scene_texels, emit_pipeline)
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.tb import bulk
+from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
+                                 decode_words, encode_words, run_bulk)
+from bumprtl.sim.tb.bulk_sources import pipeline_map
+
+# Icarus is ~1000x slower than Verilator on the pipeline: a smaller frame, the same patterns.
+FRAME = {"icarus": 32, "verilator": 64}
+
+
+def _frame(size):
+    scene = load_scene_config("default")
+    inputs, words, polygon, table, base = scene_stimulus(scene, size)
+    texels = scene_texels(scene, base)
+    return scene, inputs, words, polygon, table, texels
+
+
+@pytest.mark.parametrize("sim", SIMULATORS)
+def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
+    """A frame of the default scene through its emitted pipeline under all four traffic
+    patterns: every output field equals the golden model's (checked in cocotb and here),
+    the image equals the golden render byte for byte; no stall means one pixel per clock,
+    stalls cost cycles; a second run reuses the build."""
+    size = FRAME[sim]
+    scene, inputs, words, polygon, table, texels = _frame(size)
+    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
+    outs, cycles, r = run_pipeline_bulk(scene, inputs, words, polygon, table, sim, build_dir,
+                                        patterns=tuple(TRAFFIC), texels=texels, expected=golden)
+    assert r.checked
+    n = size * size
+    latency = json.loads((build_dir / "rtl" / "pipeline.json").read_text())["latency"]
+    for pattern in TRAFFIC:
+        assert r.pixels[pattern] == n
+        assert np.array_equal(outs[pattern]["tag"], inputs["tag"]), pattern
+        for field, want in golden.items():
+            assert np.array_equal(outs[pattern][field], want), (pattern, field)
+    assert cycles["no_stall"] <= n + latency + 2
+    for pattern in ("input_gaps", "backpressure", "both"):
+        assert cycles[pattern] > 1.2 * n, pattern
+    image = render_rtl(scene, size, sim, build_dir / "render", progress=False)
+    assert image.cached                                   # the same Verilog: built once
+    assert image.image.tobytes() == golden_render(scene, size).tobytes()
+
+
+def test_bulk_fails_on_one_wrong_golden_value(build_dir):
+    """The check can fail: one corrupted golden value is reported with its pattern, output
+    index and field (Icarus: a one-second build)."""
+    scene, inputs, words, polygon, table, texels = _frame(16)
+    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
+    golden["color"] = golden["color"].copy()
+    golden["color"][77] ^= 1
+    with pytest.raises(AssertionError, match=r"output 77 field color: RTL \d+ != golden \d+"):
+        run_pipeline_bulk(scene, inputs, words, polygon, table, "icarus", build_dir,
+                          patterns=("backpressure",), texels=texels, expected=golden)
+
+
+@pytest.mark.parametrize("sim", SIMULATORS)
+def test_bulk_deadlock_ends_in_a_timeout(sim, build_dir):
+    """Output ready never rises: the pipeline fills and stops. The run ends (it never
+    hangs) with a timeout naming the pixels that went in and came out."""
+    scene, inputs, words, polygon, table, texels = _frame(16)
+    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    with pytest.raises(SimulationTimeout,
+                       match=r"deadlock\): pattern stuck: [1-9]\d* pixels went in, 0 came out of 256"):
+        run_bulk(sim, v, j, build_dir / "bulk", patterns=("stuck",), inputs=inputs,
+                 traffic={"stuck": (0.0, 1.0)}, idle_limit=500)
+
+
+def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkeypatch):
+    """Fields and widths are checked against the sidecar before any build."""
+    v, j = emit_unit("sincos", Config(angle_bits=12), build_dir / "rtl")
+    monkeypatch.setattr(bulk, "build", lambda *a, **k: pytest.fail("built before the check"))
+    n = 10
+    good = {"angle": np.arange(n), "tag": np.arange(n)}
+    cases = [({"angle": np.arange(n)}, r"lacks field 'tag'"),
+             ({**good, "phase": np.arange(n)}, r"'phase' is not an input field of sincos.json"),
+             ({**good, "angle": np.r_[np.arange(n - 1), 1 << 12]},
+              r"'angle' needs 13 bits \(values 0\.\.4096\), sincos.json i__payload field 'angle' "
+              r"is 12 bits \(unsigned, 0\.\.4095\)"),
+             ({**good, "tag": np.arange(n + 1)}, r"fields differ in length: \[10, 11\]"),
+             ({**good, "tag": np.array([-1] * n)}, r"'tag' needs \d+ bits \(values -1\.\.-1\)"),
+             ({**good, "angle": np.arange(n) * 0.5}, r"'angle' must be an integer array")]
+    for inputs, message in cases:
+        with pytest.raises(BumpError, match=message):
+            run_bulk("verilator", v, j, build_dir / "bulk", inputs=inputs)
+    with pytest.raises(BumpError, match=r"'angle' is 16 bits wide, sincos.json i__payload "
+                                        r"field 'angle' is 12 bits"):
+        run_bulk("verilator", v, j, build_dir / "bulk", inputs=good, widths={"angle": 16})
+    assert check_stimulus(json.loads(j.read_text()), good) == n
+
+
+def test_bulk_codec_round_trip():
+    """Fields straddling 32-bit limbs, signed and unsigned, through the stimulus encoding
+    ($fread: big-endian bytes) and the output decoding ($fwrite %u: little-endian limbs)."""
+    fields = {"a": (0, 7, True), "b": (7, 30, False), "c": (37, 63, False), "d": (100, 4, True)}
+    width = 104
+    rng = np.random.default_rng(5)
+    arrays = {"a": rng.integers(-64, 64, 100), "b": rng.integers(0, 1 << 30, 100),
+              "c": rng.integers(0, 1 << 62, 100), "d": rng.integers(-8, 8, 100)}
+    data = encode_words(fields, width, arrays)
+    assert len(data) == 100 * 13
+    words = [int.from_bytes(data[13 * i:13 * i + 13], "big") for i in range(100)]
+    limbs = b"".join(w.to_bytes(16, "little") for w in words)       # the %u layout
+    back = decode_words(fields, width, limbs)
+    for k in fields:
+        assert np.array_equal(back[k], arrays[k]), k
+
+
+# --- make regress: >= 10^7 vectors per unit on Verilator --------------------------------------
+
+REGRESS_VECTORS = 10_000_000
+PER_PATTERN = REGRESS_VECTORS // len(TRAFFIC)          # x 4 patterns = 10^7 through the unit
+
+
+def _regress(unit_v, unit_j, source, build_dir):
+    r = run_bulk("verilator", unit_v, unit_j, build_dir / "bulk", patterns=tuple(TRAFFIC),
+                 source=source, keep=False)
+    assert r.checked
+    assert sum(r.pixels.values()) >= REGRESS_VECTORS
+    return r
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("unit", ["rotation", "illumination"])
+@pytest.mark.parametrize("method", ["exact", "lee"])
+def test_bulk_regress_datapath_1e7_verilator(unit, method, build_dir):
+    """The edge cases, then random pixels, bit-exact against the unit's golden model."""
+    v, j = emit_unit(unit, Config(method=method), build_dir / "rtl")
+    _regress(v, j, {"kind": "datapath", "n": PER_PATTERN, "seed": 1}, build_dir)
+
+
+@pytest.mark.regress
+def test_bulk_regress_palette_1e7_verilator(build_dir):
+    """sN = 200 (out-of-range indices occur) with the eq. 2 blend."""
+    v, j = emit_unit("palette", Config(palette_size=200, palette_blend=True, tag_bits=8),
+                     build_dir / "rtl")
+    _regress(v, j, {"kind": "palette", "n": PER_PATTERN, "seed": 1}, build_dir)
+
+
+@pytest.mark.regress
+def test_bulk_regress_sincos_1e7_verilator(build_dir):
+    v, j = emit_unit("sincos", Config(), build_dir / "rtl")
+    _regress(v, j, {"kind": "sincos", "n": PER_PATTERN, "seed": 1}, build_dir)
+
+
+@pytest.mark.regress
+def test_bulk_regress_pipeline_1e7_verilator(build_dir):
+    """The default pipeline with a stress-case bump map: chunks of stress vectors (every
+    case of sim/golden/stress.py through the fetch unit) and of random payloads over the
+    whole port ranges, under all four traffic patterns."""
+    scene = load_scene_config("default")
+    v, j = emit_pipeline(scene, pipeline_map(scene, 0), None, build_dir, None)
+    _regress(v, j, {"kind": "pipeline", "n": PER_PATTERN, "seed": 1, "map_seed": 0}, build_dir)
