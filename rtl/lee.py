@@ -51,7 +51,8 @@ from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_ma
                      lee_reciprocal_bits, lee_reciprocal_table)
 
 __all__ = ["LeeRotation", "LeeIllumination", "rotated_layout",
-           "below_horizon", "quarter_address", "ratio_index", "prop_address", "phi_quadrant",
+           "below_horizon", "quarter_address", "ratio_index", "asin_address", "prop_address",
+           "phi_quadrant",
            "magnitude", "theta_from_prop"]
 
 
@@ -89,6 +90,13 @@ def ratio_index(p, cfg: Config):
     for e in range(1, lee_atan_ratio_bits(cfg) - m):
         index = _select(p >= (1 << (m + e)), (e << m) + (p >> e), index)
     return index
+
+
+def asin_address(s2, cfg: Config):
+    """Eq. 7's asin ROM address: |s| = |s2| / 2 (s2 = sin X + sin Y, B fractional bits)
+    rounded to lee_asin_index_bits fractional bits."""
+    magnitude_s2 = abs(s2) if isinstance(s2, (Value, ValueCastable)) else np.abs(s2)
+    return round_shift(magnitude_s2, cfg.frac_bits + 1 - lee_asin_index_bits(cfg))
 
 
 def prop_address(product, cfg: Config):
@@ -171,7 +179,7 @@ class LeeRotation(PipeUnit):
                                             ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k))))
         s2 = sx + sy                                                       # adder 4: 2 s (eq. 7)
         asin_rom = _rom(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1)
-        asin = _read(m, pipe, asin_rom, round_shift(abs(s2), b + 1 - lee_asin_index_bits(cfg)))
+        asin = _read(m, pipe, asin_rom, asin_address(s2, cfg))
         s_negative = pipe.register(s2[-1], f"{v}_s_negative")              # stage 3
         y2 = pipe.register(cy - cx, f"{v}_y2")                             # adder 5: 2 sin th sin D
         below = pipe.delay(below_horizon(a.theta, cfg), 3, f"{v}_below")

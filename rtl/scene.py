@@ -338,5 +338,6 @@ def load_scene_config(source, overrides=None, flags=None, defaults=None) -> Scen
                              f" map, but {where} gives {maps[0]}")
         if len(maps) == 1 and isinstance(keys[maps[0]], str):
             resample = keys.get("resample", False) is True
-            keys["texture_size"] = map_size(keys[maps[0]], resample, keys.get("texture_size"))
+            keys["texture_size"] = map_size(keys[maps[0]], resample, keys.get("texture_size"),
+                                            maps[0].split("_")[0])
     return SceneConfig(**keys)

@@ -59,7 +59,8 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
         x0 = specular_base(cfg)
         h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
         # h - x0, or 0 below x0 (word 0 of the table is 0 there)
-        above = pipe.register(Mux(h < x0, 0, h - x0)[:b + 1], "spec_offset")    # stage 2
+        offset = Mux(h < x0, 0, h - x0)[:b + 1] if x0 else h
+        above = pipe.register(offset, "spec_offset")                            # stage 2
         rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8 + f), "specular_table", ports=2)
         j = above[r:]
         # word j + 1; at j = 2**s (h = 1, so the fraction is 0) any word will do: j's low

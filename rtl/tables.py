@@ -102,18 +102,22 @@ def specular_step_bits(cfg: Config) -> int:
     return best
 
 
-def specular_base(cfg: Config) -> int:
-    """x0 with B fractional bits: the table's word 0 stands for N'.H = x0 (0 when t = s)."""
-    s, t = specular_index_bits(cfg), specular_step_bits(cfg)
+def specular_base(cfg: Config, step_bits=None) -> int:
+    """x0 with B fractional bits: the table's word 0 stands for N'.H = x0 (0 when t = s).
+    ``step_bits``: t other than :func:`specular_step_bits` (the candidates of ``bumprtl
+    bench specular``)."""
+    s = specular_index_bits(cfg)
+    t = specular_step_bits(cfg) if step_bits is None else step_bits
     return cfg.one - (1 << (cfg.frac_bits - t + s))
 
 
-def specular_table(cfg: Config) -> np.ndarray:
+def specular_table(cfg: Config, step_bits=None) -> np.ndarray:
     """``cos^n`` table (eq. 2's (N'.H)^n): word j = round(255 (x0 + j 2**-t)**n 2**F),
     j = 0 .. 2**s, with F = SPEC_FRAC_BITS fractional bits; word 0 is 0 and word 2**s (N'.H =
     1) is 255 2**F. rtl/shade.py reads words j and j + 1 and interpolates."""
-    s, t = specular_index_bits(cfg), specular_step_bits(cfg)
-    x = specular_base(cfg) / cfg.one + np.arange((1 << s) + 1, dtype=np.float64) / (1 << t)
+    s = specular_index_bits(cfg)
+    t = specular_step_bits(cfg) if step_bits is None else step_bits
+    x = specular_base(cfg, t) / cfg.one + np.arange((1 << s) + 1, dtype=np.float64) / (1 << t)
     return np.rint(_spec_scale() * x ** cfg.spec_exponent).astype(np.int64)
 
 

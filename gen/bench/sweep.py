@@ -3,10 +3,11 @@
 For each method (``exact`` and ``lee`` over a grid of angle bits and value bits,
 ``palette`` over palette sizes, the Table 1 baselines) one *point* records
 
-* **error** against float64 (``conventional``): max / mean diffuse LSB of the bit-exact
-  model on random valid and adversarial vectors (unquantized inputs), and PSNR / max LSB
-  of the shaded image on the scenes. ``error_lsb`` = the worst max LSB over all of them:
-  the number ``bumprtl recommend --max-error-lsb`` compares;
+* **error** against float64 (``conventional``): max / mean LSB of the bit-exact model's
+  diffuse, specular and colour outputs on random valid vectors and on the adversarial
+  search aimed at each channel (unquantized inputs), and PSNR / max LSB of the shaded
+  image (eq. 2's 8-bit colour) on the scenes. ``error_lsb`` = the worst max LSB of the
+  colour over all of them: the number ``bumprtl recommend --max-error-lsb`` compares;
 * **cost** from the Yosys netlist of the method's per-pixel units (gen/flow/resources.py:
   multipliers, ROM bits, RAM bits, adders) and, with ``--fpga``, ECP5 LUT4/FF/DSP/BRAM and
   Fmax of the unit(s) placed by gen/flow/fpga.py;
@@ -35,12 +36,12 @@ from tqdm import tqdm
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.rtl.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.pipe import ECP5
-from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
-from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
+from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.palette import palette_rgb, quantize_normal_map, world_normal_map
 from bumprtl.sim.scenes import load_scene
-from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
+from bumprtl.sim.scenes.imaging import max_diff, psnr
 from bumprtl.gen.bench.golden import _sim_rate
 from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, pipeline_component,
                                    place_component)
@@ -81,9 +82,12 @@ def _best_time(fn, repeats=3):
 
 
 def error_lsb(point):
-    """Worst max LSB over every error set the point measured (None if it measured none)."""
+    """Worst max LSB of the colour (what a pixel shows) over every error set the point
+    measured: random, adversarial and the scenes (None if it measured none). Points without
+    per-channel data (older sweeps) fall back to their diffuse sets."""
     err = point.get("error") or {}
-    maxima = [err[k]["max"] for k in ("random", "adversarial") if k in err]
+    sets = err.get("channels", {}).get("color", err)
+    maxima = [sets[k]["max"] for k in ("random", "adversarial") if k in sets]
     maxima += [s["max_lsb"] for s in err.get("scenes", {}).values() if "max_lsb" in s]
     return max(maxima) if maxima else None
 
@@ -123,32 +127,41 @@ class Context:
         self.grid, self.work = grid, Path(work)
         self.px = PixelInputs.random(grid.samples, np.random.default_rng(seed))
         self.scenes = {name: load_scene(name, size=grid.size) for name in grid.scenes}
-        self.refs = {name: compose(s, conventional(s.px, Config()).color) for name, s in self.scenes.items()}
+        self.refs = {name: to_8bit(conventional(s.px, Config()).color) for name, s in self.scenes.items()}
         self._adversarial = {}
 
-    def adversarial(self, cfg):
-        """Adversarial vectors depend on the angle grid only: one set per angle_bits."""
-        if cfg.angle_bits not in self._adversarial:
-            self._adversarial[cfg.angle_bits] = adversarial_pixels(cfg)
-        return self._adversarial[cfg.angle_bits]
+    def adversarial(self, cfg, channel="diffuse"):
+        """Adversarial vectors depend on the angle grid (and the exponent) only: one set per
+        angle_bits and channel."""
+        key = (cfg.angle_bits, cfg.spec_exponent, channel)
+        if key not in self._adversarial:
+            self._adversarial[key] = adversarial_pixels(cfg, channel=channel)
+        return self._adversarial[key]
 
 
 def _stats(err):
     return {"max": int(err.max()), "mean": round(float(err.mean()), 5), "n": int(err.size)}
 
 
-def _scene_stats(ctx, name, img):
-    p = psnr(ctx.refs[name], img)
-    return {"psnr_db": None if p == float("inf") else round(p, 2), "max_lsb": max_diff(ctx.refs[name], img)}
+def _scene_stats(ctx, name, intensity8):
+    """PSNR / max of an 8-bit shaded intensity against float64's over the scene's geometry
+    (the measure of sim/golden/accuracy.scene_error)."""
+    m = ctx.scenes[name].mask
+    ref, img = ctx.refs[name][m], np.asarray(intensity8)[m]
+    p = psnr(ref, img)
+    return {"psnr_db": None if p == float("inf") else round(p, 2), "max_lsb": max_diff(ref, img)}
 
 
 def perpixel_error(ctx, cfg):
-    out = {"random": _stats(diffuse_error_lsb(datapath_fixed, ctx.px, cfg)),
-           "adversarial": _stats(diffuse_error_lsb(datapath_fixed, ctx.adversarial(cfg), cfg)),
-           "scenes": {}}
+    """Per channel: random and adversarial (the search aimed at that channel) max / mean;
+    the diffuse sets also at the top level (older readers); the scenes' colour image."""
+    random = term_errors_lsb(datapath_fixed, ctx.px, cfg)
+    channels = {c: {"random": _stats(random[c]),
+                    "adversarial": _stats(term_errors_lsb(datapath_fixed, ctx.adversarial(cfg, c), cfg)[c])}
+                for c in CHANNELS}
+    out = {**channels["diffuse"], "channels": channels, "scenes": {}}
     for name, scene in ctx.scenes.items():
-        color = datapath_fixed(encode_pixels(scene.px, cfg), cfg)["color"] / 255.0
-        out["scenes"][name] = _scene_stats(ctx, name, compose(scene, color))
+        out["scenes"][name] = scene_error(scene, cfg, datapath_fixed)
     return out
 
 
@@ -295,7 +308,7 @@ def palette_point(ctx, size, opts):
             scenes[name] = {"reason": str(e)}
             continue
         rgb, _ = palette_rgb(scene, cfg, qmap=qmap)
-        scenes[name] = _scene_stats(ctx, name, compose(scene, rgb.mean(-1)))
+        scenes[name] = _scene_stats(ctx, name, to_8bit(rgb.mean(-1)))
         speeds.append(scene.mask.size / _best_time(lambda: palette_rgb(scene, cfg, qmap=qmap)))
     if not speeds:
         return _invalid("palette", {"palette_size": size}, "; ".join(s["reason"] for s in scenes.values()))
@@ -363,11 +376,15 @@ def _row(p, front):
     psnrs = [s["psnr_db"] for s in scenes]
     psnr = None if not scenes else ("inf" if all(v is None for v in psnrs) else
                                     f"{min(v for v in psnrs if v is not None):.1f}")
-    rnd, adv = err.get("random"), err.get("adversarial")
     f = cost.get("fpga", {})
     hw = speed.get("hw_pix_s")
-    return (f"| {point_label(p)} | {_fmt(rnd and rnd['max'])} / {_fmt(rnd and rnd['mean'], '{:.3f}')} "
-            f"| {_fmt(adv and adv['max'])} / {_fmt(adv and adv['mean'], '{:.3f}')} "
+    channels = err.get("channels", {})
+
+    def cell(c):
+        sets = channels.get(c, {})
+        rnd, adv = sets.get("random"), sets.get("adversarial")
+        return f"{_fmt(rnd and rnd['max'])} / {_fmt(adv and adv['max'])}"
+    return (f"| {point_label(p)} | {cell('diffuse')} | {cell('specular')} | {cell('color')} "
             f"| {_fmt(psnr)} / {_fmt(max((s['max_lsb'] for s in scenes), default=None))} "
             f"| **{error_lsb(p)}** | {cost['multipliers']} | {cost.get('dividers', 0)} / {cost.get('sqrts', 0)} "
             f"| {cost['adders']} | {cost['table_bits']} "
@@ -385,19 +402,21 @@ def markdown(data, command, plot_paths=()):
              f"{g['frac_bits']}, palette sizes {g['palette_sizes']}; {g['samples']} random valid "
              f"vectors, seed {data['seed']}; adversarial vectors of sim/golden/accuracy.py per "
              f"angle width; scenes {', '.join(g['scenes'])} at {g['size']}x{g['size']}).", "",
-             "Errors are 8-bit LSB against float64 `conventional` on unquantized inputs: diffuse "
-             "max / mean on the vectors, colour-image PSNR (worst scene, dB) / max LSB on the "
-             "scenes. **error** = the worst max over all sets (what `bumprtl recommend` uses). "
+             "Errors are 8-bit LSB against float64 `conventional` on unquantized inputs: per "
+             "output channel, max on the random vectors / max on the adversarial search aimed at "
+             "that channel; eq. 2's colour image on the scenes, PSNR (worst scene, dB) / max LSB "
+             "over the pixels the geometry covers. **error** = the worst colour max over all "
+             "sets (what `bumprtl recommend` ranks on). "
              "Cost: Yosys coarse netlist of the per-pixel units (rotation + illumination, or the "
              "palette LUT; gen/flow/resources.py); the bump map itself is not in it: `map bits` per texel is "
              "2 x angle bits for N' angles, 3 x (frac bits + 2) for Peercy's and Ernst's Cartesian N', "
              "log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
              f"of 3; float64 `conventional` ran at {data['float64_conventional_mpix_s']:.2f} Mpix/s "
              "on the same vectors). `pareto` = on the front of error against ROM+RAM bits.", "",
-             "| point | random max / mean | adversarial max / mean | scenes PSNR / max | error "
-             "| mult | div / sqrt | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM | Fmax MHz "
-             "| golden Mpix/s | sim pix/s | hw Mpix/s | pareto |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| point | diffuse rnd / adv | specular rnd / adv | colour rnd / adv | scenes PSNR / max "
+             "| error | mult | div / sqrt | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM "
+             "| Fmax MHz | golden Mpix/s | sim pix/s | hw Mpix/s | pareto |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [_row(p, front) for p in pts]
     other = [p for p in data["points"] if p["status"] != "ok"]
     if other:

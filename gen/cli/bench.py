@@ -4,7 +4,7 @@ Each kind lives in its own module with ``add_parser(subparsers)``; register it i
 """
 
 from bumprtl.gen.bench import (accuracy, float64, golden, lee_widths, palette, rtl_sim, skip,
-                                stress, sweep)
+                                specular, stress, sweep)
 
 # kind -> module of gen/bench/ providing add_parser(subparsers); each benchmark module adds
 # its own line here.
@@ -12,6 +12,7 @@ BENCHES = {
     "float64": float64,
     "golden": golden,
     "accuracy": accuracy,
+    "specular": specular,
     "lee-widths": lee_widths,
     "palette": palette,
     "sweep": sweep,

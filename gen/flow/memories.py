@@ -17,6 +17,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from amaranth.hdl import Fragment
 
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.config import BumpError
@@ -74,11 +75,17 @@ def check_fits(roms, device, what):
     return map_blocks + other, have
 
 
+def unit_memories(dut):
+    """Every memory of an elaborated unit (``name`` -> depth, width, bits): the records its
+    StallPipes keep while it elaborates (rtl/pipe.py)."""
+    Fragment.get(dut, None)
+    return dict(sorted(dut.memories.items()))
+
+
 def check_scene_fits(scene, device, unit="pipeline"):
     """:func:`check_fits` for the memories of ``scene``'s pipeline (or fetch unit)."""
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
-    dut = build(scene)
-    return check_fits(UNITS[unit].sidecar(scene, dut)["roms"], device, scene.picture or scene.name)
+    return check_fits(unit_memories(build(scene)), device, scene.picture or scene.name)
 
 
 def hex_text(words, width):
@@ -185,11 +192,14 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
     init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
     spec = UNITS[unit]
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
+    fit = None
+    if device is not None:                      # before building a large map's contents
+        fit = check_scene_fits(scene, device, unit)
     dut = build(scene, init=init("map"), texture=init("texture"))
     sidecar = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
-    if device is not None:
-        blocks, have = check_fits(sidecar["roms"], device, scene.picture or scene.name)
-        sidecar["block_ram"] = {"device": device, "dp16kd_needed": blocks, "dp16kd_available": have,
+    if fit is not None:
+        sidecar["block_ram"] = {"device": device, "dp16kd_needed": fit[0],
+                                "dp16kd_available": fit[1],
                                 "note": "maps tiled into DP16KD shapes, one block per other table"}
     sidecar["memory_images"] = {n: {k: v for k, v in img.items() if k != "words"}
                                 for n, img in images.items()}

@@ -1,5 +1,6 @@
 """``bumprtl recommend --max-error-lsb E [--device D]``: the cheapest configuration whose
-measured error meets the bound, from the sweep data (``bumprtl bench sweep``), with the
+measured colour error (eq. 2's output, what a pixel shows; gen/bench/sweep.error_lsb) meets
+the bound, from the sweep data (``bumprtl bench sweep``), with the
 evidence: its error sets, its cost, its speed, the runners-up and the command that made
 the numbers. Nothing is re-measured or estimated here. Without ``--sweep`` and without a local
 sweep (``build/bench/sweep.json``), it reads the sweep that ships in ``docs/data/sweep.json``
@@ -79,10 +80,12 @@ def recommend(data, max_error_lsb, device=None):
 
 def _evidence(p):
     err, cost, speed = p["error"], p["cost"], p["speed"]
-    lines = [f"  error (8-bit LSB vs float64): worst {error_lsb(p)}"]
-    for k in ("random", "adversarial"):
-        if k in err:
-            lines.append(f"    {k}: max {err[k]['max']}, mean {err[k]['mean']} over {err[k]['n']} vectors")
+    lines = [f"  error (8-bit LSB vs float64): worst colour {error_lsb(p)}"]
+    for channel, sets in (err.get("channels") or {"diffuse": err}).items():
+        for k in ("random", "adversarial"):
+            if k in sets:
+                lines.append(f"    {channel} {k}: max {sets[k]['max']}, mean {sets[k]['mean']} "
+                             f"over {sets[k]['n']} vectors")
     for name, s in err.get("scenes", {}).items():
         if "max_lsb" in s:
             lines.append(f"    scene {name}: PSNR {s['psnr_db']} dB, max {s['max_lsb']}")
@@ -112,7 +115,7 @@ def run(args):
     best, meeting = recommend(data, args.max_error_lsb, args.device)
     order = ("DSP, block RAM, LUT4 on " + args.device if args.device else
              "multipliers + dividers + square roots, then ROM+RAM bits, then adders")
-    print(f"cheapest configuration with worst measured error <= {args.max_error_lsb} LSB "
+    print(f"cheapest configuration with worst measured colour error <= {args.max_error_lsb} LSB "
           f"(cheapest by {order}):\n")
     print(f"  {point_label(best)}: {_flags(best)}")
     print("\n".join(_evidence(best)))
@@ -127,9 +130,9 @@ def run(args):
 def add_parser(sub):
     p = sub.add_parser("recommend", help="cheapest configuration meeting an error bound (from the sweep)",
                        description="Reads the `bumprtl bench sweep` JSON and prints the cheapest "
-                                   "configuration whose worst measured error is within the bound, "
+                                   "configuration whose worst measured colour error is within the bound, "
                                    "with the evidence. Exits 2 when none meets it.")
-    p.add_argument("--max-error-lsb", type=float, required=True, help="bound on the worst error, 8-bit LSB")
+    p.add_argument("--max-error-lsb", type=float, required=True, help="bound on the worst colour error, 8-bit LSB")
     p.add_argument("--device", default=None, help="rank by ECP5 cost on this device (needs sweep --fpga)")
     p.add_argument("--sweep", type=Path, default=None,
                    help=f"sweep JSON (default: {LOCAL_SWEEP}, else the sweep shipped in "

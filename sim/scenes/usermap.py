@@ -182,13 +182,36 @@ def _sized(path, arr, size, resample):
     return _resize(arr, size)
 
 
-def map_size(path, resample=False, texture_size=None):
+def _check_png(path, kind, depth, ctype):
+    """The channel count and bit depth a ``kind`` map's PNG must have."""
+    channels = _PNG_CHANNELS[ctype]
+    if kind == "height":
+        if channels != 1 or ctype == 3:
+            hint = " (an RGB normal map goes to --normal-map)" if ctype in (2, 6) else ""
+            raise MapError(f"{path}: {_PNG_KIND[ctype]} PNG with {channels} channel(s); a "
+                           f"height map is a 1-channel greyscale PNG{hint}")
+        if depth not in (8, 16):
+            raise MapError(f"{path}: {depth}-bit greyscale PNG; a height map is 8- or 16-bit")
+    else:
+        if ctype not in (2, 6):
+            hint = " (a greyscale height map goes to --height-map)" if ctype in (0, 4) else ""
+            raise MapError(f"{path}: {_PNG_KIND[ctype]} PNG with {channels} channel(s); a "
+                           f"normal map is an RGB PNG (3 channels){hint}")
+        if depth != 8:
+            raise MapError(f"{path}: {depth}-bit RGB PNG; a normal map must be 8 bits per "
+                           f"channel (save it as 8-bit RGB)")
+
+
+def map_size(path, resample=False, texture_size=None, kind=None):
     """The side the map at ``path`` will have (reading only the header when it can):
-    its own, ``texture_size`` when given, or the nearest allowed size with ``resample``."""
+    its own, ``texture_size`` when given, or the nearest allowed size with ``resample``.
+    With ``kind`` (height or normal) a PNG's channels and bit depth are checked too."""
     suffix = _suffix(path)
     raw = _read_bytes(path)
     if suffix == ".png":
-        w, h, _depth, _ctype = _png_header(path, raw)
+        w, h, depth, ctype = _png_header(path, raw)
+        if kind is not None:
+            _check_png(path, kind, depth, ctype)
     else:
         shape = _load_npy(path, raw).shape
         if len(shape) < 2:
@@ -218,12 +241,7 @@ def read_height(path, size=None, resample=False):
             raise MapError(f"{path}: a height map must be a 2-D array, got shape {h.shape}")
     else:
         w, hh, depth, ctype = _png_header(path, raw)
-        if _PNG_CHANNELS[ctype] != 1 or ctype == 3:
-            hint = " (an RGB normal map goes to --normal-map)" if ctype in (2, 6) else ""
-            raise MapError(f"{path}: {_PNG_KIND[ctype]} PNG with {_PNG_CHANNELS[ctype]} "
-                           f"channel(s); a height map is a 1-channel greyscale PNG{hint}")
-        if depth not in (8, 16):
-            raise MapError(f"{path}: {depth}-bit greyscale PNG; a height map is 8- or 16-bit")
+        _check_png(path, "height", depth, ctype)
         img = _decode_png(path, raw)
         h = np.asarray(img, dtype=np.float64) / (255.0 if depth == 8 else 65535.0)
         if h.shape != (hh, w):
@@ -253,14 +271,8 @@ def read_normals(path, convention="opengl", size=None, resample=False):
         right, up, out = img[..., 0], img[..., 1], img[..., 2]
     else:
         w, hh, depth, ctype = _png_header(path, raw)
+        _check_png(path, "normal", depth, ctype)
         channels = _PNG_CHANNELS[ctype]
-        if ctype not in (2, 6):
-            hint = " (a greyscale height map goes to --height-map)" if ctype in (0, 4) else ""
-            raise MapError(f"{path}: {_PNG_KIND[ctype]} PNG with {channels} channel(s); a "
-                           f"normal map is an RGB PNG (3 channels){hint}")
-        if depth != 8:
-            raise MapError(f"{path}: {depth}-bit RGB PNG; a normal map must be 8 bits per "
-                           f"channel (save it as 8-bit RGB)")
         rgb = np.asarray(_decode_png(path, raw), dtype=np.float64)
         if rgb.shape != (hh, w, channels):
             raise MapError(f"{path}: decoded {rgb.shape} texels, the header says {hh}x{w}x{channels}")

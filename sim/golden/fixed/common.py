@@ -36,13 +36,15 @@ def quantize_pixels(px: PixelInputs, cfg: Config):
             for f in fields(px)}
 
 
-def specular_fine_fixed(h, cfg: Config):
+def specular_fine_fixed(h, cfg: Config, step_bits=None):
     """255 h**n with SPEC_FRAC_BITS fractional bits for h = clamp(N'.H) (B fractional bits):
     the cos^n table (rtl/tables.py) read at words j, j + 1 of h - x0 = j 2**r + f and
-    interpolated, T[j] + floor((T[j+1] - T[j]) f / 2**r); 0 below x0 (word 0)."""
-    table = specular_table(cfg)
-    s_bits, r = specular_index_bits(cfg), cfg.frac_bits - specular_step_bits(cfg)
-    x0 = specular_base(cfg)
+    interpolated, T[j] + floor((T[j+1] - T[j]) f / 2**r); 0 below x0 (word 0).
+    ``step_bits``: another table step than the RTL's (``bumprtl bench specular``)."""
+    t = specular_step_bits(cfg) if step_bits is None else step_bits
+    table = specular_table(cfg, t)
+    s_bits, r = specular_index_bits(cfg), cfg.frac_bits - t
+    x0 = specular_base(cfg, t)
     above = np.where(h < x0, 0, h - x0)
     j = above >> r
     t0 = table[j]

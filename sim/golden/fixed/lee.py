@@ -22,8 +22,8 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.lee import (below_horizon, magnitude, phi_quadrant, prop_address, quarter_address,
-                        ratio_index, theta_from_prop)
+from bumprtl.rtl.lee import (asin_address, below_horizon, magnitude, phi_quadrant, prop_address,
+                        quarter_address, ratio_index, theta_from_prop)
 from bumprtl.rtl.tables import (cos_lookup, lee_asin_index_bits, lee_asin_table, lee_atan_table,
                            lee_prop_table, lee_reciprocal_table, sin_lookup)
 from bumprtl.sim.golden.fixed.common import (check_channel, polar_illumination_fixed,
@@ -47,7 +47,7 @@ def rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg: Config):
     x, y = a_theta + d, a_theta - d                                    # eq. 6 (erratum 1)
     s2 = sin_lookup(cfg, x).astype(np.int64) + sin_lookup(cfg, y)
     y2 = cos_lookup(cfg, y).astype(np.int64) - cos_lookup(cfg, x)
-    asin = lee_asin_table(cfg)[round_shift(np.abs(s2), b + 1 - lee_asin_index_bits(cfg))]
+    asin = lee_asin_table(cfg)[asin_address(s2, cfg)]
     theta_x = np.where(s2 < 0, -asin, asin)                            # eq. 7
     theta_x = np.where(below_horizon(a_theta, cfg), (1 << (k + 1)) - theta_x, theta_x)  # erratum 6
     z = (theta_x - n_theta) & (cfg.full_circle - 1)                    # Z, read as [-180, 180)

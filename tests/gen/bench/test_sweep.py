@@ -11,7 +11,7 @@ from bumprtl.gen.bench import skip as bench_skip
 from bumprtl.gen.bench import sweep as bench_sweep
 from bumprtl.gen.bench.sweep import Grid, error_lsb, pareto_front, sweep, write_section
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.accuracy import diffuse_error_lsb
+from bumprtl.sim.golden.accuracy import diffuse_error_lsb, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.rtl.methods import BASELINES, datapath_fixed
 from bumprtl.rtl.scene import load_scene_config
@@ -47,6 +47,12 @@ def test_error_lsb_is_worst_of_sets():
                    "scenes": {"a": {"max_lsb": 7}, "b": {"reason": "skipped"}}}}
     assert error_lsb(p) == 7
     assert error_lsb({"error": {}}) is None
+    # with per-channel sets the colour's count, not the diffuse's
+    p = {"error": {"random": {"max": 9}, "channels": {"diffuse": {"random": {"max": 9}},
+                                                      "color": {"random": {"max": 1},
+                                                                "adversarial": {"max": 3}}},
+                   "scenes": {"a": {"max_lsb": 2}}}}
+    assert error_lsb(p) == 3
 
 
 def test_write_section_keeps_other_sections(tmp_path):
@@ -77,7 +83,9 @@ def test_tiny_sweep_points(tiny):
     cfg = Config(angle_bits=6, frac_bits=5)
     err = diffuse_error_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)
     assert exact6["error"]["random"]["max"] == err.max()
-    assert error_lsb(exact6) >= err.max()
+    colour = term_errors_lsb(datapath_fixed, PixelInputs.random(300, np.random.default_rng(4)), cfg)["color"]
+    assert exact6["error"]["channels"]["color"]["random"]["max"] == colour.max()
+    assert error_lsb(exact6) >= colour.max()            # recommend ranks on the colour
     assert exact6["cost"]["multipliers"] > 0 and exact6["cost"]["table_bits"] > 0
     assert exact6["speed"]["golden_mpix_s"] > 0
 

@@ -9,8 +9,8 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.gen.flow import resources
-from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_verilog,
-                                        multiplier_pairs)
+from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_netlist,
+                                        count_verilog, multiplier_pairs)
 from bumprtl.rtl.config import BumpError
 
 
@@ -155,3 +155,33 @@ def test_yosys_killed_by_a_signal_is_retried_once(monkeypatch, tmp_path):
     with pytest.raises(SynthesisError, match="status -7"):
         resources.run_yosys("help", "y.log", tmp_path)
     assert sum("-p" in r for r in runs) == 2 and all("-p" in r for r in runs)   # warmed once
+
+
+def _macc(products, addends=(), y_width=16):
+    """A hand-written $macc_v2 cell: ``products`` = [(A bits, B bits)], ``addends`` = [C bits]
+    (a bit is a net number or a constant "0"/"1", LSB first)."""
+    pack = lambda widths: sum(w << (16 * i) for i, w in enumerate(widths))
+    return {"type": "$macc_v2", "port_directions": {"Y": "output"},
+            "parameters": {"NPRODUCTS": len(products), "NADDENDS": len(addends),
+                           "A_WIDTHS": pack([len(a) for a, _ in products]),
+                           "B_WIDTHS": pack([len(b) for _, b in products]),
+                           "C_WIDTHS": pack([len(c) for c in addends]), "Y_WIDTH": y_width},
+            "connections": {"A": [x for a, _ in products for x in a],
+                            "B": [x for _, b in products for x in b],
+                            "C": [x for c in addends for x in c], "Y": list(range(100, 100 + y_width))}}
+
+
+def test_macc_terms_classified_by_their_operands():
+    """The counting rules on a netlist written by hand (Yosys usually turns a product by a
+    power of two into a shift before the counter sees it): a signal x signal product is a
+    multiplier, x 3 a constant multiplier, x 4 a shift (a signal term, no multiplier), x 0
+    nothing; T signal terms are T - 1 adders, a constant addend one constant adder."""
+    sig = lambda n, w: list(range(n, n + w))
+    const = lambda v, w: ["1" if v >> i & 1 else "0" for i in range(w)]
+    cell = _macc([(sig(2, 6), sig(10, 5)), (sig(20, 6), const(3, 3)), (sig(30, 6), const(4, 3)),
+                  (sig(40, 6), const(0, 3))], addends=[sig(50, 8), const(5, 4)])
+    netlist = {"modules": {"top": {"ports": {"y": {"direction": "output", "bits": sig(100, 16)}},
+                                   "cells": {"m": cell}}}}
+    counts = count_netlist(netlist, "top")
+    assert counts.multipliers == ["6x5"] and counts.const_multipliers == [6]
+    assert counts.adders == [16] * 3 and counts.const_adders == [16]    # 4 signal terms
