@@ -53,7 +53,7 @@ def _failure(cfg, channel, kind, row, sets):
     px = sets[row["sets"][kind]]
     i = row[kind]["worst"]
     one = px.subset(slice(i, i + 1))
-    angles = ", ".join(f"{f.name}={float(getattr(one, f.name)[0]):.9f}" for f in fields(one))
+    angles = ", ".join(f"{f.name}={float(getattr(one, f.name)[0])!r}" for f in fields(one))
     got = datapath_fixed(encode_pixels(one, cfg), cfg)[channel][0]
     want = to_8bit(getattr(conventional(one, cfg), channel))[0]
     return (f"FAIL {cfg.method} angle_bits={cfg.angle_bits} frac_bits={cfg.frac_bits} "

@@ -12,6 +12,7 @@ model. Rates exclude the build and the emission: ``run`` is the whole simulator 
 machine may be shared. The section goes into docs/bench.md.
 """
 
+import json
 import os
 import time
 from pathlib import Path
@@ -100,7 +101,7 @@ def markdown(rows, command, scene, size):
         bulk, per = get.get(("bulk", "verilog")), get.get(("per-cycle", "cocotb"))
         if bulk and per:
             lines.append(f"- {sim}: bulk / per-cycle = {per['run_s'] / bulk['run_s']:.1f}x "
-                         f"(whole runs), {per['run_s'] / bulk['stream_s']:.0f}x (bulk streaming "
+                         f"(whole runs), {per['run_s'] / bulk['stream_s']:.1f}x (bulk streaming "
                          "against the per-cycle run)")
         other = get.get(("bulk", "cocotb"))
         if bulk and other:
@@ -116,6 +117,7 @@ def run(args):
         (f" --simulators {' '.join(sims)}" if list(sims) != list(SIMULATORS) else "")
     print(command, flush=True)
     rows = rtl_sim_rows(args.scene, args.size, sims, args.work)
+    (Path(args.work) / "rows.json").write_text(json.dumps(rows, indent=1) + "\n")
     text = markdown(rows, command, args.scene, args.size)
     if args.docs:
         write_section(args.docs, "rtl-sim", text)

@@ -80,11 +80,11 @@ def map_overrides(args):
 _SCENE_KEYS = {f.name for f in dataclasses.fields(SceneConfig)}
 
 
-def scene_from_args(args, source, extra=None, defaults=None):
+def scene_from_args(args, source, extra=None, defaults=None, flags=None):
     """The SceneConfig of ``source`` (a built-in name or a TOML file) with the Config and
     map flags that were given (and ``extra`` keys; ``defaults`` where nothing sets a key);
     a flag that contradicts a key the source sets is an error naming both, never a silent
-    override."""
+    override. ``flags``: the flag that set each ``extra`` key, for messages."""
     given = {f.name: getattr(args, f.name) for f in dataclasses.fields(Config)
              if getattr(args, f.name, None) is not None}
     for key in given:
@@ -92,4 +92,4 @@ def scene_from_args(args, source, extra=None, defaults=None):
             raise BumpError(f"{flag_name(key)} does not apply to a scene: the scene decides it "
                             f"({source!r}); its keys are in rtl/scene.py")
     return load_scene_config(source, {**given, **map_overrides(args), **(extra or {})},
-                             defaults=defaults)
+                             flags=flags, defaults=defaults)

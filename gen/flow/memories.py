@@ -161,15 +161,23 @@ _FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "heig
               "palette_size")
 
 
+_PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",
+                  "resample")
+
+
 def scene_command(unit, scene, load="initial"):
-    """The ``bumprtl emit`` line that reproduces ``unit`` of ``scene``: ``--scene NAME`` plus
-    a flag for every key with a flag that differs from the named scene's."""
+    """The ``bumprtl emit`` line that reproduces ``unit``'s Verilog for ``scene``: ``--scene
+    NAME`` plus a flag for every key with a flag that differs from the named scene's. With
+    ``load = "port"`` the Verilog holds no map, so the keys that only shape the map's
+    contents are left out: every map of one size gives the same Verilog."""
     parts = ["bumprtl", "emit", unit, "--scene", scene.name]
     try:
         base = load_scene_config(scene.name)
     except BumpError:                                  # a scene built in code: no source
         base = None
     for key in _FLAG_KEYS if base is not None else ():
+        if load == "port" and key in _PICTURE_FLAGS:
+            continue
         value = getattr(scene, key)
         if value == getattr(base, key) or value is None:
             continue

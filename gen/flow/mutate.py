@@ -326,7 +326,8 @@ def markdown(outcomes, command, wall_s):
         result = o.status if o.status != "equivalent" else f"equivalent: {m.equivalent}"
         if o.status in ("survived", "error"):
             result += f" ({o.detail})"
-        lines.append(f"| `{m.id}` | {m.models} | {guards} | {result} | {o.seconds:.1f} |")
+        cell = lambda text: text.replace("|", "\\|")
+        lines.append(f"| `{m.id}` | {cell(m.models)} | {guards} | {cell(result)} | {o.seconds:.1f} |")
     return "\n".join(lines)
 
 
@@ -399,6 +400,8 @@ def main(argv=None):
     p.add_argument("--logs", type=Path, default=Path("build/mutate/logs"),
                    help="pytest output of each mutant's run (default: build/mutate/logs)")
     args = p.parse_args(argv)
+    # SIGTERM (a killed make) unwinds like Ctrl-C, so the mutated file is restored.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     t0 = time.perf_counter()
     root, env = ROOT, None
     try:

@@ -151,7 +151,8 @@ def render_scene(args, rtl=False) -> SceneConfig:
             raise BumpError(f"--method {args.render_method} with --rtl: a scene pipeline is built for "
                             f"exact, lee_corrected (lee) or palette")
     defaults = None if rtl else {"texture_size": args.size}
-    return scene_from_args(args, source or "default", extra, defaults)
+    return scene_from_args(args, source or "default", extra, defaults,
+                           {"image": "--scene", "method": "--method", "shading": "--method"})
 
 
 def run(args):

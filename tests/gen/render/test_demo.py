@@ -6,20 +6,31 @@ import sys
 import numpy as np
 from PIL import Image
 
-from bumprtl.gen.render.demo import DEMO_SCENES, demo_methods, rtl_mismatch
+from bumprtl.gen.render.demo import DEMO_SCENES, demo_map_size, demo_methods, rtl_mismatch
+from bumprtl.gen.render.images import FIXED_METHODS, float_image
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.heightfields import brick_lines
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 
 CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
 
 
 def _report_rows(text):
-    """(scene, method) -> (psnr, max diff, seconds, file) from report.txt's table."""
+    """(scene, method) -> (psnr, max diff, fixed psnr, fixed max, seconds, file) from
+    report.txt's table ('-' fixed columns: None)."""
     rows = {}
     for line in text.splitlines():
         parts = line.split()
-        if len(parts) == 7 and parts[0] in DEMO_SCENES:
-            rows[parts[0], parts[1]] = (float(parts[2]), int(parts[3]), float(parts[4]), parts[6])
+        if len(parts) == 9 and parts[0] in DEMO_SCENES:
+            fixed = (None, None) if parts[4] == "-" else (float(parts[4]), int(parts[5]))
+            rows[parts[0], parts[1]] = (float(parts[2]), int(parts[3]), *fixed, float(parts[6]),
+                                        parts[8])
     return rows
+
+
+def _psnr(ref, img):
+    mse = np.mean((ref - img) ** 2)
+    return float("inf") if mse == 0 else 10 * np.log10(255 ** 2 / mse)
 
 
 def test_demo_writes_pngs_and_a_report_that_matches_them(tmp_path):
@@ -32,16 +43,20 @@ def test_demo_writes_pngs_and_a_report_that_matches_them(tmp_path):
     methods = demo_methods()
     assert methods[0] == "conventional" and set(FLOAT_MODELS) <= set(methods)
     assert set(rows) == {(s, m) for s in DEMO_SCENES for m in methods}
-    for (scene, method), (db, diff, seconds, name) in rows.items():
+    for (scene, method), (db, diff, fdb, fdiff, seconds, name) in rows.items():
         ref = np.asarray(Image.open(tmp_path / f"{scene}_conventional.png"), float)
         img = np.asarray(Image.open(tmp_path / name), float)
         assert img.shape == (32, 32, 3) and seconds >= 0
-        mse = np.mean((ref - img) ** 2)                 # PSNR recomputed from the PNGs
-        assert diff == np.abs(ref - img).max()
-        assert db == float("inf") if mse == 0 else abs(db - 10 * np.log10(255 ** 2 / mse)) < 0.006
+        assert diff == np.abs(ref - img).max()           # recomputed from the PNGs
+        assert db == _psnr(ref, img) or abs(db - _psnr(ref, img)) < 0.006
         if method != "conventional":
             assert (tmp_path / f"{scene}_{method}_compare.png").exists()
+        assert (fdb is None) == (method not in FIXED_METHODS), method
+        if fdb is not None:                              # the fixed-point render's PNG
+            fixed = np.asarray(Image.open(tmp_path / f"{scene}_{method}_fixed.png"), float)
+            assert fdiff == np.abs(ref - fixed).max() and abs(fdb - _psnr(ref, fixed)) < 0.006
     assert rows["bricks", "exact"][:2] == (float("inf"), 0)
+    assert rows["bricks", "exact"][3] <= 2 and rows["globe", "exact"][3] <= 2
     _check_rtl_section(tmp_path, (tmp_path / "report.txt").read_text())
 
 
@@ -56,7 +71,24 @@ def _check_rtl_section(out, report):
     pixels, cycles, cpp = int(m[1]), int(m[2]), float(m[3])
     assert pixels == 32 * 32 and pixels < cycles <= pixels + meta["latency"] + 1
     assert abs(cpp - cycles / pixels) < 1e-4
-    assert "identical bytes" in report and "multipliers" in report and "RAM bits 98304" in report
+    t = demo_map_size(32)                                          # the largest that fits: 32
+    lines = [int(r) for r in brick_lines(t)[0]]                    # narrow map: on texel rows
+    green = rtl[..., 1].astype(float).mean(axis=1)                 # mortar is grey: more green
+    assert min(green[lines]) > max(np.delete(green, lines)) + 10   # rtl.png shows the courses
+    assert t == 32 and f"map {t}x{t} x 24 bits" in report and f"RAM bits {t * t * 24}" in report
+    assert "identical bytes" in report and "multipliers" in report
+    assert (out / "pipeline" / "pipeline_map.hex").read_text().count("\n") == t * t
+    ref, _ = float_image(load_scene_config("default").replace(texture_size=t), "conventional", 32,
+                         progress=False)
+    m = re.search(r"rtl.png vs float64 conventional \(same scene and map\): PSNR ([\d.]+) dB, "
+                  r"max difference (\d+)", report)
+    assert abs(float(m[1]) - _psnr(ref.astype(float), rtl.astype(float))) < 0.006
+    assert int(m[2]) == np.abs(ref.astype(int) - rtl.astype(int)).max() <= 2
+
+
+def test_demo_map_is_the_largest_that_fits_the_device():
+    assert demo_map_size(512) == 256 and demo_map_size(64) == 64
+    assert demo_map_size(512, device="LFE5U-25F") == 128
 
 
 def test_rtl_mismatch_names_the_difference():

@@ -159,7 +159,7 @@ def test_flags_that_contradict_the_toml_name_both(tmp_path, capsys):
     toml.write_text('image = "wood"\ntexture_size = 32\nangle_bits = 12\n')
     out = str(tmp_path / "x.png")
     _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--scene", "bricks",
-                              "--out", out], "--image bricks", "image = 'wood'", "wood.toml")
+                              "--out", out], "--scene bricks", "image = 'wood'", "wood.toml")
     _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--texture-size", "64",
                               "--out", out], "--texture-size 64", "texture_size = 32")
     _one_line_exit_2(capsys, ["render", "--rtl", "--pipeline", str(toml), "--height-map", "x.png",

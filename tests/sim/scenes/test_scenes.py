@@ -7,8 +7,10 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.exact import exact
-from bumprtl.sim.scenes import SCENES, light_direction, load_scene
-from bumprtl.sim.scenes.heightfields import height_to_normals, smooth_noise
+from bumprtl.sim.scenes import (REFERENCE_TEXTURE_SIZE, SCENES, bump_strength, light_direction,
+                                load_scene)
+from bumprtl.sim.scenes.heightfields import (BRICK_BEVEL, HEIGHTFIELDS, brick_lines,
+                                             height_to_normals, smooth_noise)
 from bumprtl.sim.scenes.imaging import compose, psnr
 
 
@@ -196,3 +198,100 @@ def test_bad_height_map_dtype_and_strength():
         height_to_normals(np.full((4, 4), "a"))
     with pytest.raises(BumpError, match="strength"):
         height_to_normals(np.zeros((4, 4)), strength=-1.0)
+
+
+# --- Every procedural scene reads as itself at every allowed map size ----------------------
+# Pictures of the scene on a T x T map, rendered at S = min(T, 256) pixels (one texel per
+# pixel up to 256), float64 conventional. 2048 and 4096 (a 4096^2 map takes a minute to
+# build on the 2-core machine) run in `make regress`.
+MAP_SIZES = [16, 32, 64, 128, 256, 512, 1024,
+             pytest.param(2048, marks=pytest.mark.regress), pytest.param(4096, marks=pytest.mark.regress)]
+
+
+def _shade(name, t, azimuth=30.0):
+    s = load_scene(name, size=min(t, 256), texture_size=t, light_azimuth=azimuth, light_elevation=45)
+    return s, conventional(s.px).color
+
+
+def _line_margin(profiles, size, half):
+    """(smallest feature at a line, largest feature away from every line) of 1-D picture
+    profiles: feature = |profile - median|; 'at' = within ``half`` pixels (wrapping)."""
+    at_line, away = np.inf, 0.0
+    y = np.arange(size) + 0.5
+    for p, lines in profiles:
+        d = np.abs(p - np.median(p))
+        dist = np.array([np.abs((y - c + size / 2) % size - size / 2) for c in lines])
+        at_line = min(at_line, *(d[di <= half].max() for di in dist))
+        far = dist.min(0) > half
+        away = max(away, d[far].max() if far.any() else 0.0)
+    return at_line, away
+
+
+@pytest.mark.parametrize("t", MAP_SIZES)
+def test_bricks_show_mortar_lines_where_the_bricks_are(t):
+    """The picture's strongest row features sit on the 8 course lines and, inside each
+    course, its strongest column features on the 4 joints of that course (running bond:
+    odd courses shifted half a brick), at every map size: in the mortar colour and in the
+    relief (light from the top for the courses, from the right for the joints). Only at
+    T = 16, where a course is 2 texels, the courses show in colour alone: the central
+    difference of a 2-periodic height profile is zero."""
+    size = min(t, 256)
+    k = t / size                                   # texels per pixel
+    rows, joints = brick_lines(t)
+    ramp = max(BRICK_BEVEL * t / 16, 1.0)           # the bevel, texels
+    half = max(1.5, (ramp + 2) / k)                 # a line's reach in pixels
+    to_px = lambda c: (c + 0.5) / k                 # texel coordinate -> pixel coordinate
+    s, top = _shade("bricks", t, azimuth=90)
+    colour = compose(s, top)[..., 1].astype(float)  # mortar is grey: far more green than brick
+    at, away = _line_margin([(colour.mean(1), [to_px(r) for r in rows])], size, half)
+    assert at > 20 and at > 2 * away, ("colour rows", at, away)
+    if t > 16:
+        at, away = _line_margin([(top.mean(1), [to_px(r) for r in rows])], size, half)
+        assert at > 0.2 and at > 2 * away, ("relief rows", at, away)
+    _, side = _shade("bricks", t, azimuth=0)
+    centre = (np.arange(size) + 0.5) * k - 0.5      # texel coordinate of each pixel row
+    profiles = []
+    for course, js in enumerate(joints):
+        inside = (centre >= rows[course] + ramp - 1e-9) & (centre <= rows[course] + t / 8 - ramp + 1e-9)
+        profiles.append((side[inside].mean(0), [to_px(j) for j in js]))
+    at, away = _line_margin(profiles, size, half)
+    assert at > 0.2 and at > 2 * away, ("relief joints", at, away)
+
+
+def _box(img, size):
+    k = img.shape[0] // size
+    return img.reshape(size, k, size, k).mean(axis=(1, 3))
+
+
+@pytest.mark.parametrize("t", MAP_SIZES)
+def test_bumps_wood_and_text_read_as_themselves(t):
+    """bumps: the picture's strongest frequency is the egg-crate's 6 x 6 periods per map;
+    wood: the picture correlates with the 512^2 map's picture seen at the same resolution
+    (box-filtered; r >= 0.45, where aliased rings at 16^2 gave 0.26); text: >= 90 % of the
+    picture's shading lies on the letters of the 512^2 map (dilated by a pixel)."""
+    size = min(t, 256)
+    _, img = _shade("bumps", t)
+    f = np.abs(np.fft.fft2(img - img.mean()))
+    ky, kx = np.unravel_index(np.argmax(f), f.shape)
+    assert {abs((ky + size // 2) % size - size // 2), abs((kx + size // 2) % size - size // 2)} == {6}
+    _, img = _shade("wood", t)
+    ref = _box(_shade("wood", 512)[1], size)
+    assert np.corrcoef(img.ravel(), ref.ravel())[0, 1] >= 0.45
+    _, img = _shade("text", t)
+    letters = _box((HEIGHTFIELDS["text"](512) < 0.98).astype(float), size) > 0
+    near = letters.copy()
+    for axis in (0, 1):
+        for step in (1, -1):
+            near |= np.roll(letters, step, axis)
+    d = np.abs(img - np.median(img))
+    assert d[near].sum() >= 0.9 * d.sum()
+
+
+@pytest.mark.parametrize("t", [1024, pytest.param(4096, marks=pytest.mark.regress)])
+def test_larger_maps_keep_the_slopes_of_the_reference_size(t):
+    """Above 512^2 heights scale with T / 512 (bump_strength), so the relief of a larger map
+    of the same scene shades like the 512^2 one (without the scaling: T / 512 times flatter)."""
+    assert bump_strength("bumps", t) == SCENES["bumps"][2] * t / REFERENCE_TEXTURE_SIZE
+    assert bump_strength("bumps", 64) == bump_strength("bumps", 512) == SCENES["bumps"][2]
+    relief = [_shade("bumps", n)[1].std() for n in (512, t)]
+    assert abs(relief[1] / relief[0] - 1) < 0.05, relief

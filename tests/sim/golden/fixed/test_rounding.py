@@ -24,7 +24,7 @@ import pytest
 from bumprtl.rtl.baselines import kim as kim_rtl
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q
-from bumprtl.rtl.lee import prop_address, theta_from_prop
+from bumprtl.rtl.lee import asin_address, prop_address, theta_from_prop
 from bumprtl.rtl.palette import mul8
 from bumprtl.rtl.tables import (SPEC_FRAC_BITS, blend_coefficients, cos_lookup,
                                 lee_asin_index_bits, lee_prop_index_bits, phong_coefficients)
@@ -216,20 +216,12 @@ def test_lee_theta_from_prop():
 
 
 def test_lee_asin_address():
-    """Eq. 7's asin, where the rotation is the identity (N = +z, D = 0: th' = th_A exactly in
-    float64): the error of th' (angle steps) is the sine ROMs', the asin address's and the
-    asin table's roundings. Each moves th' by at most half a step times asin's slope over the
-    angle step: sin ROM u/2 (twice, halved), the address half of 2**-a, the table half a step;
-    the mean must stay near 0 (an address truncated instead of rounded moves it by -0.08 steps
-    at the defaults)."""
+    """Eq. 7's asin address |s| = |sin X + sin Y| / 2 to a fractional bits, rounded (the
+    helper the RTL and the golden model share)."""
     cfg = CFG.replace(method="lee")
-    theta = np.random.default_rng(29).integers(0, (1 << cfg.k) * 3 // 4, N)   # below 67.5 deg
-    phi, out = fixed_lee.rotate_fixed(np.zeros(N, np.int64), theta, 0, 0, cfg)
-    step = 2 * np.pi / cfg.full_circle
-    slope = 1 / math.cos(np.pi * 3 / 8) / step                 # d asin / ds in steps, at 67.5 deg
-    width = 2 * (slope * (2.0 ** -(cfg.frac_bits + 1) + 2.0 ** -(lee_asin_index_bits(cfg) + 1)) + 0.5)
-    assert set(np.unique(phi)) == {0}
-    assert_unbiased(out - theta, width, "lee asin")
+    shift = cfg.frac_bits + 1 - lee_asin_index_bits(cfg)
+    s2 = np.random.default_rng(29).integers(-2 * cfg.one, 2 * cfg.one + 1, N)
+    assert_rounds_to_nearest(asin_address(s2, cfg), np.abs(s2) / 2 ** shift, "lee asin address")
 
 
 # --- the kim baseline's helpers (B fractional bits) ------------------------------------------
