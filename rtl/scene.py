@@ -224,7 +224,11 @@ class SceneConfig:
         return asdict(self)
 
     def replace(self, **changes):
-        return load_scene_config({**self.to_dict(), **changes, "rotation": changes.get("rotation")})
+        """A copy with some keys changed (validated again); a new map replaces the picture."""
+        keys = self.to_dict()
+        if any(changes.get(k) is not None for k in MAP_KEYS):
+            keys.update(image=None, **{k: None for k in MAP_KEYS})
+        return load_scene_config({**keys, **changes, "rotation": changes.get("rotation")})
 
 
 def light_fields(scene: SceneConfig):

@@ -14,7 +14,7 @@ from PIL import Image
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.emit import lint
-from bumprtl.gen.flow.memories import bram_blocks, check_scene_fits
+from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, check_scene_fits
 from bumprtl.gen.render import images, rtl
 from bumprtl.gen.render.images import fixed_image
 from bumprtl.gen.render.rtl import scene_memories
@@ -64,6 +64,8 @@ def test_render_height_map_float64_and_fixed(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "exact (fixed)" in text and "PSNR" in text
     scene = load_scene_config("default", {"height_map": str(path)})
+    assert scene == load_scene_config("default").replace(height_map=str(path))
+    assert (scene.image, scene.texture_size, scene.picture) == (None, 64, str(path))
     want = fixed_image(scene, "exact", 64, light_elevation=45.0, light="directional")
     assert np.array_equal(np.asarray(Image.open(fixed)), want)
     assert not np.array_equal(want, img)                   # fixed point is not float64
@@ -233,3 +235,11 @@ def test_recommend_without_a_local_sweep_reads_the_shipped_one(tmp_path, monkeyp
     local.write_text(json.dumps({"command": "toy", "points": []}))
     assert main(["recommend", "--max-error-lsb", "2"]) == 2          # the local one, empty
     assert "no local sweep" not in capsys.readouterr().out
+
+
+def test_device_block_ram_counts_are_nextpnrs():
+    """DEVICE_BRAM against the DP16KD count nextpnr-ecp5 reported in the shipped sweep."""
+    data = json.loads(rec.SHIPPED_SWEEP.read_text())
+    seen = {p["cost"]["fpga"]["device"]: p["cost"]["fpga"]["available"]["BRAM"]
+            for p in data["points"] if p.get("cost", {}).get("fpga", {}).get("available")}
+    assert seen and all(DEVICE_BRAM[d] == n for d, n in seen.items())
