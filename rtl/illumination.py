@@ -18,7 +18,8 @@ def Illumination(cfg: Config, target=None):
     ``methods.get(cfg.method).illumination`` (a ``wiring.Component``).
 
     Input payload: the matching rotation unit's output layout; output payload:
-    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, tag). ``latency`` depends on
+    ``layouts.shade_layout(cfg)`` (diffuse, specular, color and the unrounded diffuse_fine,
+    specular_fine, tag). ``latency`` depends on
     the method; 1 pixel per clock. ``target``: None (generic) or ``pipe.ECP5()``.
     """
     return get(cfg.method).illumination(cfg, target=target)

@@ -1,7 +1,9 @@
 """The illumination back end every method shares (Lee Sec. 3.2, Fig. 8).
 
-The back end turns the dot products N'.L' and N'.H' into 8-bit diffuse and specular
-intensities and the Phong sum of eq. (2); it is shared by every method and mirrored
+The back end turns the dot products N'.L' and N'.H' into the diffuse and specular terms
+(unrounded, and rounded to 8 bits for their ports) and the Phong sum of eq. (2), rounded
+once from the unrounded terms; the specular cos^n is an interpolated table (Fig. 8's
+specular table, rtl/tables.specular_table). It is shared by every method and mirrored
 operation for operation by ``sim/golden/fixed/common.shade_fixed``. A method's
 illumination datapath is an :class:`IlluminationDatapath` (its dot products, then
 :func:`shade_stages`); the ``Illumination`` entry point (rtl/illumination.py) picks the
@@ -23,8 +25,8 @@ __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 
 # Registers of shade_stages: clamp, table address (and the 8-bit diffuse), table read and
 # table output register (ROM_LATENCY), the word difference, the interpolation product
-# (PRODUCT_LATENCY), the interpolated specular, the Phong product KS s (PRODUCT_LATENCY; KD d
-# runs beside the table), the Phong sum, its rounding and clamp.
+# (PRODUCT_LATENCY), the interpolated specular, the Phong products KS s and KD d
+# (PRODUCT_LATENCY; d waits beside the table), the Phong sum, its rounding and clamp.
 FINE_STAGE = 2 + ROM_LATENCY + 1 + PRODUCT_LATENCY + 1     # specular_fine's register
 SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 
@@ -52,8 +54,9 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
     # 255 d as (d << 8) - d: a carry chain instead of a DSP block (same integers as d * 255).
     diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage 2
-    kd_term = pipe.multiply(d, kd, "kd_diffuse")                                 # 1 + PRODUCT
-    kd_term = pipe.delay(kd_term, SHADE_LATENCY - 3 - PRODUCT_LATENCY, "kd_diffuse_d")
+    # d waits beside the table path (and leaves as diffuse_fine); KD d is taken where KS s is
+    d_late = pipe.delay(d, FINE_STAGE - 1, "diffuse_fine_d")                     # FINE_STAGE
+    kd_term = pipe.multiply(d_late, kd, "kd_diffuse")                            # + PRODUCT
     if cfg.specular:
         s_bits, r = specular_index_bits(cfg), b - specular_step_bits(cfg)
         x0 = specular_base(cfg)
@@ -89,7 +92,7 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 2
     return {"diffuse": pipe.delay(diffuse, SHADE_LATENCY - 2, "diffuse_out"),
             "specular": specular, "color": color,
-            "diffuse_fine": pipe.delay(d, SHADE_LATENCY - 1, "diffuse_fine_out"),
+            "diffuse_fine": pipe.delay(d_late, SHADE_LATENCY - FINE_STAGE, "diffuse_fine_out"),
             "specular_fine": fine}
 
 
@@ -99,7 +102,8 @@ class IlluminationDatapath(PipeUnit):
     input, :func:`shade_stages` does eq. (2), and the tag rides along.
 
     A ``wiring.Component`` (:class:`pipe.PipeUnit`): ``i`` carries ``in_layout``, ``o``
-    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, tag); ``latency`` =
+    ``layouts.shade_layout(cfg)`` (diffuse, specular, color, diffuse_fine, specular_fine,
+    tag); ``latency`` =
     ``dot_latency`` + SHADE_LATENCY; 1 pixel per clock. Subclasses set ``dot_latency`` and
     implement ``dots(m, pipe, payload) -> {"l": .., "h": ..}``.
     """
