@@ -10,12 +10,13 @@ from dataclasses import fields
 
 import numpy as np
 
-from bumprtl.rtl.config import Config, ConfigError
+from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.rtl.methods import METHODS, datapath_fixed, encode_pixels
 from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
-                                         term_errors_lsb)
+                                         scene_error, term_errors_lsb)
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.gen.flow.units import build_unit
 
 __all__ = ["measure", "run", "add_parser"]
@@ -64,9 +65,13 @@ def _failure(cfg, channel, kind, row, sets):
 def run(args):
     for n in args.spec_exponent:                 # a bad exponent is an error, not a skipped row
         Config(spec_exponent=n, spec_index_bits=args.spec_index_bits)
+    size = args.scene_size
+    if size and not (16 <= size <= 4096 and size & (size - 1) == 0):
+        raise BumpError(f"scene_size must be 0 or a power of two in [16, 4096], got {size}")
     print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} "
           f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
-          f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits}")
+          f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits} "
+          f"--scene-size {args.scene_size}")
     print(f"\nerror in 8-bit LSB against float64 on unquantized inputs, per output channel: "
           f"{args.samples} random valid pixels (seed 11); the adversarial search aimed at the "
           f"channel (seed 7); the arithmetic search (on-grid N', H near N', seed 5). "
@@ -95,9 +100,30 @@ def run(args):
                     failures += [_failure(cfg, channel, k, row, sets)
                                  for k in ("random", "adversarial", "arithmetic")
                                  if row[k]["max"] > row["bound"]]
+    if args.scene_size:
+        _scenes(args)
     for line in failures:
         print(line)
     return 1 if failures else 0
+
+
+def _scenes(args):
+    """Every built-in scene shaded at the default widths of ``args.method``: eq. 2's colour
+    image and, where the scene has a colour texture, the texture blend on its 8-bit albedo
+    (sim/golden/accuracy.scene_error), over the pixels the geometry covers."""
+    cfg = Config(method=args.method, spec_index_bits=args.spec_index_bits)
+    print(f"\nscenes at {args.scene_size}x{args.scene_size} (angle bits {cfg.angle_bits}, frac bits "
+          f"{cfg.frac_bits}, n = {cfg.spec_exponent}): PSNR (dB) / max LSB against float64 "
+          f"`conventional` on the unquantized inputs\n")
+    print("| scene | colour (eq. 2) | texture blend |")
+    print("|---|---|---|")
+    for name in SCENES:
+        scene = load_scene(name, size=args.scene_size)
+        rows = [scene_error(scene, cfg, datapath_fixed)]
+        if scene.albedo is not None:
+            rows.append(scene_error(scene, cfg, datapath_fixed, blend=True))
+        cells = [f"{r['psnr_db']} / {r['max_lsb']}" for r in rows] + ["—"] * (2 - len(rows))
+        print(f"| {name} | {' | '.join(cells)} |", flush=True)
 
 
 def add_parser(sub):
@@ -114,4 +140,6 @@ def add_parser(sub):
     p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
                    help="Phong exponents n (default: 16)")
     p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
+    p.add_argument("--scene-size", type=int, default=128,
+                   help="also shade every built-in scene at this size, default widths (0: no scenes)")
     p.set_defaults(func=run)

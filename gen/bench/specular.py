@@ -16,8 +16,11 @@ inputs (unquantized; sim/golden/accuracy.py). Cost: words x width and DP16KD cou
 (1024 x 18 or 2048 x 9 words a block; a 2^s + 1-th word in flip-flops), multipliers.
 """
 
+from pathlib import Path
+
 import numpy as np
 
+from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.methods import datapath_fixed, encode_pixels
@@ -110,6 +113,11 @@ def run(args):
                   f"{errs['adversarial'].max()} / {errs['adversarial'].mean():.4f} |", flush=True)
     print(f"\nstep of the kept table (2^-t) per n: "
           + ", ".join(f"n={n}: t={specular_step_bits(Config(spec_exponent=n))}" for n in args.spec_exponent))
+    counts = count_unit("illumination", Config(), args.work).summary()
+    print("\nIllumination at the default widths, Yosys coarse netlist (gen/flow/resources.py): "
+          + ", ".join(f"{k} {counts[k]}" for k in ("multipliers", "const_multipliers", "tables",
+                                                   "table_bits", "table_reads", "adders",
+                                                   "register_bits")))
     return 0
 
 
@@ -120,4 +128,6 @@ def add_parser(sub):
                                    "against float64 and cost per exponent.")
     p.add_argument("--samples", type=int, default=1_000_000)
     p.add_argument("--spec-exponent", type=int, nargs="+", default=[1, 2, 16, 64, 256, 1024])
+    p.add_argument("--work", type=Path, default=Path("build/bench/specular"),
+                   help="netlist of the Illumination unit counted at the end")
     p.set_defaults(func=run)

@@ -65,9 +65,10 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env, version
 from bumprtl.sim.traffic import PATTERNS as TRAFFIC
 
-__all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "SimulationTimeout",
-           "BulkResult", "wrapper_verilog", "check_stimulus", "encode_words", "decode_words",
-           "setup_writes", "build", "run_bulk", "density"]
+__all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "PERIOD",
+           "SimulationTimeout", "BulkResult", "wrapper_verilog", "host_fields", "setup_arrays",
+           "check_stimulus", "encode_words", "decode_words", "setup_writes", "build_args",
+           "build", "cache_root", "run_bulk", "density"]
 
 SIMULATORS = ("icarus", "verilator")
 CLOCKS = ("verilog", "cocotb")          # who toggles clk: the wrapper itself or cocotb's Clock
@@ -104,7 +105,7 @@ def density(p):
 
 def _host_ports(meta):
     """The unit's inputs besides the two streams, clk and rst (map/LUT/polygon host ports):
-    the wrapper passes them through so cocotb can drive a set-up before the stream."""
+    the wrapper registers them on their way in and plays set-up words into them."""
     return {name: p["width"] for name, p in sorted(meta["ports"].items())
             if p["dir"] == "in" and name not in STREAM_PORTS}
 

@@ -13,7 +13,8 @@ from bumprtl.rtl.methods import datapath_fixed, encode_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
 
-ARGS = ["bench", "accuracy", "--samples", "3000", "--angle-bits", "12", "--frac-bits", "13"]
+ARGS = ["bench", "accuracy", "--samples", "3000", "--angle-bits", "12", "--frac-bits", "13",
+        "--scene-size", "16"]
 
 
 @pytest.fixture
@@ -34,6 +35,8 @@ def test_rows_per_channel_within_the_bounds(small_searches, capsys):
         assert row and int(row.group(4)) == bound, (channel, out)
         assert max(int(g) for g in row.groups()[:3]) <= bound
     assert "FAIL" not in out
+    assert re.search(r"\| bricks \| [\d.]+ / \d \| [\d.]+ / \d \|", out)      # colour and the blend
+    assert re.search(r"\| moon \| [\d.]+ / \d \| — \|", out)                  # no colour texture
 
 
 def test_an_error_above_its_bound_exits_1_with_the_input(small_searches, monkeypatch, capsys):
@@ -57,7 +60,10 @@ def test_an_error_above_its_bound_exits_1_with_the_input(small_searches, monkeyp
     assert re.search(rf"error {abs(got - want)} LSB > bound 0", line)
 
 
-def test_bad_exponent_is_one_line_exit_2(capsys):
-    assert main(ARGS + ["--spec-exponent", "2000"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "spec_exponent" in err and len(err.splitlines()) == 1
+@pytest.mark.parametrize("flag, value, name", [("--spec-exponent", "2000", "spec_exponent"),
+                                               ("--scene-size", "100", "scene_size")])
+def test_bad_input_is_one_line_exit_2(capsys, flag, value, name):
+    assert main(ARGS + [flag, value]) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert name in err and len(err.splitlines()) == 1 and "|" not in captured.out
