@@ -45,13 +45,13 @@ def test_default_random_within_each_bound_and_1_lsb_in_diffuse_and_colour(defaul
     bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
     assert bounds == {"diffuse": 1, "specular": 4, "color": 2}
     for c in CHANNELS:
-        assert got[c] <= bounds[c], (c, got, bounds)
+        assert got[c] <= bounds[c] <= 2 * got[c], (c, got, bounds)      # held, and tight
     assert got["diffuse"] <= 1 and got["color"] <= 1
     # the angle grid of 12-bit angles costs the default n = 16 a second LSB of specular
     assert got["specular"] == 2
 
 
-@pytest.mark.parametrize("exponent", [2, 16, 1024])
+@pytest.mark.parametrize("exponent", [16, 1024])
 def test_bounds_hold_and_are_tight(exponent):
     """Per channel: max over random, the adversarial searches aimed at the specular term and
     at the colour, and the arithmetic search, <= bound and >= bound / 2."""
@@ -77,9 +77,9 @@ def test_colour_adversarial_within_1_lsb_at_the_default():
     assert got["color"] <= 1 and got["diffuse"] <= 1
 
 
-@pytest.mark.parametrize("exponent", [1, 2])
+@pytest.mark.parametrize("exponent", [1, 2, 3])
 def test_small_exponents_reach_1_lsb_of_specular(exponent):
-    """At the default widths only n <= 2 keep the specular term within 1 LSB: the angle
+    """At the default widths only n <= 3 keep the specular term within 1 LSB: the angle
     grid alone moves a steeper cos^n by more (docs/fixed_point.md)."""
     cfg = Config(spec_exponent=exponent)
     for px in (PixelInputs.random(50_000, np.random.default_rng(11)),
