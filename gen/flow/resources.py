@@ -215,6 +215,13 @@ def count_netlist(netlist, top):
             counts.register_bits += _int(cell["parameters"]["WIDTH"])
         elif kind in modules and kind.endswith("sqrt"):
             counts.sqrts += 1
+    # Cell names (and so the order of the cells) depend on the Yosys front end; the counts
+    # do not: widest first.
+    for f in ("multipliers", "const_multipliers", "dividers"):
+        setattr(counts, f, sorted(getattr(counts, f),
+                                  key=lambda s: [-int(w) for w in re.split("[x/]", str(s))]))
+    for f in ("adders", "const_adders", "comparators"):
+        setattr(counts, f, sorted(getattr(counts, f), reverse=True))
     return counts
 
 
@@ -271,6 +278,31 @@ def strip_zero_init(text):
     return _ZERO_INIT.sub("", text)
 
 
+_ROM_INIT = re.compile(r"^( *)initial begin\n((?: *\\?[\w$.]+ *\[\d+\] = \d+'[hdb][0-9a-fA-F_]+;\n)+) *end\n",
+                       re.M)
+_ROM_WORD = re.compile(r"^ *(\\?[\w$.]+) *\[(\d+)\] = \d+'([hdb])([0-9a-fA-F_]+);$", re.M)
+
+
+def roms_as_readmemh(text, work_dir, stem):
+    """Move each memory ``initial`` block (one assignment per word) into a ``$readmemh``
+    file under ``work_dir``: the same contents, but Yosys's Verilog front end reads a hex
+    file in a fraction of the time it takes to parse tens of thousands of assignments."""
+    n = [0]
+
+    def sub(m):
+        words = _ROM_WORD.findall(m.group(2))
+        name = words[0][0]
+        if any(w[0] != name or int(w[1]) != k for k, w in enumerate(words)):
+            return m.group(0)                  # not one memory written word by word: keep
+        base = {"h": 16, "d": 10, "b": 2}
+        hex_path = Path(work_dir) / f"{stem}.rom{n[0]}.hex"
+        n[0] += 1
+        hex_path.write_text("".join(f"{int(v.replace('_', ''), base[r]):x}\n" for _n, _i, r, v in words))
+        name += " " if name.startswith("\\") else ""      # an escaped identifier ends in a space
+        return f'{m.group(1)}initial $readmemh("{hex_path.name}", {name});\n'
+    return _ROM_INIT.sub(sub, text)
+
+
 def count_verilog(v_path, top, work_dir=None):
     """Synthesize ``v_path`` (top module ``top``) with :data:`SCRIPT` and count it."""
     v_path = Path(v_path)
@@ -279,7 +311,7 @@ def count_verilog(v_path, top, work_dir=None):
     work_dir = Path(work_dir or v_path.parent).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
     src = f"{top}.in.v"                       # YoWASP only sees its working directory
-    (work_dir / src).write_text(strip_zero_init(v_path.read_text()))
+    (work_dir / src).write_text(roms_as_readmemh(strip_zero_init(v_path.read_text()), work_dir, top))
     run_yosys(f"read_verilog {src}; hierarchy -check -top {top}; {SCRIPT}; "
               f"write_json {top}.coarse.json", f"{top}.coarse.log", work_dir)
     return count_netlist(json.loads((work_dir / f"{top}.coarse.json").read_text()), top)

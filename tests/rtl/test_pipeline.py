@@ -1,6 +1,6 @@
 """BumpPipeline in the Amaranth simulator, bit for bit against sim/golden/fixed/pipeline.py,
-for every combination of the SceneConfig switches; lint of the emitted Verilog; throughput
-and backpressure (tags in order, each once)."""
+for every pair of SceneConfig switch values (every combination under make regress); lint of
+the emitted Verilog; throughput and backpressure (tags in order, each once)."""
 
 import itertools
 import json
@@ -9,11 +9,12 @@ import re
 import numpy as np
 import pytest
 from amaranth.hdl import Module, Signal
-from amaranth.lib import wiring
+from amaranth.lib import data, wiring
 from amaranth.lib.memory import Memory
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
@@ -112,12 +113,66 @@ def run(scene, n, pattern, seed=0):
     return cycles, dut.latency
 
 
-@pytest.mark.parametrize("keys", combinations(), ids=lambda k: "-".join(str(v) for v in k.values()))
-def test_every_switch_combination_lint_clean_and_bit_exact(keys, build_dir):
+def pairwise(combos):
+    """A subset of ``combos`` in which every pair of switch values that occurs together in
+    some combination occurs together at least once (greedy covering array, deterministic)."""
+    def pairs(k):
+        items = sorted((f, str(v)) for f, v in k.items())
+        return set(itertools.combinations(items, 2))
+    uncovered = set().union(*(pairs(k) for k in combos))
+    chosen = []
+    while uncovered:
+        best = max(combos, key=lambda k: len(pairs(k) & uncovered))
+        chosen.append(best)
+        uncovered -= pairs(best)
+    return chosen
+
+
+def test_pairwise_covers_every_pair_with_fewer_cases():
+    full, cover = combinations(), pairwise(combinations())
+    want = set().union(*({(a, b) for a in k.items() for b in k.items() if a[0] < b[0]} for k in full))
+    got = set().union(*({(a, b) for a in k.items() for b in k.items() if a[0] < b[0]} for k in cover))
+    assert got == want and len(cover) < len(full) // 3 and all(k in full for k in cover)
+
+
+def _switch_case(keys, build_dir):
     scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
     v, _ = emit_unit("pipeline", scene, build_dir)
     assert lint(v) == []
     run(scene, 60, "no_stall")
+
+
+def _ids(k):
+    return "-".join(str(v) for v in k.values())
+
+
+# make test: every pair of switch values (two-way interactions) once; make regress: all of them.
+@pytest.mark.parametrize("keys", pairwise(combinations()), ids=_ids)
+def test_every_switch_pair_lint_clean_and_bit_exact(keys, build_dir):
+    _switch_case(keys, build_dir)
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("keys", combinations(), ids=_ids)
+def test_every_switch_combination_lint_clean_and_bit_exact(keys, build_dir):
+    _switch_case(keys, build_dir)
+
+
+@pytest.mark.parametrize("keys", [{}, {"bump_map": "flat"}, {"specular": False}])
+def test_extra_lights_are_an_array_after_light_0(keys):
+    """Light 0's vectors are the one-light fields l, h; lights 1..m-1 an ArrayLayout of
+    {l, [h]} (extra_lights); the lights' angles lie one after the other in the payload, the
+    bits the golden model and the stimulus address through light_keys."""
+    scene = load_scene_config({"name": "t", "texture_size": 16, "lights": 3, **keys})
+    layout = BumpPipeline(scene).i.payload.shape()
+    extra = layout["extra_lights"].shape
+    assert isinstance(extra, data.ArrayLayout) and extra.length == 2
+    assert extra.elem_shape == light_layout(scene.config)
+    fields, keys = layout_fields(layout), light_keys(scene.config)
+    assert [k["l.phi"] for k in keys] == ["l.phi", "extra_lights.0.l.phi", "extra_lights.1.l.phi"]
+    offsets = [fields[name][0] for k in keys for name in k.values()]
+    first = fields["l.phi"][0]
+    assert offsets == [first + n * scene.angle_bits for n in range(len(offsets))]
 
 
 @pytest.mark.parametrize("pattern", [p for p in PATTERNS if p != "no_stall"])

@@ -1,5 +1,6 @@
 """The resource counter on hand-written Amaranth modules whose contents are known."""
 
+import json
 import subprocess
 
 import pytest
@@ -11,7 +12,8 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.gen.flow import resources
 from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_netlist,
                                         count_verilog, multiplier_pairs)
-from bumprtl.rtl.config import BumpError
+from bumprtl.gen.flow.units import emit_unit
+from bumprtl.rtl.config import BumpError, Config
 
 
 class Known(wiring.Component):
@@ -185,3 +187,23 @@ def test_macc_terms_classified_by_their_operands():
     counts = count_netlist(netlist, "top")
     assert counts.multipliers == ["6x5"] and counts.const_multipliers == [6]
     assert counts.adders == [16] * 3 and counts.const_adders == [16]    # 4 signal terms
+
+
+def test_roms_read_through_readmemh_give_the_same_netlist(tmp_path):
+    """count_verilog hands Yosys the ROM contents as $readmemh files (roms_as_readmemh):
+    the memories' INIT and every count are the same as from the word-by-word initial block."""
+    v, _ = emit_unit("sincos", Config(angle_bits=8, frac_bits=9), tmp_path / "rom")
+    text = v.read_text()
+    fast = resources.roms_as_readmemh(text, tmp_path, "sincos")
+    assert "$readmemh(" in fast and len(fast) < len(text)
+    inits = {}
+    for name, src in (("slow", text), ("fast", fast)):
+        (tmp_path / f"{name}.v").write_text(src)
+        resources.run_yosys(f"read_verilog {name}.v; hierarchy -top sincos; {resources.SCRIPT}; "
+                            f"write_json {name}.json", f"{name}.log", tmp_path)
+        netlist = json.loads((tmp_path / f"{name}.json").read_text())
+        cells = netlist["modules"]["sincos"]["cells"].values()
+        inits[name] = sorted(c["parameters"]["INIT"] for c in cells if c["type"] == "$mem_v2")
+        inits[name + "_counts"] = count_netlist(netlist, "sincos")
+    assert inits["slow"] == inits["fast"] and inits["fast"] and any("1" in i for i in inits["fast"])
+    assert inits["slow_counts"] == inits["fast_counts"]
