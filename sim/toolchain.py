@@ -5,6 +5,7 @@ The system Verilator (Debian 5.006) is too old for cocotb 2, so every call goes 
 """
 
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -16,7 +17,7 @@ try:
 except ImportError:
     verilator = None
 
-__all__ = ["verilator_root", "tool_env", "require", "ToolMissing", "VERILATOR_WAIVERS"]
+__all__ = ["verilator_root", "tool_env", "require", "ToolMissing", "VERILATOR_WAIVERS", "roms_as_readmemh"]
 
 # The three warning classes that Amaranth's Verilog back end always produces (generator
 # artefacts, not design faults: docs/architecture.md, Lint policy).
@@ -84,3 +85,28 @@ def version(argv):
         return None
     text = (out.stdout or out.stderr).strip()
     return text.splitlines()[0] if text else None
+
+
+_ROM_INIT = re.compile(r"^( *)initial begin\n((?: *\\?[\w$.]+ *\[\d+\] = \d+'[hdb][0-9a-fA-F_]+;\n)+) *end\n",
+                       re.M)
+_ROM_WORD = re.compile(r"^ *(\\?[\w$.]+) *\[(\d+)\] = \d+'([hdb])([0-9a-fA-F_]+);$", re.M)
+
+
+def roms_as_readmemh(text, work_dir, stem):
+    """Move each memory ``initial`` block (one assignment per word) into a ``$readmemh``
+    file under ``work_dir``: the same contents, but Yosys's Verilog front end reads a hex
+    file in a fraction of the time it takes to parse tens of thousands of assignments."""
+    n = [0]
+
+    def sub(m):
+        words = _ROM_WORD.findall(m.group(2))
+        name = words[0][0]
+        if any(w[0] != name or int(w[1]) != k for k, w in enumerate(words)):
+            return m.group(0)                  # not one memory written word by word: keep
+        base = {"h": 16, "d": 10, "b": 2}
+        hex_path = Path(work_dir) / f"{stem}.rom{n[0]}.hex"
+        n[0] += 1
+        hex_path.write_text("".join(f"{int(v.replace('_', ''), base[r]):x}\n" for _n, _i, r, v in words))
+        name += " " if name.startswith("\\") else ""      # an escaped identifier ends in a space
+        return f'{m.group(1)}initial $readmemh("{hex_path.name}", {name});\n'
+    return _ROM_INIT.sub(sub, text)

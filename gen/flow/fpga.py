@@ -23,11 +23,12 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, strip_zero_init
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit"]
 
@@ -73,8 +74,10 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF, seed=1):
     flag = check_device(device)
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    # strip_zero_init: a zero-filled RAM maps to the same cells
-    (work_dir / f"{top}.in.v").write_text(strip_zero_init(Path(v_path).read_text()))  # YoWASP sees its cwd only
+    # strip_zero_init: a zero-filled RAM maps to the same cells; roms_as_readmemh: the same
+    # ROM contents, read by Yosys from hex files (its front end is slow on word-by-word inits)
+    text = roms_as_readmemh(strip_zero_init(Path(v_path).read_text()), work_dir, top)
+    (work_dir / f"{top}.in.v").write_text(text)               # YoWASP sees its cwd only
     shutil.copyfile(lpf, work_dir / "clock.lpf")
     run_yosys(f"read_verilog {top}.in.v; synth_ecp5 -top {top} -json {top}.ecp5.json",
               f"{top}.synth.log", work_dir)
@@ -143,13 +146,9 @@ def pipeline_component(cfg, target=None):
 
 CACHE = Path("build/fpga_cache")
 
-# Designs the ECP5 flow does not place, and why (measured, not guessed): reports and the
-# sweep show the reason instead of numbers.
-NOT_PLACED = {
-    d: ("not placed: synth_ecp5's ABC9 step on the 6 combinational dividers and 2 square roots "
-        "(66,489 AND gates) ran 25 minutes without finishing on the 2-core machine and was "
-        "stopped; its Yosys counts are in docs/table1.md")
-    for d in ("peercy", "ernst")}
+# Designs the ECP5 flow does not place, and why (the registry's Method.not_placed): reports
+# and the sweep show the reason instead of numbers.
+NOT_PLACED = {name: m.not_placed for name, m in METHODS.items() if m.not_placed}
 
 
 def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):

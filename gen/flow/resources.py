@@ -36,7 +36,7 @@ from pathlib import Path
 from amaranth.back import verilog
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
 from bumprtl.gen.flow.units import emit_unit
 
 __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
@@ -276,31 +276,6 @@ def strip_zero_init(text):
     e.g. the palette's colour table): Yosys's front end is slow on tens of thousands of such
     lines and a zero-initialised RAM costs the same hardware. Non-zero ROM contents stay."""
     return _ZERO_INIT.sub("", text)
-
-
-_ROM_INIT = re.compile(r"^( *)initial begin\n((?: *\\?[\w$.]+ *\[\d+\] = \d+'[hdb][0-9a-fA-F_]+;\n)+) *end\n",
-                       re.M)
-_ROM_WORD = re.compile(r"^ *(\\?[\w$.]+) *\[(\d+)\] = \d+'([hdb])([0-9a-fA-F_]+);$", re.M)
-
-
-def roms_as_readmemh(text, work_dir, stem):
-    """Move each memory ``initial`` block (one assignment per word) into a ``$readmemh``
-    file under ``work_dir``: the same contents, but Yosys's Verilog front end reads a hex
-    file in a fraction of the time it takes to parse tens of thousands of assignments."""
-    n = [0]
-
-    def sub(m):
-        words = _ROM_WORD.findall(m.group(2))
-        name = words[0][0]
-        if any(w[0] != name or int(w[1]) != k for k, w in enumerate(words)):
-            return m.group(0)                  # not one memory written word by word: keep
-        base = {"h": 16, "d": 10, "b": 2}
-        hex_path = Path(work_dir) / f"{stem}.rom{n[0]}.hex"
-        n[0] += 1
-        hex_path.write_text("".join(f"{int(v.replace('_', ''), base[r]):x}\n" for _n, _i, r, v in words))
-        name += " " if name.startswith("\\") else ""      # an escaped identifier ends in a space
-        return f'{m.group(1)}initial $readmemh("{hex_path.name}", {name});\n'
-    return _ROM_INIT.sub(sub, text)
 
 
 def count_verilog(v_path, top, work_dir=None):

