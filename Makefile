@@ -42,7 +42,7 @@ demo: $(STAMP)
 	$(RUN) $(VENV)/bin/bumprtl demo --out build/demo
 
 test: $(STAMP)
-	$(RUN) $(PY) -m pytest -n $(JOBS) -m "not regress and not fpga" $(PYTEST_ARGS)
+	$(RUN) $(PY) -m pytest -n $(JOBS) -m "not regress and not fpga and not formal" $(PYTEST_ARGS)
 
 regress: $(STAMP)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m regress $(PYTEST_ARGS)
@@ -53,9 +53,11 @@ regress: $(STAMP)
 mutate: $(STAMP)
 	$(RUN) $(PY) -m bumprtl.gen.flow.mutate $(MUTATE_ARGS)
 
-# Every unit and scene pipeline, every property, the broken units (sim/formal/run.py).
+# Every unit and scene pipeline, every property, the broken units (sim/formal/run.py), then
+# the formal tests left out of make test (pytest marker formal).
 formal: $(STAMP)
 	$(RUN) $(PY) -m bumprtl.sim.formal.run -j $(JOBS) --doc docs/formal.md $(FORMAL_ARGS)
+	$(RUN) $(PY) -m pytest -n $(JOBS) -m formal tests/sim/formal
 
 fpga: $(STAMP)
 	$(RUN) $(PY) -m pytest -m fpga $(PYTEST_ARGS)

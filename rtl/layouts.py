@@ -6,7 +6,8 @@ from amaranth.lib import data
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 
-__all__ = ["angle_shape", "polar_layout", "pixel_layout", "shade_layout", "layout_fields"]
+__all__ = ["angle_shape", "polar_layout", "light_layout", "light_fields", "light_keys",
+           "pixel_layout", "shade_layout", "layout_fields"]
 
 
 def angle_shape(cfg: Config):
@@ -17,6 +18,37 @@ def angle_shape(cfg: Config):
 def polar_layout(cfg: Config):
     """A direction in polar angles: phi (azimuth), theta (from +z)."""
     return data.StructLayout({"phi": angle_shape(cfg), "theta": angle_shape(cfg)})
+
+
+def light_layout(cfg: Config):
+    """One light's vectors in polar angles: L (``l``) and, with specular, H (``h``)."""
+    fields = {"l": polar_layout(cfg)}
+    if cfg.specular:
+        fields["h"] = polar_layout(cfg)
+    return data.StructLayout(fields)
+
+
+def light_fields(cfg: Config):
+    """The per-light input fields of a pipeline with ``cfg.lights`` lights: light 0's L and H
+    are ``l`` and ``h`` (:func:`pixel_layout`'s, so they ride through the rotation unit),
+    lights 1..m-1 are ``extra_lights``, an ``ArrayLayout`` of m - 1 :func:`light_layout`
+    (element j - 1 is light j; absent with one light). In this order the bits are light 0,
+    light 1, ... one after the other."""
+    fields = {name: field.shape for name, field in light_layout(cfg)}
+    if cfg.lights > 1:
+        fields["extra_lights"] = data.ArrayLayout(light_layout(cfg), cfg.lights - 1)
+    return fields
+
+
+def light_keys(cfg: Config):
+    """Per light j, ``{one-light key: pipeline key}`` of its angles in the flattened payload
+    (:func:`layout_fields`' names, as the golden models and stimulus files key them): light 0
+    ``{"l.phi": "l.phi", ...}``, light 1 ``{"l.phi": "extra_lights.0.l.phi", ...}``. Read off
+    :func:`light_fields`, whose bits hold the lights one after the other."""
+    own = list(layout_fields(light_layout(cfg)))
+    names = list(layout_fields(data.StructLayout(light_fields(cfg))))
+    k = len(own)
+    return [dict(zip(own, names[j * k:(j + 1) * k])) for j in range(cfg.lights)]
 
 
 def pixel_layout(cfg: Config):

@@ -5,10 +5,12 @@ A method is its hardware (a rotation, or setup, Component and an illumination Co
 rtl/exact.py, rtl/lee.py, rtl/baselines/<name>.py), its bit-exact golden models
 (sim/golden/fixed/<name>.py: ``rotation_fixed``, ``illumination_fixed``, ``encode`` when its
 inputs are not binary angles, ``predicted_error_bound_lsb``), its float64 reference
-(sim/golden/float/<name>.py) and a few facts (title, Table 1 baseline or not). Everything
+(sim/golden/float/<name>.py) and a few facts (title, Table 1 baseline or not, whether
+lights can share its rotated normal, why the FPGA flow does not place it). Everything
 that depends on the method reads it from here: ``rotation.VectorRotation`` and
-``illumination.Illumination``, the golden dispatch below, the emitter's sidecar
-(gen/flow/units.py), the stress bench, the sweep, the Table 1 report and the tests.
+``illumination.Illumination``, the golden dispatch below, the scene checks
+(rtl/scene.py), the emitter's sidecar (gen/flow/units.py), the stress bench, the sweep,
+the Table 1 and FPGA reports, the fixed-point render and the tests.
 
 Adding a method: its RTL module, its golden module(s), one entry in :data:`METHODS` and its
 name in ``config.METHOD_NAMES`` (Config validates against those names without importing
@@ -79,6 +81,13 @@ class Method:
         the shared edge-case stimulus drives every method.
     cartesian : bool
         The inputs (and a bump map's N') are Cartesian components, not binary angles.
+    rotates_normal : bool
+        The rotation turns N' into N's frame once (n'') and keeps each vector's terms apart
+        from it, instead of rotating L and H into tangent space. Only such a method lets a
+        scene have a flat bump map (n'' rotated once per polygon) or several lights (they
+        share the one n''); the pipeline then builds the vectors' terms with
+        ``rtl/exact.vector_terms`` (``pipeline.VectorTerms``) and the polygon's n'' with
+        ``sim/golden/fixed/exact.rotation_fixed``, the exact method's.
     predicted_error_bound_lsb : callable
         ``(cfg, channel="diffuse", lights=1) -> int``: the proven error bound of one output
         channel (``diffuse``, ``specular``, ``color``, ``blend``) against float64, 8-bit LSB.
@@ -86,6 +95,9 @@ class Method:
         What the bound means and where it is proved or measured (the emitter's sidecar).
     reference : callable or None
         The float64 model ``(PixelInputs, cfg) -> Result`` (sim/golden/float/).
+    not_placed : str or None
+        Why the ECP5 flow (gen/flow/fpga.py) does not place this method's units; None: it
+        is placed.
     """
 
     name: str
@@ -100,9 +112,11 @@ class Method:
     encode: Callable
     from_angle_codes: Callable
     cartesian: bool
+    rotates_normal: bool
     predicted_error_bound_lsb: Callable
     error_note: str
     reference: Optional[Callable] = None
+    not_placed: Optional[str] = None
 
     @property
     def per_pixel(self):
@@ -125,6 +139,10 @@ _UNQUANTIZED = "diffuse (error_bound_lsb; every channel in error_bounds_lsb) vs 
 _CARTESIAN_NOTE = (f"{_UNQUANTIZED}, Cartesian input codes from "
                    "sim/golden/fixed/peercy.encode "
                    "(proof: sim/golden/fixed/peercy.predicted_error_bound_lsb)")
+# Measured, not guessed: reports and the sweep show this reason instead of numbers.
+_NOT_PLACED = ("not placed: synth_ecp5's ABC9 step on the 6 combinational dividers and 2 square "
+               "roots (66,489 AND gates) ran 25 minutes without finishing on the 2-core machine "
+               "and was stopped; its Yosys counts are in docs/table1.md")
 
 METHODS = {m.name: m for m in (
     Method("exact", "exact angular method", baseline=False, table1_column=6,
@@ -133,6 +151,7 @@ METHODS = {m.name: m for m in (
            rotation_fixed=fixed_exact.rotation_fixed,
            illumination_fixed=fixed_exact.illumination_fixed,
            encode=quantize_pixels, from_angle_codes=_same_codes, cartesian=False,
+           rotates_normal=True,
            predicted_error_bound_lsb=fixed_exact.predicted_error_bound_lsb,
            error_note=f"{_UNQUANTIZED} (proof: sim/golden/fixed/exact.predicted_error_bound_lsb)",
            reference=exact),
@@ -142,6 +161,7 @@ METHODS = {m.name: m for m in (
            rotation_fixed=fixed_lee.rotation_fixed,
            illumination_fixed=fixed_lee.illumination_fixed,
            encode=quantize_pixels, from_angle_codes=_same_codes, cartesian=False,
+           rotates_normal=False,
            predicted_error_bound_lsb=fixed_lee.predicted_error_bound_lsb,
            error_note=("lee's geometric approximations: no width bounds the diffuse error vs "
                        "float64 below the full range (measured by bumprtl bench float64, bench "
@@ -153,24 +173,25 @@ METHODS = {m.name: m for m in (
            rotation_fixed=fixed_peercy.rotation_fixed,
            illumination_fixed=fixed_peercy.illumination_fixed,
            encode=fixed_peercy.encode, from_angle_codes=fixed_peercy.from_angle_codes,
-           cartesian=True,
+           cartesian=True, rotates_normal=False,
            predicted_error_bound_lsb=fixed_peercy.predicted_error_bound_lsb,
-           error_note=_CARTESIAN_NOTE, reference=peercy),
+           error_note=_CARTESIAN_NOTE, reference=peercy, not_placed=_NOT_PLACED),
     Method("ernst", "Ernst et al. 1998", baseline=True, table1_column=4,
            rotation=ErnstRotation, illumination=ErnstIllumination,
            rotated_layout=setup_output_layout,
            rotation_fixed=fixed_ernst.rotation_fixed,
            illumination_fixed=fixed_ernst.illumination_fixed,
            encode=fixed_ernst.encode, from_angle_codes=fixed_ernst.from_angle_codes,
-           cartesian=True,
+           cartesian=True, rotates_normal=False,
            predicted_error_bound_lsb=fixed_ernst.predicted_error_bound_lsb,
-           error_note=_CARTESIAN_NOTE, reference=ernst),
+           error_note=_CARTESIAN_NOTE, reference=ernst, not_placed=_NOT_PLACED),
     Method("kim", "Kim et al. 2001", baseline=True, table1_column=3,
            rotation=KimRotation, illumination=KimIllumination,
            rotated_layout=rtl_lee.rotated_layout,
            rotation_fixed=fixed_kim.rotation_fixed,
            illumination_fixed=fixed_kim.illumination_fixed,
            encode=quantize_pixels, from_angle_codes=_same_codes, cartesian=False,
+           rotates_normal=False,
            predicted_error_bound_lsb=fixed_kim.predicted_error_bound_lsb,
            error_note=f"{_UNQUANTIZED} (proof: sim/golden/fixed/kim.predicted_error_bound_lsb)",
            reference=kim),

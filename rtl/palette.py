@@ -80,11 +80,18 @@ class PaletteLUT(wiring.Component):
         Reads ``palette_size`` (sN), ``color_bits``, ``palette_blend`` and ``tag_bits``.
     target : None or pipe.ECP5
         Elaboration target (None: the generic form every simulator runs).
+    bank_in : bool
+        The input payload carries ``bank``: the pixel reads that bank instead of the one in
+        front. For a unit that samples :attr:`bank` where it accepts the pixel, stages
+        upstream (BumpPipeline: at its input, ahead of the fetch), so the pixel reads the
+        bank that was in front when *that* unit accepted it; that unit must also hold back
+        host writes to a bank its pixels in flight still read (``lut_w_ready``).
 
     Members
     -------
-    i : In(stream.Signature({index: unsigned(ceil log2 sN), [base: rgba], tag}))
-        ``base`` (only with ``palette_blend``) is the base colour ``(ro, go, bo, ao)``.
+    i : In(stream.Signature({index: unsigned(ceil log2 sN), [base: rgba], [bank], tag}))
+        ``base`` (only with ``palette_blend``) is the base colour ``(ro, go, bo, ao)``;
+        ``bank`` (only with ``bank_in``) the bank to read.
     o : Out(stream.Signature({color: rgba, oor: 1, tag}))
         ``color`` is the table entry, or with ``palette_blend`` eq. 2:
         ``r = ro * ai + (1 - ro) * ri`` (products rounded to nearest, see
@@ -97,8 +104,10 @@ class PaletteLUT(wiring.Component):
     swap : In(1)
         Strobe: exchanges front and back banks at the end of the cycle (a write in the same
         cycle belongs to the bank being published). A pixel reads the bank that was in front
-        in the cycle it was accepted, so no lookup ever sees a half-written table; swaps may
-        come at any time, also under backpressure.
+        in the cycle it was accepted (with ``bank_in``: the bank its payload names), so no
+        lookup ever sees a half-written table; swaps may come at any time, also under
+        backpressure. The lookup is done in the cycle the pixel is accepted: a write after
+        that cannot change it.
     bank : Out(1)
         The current front bank.
 
@@ -107,12 +116,14 @@ class PaletteLUT(wiring.Component):
     pixel per clock when not stalled.
     """
 
-    def __init__(self, cfg: Config, target=None):
-        self.cfg, self.target, self.memories = cfg, target, {}
+    def __init__(self, cfg: Config, target=None, bank_in=False):
+        self.cfg, self.target, self.memories, self.bank_in = cfg, target, {}, bank_in
         ib = index_bits(cfg)
         fields = {"index": unsigned(ib)}
         if cfg.palette_blend:
             fields["base"] = rgba_layout(cfg)
+        if bank_in:
+            fields["bank"] = unsigned(1)
         fields["tag"] = unsigned(cfg.tag_bits)
         super().__init__({
             "i": In(stream.Signature(data.StructLayout(fields))),
@@ -151,9 +162,10 @@ class PaletteLUT(wiring.Component):
 
         index = self.i.payload.index
         oor_in = index >= size
+        read_bank = self.i.payload.bank if self.bank_in else front
         rp = table.read_port(domain="sync")
         m.d.comb += [rp.en.eq(pipe.adv),
-                     rp.addr.eq(Mux(oor_in, 0, index) + Mux(front, size, 0))]
+                     rp.addr.eq(Mux(oor_in, 0, index) + Mux(read_bank, size, 0))]
         oor = pipe.register(oor_in, "oor_d1")
         word = Mux(oor, 0, rp.data)
         entry = _channels(word, cfg)

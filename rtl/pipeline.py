@@ -29,16 +29,17 @@ from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
 from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, vector_terms
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.layouts import angle_shape, pixel_layout, polar_layout, shade_layout
+from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
+                                 shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import StallPipe
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config
+from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout
 
-__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "light_fields"]
+__all__ = ["BumpPipeline", "VectorTerms", "LightSum"]
 
 
 def _vector_layout(cfg):
@@ -46,19 +47,23 @@ def _vector_layout(cfg):
 
 
 class VectorTerms(wiring.Component):
-    """The per-vector half of the exact rotation (docs/architecture.md, The exact angular method) for vectors ``names``:
+    """The per-vector half of the exact rotation (docs/architecture.md, The exact angular
+    method) for each vector A of ``count`` lights:
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D, 2p = s(X) + s(Y), 2y = c(Y) - c(X),
     z = c(th_A). Built by ``exact.vector_terms``, the function ``exact.ExactRotation`` uses, with
-    the same latency, so it runs in lock step beside it. Input {n_phi, <name>: polar, tag};
-    output {<name>: p2, y2, z, tag}."""
+    the same latency, so it runs in lock step beside it. Input {n_phi, lights:
+    ArrayLayout(light_layout, count), tag}; output {lights: ArrayLayout({l, [h]: {p2, y2, z}},
+    count), tag}. ``first``: the pipeline's number of the first of these lights (its
+    registers are named ``l_*``, ``l1_*``, ... after the pipeline's lights)."""
 
     latency = ExactRotation.latency
 
-    def __init__(self, cfg, names, target=None):
-        self.cfg, self.names, self.target, self.memories = cfg, tuple(names), target, {}
-        fields_in = {"n_phi": angle_shape(cfg), **{v: polar_layout(cfg) for v in names},
+    def __init__(self, cfg, count, first=0, target=None):
+        self.cfg, self.count, self.first, self.target, self.memories = cfg, count, first, target, {}
+        terms = data.StructLayout({v: _vector_layout(cfg) for v, _ in light_layout(cfg)})
+        fields_in = {"n_phi": angle_shape(cfg), "lights": data.ArrayLayout(light_layout(cfg), count),
                      "tag": unsigned(cfg.tag_bits)}
-        fields_out = {**{v: _vector_layout(cfg) for v in names}, "tag": unsigned(cfg.tag_bits)}
+        fields_out = {"lights": data.ArrayLayout(terms, count), "tag": unsigned(cfg.tag_bits)}
         super().__init__({"i": In(stream.Signature(data.StructLayout(fields_in))),
                           "o": Out(stream.Signature(data.StructLayout(fields_out)))})
 
@@ -68,9 +73,12 @@ class VectorTerms(wiring.Component):
         self.memories = pipe.memories
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
-        for v in self.names:
-            for name, value in vector_terms(pipe, rom, px[v], px.n_phi, v, self.latency).items():
-                m.d.comb += out[v][name].eq(value)
+        for k in range(self.count):
+            j = self.first + k                     # the pipeline's light number
+            for v, _ in light_layout(self.cfg):
+                label = v + str(j) if j else v
+                terms = vector_terms(pipe, rom, px.lights[k][v], px.n_phi, label, self.latency)
+                m.d.comb += [out.lights[k][v][name].eq(value) for name, value in terms.items()]
         m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
         return m
 
@@ -141,8 +149,10 @@ class BumpPipeline(wiring.Component):
     Members
     -------
     i : In(stream.Signature(...))
-        varying map: {u, v, [level], n, l, [h], [l1, h1, ...], tag}; flat map:
-        {[u, v, [level] with a texture], l, [h], ..., tag}; palette: {u, v, [level], tag}.
+        varying map: {u, v, [level], n, l, [h], [extra_lights], tag}; flat map:
+        {[u, v, [level] with a texture], l, [h], [extra_lights], tag}; palette: {u, v,
+        [level], tag}. Light 0's vectors are ``l``, ``h``; with m > 1 lights
+        ``extra_lights[j - 1]`` = {l, [h]} holds light j's (``layouts.light_fields``).
         Angles are binary angles.
     o : Out(stream.Signature(...))
         ``shade_layout`` (diffuse, specular, color, diffuse_fine, specular_fine, tag; with
@@ -155,8 +165,17 @@ class BumpPipeline(wiring.Component):
         Host write port of the colour texture (``texture = true``).
     poly_en, poly : In
         Flat map: the polygon registers {n_phi, x4, y2, z4} (n'' rotated once per polygon).
-    lut_w_en, lut_w_addr, lut_w_data, lut_swap, lut_bank :
-        Palette: PaletteLUT's host port.
+    lut_w_en, lut_w_addr, lut_w_data, lut_swap, lut_bank, lut_w_ready :
+        Palette: PaletteLUT's host port. The pipeline samples the front bank (``lut_bank``)
+        in the cycle it accepts a pixel and the pixel carries it through the fetch: every
+        pixel reads the bank that was in front when the *pipeline* accepted it, whatever the
+        host swaps while it is in flight, so a frame (the pixels between two swaps) reads
+        one bank and a swap takes effect with the first pixel accepted after it. A write
+        (``lut_w_en``, to the back bank) is done in a cycle with ``lut_w_ready`` high, a
+        valid/ready handshake: the host holds ``lut_w_en``/``addr``/``data`` until it sees
+        ``lut_w_ready``. It is low while a pixel accepted before the last swap still waits
+        in the fetch stages to read the back bank (at most the fetch latency after the swap
+        without backpressure); before the first pixel and between frames it is high.
 
     ``latency`` is the sum of the units' latencies; 1 pixel per clock when not stalled.
     ``built`` lists the units and why each was built; after elaboration ``memories`` lists
@@ -176,9 +195,11 @@ class BumpPipeline(wiring.Component):
             self._plan_shading(init)
         if "fetch" in self.units:
             in_layout = self.units["fetch"].i.payload.shape()
+            if scene.shading == "palette":          # the bank rides inside, from lut_bank
+                in_layout = data.StructLayout({f: in_layout[f].shape for f, _ in in_layout
+                                               if f != "bank"})
         else:                                       # flat map: the light vectors and the tag
-            terms = self.units["terms"].i.payload.shape()
-            in_layout = data.StructLayout({f: terms[f].shape for f, _ in terms if f != "n_phi"})
+            in_layout = data.StructLayout({**light_fields(cfg), "tag": unsigned(cfg.tag_bits)})
         ports["i"] = In(stream.Signature(in_layout))
         ports["o"] = Out(stream.Signature(self.units[self._last].o.payload.shape()))
         if "fetch" in self.units and has_map(scene):
@@ -195,7 +216,7 @@ class BumpPipeline(wiring.Component):
             lut = self.units["palette"]
             ports.update({"lut_w_en": In(1), "lut_w_addr": In(lut.w_addr.shape()),
                           "lut_w_data": In(lut.w_data.shape()), "lut_swap": In(1),
-                          "lut_bank": Out(1)})
+                          "lut_bank": Out(1), "lut_w_ready": Out(1)})
         super().__init__(ports)
 
     # --- planning: which units, and why -----------------------------------------------------
@@ -217,7 +238,7 @@ class BumpPipeline(wiring.Component):
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):
-        lut = PaletteLUT(self.cfg, self.target)
+        lut = PaletteLUT(self.cfg, self.target, bank_in=True)
         self._fetch(lut.i.payload.shape(), init, "a palette index")
         if self.scene.texture:
             self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
@@ -228,30 +249,28 @@ class BumpPipeline(wiring.Component):
 
     def _plan_shading(self, init):
         s, cfg = self.scene, self.cfg
-        lights = light_fields(s)
-        extra = [v for names in lights[1:] for v in names]
         spec = "with the H path and specular table" if s.specular else \
             "specular = false: no H path, no specular table"
         rot_layer = []
         if s.rotation == "per-pixel":
             fields = {name: f.shape for name, f in pixel_layout(cfg)}
             tag = fields.pop("tag")
-            self._fetch(data.StructLayout({**fields, **{v: polar_layout(cfg) for v in extra},
-                                           "tag": tag}), init, "N' (polar angles)")
+            fields.update(light_fields(cfg))   # l, h stay in place; extra_lights after b
+            self._fetch(data.StructLayout({**fields, "tag": tag}), init, "N' (polar angles)")
             self._add("rotation", VectorRotation(cfg, self.target),
                       f"rotation = 'per-pixel': N' rotated into N's frame every pixel ({spec})")
             rot_layer.append("rotation")
-            term_names = extra
+            first = 1                          # light 0 rides in the rotation
         else:
-            term_names = [v for names in lights for v in names]
+            first = 0
             if s.texture:                      # no bump map, but the colour texture is fetched
-                terms = {v: polar_layout(cfg) for v in term_names}
-                self._fetch(data.StructLayout({**terms, "tag": unsigned(cfg.tag_bits)}), init, "")
-        if term_names:
+                self._fetch(data.StructLayout({**light_fields(cfg), "tag": unsigned(cfg.tag_bits)}),
+                            init, "")
+        if s.lights > first:
             why = ("bump_map = 'flat': n'' written once per polygon, per pixel only the light "
                    "terms" if s.rotation == "per-polygon" else
                    f"lights = {s.lights}: lights 1..{s.lights - 1} share light 0's rotated normal")
-            self._add("terms", VectorTerms(cfg, term_names, self.target), why)
+            self._add("terms", VectorTerms(cfg, s.lights - first, first, self.target), why)
             rot_layer.append("terms")
         ill = []
         for j in range(s.lights):
@@ -325,20 +344,7 @@ class BumpPipeline(wiring.Component):
                 m.d.comb += [getattr(f, f"{port}w_{k}").eq(getattr(self, f"{prefix}w_{k}"))
                              for k in ("en", "addr", "data")]
         if s.shading == "palette":
-            lut, f = u["palette"], u["fetch"]
-            wiring.connect(m, wiring.flipped(self.i), f.i)
-            if s.texture:                      # Tarini eq. 2: the texel is the base colour
-                m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
-                             lut.i.payload.index.eq(f.o.payload.index),
-                             lut.i.payload.base.eq(Cat(f.o.payload.texel.as_value(),
-                                                       Const(255, 8))),
-                             lut.i.payload.tag.eq(f.o.payload.tag)]
-            else:
-                wiring.connect(m, f.o, lut.i)
-            wiring.connect(m, lut.o, wiring.flipped(self.o))
-            m.d.comb += [lut.w_en.eq(self.lut_w_en), lut.w_addr.eq(self.lut_w_addr),
-                         lut.w_data.eq(self.lut_w_data), lut.swap.eq(self.lut_swap),
-                         self.lut_bank.eq(lut.bank)]
+            self._elaborate_palette(m)
             return m
         if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
             wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
@@ -351,7 +357,7 @@ class BumpPipeline(wiring.Component):
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg
-        lights = light_fields(s)
+        vectors = [v for v, _ in light_layout(cfg)]
         if "fetch" in u:
             wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
             src = u["fetch"].o
@@ -363,14 +369,15 @@ class BumpPipeline(wiring.Component):
         if "rotation" in u:
             m.d.comb += [u["rotation"].i.payload[f].eq(src.payload[f])
                          for f, _ in pixel_layout(cfg)]
+        # light j's l, h: light 0's at the top of the payload, the others in extra_lights
+        given = [src.payload] + [src.payload.extra_lights[k] for k in range(s.lights - 1)]
         terms = u.get("terms")
         if terms is not None:
-            for f, _ in terms.i.payload.shape():
-                if f == "n_phi":
-                    value = src.payload.n.phi if poly is None else poly.n_phi
-                else:
-                    value = src.payload[f]
-                m.d.comb += terms.i.payload[f].eq(value)
+            t = terms.i.payload
+            m.d.comb += t.n_phi.eq(src.payload.n.phi if poly is None else poly.n_phi)
+            m.d.comb += [t.lights[k][v].eq(given[terms.first + k][v])
+                         for k in range(terms.count) for v in vectors]
+            m.d.comb += t.tag.eq(src.payload.tag)
         if s.texture:
             m.d.comb += u["texel_r"].i.payload.texel.eq(src.payload.texel)
         lead = u[rot_layer[0]].o
@@ -378,12 +385,13 @@ class BumpPipeline(wiring.Component):
         for n in rot_layer[1:]:
             m.d.comb += u[n].o.ready.eq(lead.ready)
         n_src = u["rotation"].o.payload.n if poly is None else poly.n
-        for j, names in enumerate(lights):
-            ill = u[ill_layer[j]].i.payload
+        # light j's rotated l, h: light 0's from the rotation (varying map), the rest from terms
+        rotated = ([u["rotation"].o.payload] if "rotation" in u else []) + \
+            ([terms.o.payload.lights[k] for k in range(terms.count)] if terms is not None else [])
+        for j, name in enumerate(ill_layer[:s.lights]):
+            ill = u[name].i.payload
             m.d.comb += [ill.n.eq(n_src), ill.tag.eq(lead.payload.tag)]
-            for std, name in zip(("l", "h"), names):
-                rot_out = u["rotation"].o.payload if j == 0 and "rotation" in u else terms.o.payload
-                m.d.comb += ill[std].eq(rot_out[name])
+            m.d.comb += [ill[v].eq(rotated[j][v]) for v in vectors]
         if s.texture:
             m.d.comb += u["texel_i"].i.payload.texel.eq(u["texel_r"].o.payload.texel)
         lead = u[ill_layer[0]].o
@@ -401,6 +409,33 @@ class BumpPipeline(wiring.Component):
             m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
         wiring.connect(m, total.o, wiring.flipped(self.o))
+
+    def _elaborate_palette(self, m):
+        """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel."""
+        lut, f = self.units["palette"], self.units["fetch"]
+        m.d.comb += [f.i.valid.eq(self.i.valid), self.i.ready.eq(f.i.ready),
+                     f.i.payload.bank.eq(lut.bank)]
+        m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
+        if self.scene.texture:                 # Tarini eq. 2: the texel is the base colour
+            m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
+                         lut.i.payload.index.eq(f.o.payload.index),
+                         lut.i.payload.base.eq(Cat(f.o.payload.texel.as_value(), Const(255, 8))),
+                         lut.i.payload.bank.eq(f.o.payload.bank),
+                         lut.i.payload.tag.eq(f.o.payload.tag)]
+        else:
+            wiring.connect(m, f.o, lut.i)
+        wiring.connect(m, lut.o, wiring.flipped(self.o))
+        # Pixels between the input and the LUT per bank they read: a write to the back bank
+        # waits (lut_w_ready low) while one of them still has to read it.
+        take_in, take_lut = self.i.valid & self.i.ready, lut.i.valid & lut.i.ready
+        waiting = [Signal(range(f.latency + 1), name=f"lut_bank{b}_pending") for b in (0, 1)]
+        for b, count in enumerate(waiting):
+            m.d.sync += count.eq(count + (take_in & (lut.bank == b))
+                                 - (take_lut & (lut.i.payload.bank == b)))
+        m.d.comb += [self.lut_w_ready.eq(~Mux(lut.bank, waiting[0], waiting[1]).any()),
+                     lut.w_en.eq(self.lut_w_en & self.lut_w_ready),
+                     lut.w_addr.eq(self.lut_w_addr), lut.w_data.eq(self.lut_w_data),
+                     lut.swap.eq(self.lut_swap), self.lut_bank.eq(lut.bank)]
 
     def _poly_reg(self, m):
         """The polygon registers, written by the host when ``poly_en`` (once per polygon)."""

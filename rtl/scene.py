@@ -13,12 +13,12 @@ from dataclasses import dataclass, fields, asdict
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.rtl.methods import PER_PIXEL, get
 from bumprtl.sim.scenes import GEOMETRIES, SCENES
 from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE, map_size
 
 __all__ = ["SceneConfig", "SceneError", "BUILTIN", "load_scene_config", "ADDRESSING",
-           "BUMP_MAPS", "SHADINGS", "ROTATIONS", "MAP_KEYS", "light_fields", "flag_name"]
+           "BUMP_MAPS", "SHADINGS", "ROTATIONS", "MAP_KEYS", "flag_name"]
 
 ADDRESSING = ("wrap", "clamp")
 BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
@@ -142,12 +142,16 @@ class SceneConfig:
             raise SceneError(f"method must be one of {', '.join(PER_PIXEL)} in a scene (the "
                              f"baselines are built for the cost comparison only), got {self.method!r}")
         self._check_rotation()
-        if self.rotation == "per-polygon" and self.method != "exact":
-            raise SceneError(f"bump_map = 'flat' needs method = 'exact' (its rotation of N' once "
-                             f"per polygon is the exact method's n''), got {self.method!r}")
-        if self.lights > 1 and self.method != "exact" and self.shading == "per-pixel":
-            raise SceneError(f"lights = {self.lights} needs method = 'exact' (lights share the one "
-                             f"rotated normal n''; the lee method rotates each light instead)")
+        rotates_normal = get(self.method).rotates_normal
+        allowed = " or ".join(repr(n) for n in PER_PIXEL if get(n).rotates_normal)
+        if self.rotation == "per-polygon" and not rotates_normal:
+            raise SceneError(f"bump_map = 'flat' needs method = {allowed} (its rotation of N' once "
+                             f"per polygon is the rotated normal n''), got {self.method!r}",
+                             "bump_map")
+        if self.lights > 1 and not rotates_normal and self.shading == "per-pixel":
+            raise SceneError(f"lights = {self.lights} needs method = {allowed} (lights share the "
+                             f"one rotated normal n''; the {self.method} method rotates each light "
+                             f"instead)", "lights")
 
     def _check_picture(self):
         """image, or one user map (then image is None), and the keys that go with them."""
@@ -229,15 +233,6 @@ class SceneConfig:
         if any(changes.get(k) is not None for k in MAP_KEYS):
             keys.update(image=None, **{k: None for k in MAP_KEYS})
         return load_scene_config({**keys, **changes, "rotation": changes.get("rotation")})
-
-
-def light_fields(scene: SceneConfig):
-    """Payload names of each light's vectors: ``("l", "h")`` for light 0, ``("l1", "h1")``..."""
-    names = []
-    for j in range(scene.lights):
-        suffix = "" if j == 0 else str(j)
-        names.append((f"l{suffix}",) + ((f"h{suffix}",) if scene.specular else ()))
-    return names
 
 
 def _choice(key, value, allowed):

@@ -2,64 +2,88 @@
 channel (diffuse, specular, colour), on random inputs and on the adversarial searches aimed
 at each channel, beside the proven bound of each channel (the sidecar's ``error_bounds_lsb``).
 
-A measured error above its bound is a failure: the offending input is printed and the
-command exits 1.
+Two measures per channel, on the same pixels:
+
+* **end-to-end**: float64 on the unquantized inputs (what the bound is about): the input
+  rounding to the angle grid plus the datapath's arithmetic;
+* **arithmetic**: float64 on the angles the hardware receives (the inputs rounded to the
+  grid, sim/golden/accuracy.on_grid): the datapath's own error, without the input rounding.
+  Not for the Cartesian-input methods (Peercy, Ernst): printed as "—".
+
+A measured error (either measure) above its bound is a failure: the offending input is
+printed and the command exits 1.
 """
 
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 
 from bumprtl.rtl.config import BumpError, Config, ConfigError
-from bumprtl.rtl.methods import METHODS, datapath_fixed, encode_pixels
+from bumprtl.rtl.methods import METHODS, datapath_fixed, encode_pixels, get
+from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
+                                         crater_scene, grid_errors_lsb, on_grid, reference_blend,
                                          scene_error, term_errors_lsb)
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
+from bumprtl.sim.golden.fixed.common import phong_sum_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.scenes import SCENES, load_scene
-from bumprtl.gen.flow.units import build_unit
+from bumprtl.gen.flow.units import build_unit, error_bounds
 
-__all__ = ["measure", "run", "add_parser"]
+__all__ = ["measure", "light_sums", "run", "add_parser"]
 
 
 def _stats(err):
     return {"max": int(err.max()), "mean": float(err.mean()), "worst": int(np.argmax(err))}
 
 
+KINDS = ("random", "adversarial", "search")       # the three pixel sets of a channel's row
+
+
 def measure(cfg: Config, px: PixelInputs):
-    """Per channel: the errors (8-bit LSB) on the random pixels ``px``, on the adversarial
-    search aimed at that channel, and on the arithmetic search (specular and colour); the
+    """Per channel, on the random pixels ``px``, on the adversarial search aimed at that
+    channel and on the search aimed at the dot product's arithmetic error (``search``):
+    the end-to-end errors (8-bit LSB; ``random``, ``adversarial``, ``search``) and the
+    arithmetic errors (``grid``: {kind: stats}, None for a Cartesian-input method); the
     bound; and the pixel sets, so that a failure can be shown."""
-    sets = {"random": px}
-    out = {}
-    arith = arithmetic_pixels(datapath_fixed, cfg)
+    sets = {"random": px, "search": arithmetic_pixels(datapath_fixed, cfg)}
     for channel in CHANNELS:
         sets[f"adversarial {channel}"] = adversarial_pixels(cfg, channel=channel)
     bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
     errors = {name: term_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
-    errors["arithmetic"] = term_errors_lsb(datapath_fixed, arith, cfg)
-    sets["arithmetic"] = arith
+    grid = {name: grid_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
+    out = {}
     for channel in CHANNELS:
-        out[channel] = {"random": _stats(errors["random"][channel]),
-                        "adversarial": _stats(errors[f"adversarial {channel}"][channel]),
-                        "arithmetic": _stats(errors["arithmetic"][channel]),
-                        "bound": bounds[channel],
-                        "sets": {"random": "random", "adversarial": f"adversarial {channel}",
-                                 "arithmetic": "arithmetic"}}
+        names = {"random": "random", "adversarial": f"adversarial {channel}", "search": "search"}
+        out[channel] = {**{k: _stats(errors[names[k]][channel]) for k in KINDS},
+                        "grid": None if grid["random"] is None else
+                        {k: _stats(grid[names[k]][channel]) for k in KINDS},
+                        "bound": bounds[channel], "sets": names}
     return out, sets
 
 
-def _failure(cfg, channel, kind, row, sets):
-    """One line per failure: the set, the measured and bound, and the offending pixel."""
+def _failure(cfg, channel, kind, row, sets, grid=False):
+    """One line per failure: the set, the measure, the measured and bound, and the
+    offending pixel (and, for the arithmetic measure, the angles float64 was given)."""
     px = sets[row["sets"][kind]]
-    i = row[kind]["worst"]
+    stats = row["grid"][kind] if grid else row[kind]
+    i = stats["worst"]
     one = px.subset(slice(i, i + 1))
-    angles = ", ".join(f"{f.name}={float(getattr(one, f.name)[0])!r}" for f in fields(one))
+    ref = on_grid(one, cfg) if grid else one
+    angles = lambda p: ", ".join(f"{f.name}={float(getattr(p, f.name)[0])!r}" for f in fields(p))
     got = datapath_fixed(encode_pixels(one, cfg), cfg)[channel][0]
-    want = to_8bit(getattr(conventional(one, cfg), channel))[0]
+    want = to_8bit(getattr(conventional(ref, cfg), channel))[0]
+    where = f"; float64 on the received angles ({angles(ref)})" if grid else ""
     return (f"FAIL {cfg.method} angle_bits={cfg.angle_bits} frac_bits={cfg.frac_bits} "
-            f"spec_exponent={cfg.spec_exponent} {channel} ({kind}): error {row[kind]['max']} LSB > "
-            f"bound {row['bound']} at pixel ({angles}) [radians]: fixed {int(got)}, float64 {int(want)}")
+            f"spec_exponent={cfg.spec_exponent} {channel} ({kind}, "
+            f"{'arithmetic' if grid else 'end-to-end'}): error {stats['max']} LSB > "
+            f"bound {row['bound']} at pixel ({angles(one)}) [radians]{where}: "
+            f"fixed {int(got)}, float64 {int(want)}")
+
+
+def _grid_cell(row):
+    g = row["grid"]
+    return "—" if g is None else " / ".join(str(g[k]["max"]) for k in KINDS)
 
 
 def run(args):
@@ -72,15 +96,19 @@ def run(args):
           f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
           f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits} "
           f"--scene-size {args.scene_size}")
-    print(f"\nerror in 8-bit LSB against float64 on unquantized inputs, per output channel: "
-          f"{args.samples} random valid pixels (seed 11); the adversarial search aimed at the "
-          f"channel (seed 7); the arithmetic search (on-grid N', H near N', seed 5). "
-          f"bound = the sidecar's error_bounds_lsb (proof: predicted_error_bound_lsb)\n")
-    print("| angle bits | frac bits | n | channel | random max / mean | adversarial max / mean "
-          "| arithmetic max | bound | worst / bound |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(f"\nerror in 8-bit LSB per output channel, on {args.samples} random valid pixels (seed "
+          f"11), the adversarial search aimed at the channel (seed 7) and the search aimed at "
+          f"the dot product's arithmetic error (on-grid N', H near N', seed 5). end-to-end = "
+          f"against float64 on the unquantized inputs (input rounding + arithmetic); "
+          f"arithmetic = against float64 on the angles the hardware receives (the inputs "
+          f"rounded to the angle grid; — for Cartesian inputs). bound = the sidecar's "
+          f"error_bounds_lsb (end-to-end; proof: predicted_error_bound_lsb)\n")
+    print("| angle bits | frac bits | n | channel | end-to-end random max / mean "
+          "| end-to-end adversarial max / mean | end-to-end search max "
+          "| arithmetic max (random / adversarial / search) | bound | worst / bound |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     px = PixelInputs.random(args.samples, np.random.default_rng(11))
-    failures = []
+    failures, summary = [], []
     for a in args.angle_bits:
         for b in args.frac_bits:
             for n in args.spec_exponent:
@@ -91,15 +119,22 @@ def run(args):
                     continue
                 result, sets = measure(cfg, px)
                 for channel, row in result.items():
-                    top = max(row[k]["max"] for k in ("random", "adversarial", "arithmetic"))
+                    top = max(row[k]["max"] for k in KINDS)
+                    if row["grid"] is not None:
+                        top = max(top, *(row["grid"][k]["max"] for k in KINDS))
                     ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
                     print(f"| {a} | {b} | {n} | {channel} | {row['random']['max']} / "
                           f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
-                          f"{row['adversarial']['mean']:.4f} | {row['arithmetic']['max']} | "
-                          f"{row['bound']} | {ratio} |", flush=True)
-                    failures += [_failure(cfg, channel, k, row, sets)
-                                 for k in ("random", "adversarial", "arithmetic")
+                          f"{row['adversarial']['mean']:.4f} | {row['search']['max']} | "
+                          f"{_grid_cell(row)} | {row['bound']} | {ratio} |", flush=True)
+                    failures += [_failure(cfg, channel, k, row, sets) for k in KINDS
                                  if row[k]["max"] > row["bound"]]
+                    if row["grid"] is not None:
+                        failures += [_failure(cfg, channel, k, row, sets, grid=True) for k in KINDS
+                                     if row["grid"][k]["max"] > row["bound"]]
+                summary.append(_summary(cfg, result))
+    print("\n" + "\n".join(summary))
+    failures += _lights(args, px)
     if args.scene_size:
         _scenes(args)
     for line in failures:
@@ -107,9 +142,110 @@ def run(args):
     return 1 if failures else 0
 
 
+def _summary(cfg, result):
+    """One line per Config: the worst end-to-end and arithmetic error of each channel, and
+    what the difference is."""
+    def worst(row, grid=False):
+        return max((row["grid"] if grid else row)[k]["max"] for k in KINDS)
+    head = f"angle bits {cfg.angle_bits}, frac bits {cfg.frac_bits}, n = {cfg.spec_exponent}:"
+    e2e = ", ".join(f"{c} {worst(r)}" for c, r in result.items())
+    if any(r["grid"] is None for r in result.values()):
+        return f"{head} end-to-end max {e2e} LSB (Cartesian inputs: no arithmetic-only measure)"
+    arith = ", ".join(f"{c} {worst(r, True)}" for c, r in result.items())
+    return (f"{head} arithmetic max {arith} LSB; end-to-end max {e2e} LSB "
+            f"(end to end adds the inputs' rounding to the {cfg.angle_bits}-bit angle grid)")
+
+
+def _outputs(pxs, cfg, texels, grid=False):
+    """Eq. 2's colour of the lights ``pxs`` (one PixelInputs a light, the same N and N')
+    and the texture blend on ``texels``: the fixed-point model's (the lights' unrounded
+    terms summed and rounded once, LightSum / TextureBlend) and float64's, on the
+    unquantized inputs or (``grid``) on the angles the hardware receives."""
+    outs = [datapath_fixed(encode_pixels(p, cfg), cfg) for p in pxs]
+    refs = [conventional(on_grid(p, cfg) if grid else p, cfg) for p in pxs]
+    d, s = sum(o["diffuse_fine"] for o in outs), sum(o["specular_fine"] for o in outs)
+    ks = cfg.ks if cfg.specular else 0.0
+    want = to_8bit(np.clip(cfg.ka + sum(cfg.kd * np.clip(r.ndotl, 0, 1) + ks * r.specular
+                                        for r in refs), 0, 1))
+    blend = texture_blend([o["diffuse_fine"] for o in outs], [o["specular_fine"] for o in outs],
+                          texels, cfg)[0]
+    want_blend = reference_blend(refs, texels, cfg)
+    err = lambda a, b: np.abs(np.asarray(a, np.int64) - np.asarray(b, np.int64))
+    return {"color": err(phong_sum_fixed(d, s, cfg), want),
+            "blend": np.max([err(blend[c], want_blend[c]) for c in RGB], axis=0)}
+
+
+def light_sums(cfg: Config, px: PixelInputs):
+    """Eq. 2 summed over m = 1 and 2 lights and the texture blend (random texels, seed 3),
+    per output: {(m, output): {random, adversarial, grid: {random, adversarial} | None,
+    bound, sets}}. Random: ``px`` and, for the second light, L and H of other random pixels
+    (seed 12) on the same N and N'. Adversarial: the search aimed at the colour with every
+    light the same (the lights' errors then add up). The bounds are the pipeline sidecar's
+    (error_bounds with ``lights`` and ``texture``)."""
+    other = PixelInputs.random(len(px), np.random.default_rng(12))
+    other = replace(other, n_phi=px.n_phi, n_theta=px.n_theta, b_phi=px.b_phi, b_theta=px.b_theta)
+    adv = adversarial_pixels(cfg, channel="color")
+    rng = np.random.default_rng(3)
+    out = {}
+    for m in (1, 2):
+        sets = {"random": [px, other][:m], "adversarial": [adv] * m}
+        texels = {k: {c: rng.integers(0, 256, len(p[0])) for c in RGB} for k, p in sets.items()}
+        e2e = {k: _outputs(p, cfg, texels[k]) for k, p in sets.items()}
+        grid = (None if get(cfg.method).cartesian else
+                {k: _outputs(p, cfg, texels[k], grid=True) for k, p in sets.items()})
+        for output in ("color", "blend"):
+            bound = error_bounds(cfg, m, texture=output == "blend")["color"]
+            out[(m, output)] = {**{k: _stats(e2e[k][output]) for k in sets},
+                                "grid": None if grid is None else
+                                {k: _stats(grid[k][output]) for k in sets},
+                                "bound": bound, "sets": sets, "texels": texels}
+    return out
+
+
+def _lights(args, px):
+    """The light-sum and blend table at the default widths of ``args.method``; returns the
+    failure lines."""
+    cfg = Config(method=args.method, spec_index_bits=args.spec_index_bits)
+    print(f"\neq. 2's colour summed over m lights (LightSum) and the texture blend (TextureBlend, "
+          f"random texels), rounded once, at angle bits {cfg.angle_bits}, frac bits "
+          f"{cfg.frac_bits}, n = {cfg.spec_exponent}: random = the {len(px)} pixels (a second "
+          f"light: random L, H on the same N, N', seed 12); adversarial = the search aimed at "
+          f"the colour, every light the same; bound = the pipeline sidecar's error_bounds_lsb "
+          f"color of an m-light (textured) scene\n")
+    print("| lights | output | end-to-end random max / mean | end-to-end adversarial max / mean "
+          "| arithmetic max (random / adversarial) | bound | worst / bound |")
+    print("|---|---|---|---|---|---|---|")
+    failures = []
+    for (m, output), row in light_sums(cfg, px).items():
+        kinds = ("random", "adversarial")
+        grid = row["grid"]
+        top = max([row[k]["max"] for k in kinds] + ([grid[k]["max"] for k in kinds] if grid else []))
+        cell = "—" if grid is None else " / ".join(str(grid[k]["max"]) for k in kinds)
+        ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
+        print(f"| {m} | {'colour' if output == 'color' else 'blend'} | {row['random']['max']} / "
+              f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
+              f"{row['adversarial']['mean']:.4f} | {cell} | {row['bound']} | "
+              f"{ratio} |", flush=True)
+        for k in kinds:
+            for measure, stats in (("end-to-end", row[k]), ("arithmetic", grid and grid[k])):
+                if stats and stats["max"] > row["bound"]:
+                    i = stats["worst"]
+                    lights = "; ".join(
+                        f"light {j + 1}: " + ", ".join(f"{f.name}={float(getattr(p, f.name)[i])!r}"
+                                                       for f in fields(p))
+                        for j, p in enumerate(row["sets"][k]))
+                    tex = (f", texel {tuple(int(row['texels'][k][c][i]) for c in RGB)}"
+                           if output == "blend" else "")
+                    failures.append(f"FAIL {cfg.method} lights={m} {output} ({k}, {measure}): "
+                                    f"error {stats['max']} LSB > bound {row['bound']} at pixel "
+                                    f"{i} ({lights}) [radians]{tex}")
+    return failures
+
+
 def _scenes(args):
-    """Every built-in scene shaded at the default widths of ``args.method``: eq. 2's colour
-    image and, where the scene has a colour texture, the texture blend on its 8-bit albedo
+    """Every built-in scene and the unseen crater map (sim/golden/accuracy.crater_scene)
+    shaded at the default widths of ``args.method``: eq. 2's colour image and, where the
+    scene has a colour texture, the texture blend on its 8-bit albedo
     (sim/golden/accuracy.scene_error), over the pixels the geometry covers."""
     cfg = Config(method=args.method, spec_index_bits=args.spec_index_bits)
     print(f"\nscenes at {args.scene_size}x{args.scene_size} (angle bits {cfg.angle_bits}, frac bits "
@@ -117,8 +253,9 @@ def _scenes(args):
           f"`conventional` on the unquantized inputs\n")
     print("| scene | colour (eq. 2) | texture blend |")
     print("|---|---|---|")
-    for name in SCENES:
-        scene = load_scene(name, size=args.scene_size)
+    for name in (*SCENES, "craters"):
+        scene = (crater_scene(size=args.scene_size) if name == "craters" else
+                 load_scene(name, size=args.scene_size))
         rows = [scene_error(scene, cfg, datapath_fixed)]
         if scene.albedo is not None:
             rows.append(scene_error(scene, cfg, datapath_fixed, blend=True))

@@ -28,7 +28,8 @@ def run(args):
                             f"scene's memories), not to {args.unit}")
         cfg = config_from_args(args)
     if args.interface == "axis":
-        v_path, j_path = emit_axis(args.unit, cfg, args.out, args.tdata_width)
+        images = _scene_images(args.unit, cfg, args) if args.unit in SCENE_UNITS else None
+        v_path, j_path, hexes = emit_axis(args.unit, cfg, args.out, args.tdata_width, images)
     elif args.tdata_width is not None:
         raise BumpError("--tdata-width needs --interface axis")
     elif args.unit in SCENE_UNITS:
@@ -48,13 +49,17 @@ def run(args):
     return 0
 
 
+def _scene_images(unit, scene, args):
+    """The scene unit's memory images: built-in initial contents, or for the host write port."""
+    words, texels, table = scene_memories(scene)
+    return memory_images(unit, scene, words, texels, table, args.load or "initial")
+
+
 def _emit_scene(unit, scene, args):
     """The scene unit with its memory contents: built in, or for the host write port."""
-    load = args.load or "initial"
-    words, texels, table = scene_memories(scene)
-    images = memory_images(unit, scene, words, texels, table, load)
+    images = _scene_images(unit, scene, args)
     return emit_scene_unit(unit, scene, args.out, images, args.device or DEFAULT_DEVICE,
-                           scene_command(unit, scene, load))
+                           scene_command(unit, scene, args.load or "initial"))
 
 
 def add_parser(sub):

@@ -4,14 +4,23 @@
 The sidecar is the unit's own (config with the user's ``tag_bits``, latency, ROM sizes,
 error bound) plus ``interface: axis`` and ``axis``: tdata width, the tdata field packing of
 both buses, the tuser/tlast conventions and the reset.
+
+A scene unit (``pipeline``, ``fetch``) is built with its memory images
+(gen/flow/memories.py ``memory_images``): the ``load = "initial"`` ones as the Verilog's
+initial contents, each written beside it as ``<unit>_axis_<memory>.hex`` and described in
+the sidecar's ``memory_images``, as ``bumprtl emit`` does without ``--interface axis``.
 """
 
 import json
+from pathlib import Path
 
 from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.memories import hex_text, scene_command
 from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, canonical_command
 from bumprtl.rtl.axis import AxisWrapper
+from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipeline import BumpPipeline
 
 __all__ = ["build_axis", "emit_axis", "axis_name"]
 
@@ -20,30 +29,55 @@ def axis_name(name):
     return f"{name}_axis"
 
 
-def build_axis(name, cfg, tdata_width=None):
-    """``(wrapper, sidecar, command)`` for unit ``name`` in AXI4-Stream ports."""
+def _builder(name, images):
+    """Config -> the unit, with the initial contents of ``images`` for a scene unit."""
+    if name not in SCENE_UNITS or not images:
+        return lambda c: UNITS[name].build(c, target=None)
+    init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
+    cls = BumpPipeline if name == "pipeline" else BumpMapFetch
+    return lambda scene: cls(scene, init=init("map"), texture=init("texture"))
+
+
+def build_axis(name, cfg, tdata_width=None, images=None):
+    """``(wrapper, sidecar, command)`` for unit ``name`` in AXI4-Stream ports; ``images``:
+    a scene unit's memory images (``memory_images``), None for empty memories."""
     if name not in UNITS:
         raise BumpError(f"unit must be one of {', '.join(UNITS)}, got {name!r}")
     unit = UNITS[name]
-    wrapper = AxisWrapper(lambda c: unit.build(c, target=None), cfg, tdata_width)
+    wrapper = AxisWrapper(_builder(name, images), cfg, tdata_width)
     inner = unit.sidecar(cfg.replace(tag_bits=cfg.tag_bits + 1), wrapper.unit)
     sidecar = {**inner, "config": cfg.config.to_dict() if name in SCENE_UNITS else cfg.to_dict(),
                "interface": "axis", "axis": wrapper.sidecar()}
     if "scene" in inner:
         sidecar["scene"] = cfg.to_dict()
-    command = canonical_command(unit, cfg) + " --interface axis"
+    if images:
+        sidecar["memory_images"] = {
+            n: {**{k: v for k, v in img.items() if k != "words"},
+                "file": f"{axis_name(name)}_{n}.hex"} for n, img in images.items()}
+    command = (canonical_command(unit, cfg) if name not in SCENE_UNITS or not images
+               else scene_command(name, cfg, _load(images))) + " --interface axis"
     if tdata_width is not None:
         command += f" --tdata-width {tdata_width}"
     return wrapper, sidecar, command
 
 
-def emit_axis(name, cfg, out_dir, tdata_width=None):
-    """Write ``<out_dir>/<name>_axis.v`` and ``.json`` (one flattened module); returns the
-    two paths."""
-    wrapper, sidecar, command = build_axis(name, cfg, tdata_width)
+def _load(images):
+    return images["map"]["load"] if "map" in images else "initial"
+
+
+def emit_axis(name, cfg, out_dir, tdata_width=None, images=None):
+    """Write ``<out_dir>/<name>_axis.v`` and ``.json`` (one flattened module) and, for a
+    scene unit with ``images``, one ``$readmemh`` file per image; returns ``(v, json,
+    [hex...])``."""
+    wrapper, sidecar, command = build_axis(name, cfg, tdata_width, images)
     v_path, j_path = emit(wrapper, axis_name(name), command, out_dir, sidecar, flatten=True)
     meta = json.loads(j_path.read_text())
     for port in ("clk", "rst"):                 # aclk/aresetn instead (port_table adds these)
         meta["ports"].pop(port, None)
     j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
-    return v_path, j_path
+    hexes = []
+    for n, img in (images or {}).items():
+        path = Path(out_dir) / sidecar["memory_images"][n]["file"]
+        path.write_text(hex_text(img["words"], img["width"]))
+        hexes.append(path)
+    return v_path, j_path, hexes

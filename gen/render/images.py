@@ -12,7 +12,7 @@ import numpy as np
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed, encode_pixels
+from bumprtl.rtl.methods import METHODS, PER_PIXEL, datapath_fixed, encode_pixels
 from bumprtl.rtl.scene import SceneConfig
 from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
@@ -32,10 +32,11 @@ PALETTE = "palette"                # Tarini et al.'s quantized normal map (sim/g
 QUANTIZERS = ("median-cut", "kmeans")
 MODELS = ("float64", "fixed")
 # render method -> the registry method (rtl/methods.py) whose bit-exact model renders it with
-# --model fixed; palette: the pipeline's PaletteLUT. conventional and lee_printed have no
-# hardware.
-FIXED_METHODS = {"exact": "exact", "lee_corrected": "lee", "peercy": "peercy", "kim": "kim",
-                 "ernst": "ernst", PALETTE: PALETTE}
+# --model fixed: the float64 model that is a method's ``reference``; palette: the pipeline's
+# PaletteLUT. conventional and lee_printed have no hardware.
+_FLOAT_NAMES = {model: name for name, model in FLOAT_MODELS.items()}
+FIXED_METHODS = {**{_FLOAT_NAMES[m.reference]: m.name for m in METHODS.values()
+                    if m.reference in _FLOAT_NAMES}, PALETTE: PALETTE}
 
 
 def render_methods():

@@ -20,8 +20,9 @@ import numpy as np
 
 from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import SceneConfig, light_fields, load_scene_config, BUILTIN
+from bumprtl.rtl.scene import SceneConfig, load_scene_config, BUILTIN
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
 from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
@@ -96,11 +97,10 @@ def scene_stimulus(scene: SceneConfig, size, azimuth=30.0, **light):
                 raise BumpError(f"bump_map = 'flat' renders one polygon: {scene.picture!r} is "
                                 f"not on a plane (its normal varies); use a plane scene")
             polygon = polygon_fixed(codes["n.phi"].flat[0], codes["n.theta"].flat[0], 0, 0, scene)
-        for j, names in enumerate(light_fields(scene)):
+        for j, keys in enumerate(light_keys(cfg)):
             turn = azimuth if j == 0 else (azimuth + LIGHT_AZIMUTH_STEP * j) % 360
             lit = quantize_pixels(sim_scene(scene, size, turn, **light).px, cfg)
-            for std, name in zip(("l", "h"), names):
-                inputs[f"{name}.phi"], inputs[f"{name}.theta"] = lit[f"{std}.phi"], lit[f"{std}.theta"]
+            inputs.update({key: lit[own] for own, key in keys.items()})
     inputs = {k: np.asarray(v, np.int64).ravel() for k, v in inputs.items()}
     inputs["tag"] = np.arange(size * size, dtype=np.int64) & ((1 << scene.tag_bits) - 1)
     return inputs, words, polygon, table, base
@@ -231,18 +231,20 @@ def _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load):
 
 def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir,
                       patterns=("no_stall",), texels=None, rtl_dir=None, expected=None,
-                      clock="verilog", load="initial"):
+                      load="initial", **build):
     """:func:`run_pipeline` on the bulk path (sim/tb/bulk.py): the pixels travel as arrays
     and the clock runs in the simulator; the build is cached under build/sim_cache by the
-    Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel;
-    ``clock="cocotb"`` drives the clock with cocotb's Clock instead of the wrapper's own.
-    ``load = "port"``: the memories are written through the host ports in the set-up.
+    Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel.
+    ``build``: the bulk build's ``clock``, ``io``, ``opt_fast``, ``extra``
+    (sim/tb/bulk.build_options; by default the simulator's fastest), e.g. ``clock="cocotb"``
+    drives the clock with cocotb's Clock. ``load = "port"``: the memories are written
+    through the host ports in the set-up.
     Returns ({pattern: {field: array}}, {pattern: cycles}, :class:`BulkResult`)."""
     build_dir = Path(build_dir).resolve()
     v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
     meta = json.loads(Path(j).read_text())
     r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
-                 expected=expected, setup=writes + setup_writes(meta, polygon, table), clock=clock)
+                 expected=expected, setup=writes + setup_writes(meta, polygon, table), **build)
     return r.outputs, r.cycles, r
 
 

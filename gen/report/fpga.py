@@ -21,7 +21,7 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import BUILTIN
+from bumprtl.rtl.scene import BUILTIN, load_scene_config
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, check_device,
                                    lpf_mhz, pipeline_component, place_component)
@@ -38,7 +38,8 @@ def fpga_units(cfg):
     every built-in scene class (row ``scene:<name>``)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
     return ([(f"{d}_{row}", d, row) for d in TABLE1_ORDER if d not in NOT_PLACED for row in rows(d)]
-            + [(f"scene_{s.replace('-', '_')}", "exact", f"scene:{s}") for s in BUILTIN])
+            + [(f"scene_{s.replace('-', '_')}", load_scene_config(s).method, f"scene:{s}")
+               for s in BUILTIN])
 
 
 def run_fpga(args):

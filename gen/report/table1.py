@@ -71,7 +71,7 @@ def netlist_multiplier_savings(counts):
     if "lee" not in counts:
         return {}
     return {d: (total(d), total("lee"), 1 - total("lee") / total(d))
-            for d in counts if d not in ("lee", "exact") and total(d)}
+            for d in counts if METHODS[d].baseline and total(d)}
 
 
 def count_design(name, cfg, work_dir):

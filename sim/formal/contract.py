@@ -16,9 +16,12 @@ One wrapper checks one property (:data:`PROPERTIES`):
 ``latency``  with ``o.ready`` held high the output is the input ``latency`` cycles later,
              valid for valid and tag for tag (no bubble added, none removed);
 ``cover``    vacuity check: a transfer, a stall and a transfer after a stall are reachable.
-``bank``     PaletteLUT's double buffer (units with ``swap``/``w_*``/``bank`` ports): a pixel
-             reads the entry of the bank that was in front in the cycle it was accepted,
-             whatever the host writes or swaps while it is in flight or stalled. The swap
+``bank``     PaletteLUT's double buffer (units with ``swap``/``w_*``/``bank`` ports, and
+             palette scene pipelines with ``lut_*`` ports): a pixel reads the entry of the
+             bank that was in front in the cycle it was accepted (by the pipeline, at its
+             input, ahead of the fetch), whatever the host writes (the writes the unit
+             took: ``lut_w_en & lut_w_ready`` for a pipeline) or swaps while it is in flight
+             or stalled. The swap
              strobe is the frame boundary (the host strobes it between frames; PaletteLUT
              has no frame signal of its own), so all pixels of a frame read one bank and a
              swap strobed while the last pixels of a frame are still in the pipe takes
@@ -125,7 +128,7 @@ class StreamContract(Elaboratable):
         if prop == "bank":
             if getattr(dut, "cfg", None) is None or dut.cfg.palette_blend:
                 raise ValueError("bank: a PaletteLUT without the blend stage")
-            self.watch_addr = Signal(len(dut.w_addr), name="watch_addr")   # any constant
+            self.watch_addr = Signal(len(self._host("w_addr")), name="watch_addr")  # any constant
             self.watch_pick = Signal(name="watch_pick")                    # any sequence
             self._free = [self.watch_addr, self.watch_pick]
 
@@ -293,28 +296,58 @@ class StreamContract(Elaboratable):
         m.d.comb += [Cover(take_out), Cover(o.valid & ~o.ready), Cover(stalled & take_out),
                      Cover(take_in & take_out)]
 
+    def _host(self, name):
+        """A palette host port: ``w_en``, ``swap``, ... of a PaletteLUT, ``lut_w_en``, ... of
+        a scene pipeline (None when absent, e.g. ``w_ready`` of a unit)."""
+        dut = self.dut
+        return getattr(dut, name, None) if hasattr(dut, "swap") else getattr(dut, f"lut_{name}", None)
+
     def _bank(self, m, i, o, take_in, take_out, stages):
         dut, size = self.dut, self.dut.cfg.palette_size
+        swap, bank_out = self._host("swap"), self._host("bank")
+        w_en, w_addr, w_data = self._host("w_en"), self._host("w_addr"), self._host("w_data")
+        w_ready = self._host("w_ready")
+        wrote = w_en if w_ready is None else w_en & w_ready        # the writes the unit took
         sel, pick = self.watch_addr, self.watch_pick
         sel_q, first = Signal.like(sel, reset_less=True), Signal(init=1, reset_less=True)
         m.d.sync += [sel_q.eq(sel), first.eq(0)]
         m.d.comb += [Assume(first | (sel == sel_q)), Assume(sel < size)]
         front = Signal(name="ref_front")                 # reset with the unit, like its bank
-        with m.If(dut.swap):
+        with m.If(swap):
             m.d.sync += front.eq(~front)
-        self._check(m, dut.bank == front, "bank: the bank output is not the front bank")
-        word = len(dut.w_data.as_value())
+        self._check(m, bank_out == front, "bank: the bank output is not the front bank")
+        word = len(w_data.as_value())
         # The watched entry in bank 0 and bank 1 (memory is not reset, neither are these).
         shadow = [Signal(word, name=f"ref_bank{b}_entry", reset_less=True) for b in (0, 1)]
-        with m.If(dut.w_en & (dut.w_addr == sel)):
+        with m.If(wrote & (w_addr == sel)):
             with m.If(front):
-                m.d.sync += shadow[0].eq(dut.w_data.as_value())
+                m.d.sync += shadow[0].eq(w_data.as_value())
             with m.Else():
-                m.d.sync += shadow[1].eq(dut.w_data.as_value())
+                m.d.sync += shadow[1].eq(w_data.as_value())
         occ = self._occupancy(m, take_in, take_out, stages)
         watching, ahead = Signal(name="watching"), Signal.like(occ, name="watch_ahead")
         expected = Signal(word, name="watch_expected")
-        start = take_in & (i.payload.index == sel) & ~watching & pick
+        # Which index the watched pixel looks up: a PaletteLUT's input carries it; a scene
+        # pipeline's fetch finds it, so the pixel is followed to the LUT's input (``match``:
+        # it looked up the watched entry).
+        lut = getattr(dut, "units", {}).get("palette")
+        if lut is None:
+            start = take_in & (i.payload.index == sel) & ~watching & pick
+            match = Const(1)
+        else:
+            start = take_in & ~watching & pick
+            take_lut = lut.i.valid & lut.i.ready
+            occ_f = Signal.like(occ, name="before_lut")          # accepted, not yet at the LUT
+            m.d.sync += occ_f.eq(occ_f + take_in - take_lut)
+            before, ahead_f = Signal(name="watch_before_lut"), Signal.like(occ, name="watch_ahead_lut")
+            match = Signal(name="watch_match")
+            at_lut = before & take_lut & (ahead_f == 0)
+            with m.If(start):
+                m.d.sync += [before.eq(1), ahead_f.eq(occ_f - take_lut)]
+            with m.Elif(at_lut):
+                m.d.sync += [before.eq(0), match.eq(lut.i.payload.index == sel)]
+            with m.Elif(before & take_lut):
+                m.d.sync += ahead_f.eq(ahead_f - 1)
         deliver = watching & take_out & (ahead == 0)
         with m.If(start):
             m.d.sync += [watching.eq(1), ahead.eq(occ - take_out),
@@ -323,11 +356,11 @@ class StreamContract(Elaboratable):
             m.d.sync += watching.eq(0)
         with m.Elif(watching & take_out):
             m.d.sync += ahead.eq(ahead - 1)
-        self._check(m, ~deliver | (o.payload.color.as_value() == expected),
-                           "bank: a pixel read another bank than the one in front when it was accepted")
+        self._check(m, ~deliver | ~match | (o.payload.color.as_value() == expected),
+                    "bank: a pixel read another bank than the one in front when it was accepted")
         swapped = Signal(name="swapped_in_flight")
         with m.If(start):
             m.d.sync += swapped.eq(0)
-        with m.Elif(watching & dut.swap):
+        with m.Elif(watching & swap):
             m.d.sync += swapped.eq(1)
-        m.d.comb += Cover(deliver & swapped & (shadow[0] != shadow[1]) & (expected != 0))
+        m.d.comb += Cover(deliver & match & swapped & (shadow[0] != shadow[1]) & (expected != 0))

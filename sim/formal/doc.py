@@ -20,9 +20,15 @@ def table(rows):
 def write_doc(path, rows, args=""):
     """Replace the table between the markers of ``path`` (the prose around it stays)."""
     path = Path(path)
-    block = (f"{BEGIN}\nProduced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
-             f"--doc docs/formal.md`; `bumprtl formal` is the same command):\n\n"
-             f"{table(rows)}\n{END}")
+    if "--merge" in args.split():
+        how = (f"Produced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 --doc "
+               f"docs/formal.md`; `bumprtl formal` is the same command); the rows it names "
+               f"re-checked by `python -m bumprtl.sim.formal.run {args}`, the others kept "
+               f"from the previous run's `results.json`")
+    else:
+        how = (f"Produced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
+               f"--doc docs/formal.md`; `bumprtl formal` is the same command)")
+    block = f"{BEGIN}\n{how}:\n\n{table(rows)}\n{END}"
     text = path.read_text() if path.exists() else f"# Formal proofs\n\n{BEGIN}\n{END}\n"
     if BEGIN in text and END in text:
         head, rest = text.split(BEGIN, 1)

@@ -14,10 +14,12 @@ from amaranth.lib import wiring
 
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import BUILTIN, load_scene_config
 from bumprtl.rtl.sincos import SinCos
 
 __all__ = ["MUTANTS", "EagerStallSinCos", "Dropper", "Duplicator", "Glitcher", "ExtraStage",
-           "Spontaneous", "SwapAheadPalette"]
+           "Spontaneous", "SwapAheadPalette", "UncarriedBankPipeline"]
 
 
 _INIT = StallPipe.__init__
@@ -190,6 +192,31 @@ class SwapAheadPalette(wiring.Component):
         return m
 
 
+class UncarriedBankPipeline(BumpPipeline):
+    """The palette scene pipeline (``palette_size``/``tag_bits`` of ``cfg``, 16^2 map) wired
+    the way it was before the bank rode with the pixel: the LUT reads the bank in front when
+    the pixel reaches it, behind the fetch, and host writes are never held back
+    (``lut_w_ready`` always high). Breaks ``bank``."""
+
+    def __init__(self, cfg):
+        keys = {**BUILTIN["palette"], "texture_size": 16, "palette_size": cfg.palette_size,
+                "angle_bits": cfg.angle_bits, "frac_bits": cfg.frac_bits,
+                "spec_index_bits": cfg.spec_index_bits, "tag_bits": cfg.tag_bits}
+        super().__init__(load_scene_config(keys))
+
+    def _elaborate_palette(self, m):
+        lut, f = self.units["palette"], self.units["fetch"]
+        m.d.comb += [f.i.valid.eq(self.i.valid), self.i.ready.eq(f.i.ready)]
+        m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
+        m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
+                     lut.i.payload.index.eq(f.o.payload.index), lut.i.payload.tag.eq(f.o.payload.tag),
+                     lut.i.payload.bank.eq(lut.bank)]           # the bank at the LUT, not at entry
+        wiring.connect(m, lut.o, wiring.flipped(self.o))
+        m.d.comb += [self.lut_w_ready.eq(1), lut.w_en.eq(self.lut_w_en),
+                     lut.w_addr.eq(self.lut_w_addr), lut.w_data.eq(self.lut_w_data),
+                     lut.swap.eq(self.lut_swap), self.lut_bank.eq(lut.bank)]
+
+
 # mutant -> the property it must fail
 MUTANTS = {
     "eager_stall": (EagerStallSinCos, "ready"),
@@ -199,4 +226,5 @@ MUTANTS = {
     "extra_stage": (ExtraStage, "latency"),
     "spontaneous": (Spontaneous, "quiet"),
     "swap_ahead": (SwapAheadPalette, "bank"),
+    "uncarried_bank": (UncarriedBankPipeline, "bank"),
 }

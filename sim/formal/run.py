@@ -28,7 +28,7 @@ __all__ = ["Row", "check", "check_mutant", "run", "table", "main", "INDUCTION_DE
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
 BMC_MARGIN = 6               # BMC depth = latency + this (every pixel reaches the output)
 PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
-BANK_DEPTH = 8               # the palette bank check: write, swap, accept, stall, swap, deliver
+BANK_MARGIN = 7              # palette bank BMC depth = latency + this (docs/formal.md)
 
 
 @dataclass
@@ -65,13 +65,15 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
     if prop == "bank_cover":         # the bank check's trace of interest is reachable
         dut = target.unit()
         top = StreamContract(dut, "bank", lemmas=False)
-        res = _job(top, workdir, prop, "cover", BANK_DEPTH + 2, script=("memory_map", "opt -fast"))
+        res = _job(top, workdir, prop, "cover", dut.latency + BANK_MARGIN + 2,
+                   script=("memory_map", "opt -fast"))
         result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
         return _row(target, prop, result, res, top, dut, t0)
     if prop == "bank":
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
-        res = _job(top, workdir, prop, "bmc", BANK_DEPTH, script=("memory_map", "opt -fast"))
+        res = _job(top, workdir, prop, "bmc", dut.latency + BANK_MARGIN,
+                   script=("memory_map", "opt -fast"))
         return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
     dut = target.unit()
     top = StreamContract(dut, prop)
@@ -102,7 +104,7 @@ def check_mutant(name, root, cfg=None):
     dut = cls(cfg)
     top = StreamContract(dut, prop, lemmas=False)
     t0 = time.perf_counter()
-    depth = BANK_DEPTH if prop == "bank" else dut.latency + BMC_MARGIN
+    depth = dut.latency + (BANK_MARGIN if prop == "bank" else BMC_MARGIN)
     script = ("memory_map", "opt -fast") if prop == "bank" else ()
     res = run_sby(top, Path(root) / "mutants", name, mode="bmc", depth=depth, script=script)
     result = "fails as expected" if res.status == "FAIL" and res.trace else \
@@ -165,6 +167,19 @@ def report_failures(rows, out=None):
     return bad
 
 
+def _ordered(rows):
+    """Rows in table order: the targets as :data:`TARGETS` lists them, each with its
+    properties in order, then the broken units as :data:`MUTANTS` lists them."""
+    units = list(TARGETS) + [f"mutant {n}" for n in MUTANTS]
+
+    def key(r):
+        n = units.index(r.unit) if r.unit in units else len(units)
+        props = TARGETS[r.unit].props if r.unit in TARGETS else ()
+        return n, props.index(r.prop) if r.prop in props else len(props), r.unit
+
+    return sorted(rows, key=key)
+
+
 def add_arguments(p):
     p.add_argument("units", nargs="*", metavar="UNIT",
                    help=f"targets to check (default: all): {', '.join(TARGETS)}")
@@ -197,7 +212,7 @@ def execute(args):
 
     def merged(rows):
         new = {(r.unit, r.prop): r for r in rows}
-        return [new.pop((r.unit, r.prop), r) for r in base] + list(new.values())
+        return _ordered([new.pop((r.unit, r.prop), r) for r in base] + list(new.values()))
 
     def save(rows):
         args.out.mkdir(parents=True, exist_ok=True)

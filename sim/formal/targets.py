@@ -114,7 +114,10 @@ def _targets():
     out.append(Target("fetch", _fetch))
     out.append(Target("texture_blend", _texture_blend))
     for name in BUILTIN:
-        out.append(Target(f"pipeline_{name}", _pipeline(name), slow=True, note=f"scene {name}"))
+        palette = load_scene_config(BUILTIN[name]).shading == "palette"
+        out.append(Target(f"pipeline_{name}", _pipeline(name),
+                          STREAM + (("bank", "bank_cover") if palette else ()), slow=True,
+                          note=f"scene {name}"))
     return out
 
 

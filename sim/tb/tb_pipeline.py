@@ -42,8 +42,12 @@ async def _host_setup(dut, meta, stim):
         dut.poly_en.value = 0
     if "lut_w_en" in ports:
         for addr, word in enumerate(stim["lut"].tolist()):
-            dut.lut_w_en.value, dut.lut_w_addr.value, dut.lut_w_data.value = 1, addr, int(word)
-            await RisingEdge(dut.clk)
+            taken = False
+            while not taken:                # held until lut_w_ready (rtl/pipeline.py)
+                dut.lut_w_en.value, dut.lut_w_addr.value, dut.lut_w_data.value = 1, addr, int(word)
+                await ReadOnly()
+                taken = bool(int(dut.lut_w_ready.value))
+                await RisingEdge(dut.clk)
         dut.lut_w_en.value, dut.lut_swap.value = 0, 1
         await RisingEdge(dut.clk)
         dut.lut_swap.value = 0

@@ -1,8 +1,11 @@
 """SceneConfig: built-in scenes, TOML files, and bad input naming the key."""
 
+import dataclasses
+
 import pytest
 
 from bumprtl.gen.cli.main import main
+from bumprtl.rtl import methods
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.scene import BUILTIN, SceneConfig, load_scene_config
 
@@ -62,6 +65,22 @@ def test_derived_rotation():
     assert SceneConfig(bump_map="flat").rotation == "per-polygon"
     assert SceneConfig(shading="palette").rotation == "none"
     assert SceneConfig().rotation == "per-pixel"
+
+
+def test_flat_map_and_lights_follow_the_registry(monkeypatch):
+    """A flat map and several lights need a method whose registry record rotates N' (one
+    n'' shared); the scene reads ``Method.rotates_normal``, never the method's name."""
+    for keys, field in (({"lights": 2}, "lights"), ({"bump_map": "flat"}, "bump_map")):
+        with pytest.raises(BumpError) as e:
+            SceneConfig(method="lee", **keys)
+        assert e.value.field == field and "'exact'" in str(e.value)
+    assert SceneConfig(method="lee", lights=2, shading="palette").lights == 2
+    for name, rotates in (("lee", True), ("exact", False)):
+        monkeypatch.setitem(methods.METHODS, name,
+                            dataclasses.replace(methods.METHODS[name], rotates_normal=rotates))
+    assert SceneConfig(method="lee", lights=2, bump_map="flat").rotation == "per-polygon"
+    with pytest.raises(BumpError, match="lights = 2 needs method = 'lee'"):
+        SceneConfig(lights=2)
 
 
 # SceneConfig's ranges (its docstring), each refused one step outside on both sides with the

@@ -34,7 +34,9 @@ class PaletteLUTModel:
 
     A pixel accepted in a cycle reads the front bank as it was in that cycle; host writes
     go to the back bank; a swap strobe exchanges the banks at the end of its cycle (a write
-    in the same cycle lands in the bank being published).
+    in the same cycle lands in the bank being published). It models the palette scene
+    pipeline too, with "accepted" meaning at the pipeline's input and ``clock``'s
+    ``write`` the writes the pipeline took (``lut_w_en & lut_w_ready``).
     """
 
     def __init__(self, cfg: Config):

@@ -3,7 +3,8 @@
 It skips the same work the generator skips: no H terms without specular, the N' rotation
 once per polygon for a flat bump map, m lights dotted with one rotated normal, only a table
 lookup with palette shading. Inputs and outputs are dicts of arrays keyed like the flattened
-payloads (``"u"``, ``"n.phi"``, ``"l1.theta"``, ...).
+payloads (``"u"``, ``"n.phi"``, ``"extra_lights.0.l.theta"``, ...; each light's keys:
+``rtl/layouts.light_keys``).
 
 Several lights (eq. 2 of Lee et al. summed over lights): each light j gives the unrounded
 terms d_j = clamp(N'.L_j) and s_j = 255 (N'.H_j)^n with F fractional bits
@@ -24,8 +25,9 @@ import numpy as np
 from bumprtl.rtl.bumpfetch import (has_map, level_bases, pack_texels, texel_address, coord_bits,
                                    level_bits, memory_depth)
 from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.scene import SceneConfig, light_fields
+from bumprtl.rtl.scene import SceneConfig
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.texture import RGB, texture_blend
@@ -36,7 +38,7 @@ from bumprtl.sim.golden.vectors import random_codes
 # The outputs of one Illumination unit (rtl/layouts.shade_layout) a single-light pipeline has.
 SHADE_OUTPUTS = ("diffuse", "specular", "color", "diffuse_fine", "specular_fine")
 
-__all__ = ["SHADE_OUTPUTS", "light_fields", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
+__all__ = ["SHADE_OUTPUTS", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
            "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
            "random_inputs", "as_payload_list", "unpack_rgb"]
 
@@ -77,11 +79,11 @@ def map_words(levels, scene: SceneConfig):
     return words
 
 
-def _light_codes(codes, names):
-    """The codes of one light renamed to the ``l``/``h`` keys the unit models read."""
+def _light_codes(codes, keys):
+    """The codes of one light (``keys``: one entry of ``light_keys``) under the ``l``/``h``
+    keys the unit models read."""
     out = {k: codes[k] for k in ("n.phi", "n.theta", "b.phi", "b.theta") if k in codes}
-    for std, name in zip(("l", "h"), names):
-        out[f"{std}.phi"], out[f"{std}.theta"] = codes[f"{name}.phi"], codes[f"{name}.theta"]
+    out.update({own: codes[key] for own, key in keys.items()})
     return out
 
 
@@ -111,7 +113,11 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
     ``words``: the bump map memory (varying map); ``polygon``: the per-polygon n'' terms
     (flat map, :func:`polygon_fixed`); ``texels``: the colour-texture memory (texture =
     true). Palette shading returns the ``index`` of each pixel (and the ``texel`` word with
-    a texture; the colour is PaletteLUT's: ``sim/golden/fixed/palette_lut.py``).
+    a texture); the colour is :class:`~bumprtl.sim.golden.fixed.palette_lut.PaletteLUTModel`'s
+    lookup of that index in the cycle the *pipeline* accepted the pixel (the bank then in
+    front, with the host writes the pipeline took, ``lut_w_en & lut_w_ready``): the
+    pipeline carries the bank through the fetch and holds back writes to a bank a pixel in
+    flight still reads, so the table a pixel sees is fixed when it enters.
     """
     cfg = scene.config
     codes = dict(inputs)
@@ -122,8 +128,8 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
     if scene.shading == "palette":
         return {"index": codes["index"], **({"texel": tex} if scene.texture else {})}
     shades = []
-    for names in light_fields(scene):
-        light = _light_codes(codes, names)
+    for keys in light_keys(cfg):
+        light = _light_codes(codes, keys)
         if polygon is None:
             rot = rotation_fixed(light, cfg)
         else:                                      # n'' once per polygon, terms per pixel
@@ -165,12 +171,11 @@ def random_inputs(scene: SceneConfig, n, rng):
         if scene.mip_levels > 1:
             out["level"] = rng.integers(0, 1 << level_bits(scene), n)
     if scene.shading == "per-pixel":
-        for j, names in enumerate(light_fields(scene)):
+        for j, keys in enumerate(light_keys(scene.config)):
             codes = random_codes(n, scene.config, seed=int(rng.integers(1 << 30)))
             if j == 0 and scene.bump_map == "varying":
                 out["n.phi"], out["n.theta"] = codes["n.phi"], codes["n.theta"]
-            for std, name in zip(("l", "h"), names):
-                out[f"{name}.phi"], out[f"{name}.theta"] = codes[f"{std}.phi"], codes[f"{std}.theta"]
+            out.update({key: codes[own] for own, key in keys.items()})
     mask = (1 << scene.tag_bits) - 1
     out["tag"] = np.arange(n) & mask
     return {k: np.asarray(v, np.int64) for k, v in out.items()}

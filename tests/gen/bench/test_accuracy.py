@@ -27,37 +27,112 @@ def small_searches(monkeypatch):
                         lambda model, cfg: real_arith(model, cfg, candidates=4000, keep=20, reach=1))
 
 
+ROW = r"\| 12 \| 13 \| 16 \| {} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \| (.+?) \| (\d+) \|"
+
+
 def test_rows_per_channel_within_the_bounds(small_searches, capsys):
+    """Both measures per channel: end-to-end under the bound, and the arithmetic alone
+    (float64 on the received angles) within 1 LSB on every channel at the default."""
     assert main(ARGS) == 0
     out = capsys.readouterr().out
     for channel, bound in (("diffuse", 1), ("specular", 4), ("color", 2)):
-        row = re.search(rf"\| 12 \| 13 \| 16 \| {channel} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \| (\d+) \|", out)
-        assert row and int(row.group(4)) == bound, (channel, out)
+        row = re.search(ROW.format(channel), out)
+        assert row and int(row.group(5)) == bound, (channel, out)
         assert max(int(g) for g in row.groups()[:3]) <= bound
+        arithmetic = [int(v) for v in row.group(4).split(" / ")]
+        assert len(arithmetic) == 3 and max(arithmetic) <= 1, (channel, row.group(0))
+    summary = re.search(r"angle bits 12, frac bits 13, n = 16: arithmetic max diffuse (\d), "
+                        r"specular (\d), color (\d) LSB; end-to-end max diffuse (\d), specular "
+                        r"(\d), color (\d) LSB \(end to end adds the inputs' rounding to the "
+                        r"12-bit angle grid\)", out)
+    assert summary and max(int(g) for g in summary.groups()[:3]) <= 1, out
     assert "FAIL" not in out
     assert re.search(r"\| bricks \| [\d.]+ / \d \| [\d.]+ / \d \|", out)      # colour and the blend
     assert re.search(r"\| moon \| [\d.]+ / \d \| — \|", out)                  # no colour texture
+    assert re.search(r"\| craters \| [\d.]+ / \d \| — \|", out)               # the unseen map
 
 
-def test_an_error_above_its_bound_exits_1_with_the_input(small_searches, monkeypatch, capsys):
+def test_cartesian_inputs_have_no_arithmetic_measure(small_searches, capsys):
+    assert main(ARGS[:2] + ["--method", "peercy"] + ARGS[2:-2] + ["--scene-size", "0"]) == 0
+    out = capsys.readouterr().out
+    for channel in ("diffuse", "specular", "color"):
+        assert re.search(ROW.format(channel).replace("(.+?)", "—"), out), (channel, out)
+    assert "Cartesian inputs: no arithmetic-only measure" in out
+
+
+def _tighten(monkeypatch, channel):
     real = accuracy.build_unit
 
     def tight(unit, cfg):
         dut, sidecar, command = real(unit, cfg)
-        return dut, {**sidecar, "error_bounds_lsb": {**sidecar["error_bounds_lsb"], "diffuse": 0}}, command
+        return dut, {**sidecar, "error_bounds_lsb": {**sidecar["error_bounds_lsb"], channel: 0}}, command
     monkeypatch.setattr(accuracy, "build_unit", tight)
+
+
+def _angles(text):
+    return PixelInputs(**{k: np.array([float(v)]) for k, v in
+                          re.findall(r"\b([nlhb]_(?:phi|theta))=([\d.e+-]+)", text)})
+
+
+def test_an_error_above_its_bound_exits_1_with_the_input(small_searches, monkeypatch, capsys):
+    _tighten(monkeypatch, "diffuse")
     assert main(ARGS) == 1
     lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("FAIL")]
     assert lines and all(" diffuse (" in ln for ln in lines)
     line = lines[0]
-    angles = dict(re.findall(r"\b([nlhb]_(?:phi|theta))=([\d.e+-]+)", line))
-    assert len(angles) == 8
-    px = PixelInputs(**{k: np.array([float(v)]) for k, v in angles.items()})
+    assert "(random, end-to-end)" in line
+    px = _angles(line)
     cfg = Config()
     got = int(datapath_fixed(encode_pixels(px, cfg), cfg)["diffuse"][0])
     want = int(to_8bit(conventional(px, cfg).diffuse)[0])
     assert f"fixed {got}, float64 {want}" in line and got != want       # the input reproduces it
     assert re.search(rf"error {abs(got - want)} LSB > bound 0", line)
+
+
+def test_an_arithmetic_error_above_its_bound_prints_the_received_angles(small_searches, monkeypatch,
+                                                                          capsys):
+    """The arithmetic measure is checked against the bound too; its line gives the input and
+    the grid angles float64 was given, and those reproduce the error."""
+    _tighten(monkeypatch, "specular")
+    assert main(ARGS) == 1
+    lines = [ln for ln in capsys.readouterr().out.splitlines()
+             if ln.startswith("FAIL") and ", arithmetic)" in ln]
+    assert lines and all(" specular (" in ln for ln in lines)
+    given, received = lines[0].split("; float64 on the received angles")
+    px, grid = _angles(given), _angles(received)
+    cfg = Config()
+    got = int(datapath_fixed(encode_pixels(px, cfg), cfg)["specular"][0])
+    want = int(to_8bit(conventional(grid, cfg).specular)[0])
+    assert f"fixed {got}, float64 {want}" in lines[0] and got != want
+    assert int(datapath_fixed(encode_pixels(grid, cfg), cfg)["specular"][0]) == got
+
+
+LIGHT_ROW = (r"\| {} \| {} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) / (\d+) \| (\d+) \| "
+             r"[\d.]+ \|")
+
+
+def test_light_sums_and_blend_rows(small_searches, capsys):
+    """Eq. 2 over one and two lights and the texture blend: end to end under the pipeline
+    sidecar's bound, the arithmetic within 1 LSB, one light within 1 LSB."""
+    assert main(ARGS[:-1] + ["0"]) == 0
+    out = capsys.readouterr().out
+    for lights, output, bound in ((1, "colour", 2), (1, "blend", 2), (2, "colour", 3), (2, "blend", 3)):
+        row = re.search(LIGHT_ROW.format(lights, output), out)
+        assert row, (lights, output, out)
+        rnd, adv, ar_rnd, ar_adv, b = (int(g) for g in row.groups())
+        assert b == bound and max(rnd, adv) <= bound and max(ar_rnd, ar_adv) <= 1
+        if lights == 1:
+            assert max(rnd, adv) <= 1
+
+
+def test_a_light_sum_above_its_bound_exits_1(small_searches, monkeypatch, capsys):
+    real = accuracy.error_bounds
+    monkeypatch.setattr(accuracy, "error_bounds", lambda cfg, lights=1, texture=False: (
+        {**real(cfg, lights, texture), "color": 0} if lights == 2 and texture else real(cfg, lights, texture)))
+    assert main(ARGS[:-1] + ["0"]) == 1
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("FAIL")]
+    assert lines and all("lights=2 blend (" in ln for ln in lines)
+    assert "light 2: n_phi=" in lines[0] and ", texel (" in lines[0]
 
 
 @pytest.mark.parametrize("flag, value, name", [("--spec-exponent", "2000", "spec_exponent"),

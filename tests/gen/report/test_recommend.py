@@ -53,6 +53,29 @@ def test_arithmetic_units_before_memory():
     assert recommend(data, 1)[0]["angle_bits"] == 12      # 6 multipliers beat 30 + 6 + 2
 
 
+def _channels_point(name, diffuse, color, mult):
+    """A sweep point with per-channel sets (``bumprtl bench sweep``): its diffuse and colour
+    maxima differ."""
+    p = _point(name, max(diffuse, color), 1000, mult=mult)
+    sets = lambda m: {"random": {"max": m, "mean": 0.1, "n": 10},
+                      "adversarial": {"max": m, "mean": 0.5, "n": 13}}
+    p["error"] = {**sets(diffuse), "channels": {"diffuse": sets(diffuse), "specular": sets(3),
+                                                 "color": sets(color)},
+                  "scenes": {"bricks": {"psnr_db": 59.0, "max_lsb": color}}}
+    return p
+
+
+def test_ranks_on_the_colour_not_the_diffuse():
+    """What a pixel shows is the colour: a cheap point whose diffuse misses 1 LSB but whose
+    colour meets it wins over a dearer one whose diffuse meets it and colour does not."""
+    data = {"points": [_channels_point((10, 13), diffuse=3, color=1, mult=4),
+                       _channels_point((12, 13), diffuse=1, color=2, mult=8)]}
+    best, meeting = recommend(data, 1)
+    assert (best["angle_bits"], len(meeting)) == (10, 1)
+    with pytest.raises(BumpError, match=r"smallest measured error is 1 LSB"):
+        recommend(data, 0.5)
+
+
 def test_none_meets_bound_names_smallest_error():
     with pytest.raises(BumpError, match=r"smallest measured error is 1 LSB"):
         recommend(TOY, 0.5)

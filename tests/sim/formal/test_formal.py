@@ -1,10 +1,13 @@
-"""The quick subset of `make formal` (sim/formal/): SinCos's stream contract proved by
-k-induction, every broken unit caught, and the runner's failure report. The whole table
-(every unit and scene pipeline) is `make formal`."""
+"""The quick subset of `make formal` (sim/formal/) in `make test`: SinCos's stream contract
+and one scene pipeline's order proved by k-induction, two broken units caught (the stall
+enable of the issue, and the palette pipeline's bank), and the runner's failure report.
+The rest (every broken unit here, marked ``formal``; every unit and scene pipeline in the
+table) is `make formal`."""
 
 from pathlib import Path
 
 import pytest
+from amaranth.back import rtlil
 
 from bumprtl.sim.formal import run as formal_run
 from bumprtl.sim.formal.contract import StreamContract
@@ -21,7 +24,18 @@ def test_sincos_contract_is_proved_by_induction(prop, build_dir):
         assert row.lemmas > 0          # the pipeline-register lemmas were found and asserted
 
 
-@pytest.mark.parametrize("name", list(MUTANTS))
+QUICK_MUTANTS = ("eager_stall", "uncarried_bank")
+
+
+def test_scene_pipeline_order_is_proved_by_induction(build_dir):
+    """The palette scene pipeline (fetch -> LUT, two layers): order with its layer lemmas."""
+    row = check(TARGETS["pipeline_palette"], "order", build_dir)
+    assert row.result == "proved", row
+    assert row.lemmas > row.latency
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=() if n in QUICK_MUTANTS else pytest.mark.formal)
+                                  for n in MUTANTS])
 def test_broken_unit_fails_its_property(name, build_dir):
     """Each property can fail: the unit built to break it gives a counterexample trace."""
     row = check_mutant(name, build_dir)
@@ -44,7 +58,6 @@ def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir,
 def test_lemmas_come_from_the_units_own_registers():
     """The order lemmas cover every stage: one tag register per stage of SinCos, plus the
     next input tag."""
-    from amaranth.back import rtlil
     top = StreamContract(TARGETS["sincos"].unit(), "order")
     rtlil.convert(top, name="top", ports=top.free_inputs())
     latency = top.dut.latency

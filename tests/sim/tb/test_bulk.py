@@ -111,6 +111,25 @@ def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkey
     assert check_stimulus(json.loads(j.read_text()), good) == n
 
 
+def test_bulk_build_options_are_checked_before_the_build(build_dir, monkeypatch):
+    """Verilator's C++ clock and DPI I/O are refused on Icarus, and a bad option on either
+    simulator, in one line naming the option, before anything is built."""
+    v, j = emit_unit("sincos", Config(angle_bits=12), build_dir / "rtl")
+    monkeypatch.setattr(bulk, "build", lambda *a, **k: pytest.fail("built before the check"))
+    good = {"angle": np.arange(4), "tag": np.arange(4)}
+    cases = [("icarus", {"clock": "cxx"}, r"clock 'cxx' needs Verilator's C\+\+ build; on "
+                                          r"icarus clock must be 'verilog'"),
+             ("icarus", {"io": "dpi"}, r"io 'dpi' needs Verilator's C\+\+ build"),
+             ("icarus", {"opt_fast": "-O2"}, r"opt_fast and extra are Verilator build options"),
+             ("verilator", {"clock": "vpi"}, r"clock must be one of verilog, cocotb, cxx, got 'vpi'"),
+             ("verilator", {"io": "mmap"}, r"io must be one of file, dpi, got 'mmap'"),
+             ("verilator", {"opt_fast": "-O3 -march=native"}, r"opt_fast must be one g\+\+ flag")]
+    for sim, opts, message in cases:
+        with pytest.raises(BumpError, match=message):
+            run_bulk(sim, v, j, build_dir / "bulk", inputs=good, **opts)
+    assert bulk.build_options("verilator") == {**bulk.DEFAULTS["verilator"], "extra": ()}
+
+
 def test_bulk_codec_round_trip():
     """Fields straddling 32-bit limbs, signed and unsigned, through the stimulus encoding
     ($fread: big-endian bytes) and the output decoding ($fwrite %u: little-endian limbs)."""

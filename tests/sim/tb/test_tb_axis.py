@@ -8,22 +8,64 @@ import pytest
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.axis import emit_axis
+from bumprtl.gen.flow.memories import memory_images
+from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.scene import BUILTIN, load_scene_config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
 SMALL = Config(angle_bits=8, frac_bits=8, tag_bits=6)
+# The default scene at small widths and a 16 x 16 map (its bump map as initial contents).
+SCENE = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8, "tag_bits": 6,
+                           "texture_size": 16})
 
 
-@pytest.mark.parametrize("sim,unit", [("icarus", "rotation"), ("verilator", "rotation")])
+# make test: rotation on both simulators, illumination on Icarus (its Verilator build is
+# half a minute; make regress runs it); the scene pipeline on both (below).
+@pytest.mark.parametrize("sim,unit", [("icarus", "rotation"), ("verilator", "rotation"),
+                                      ("icarus", "illumination"),
+                                      pytest.param("verilator", "illumination",
+                                                   marks=pytest.mark.regress)])
 def test_axis_cocotb_bit_exact_with_pauses(sim, unit, build_dir):
-    v, j = emit_axis(unit, SMALL, build_dir / "rtl")
+    v, j, _ = emit_axis(unit, SMALL, build_dir / "rtl")
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_axis", build_dir / sim,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 40})
     assert (run.tests, run.failures) == (1, 0)
 
 
+def _scene_axis(scene, out):
+    images = memory_images("pipeline", scene, *scene_memories(scene))
+    return emit_axis("pipeline", scene, out, images=images)
+
+
+@pytest.mark.parametrize("sim", SIMULATORS)
+def test_axis_scene_pipeline_bit_exact_with_pauses(sim, build_dir):
+    """The default scene's pipeline (bump map in initial contents, no host writes) in
+    AXI4-Stream ports: bit-exact against the golden pipeline, tlast/tuser on their pixels."""
+    v, j, hexes = _scene_axis(SCENE, build_dir / "rtl")
+    assert [h.name for h in hexes] == ["pipeline_axis_map.hex"]
+    meta = json.loads(j.read_text())
+    assert meta["memory_images"]["map"]["file"] == "pipeline_axis_map.hex"
+    assert meta["command"].startswith("bumprtl emit pipeline --scene default")
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_axis", build_dir / sim,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 21})
+    assert (run.tests, run.failures) == (1, 0)
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("sim", SIMULATORS)
+@pytest.mark.parametrize("scene", ["default", "diffuse", "two-lights"])
+def test_axis_scene_pipeline_volume(sim, scene, build_dir):
+    """More pixels through more scenes' pipelines at the default widths (make regress)."""
+    cfg = load_scene_config({**BUILTIN[scene], "texture_size": 64})
+    v, j, _ = _scene_axis(cfg, build_dir / "rtl")
+    run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_axis", build_dir / sim,
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 3000})
+    assert (run.tests, run.failures) == (1, 0)
+
+
 def test_axis_ports_and_byte_aligned_packing(tmp_path):
-    v, j = emit_axis("rotation", SMALL, tmp_path)
+    v, j, _ = emit_axis("rotation", SMALL, tmp_path)
     meta = json.loads(j.read_text())
     ports, axis = meta["ports"], meta["axis"]
     for p in ("aclk", "aresetn", "s_axis_tdata", "s_axis_tvalid", "s_axis_tready", "s_axis_tuser",
