@@ -169,7 +169,12 @@ def golden_render(scene, size, **light):
     """The fixed-point golden image of ``scene``: 8-bit RGB."""
     scene = load_scene_config(scene)
     inputs, words, polygon, table, base = scene_stimulus(scene, size, **light)
-    out = pipeline_fixed(inputs, scene, words, polygon, scene_texels(scene, base))
+    return _golden_image(scene, inputs, words, polygon, table, base, scene_texels(scene, base))
+
+
+def _golden_image(scene, inputs, words, polygon, table, base, texels):
+    """:func:`golden_render` of stimulus already made (:func:`scene_stimulus`)."""
+    out = pipeline_fixed(inputs, scene, words, polygon, texels)
     if scene.shading == "palette":
         entry = unpack_rgba(table[out["index"]], scene.config)
         if scene.texture:                  # Tarini eq. 2, the texel as the base colour
@@ -270,7 +275,8 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
     pixels = outs["no_stall"]
     if not np.array_equal(pixels["tag"], inputs["tag"]):
         raise AssertionError("RTL render: pixel tags out of order (lost or duplicated pixels)")
-    return RtlRender(_image(base, pixels, scene), golden_render(scene, size, **light),
+    return RtlRender(_image(base, pixels, scene),
+                     _golden_image(scene, inputs, words, polygon, table, base, texels),
                      cycles["no_stall"], *times)
 
 
