@@ -429,6 +429,7 @@ class BumpPipeline(wiring.Component):
         # waits (lut_w_ready low) while one of them still has to read it.
         take_in, take_lut = self.i.valid & self.i.ready, lut.i.valid & lut.i.ready
         waiting = [Signal(range(f.latency + 1), name=f"lut_bank{b}_pending") for b in (0, 1)]
+        self.lut_pending = waiting                 # read by sim/formal's bank lemmas
         for b, count in enumerate(waiting):
             m.d.sync += count.eq(count + (take_in & (lut.bank == b))
                                  - (take_lut & (lut.i.payload.bank == b)))

@@ -106,8 +106,9 @@ def _layout(name, scene):
     if name == "texture":
         return f"RGB colour texel, r in bits [7:0], g [15:8], b [23:16]; {where}"
     return (f"colour-table entry i (palette normal i shaded for one frame): r [7:0], g [15:8], "
-            f"b [23:16], a [31:24] (Lambert intensity, Tarini Sec. 5.1); written through lut_w_*, "
-            f"then lut_swap (double-buffered), never initial contents")
+            f"b [23:16], a [31:24] (Lambert intensity, Tarini Sec. 5.1); written through lut_w_* "
+            f"(a write is taken when lut_w_ready is high), then lut_swap (double-buffered), "
+            f"never initial contents")
 
 
 def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
@@ -134,7 +135,7 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
         images[name] = {"words": w, "width": width, "depth": depth,
                         "file": f"{unit}_{name}.hex", "layout": _layout(name, scene),
                         "port": [f"{p}w_en", f"{p}w_addr", f"{p}w_data"] +
-                                (["lut_swap"] if name == "lut" else []),
+                                (["lut_w_ready", "lut_swap"] if name == "lut" else []),
                         "load": "port" if name == "lut" else load}
     return images
 

@@ -21,8 +21,7 @@ One wrapper checks one property (:data:`PROPERTIES`):
              bank that was in front in the cycle it was accepted (by the pipeline, at its
              input, ahead of the fetch), whatever the host writes (the writes the unit
              took: ``lut_w_en & lut_w_ready`` for a pipeline) or swaps while it is in flight
-             or stalled. The swap
-             strobe is the frame boundary (the host strobes it between frames; PaletteLUT
+             or stalled. The swap strobe is the frame boundary (the host strobes it between frames; PaletteLUT
              has no frame signal of its own), so all pixels of a frame read one bank and a
              swap strobed while the last pixels of a frame are still in the pipe takes
              effect only for the pixels accepted after it. A symbolic entry (any address,
@@ -31,8 +30,11 @@ One wrapper checks one property (:data:`PROPERTIES`):
 
 k-induction needs the contract to be inductive, so the wrapper also asserts *lemmas* about
 the unit's own pipeline registers: the number of valid stages equals the pixels in flight,
-the tag held in each valid stage is the one the order says, and units that run in lock step
-have equal valid chains. It finds those registers by observing
+the tag held in each valid stage is the one the order says, units that run in lock step
+have equal valid chains, and (``bank``) the shadows are the table's watched entries (two
+asynchronous read ports added to the memory while it elaborates), the bank bits in flight
+are what the pipeline's ``lut_w_ready`` counters count, and the watched pixel sits where
+its position says with the bank of its acceptance. It finds those registers by observing
 :class:`bumprtl.rtl.pipe.StallPipe` while the unit elaborates (:func:`observe_pipes`:
 the valid chain and the ``tag`` delay line of every pipe, keyed by its input valid), so no
 unit carries formal-only code. ``lemmas=False`` leaves them out (plain BMC, and the broken
@@ -52,34 +54,47 @@ __all__ = ["PROPERTIES", "StreamContract", "observe_pipes", "pipeline_layers"]
 
 PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
 
-_TAG_REG = re.compile(r"tag_d(\d+)$")
+_TAG_REG = re.compile(r"(tag|bank)_d(\d+)$")
 
 
 @contextlib.contextmanager
-def observe_pipes():
+def observe_pipes(read_ports=0):
     """Record every :class:`StallPipe` built while the block runs: yields a dict
     ``id(input valid signal) -> {"valid": [i.valid, stage1, ...], "adv": adv,
-    "tags": {n: tag register of stage n}}``. StallPipe itself is restored afterwards."""
+    "tags": {n: tag register of stage n}, "banks": {n: bank register of stage n},
+    "memories": {name: [comb read port, ...]}}``; ``read_ports``: that many asynchronous
+    read ports are added to every memory a pipe adds with ``StallPipe.memory`` (before it
+    elaborates), for assertions about its contents. StallPipe itself is restored
+    afterwards."""
     seen = {}
-    init, register = StallPipe.__init__, StallPipe.register
+    init, register, memory = StallPipe.__init__, StallPipe.register, StallPipe.memory
 
     def observed_init(self, *args, **kwargs):
         init(self, *args, **kwargs)
-        self._formal = {"valid": list(self.valid), "adv": self.adv, "tags": {}}
+        self._formal = {"valid": list(self.valid), "adv": self.adv, "tags": {}, "banks": {},
+                        "memories": {}}
         seen[id(self.valid[0])] = self._formal
 
     def observed_register(self, value, name, *args, **kwargs):
         reg = register(self, value, name, *args, **kwargs)
         match = _TAG_REG.match(str(name))
         if match and hasattr(self, "_formal"):
-            self._formal["tags"][int(match.group(1))] = reg
+            self._formal[match.group(1) + "s"][int(match.group(2))] = reg
         return reg
 
-    StallPipe.__init__, StallPipe.register = observed_init, observed_register
+    def observed_memory(self, name, mem):
+        out = memory(self, name, mem)
+        if hasattr(self, "_formal") and read_ports:
+            self._formal["memories"][name] = [mem.read_port(domain="comb")
+                                              for _ in range(read_ports)]
+        return out
+
+    StallPipe.__init__, StallPipe.register, StallPipe.memory = \
+        observed_init, observed_register, observed_memory
     try:
         yield seen
     finally:
-        StallPipe.__init__, StallPipe.register = init, register
+        StallPipe.__init__, StallPipe.register, StallPipe.memory = init, register, memory
 
 
 def pipeline_layers(dut):
@@ -178,8 +193,10 @@ class StreamContract(Elaboratable):
     def elaborate(self, platform):
         m = Module()
         dut = self.dut
-        with observe_pipes() if self.lemmas else contextlib.nullcontext({}) as pipes:
+        ports = 2 if self.prop == "bank" else 0          # the watched entry of both banks
+        with observe_pipes(ports) if self.lemmas else contextlib.nullcontext({}) as pipes:
             fragment = Fragment.get(dut, platform)
+        self._pipes = pipes
         m.submodules.dut = _Built(fragment)
         i, o = dut.i, dut.o
         take_in = i.valid & i.ready
@@ -340,10 +357,10 @@ class StreamContract(Elaboratable):
             occ_f = Signal.like(occ, name="before_lut")          # accepted, not yet at the LUT
             m.d.sync += occ_f.eq(occ_f + take_in - take_lut)
             before, ahead_f = Signal(name="watch_before_lut"), Signal.like(occ, name="watch_ahead_lut")
-            match = Signal(name="watch_match")
+            match, wbank = Signal(name="watch_match"), Signal(name="watch_bank")
             at_lut = before & take_lut & (ahead_f == 0)
             with m.If(start):
-                m.d.sync += [before.eq(1), ahead_f.eq(occ_f - take_lut)]
+                m.d.sync += [before.eq(1), ahead_f.eq(occ_f - take_lut), wbank.eq(front)]
             with m.Elif(at_lut):
                 m.d.sync += [before.eq(0), match.eq(lut.i.payload.index == sel)]
             with m.Elif(before & take_lut):
@@ -364,3 +381,41 @@ class StreamContract(Elaboratable):
         with m.Elif(watching & swap):
             m.d.sync += swapped.eq(1)
         m.d.comb += Cover(deliver & match & swapped & (shadow[0] != shadow[1]) & (expected != 0))
+        if not self.lemmas:
+            return
+        # Lemmas (k-induction): the shadows are the memory's entries (read through two
+        # asynchronous ports observe_pipes added to the table), and where the watched pixel
+        # is, with what it will read.
+        rec = self._pipes.get(id((dut if lut is None else lut).i.valid))
+        ports = rec["memories"].get("table") if rec else None
+        if not ports:
+            return
+        for b, port in enumerate(ports):
+            m.d.comb += port.addr.eq(sel + b * size)
+            self._lemma(m, shadow[b] == port.data, "the shadow of the watched entry is the table's")
+        color = o.payload.color.as_value()
+        if lut is None:
+            self._lemma(m, ~watching | (o.valid & (ahead == 0) & (color == expected)),
+                        "the watched pixel waits at the output with its entry")
+            return
+        fetch = self._pipes[id(dut.units["fetch"].i.valid)]
+        valid = fetch["valid"][1:]
+        banks = [fetch["banks"][n] for n in range(1, len(valid) + 1)]
+        for b, pending in enumerate(dut.lut_pending):
+            self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks)),
+                        "the per-bank counters count the fetch stages' bank bits")
+        self._lemma(m, occ_f == sum(valid), "pixels before the LUT = valid fetch stages")
+        found, downstream = Const(0), Const(0, 4)
+        for v, bank in reversed(list(zip(valid, banks))):
+            found = found | (v & (downstream == ahead_f) & (bank == wbank))
+            downstream = downstream + v
+        waiting_f = watching & before
+        self._lemma(m, ~waiting_f | found,
+                    "the watched pixel is in the fetch with the bank of its acceptance")
+        self._lemma(m, ~waiting_f | (Mux(wbank, ports[1].data, ports[0].data) == expected),
+                    "its entry is unchanged while it waits")
+        self._lemma(m, ~waiting_f | (ahead == ahead_f + lut.o.valid), "pixels ahead of it")
+        self._lemma(m, ~(watching & ~before) | (lut.o.valid & (ahead == 0) &
+                                                (~match | (color == expected))),
+                    "past the LUT it waits at the output with its entry")
+        self._lemma(m, watching | ~before, "only the watched pixel is followed")
