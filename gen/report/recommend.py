@@ -88,7 +88,8 @@ def _evidence(p):
                              f"over {sets[k]['n']} vectors")
     for name, s in err.get("scenes", {}).items():
         if "max_lsb" in s:
-            lines.append(f"    scene {name}: PSNR {s['psnr_db']} dB, max {s['max_lsb']}")
+            psnr = "inf (identical)" if s["psnr_db"] is None else f"{s['psnr_db']} dB"
+            lines.append(f"    scene {name}: PSNR {psnr}, max {s['max_lsb']}")
     lines.append(f"  cost: {cost['multipliers']} multipliers, {cost['adders']} adders, "
                  f"{cost['table_bits']} ROM bits, {cost['ram_bits']} RAM bits")
     if "fpga" in cost:

@@ -65,13 +65,20 @@ def _channels_point(name, diffuse, color, mult):
     return p
 
 
-def test_ranks_on_the_colour_not_the_diffuse():
+def test_ranks_on_the_colour_not_the_diffuse(tmp_path, capsys):
     """What a pixel shows is the colour: a cheap point whose diffuse misses 1 LSB but whose
     colour meets it wins over a dearer one whose diffuse meets it and colour does not."""
     data = {"points": [_channels_point((10, 13), diffuse=3, color=1, mult=4),
                        _channels_point((12, 13), diffuse=1, color=2, mult=8)]}
     best, meeting = recommend(data, 1)
     assert (best["angle_bits"], len(meeting)) == (10, 1)
+    data["points"][0]["error"]["scenes"]["bricks"] = {"psnr_db": None, "max_lsb": 0}
+    path = tmp_path / "sweep.json"
+    path.write_text(json.dumps(data))
+    assert main(["recommend", "--max-error-lsb", "1", "--sweep", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "worst colour 1" in out and "color random: max 1" in out and "diffuse random: max 3" in out
+    assert "scene bricks: PSNR inf (identical), max 0" in out
     with pytest.raises(BumpError, match=r"smallest measured error is 1 LSB"):
         recommend(data, 0.5)
 

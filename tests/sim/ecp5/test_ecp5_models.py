@@ -14,17 +14,23 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay, model_sources, run_vectors
 
 
-def _mult_top(build_dir, regs, signed_a, signed_b):
-    """A wrapper around one MULT18X18D: ``regs`` names the register groups in use."""
-    params = ", ".join(f'.REG_{r}_CLK("CLK0"), .REG_{r}_CE("CE0"), .REG_{r}_RST("RST0")' for r in regs)
+GROUPS = ("INPUTA", "INPUTB", "PIPELINE", "OUTPUT")
+
+
+def _mult_top(build_dir, regs, signed_a, signed_b, resetmode="SYNC"):
+    """A wrapper around one MULT18X18D, CLK0..3 all on ``clk``: ``regs`` maps each register
+    group in use to its (CE index, RST index), e.g. {"OUTPUT": (2, 1)} is REG_OUTPUT on
+    CLK0 / CE2 / RST1; the others are bypassed (REG_*_CLK = "NONE")."""
+    params = ", ".join(f'.REG_{r}_CLK("CLK0"), .REG_{r}_CE("CE{c}"), .REG_{r}_RST("RST{x}")'
+                       for r, (c, x) in regs.items())
     bit = lambda p, n: ", ".join(f".{p}{i}({p.lower()}[{i}])" for i in range(n))
-    text = f"""module mult_top(input clk, input rst, input [17:0] a, input [17:0] b, input ce,
-                input reset, output [35:0] p);
-  MULT18X18D #({params}{", " if regs else ""}.RESETMODE("SYNC")) m (
+    text = f"""module mult_top(input clk, input rst, input [17:0] a, input [17:0] b, input [3:0] ce,
+                input [3:0] reset, output [35:0] p);
+  MULT18X18D #({params}{", " if regs else ""}.RESETMODE("{resetmode}")) m (
     {bit("A", 18)}, {bit("B", 18)}, {", ".join(f".C{i}(1'b0)" for i in range(18))},
     .SIGNEDA(1'b{int(signed_a)}), .SIGNEDB(1'b{int(signed_b)}), .SOURCEA(1'b0), .SOURCEB(1'b0),
-    .CLK0(clk), .CLK1(1'b0), .CLK2(1'b0), .CLK3(1'b0), .CE0(ce), .CE1(1'b0), .CE2(1'b0),
-    .CE3(1'b0), .RST0(reset), .RST1(1'b0), .RST2(1'b0), .RST3(1'b0), {bit("P", 36)});
+    .CLK0(clk), .CLK1(clk), .CLK2(clk), .CLK3(clk), .CE0(ce[0]), .CE1(ce[1]), .CE2(ce[2]),
+    .CE3(ce[3]), .RST0(reset[0]), .RST1(reset[1]), .RST2(reset[2]), .RST3(reset[3]), {bit("P", 36)});
 endmodule
 """
     path = build_dir / "mult_top.v"
@@ -32,41 +38,76 @@ endmodule
     return path
 
 
-@pytest.mark.parametrize("regs", [(), ("INPUTA", "INPUTB", "OUTPUT"),
-                                  ("INPUTA", "INPUTB", "PIPELINE", "OUTPUT"), ("OUTPUT",)])
+def _mult_reference(regs, a, b, ce, reset, signed_a, signed_b):
+    """P after each rising edge, register by register: INPUTA/B take A/B, PIPELINE the
+    product of the (registered or not) operands, OUTPUT the (registered or not) product;
+    a group's reset (its RSTn) clears it and wins over its enable (its CEn)."""
+    val = lambda x, s: x - (1 << 18) if s and x >> 17 else x
+    prod = lambda x, y: (val(int(x), signed_a) * val(int(y), signed_b)) & ((1 << 36) - 1)
+    state = dict.fromkeys(regs, 0)
+
+    def path(k):
+        av = state.get("INPUTA", a[k])
+        bv = state.get("INPUTB", b[k])
+        m_in = prod(av, bv)
+        mv = state.get("PIPELINE", m_in)
+        return m_in, mv, state.get("OUTPUT", mv)
+
+    out = []
+    for k in range(len(a)):
+        m_in, mv, _ = path(k)
+        d = {"INPUTA": a[k], "INPUTB": b[k], "PIPELINE": m_in, "OUTPUT": mv}
+        state = {g: 0 if reset[k] >> x & 1 else d[g] if ce[k] >> c & 1 else state[g]
+                 for g, (c, x) in regs.items()}
+        out.append(path(k)[2])
+    return out
+
+
+MULT_MODES = {
+    "comb": {},
+    "in": {"INPUTA": (0, 0), "INPUTB": (0, 0)},
+    "in_out": {"INPUTA": (0, 0), "INPUTB": (0, 0), "OUTPUT": (0, 0)},        # rtl/pipe.py's
+    "in_pipe_out": dict.fromkeys(GROUPS, (0, 0)),
+    "out": {"OUTPUT": (0, 0)},
+    "pipe": {"PIPELINE": (0, 0)},
+    "a_only": {"INPUTA": (0, 0)},
+    "own_ce_rst": {"INPUTA": (1, 2), "INPUTB": (2, 3), "PIPELINE": (3, 0), "OUTPUT": (0, 1)},
+}
+
+
+@pytest.mark.parametrize("mode", MULT_MODES)
 @pytest.mark.parametrize("signed_a, signed_b", [(1, 1), (0, 0), (1, 0)])
-def test_mult18x18d_model_products(regs, signed_a, signed_b, build_dir):
-    """P = A x B (18-bit operands, signed or unsigned per SIGNEDA/B, 36-bit P) after as many
-    CE0 clocks as register stages are on the A -> P path; RST0 clears the registers."""
-    rng = np.random.default_rng(len(regs) * 7 + signed_a * 2 + signed_b)
+def test_mult18x18d_model_products(mode, signed_a, signed_b, build_dir):
+    """P = A x B (18-bit operands, signed or unsigned per SIGNEDA/B, 36-bit P) through each
+    register mode (input, pipeline, output registers; each on its own CE/RST in
+    own_ce_rst), cycle by cycle against plain products under random CE and RST."""
+    regs = MULT_MODES[mode]
+    rng = np.random.default_rng(sorted(MULT_MODES).index(mode) * 7 + signed_a * 2 + signed_b)
     n = 400
     a = rng.integers(0, 1 << 18, n)
     b = rng.integers(0, 1 << 18, n)
     a[:4], b[:4] = [0x20000, 0x1FFFF, 0x3FFFF, 0], [0x20000, 0x20000, 0x3FFFF, 5]   # extremes
-    ce = (rng.random(n) < 0.7).astype(int) if regs else np.ones(n, int)
-    reset = np.zeros(n, int)
-    reset[n // 2] = 1 if regs else 0
-    top = _mult_top(build_dir, regs, signed_a, signed_b)
+    ce = rng.integers(0, 16, n) | np.where(rng.random(n) < 0.5, 15, 0)     # CEn each ~3/4 on
+    reset = np.where(rng.random(n) < 0.03, rng.integers(1, 16, n), 0)
+    top = _mult_top(build_dir, regs, signed_a, signed_b, "ASYNC" if mode == "pipe" else "SYNC")
     out = run_vectors([top, *model_sources()], "mult_top",
-                      {"a": (18, a), "b": (18, b), "ce": (1, ce), "reset": (1, reset)},
+                      {"a": (18, a), "b": (18, b), "ce": (4, ce), "reset": (4, reset)},
                       {"p": 36}, build_dir)["p"]
-    val = lambda x, s: x - (1 << 18) if s and x >> 17 else x
-    want = [(val(int(x), signed_a) * val(int(y), signed_b)) & ((1 << 36) - 1) for x, y in zip(a, b)]
-    stages = sum(r in regs for r in ("INPUTA", "PIPELINE", "OUTPUT"))
-    if not stages:                       # combinational: P follows A, B in the same cycle
-        assert out == want
-        return
-    checked = 0
-    # exact check: replay the enabled inputs through the register stages
-    regs_v = [0] * stages
-    for k in range(n):
-        if reset[k]:
-            regs_v = [0] * stages
-        elif ce[k]:
-            regs_v = [want[k]] + regs_v[:-1]
-        assert out[k] == regs_v[-1], (k, regs)
-        checked += 1
-    assert checked == n
+    want = _mult_reference(regs, a, b, ce, reset, signed_a, signed_b)
+    assert out == want
+    val = lambda x, s: int(x) - (1 << 18) if s and x >> 17 else int(x)
+    prod = lambda x, y: (val(x, signed_a) * val(y, signed_b)) & ((1 << 36) - 1)
+    # and directly: with every enable on and no reset, P sampled after the edge that takes
+    # operand k is the plain product of the operands r - 1 edges back, r the registers on
+    # each operand's path (0 registers: the same cycle)
+    lag_a = max(0, sum(g in regs for g in ("INPUTA", "PIPELINE", "OUTPUT")) - 1)
+    lag_b = max(0, sum(g in regs for g in ("INPUTB", "PIPELINE", "OUTPUT")) - 1)
+    lag = max(lag_a, lag_b)
+    steady = [k for k in range(lag, n)
+              if all(ce[j] == 15 and reset[j] == 0 for j in range(k - lag, k + 1))]
+    assert len(steady) > 20
+    for k in steady:
+        assert out[k] == prod(a[k - lag_a], b[k - lag_b]), (mode, k)
 
 
 def _rom_lockstep(init, nports, build_dir, n, seed, sweep=True):
