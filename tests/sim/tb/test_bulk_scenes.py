@@ -55,6 +55,10 @@ def scenes_rtl(tmp_path_factory):
     return cfg, out
 
 
+# Two Verilator builds: make regress (the golden model's 58 dB per scene is in make test,
+# tests/sim/golden/fixed/test_channels.py; both units' RTL equals the golden model bit for
+# bit in tests/sim/tb/test_tb_datapath.py).
+@pytest.mark.regress
 @pytest.mark.parametrize("name", list(SCENES) + ["craters"])
 def test_scene_through_the_rtl_at_least_58_db_max_1(scenes_rtl, name):
     cfg, out = scenes_rtl

@@ -20,9 +20,11 @@ SCENE = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8
                            "texture_size": 16})
 
 
-# make test: rotation on both simulators, illumination on Icarus (its Verilator build is
-# half a minute; make regress runs it); the scene pipeline on both (below).
-@pytest.mark.parametrize("sim,unit", [("icarus", "rotation"), ("verilator", "rotation"),
+# make test: rotation and illumination on Icarus, the scene pipeline on both (below); make
+# regress: the units on Verilator too (each build is half a minute).
+@pytest.mark.parametrize("sim,unit", [("icarus", "rotation"),
+                                      pytest.param("verilator", "rotation",
+                                                   marks=pytest.mark.regress),
                                       ("icarus", "illumination"),
                                       pytest.param("verilator", "illumination",
                                                    marks=pytest.mark.regress)])

@@ -68,7 +68,7 @@ def test_every_method_renders_the_unseen_map(crater_scene):
     assert rows["lee_corrected"][2] < 40 and rows["palette"][0] > 25
 
 
-@pytest.mark.parametrize("sim", ["icarus", "verilator"])
+@pytest.mark.parametrize("sim", ["icarus", pytest.param("verilator", marks=pytest.mark.regress)])
 def test_rtl_render_of_a_map_written_through_the_host_port(sim, crater_scene, build_dir):
     """The Verilog holds no map (load = port): cocotb writes the crater map through
     map_w_en/map_w_addr/map_w_data, then streams the pixels; the image equals the
