@@ -112,10 +112,10 @@ module mult18x18d_reg #(parameter W = 1, parameter CLK = "NONE", parameter CE = 
       assign q = r;
       if (RESETMODE == "ASYNC") begin : async
         always @(posedge clk[NC] or posedge rst[NR])
-          if (ce[NE]) r <= d;
+          if (rst[NR]) r <= 0; else if (ce[NE]) r <= d;
       end else begin : sync
         always @(posedge clk[NC])
-          if (ce[NE]) r <= d;
+          if (rst[NR]) r <= 0; else if (ce[NE]) r <= d;
       end
     end
   endgenerate

@@ -3,12 +3,15 @@ MULT18X18D, ...) run under Icarus with Yosys' cells_sim.v and the sim/ecp5 model
 
 make test: Yosys' own block-RAM mapping of a ROM in the x4 mode (x9 and x2: make fpga)
 agrees with the DP16KD model's word layout (rtl/pipe.dp16kd_initvals packs the same way), and
-rtl/pipe.RegisteredRAM's ECP5 form equals its generic form under random writes and reads.
+rtl/pipe.RegisteredRAM's ECP5 form equals its generic form under random writes and reads;
+the default scene's BumpPipeline after synth_ecp5 renders one 16 x 16 frame bit-exact.
 make fpga: the ECP5 form of the exact rotation -> illumination pipeline and of the default
 scene's BumpPipeline, synthesized, bit-exact against the golden model on 10^4 pixels under
-random backpressure and input gaps (cocotb, sim/tb/tb_pipeline.py)."""
+random backpressure and input gaps (cocotb on Icarus, sim/tb/tb_pipeline.py; the traffic
+patterns "both" and "backpressure" of sim/traffic.py)."""
 
 import json
+import time
 
 import numpy as np
 import pytest
@@ -94,20 +97,29 @@ def test_yosys_bram_mapping_agrees_with_the_model(depth, width, build_dir):
     assert out == init
 
 
-def _postsynth_stream(component, label, inputs, build_dir, patterns):
+def _postsynth_stream(component, label, inputs, build_dir, patterns, polygon=None):
     """Synthesize ``component`` (ECP5 form), stream ``inputs`` (flattened payload arrays)
-    through its netlist under cocotb/Icarus; {pattern: {field: array}}."""
+    through its netlist under cocotb/Icarus (sim/ecp5.postsynth_sources says why not
+    Verilator); {pattern: {field: array}}. The synthesis, build and run wall times are
+    printed (pytest -s) and written to ``build_dir/timing.json``."""
+    t0 = time.perf_counter()
     text = verilog.convert(component, name=label, emit_src=False)
     netlist = synth_netlist(text, label, build_dir / "synth")
+    synth_s = time.perf_counter() - t0
     sidecar = build_dir / f"{label}.json"
     sidecar.write_text(json.dumps({"ports": port_table(component)}))
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
-    write_stimulus(stim, inputs, None, None)
+    write_stimulus(stim, inputs, polygon, None)
     sources, includes = postsynth_sources(build_dir / "cells")
-    run_cocotb("icarus", netlist, "bumprtl.sim.tb.tb_pipeline", build_dir / "icarus",
-               {"BUMPRTL_SIDECAR": sidecar, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
-                "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": 0},
-               sources=sources, includes=includes)
+    run = run_cocotb("icarus", netlist, "bumprtl.sim.tb.tb_pipeline", build_dir / "icarus",
+                     {"BUMPRTL_SIDECAR": sidecar, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
+                      "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": 0},
+                     sources=sources, includes=includes)
+    pixels = len(next(iter(inputs.values()))) * len(patterns)
+    timing = {"synth_s": round(synth_s, 1), "build_s": round(run.build_s, 1),
+              "sim_s": round(run.run_s, 1), "pixels": pixels, "patterns": list(patterns)}
+    (build_dir / "timing.json").write_text(json.dumps(timing))
+    print(f"\npost-synthesis {label}: {timing}")
     res = dict(np.load(result))
     return {p: {k[len(p) + 1:]: v for k, v in res.items() if k.startswith(p + ".")
                 and not k.endswith(".cycles")} for p in patterns}
@@ -139,18 +151,22 @@ def test_postsynth_exact_pipeline_bit_exact(build_dir):
             assert np.array_equal(out[field], golden[field]), (pattern, field)
 
 
-@pytest.mark.fpga
-def test_postsynth_scene_pipeline_bit_exact(build_dir):
+@pytest.mark.parametrize("size, n, patterns", [
+    pytest.param(16, 256, ["both"], marks=pytest.mark.fpga),   # a quick case: one 16 x 16 frame
+    pytest.param(128, 10_000, PATTERNS, marks=pytest.mark.fpga)])
+def test_postsynth_scene_pipeline_bit_exact(size, n, patterns, build_dir):
     """The default scene's BumpPipeline (fetch -> rotation -> illumination, bump map in
-    DP16KD blocks, products in MULT18X18D) after synth_ecp5: a 100 x 100 render (10^4
-    pixels) per traffic pattern bit-exact against sim/golden/fixed/pipeline.py."""
+    DP16KD blocks, products in MULT18X18D) after synth_ecp5: the first ``n`` pixels of a
+    ``size`` x ``size`` render per traffic pattern bit-exact against
+    sim/golden/fixed/pipeline.py."""
     scene = load_scene_config("default")
-    inputs, words, polygon, table, base = scene_stimulus(scene, 100)
+    inputs, words, polygon, table, base = scene_stimulus(scene, size)
+    inputs = {k: v[:n] for k, v in inputs.items()}
     comp = BumpPipeline(scene, init=words, target=ECP5())
-    outs = _postsynth_stream(comp, "scene_default", inputs, build_dir, PATTERNS)
+    outs = _postsynth_stream(comp, "scene_default", inputs, build_dir, patterns, polygon)
     golden = pipeline_fixed(inputs, scene, words, polygon, None)
-    assert len(inputs["tag"]) == 10_000
-    for pattern in PATTERNS:
+    assert len(inputs["tag"]) == n
+    for pattern in patterns:
         out = outs[pattern]
         assert out["tag"].tolist() == inputs["tag"].tolist(), pattern
         for field, want in golden.items():
