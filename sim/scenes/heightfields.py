@@ -6,7 +6,7 @@ from PIL import Image, ImageDraw, ImageFilter, ImageFont
 
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["HEIGHTFIELDS", "height_to_normals", "normals_from_gradient", "smooth_noise"]
+__all__ = ["HEIGHTFIELDS", "craters", "height_to_normals", "normals_from_gradient", "smooth_noise"]
 
 
 def _grid(t):
@@ -93,6 +93,20 @@ def wood(t):
     u, v = _grid(t)
     r = np.hypot(u - 0.3, (v - 1.4) * 0.35) * 28 + 0.6 * np.sin(u * 9 * np.pi)
     return 0.5 + 0.5 * np.sin(r * np.pi)
+
+
+def craters(t, seed, n, radius=(0.1, 0.3)):
+    """An unseen height map, as a user would bring one: ``n`` random craters (a bowl and a
+    rim each; radius a random fraction in ``radius`` of T) with a fixed ``seed``, tiling."""
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:t, 0:t] + 0.5
+    h = np.zeros((t, t))
+    for _ in range(n):
+        cx, cy = rng.uniform(0, t, 2)
+        r = rng.uniform(*radius) * t
+        d = np.hypot((x - cx + t / 2) % t - t / 2, (y - cy + t / 2) % t - t / 2) / r
+        h += np.where(d < 1, d ** 2 - 1, 0.3 * np.exp(-((d - 1) / 0.3) ** 2))
+    return (h - h.min()) / np.ptp(h)
 
 
 def bumps(t):

@@ -21,22 +21,15 @@ from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.report import recommend as rec
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.sim.golden.common import polar_to_cartesian
+from bumprtl.sim.scenes import heightfields
 from bumprtl.sim.scenes.usermap import load_bump_map, normals_to_rgb, write_png
 
 CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
 
 
-def craters(t, seed=11, n=10):
-    """An unseen height map: random craters (bowl and rim), fixed seed, tiling."""
-    rng = np.random.default_rng(seed)
-    y, x = np.mgrid[0:t, 0:t] + 0.5
-    h = np.zeros((t, t))
-    for _ in range(n):
-        cx, cy = rng.uniform(0, t, 2)
-        r = rng.uniform(0.08, 0.25) * t
-        d = np.hypot((x - cx + t / 2) % t - t / 2, (y - cy + t / 2) % t - t / 2) / r
-        h += np.where(d < 1, d ** 2 - 1, 0.3 * np.exp(-((d - 1) / 0.3) ** 2))
-    return (h - h.min()) / np.ptp(h)
+def craters(t, n=10):
+    """The unseen map of this file: sim/scenes/heightfields.craters, its own seed and radii."""
+    return heightfields.craters(t, seed=11, n=n, radius=(0.08, 0.25))
 
 
 def _png(path, h):

@@ -1,5 +1,5 @@
-"""An unseen user map (random craters, fixed seed, made here) through every method's golden
-models, the fixed-point render and the RTL on both simulators: the map is written through
+"""An unseen user map (random craters, fixed seed: sim/scenes/heightfields.craters) through
+every method's golden models, the fixed-point render and the RTL on both simulators: the map is written through
 the pipeline's host write port, and the RTL image equals the fixed-point render (and the
 golden render) byte for byte."""
 
@@ -12,23 +12,16 @@ from PIL import Image
 from bumprtl.gen.render.images import FIXED_METHODS, fixed_image, float_image, render_methods
 from bumprtl.gen.render.rtl import render_rtl
 from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes import heightfields
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 
 SIZE = 32                           # map and image: small, so make test stays fast
 EXACT_COLOUR_LSB = 2                # exact at the default widths: worst colour error, docs/bench.md
 
 
-def craters(t, seed=2024, n=9):
-    """Random craters (bowl and rim) on a tiling T x T height field, heights in [0, 1]."""
-    rng = np.random.default_rng(seed)
-    y, x = np.mgrid[0:t, 0:t] + 0.5
-    h = np.zeros((t, t))
-    for _ in range(n):
-        cx, cy = rng.uniform(0, t, 2)
-        r = rng.uniform(0.1, 0.3) * t
-        d = np.hypot((x - cx + t / 2) % t - t / 2, (y - cy + t / 2) % t - t / 2) / r
-        h += np.where(d < 1, d ** 2 - 1, 0.3 * np.exp(-((d - 1) / 0.3) ** 2))
-    return (h - h.min()) / np.ptp(h)
+def craters(t):
+    """The unseen map of this file: sim/scenes/heightfields.craters, its own seed."""
+    return heightfields.craters(t, seed=2024, n=9)
 
 
 @pytest.fixture(scope="module")
