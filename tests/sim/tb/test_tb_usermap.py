@@ -1,7 +1,7 @@
 """An unseen user map (random craters, fixed seed: sim/scenes/heightfields.craters) through
-every method's golden models, the fixed-point render and the RTL on both simulators: the map is written through
-the pipeline's host write port, and the RTL image equals the fixed-point render (and the
-golden render) byte for byte."""
+every method's golden models, the fixed-point render and the RTL on both simulators: the
+map is written through the pipeline's host write port, and the RTL image equals the
+fixed-point render (and the golden render) byte for byte."""
 
 import re
 
