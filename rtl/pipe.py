@@ -99,10 +99,11 @@ def read_port(addr_bits, shape, name):
 class RegisteredROM(Elaboratable):
     """A ROM whose ``ports`` read ports (:func:`read_port`) give ``data`` ROM_LATENCY ``en`` cycles after
     ``addr`` (synchronous read, then an output register). On ECP5 (``target``
-    :class:`ECP5`) that is one DP16KD with both ports and its own output registers
-    (REGMODE OUTREG: the clock-to-out of an unregistered block RAM leaves the
-    cycle); a table of 2**n + 1 words whose word 0 is 0 keeps its last word in a flip-flop
-    (the address wraps to word 0 and the word is OR'ed in). Elsewhere (``target=None``): an
+    :class:`ECP5`) that is DP16KD blocks (one x18 block up to 1024 words, deeper tables in
+    the widest mode that holds them, blocks side by side for the width: :meth:`mode`) with
+    both ports and their own output registers (REGMODE OUTREG: the clock-to-out of an
+    unregistered block RAM leaves the cycle); a table of 2**n + 1 words whose word 0 is 0
+    keeps its last word in a flip-flop (the address wraps to word 0 and the word is OR'ed in). Elsewhere (``target=None``): an
     Amaranth Memory and a register. ``depth`` and ``width`` are the table's size."""
 
     def __init__(self, init, shape, ports, name, target=None):
@@ -112,17 +113,34 @@ class RegisteredROM(Elaboratable):
         self.en = Signal(name=f"{name}_en")
         self.ports = [read_port(addr_bits, shape, f"{name}_p{n}") for n in range(ports)]
 
+    def _spills(self):
+        """A table of 2**n + 1 words whose word 0 is 0 keeps its last word in a flip-flop."""
+        n = self.depth - 1
+        return n >= 1 and n & (n - 1) == 0 and self.init[0] == 0
+
+    def mode(self, target):
+        """(data bits, words, address shift) of the DP16KD mode of the ECP5 form: one block
+        (x18) up to 1024 words (1025 with the spill word), else the widest mode
+        (:data:`DP16KD_MODES`) holding the words, blocks side by side for the width, at most
+        :data:`ROM_MAX_BLOCKS`; None: the generic form (more than two ports, or too big)."""
+        words = self.depth - self._spills()
+        if len(self.ports) > 2:
+            return None
+        if words <= target.bram_words:
+            return DP16KD_MODES[0] if self.width <= target.bram_width else None
+        mode = next((m for m in DP16KD_MODES if m[1] >= words), None)
+        if mode is None or -(-self.width // mode[0]) > ROM_MAX_BLOCKS:
+            return None
+        return mode
+
     def _fits(self, target):
-        words, width = self.depth, self.width
-        spill = words == target.bram_words + 1 and self.init[0] == 0
-        return (len(self.ports) <= 2 and width <= target.bram_width
-                and (words <= target.bram_words or spill))
+        return self.mode(target) is not None
 
     def elaborate(self, platform):
         m = Module()
         target = self.target
         if getattr(target, "bram", None) == "DP16KD" and self._fits(target):
-            self._dp16kd(m, target)
+            self._dp16kd(m, *self.mode(target))
             return m
         m.submodules.mem = mem = Memory(shape=self.shape, depth=len(self.init), init=self.init)
         for port in self.ports:
@@ -132,43 +150,43 @@ class RegisteredROM(Elaboratable):
                 m.d.sync += port.data.eq(read.data)
         return m
 
-    def _dp16kd(self, m, target):
-        words = target.bram_words
-        slots = [0] * words
-        for n, x in enumerate(self.init[:words]):
-            slots[n] = x & ((1 << 18) - 1)
-        params = {}
-        for row in range(64):                   # INITVAL_xx: 16 words in 20-bit slots
-            value = 0
-            for n in range(16):
-                value |= slots[row * 16 + n] << (20 * n)
-            params[f"p_INITVAL_{row:02X}"] = Const(value, 320)
-        params.update(p_DATA_WIDTH_A=18, p_DATA_WIDTH_B=18, p_REGMODE_A="OUTREG",
-                      p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
-                      p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
-                      p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+    def _dp16kd(self, m, bits, words, shift):
         zero = Const(0, 1)
-        for side, port in zip("AB", self.ports + self.ports[:1]):
-            addr, dout = Signal(14, name=f"{port.addr.name}_{side}"), Signal(18)
-            m.d.comb += addr[4:].eq(port.addr[:10])           # 18-bit mode: word address 13:4
-            params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
-                           f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
-            params.update({f"i_CS{side}{n}": zero for n in range(3)})
-            params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
-            params.update({f"i_DI{side}{n}": zero for n in range(18)})
-            params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
-            if side == "B" and len(self.ports) == 1:
-                break
-            data = dout
-            if len(self.init) > words:          # the last word: address wrapped to word 0 (= 0)
+        abits = words.bit_length() - 1
+        sides = list(zip("AB", self.ports + self.ports[:1]))[:max(2, len(self.ports))]
+        douts = {side: Signal(self.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
+        for col in range(-(-self.width // bits)):
+            lo, hi = col * bits, min(self.width, (col + 1) * bits)
+            params = dp16kd_initvals([(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
+                                     bits)
+            params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="OUTREG",
+                          p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
+                          p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
+                          p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+            for side, port in sides:
+                addr, dout = Signal(14, name=f"{port.addr.name}_{side}{col}"), Signal(18)
+                m.d.comb += addr[shift:shift + abits].eq(port.addr[:abits])    # word address
+                params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
+                               f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
+                params.update({f"i_CS{side}{n}": zero for n in range(3)})
+                params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
+                params.update({f"i_DI{side}{n}": zero for n in range(18)})
+                params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+                m.d.comb += douts[side][lo:hi].eq(dout[:hi - lo])
+            m.submodules[f"bram{col}" if col else "bram"] = Instance("DP16KD", **params)
+        for side, port in sides[:len(self.ports)]:
+            data = douts[side]
+            if self.depth > words:              # the last word: address wrapped to word 0 (= 0)
                 last = Signal(name=f"{port.addr.name}_last")
                 last_d = Signal(name=f"{port.addr.name}_last_d")
                 with m.If(self.en):
                     m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
-                data = dout | Mux(last_d, self.init[words], 0)
+                data = data | Mux(last_d, self.init[words], 0)
             m.d.comb += port.data.eq(data)
-        m.submodules.bram = Instance("DP16KD", **params)
 
+
+# Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5.
+ROM_MAX_BLOCKS = 4
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
 DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))

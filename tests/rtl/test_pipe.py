@@ -174,15 +174,22 @@ def test_ecp5_product_uses_the_dsp_registers():
 
 
 def test_ecp5_forms_only_where_the_block_fits():
-    """Operands wider than 18 bits (signed) and tables deeper than 1025 words or wider than
-    18 bits keep the generic form (Yosys then splits them as before)."""
+    """Operands wider than 18 bits (signed), tables of up to 1025 words wider than 18 bits and
+    deeper tables that need more than ROM_MAX_BLOCKS blocks keep the generic form (Yosys then
+    splits them as before)."""
     assert not _instances(RegisteredProduct(signed(19), signed(4), "p", target=ECP5()))
     assert not _instances(RegisteredProduct(unsigned(18), signed(4), "p", target=ECP5()))
     assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p", target=ECP5()))) == 1
-    assert not _instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r", target=ECP5()))  # word 0 != 0
-    assert not _instances(RegisteredROM(range(2049), unsigned(12), 2, "r", target=ECP5()))
+    # 1025 words with word 0 != 0: no spill word, two x9 blocks
+    assert len(_instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r", target=ECP5()))) == 2
     assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r", target=ECP5()))
     assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r", target=ECP5()))) == 1
+    # deeper: the widest mode that holds the words, blocks side by side (2049 = 2048 + spill)
+    assert len(_instances(RegisteredROM(range(2049), unsigned(17), 2, "r", target=ECP5()))) == 2
+    assert not _instances(RegisteredROM(range(1, 2050), unsigned(17), 2, "r", target=ECP5()))  # 5 x4
+    assert len(_instances(RegisteredROM(range(2048), unsigned(36), 2, "r", target=ECP5()))) == 4
+    assert not _instances(RegisteredROM(range(2048), unsigned(37), 2, "r", target=ECP5()))
+
 
 
 # --- the stall rule as a throughput property ---------------------------------------------------

@@ -135,15 +135,16 @@ def _rom_lockstep(init, nports, build_dir, n, seed, sweep=True):
     return en, addrs, generic, ecp5
 
 
-@pytest.mark.parametrize("depth, nports", [(1025, 2), (1025, 1), (1024, 2), (300, 1)])
+@pytest.mark.parametrize("depth, nports", [(1025, 2), (1025, 1), (1024, 2), (300, 1), (2049, 2), (1500, 1)])
 def test_registered_rom_ecp5_form_every_word(depth, nports, build_dir):
-    """Every word (1025: the spill word in its flip-flop) read through the DP16KD model equals
-    the generic form and the table, ROM_LATENCY enabled clocks after its address."""
+    """Every word (1025, 2049: the spill word in its flip-flop; 2049, 1500: two x9 blocks side
+    by side) read through the DP16KD model equals the generic form and the table,
+    ROM_LATENCY enabled clocks after its address."""
     rng = np.random.default_rng(depth + nports)
     init = [0] + rng.integers(0, 1 << 18, depth - 1).tolist()
-    if depth == 1025:
+    if depth in (1025, 2049):
         init[-1] = (1 << 18) - 1                 # the spill word: every bit set
-    assert RegisteredROM(init, unsigned(18), nports, "rom")._fits(ECP5()) == (depth <= 1025)
+    assert RegisteredROM(init, unsigned(18), nports, "rom")._fits(ECP5())
     n = int(depth / 0.6) + 200
     en, addrs, generic, ecp5 = _rom_lockstep(init, nports, build_dir, n, seed=depth)
     for p in range(nports):
