@@ -139,11 +139,6 @@ _UNQUANTIZED = "diffuse (error_bound_lsb; every channel in error_bounds_lsb) vs 
 _CARTESIAN_NOTE = (f"{_UNQUANTIZED}, Cartesian input codes from "
                    "sim/golden/fixed/peercy.encode "
                    "(proof: sim/golden/fixed/peercy.predicted_error_bound_lsb)")
-# Measured, not guessed: reports and the sweep show this reason instead of numbers.
-_NOT_PLACED = ("not placed: synth_ecp5's ABC9 step on the 6 combinational dividers and 2 square "
-               "roots (66,489 AND gates) ran 25 minutes without finishing on the 2-core machine "
-               "and was stopped; its Yosys counts are in docs/table1.md")
-
 METHODS = {m.name: m for m in (
     Method("exact", "exact angular method", baseline=False, table1_column=6,
            rotation=ExactRotation, illumination=ExactIllumination,
@@ -175,7 +170,7 @@ METHODS = {m.name: m for m in (
            encode=fixed_peercy.encode, from_angle_codes=fixed_peercy.from_angle_codes,
            cartesian=True, rotates_normal=False,
            predicted_error_bound_lsb=fixed_peercy.predicted_error_bound_lsb,
-           error_note=_CARTESIAN_NOTE, reference=peercy, not_placed=_NOT_PLACED),
+           error_note=_CARTESIAN_NOTE, reference=peercy),
     Method("ernst", "Ernst et al. 1998", baseline=True, table1_column=4,
            rotation=ErnstRotation, illumination=ErnstIllumination,
            rotated_layout=setup_output_layout,
@@ -184,7 +179,7 @@ METHODS = {m.name: m for m in (
            encode=fixed_ernst.encode, from_angle_codes=fixed_ernst.from_angle_codes,
            cartesian=True, rotates_normal=False,
            predicted_error_bound_lsb=fixed_ernst.predicted_error_bound_lsb,
-           error_note=_CARTESIAN_NOTE, reference=ernst, not_placed=_NOT_PLACED),
+           error_note=_CARTESIAN_NOTE, reference=ernst),
     Method("kim", "Kim et al. 2001", baseline=True, table1_column=3,
            rotation=KimRotation, illumination=KimIllumination,
            rotated_layout=rtl_lee.rotated_layout,

@@ -18,9 +18,14 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
   of the result comes from its carry/sign outputs), i.e. ``<``, ``>=``, clamps.
 * **tables**: every ``$mem_v2`` with no write port (a ROM), with depth x width, bits and
   read ports; memories with write ports are listed as RAMs.
-* **dividers**: ``$div``/``$divfloor``/``$mod``/``$modfloor`` cells, by operand widths.
-* **square roots**: instances of a submodule whose name ends in ``sqrt`` (kept as a black
-  box while flattening; its inner adders are not counted as adders).
+* **dividers**: ``$div``/``$divfloor``/``$mod``/``$modfloor`` cells, and instances of a
+  submodule whose name ends in ``_div`` (a pipelined divider whose operands are the signals
+  ``dividend`` and ``divisor`` inside it, e.g. rtl/baselines/peercy.PeercyDivider; its
+  ports may be narrower, Amaranth leaves constant operand bits out of them), by operand
+  widths.
+* **square roots**: instances of a submodule whose name ends in ``sqrt``.
+  Square roots and ``_div`` dividers are kept as black boxes while flattening: their inner
+  adders are not counted as adders, their inner registers are counted as register bits.
 * **register bits**: the widths of all flip-flop cells (``$dff``, ``$sdffe``, ...).
 """
 
@@ -44,7 +49,7 @@ __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog
 
 # The coarse, technology-independent synthesis the counts are taken from (memories kept as
 # memories).
-SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt; flatten; "
+SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt *_div; flatten; "
           "opt; wreduce; alumacc; opt; memory -nomap; opt_clean")
 
 _FF_TYPES = {"$dff", "$dffe", "$adff", "$adffe", "$sdff", "$sdffe", "$sdffce", "$aldff",
@@ -177,6 +182,12 @@ def _count_memory(counts, name, cell):
     (counts.tables if _int(p["WR_PORTS"]) == 0 else counts.rams).append(entry)
 
 
+def _register_bits(module):
+    """Flip-flop bits of the cells of one netlist module."""
+    return sum(_int(c["parameters"]["WIDTH"]) for c in module["cells"].values()
+               if c["type"] in _FF_TYPES)
+
+
 def _used_bits(module):
     """Net bits that something reads: a cell input or a module output."""
     used = set()
@@ -215,6 +226,11 @@ def count_netlist(netlist, top):
             counts.register_bits += _int(cell["parameters"]["WIDTH"])
         elif kind in modules and kind.endswith("sqrt"):
             counts.sqrts += 1
+            counts.register_bits += _register_bits(modules[kind])
+        elif kind in modules and kind.endswith("_div"):
+            a, b = (len(modules[kind]["netnames"][n]["bits"]) for n in ("dividend", "divisor"))
+            counts.dividers.append(f"{a}/{b}")
+            counts.register_bits += _register_bits(modules[kind])
     # Cell names (and so the order of the cells) depend on the Yosys front end; the counts
     # do not: widest first.
     for f in ("multipliers", "const_multipliers", "dividers"):

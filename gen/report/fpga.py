@@ -33,9 +33,9 @@ __all__ = ["fpga_units", "fpga_report", "write_report", "add_parser"]
 
 def fpga_units(cfg):
     """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
-    pipeline (setup -> illumination; their combinational dividers and square roots make
-    synth_ecp5 slow on every netlist, so not each unit again), then the BumpPipeline of
-    every built-in scene class (row ``scene:<name>``)."""
+    pipeline (setup -> illumination only: their per-unit numbers are Table 1's Yosys counts,
+    and with their pipelined square roots and dividers they are the largest netlists to
+    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
     return ([(f"{d}_{row}", d, row) for d in TABLE1_ORDER if d not in NOT_PLACED for row in rows(d)]
             + [(f"scene_{s.replace('-', '_')}", load_scene_config(s).method, f"scene:{s}")

@@ -22,7 +22,7 @@ __all__ = ["ErnstRotation", "ErnstIllumination"]
 
 class ErnstRotation(PeercyRotation):
     """Setup datapath, Ernst: Peercy's transform and normalization of L and H (same
-    layouts, latency 7)."""
+    layouts, latency ``peercy.rotation_latency(cfg)``)."""
 
 
 class ErnstIllumination(PeercyIllumination):

@@ -13,12 +13,13 @@ Setup (:class:`PeercyRotation`, Table 1's "illumination environment setup"), per
    rounding back to B fractional bits per component;
 2. normalization, A_n = A_t / |A_t|: 3 multipliers (squares) and 2 adders for
    s = |A_t|**2 (2B fractional bits), one square root r = isqrt(4 s) = floor(2 |A_t| 2**B)
-   (B + 1 fractional bits; the :class:`PeercySqrt` submodule ``{a}_sqrt``, a combinational
-   restoring square root), and 3 dividers q = floor(|a| 2**(B+2) / r) on magnitudes (one
-   extra quotient bit), then round half up q' = (q + 1) >> 1 (a constant adder, exactly
-   the rounded quotient) and the sign of a put back (round half away from zero, so the
-   normalization is odd-symmetric). A zero vector gives r = 0 and a zero quotient
-   (Amaranth defines x // 0 = 0; the golden model does the same).
+   (B + 1 fractional bits; the :class:`PeercySqrt` submodule ``{a}_sqrt``), and 3 dividers
+   q = floor(|a| 2**(B+2) / r) on magnitudes (one extra quotient bit; the
+   :class:`PeercyDivider` submodules ``{a}_{x,y,z}_div``), then round half up
+   q' = (q + 1) >> 1 (a constant adder, exactly the rounded quotient) and the sign of a put
+   back (round half away from zero, so the normalization is odd-symmetric). A zero vector
+   gives r = 0 and a zero quotient (Amaranth defines x // 0 = 0; the golden model and the
+   divider do the same).
 
 Counts for L and H: 24 multipliers (18 transform + 6 squares), 16 adders (12 + 4), 2 square
 roots, 6 dividers. The paper counts 27 multipliers, 18 adders, 3 square roots and 9
@@ -36,9 +37,17 @@ floor(2 sqrt(s)) <= sqrt 2 for s >= 1), which fits the signed(B + 2) output.
 
 Timing: every product is a ``StallPipe.multiply`` (operand and product registers, one
 MULT18X18D on ECP5 when both operands fit 18 bits: all 30 of them at B = 13). The square
-root and the dividers are combinational, each alone between two registers: Yosys must see a
-``$div`` cell to count a divider, so they are not hand-pipelined, and they set this unit's
-Fmax, which is part of the baseline's cost.
+root and the dividers are pipelined by hand, one result bit per stage with a register
+after each, every register enabled by the pipe's ``adv`` (B. Parhami, Computer Arithmetic:
+Algorithms and Hardware Designs, ch. 13, restoring division, and ch. 21, the restoring
+shift/subtract square root): :func:`sqrt_stages` = B + 6 stages of at most a (B + 8)-bit
+subtractor, :func:`quotient_bits` = B + 2 stages of a (B + 7)-bit one. B + 2 quotient bits
+are exact: r = isqrt(4 s) >= isqrt(4 a**2) = 2 |a|, so q <= 2**(B+1). Each is a submodule
+whose name ends in ``sqrt`` or ``_div``, which gen/flow/resources.py keeps as a black box and
+counts as one square root or one divider (Table 1's "SQRt" and "division units"). Latency
+:func:`rotation_latency` (43 at B = 13); 1 pixel per clock. Every sum of three products (the
+transform and the dots N'.A_n, :func:`sum3_rounded`, and |A_t|**2) is two registered
+2-operand adders, not one 3-operand adder behind the DSP blocks' outputs.
 
 Illumination (:class:`PeercyIllumination`): N'.L_n and N'.H_n (6 multipliers, 4 adders, one
 rounding each), then the shared Phong back end of eq. (2) with the same cos^n specular
@@ -47,7 +56,7 @@ The paper gives no illumination row for Peercy ("Not Available"); this is Ernst'
 "straightforward Phong" (rtl/baselines/ernst.py), used for Peercy too.
 """
 
-from amaranth.hdl import Cat, Const, Elaboratable, Module, Mux, Signal, signed, unsigned
+from amaranth.hdl import Cat, Const, Elaboratable, Module, Mux, Signal, Value, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
@@ -55,17 +64,14 @@ from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
 from bumprtl.rtl.shade import IlluminationDatapath
 
-__all__ = ["PeercyRotation", "PeercyIllumination", "PeercySqrt", "vectors", "cartesian_layout",
-           "setup_input_layout", "setup_output_layout", "component_width", "square_bits",
-           "ROTATION_LATENCY", "DOT_LATENCY"]
+__all__ = ["PeercyRotation", "PeercyIllumination", "PeercySqrt", "PeercyDivider", "vectors",
+           "cartesian_layout", "setup_input_layout", "setup_output_layout", "component_width",
+           "square_bits", "sqrt_stages", "quotient_bits", "rotation_latency", "sum3_rounded",
+           "DOT_LATENCY"]
 
 AXES = ("x", "y", "z")
 FRAME = ("t", "b", "n")       # tangent, binormal, normal: the rows of the 3x3 transform
-# Registers of the setup: products (PRODUCT_LATENCY: operand and product registers, one
-# DSP block on ECP5), transformed sums, squares (PRODUCT_LATENCY; |a| rides along),
-# |A_t|**2, square root, quotient, signed result.
-ROTATION_LATENCY = 2 * PRODUCT_LATENCY + 5
-DOT_LATENCY = PRODUCT_LATENCY + 1     # products, sum (then rtl/shade.SHADE_LATENCY)
+DOT_LATENCY = PRODUCT_LATENCY + 2     # products, two sum stages (then rtl/shade.SHADE_LATENCY)
 
 
 def vectors(cfg: Config):
@@ -102,9 +108,47 @@ def square_bits(cfg: Config):
     return 2 * cfg.frac_bits + 9
 
 
+def sqrt_stages(cfg: Config):
+    """Stages of the square root of 4 s (2B + 11 bits): one per root bit, B + 6."""
+    return (square_bits(cfg) + 3) // 2
+
+
+def quotient_bits(cfg: Config):
+    """Quotient bits (= divider stages) of q = floor(|a| 2**(B+2) / r) <= 2**(B+1): B + 2."""
+    return cfg.frac_bits + 2
+
+
+def rotation_latency(cfg: Config):
+    """Registers of the setup: products (PRODUCT_LATENCY: operand and product registers, one
+    DSP block on ECP5), transformed sums (2), squares (PRODUCT_LATENCY; |a| rides along),
+    |A_t|**2 (2), the square root's stages, the divider's stages, signed result."""
+    return 2 * PRODUCT_LATENCY + 5 + sqrt_stages(cfg) + quotient_bits(cfg)
+
+
+def sum3_rounded(reg, p, b, name):
+    """round((p0 + p1 + p2) / 2**b) two ``reg`` stages later (``reg``: a StallPipe's
+    ``register``): one 2-operand carry chain a cycle, the rounding half of
+    rtl/fixed.round_shift riding in the first, so three products leaving their DSP
+    blocks are not summed in one cycle."""
+    p01 = reg(p[0] + p[1] + (1 << (b - 1)), f"{name}_01")
+    return reg((p01 + reg(p[2], f"{name}_2")) >> b, name)
+
+
+def _stage(m, en, value, name):
+    """``value`` through one register enabled by ``en`` (the enclosing pipe's ``adv``)."""
+    value = Value.cast(value)
+    reg = Signal(value.shape(), name=name)
+    with m.If(en):
+        m.d.sync += reg.eq(value)
+    return reg
+
+
 class PeercySqrt(Elaboratable):
-    """Integer square root, ``root = floor(sqrt(radicand))``, combinational, restoring
-    (one bit of the root per step: try (root << 2) | 1 against the remainder).
+    """Integer square root, ``root = floor(sqrt(radicand))``, pipelined: radix-2 restoring,
+    one bit of the root per stage (try (root << 2) | 1 against the remainder with the next
+    two radicand bits shifted in; Parhami ch. 21), a register after each. ``root`` comes
+    ``stages`` (= ``root_bits``) ``en`` cycles after ``radicand``; ``en`` is the enclosing
+    pipe's ``adv``, so a stall freezes every stage.
 
     Its Amaranth submodule name ends in ``sqrt`` so that gen/flow/resources.py keeps it as a
     black box and counts it as one square root (Table 1's "SQRt").
@@ -112,26 +156,73 @@ class PeercySqrt(Elaboratable):
 
     def __init__(self, width):
         self.width = width
-        self.root_bits = (width + 1) // 2
+        self.root_bits = self.stages = (width + 1) // 2
         self.radicand = Signal(width)
+        self.en = Signal()
         self.root = Signal(self.root_bits)
 
     def elaborate(self, platform):
         m = Module()
         n = self.root_bits
-        w = n + 2                                 # the remainder stays <= 2 root < 2**(n+1)
-        x = Cat(self.radicand, Const(0, 2 * n - self.width))
-        rem, root = Const(0, w), Const(0, 0)
+        low = Cat(self.radicand, Const(0, 2 * n - self.width))   # radicand bits still to use
+        rem, root = Const(0, 1), Const(0, 0)
         for k in reversed(range(n)):
-            # One named signal per step keeps the netlist (and the simulator) linear in n.
-            rem4 = Cat(x[2 * k:2 * k + 2], rem)[:w]
-            diff = Signal(w + 1, name=f"diff{k}")
-            m.d.comb += diff.eq(rem4 - Cat(Const(1, 2), root))    # borrow in the top bit
+            j = n - 1 - k                     # root bits so far: rem <= 2 root < 2**(j+1)
+            rem4 = Cat(low[2 * k:2 * k + 2], rem)                    # j + 3 bits
+            # rem4 - (4 root + 1) is in (-2**(j+2), 2**(j+2)): j + 3 bits, the borrow on top
+            diff = Signal(j + 3, name=f"diff{k}")
+            m.d.comb += diff.eq(rem4 - Cat(Const(1, 2), root))
             fits = ~diff[-1]
-            rem = Signal(w, name=f"rem{k}")
-            m.d.comb += rem.eq(Mux(fits, diff[:w], rem4))
-            root = Cat(fits, root)
+            root = _stage(m, self.en, Cat(fits, root), f"root{k}")
+            if k:                             # the new remainder <= 2 root < 2**(j+2)
+                rem = _stage(m, self.en, Mux(fits, diff[:j + 2], rem4[:j + 2]), f"rem{k}")
+                low = _stage(m, self.en, low[:2 * k], f"radicand{k}")
         m.d.comb += self.root.eq(root)
+        return m
+
+
+class PeercyDivider(Elaboratable):
+    """``quotient = floor(dividend / divisor)``, 0 for a zero divisor (Amaranth's ``//``),
+    pipelined: restoring division, one quotient bit per stage, most significant first (the
+    remainder with the next dividend bit shifted in, less the divisor if it fits; Parhami
+    ch. 13), a register after each. ``quotient`` comes ``stages`` (= ``quotient_bits``)
+    ``en`` cycles after the operands; ``en`` is the enclosing pipe's ``adv``.
+
+    ``quotient_bits`` (default: the dividend's width, exact for every input) may be fewer
+    when the caller knows ``dividend < divisor * 2**quotient_bits``; then the remainder stays
+    below the divisor and every stage is a (divisor width + 1)-bit subtractor.
+
+    Its Amaranth submodule name ends in ``_div`` so that gen/flow/resources.py keeps it as a
+    black box and counts it as one divider (Table 1's "division unit"), listed by the widths
+    of ``dividend`` and ``divisor``.
+    """
+
+    def __init__(self, dividend_bits, divisor_bits, quotient_bits=None):
+        self.quotient_bits = self.stages = (dividend_bits if quotient_bits is None
+                                            else quotient_bits)
+        self.dividend = Signal(dividend_bits)
+        self.divisor = Signal(divisor_bits)
+        self.en = Signal()
+        self.quotient = Signal(self.quotient_bits)
+
+    def elaborate(self, platform):
+        m = Module()
+        nq, dw = self.quotient_bits, len(self.divisor)
+        x = Cat(self.dividend, Const(0, max(0, nq - len(self.dividend))))
+        rem, low = x[nq:nq + dw], x[:nq]      # dividend >> nq < divisor: the precondition
+        d, zero, quo = self.divisor, ~self.divisor.any(), Const(0, 0)
+        for i in reversed(range(nq)):
+            t = Cat(low[i], rem)              # < 2 divisor, so t - divisor is in
+            diff = Signal(dw + 1, name=f"diff{i}")    # (-2**dw, 2**dw): the borrow on top
+            m.d.comb += diff.eq(t - d)
+            fits = ~diff[-1] & ~zero
+            quo = _stage(m, self.en, Cat(fits, quo), f"quotient{i}")
+            if i:                             # the new remainder < divisor < 2**dw
+                rem = _stage(m, self.en, Mux(fits, diff[:dw], t[:dw]), f"rem{i}")
+                low = _stage(m, self.en, low[:i], f"dividend{i}")
+                d = _stage(m, self.en, d, f"divisor{i}")
+                zero = _stage(m, self.en, zero, f"zero{i}")
+        m.d.comb += self.quotient.eq(quo)
         return m
 
 
@@ -140,41 +231,42 @@ class PeercyRotation(PipeUnit):
     ``wiring.Component``).
 
     Input :func:`setup_input_layout`; output :func:`setup_output_layout` (L_n, H_n in tangent
-    space, N' passed through). Latency :data:`ROTATION_LATENCY` (2 PRODUCT_LATENCY + 5 = 9);
-    1 pixel per clock.
+    space, N' passed through). Latency :func:`rotation_latency` (2 PRODUCT_LATENCY + 5 +
+    (B + 6) + (B + 2) = 43 at B = 13); 1 pixel per clock.
     """
 
-    latency = ROTATION_LATENCY
-
     def __init__(self, cfg: Config, target=None):
+        self.latency = rotation_latency(cfg)
         super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target)
 
     def build(self, m, pipe):
         cfg, b = self.cfg, self.cfg.frac_bits
         reg = pipe.register
         px, out = self.i.payload, self.o.payload
-        cw = component_width(cfg)
+        cw, ns, nq = component_width(cfg), sqrt_stages(cfg), quotient_bits(cfg)
         for v in vectors(cfg):
             a = px[v]
             comps = {}
             for row, axis in zip(FRAME, AXES):             # A_t = (T.A, B.A, N.A)
                 p = [pipe.multiply(px[row][c], a[c], f"{v}_{row}{c}") for c in AXES]  # + P
-                comps[axis] = reg(round_shift(p[0] + p[1] + p[2], b)[:cw].as_signed(),
-                                  f"{v}t_{axis}")                                    # + 1
+                comps[axis] = sum3_rounded(reg, p, b, f"{v}t_{axis}")[:cw].as_signed()  # + 2
             sq = [pipe.multiply(comps[c], comps[c], f"{v}t_{c}_sq") for c in AXES]   # + P
             mag = {c: pipe.delay(Mux(comps[c] < 0, -comps[c], comps[c])[:cw - 1],
                                  PRODUCT_LATENCY, f"{v}t_{c}_mag") for c in AXES}
-            neg = {c: pipe.delay(comps[c][-1], PRODUCT_LATENCY + 3, f"{v}t_{c}_neg") for c in AXES}
+            neg = {c: pipe.delay(comps[c][-1], PRODUCT_LATENCY + 2 + ns + nq, f"{v}t_{c}_neg")
+                   for c in AXES}
             # x**2 >= 0 and < 2**(2B+8): the low 2B+8 bits of each signed square are exact
             sq = [q[:square_bits(cfg) - 1] for q in sq]
-            s = reg(sq[0] + sq[1] + sq[2], f"{v}t_len2")                             # + 1
+            s = reg(reg(sq[0] + sq[1], f"{v}t_len2_xy") + reg(sq[2], f"{v}t_len2_z"),
+                    f"{v}t_len2")                                                    # + 2
             m.submodules[f"{v}_sqrt"] = root = PeercySqrt(square_bits(cfg) + 2)
-            m.d.comb += root.radicand.eq(s << 2)
-            r = reg(root.root, f"{v}t_len")                                          # + 1
+            m.d.comb += [root.radicand.eq(s << 2), root.en.eq(pipe.adv)]
+            r = root.root                                                            # + ns
             for c in AXES:
-                num = pipe.delay(mag[c], 2, f"{v}t_{c}_num") << (b + 2)
-                q = reg(num // r, f"{v}n_{c}_q")                                     # + 1
-                q = round_shift(q, 1)
+                num = pipe.delay(mag[c], 2 + ns, f"{v}t_{c}_num").shift_left(b + 2)
+                m.submodules[f"{v}_{c}_div"] = div = PeercyDivider(len(num), len(r), nq)
+                m.d.comb += [div.dividend.eq(num), div.divisor.eq(r), div.en.eq(pipe.adv)]
+                q = round_shift(div.quotient, 1)                                     # + nq
                 m.d.comb += out[v][c].eq(reg(Mux(neg[c], -q, q)[:cfg.sincos_width],
                                              f"{v}n_{c}"))                           # + 1
         for c in AXES:
@@ -188,7 +280,8 @@ class PeercyIllumination(IlluminationDatapath):
     table, Phong sum of eq. 2).
 
     Input :func:`setup_output_layout`; output ``shade_layout(cfg)``.
-    Latency PRODUCT_LATENCY (operand and product registers) + 1 (sum) + SHADE_LATENCY;
+    Latency DOT_LATENCY = PRODUCT_LATENCY (operand and product registers) + 2 (the sum,
+    :func:`sum3_rounded`) + SHADE_LATENCY;
     1 pixel per clock.
     """
 
@@ -202,6 +295,5 @@ class PeercyIllumination(IlluminationDatapath):
         for v in vectors(self.cfg):
             a = payload[v]
             p = [pipe.multiply(n[c], a[c], f"{v}_dot_{c}") for c in AXES]            # + P
-            dots[v] = pipe.register(round_shift(p[0] + p[1] + p[2], self.cfg.frac_bits),
-                                    f"{v}_dot")                                      # + 1
+            dots[v] = sum3_rounded(pipe.register, p, self.cfg.frac_bits, f"{v}_dot")   # + 2
         return dots
