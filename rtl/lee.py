@@ -11,7 +11,7 @@ Mapping to the paper (Sec. 4 and Table 1), per vector A in {L, H}:
 paper element          hardware here
 =====================  ==================================================================
 sin & cos LUT          ``{a}_sincos_rom``: one quarter-wave ROM, 4 read ports (sin X, sin Y,
-                       cos X, cos Y), sign/mirroring in logic (rtl/sincos.sine_read)
+                       cos X, cos Y), sign/mirroring in logic (:func:`sine_value`)
 Sin^-1 table (eq. 7)   ``{a}_asin_rom``: asin of |s|, tables.lee_asin_table
 1/sin table (eq. 9)    ``{a}_inv_sin_rom``: quarter-wave 1/|sin Z|, saturating (erratum 8)
 1/cos table (eq. 27)   ``{a}_inv_cos_rom``: the same contents read at Z + 90 deg
@@ -32,28 +32,42 @@ brackets, the sum) and one multiplier: Table 1's 6 cosine tables and 2 multiplie
 12 here against the paper's 11 (Table 1) or 13 (Sec. 4.2, erratum 9). The diffuse and
 specular tables of Fig. 8 are the shared back end of rtl/shade.py (diffuse there is a
 constant multiply by 255, specular the cos^n block-RAM table).
+
+Timing: both units are pipelined at 1 pixel per clock with registers only (the arithmetic
+and the tables are the golden model's): every table read is registered before and after
+the block RAM (:func:`rom_read`, :func:`sine_value`, sincos.sine_read), every product is a
+registered DSP product, and long carry and mux chains are cut by the ``stage`` hooks of the
+shared helpers (identity in the golden model). The tables wider or deeper than one DP16KD,
+the sin & cos ROM with four reads and the products by a 1/sin, 1/cos word (wider than a DSP
+input) have ECP5 forms of their own here (:class:`BlockROM`, :class:`WideProduct`) with the
+same generic form, so gen/flow/resources.py counts them as before. Each unit's ``latency``
+is the sum of its stages (the class docstrings list them); the tables' addresses depend on
+the previous table's output within the pixel, which makes the setup deep, not slow.
 """
 
 import numpy as np
-from amaranth.hdl import Mux, Value, ValueCastable, unsigned
+from amaranth.hdl import (Cat, ClockSignal, Const, Elaboratable, Instance, Module, Mux, Signal, Value,
+                          ValueCastable, unsigned)
 from amaranth.lib import data
-from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
-from bumprtl.rtl.pipe import PipeUnit
+from bumprtl.rtl.pipe import (DP16KD_MODES, PRODUCT_LATENCY, ROM_LATENCY, PipeUnit, RegisteredProduct,
+                             RegisteredROM, dp16kd_initvals)
 from bumprtl.rtl.shade import IlluminationDatapath
-from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
+from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
                      lee_atan_ratio_bits, lee_atan_table, lee_prop_index_bits, lee_prop_table,
-                     lee_reciprocal_bits, lee_reciprocal_table)
+                     lee_reciprocal_bits, lee_reciprocal_table, quarter_sine)
 
-__all__ = ["LeeRotation", "LeeIllumination", "rotated_layout",
+__all__ = ["LeeRotation", "LeeIllumination", "rotated_layout", "BlockROM", "block_rom", "rom_read",
+           "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value", "WideProduct",
+           "WIDE_PRODUCT_LATENCY", "wide_multiply",
            "below_horizon", "quarter_address", "ratio_index", "asin_address", "prop_address",
            "phi_quadrant",
-           "magnitude", "theta_from_prop"]
+           "magnitude", "prop_term", "theta_from_prop"]
 
 
 # --- Arithmetic shared with sim/golden/fixed/lee.py (Amaranth values or int64 arrays) -------
@@ -62,6 +76,15 @@ def _select(cond, a, b):
     if isinstance(cond, (Value, ValueCastable)):
         return Mux(cond, a, b)
     return np.where(cond, a, b)
+
+
+def _same(value, name):
+    """The golden model's stage: none (the RTL passes a registering one, StallPipe.register)."""
+    return value
+
+
+def _times(a, b):
+    return a * b
 
 
 def _wrap(x, cfg: Config):
@@ -81,13 +104,19 @@ def quarter_address(angle, cfg: Config):
     return _select((a >> cfg.k) & 1, (1 << cfg.k) - index, index)
 
 
-def ratio_index(p, cfg: Config):
+def ratio_index(p, cfg: Config, stage=_same):
     """Floating-point address of the atan ROM for a ratio ``p`` < 2**W (k fractional bits):
     ``p`` itself below 2**(M+1), else e * 2**M + (p >> e) where the leading one of ``p`` is
-    bit M + e (a priority encoder: W - M - 1 comparators and muxes)."""
+    bit M + e (a priority encoder: W - M - 1 comparators and muxes, the last true one wins).
+    ``stage(value, name)`` cuts the mux chain in two halves (the RTL registers there)."""
     m = lee_atan_mantissa_bits(cfg)
+    top = lee_atan_ratio_bits(cfg) - m
+    half = max(1, top // 2)
     index = p
-    for e in range(1, lee_atan_ratio_bits(cfg) - m):
+    for e in range(1, half):
+        index = _select(p >= (1 << (m + e)), (e << m) + (p >> e), index)
+    p, index = stage(p, "ratio_p"), stage(index, "ratio_index")
+    for e in range(half, top):
         index = _select(p >= (1 << (m + e)), (e << m) + (p >> e), index)
     return index
 
@@ -99,11 +128,13 @@ def asin_address(s2, cfg: Config):
     return round_shift(magnitude_s2, cfg.frac_bits + 1 - lee_asin_index_bits(cfg))
 
 
-def prop_address(product, cfg: Config):
+def prop_address(product, cfg: Config, stage=_same):
     """T_prop address: |y_k| = |y2| (1/|cos Z|) / 2 rounded to p fractional bits and clamped
-    to 1.0 (erratum 4). ``product`` = |y2| x 1/|cos Z| has 2B fractional bits."""
+    to 1.0 (erratum 4). ``product`` = |y2| x 1/|cos Z| has 2B fractional bits. ``stage``
+    between the rounding and the clamp."""
     p = lee_prop_index_bits(cfg)
     y_k = round_shift(product, 2 * cfg.frac_bits + 1 - p)
+    y_k = stage(y_k, "y_k")
     return _select(y_k > (1 << p), 1 << p, y_k)
 
 
@@ -113,16 +144,23 @@ def magnitude(z, cfg: Config):
     return negative, _select(negative, cfg.full_circle - z, z)
 
 
-def phi_quadrant(atan, z_negative, y_negative, cfg: Config):
+def phi_quadrant(atan, z_negative, y_negative, cfg: Config, stage=_same):
     """atan2(y, sin Z) from atan(|y / sin Z|) (erratum 3): 180 - a when sin Z < 0, negated
-    when y < 0. 0/0 reads atan(0) = 0 (the ratio is 0)."""
+    when y < 0. 0/0 reads atan(0) = 0 (the ratio is 0). ``stage`` between the two steps."""
     half_turn = _select(z_negative, (1 << (cfg.k + 1)) - atan, atan)
+    half_turn, y_negative = stage(half_turn, "half_turn"), stage(y_negative, "y_negative")
     return _wrap(_select(y_negative, -half_turn, half_turn), cfg)
+
+
+def prop_term(abs_z, prop, cfg: Config, mul=_times):
+    """Eq. 19's (90 - |Z|) theta_prop, rounded to the angle grid (``mul``: the plain product
+    for the golden model, a registered one, StallPipe.multiply, in the RTL)."""
+    return round_shift(mul((1 << cfg.k) - abs_z, prop), cfg.frac_bits)
 
 
 def theta_from_prop(abs_z, prop, cfg: Config):
     """Eq. 19 with erratum 5: th_A' = |Z| + (90 - |Z|) theta_prop, rounded to the angle grid."""
-    return abs_z + round_shift(((1 << cfg.k) - abs_z) * prop, cfg.frac_bits)
+    return abs_z + prop_term(abs_z, prop, cfg)
 
 
 # --- The datapaths ---------------------------------------------------------------------------
@@ -136,27 +174,197 @@ def rotated_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-def _rom(pipe, name, table, width):
-    return pipe.memory(name, Memory(shape=unsigned(width), depth=len(table), init=table.tolist()))
+# --- ECP5 forms of the tables and products RegisteredROM / RegisteredProduct leave to Yosys --
+
+class BlockROM(RegisteredROM):
+    """A :class:`pipe.RegisteredROM`: the same read ports, ROM_LATENCY, and the same generic
+    form (one Memory with every read port: one table in gen/flow/resources.py's counts). Its
+    ECP5 form also covers the tables RegisteredROM leaves to Yosys' block-RAM inference (more
+    than two read ports, wider than 18 bits, deeper than 1024 words), which maps them without
+    the block RAM's output register: here each pair of read ports gets the table in the
+    widest DP16KD mode (pipe.DP16KD_MODES) that holds ``depth - 1`` words, blocks side by side
+    for the width, each with its output register (REGMODE OUTREG); a last word past the
+    mode's depth sits in a flip-flop, as in RegisteredROM."""
+
+    def elaborate(self, platform):
+        target = self.target
+        mode = next((md for md in DP16KD_MODES if md[1] >= self.depth - 1), None)
+        if getattr(target, "bram", None) != "DP16KD" or self._fits(target) or mode is None:
+            return super().elaborate(platform)
+        m = Module()
+        bits, words, shift = mode
+        zero = Const(0, 1)
+        for group in range(0, len(self.ports), 2):
+            ports = self.ports[group:group + 2]
+            columns = [[] for _ in ports]
+            for col in range(-(-self.width // bits)):
+                lo, hi = col * bits, min(self.width, (col + 1) * bits)
+                params = dp16kd_initvals([(x >> lo) & ((1 << (hi - lo)) - 1)
+                                          for x in self.init[:words]], bits)
+                params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="OUTREG",
+                              p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
+                              p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
+                              p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+                for side, port, out in zip("AB", ports, columns):
+                    addr = Signal(14, name=f"{port.addr.name}_{side}{col}")
+                    dout = Signal(18, name=f"{port.data.name}_{side}{col}")
+                    m.d.comb += addr[shift:].eq(port.addr)      # mode x{bits}: word address
+                    params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
+                                   f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
+                    params.update({f"i_CS{side}{n}": zero for n in range(3)})
+                    params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
+                    params.update({f"i_DI{side}{n}": zero for n in range(18)})
+                    params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+                    out.append(dout[:hi - lo])
+                m.submodules[f"bram{group // 2}_{col}"] = Instance("DP16KD", **params)
+            for port, out in zip(ports, columns):
+                data = Cat(*out)
+                if self.depth > words:          # the last word: the address wrapped to word 0
+                    last = Signal(name=f"{port.addr.name}_last")
+                    last_d = Signal(name=f"{port.addr.name}_last_d")
+                    with m.If(self.en):
+                        m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
+                    data = Mux(last_d, self.init[words], data)
+                m.d.comb += port.data.eq(data)
+        return m
 
 
-def _read(m, pipe, rom, address):
-    """One synchronous read, enabled by ``adv``: the data is one stage after ``address``."""
-    port = rom.read_port(domain="sync")
-    m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(address)]
-    return port.data
+def block_rom(pipe, init, shape, name, ports):
+    """A :class:`BlockROM` with ``ports`` read ports enabled by ``adv``, recorded in the pipe's
+    ``memories`` as ``pipe.rom`` records its ROMs."""
+    rom = pipe.memory(name, BlockROM(init, shape, ports, name, target=pipe.target))
+    pipe.m.d.comb += rom.en.eq(pipe.adv)
+    return rom
+
+
+# Stages of a WideProduct: a RegisteredProduct, then one more register.
+WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 1
+
+
+class WideProduct(Elaboratable):
+    """``p = a * b`` WIDE_PRODUCT_LATENCY ``en`` cycles after ``a``/``b``, for a ``b`` wider than
+    one DSP input. Generic form: a :class:`pipe.RegisteredProduct`, then a register (one
+    product in the counts). ECP5 form (``target`` with a MULT18X18D and ``a`` fitting one
+    input): ``b`` in 17-bit limbs, one RegisteredProduct per limb (a MULT18X18D with its
+    input and output registers), their shifted sum in the register; Yosys would otherwise
+    build the product from DSP blocks without their registers and a carry chain, all in
+    one cycle."""
+
+    def __init__(self, a_shape, b_shape, name, target=None):
+        self.target = target
+        self.a = Signal(a_shape, name=f"{name}_a")
+        self.b = Signal(b_shape, name=f"{name}_b")
+        self.en = Signal(name=f"{name}_en")
+        self.p = Signal((self.a * self.b).shape(), name=name)
+
+    def elaborate(self, platform):
+        m = Module()
+        a, b = self.a.shape(), self.b.shape()
+        width = getattr(self.target, "dsp_width", None)
+        if getattr(self.target, "dsp", None) == "MULT18X18D" and a.width + (not a.signed) <= width:
+            step = width - 1
+            limbs = [(lo, self.b[lo:lo + step]) for lo in range(0, b.width, step)]
+            if b.signed:                                   # the top limb keeps b's sign
+                limbs[-1] = (limbs[-1][0], limbs[-1][1].as_signed())
+        else:
+            limbs = [(0, self.b)]
+        terms = []
+        for n, (lo, limb) in enumerate(limbs):
+            unit = RegisteredProduct(a, limb.shape(), f"limb{n}", target=self.target)
+            m.submodules[f"limb{n}"] = unit
+            m.d.comb += [unit.a.eq(self.a), unit.b.eq(limb), unit.en.eq(self.en)]
+            terms.append(unit.p if lo == 0 else unit.p << lo)
+        with m.If(self.en):
+            m.d.sync += self.p.eq(sum(terms[1:], terms[0]))
+        return m
+
+
+def wide_multiply(pipe, a, b, name):
+    """``a * b`` WIDE_PRODUCT_LATENCY ``adv`` stages later (:class:`WideProduct`)."""
+    a, b = Value.cast(a), Value.cast(b)
+    unit = WideProduct(a.shape(), b.shape(), name, target=pipe.target)
+    pipe.m.submodules[name] = unit
+    pipe.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(pipe.adv)]
+    return unit.p
+
+
+def sine_rom(pipe, cfg: Config, name, ports):
+    """The quarter-wave sine ROM (tables.quarter_sine) as a :class:`BlockROM` with ``ports``
+    read ports, each read through sincos.sine_read(registered=True)."""
+    return block_rom(pipe, quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
+
+
+def rom_read(pipe, name, table, width, address):
+    """One read of a :class:`BlockROM` at ``address``: the address is registered first and the
+    data once more after the ROM's own output register (the routes to the block RAM's
+    address pins and from its data pins each get a cycle of their own), so the data comes
+    ROM_STAGES ``adv`` stages after ``address``."""
+    rom = block_rom(pipe, np.asarray(table).tolist(), unsigned(width), name, ports=1)
+    pipe.m.d.comb += rom.ports[0].addr.eq(pipe.register(address, f"{name}_address"))
+    return pipe.register(rom.ports[0].data, f"{name}_data")
+
+
+# rom_read: the address register, the ROM read and its output register, the data register.
+ROM_STAGES = 2 + ROM_LATENCY
+# sine_value: sincos.sine_read(registered=True) and the data register.
+SINE_STAGES = REGISTERED_SINE_LATENCY + 1
+
+
+def sine_value(m, pipe, port, angle, cfg: Config, name):
+    """``sin(angle)`` through ``port`` of a :func:`sine_rom`, SINE_STAGES ``adv`` stages later:
+    sincos.sine_read(registered=True) (angle, mirrored address, read, output register,
+    sign; bit-exact with tables.sin_lookup) with the word registered once more before the
+    sign's carry chain, as :func:`rom_read` does. ``cos(a)`` is ``sin(a + 2**k)``."""
+    k = cfg.k
+    a = pipe.register(angle[:cfg.angle_bits], f"{name}_angle")
+    quadrant, index = a[k:], a[:k]
+    m.d.comb += port.addr.eq(pipe.register(Mux(quadrant[0], (1 << k) - index, index),
+                                           f"{name}_address"))
+    negative = pipe.delay(quadrant[1], 2 + ROM_LATENCY, f"{name}_negative")
+    value = pipe.register(port.data, f"{name}_word")
+    return pipe.register(Mux(negative, -value, value), name)
+
+
+S, P, W = SINE_STAGES, PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
 
 
 class LeeRotation(PipeUnit):
     """VectorRotation datapath, lee method (Fig. 7 once per vector; see the module table),
     whatever ``cfg.method`` says; a ``wiring.Component``.
 
-    Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Stages per vector:
-    1-2 sin/cos X, Y; 3 asin; 4 1/sin Z, 1/cos Z; 5 products; 6 atan, T_prop; 7 ph', th'.
-    Latency 7; 1 pixel per clock.
+    Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Every table read is a
+    :class:`BlockROM` (DP16KD blocks with their output registers on ECP5) behind an address
+    register, every product registered (``pipe.multiply``; the two by a reciprocal, wider
+    than a DSP input, :func:`wide_multiply`), and at most one carry chain or half a mux
+    chain lies between two registers. Per vector, in ``adv`` stages
+    (S = SINE_STAGES, R = ROM_STAGES, P = PRODUCT_LATENCY, W = WIDE_PRODUCT_LATENCY):
+
+    ======================  ======================================================
+    stage                   what is registered
+    ======================  ======================================================
+    S                       sin X, sin Y, cos X, cos Y (:func:`sine_value`)
+    S + 1                   s2 = sin X + sin Y, y2 = cos Y - cos X
+    S + 2                   |s2| (its sign and |y2| alongside)
+    S + 2 + R               asin (address: |s2| rounded, eq. 7)
+    S + 3 + R, S + 4 + R    the signed asin, erratum 6's 180 - th_x
+    S + 5 + R               Z = th_x - th_N
+    S + 6 + R               |Z| and the sign of Z (erratum 5)
+    S + 5 + 2R              1/|sin Z|, 1/|cos Z| (addresses: the mirrored quarter index)
+    S + 5 + 2R + W          |y2| / |sin Z| and |y2| / |cos Z| (eqs 9, 27)
+    S + 6 + 2R + W          half the atan address encoder; y_k rounded
+    S + 6 + 3R + W          atan (the encoder's other half); T_prop (y_k clamped)
+    S + 8 + 3R + W          ph' (180 -/+ atan, then its sign: erratum 3)
+    S + 6 + 3R + W + P      (90 - |Z|) theta_prop (eq. 19)
+    S + 7 + 3R + W + P      rounded
+    S + 8 + 3R + W + P      th' = |Z| + that: the latency
+    ======================  ======================================================
+
+    1 pixel per clock. Each table's address depends on the previous table's output within
+    the same pixel (asin -> Z -> 1/sin, 1/cos -> products -> atan, T_prop), so the chain of
+    reads is sequential; every link of it has a register of its own.
     """
 
-    latency = 7
+    latency = S + 8 + 3 * ROM_STAGES + W + P
 
     def __init__(self, cfg: Config, target=None):
         super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
@@ -171,42 +379,46 @@ class LeeRotation(PipeUnit):
 
     def _rotate(self, m, pipe, v, a, n):
         cfg, k, b = self.cfg, self.cfg.k, self.cfg.frac_bits
+        reg, delay, R = pipe.register, pipe.delay, ROM_STAGES
+        stage = lambda value, name: reg(value, f"{v}_{name}")
         d = a.phi - n.phi                                                  # adder 1
         x, y = a.theta + d, a.theta - d                                    # adders 2, 3 (eq. 6)
-        sincos = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
-        sx, sy, cx, cy = (sine_read(m, pipe, sincos.read_port(domain="sync"), angle, cfg, f"{v}_{nm}")
-                          for nm, angle in (("sin_x", x), ("sin_y", y),
-                                            ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k))))
-        s2 = sx + sy                                                       # adder 4: 2 s (eq. 7)
-        asin_rom = _rom(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1)
-        asin = _read(m, pipe, asin_rom, asin_address(s2, cfg))
-        s_negative = pipe.register(s2[-1], f"{v}_s_negative")              # stage 3
-        y2 = pipe.register(cy - cx, f"{v}_y2")                             # adder 5: 2 sin th sin D
-        below = pipe.delay(below_horizon(a.theta, cfg), 3, f"{v}_below")
-        theta_n = pipe.delay(n.theta, 3, f"{v}_theta_n")
-        theta_x = Mux(s_negative, -asin, asin)
-        theta_x = Mux(below, (1 << (k + 1)) - theta_x, theta_x)            # erratum 6
-        z = _wrap(theta_x - theta_n, cfg)                                  # adder 6: Z
-        inv = lee_reciprocal_table(cfg)
-        width = lee_reciprocal_bits(cfg)
-        inv_sin = _read(m, pipe, _rom(pipe, f"{v}_inv_sin_rom", inv, width), quarter_address(z, cfg))
-        inv_cos = _read(m, pipe, _rom(pipe, f"{v}_inv_cos_rom", inv, width),
-                        quarter_address(z + (1 << k), cfg))                # stage 4
-        z = pipe.register(z, f"{v}_z")
-        y2 = pipe.register(y2, f"{v}_y2_4")
-        ay2 = abs(y2)
-        ratio = pipe.register(ay2 * inv_sin, f"{v}_ratio") >> (2 * b + 1 - k)   # stage 5
-        product = pipe.register(ay2 * inv_cos, f"{v}_yk_product")
-        atan = _read(m, pipe, _rom(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
-                     ratio_index(ratio, cfg))
-        prop = _read(m, pipe, _rom(pipe, f"{v}_prop_rom", lee_prop_table(cfg), b + 1),
-                     prop_address(product, cfg))                            # stage 6
-        z = pipe.delay(z, 2, f"{v}_z")
-        y_negative = pipe.delay(y2[-1], 2, f"{v}_y_negative")
-        z_negative, abs_z = magnitude(z, cfg)
-        phi = pipe.register(phi_quadrant(atan, z_negative, y_negative, cfg), f"{v}_phi")
-        theta = pipe.register(_wrap(theta_from_prop(abs_z, prop, cfg), cfg), f"{v}_theta")
-        return phi, theta                                                   # stage 7
+        sincos = sine_rom(pipe, cfg, f"{v}_sincos_rom", ports=4)
+        sx, sy, cx, cy = (sine_value(m, pipe, port, angle, cfg, f"{v}_{nm}")
+                          for port, (nm, angle) in zip(sincos.ports, (
+                              ("sin_x", x), ("sin_y", y),
+                              ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k)))))  # S
+        s2 = reg(sx + sy, f"{v}_s2")                                       # adder 4: 2 s (eq. 7)
+        y2 = reg(cy - cx, f"{v}_y2")                                       # adder 5: 2 sin th sin D
+        abs_s2 = reg(abs(s2), f"{v}_abs_s2")                               # S + 2
+        asin = rom_read(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1,
+                    asin_address(abs_s2, cfg))                             # S + 2 + R
+        s_negative = delay(s2[-1], 1 + R, f"{v}_s_negative")
+        below = delay(below_horizon(a.theta, cfg), S + 3 + R, f"{v}_below")
+        theta_n = delay(n.theta, S + 4 + R, f"{v}_theta_n")
+        theta_x = reg(Mux(s_negative, -asin, asin), f"{v}_theta_x")
+        theta_x = reg(Mux(below, (1 << (k + 1)) - theta_x, theta_x), f"{v}_theta_x_e6")  # erratum 6
+        z = reg(_wrap(theta_x - theta_n, cfg), f"{v}_z")                   # adder 6: Z, S + 5 + R
+        inv, width = lee_reciprocal_table(cfg), lee_reciprocal_bits(cfg)
+        inv_sin = rom_read(pipe, f"{v}_inv_sin_rom", inv, width, quarter_address(z, cfg))
+        inv_cos = rom_read(pipe, f"{v}_inv_cos_rom", inv, width,
+                       quarter_address(z + (1 << k), cfg))                 # S + 5 + 2R
+        ay2 = delay(abs(y2), 4 + 2 * R, f"{v}_abs_y2")
+        ratio = wide_multiply(pipe, ay2, inv_sin, f"{v}_ratio") >> (2 * b + 1 - k)
+        product = wide_multiply(pipe, ay2, inv_cos, f"{v}_yk_product")    # S + 5 + 2R + W
+        atan = rom_read(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1,
+                    ratio_index(ratio, cfg, stage))
+        prop = rom_read(pipe, f"{v}_prop_rom", lee_prop_table(cfg), b + 1,
+                    prop_address(product, cfg, stage))                    # S + 6 + 3R + W
+        z_negative, abs_z = (delay(reg(x, f"{v}_{nm}"), 2 * R + W, f"{v}_{nm}")
+                             for x, nm in zip(magnitude(z, cfg), ("z_negative", "abs_z")))
+        y_negative = delay(y2[-1], 5 + 3 * R + W, f"{v}_y_negative")      # S + 6 + 3R + W
+        phi = reg(phi_quadrant(atan, z_negative, y_negative, cfg, stage), f"{v}_phi")
+        term = reg(prop_term(abs_z, prop, cfg, lambda x, w: pipe.multiply(x, w, f"{v}_theta_prop")),
+                   f"{v}_theta_term")                                      # S + 7 + 3R + W + P
+        theta = reg(_wrap(delay(abs_z, P + 1, f"{v}_abs_z_sum") + term, cfg),  # theta_from_prop's sum
+                    f"{v}_theta")
+        return delay(phi, P, f"{v}_phi"), theta                           # S + 8 + 3R + W + P
 
 
 class LeeIllumination(IlluminationDatapath):
@@ -214,11 +426,15 @@ class LeeIllumination(IlluminationDatapath):
     N'.A' = ((c- + c+) 2**B + (c- - c+) c_phi) / 2**(B+1), one rounding, where
     c+- = cos(th_A' +- th_N') and c_phi = cos(ph_A' - ph_N'); then the shared back end.
 
-    Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency 4 (cosines, product, sum) + SHADE_LATENCY; 1 pixel per clock.
+    Input :func:`rotated_layout`; output ``shade_layout(cfg)``. Each cosine table is a
+    one-port :func:`sine_rom` (one DP16KD with its output register on ECP5) read
+    by sincos.sine_read (angle sum, address, read, output register, sign:
+    REGISTERED_SINE_LATENCY stages); then c- + c+ and c- - c+ (1), the registered product
+    (PRODUCT_LATENCY), the sum and its rounding (1): ``dot_latency``, plus SHADE_LATENCY;
+    1 pixel per clock.
     """
 
-    dot_latency = 4
+    dot_latency = REGISTERED_SINE_LATENCY + P + 2
 
     def __init__(self, cfg: Config, target=None):
         super().__init__(cfg, rotated_layout(cfg), target)
@@ -231,10 +447,12 @@ class LeeIllumination(IlluminationDatapath):
         angles = {"plus": a.theta + n.theta, "minus": a.theta - n.theta, "phi": a.phi - n.phi}
         c = {}
         for name, angle in angles.items():                                 # 3 cosine tables
-            rom = pipe.memory(f"{v}_cos_{name}_rom", quarter_wave_rom(cfg))
-            c[name] = sine_read(m, pipe, rom.read_port(domain="sync"), angle + (1 << cfg.k), cfg,
-                                f"{v}_cos_{name}")                          # stage 2
-        first = pipe.register(c["minus"] + c["plus"], f"{v}_first")       # stage 3
-        second = pipe.register((c["minus"] - c["plus"]) * c["phi"], f"{v}_second")
+            rom = sine_rom(pipe, cfg, f"{v}_cos_{name}_rom", ports=1)
+            c[name] = sine_read(m, pipe, rom.ports[0], angle + (1 << cfg.k), cfg,
+                                f"{v}_cos_{name}", registered=True)
+        first = pipe.register(c["minus"] + c["plus"], f"{v}_first")
+        diff = pipe.register(c["minus"] - c["plus"], f"{v}_diff")
+        second = pipe.multiply(diff, pipe.register(c["phi"], f"{v}_cos_phi"), f"{v}_second")
+        first = pipe.delay(first, P, f"{v}_first")
         return pipe.register(round_shift((first << cfg.frac_bits) + second, cfg.frac_bits + 1),
-                             f"{v}_dot")                                    # stage 4
+                             f"{v}_dot")

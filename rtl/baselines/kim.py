@@ -56,22 +56,30 @@ Illumination per vector: ``{a}_sincos_rom`` with 3 reads (sin/cos th_A', cos(ph_
 shared ``b_sincos_rom`` (sin/cos th_N'), 3 multipliers (cos cos, sin sin, x cos), 2 adders
 (ph_A' - ph_N', the sum): Table 1's 6 multipliers; 8 reads in 3 ROMs plus the specular
 table against its 12 LUTs; 4 adders plus the back end's Phong sum against its 5.
+
+Timing: both units run at 1 pixel per clock, pipelined with registers only (the golden
+model's arithmetic and tables): the sin/cos and table reads and the ECP5 forms of the
+tables are rtl/lee.py's (lee.sine_value, lee.rom_read, lee.BlockROM), every product is a
+RegisteredProduct, and the helpers' ``stage`` hooks cut the long carry and mux chains
+(identity in the golden model). ``latency`` is the sum of the stages listed in each class.
+The reads are sequential within a pixel (1/p -> atan -> sin/cos a0 and asin), which makes
+the setup deep, not slow.
 """
 
 import itertools
 
 import numpy as np
-from amaranth.hdl import C, Cat, Mux, Value, ValueCastable, unsigned
-from amaranth.lib.memory import Memory
+from amaranth.hdl import C, Cat, Mux, Value, ValueCastable
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout
-from bumprtl.rtl.lee import ratio_index, rotated_layout
+from bumprtl.rtl.lee import (ROM_STAGES, SINE_STAGES, ratio_index, rom_read, rotated_layout, sine_rom,
+                             sine_value)
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
 from bumprtl.rtl.shade import IlluminationDatapath
-from bumprtl.rtl.sincos import quarter_wave_rom, sine_read
+from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (kim_reciprocal_bits, kim_reciprocal_table, lee_asin_index_bits,
                       lee_asin_table, lee_atan_table)
 
@@ -112,9 +120,16 @@ def _times(a, b):
     return a * b
 
 
+def _same(value, name):
+    """The golden model's stage: none (the RTL passes a registering one, StallPipe.register)."""
+    return value
+
+
 # Every helper that multiplies takes ``mul``: the plain product for the golden model, a
 # registered product (StallPipe.multiply, PRODUCT_LATENCY stages) in the RTL. All the terms a
-# helper adds are products, so they arrive together.
+# helper adds are products, so they arrive together. A helper that takes ``stage(value,
+# name)`` calls it on every value that crosses one of its steps: nothing in the golden
+# model, a register in the RTL (the arithmetic is the same either way).
 
 def matrix_entries(st, ct, sp, cp, cfg: Config, mul=_times):
     """The four product entries of M = R_y(-th_N) R_z(-ph_N) =
@@ -131,30 +146,40 @@ def cartesian(st, sp, cp, cfg: Config, mul=_times):
     return _fit(round_shift(mul(st, cp), b), b + 2), _fit(round_shift(mul(st, sp), b), b + 2)
 
 
-def transform(mat, n, a, cfg: Config, mul=_times):
+def transform(mat, n, a, cfg: Config, mul=_times, stage=_same):
     """A' = M A: each coordinate one sum of full products, rounded once and clamped to
-    [-1, 1]. ``mat`` = (m00, m01, m20, m21), ``n`` = (st, ct, sp, cp) of N, ``a`` = (x, y, z)."""
+    [-1, 1]. ``mat`` = (m00, m01, m20, m21), ``n`` = (st, ct, sp, cp) of N, ``a`` = (x, y, z).
+    ``stage`` after the first sums and after the rounding."""
     (m00, m01, m20, m21), (st, ct, sp, cp), (x, y, z) = mat, n, a
     b = cfg.frac_bits
-    return (_clamp_unit(round_shift(mul(m00, x) + mul(m01, y) - mul(st, z), b), cfg),
-            _clamp_unit(round_shift(mul(cp, y) - mul(sp, x), b), cfg),
-            _clamp_unit(round_shift(mul(m20, x) + mul(m21, y) + mul(ct, z), b), cfg))
+    terms = ((mul(m00, x) + mul(m01, y), mul(st, z)), (mul(cp, y), mul(sp, x)),
+             (mul(m20, x) + mul(m21, y), mul(ct, z)))
+    (u0, w0), (u1, w1), (u2, w2) = ((stage(u, f"{c}_u"), stage(w, f"{c}_w"))
+                                    for (u, w), c in zip(terms, "xyz"))
+    sums = (u0 - w0, u1 - w1, u2 + w2)
+    return tuple(_clamp_unit(stage(round_shift(t, b), f"{c}_rounded"), cfg)
+                 for t, c in zip(sums, "xyz"))
 
 
-def octant(x, y):
-    """(swap, p, q): swap = |y| > |x|, p = max(|x|, |y|), q = min(|x|, |y|)."""
-    ax, ay = _abs(x), _abs(y)
+def octant(x, y, stage=_same):
+    """(swap, p, q): swap = |y| > |x|, p = max(|x|, |y|), q = min(|x|, |y|); ``stage``
+    after the magnitudes."""
+    ax, ay = stage(_abs(x), "abs_x"), stage(_abs(y), "abs_y")
     swap = ay > ax
     return swap, _select(swap, ay, ax), _select(swap, ax, ay)
 
 
-def normalize(p, q, cfg: Config):
+def normalize(p, q, cfg: Config, stage=_same):
     """(p << e, q << e) with e the leading zeros of the B + 1 bit p, so p << e has its leading
     one at bit B (a value in [1, 2)); p = 0 gives (0, 0). A leading-one detector and two
-    shifters: the ratio q / p is unchanged and the reciprocal ROM sees a mantissa."""
+    shifters: the ratio q / p is unchanged and the reciprocal ROM sees a mantissa.
+    ``stage`` cuts the chain of muxes in three."""
     b = cfg.frac_bits
     pn, qn = p, q
+    cuts = [min(b, (b + 1) * j // 3 + 1) for j in (1, 2)]
     for e in range(1, b + 1):                      # the last (largest) true e wins
+        for n in range(cuts.count(e)):
+            p, q, pn, qn = (stage(x, f"{nm}{e}_{n}") for x, nm in zip((p, q, pn, qn), ("p", "q", "pn", "qn")))
         small = p < (1 << (b + 1 - e))
         pn, qn = _select(small, p << e, pn), _select(small, q << e, qn)
     return _fit(pn, b + 1, signed=False), _fit(qn, b + 1, signed=False)
@@ -172,13 +197,16 @@ def ratio_of(product, cfg: Config):
     return product >> (2 * cfg.frac_bits - cfg.k)
 
 
-def phi_from_octant(a0, swap, x_negative, y_negative, cfg: Config):
+def phi_from_octant(a0, swap, x_negative, y_negative, cfg: Config, stage=_same):
     """atan2(y', x') from a0 = atan(q / p) in [0, 45] deg: 90 - a0 when |y'| > |x'|,
-    180 - that when x' < 0, negated when y' < 0. atan2(0, 0) = 0."""
+    180 - that when x' < 0, negated when y' < 0. atan2(0, 0) = 0. ``stage`` after each of
+    the first two steps."""
     k = cfg.k
     first = _select(swap, (1 << k) - a0, a0)
-    half = _select(x_negative, (1 << (k + 1)) - first, first)
-    phi = _select(y_negative, -half, half)
+    first = stage(first, "phi_first")
+    x_negative, y_negative = stage(x_negative, "phi_x_neg"), stage(y_negative, "phi_y_neg")
+    half = stage(_select(x_negative, (1 << (k + 1)) - first, first), "phi_half")
+    phi = _select(stage(y_negative, "phi_y_neg2"), -half, half)
     return phi[:cfg.angle_bits] if _hdl(phi) else phi & (cfg.full_circle - 1)
 
 
@@ -189,12 +217,12 @@ def rho_of(p, q, ca0, sa0, cfg: Config, mul=_times):
     return _fit(round_shift(mul(p, ca0) + mul(q, sa0), b), b + 3)
 
 
-def theta_select(rho, z, cfg: Config):
+def theta_select(rho, z, cfg: Config, stage=_same):
     """(use_rho, z_negative, v): v = min(rho, |z'|) <= 1/sqrt(2) (up to rounding), the
-    argument of the asin read where asin is not steep."""
-    az = _abs(z)
+    argument of the asin read where asin is not steep; ``stage`` after |z'|."""
+    az, rho, z_negative = stage(_abs(z), "abs_z"), stage(rho, "rho"), stage(z < 0, "z_negative")
     use_rho = rho <= az
-    return use_rho, z < 0, _select(use_rho, rho, az)
+    return use_rho, z_negative, _select(use_rho, rho, az)
 
 
 def asin_address(v, cfg: Config):
@@ -203,10 +231,12 @@ def asin_address(v, cfg: Config):
     return round_shift(v, b - a) if a <= b else v << (a - b)
 
 
-def theta_from_octant(asin, use_rho, z_negative, cfg: Config):
-    """th_A' = asin(rho) or 90 - asin(|z'|), mirrored to 180 - th when z' < 0."""
+def theta_from_octant(asin, use_rho, z_negative, cfg: Config, stage=_same):
+    """th_A' = asin(rho) or 90 - asin(|z'|), mirrored to 180 - th when z' < 0; ``stage``
+    between the two."""
     k = cfg.k
-    th0 = _select(use_rho, asin, (1 << k) - asin)
+    th0 = stage(_select(use_rho, asin, (1 << k) - asin), "th0")
+    z_negative = stage(z_negative, "th_z_negative")
     theta = _select(z_negative, (1 << (k + 1)) - th0, th0)
     return theta[:cfg.angle_bits] if _hdl(theta) else theta & (cfg.full_circle - 1)
 
@@ -218,22 +248,12 @@ def dot_terms(st_a, ct_a, st_n, ct_n, cfg: Config, mul=_times):
 
 
 def dot_sum(cc, ss, cphi, cfg: Config, mul=_times):
-    """Eq. (3): N'.A = cc + ss cos(ph_A - ph_N'), rounded once to B bits."""
+    """Eq. (3): N'.A = cc + ss cos(ph_A - ph_N'), rounded once to B bits (``cc`` comes with
+    the product)."""
     return round_shift(cc + mul(ss, cphi), cfg.frac_bits)
 
 
 # --- The datapaths ---------------------------------------------------------------------------
-
-def _read(m, pipe, rom, address):
-    """One synchronous read, enabled by ``adv``: the data is one stage after ``address``."""
-    port = rom.read_port(domain="sync")
-    m.d.comb += [port.en.eq(pipe.adv), port.addr.eq(address)]
-    return port.data
-
-
-def _rom(pipe, name, table, width):
-    return pipe.memory(name, Memory(shape=unsigned(width), depth=len(table), init=table.tolist()))
-
 
 def _multiplier(pipe, prefix):
     """``mul`` for the helpers: each product a RegisteredProduct (StallPipe.multiply) named
@@ -242,7 +262,12 @@ def _multiplier(pipe, prefix):
     return lambda a, b: pipe.multiply(a, b, f"{prefix}_mul{next(count)}")
 
 
-P = PRODUCT_LATENCY
+def _stage(pipe, prefix):
+    """``stage`` for the helpers: one ``adv`` register named ``{prefix}_{name}``."""
+    return lambda value, name: pipe.register(value, f"{prefix}_{name}")
+
+
+S, P, R = SINE_STAGES, PRODUCT_LATENCY, ROM_STAGES
 
 
 class KimRotation(PipeUnit):
@@ -250,13 +275,38 @@ class KimRotation(PipeUnit):
     Cartesian, M, back to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
     through, polar binary angles, as rtl/lee.py).
 
-    Stages (P = PRODUCT_LATENCY, every product a RegisteredProduct as in rtl/exact.py):
-    2 sin/cos; +P+1 M, x, y; +P+1 x', y', z'; +1 octant; +1 1/p; +P q/p; +1 atan; +1 ph';
-    sin/cos a0 at atan + 2; +P+1 rho; +1 asin; +1 th'. Latency 12 + 4P = 20; 1 pixel per
-    clock.
+    Every sin/cos read is lee.sine_value (S = SINE_STAGES: angle, address, read, output
+    register, data register, sign), every other table read lee.rom_read (R = ROM_STAGES:
+    address register, read, output register, data register), every product a
+    RegisteredProduct (P = PRODUCT_LATENCY), and at most one carry chain or half a mux chain
+    lies between two registers. Per vector, in ``adv`` stages:
+
+    ========================  ==================================================
+    stage                     what is registered
+    ========================  ==================================================
+    S                         sin/cos of th_N, ph_N, th_A, ph_A
+    S + P + 1                 M (4 entries, rounded); x, y (rounded)
+    S + 2P + 2, + 3, + 4      M A: the pair sums, the rounding, the clamp
+    S + 2P + 5, + 6           |x'|, |y'|; swap, p, q
+    S + 2P + 7, + 8           two thirds of the leading-one normalizer
+    S + 2P + 8 + R            1/p (address: the normalized mantissa)
+    S + 3P + 8 + R            q / p
+    S + 3P + 9 + R            half the atan address encoder
+    S + 3P + 9 + 2R           a0 = atan(q / p)
+    S + 3P + 12 + 2R          ph' (three steps: 90 -, 180 -, sign)
+    2S + 3P + 9 + 2R          sin a0, cos a0
+    2S + 4P + 10 + 2R         rho (the sum and its rounding)
+    2S + 4P + 12 + 2R         |z'|; use_rho, v = min(rho, |z'|)
+    2S + 4P + 12 + 3R         asin(v)
+    2S + 4P + 14 + 3R         th' (two steps): the latency
+    ========================  ==================================================
+
+    1 pixel per clock. The atan address depends on the reciprocal read, and the sin/cos a0
+    and asin addresses on the atan read, within the same pixel: the reads are sequential,
+    each behind registers of its own.
     """
 
-    latency = 12 + 4 * P
+    latency = 2 * S + 4 * P + 14 + 3 * R
 
     def __init__(self, cfg: Config, target=None):
         super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
@@ -264,14 +314,15 @@ class KimRotation(PipeUnit):
     def build(self, m, pipe):
         cfg, k = self.cfg, self.cfg.k
         px, o = self.i.payload, self.o.payload
-        rom = pipe.memory("n_sincos_rom", quarter_wave_rom(cfg))
-        read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg, name)
-        n = (read(px.n.theta, "n_sin_theta"), read(px.n.theta + (1 << k), "n_cos_theta"),
-             read(px.n.phi, "n_sin_phi"), read(px.n.phi + (1 << k), "n_cos_phi"))   # 2
+        rom = sine_rom(pipe, cfg, "n_sincos_rom", ports=4)
+        n = tuple(sine_value(m, pipe, port, angle, cfg, name)
+                  for port, (angle, name) in zip(rom.ports, (
+                      (px.n.theta, "n_sin_theta"), (px.n.theta + (1 << k), "n_cos_theta"),
+                      (px.n.phi, "n_sin_phi"), (px.n.phi + (1 << k), "n_cos_phi"))))   # S
         mat = tuple(pipe.register(e, f"m{nm}") for e, nm in
                     zip(matrix_entries(*n, cfg, _multiplier(pipe, "m")), ("00", "01", "20", "21")))
         n = tuple(pipe.delay(e, P + 1, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp")))
-        for v in vectors(cfg):                                                      # 3 + P
+        for v in vectors(cfg):                                                      # S + P + 1
             phi, theta = self._vector(m, pipe, v, px[v], mat, n)
             m.d.comb += [o[v].phi.eq(phi), o[v].theta.eq(theta)]
         m.d.comb += [o.b.eq(pipe.delay(px.b, self.latency, "b")),
@@ -280,37 +331,42 @@ class KimRotation(PipeUnit):
     def _vector(self, m, pipe, v, a, mat, n):
         cfg, k = self.cfg, self.cfg.k
         reg, delay = pipe.register, pipe.delay
-        mul = _multiplier(pipe, v)
-        rom = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
-        read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle, cfg,
-                                             f"{v}_{name}")
+        mul, stage = _multiplier(pipe, v), _stage(pipe, v)
+        rom = sine_rom(pipe, cfg, f"{v}_sincos_rom", ports=6)
+        ports = iter(rom.ports)
+        read = lambda angle, name: sine_value(m, pipe, next(ports), angle, cfg, f"{v}_{name}")
         st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
-        sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # 2
+        sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # S
         x, y = (reg(c, f"{v}_{nm}") for c, nm in zip(cartesian(st, sp, cp, cfg, mul), "xy"))
-        z = delay(ct, P + 1, f"{v}_z")                                              # 3 + P
+        z = delay(ct, P + 1, f"{v}_z")                                              # S + P + 1
         xp, yp, zp = (reg(c, f"{v}_{nm}_rot") for c, nm in
-                      zip(transform(mat, n, (x, y, z), cfg, mul), "xyz"))           # 4 + 2P
-        swap, p, q = octant(xp, yp)
-        swap, p, q = reg(swap, f"{v}_swap"), reg(p, f"{v}_p"), reg(q, f"{v}_q")     # 5 + 2P
+                      zip(transform(mat, n, (x, y, z), cfg, mul, stage), "xyz"))    # S + 2P + 4
+        swap, p, q = (reg(c, f"{v}_{nm}") for c, nm in
+                      zip(octant(xp, yp, stage), ("swap", "p", "q")))              # S + 2P + 6
         x_neg, y_neg = reg(xp < 0, f"{v}_x_negative"), reg(yp < 0, f"{v}_y_negative")
-        pn, qn = normalize(p, q, cfg)
-        recip = _read(m, pipe, _rom(pipe, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1),
-                      reciprocal_address(pn, cfg))                                  # 6 + 2P
-        product = mul(reg(qn, f"{v}_qn"), recip)                                    # 6 + 3P
-        a0 = _read(m, pipe, _rom(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1),
-                   ratio_index(ratio_of(product, cfg), cfg))                        # 7 + 3P
-        phi = reg(phi_from_octant(a0, delay(swap, P + 2, f"{v}_swap"), delay(x_neg, P + 2, f"{v}_x_neg"),
-                                  delay(y_neg, P + 2, f"{v}_y_neg"), cfg), f"{v}_phi")  # 8 + 3P
+        pn, qn = normalize(p, q, cfg, stage)                                        # S + 2P + 8
+        recip = rom_read(pipe, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1,
+                         reciprocal_address(pn, cfg))                               # S + 2P + 8 + R
+        product = mul(delay(qn, R, f"{v}_qn"), recip)                               # S + 3P + 8 + R
+        a0 = rom_read(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1,
+                      ratio_index(ratio_of(product, cfg), cfg, stage))              # S + 3P + 9 + 2R
+        phi = reg(phi_from_octant(a0, delay(swap, P + 3 + 2 * R, f"{v}_swap"),
+                                  delay(x_neg, P + 4 + 2 * R, f"{v}_x_neg"),
+                                  delay(y_neg, P + 4 + 2 * R, f"{v}_y_neg"), cfg, stage),
+                  f"{v}_phi")                                                       # S + 3P + 12 + 2R
         a0 = Cat(a0, C(0, cfg.angle_bits - (k + 1)))        # a binary angle, 0 .. 45 deg
-        sa0, ca0 = read(a0, "sin_a0"), read(a0 + (1 << k), "cos_a0")                # 9 + 3P
-        rho = reg(rho_of(delay(p, P + 4, f"{v}_p"), delay(q, P + 4, f"{v}_q"), ca0, sa0, cfg, mul),
-                  f"{v}_rho")                                                       # 10 + 4P
-        use_rho, z_neg, val = theta_select(rho, delay(zp, 2 * P + 6, f"{v}_z_rot"), cfg)
-        asin = _read(m, pipe, _rom(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1),
-                     asin_address(val, cfg))                                        # 11 + 4P
-        theta = reg(theta_from_octant(asin, reg(use_rho, f"{v}_use_rho"), reg(z_neg, f"{v}_z_negative"),
-                                      cfg), f"{v}_theta")                           # 12 + 4P
-        return delay(phi, P + 4, f"{v}_phi"), theta
+        sa0, ca0 = read(a0, "sin_a0"), read(a0 + (1 << k), "cos_a0")                # 2S + 3P + 9 + 2R
+        rho = reg(rho_of(delay(p, S + P + 3 + 2 * R, f"{v}_p"), delay(q, S + P + 3 + 2 * R, f"{v}_q"),
+                         ca0, sa0, cfg, mul), f"{v}_rho")                           # 2S + 4P + 10 + 2R
+        use_rho, z_neg, val = (reg(c, f"{v}_{nm}") for c, nm in zip(
+            theta_select(rho, delay(zp, S + 2 * P + 6 + 2 * R, f"{v}_z_rot"), cfg, stage),
+            ("use_rho", "z_negative", "asin_arg")))                                 # 2S + 4P + 12 + 2R
+        asin = rom_read(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1,
+                        asin_address(val, cfg))                                     # 2S + 4P + 12 + 3R
+        theta = reg(theta_from_octant(asin, delay(use_rho, R, f"{v}_use_rho"),
+                                      delay(z_neg, R, f"{v}_z_negative"), cfg, stage),
+                    f"{v}_theta")                                                   # 2S + 4P + 14 + 3R
+        return delay(phi, S + P + 2 + R, f"{v}_phi"), theta
 
 
 class KimIllumination(IlluminationDatapath):
@@ -318,12 +374,12 @@ class KimIllumination(IlluminationDatapath):
     N'.A' = cos th_A' cos th_N' + round(sin th_A' sin th_N') cos(ph_A' - ph_N'), rounded once
     to B bits (:func:`dot_terms`, :func:`dot_sum`), then the shared back end.
 
-    Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency 4 + 2P (sin/cos; cos cos and sin sin, rounding; x cos(dph), sum) + SHADE_LATENCY;
-    1 pixel per clock.
+    Input :func:`rotated_layout`; output ``shade_layout(cfg)``. Latency
+    REGISTERED_SINE_LATENCY (sincos.sine_read) + P + 1 (cos cos and sin sin, the rounding)
+    + P + 1 (x cos(dph), the sum and its rounding) + SHADE_LATENCY; 1 pixel per clock.
     """
 
-    dot_latency = 4 + 2 * P
+    dot_latency = REGISTERED_SINE_LATENCY + 2 * P + 2
 
     def __init__(self, cfg: Config, target=None):
         super().__init__(cfg, rotated_layout(cfg), target)
@@ -331,21 +387,22 @@ class KimIllumination(IlluminationDatapath):
     def dots(self, m, pipe, payload):
         cfg, k = self.cfg, self.cfg.k
         b = payload.b
-        rom = pipe.memory("b_sincos_rom", quarter_wave_rom(cfg))
-        st_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta, cfg, "b_sin_theta")
-        ct_n = sine_read(m, pipe, rom.read_port(domain="sync"), b.theta + (1 << k), cfg, "b_cos_theta")
+        rom = sine_rom(pipe, cfg, "b_sincos_rom", ports=2)
+        st_n = sine_read(m, pipe, rom.ports[0], b.theta, cfg, "b_sin_theta", registered=True)
+        ct_n = sine_read(m, pipe, rom.ports[1], b.theta + (1 << k), cfg, "b_cos_theta",
+                         registered=True)
         dots = {}
         for v in vectors(cfg):
             a = payload[v]
             mul = _multiplier(pipe, f"{v}_dot")
-            rom = pipe.memory(f"{v}_sincos_rom", quarter_wave_rom(cfg))
-            read = lambda angle, name: sine_read(m, pipe, rom.read_port(domain="sync"), angle,
-                                                 cfg, f"{v}_{name}")
-            st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
-            cphi = read(a.phi - b.phi + (1 << k), "cos_dphi")                      # 2
-            cc, ss = dot_terms(st, ct, st_n, ct_n, cfg, mul)                         # 2 + P
-            ss = pipe.register(ss, f"{v}_ss")                                       # 3 + P
-            cc = pipe.delay(cc, P + 1, f"{v}_cc")                                   # 3 + 2P
+            rom = sine_rom(pipe, cfg, f"{v}_sincos_rom", ports=3)
+            st, ct, cphi = (sine_read(m, pipe, port, angle, cfg, f"{v}_{name}", registered=True)
+                            for port, (angle, name) in zip(rom.ports, (
+                                (a.theta, "sin_theta"), (a.theta + (1 << k), "cos_theta"),
+                                (a.phi - b.phi + (1 << k), "cos_dphi"))))          # sin/cos
+            cc, ss = dot_terms(st, ct, st_n, ct_n, cfg, mul)                         # + P
+            ss = pipe.register(ss, f"{v}_ss")                                       # + P + 1
+            cc = pipe.delay(cc, P + 1, f"{v}_cc")                                   # + 2P + 1
             cphi = pipe.delay(cphi, P + 1, f"{v}_cos_dphi")
-            dots[v] = pipe.register(dot_sum(cc, ss, cphi, cfg, mul), f"{v}_dot")  # 4 + 2P
+            dots[v] = pipe.register(dot_sum(cc, ss, cphi, cfg, mul), f"{v}_dot")   # + 2P + 2
         return dots

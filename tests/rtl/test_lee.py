@@ -9,13 +9,17 @@ tests/sim/tb/test_tb_datapath.py (cocotb on the emitted Verilog, Icarus and Veri
 
 import numpy as np
 import pytest
+from amaranth.hdl import unsigned
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.lee import LeeIllumination, LeeRotation, ratio_index
+from bumprtl.rtl.lee import (WIDE_PRODUCT_LATENCY, BlockROM, LeeIllumination, LeeRotation,
+                             WideProduct, ratio_index)
+from bumprtl.rtl.pipe import ROM_LATENCY
 from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
+from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.golden.fixed import lee as fixed_lee
 from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
 
@@ -137,6 +141,49 @@ def test_tiny_config_exhaustive_all_inputs():
     inputs = as_payloads(rot, cfg)
     out, _ = simulate_stream(LeeIllumination(cfg), inputs, "no_stall")
     assert_bit_exact(out, fixed_lee.illumination_fixed(rot, cfg), inputs)
+
+
+# --- ECP5 forms of the wide tables and products (placed by bumprtl report fpga) ---------------
+
+@pytest.mark.parametrize("depth, width, ports", [(4097, 11, 1), (1025, 23, 3)])
+def test_block_rom_ecp5_form(depth, width, ports, build_dir):
+    """BlockROM's DP16KD form (x4 mode, 3 blocks, last word in a flip-flop; x18 mode, two
+    blocks wide, two groups of ports, a non-zero word 0) reads as its generic form and the
+    table, ROM_LATENCY enabled clocks later, under a random enable: every word once, then
+    random addresses on every port."""
+    rng = np.random.default_rng(depth + ports)
+    init = rng.integers(0, 1 << width, depth).tolist()
+    n = depth + 300
+    en = (rng.random(n) < 0.8).astype(int)
+    addrs = [rng.integers(0, depth, n) for _ in range(ports)]
+    addrs[-1][:depth] = np.arange(depth)
+    abits = (depth - 1).bit_length()
+    inputs = {"rom_en": (1, en), **{f"rom_p{i}_addr": (abits, a) for i, a in enumerate(addrs)}}
+    outputs = {f"rom_p{i}_data": width for i in range(ports)}
+    forms = ecp5_lockstep(lambda t: BlockROM(init, unsigned(width), ports, "rom", target=t),
+                          inputs, outputs, build_dir,
+                          ports=lambda u: [u.en] + [s for p in u.ports for s in (p.addr, p.data)])
+    for i, a in enumerate(addrs):
+        want = enabled_delay([init[x] for x in a], en, ROM_LATENCY - 1)
+        filled = [c for c in range(n) if want[c] is not None]
+        for form in forms:
+            assert [form[f"rom_p{i}_data"][c] for c in filled] == [want[c] for c in filled]
+
+
+def test_wide_product_ecp5_form(build_dir):
+    """|y2| x 1/|sin Z| (16 x 23 bits): two MULT18X18D limbs and their sum equal the product,
+    WIDE_PRODUCT_LATENCY enabled clocks later, in both forms."""
+    rng = np.random.default_rng(7)
+    n = 400
+    a, b = rng.integers(0, 1 << 16, n), rng.integers(0, 1 << 23, n)
+    en = (rng.random(n) < 0.8).astype(int)
+    forms = ecp5_lockstep(lambda t: WideProduct(unsigned(16), unsigned(23), "prod", target=t),
+                          {"prod_a": (16, a), "prod_b": (23, b), "prod_en": (1, en)},
+                          {"prod": 39}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
+    want = enabled_delay([int(x) * int(y) for x, y in zip(a, b)], en, WIDE_PRODUCT_LATENCY - 1)
+    filled = [c for c in range(n) if want[c] is not None]
+    for form in forms:
+        assert [form["prod"][c] for c in filled] == [want[c] for c in filled]
 
 
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------
