@@ -149,6 +149,7 @@ class BumpMapFetch(wiring.Component):
     """
 
     latency = 1 + RAM_LATENCY
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
     def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None, target=None):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
@@ -195,7 +196,7 @@ class BumpMapFetch(wiring.Component):
     def elaborate(self, platform):
         scene = self.scene
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         self.memories = pipe.memories
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):

@@ -116,6 +116,8 @@ class PaletteLUT(wiring.Component):
     pixel per clock when not stalled.
     """
 
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
+
     def __init__(self, cfg: Config, target=None, bank_in=False):
         self.cfg, self.target, self.memories, self.bank_in = cfg, target, {}, bank_in
         ib = index_bits(cfg)
@@ -147,7 +149,7 @@ class PaletteLUT(wiring.Component):
     def elaborate(self, platform):
         cfg, size = self.cfg, self.cfg.palette_size
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         table = pipe.memory("table", Memory(shape=unsigned(4 * cfg.color_bits), depth=2 * size, init=[]))
         self.memories = pipe.memories
         front = Signal(name="front")

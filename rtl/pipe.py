@@ -1,9 +1,12 @@
 """Stall-safe pipeline bookkeeping shared by every unit (docs/architecture.md, Interfaces).
 
-The whole pipe advances when the output is empty or being taken,
+A unit on its own advances its whole pipe when the output is empty or being taken,
 ``adv = ~o.valid | o.ready``; every register, including the ROM read ports, is enabled by
 ``adv``, so a stall freezes the pipe and never drops a lookup. ``o.valid`` comes straight
-from a register and never depends on ``o.ready`` (stream rule 1).
+from a register and never depends on ``o.ready`` (stream rule 1). Inside a
+``BumpPipeline`` (rtl/pipeline.py) the units run in *lock-step mode* instead: ``adv`` is
+an enable the pipeline gives (a register of its own), so the stall rule is not a chain of
+``o.valid`` terms across the units.
 """
 
 from amaranth.hdl import (ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
@@ -297,13 +300,19 @@ class StallPipe:
         Number of register stages between ``i`` and ``o`` (the latency).
     target : None or ECP5
         Passed to every RegisteredROM and RegisteredProduct built through the pipe.
+    enable : None or Value
+        None (the default): the pipe stalls on its own, ``adv = ~o.valid | o.ready``.
+        Given: lock-step mode, ``adv = enable`` and ``o.ready`` is not read: the pipe
+        shifts exactly when ``enable`` is high, bubbles included, so units given the same
+        enable move as one shift register (``BumpPipeline`` gives every unit a copy of one
+        registered enable). ``i.ready`` is ``adv`` in both modes.
 
     ``memories`` records every memory built through the pipe (:meth:`rom`, :meth:`memory`):
     name -> {depth, width, bits}. A unit keeps it as its own ``memories`` when it elaborates
     (the ROM sizes of gen/flow/units.py's sidecar).
     """
 
-    def __init__(self, m, i, o, depth, target=None):
+    def __init__(self, m, i, o, depth, target=None, enable=None):
         if depth < 1:
             raise ValueError(f"pipeline depth must be >= 1, got {depth}")
         self.m = m
@@ -311,7 +320,8 @@ class StallPipe:
         self.target = target
         self.memories = {}
         self.adv = Signal(name="adv")
-        m.d.comb += [self.adv.eq(~o.valid | o.ready), i.ready.eq(self.adv)]
+        adv = ~o.valid | o.ready if enable is None else enable
+        m.d.comb += [self.adv.eq(adv), i.ready.eq(self.adv)]
         self.valid = [i.valid]
         for n in range(1, depth + 1):
             v = Signal(name=f"stage{n}_valid")
@@ -388,7 +398,13 @@ class PipeUnit(wiring.Component):
     Subclasses give ``latency`` (the pipe's depth) and ``build(m, pipe)``. After elaboration
     ``memories`` holds the pipe's record of the memories built (name -> depth, width, bits).
     1 pixel per clock when not stalled.
+
+    ``lockstep``: None (the default: the unit stalls on its own) or a 1-bit enable set
+    before elaboration (the :class:`StallPipe` ``enable``: lock-step mode, used by
+    ``BumpPipeline``).
     """
+
+    lockstep = None
 
     def __init__(self, cfg, in_layout, out_layout, target=None):
         self.cfg, self.target, self.memories = cfg, target, {}
@@ -400,7 +416,7 @@ class PipeUnit(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         self.build(m, pipe)
         self.memories = pipe.memories
         return m

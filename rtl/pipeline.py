@@ -3,7 +3,7 @@
 
 texel coordinates + world N, L, H in; shaded pixels out. Only what the scene needs is built:
 
-* varying bump map: BumpMapFetch -> VectorRotation -> Illumination (``wiring.connect``);
+* varying bump map: BumpMapFetch -> VectorRotation -> Illumination;
 * flat bump map: no map and no per-pixel N' rotation: n'' is rotated once per polygon
   (``sim/golden/fixed/pipeline.polygon_fixed``) and written to the polygon registers, per
   pixel only the light terms (:class:`VectorTerms`) and the dots remain;
@@ -17,8 +17,19 @@ texel coordinates + world N, L, H in; shaded pixels out. Only what the scene nee
   the shape of Tarini et al.'s eq. 2), which also sums the lights; palette shading blends it
   in PaletteLUT's eq. 2 as the base colour. Without a texture none of this is built.
 
-Units that run side by side in one layer have equal latency and share the downstream ready,
-so their ``adv`` signals are identical and they stay in lock step.
+Lock step and the output buffer: every unit runs in lock-step mode (rtl/pipe.StallPipe
+``enable``): all of them shift on one registered enable ``run``, bubbles included, so the
+units form one shift register and no unit's ``o.valid`` reaches another unit's clock
+enables. Each unit gets its own copy of the ``run`` register (same next state, so each
+copy drives the clock enables of one unit only). Behind the last unit sits a 2-entry
+output buffer: ``run`` = the buffer holds at most one pixel, a function of registers
+only; ``i.ready`` = ``run``. With the buffer empty the output is the last unit's output
+itself (bypass), so with ``o.ready`` held high the buffer stays empty and the latency is
+the units' sum; a pixel the consumer does not take in the cycle it leaves the last unit
+waits in the buffer, and two waiting pixels stop the pipe one cycle later (``run`` low).
+At the ports: ``i.ready`` is high whenever ``o.valid`` is low (the buffer is then empty)
+and never depends on ``o.ready`` in the same cycle; ``o.valid``/``o.payload`` come from
+registers through the bypass mux and never depend on ``o.ready``.
 """
 
 from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
@@ -57,6 +68,7 @@ class VectorTerms(wiring.Component):
     registers are named ``l_*``, ``l1_*``, ... after the pipeline's lights)."""
 
     latency = ExactRotation.latency
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
     def __init__(self, cfg, count, first=0, target=None):
         self.cfg, self.count, self.first, self.target, self.memories = cfg, count, first, target, {}
@@ -69,7 +81,7 @@ class VectorTerms(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         self.memories = pipe.memories
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
@@ -94,6 +106,7 @@ class LightSum(wiring.Component):
     Latency 3 (sums, products, clamp); bit-exact with ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
 
     latency = 3
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
     def __init__(self, scene: SceneConfig, target=None):
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
@@ -105,7 +118,7 @@ class LightSum(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
@@ -124,12 +137,20 @@ class LightSum(wiring.Component):
 
 
 def _lockstep(m, src, dsts):
-    """Feed one stream to units that run in lock step: valid to all, ready from all."""
-    ready = 1
-    for dst in dsts:
-        m.d.comb += dst.valid.eq(src.valid)
-        ready = ready & dst.ready
-    m.d.comb += src.ready.eq(ready)
+    """Feed one stream's valid to units that run in lock step (their ready is the enable)."""
+    m.d.comb += [dst.valid.eq(src.valid) for dst in dsts]
+
+
+def _feed(m, src, dst):
+    """``src`` into ``dst`` of the next layer: valid and payload (both run on the enable)."""
+    m.d.comb += [dst.valid.eq(src.valid), dst.payload.eq(src.payload)]
+
+
+# Entries of the output buffer. ``run`` is registered and falls the cycle after the buffer
+# fills. Two entries keep the pipe running through a one-cycle stall of the consumer and in
+# the cycle a waiting pixel is taken; with one (``run`` = empty) every stall would also stop
+# the input for a cycle, which only a full pipe (no input gaps) does not notice.
+BUFFER_DEPTH = 2
 
 
 class BumpPipeline(wiring.Component):
@@ -180,6 +201,14 @@ class BumpPipeline(wiring.Component):
     ``latency`` is the sum of the units' latencies; 1 pixel per clock when not stalled.
     ``built`` lists the units and why each was built; after elaboration ``memories`` lists
     every unit's memories (``unit.name`` -> depth, width, bits).
+
+    Every unit runs in lock-step mode on its copy of the registered enable ``run`` and the
+    last one feeds a :data:`BUFFER_DEPTH`-entry output buffer (module docstring):
+    ``i.ready`` = ``run`` = (at most one pixel in the buffer), high whenever ``o.valid`` is
+    low, never a function of ``o.ready`` in the same cycle. After elaboration ``buffer``
+    holds its registers (``count``, ``entries`` oldest first, ``runs``: the copies of
+    ``run`` by unit, ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by
+    sim/formal's lemmas.
     """
 
     def __init__(self, scene, init=None, texture=None, target=None):
@@ -335,6 +364,7 @@ class BumpPipeline(wiring.Component):
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()
+        self._output_buffer(m)
         for name, unit in self.units.items():
             m.submodules[name] = unit
         s, u = self.scene, self.units
@@ -347,19 +377,52 @@ class BumpPipeline(wiring.Component):
             self._elaborate_palette(m)
             return m
         if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
-            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
-            wiring.connect(m, u["fetch"].o, u["rotation"].i)
-            wiring.connect(m, u["rotation"].o, u["illumination"].i)
-            wiring.connect(m, u["illumination"].o, wiring.flipped(self.o))
+            _feed(m, self.i, u["fetch"].i)
+            _feed(m, u["fetch"].o, u["rotation"].i)
+            _feed(m, u["rotation"].o, u["illumination"].i)
             return m
         self._elaborate_layers(m)
         return m
+
+    def _output_buffer(self, m):
+        """``run`` (one copy per unit), the lock-step enables, and the output buffer behind
+        the last unit (module docstring). Drives ``i.ready``, ``o``, every unit's
+        ``o.ready`` (its enable: a pixel leaves a unit whenever the pipe runs)."""
+        last, o = self.units[self._last].o, self.o
+        count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
+        entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
+        runs = {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
+                for name in ("pipeline", *self.units)}
+        run = runs["pipeline"]
+        for name, unit in self.units.items():
+            unit.lockstep = runs[name]
+            m.d.comb += unit.o.ready.eq(runs[name])
+        held = count != 0
+        taken = o.valid & o.ready
+        m.d.comb += [self.i.ready.eq(run), o.valid.eq(held | last.valid),
+                     o.payload.eq(Mux(held, entries[0], last.payload))]       # bypass when empty
+        # Next run = (the buffer not full next cycle). Each copy counts the pixel
+        # leaving the last unit with its own value (all copies are equal): the copies' next
+        # states differ in form, so synthesis keeps one register per unit.
+        for copy in runs.values():
+            m.d.sync += copy.eq(count + (last.valid & copy) < BUFFER_DEPTH + taken)
+        left = last.valid & run                  # the pixel in the last stage moves on
+        m.d.sync += count.eq(count + left - taken)
+        pop = held & o.ready
+        with m.If(pop):
+            m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(BUFFER_DEPTH - 1)]
+        slot = Signal.like(count, name="out_slot")   # the first free entry after the pop
+        m.d.comb += slot.eq(count - pop)
+        for n in range(BUFFER_DEPTH):            # kept unless taken directly (count stays 0)
+            with m.If(left & (slot == n if n else ~slot.any())):
+                m.d.sync += entries[n].eq(last.payload)
+        self.buffer = {"count": count, "entries": entries, "runs": runs}
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg
         vectors = [v for v, _ in light_layout(cfg)]
         if "fetch" in u:
-            wiring.connect(m, wiring.flipped(self.i), u["fetch"].i)
+            _feed(m, self.i, u["fetch"].i)
             src = u["fetch"].o
         else:
             src = self.i
@@ -382,8 +445,6 @@ class BumpPipeline(wiring.Component):
             m.d.comb += u["texel_r"].i.payload.texel.eq(src.payload.texel)
         lead = u[rot_layer[0]].o
         _lockstep(m, lead, [u[n].i for n in ill_layer])
-        for n in rot_layer[1:]:
-            m.d.comb += u[n].o.ready.eq(lead.ready)
         n_src = u["rotation"].o.payload.n if poly is None else poly.n
         # light j's rotated l, h: light 0's from the rotation (varying map), the rest from terms
         rotated = ([u["rotation"].o.payload] if "rotation" in u else []) + \
@@ -395,10 +456,7 @@ class BumpPipeline(wiring.Component):
         if s.texture:
             m.d.comb += u["texel_i"].i.payload.texel.eq(u["texel_r"].o.payload.texel)
         lead = u[ill_layer[0]].o
-        for n in ill_layer[1:]:
-            m.d.comb += u[n].o.ready.eq(lead.ready)
         if s.lights == 1 and not s.texture:
-            wiring.connect(m, u[ill_layer[0]].o, wiring.flipped(self.o))
             return
         total = u["blend"] if s.texture else u["lightsum"]
         _lockstep(m, lead, [total.i])
@@ -408,23 +466,19 @@ class BumpPipeline(wiring.Component):
         if s.texture:
             m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
-        wiring.connect(m, total.o, wiring.flipped(self.o))
 
     def _elaborate_palette(self, m):
         """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel."""
         lut, f = self.units["palette"], self.units["fetch"]
-        m.d.comb += [f.i.valid.eq(self.i.valid), self.i.ready.eq(f.i.ready),
-                     f.i.payload.bank.eq(lut.bank)]
+        m.d.comb += [f.i.valid.eq(self.i.valid), f.i.payload.bank.eq(lut.bank)]
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
         if self.scene.texture:                 # Tarini eq. 2: the texel is the base colour
-            m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
-                         lut.i.payload.index.eq(f.o.payload.index),
+            m.d.comb += [lut.i.valid.eq(f.o.valid), lut.i.payload.index.eq(f.o.payload.index),
                          lut.i.payload.base.eq(Cat(f.o.payload.texel.as_value(), Const(255, 8))),
                          lut.i.payload.bank.eq(f.o.payload.bank),
                          lut.i.payload.tag.eq(f.o.payload.tag)]
         else:
-            wiring.connect(m, f.o, lut.i)
-        wiring.connect(m, lut.o, wiring.flipped(self.o))
+            _feed(m, f.o, lut.i)
         # Pixels between the input and the LUT per bank they read: a write to the back bank
         # waits (lut_w_ready low) while one of them still has to read it.
         take_in, take_lut = self.i.valid & self.i.ready, lut.i.valid & lut.i.ready

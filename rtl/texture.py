@@ -110,6 +110,7 @@ class TextureBlend(wiring.Component):
     """
 
     latency = BLEND_LATENCY
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
     def __init__(self, cfg: Config, lights=1, target=None):
         self.cfg, self.lights, self.target, self.memories = cfg, lights, target, {}
@@ -123,7 +124,7 @@ class TextureBlend(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         px = self.i.payload
         color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
                                     [px.s[j] for j in range(self.lights)],
@@ -141,6 +142,8 @@ class TexelDelay(wiring.Component):
     illumination) in lock step, so it meets that pixel's shade at the blend.
     Input/output {texel: rgb}."""
 
+    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
+
     def __init__(self, cfg: Config, latency, target=None):
         self.cfg, self.latency, self.target, self.memories = cfg, latency, target, {}
         layout = data.StructLayout({"texel": rgb_layout(cfg)})
@@ -148,6 +151,6 @@ class TexelDelay(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
         m.d.comb += self.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))
         return m

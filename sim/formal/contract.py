@@ -31,7 +31,12 @@ One wrapper checks one property (:data:`PROPERTIES`):
 k-induction needs the contract to be inductive, so the wrapper also asserts *lemmas* about
 the unit's own pipeline registers: the number of valid stages equals the pixels in flight,
 the tag held in each valid stage is the one the order says, units that run in lock step
-have equal valid chains, and (``bank``) the shadows are the table's watched entries (two
+have equal valid chains; for a scene pipeline (units in lock step on copies of one
+registered enable, an output buffer behind the last unit: ``BumpPipeline.buffer``) every
+copy of the enable is (buffer holds at most one pixel less than its depth), the buffer's
+occupancy counts as pixels in flight and its entries, oldest first, hold the tags that
+follow the order (with ``o.ready`` held high, ``latency``: the buffer stays empty); and
+(``bank``) the shadows are the table's watched entries (two
 asynchronous read ports added to the memory while it elaborates), the bank bits in flight
 are what the pipeline's ``lut_w_ready`` counters count, and the watched pixel sits where
 its position says with the bank of its acceptance. It finds those registers by observing
@@ -150,9 +155,10 @@ class StreamContract(Elaboratable):
     # --- the unit's pipeline registers ------------------------------------------------------
     def _stages(self, pipes):
         """Chain stages input -> output: ``[(valid, tag or None)]``, and the lock-step pairs
-        ``[(lead valid, other valid)]``."""
+        ``[(lead valid, other valid)]``. A scene pipeline's output buffer adds its entries
+        (oldest last: nearest the output) as the last layer's stages."""
         stages, lockstep = [], []
-        self._layer_stages = []
+        self._layer_stages, self._layer_takes, self._buffer_stages = [], [], 0
         for layer in self.layers:
             recs = [pipes.get(id(unit.i.valid)) for unit in layer]
             lead = recs[0]
@@ -161,10 +167,29 @@ class StreamContract(Elaboratable):
             for n in range(1, len(lead["valid"])):
                 stages.append((lead["valid"][n], lead["tags"].get(n)))
             self._layer_stages.append(len(lead["valid"]) - 1)
+            unit = layer[0]
+            self._layer_takes.append((unit.i.valid & unit.i.ready, unit.o.valid & unit.o.ready))
             for rec in recs[1:]:
                 if rec is not None:
                     lockstep += list(zip(lead["valid"][1:], rec["valid"][1:]))
+        if self.buffer is not None:
+            count, entries = self.buffer["count"], self.buffer["entries"]
+            for n in reversed(range(len(entries))):
+                stages.append((count > n, entries[n].tag))
+            self._layer_stages.append(len(entries))
+            last = self.layers[-1][0].o
+            self._layer_takes.append((last.valid & last.ready, self.dut.o.valid & self.dut.o.ready))
+            self._buffer_stages = len(entries)
         return stages, lockstep
+
+    def _buffer_lemmas(self, m):
+        """The output buffer's count is at most its depth and every copy of the enable is
+        (count < depth): the units run exactly while the buffer has room for two."""
+        count, entries = self.buffer["count"], self.buffer["entries"]
+        self._lemma(m, count <= len(entries), "the output buffer holds at most its depth")
+        for run in self.buffer["runs"].values():
+            self._lemma(m, run == (count < len(entries)),
+                        "every copy of the enable = the output buffer has room")
 
     def free_inputs(self):
         """Every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports) and
@@ -201,10 +226,13 @@ class StreamContract(Elaboratable):
         i, o = dut.i, dut.o
         take_in = i.valid & i.ready
         take_out = o.valid & o.ready
+        self.buffer = getattr(dut, "buffer", None) if self.lemmas else None
         stages, lockstep = self._stages(pipes) if self.lemmas else ([], [])
         if self.lemmas:
             for lead, other in lockstep:
                 self._lemma(m, lead == other, "lock-step units have equal valid chains")
+            if self.buffer is not None and stages:
+                self._buffer_lemmas(m)
         getattr(self, f"_{self.prop}")(m, i, o, take_in, take_out, stages)
         return m
 
@@ -239,17 +267,16 @@ class StreamContract(Elaboratable):
         width = (max(len(stages), self.latency) + 2).bit_length() + 1
         occ = Signal(width, name="in_flight")
         m.d.sync += occ.eq(occ + take_in - take_out)
-        if self.lemmas and stages and len(self.layers) > 1:
-            # A pipeline: one ghost counter per layer (its lead unit's handshakes) equal to
-            # that layer's valid stages, and their sum equal to the whole count. Small sums
-            # per unit instead of one long one (counting is what SAT solvers find hard).
+        if self.lemmas and stages and len(self._layer_takes) > 1:
+            # A pipeline: one ghost counter per layer (its lead unit's handshakes; the output
+            # buffer's: the last unit's output and the pipeline's) equal to that layer's
+            # valid stages, and their sum equal to the whole count. Small sums per unit
+            # instead of one long one (counting is what SAT solvers find hard).
             parts, first = [], 0
-            for n, layer in enumerate(self.layers):
-                unit = layer[0]
+            for n, (took, gave) in enumerate(self._layer_takes):
                 count = self._layer_stages[n]
                 occ_u = Signal(width, name=f"in_flight_layer{n}")
-                m.d.sync += occ_u.eq(occ_u + (unit.i.valid & unit.i.ready)
-                                     - (unit.o.valid & unit.o.ready))
+                m.d.sync += occ_u.eq(occ_u + took - gave)
                 _ahead, total = self._ahead(m, width, stages[first:first + count], f"l{n}_")
                 self._lemma(m, occ_u == total, "valid stages of a layer = its pixels in flight")
                 parts.append(occ_u)
@@ -301,6 +328,9 @@ class StreamContract(Elaboratable):
         self._check(m, o.valid == valid[-1], "latency: o.valid is not i.valid delayed by latency")
         self._check(m, ~o.valid | (o.payload.tag == tag[-1]),
                            "latency: o.tag is not i.tag delayed by latency")
+        if self.buffer is not None and stages:
+            self._lemma(m, self.buffer["count"] == 0, "the output buffer stays empty")
+            stages = stages[:len(stages) - self._buffer_stages]
         if self.lemmas and len(stages) == self.latency:
             for n, (v, t) in enumerate(stages, start=1):
                 self._lemma(m, v == valid[n], "stage n valid = i.valid n cycles ago")
@@ -414,8 +444,15 @@ class StreamContract(Elaboratable):
                     "the watched pixel is in the fetch with the bank of its acceptance")
         self._lemma(m, ~waiting_f | (Mux(wbank, ports[1].data, ports[0].data) == expected),
                     "its entry is unchanged while it waits")
-        self._lemma(m, ~waiting_f | (ahead == ahead_f + lut.o.valid), "pixels ahead of it")
-        self._lemma(m, ~(watching & ~before) | (lut.o.valid & (ahead == 0) &
-                                                (~match | (color == expected))),
-                    "past the LUT it waits at the output with its entry")
+        count, entries = self.buffer["count"], self.buffer["entries"]
+        self._lemma(m, ~waiting_f | (ahead == ahead_f + lut.o.valid + count), "pixels ahead of it")
+        # Past the LUT: in the output buffer (entry ``ahead``) or in the LUT's last stage
+        # behind the buffered pixels.
+        there = lut.o.payload.color.as_value()
+        for n in reversed(range(len(entries))):
+            there = Mux((ahead == n) & (count > n), entries[n].color.as_value(), there)
+        self._lemma(m, ~(watching & ~before) | ((ahead < count + lut.o.valid) &
+                                                ((ahead < count) | lut.o.valid) &
+                                                (~match | (there == expected))),
+                    "past the LUT it waits in the output buffer or the LUT with its entry")
         self._lemma(m, watching | ~before, "only the watched pixel is followed")

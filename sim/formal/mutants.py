@@ -206,12 +206,11 @@ class UncarriedBankPipeline(BumpPipeline):
 
     def _elaborate_palette(self, m):
         lut, f = self.units["palette"], self.units["fetch"]
-        m.d.comb += [f.i.valid.eq(self.i.valid), self.i.ready.eq(f.i.ready)]
+        m.d.comb += f.i.valid.eq(self.i.valid)
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
-        m.d.comb += [lut.i.valid.eq(f.o.valid), f.o.ready.eq(lut.i.ready),
+        m.d.comb += [lut.i.valid.eq(f.o.valid),
                      lut.i.payload.index.eq(f.o.payload.index), lut.i.payload.tag.eq(f.o.payload.tag),
                      lut.i.payload.bank.eq(lut.bank)]           # the bank at the LUT, not at entry
-        wiring.connect(m, lut.o, wiring.flipped(self.o))
         m.d.comb += [self.lut_w_ready.eq(1), lut.w_en.eq(self.lut_w_en),
                      lut.w_addr.eq(self.lut_w_addr), lut.w_data.eq(self.lut_w_data),
                      lut.swap.eq(self.lut_swap), self.lut_bank.eq(lut.bank)]

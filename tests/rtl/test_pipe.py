@@ -22,7 +22,7 @@ from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
-from bumprtl.rtl.pipeline import BumpPipeline, LightSum
+from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.rtl.sincos import SinCos
@@ -241,12 +241,14 @@ def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
 @pytest.mark.parametrize("unit", list(UNITS))
 def test_pipe_fills_while_its_output_waits(unit):
     """o.ready low from reset, a pixel offered every cycle: the pipe accepts exactly
-    ``latency`` pixels (one per stage; a chain of pipes, its total latency) and then holds.
-    With ``adv = o.ready`` it would accept none: nothing moves while the consumer waits."""
+    ``latency`` pixels (one per stage; a chain of pipes, its total latency; a BumpPipeline
+    also fills its BUFFER_DEPTH-entry output buffer) and then holds. With ``adv = o.ready``
+    it would accept none: nothing moves while the consumer waits."""
     dut = UNITS[unit]()
+    holds = dut.latency + (BUFFER_DEPTH if isinstance(dut, BumpPipeline) else 0)
     samples = run_traffic(dut, dut.latency + 20, 0.0, 1.0, 0, max_cycles=dut.latency + 20)
     accepted = sum(v and r for v, r, _, _ in samples)
-    assert accepted == dut.latency, (unit, accepted, dut.latency)
+    assert accepted == holds, (unit, accepted, holds)
     assert samples[-1][2] and not any(o_valid for _, _, o_valid, _ in samples[:dut.latency])
 
 

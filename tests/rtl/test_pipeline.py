@@ -4,6 +4,7 @@ the emitted Verilog; throughput and backpressure (tags in order, each once)."""
 
 import itertools
 import json
+import random
 import re
 
 import numpy as np
@@ -11,12 +12,13 @@ import pytest
 from amaranth.hdl import Module, Signal
 from amaranth.lib import data, wiring
 from amaranth.lib.memory import Memory
+from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
@@ -194,6 +196,74 @@ def test_one_pixel_per_clock(keys):
     n = 400
     cycles, latency = run(scene, n, "no_stall", seed=5)
     assert cycles / n <= 1 + (latency + 1) / n
+
+
+def _ports(dut, cycles, valid, ready):
+    """Drive ``dut`` (no host writes) for ``cycles`` cycles: ``i.valid`` = ``valid(cycle)``
+    (held until taken), ``o.ready`` = ``ready(cycle)``, consecutive tags. Every cycle, before
+    choosing ``o.ready``, the pipeline's stream rule is checked: ``i.ready``, ``o.valid`` and
+    ``o.payload`` are the same whether ``o.ready`` is 0 or 1 in that cycle, and ``i.ready``
+    is high whenever ``o.valid`` is low. Returns (i.ready per cycle, tags out)."""
+    top = 1 << len(dut.i.payload.tag)
+    readies, tags = [], []
+
+    async def testbench(ctx):
+        sent, offered = 0, False
+        for cycle in range(cycles):
+            offered = offered or valid(cycle)
+            ctx.set(dut.i.valid, offered)
+            ctx.set(dut.i.payload.tag, sent % top)
+            seen = []
+            for r in (0, 1):
+                ctx.set(dut.o.ready, r)
+                seen.append((ctx.get(dut.i.ready), ctx.get(dut.o.valid),
+                             ctx.get(dut.o.payload.as_value())))
+            assert seen[0] == seen[1], f"cycle {cycle}: i.ready/o.valid/o.payload follow o.ready"
+            i_ready, o_valid, _ = seen[0]
+            assert o_valid or i_ready, f"cycle {cycle}: i.ready low while o.valid low"
+            ctx.set(dut.o.ready, ready(cycle))
+            if o_valid and ready(cycle):
+                tags.append(ctx.get(dut.o.payload.tag))
+            if offered and i_ready:
+                offered, sent = False, sent + 1
+            readies.append(i_ready)
+            await ctx.tick()
+
+    sim = Simulator(dut)
+    sim.add_clock(1e-8)
+    sim.add_testbench(testbench)
+    sim.run()
+    return readies, tags
+
+
+@pytest.mark.parametrize("keys", [{"lights": 2, "texture": True}, {"shading": "palette"},
+                                  {"bump_map": "flat"}], ids=["lights2-texture", "palette", "flat"])
+def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys):
+    """The pipeline's handshake (units in lock step, output buffer): per cycle i.ready does
+    not depend on o.ready and is high whenever o.valid is low; o.valid and o.payload do not
+    depend on o.ready; under random gaps and backpressure every pixel comes out once, in
+    order (the payloads are checked bit for bit by test_stalls_lose_nothing)."""
+    scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
+    rng = random.Random(7)
+    valid = [rng.random() < 0.7 for _ in range(400)]
+    ready = [rng.random() < 0.5 for _ in range(400)]
+    _, tags = _ports(BumpPipeline(scene), 400, valid.__getitem__, ready.__getitem__)
+    top = 1 << scene.config.tag_bits
+    assert len(tags) > 100 and tags == [n % top for n in range(len(tags))]
+
+
+def test_one_consumer_stall_does_not_stop_the_input():
+    """With the output buffer empty, o.ready low for one cycle parks one pixel in the buffer
+    and i.ready stays high (the enable only falls once the buffer is full); held low, the
+    pipe fills up to latency + BUFFER_DEPTH pixels and i.ready falls."""
+    scene = load_scene_config({"name": "t", "texture_size": 16})
+    dut = BumpPipeline(scene)
+    n = dut.latency
+    readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: c != n + 2)
+    assert all(readies) and len(tags) == 3 * n - n - 1
+    dut = BumpPipeline(scene)
+    readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: False)
+    assert tags == [] and sum(readies) == n + BUFFER_DEPTH and not any(readies[n + BUFFER_DEPTH:])
 
 
 def _plan(keys):
