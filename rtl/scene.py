@@ -95,16 +95,17 @@ class SceneConfig:
     texture_size: int = 64
     addressing: str = "wrap"
     mip_levels: int = 1
-    method: str = "exact"
-    angle_bits: int = 12
-    frac_bits: int = 13
-    tag_bits: int = 16
-    spec_exponent: int = 16
-    spec_index_bits: int = 10
-    ka: float = 0.1
-    kd: float = 0.7
-    ks: float = 0.2
-    palette_size: int = 256
+    # Config's fields and defaults (rtl/config.py is the one source of both)
+    method: str = Config.method
+    angle_bits: int = Config.angle_bits
+    frac_bits: int = Config.frac_bits
+    tag_bits: int = Config.tag_bits
+    spec_exponent: int = Config.spec_exponent
+    spec_index_bits: int = Config.spec_index_bits
+    ka: float = Config.ka
+    kd: float = Config.kd
+    ks: float = Config.ks
+    palette_size: int = Config.palette_size
     height_map: str | None = None
     normal_map: str | None = None
     normal_convention: str = "opengl"

@@ -16,6 +16,8 @@ from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.rtl.methods import BASELINES, datapath_fixed
 from bumprtl.rtl.scene import load_scene_config
 
+DEFAULT_WIDTHS = (Config().angle_bits, Config().frac_bits)
+
 
 def _front(pairs):
     pts = [{"x": x, "y": y} for x, y in pairs]
@@ -173,10 +175,10 @@ def test_fpga_points_diagonal_and_all():
               if bench_sweep.fpga_selected(grid, a, b, diag)]
     assert chosen == list(zip(grid.angle_bits, grid.frac_bits))
     assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
-            if bench_sweep.fpga_selected(grid, a, b, diag, "peercy")] == [(12, 13)]
+            if bench_sweep.fpga_selected(grid, a, b, diag, "peercy")] == [DEFAULT_WIDTHS]
     default = SimpleNamespace(fpga_points="default")
     assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
-            if bench_sweep.fpga_selected(grid, a, b, default, "lee")] == [(12, 13)]
+            if bench_sweep.fpga_selected(grid, a, b, default, "lee")] == [DEFAULT_WIDTHS]
     every = SimpleNamespace(fpga_points="all")
     assert all(bench_sweep.fpga_selected(grid, a, b, every)
                for a in grid.angle_bits for b in grid.frac_bits)

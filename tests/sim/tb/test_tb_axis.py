@@ -87,7 +87,7 @@ def test_too_narrow_tdata_is_refused_in_one_line(tmp_path, capsys):
     rc = main(["emit", "rotation", "--interface", "axis", "--tdata-width", "16", "--out", str(tmp_path)])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1
-    assert "tdata_width = 16 is too narrow" in err[0] and "s_axis_tdata needs 96 bits" in err[0]
+    assert "tdata_width = 16 is too narrow" in err[0] and f"s_axis_tdata needs {8 * Config().angle_bits} bits" in err[0]
     assert not list(tmp_path.iterdir())
     rc = main(["emit", "sincos", "--interface", "axis", "--tdata-width", "20", "--out", str(tmp_path)])
     assert rc == 2 and "multiple of 8" in capsys.readouterr().err

@@ -24,7 +24,7 @@ from bumprtl.sim.golden.fixed.lee import illuminate_fixed, rotate_fixed
 from bumprtl.sim.golden.float.lee import lee_corrected
 from bumprtl.sim.golden.vectors import TINY
 
-CFG = Config(method="lee")
+CFG = Config(method="lee", angle_bits=12, frac_bits=13)   # k = 10, B = 13: the pins below
 lee_fixed_model = METHODS["lee"].datapath_fixed     # rotation then illumination, bit-exact
 
 
