@@ -88,7 +88,7 @@ def run(args):
     print(f"bumprtl bench specular --samples {args.samples} --spec-exponent "
           f"{' '.join(map(str, args.spec_exponent))}")
     print(f"\nspecular term and 8-bit specular output against float64, 8-bit LSB, at angle bits "
-          f"12, B = 13: 'term' = max |fine / 2^F - 255 x^n| over every N'.H on the B-bit grid; "
+          f"{Config().angle_bits}, B = {Config().frac_bits}: 'term' = max |fine / 2^F - 255 x^n| over every N'.H on the B-bit grid; "
           f"random = {args.samples} random valid pixels (seed 11), adversarial = the search "
           f"aimed at the specular term (seed 7)\n")
     print("| n | candidate | table (words x bits) | DP16KD | multipliers | term max | random max / mean "

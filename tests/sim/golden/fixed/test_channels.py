@@ -89,10 +89,11 @@ def test_bounds_hold_and_are_tight(exponent):
         assert measured == {"diffuse": 1, "specular": 1, "color": 1}, measured
 
 
-@pytest.mark.parametrize("exponent", [1, 2, 3])
+@pytest.mark.parametrize("exponent", [1, 4, 8])
 def test_small_exponents_reach_1_lsb_of_specular(exponent):
-    """At the default widths only n <= 3 keep the specular term within 1 LSB: the angle
-    grid alone moves a steeper cos^n by more (docs/fixed_point.md)."""
+    """At the default widths every n up to 16 keeps the specular term within 1 LSB (n = 16:
+    test_bounds_hold_and_are_tight); from n = 64 the angle grid and the dot product's
+    rounding times the slope of cos^n exceed it (docs/fixed_point.md)."""
     cfg = Config(spec_exponent=exponent)
     for px in (PixelInputs.random(50_000, np.random.default_rng(11)),
                adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular")):
