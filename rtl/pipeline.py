@@ -48,7 +48,7 @@ from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
-from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout
+from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
 
 __all__ = ["BumpPipeline", "VectorTerms", "LightSum"]
 
@@ -123,7 +123,12 @@ class LightSum(wiring.Component):
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
         ka, kd, ks = phong_coefficients(self.cfg)
-        kd_term, ks_term = pipe.register(d * kd, "kd_sum"), pipe.register(s * ks, "ks_sum")
+        # KD d, KS s from the stage-1 inputs: DSP products whose operand registers are d's and
+        # s's (rtl/texture.sum_product: the widths, a split by lights where a sum is too wide)
+        kd_term = sum_product([px.d[j] for j in range(self.lights)], b + 1, kd, pipe.multiply,
+                              "kd_sum")
+        ks_term = sum_product([px.s[j] for j in range(self.lights)], 8 + SPEC_FRAC_BITS, ks,
+                              pipe.multiply, "ks_sum")
         sat = lambda x: Mux(x > 255, 255, x)[:8]
         d8 = pipe.register(sat(round_shift((d << 8) - d, b)), "diffuse8")
         s8 = pipe.register(sat(round_shift(s, SPEC_FRAC_BITS)), "specular8")

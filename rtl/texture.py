@@ -31,12 +31,12 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipe import ECP5, StallPipe
 from bumprtl.rtl.tables import (KS_FRAC_BITS, LIT_FRAC_BITS, SPEC_FRAC_BITS, blend_coefficients,
                                 coefficient_error_lsb)
 
-__all__ = ["RGB", "rgb_layout", "texture_blend", "blend_error_bound_lsb", "TextureBlend",
-           "TexelDelay", "BLEND_LATENCY"]
+__all__ = ["RGB", "rgb_layout", "texture_blend", "sum_product", "blend_error_bound_lsb",
+           "TextureBlend", "TexelDelay", "BLEND_LATENCY"]
 
 RGB = ("r", "g", "b")
 
@@ -54,6 +54,38 @@ def _identity(value, name):
     return value
 
 
+# Widest unsigned operand of one MULT18X18D (18 bits signed: an unsigned value needs a zero bit).
+DSP_OPERAND_BITS = ECP5.dsp_width - 1
+# Most products one light sum times a coefficient is split into (more: one product of the sum).
+MAX_SPLIT = 2
+
+
+def _narrow(x, bits):
+    """``x`` (< 2**bits) as ``bits`` bits: an Amaranth sum carries a bit an addition."""
+    if isinstance(x, (Value, ValueCastable)) and Value.cast(x).shape().width > bits:
+        return Value.cast(x)[:bits]
+    return x
+
+
+def sum_product(terms, width, k, mul, name):
+    """k sum_j t_j for m terms t_j < 2**width, as sum over groups of mul(sum of the group, k):
+    exact in integers (distributivity), each group sum narrowed to the bits it needs.
+
+    Widths: a group of g terms sums below g 2**width, so it is one DSP operand (at most
+    DSP_OPERAND_BITS = 17 unsigned bits, the coefficients KD, KS <= 17 bits) while
+    width + ceil(log2 g) <= 17. Diffuse terms are B + 1 bits: at B = 13 all 8 lights' sum
+    is one DSP; at B = 16 one DSP a light. Specular terms (8 + F = 17 bits): one DSP a light.
+    Up to MAX_SPLIT products are summed after their registers (one adder); with more, or a
+    term wider than 17 bits, it is one product of the whole sum (fabric, still exact)."""
+    g = 1 << max(0, DSP_OPERAND_BITS - width)
+    groups = [terms[i:i + g] for i in range(0, len(terms), g)]
+    if len(groups) > MAX_SPLIT or width > DSP_OPERAND_BITS:
+        groups = [terms]
+    prods = [mul(_narrow(sum(grp[1:], grp[0]), width + (len(grp) - 1).bit_length()), k,
+                 name if len(groups) == 1 else f"{name}{n}") for n, grp in enumerate(groups)]
+    return sum(prods[1:], prods[0])
+
+
 def _sat(x, top):
     """min(x, top) of a non-negative value (Amaranth or int64): every term here is unsigned."""
     if isinstance(x, (Value, ValueCastable)):
@@ -64,28 +96,35 @@ def _sat(x, top):
     return np.minimum(np.asarray(x, np.int64), top)
 
 
-def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity):
+def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None):
     """The blend of the module docstring for m lights.
 
     ``diffuse``, ``specular``: lists of the lights' unrounded terms (Illumination's
     ``diffuse_fine``, ``specular_fine``); ``texel``: {r, g, b} 8-bit. ``reg(value, name)`` is
     called after each stage (a pipeline register in the RTL, identity in the golden model).
+    ``mul(value, other, name)`` is value * other two stages after its operands (default
+    reg(reg(value) * reg(other)); the RTL's StallPipe.multiply: one DSP block whose operand
+    registers stand for the stage-1 (stage-3) registers the products read).
     Returns ``(out, diffuse8, specular8)``: {r, g, b} and the light sums rounded to 8 bits,
     min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)).
     """
+    if mul is None:
+        def mul(value, other, name):
+            other = other if isinstance(other, int) else reg(other, f"{name}_b")
+            return reg(reg(value, f"{name}_a") * other, name)
     u8, b, gl = (1 << cfg.color_bits) - 1, cfg.frac_bits, LIT_FRAC_BITS
     ka, kd, ks = blend_coefficients(cfg)
     d = reg(sum(diffuse[1:], diffuse[0]), "diffuse_sum")                        # stage 1
     s = reg(sum(specular[1:], specular[0]), "specular_sum")
     tex = {c: reg(texel[c], f"texel_{c}_d1") for c in RGB}
-    kd_term, ks_term = reg(d * kd, "kd_sum"), reg(s * ks, "ks_sum")             # stage 2
+    kd_term = sum_product(diffuse, b + 1, kd, mul, "kd_sum")                    # stage 2
+    ks_term = sum_product(specular, 8 + SPEC_FRAC_BITS, ks, mul, "ks_sum")
     d8 = reg(_sat(round_shift((d << 8) - d, b), u8), "diffuse8")
     s8 = reg(_sat(round_shift(s, SPEC_FRAC_BITS), u8), "specular8")
     tex = {c: reg(tex[c], f"texel_{c}_d2") for c in RGB}
-    lit = reg(_sat(ka + (kd_term >> b), 1 << gl), "lit")                        # stage 3
+    lit = _sat(ka + (kd_term >> b), 1 << gl)                                    # stage 3
     spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
-    tex = {c: reg(tex[c], f"texel_{c}_d3") for c in RGB}
-    prod = {c: reg(tex[c] * lit, f"albedo_{c}") for c in RGB}                   # stage 4
+    prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 4
     spec = reg(spec, "spec_d4")
     out = {c: reg(_sat(round_shift(prod[c] + spec, gl), u8), f"color_{c}") for c in RGB}  # 5
     return out, d8, s8
@@ -128,7 +167,8 @@ class TextureBlend(wiring.Component):
         px = self.i.payload
         color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
                                     [px.s[j] for j in range(self.lights)],
-                                    {c: px.texel[c] for c in RGB}, self.cfg, pipe.register)
+                                    {c: px.texel[c] for c in RGB}, self.cfg, pipe.register,
+                                    pipe.multiply)
         o = self.o.payload
         m.d.comb += [o.color[c].eq(color[c]) for c in RGB]
         m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - 2, "diffuse")),

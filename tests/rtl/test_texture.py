@@ -4,8 +4,10 @@ under stalls."""
 
 import numpy as np
 import pytest
+from amaranth.hdl import Fragment, Instance
 
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import RGB, TextureBlend, blend_error_bound_lsb, texture_blend
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
@@ -29,7 +31,7 @@ def random_terms(rng, cfg, lights, n):
     return d, s
 
 
-@pytest.mark.parametrize("lights", [1, 3])
+@pytest.mark.parametrize("lights", [1, 2, 3])
 @pytest.mark.parametrize("k", [(0.1, 0.7, 0.2), (0.33, 0.45, 0.61), (0.0, 1.0, 0.0)])
 def test_blend_within_its_bound_of_float64(lights, k):
     """One rounding at the end: within 1/2 LSB plus the coefficients' quantization."""
@@ -62,19 +64,50 @@ def test_white_texel_gives_the_grey_shade_black_gives_the_highlight():
     assert black["g"][0] > 40 and black["g"][-1] == 0          # only the highlight is left
 
 
-@pytest.mark.parametrize("pattern", list(PATTERNS))
-def test_unit_bit_exact(pattern):
-    cfg, lights, n = Config(lights=2), 2, 300
+def _unit_bit_exact(cfg, lights, pattern, n):
     rng = np.random.default_rng(9)
     inputs = [{**{f"d.{j}": int(rng.integers(cfg.one + 1)) for j in range(lights)},
                **{f"s.{j}": int(rng.integers(255 << SPEC_FRAC_BITS)) for j in range(lights)},
                **{f"texel.{c}": int(rng.integers(256)) for c in RGB}, "tag": t} for t in range(n)]
     col = lambda k: np.array([p[k] for p in inputs])
-    color, d, s = texture_blend([col("d.0"), col("d.1")], [col("s.0"), col("s.1")],
+    color, d, s = texture_blend([col(f"d.{j}") for j in range(lights)],
+                                [col(f"s.{j}") for j in range(lights)],
                                 {c: col(f"texel.{c}") for c in RGB}, cfg)
     golden = {"diffuse": d, "specular": s, **{f"color.{c}": color[c] for c in RGB}}
     dut = TextureBlend(cfg, lights)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=2, pipe_handshake=True)
     assert_bit_exact(out, golden, inputs)
+    return dut, cycles
+
+
+@pytest.mark.parametrize("pattern", list(PATTERNS))
+def test_unit_bit_exact(pattern):
+    n = 300
+    dut, cycles = _unit_bit_exact(Config(lights=2), 2, pattern, n)
     if pattern == "no_stall":
         assert cycles <= n + dut.latency + 1
+
+
+@pytest.mark.parametrize("frac_bits, lights", [(13, 1), (13, 2), (16, 1), (16, 3)])
+def test_unit_bit_exact_split_and_fabric_products(frac_bits, lights):
+    """The light sums' products one DSP per sum (B = 13), one per light (B = 16, 2 lights:
+    the test above) or one fabric product of the whole sum (3 lights at B = 16)."""
+    _unit_bit_exact(Config(frac_bits=frac_bits, lights=lights), lights, "both", 120)
+
+
+def _instances(fragment):
+    if isinstance(fragment, Instance):
+        yield fragment.type
+    for sub, *_ in fragment.subfragments:
+        yield from _instances(sub)
+
+
+@pytest.mark.parametrize("frac_bits, lights, dsps", [(13, 1, 5), (13, 2, 6), (13, 8, 4),
+                                                     (16, 2, 7), (16, 3, 3)])
+def test_ecp5_products_are_dsp_blocks(frac_bits, lights, dsps):
+    """On ECP5 kd D, ks S and the three tex_c lit are MULT18X18D blocks with their registers
+    (rtl/texture.sum_product's widths): D split by lights only where the sum is too wide for
+    one operand, the 17-bit specular terms one block a light, fabric beyond MAX_SPLIT."""
+    cfg = Config(frac_bits=frac_bits, lights=lights)
+    fragment = Fragment.get(TextureBlend(cfg, lights, target=ECP5()), None)
+    assert list(_instances(fragment)) == ["MULT18X18D"] * dsps
