@@ -89,13 +89,15 @@ def _grid_cell(row):
 def run(args):
     for n in args.spec_exponent:                 # a bad exponent is an error, not a skipped row
         Config(spec_exponent=n, spec_index_bits=args.spec_index_bits)
+    _scene_config(args)                          # bad --scene-widths: one line, exit 2
     size = args.scene_size
     if size and not (16 <= size <= 4096 and size & (size - 1) == 0):
         raise BumpError(f"scene_size must be 0 or a power of two in [16, 4096], got {size}")
     print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} "
           f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
           f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits} "
-          f"--scene-size {args.scene_size}")
+          f"--scene-size {args.scene_size}"
+          + (f" --scene-widths {' '.join(map(str, args.scene_widths))}" if args.scene_widths else ""))
     print(f"\nerror in 8-bit LSB per output channel, on {args.samples} random valid pixels (seed "
           f"11), the adversarial search aimed at the channel (seed 7) and the search aimed at "
           f"the dot product's arithmetic error (on-grid N', H near N', seed 5). end-to-end = "
@@ -205,7 +207,7 @@ def light_sums(cfg: Config, px: PixelInputs):
 def _lights(args, px):
     """The light-sum and blend table at the default widths of ``args.method``; returns the
     failure lines."""
-    cfg = Config(method=args.method, spec_index_bits=args.spec_index_bits)
+    cfg = _scene_config(args)
     print(f"\neq. 2's colour summed over m lights (LightSum) and the texture blend (TextureBlend, "
           f"random texels), rounded once, at angle bits {cfg.angle_bits}, frac bits "
           f"{cfg.frac_bits}, n = {cfg.spec_exponent}: random = the {len(px)} pixels (a second "
@@ -242,12 +244,19 @@ def _lights(args, px):
     return failures
 
 
+def _scene_config(args):
+    """The Config of the light-sum, blend and scene tables: ``--scene-widths`` (angle bits,
+    frac bits) when given, else Config's default widths."""
+    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or ()))
+    return Config(method=args.method, spec_index_bits=args.spec_index_bits, **widths)
+
+
 def _scenes(args):
     """Every built-in scene and the unseen crater map (sim/golden/accuracy.crater_scene)
     shaded at the default widths of ``args.method``: eq. 2's colour image and, where the
     scene has a colour texture, the texture blend on its 8-bit albedo
     (sim/golden/accuracy.scene_error), over the pixels the geometry covers."""
-    cfg = Config(method=args.method, spec_index_bits=args.spec_index_bits)
+    cfg = _scene_config(args)
     print(f"\nscenes at {args.scene_size}x{args.scene_size} (angle bits {cfg.angle_bits}, frac bits "
           f"{cfg.frac_bits}, n = {cfg.spec_exponent}): PSNR (dB) / max LSB against float64 "
           f"`conventional` on the unquantized inputs\n")
@@ -279,4 +288,6 @@ def add_parser(sub):
     p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
     p.add_argument("--scene-size", type=int, default=128,
                    help="also shade every built-in scene at this size, default widths (0: no scenes)")
+    p.add_argument("--scene-widths", type=int, nargs=2, metavar=("ANGLE_BITS", "FRAC_BITS"),
+                   help="widths of the light-sum, blend and scene tables (default: Config's)")
     p.set_defaults(func=run)

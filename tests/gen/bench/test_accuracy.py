@@ -142,3 +142,28 @@ def test_bad_input_is_one_line_exit_2(capsys, flag, value, name):
     captured = capsys.readouterr()
     err = captured.err.strip()
     assert name in err and len(err.splitlines()) == 1 and "|" not in captured.out
+
+
+def test_scene_widths_13_16_bring_light_sums_and_blend_to_1_lsb(small_searches, capsys):
+    """The light-sum and blend table at 13-bit angles, B = 16 (``--scene-widths``): eq. 2's
+    colour and the texture blend with one and two lights within 1 LSB end to end, the angle
+    grid included (at the default widths two aligned lights reach 2, the table above)."""
+    args = ["bench", "accuracy", "--samples", "3000", "--angle-bits", "13", "--frac-bits", "16",
+            "--scene-size", "0", "--scene-widths", "13", "16"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "at angle bits 13, frac bits 16, n = 16" in out and "--scene-widths 13 16" in out
+    for lights, output in ((1, "colour"), (1, "blend"), (2, "colour"), (2, "blend")):
+        row = re.search(LIGHT_ROW.format(lights, output), out)
+        assert row, (lights, output, out)
+        rnd, adv, ar_rnd, ar_adv, bound = (int(g) for g in row.groups())
+        assert max(rnd, adv, ar_rnd, ar_adv) <= 1 <= bound, row.group(0)
+    for channel in ("diffuse", "specular", "color"):
+        row = re.search(r"\| 13 \| 16 \| 16 \| " + channel + r" \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \|", out)
+        assert row and max(int(g) for g in row.groups()) <= 1, (channel, out)
+
+
+def test_bad_scene_widths_is_one_line_exit_2(capsys):
+    assert main(["bench", "accuracy", "--scene-widths", "3", "16", "--scene-size", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "angle_bits" in err and "[4, 16]" in err and len(err.splitlines()) == 1
