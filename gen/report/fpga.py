@@ -8,6 +8,7 @@ critical paths and a cost-against-error plot.
 """
 
 import argparse
+import json
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -160,6 +161,10 @@ def write_report(args, rows, acc):
                   "is Peercy's hardware)."]
     out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
     print(f"wrote {out}")
+    data = out.parent / "data" / "fpga.json"         # read by report table1
+    data.parent.mkdir(parents=True, exist_ok=True)
+    data.write_text(json.dumps({"command": command, "device": args.device, "rows": rows,
+                                "accuracy": acc}, indent=1, sort_keys=True) + "\n")
 
 
 def _plot(rows, acc, path):

@@ -8,6 +8,7 @@ accuracy of each design's bit-exact golden model against float64, and the paper'
 :data:`TABLE1_ORDER` and :func:`accuracy` from here.
 """
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -241,10 +242,36 @@ def run_table1(args):
            "designs": {d: accuracy(d, cfg, args.samples) for d in TABLE1_ORDER}}
     command = f"bumprtl report table1 --samples {args.samples}"
     text = table1_markdown(cfg, counts, acc, command)
+    text += fpga_section(Path(args.out).parent / "data" / "fpga.json")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text + STATUS)
     print(f"wrote {args.out}")
     return 0
+
+
+def fpga_section(path):
+    """Each design's rotation -> illumination pipeline on the ECP5 at its own Fmax, from the
+    rows ``report fpga`` wrote beside docs/report.md (``data/fpga.json``); empty if absent."""
+    if not Path(path).exists():
+        return ""
+    data = json.loads(Path(path).read_text())
+    rows = {r["design"]: r for r in data["rows"] if r["row"] == "pipeline"}
+    lines = ["", "## On the ECP5, each design at its own Fmax", "",
+             f"From `{data['command']}` (docs/report.md; nextpnr on {data['device']}): each "
+             "design's rotation -> illumination pipeline, 1 pixel per clock, so Mpixel/s = Fmax; "
+             "error = diffuse, 8-bit LSB against float64.", "",
+             "| design | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | max / mean LSB |",
+             "|---|---|---|---|---|---|---|"]
+    for d in TABLE1_ORDER:
+        r, a = rows.get(d), data["accuracy"].get(d)
+        if r is None or a is None:
+            continue
+        if "error" in r:
+            lines.append(f"| {d} | not placed: {r['error']} | | | | | {a['max']} / {a['mean']:.4f} |")
+            continue
+        lines.append(f"| {d} | {r['LUT4']} | {r['FF']} | {r['DSP']} | {r['BRAM']} | "
+                     f"{r['fmax_mhz']} | {a['max']} / {a['mean']:.4f} |")
+    return "\n".join(lines) + "\n"
 
 
 STATUS = """

@@ -1,5 +1,6 @@
 """bumprtl report table1: the lee counts against the paper's Table 1, the 78 % claim, bad input."""
 
+import json
 import re
 
 import pytest
@@ -168,3 +169,23 @@ def test_baseline_counts_follow_the_papers_units(table1):
     assert _row(table1, "ernst", "illumination")["multipliers"] - 6 == lee
     claim = re.search(r"Measured, the largest saving is against (\w+)", table1)
     assert claim and claim.group(1) in BASELINES
+
+
+def test_fpga_section_lists_each_pipeline_at_its_own_fmax(tmp_path):
+    """The rows report fpga wrote (data/fpga.json) become one line per design's pipeline:
+    its cost, its Fmax and its error; a design that did not place says why; no file, no
+    section."""
+    data = {"command": "bumprtl report fpga --device LFE5U-85F", "device": "LFE5U-85F",
+            "rows": [{"design": "exact", "row": "pipeline", "LUT4": 11, "FF": 22, "DSP": 3,
+                      "BRAM": 4, "fmax_mhz": 155.5},
+                     {"design": "exact", "row": "setup", "LUT4": 1, "FF": 2, "DSP": 0,
+                      "BRAM": 1, "fmax_mhz": 999.0},
+                     {"design": "kim", "row": "pipeline", "error": "timed out"}],
+            "accuracy": {"exact": {"max": 1, "mean": 0.07}, "kim": {"max": 2, "mean": 0.1}}}
+    path = tmp_path / "fpga.json"
+    path.write_text(json.dumps(data))
+    text = report.fpga_section(path)
+    assert "| exact | 11 | 22 | 3 | 4 | 155.5 | 1 / 0.0700 |" in text
+    assert "999.0" not in text                           # units are not pipelines
+    assert "| kim | not placed: timed out |" in text
+    assert report.fpga_section(tmp_path / "absent.json") == ""
