@@ -118,9 +118,11 @@ def scenarios(dut_factory=lambda: BumpPipeline("default")):
     tr = simulate(dut, lat + 14, offer=lambda n: n >= 1, ready=lambda n: n not in stall)
     out["stall"] = (wavedrom(tr, lat - 1, lat + 12,
                              "Stall: o.ready low for 4 cycles",
-                             "o.valid and o.tag are held while o.valid & ~o.ready; the whole pipe "
-                             "freezes (i.ready = ~o.valid | o.ready falls) and the producer holds "
-                             "its pixel"),
+                             "o.valid and o.tag are held while o.valid & ~o.ready; the output "
+                             "buffer takes the two pixels still on their way, then the registered "
+                             "run enable falls (i.ready two cycles after o.ready), the whole pipe "
+                             "freezes and the producer holds its pixel; i.ready rises the cycle "
+                             "after o.ready does"),
                     {"latency": lat, "stall": list(stall), "trace": tr})
     dut = dut_factory()
     tr = simulate(dut, lat + 5, offer=lambda n: n == 1, ready=lambda n: 1)
