@@ -46,8 +46,7 @@ the previous table's output within the pixel, which makes the setup deep, not sl
 """
 
 import numpy as np
-from amaranth.hdl import (Cat, ClockSignal, Const, Elaboratable, Instance, Module, Mux, Signal, Value,
-                          ValueCastable, unsigned)
+from amaranth.hdl import Cat, Elaboratable, Module, Mux, Signal, Value, ValueCastable, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
@@ -55,7 +54,7 @@ from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
 from bumprtl.rtl.pipe import (DP16KD_MODES, PRODUCT_LATENCY, ROM_LATENCY, PipeUnit, RegisteredProduct,
-                             RegisteredROM, dp16kd_initvals)
+                             RegisteredROM, dp16kd_rom_block)
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
@@ -193,30 +192,18 @@ class BlockROM(RegisteredROM):
             return super().elaborate(platform)
         m = Module()
         bits, words, shift = mode
-        zero = Const(0, 1)
         for group in range(0, len(self.ports), 2):
             ports = self.ports[group:group + 2]
             columns = [[] for _ in ports]
             for col in range(-(-self.width // bits)):
                 lo, hi = col * bits, min(self.width, (col + 1) * bits)
-                params = dp16kd_initvals([(x >> lo) & ((1 << (hi - lo)) - 1)
-                                          for x in self.init[:words]], bits)
-                params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="OUTREG",
-                              p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
-                              p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
-                              p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
-                for side, port, out in zip("AB", ports, columns):
-                    addr = Signal(14, name=f"{port.addr.name}_{side}{col}")
-                    dout = Signal(18, name=f"{port.data.name}_{side}{col}")
-                    m.d.comb += addr[shift:].eq(port.addr)      # mode x{bits}: word address
-                    params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
-                                   f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
-                    params.update({f"i_CS{side}{n}": zero for n in range(3)})
-                    params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
-                    params.update({f"i_DI{side}{n}": zero for n in range(18)})
-                    params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+                outs = dp16kd_rom_block(m, f"bram{group // 2}_{col}",
+                                        [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
+                                        bits, shift, self.en,
+                                        [(side, port.addr, f"{port.addr.name}_{side}{col}")
+                                         for side, port in zip("AB", ports)])
+                for out, dout in zip(columns, outs.values()):
                     out.append(dout[:hi - lo])
-                m.submodules[f"bram{group // 2}_{col}"] = Instance("DP16KD", **params)
             for port, out in zip(ports, columns):
                 data = Cat(*out)
                 if self.depth > words:          # the last word: the address wrapped to word 0

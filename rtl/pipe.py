@@ -16,6 +16,7 @@ from amaranth.lib.memory import Memory, ReadPort
 from amaranth.lib.wiring import In, Out
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "RegisteredROM", "RegisteredRAM", "read_port",
+           "dp16kd_rom_block",
            "PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
@@ -154,29 +155,17 @@ class RegisteredROM(Elaboratable):
         return m
 
     def _dp16kd(self, m, bits, words, shift):
-        zero = Const(0, 1)
-        abits = words.bit_length() - 1
         sides = list(zip("AB", self.ports + self.ports[:1]))[:max(2, len(self.ports))]
         douts = {side: Signal(self.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
         for col in range(-(-self.width // bits)):
             lo, hi = col * bits, min(self.width, (col + 1) * bits)
-            params = dp16kd_initvals([(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
-                                     bits)
-            params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="OUTREG",
-                          p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
-                          p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
-                          p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
-            for side, port in sides:
-                addr, dout = Signal(14, name=f"{port.addr.name}_{side}{col}"), Signal(18)
-                m.d.comb += addr[shift:shift + abits].eq(port.addr[:abits])    # word address
-                params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": self.en,
-                               f"i_OCE{side}": self.en, f"i_WE{side}": zero, f"i_RST{side}": zero})
-                params.update({f"i_CS{side}{n}": zero for n in range(3)})
-                params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
-                params.update({f"i_DI{side}{n}": zero for n in range(18)})
-                params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+            outs = dp16kd_rom_block(m, f"bram{col}" if col else "bram",
+                                    [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
+                                    bits, shift, self.en,
+                                    [(side, port.addr, f"{port.addr.name}_{side}{col}")
+                                     for side, port in sides])
+            for side, dout in outs.items():
                 m.d.comb += douts[side][lo:hi].eq(dout[:hi - lo])
-            m.submodules[f"bram{col}" if col else "bram"] = Instance("DP16KD", **params)
         for side, port in sides[:len(self.ports)]:
             data = douts[side]
             if self.depth > words:              # the last word: address wrapped to word 0 (= 0)
@@ -186,6 +175,34 @@ class RegisteredROM(Elaboratable):
                     m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
                 data = data | Mux(last_d, self.init[words], 0)
             m.d.comb += port.data.eq(data)
+
+
+def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
+    """One DP16KD (submodule ``name``) holding ``words`` in its x``bits`` mode
+    (:data:`DP16KD_MODES`: word address on AD[13:shift]), read through one or both ports,
+    each with its output register (REGMODE OUTREG), both enabled by ``en``. ``reads``:
+    (side "A" or "B", word address, signal name) per port; an address one bit wider than the
+    mode's wraps to word 0 (the spill word of :class:`RegisteredROM`). Returns {side: 18-bit
+    data}."""
+    zero = Const(0, 1)
+    params = dp16kd_initvals(words, bits)
+    params.update(p_DATA_WIDTH_A=bits, p_DATA_WIDTH_B=bits, p_REGMODE_A="OUTREG",
+                  p_REGMODE_B="OUTREG", p_RESETMODE="SYNC", p_ASYNC_RESET_RELEASE="SYNC",
+                  p_CSDECODE_A="0b000", p_CSDECODE_B="0b000", p_WRITEMODE_A="NORMAL",
+                  p_WRITEMODE_B="NORMAL", p_GSR="DISABLED")
+    outs = {}
+    for side, word, label in reads:
+        addr, dout = Signal(14, name=label), Signal(18, name=f"{label}_do")
+        m.d.comb += addr[shift:].eq(word)                 # x{bits}: the word address
+        params.update({f"i_CLK{side}": ClockSignal(), f"i_CE{side}": en,
+                       f"i_OCE{side}": en, f"i_WE{side}": zero, f"i_RST{side}": zero})
+        params.update({f"i_CS{side}{n}": zero for n in range(3)})
+        params.update({f"i_AD{side}{n}": addr[n] for n in range(14)})
+        params.update({f"i_DI{side}{n}": zero for n in range(18)})
+        params.update({f"o_DO{side}{n}": dout[n] for n in range(18)})
+        outs[side] = dout
+    m.submodules[name] = Instance("DP16KD", **params)
+    return outs
 
 
 # Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5.
