@@ -12,7 +12,7 @@ from amaranth.lib import data
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit, fits_dsp
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
 
@@ -130,22 +130,33 @@ class ExactIllumination(IlluminationDatapath):
     once, then the shared back end (diffuse, cos^n specular table, Phong sum of eq. 2).
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``.
-    Latency PRODUCT_LATENCY (operand and product registers) + 2 (sum, rounding) +
+    Latency: the products (PRODUCT_LATENCY: operand and product registers; with B > 13 an
+    operand, n''x4 of B + 5 bits, is wider than one 18 x 18 DSP input and every product is a
+    ``pipe.WideProduct``, WIDE_PRODUCT_LATENCY, on every target) + 2 (sum, rounding) +
     SHADE_LATENCY; 1 pixel per clock.
     """
-
-    dot_latency = PRODUCT_LATENCY + 2
 
     def __init__(self, cfg: Config, target=None):
         super().__init__(cfg, rotated_layout(cfg), target)
 
+    @property
+    def wide(self):
+        """The products' operands outgrow one DSP input (rotated_layout: n.x4 is the widest)."""
+        layout = rotated_layout(self.cfg)
+        return not fits_dsp(layout["n"].shape["x4"].shape, layout["l"].shape["p2"].shape)
+
+    @property
+    def dot_latency(self):
+        return (WIDE_PRODUCT_LATENCY if self.wide else PRODUCT_LATENCY) + 2
+
     def dots(self, m, pipe, payload):
         n, dots = payload.n, {}
+        mul = pipe.wide_multiply if self.wide else pipe.multiply
         for v in vectors(self.cfg):
             a = payload[v]
-            xp = pipe.multiply(n.x4, a.p2, f"{v}_xp")                  # 3 multipliers per vector
-            yy = pipe.multiply(n.y2, a.y2, f"{v}_yy")
-            zz = pipe.multiply(n.z4, a.z, f"{v}_zz")
+            xp = mul(n.x4, a.p2, f"{v}_xp")                            # 3 multipliers per vector
+            yy = mul(n.y2, a.y2, f"{v}_yy")
+            zz = mul(n.z4, a.z, f"{v}_zz")
             # round_shift(xp + 2 yy + 2 zz, B + 3) in two carry-chain stages: the rounding
             # half rides with 2 zz, so each stage adds two operands.
             n_shift = self.cfg.frac_bits + 3

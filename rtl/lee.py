@@ -39,22 +39,22 @@ the block RAM (:func:`rom_read`, :func:`sine_value`, sincos.sine_read), every pr
 registered DSP product, and long carry and mux chains are cut by the ``stage`` hooks of the
 shared helpers (identity in the golden model). The tables wider or deeper than one DP16KD,
 the sin & cos ROM with four reads and the products by a 1/sin, 1/cos word (wider than a DSP
-input) have ECP5 forms of their own here (:class:`BlockROM`, :class:`WideProduct`) with the
+input) have ECP5 forms of their own here (:class:`BlockROM`; ``pipe.WideProduct``) with the
 same generic form, so gen/flow/resources.py counts them as before. Each unit's ``latency``
 is the sum of its stages (the class docstrings list them); the tables' addresses depend on
 the previous table's output within the pixel, which makes the setup deep, not slow.
 """
 
 import numpy as np
-from amaranth.hdl import Cat, Elaboratable, Module, Mux, Signal, Value, ValueCastable, unsigned
+from amaranth.hdl import Cat, Module, Mux, Signal, Value, ValueCastable, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
-from bumprtl.rtl.pipe import (DP16KD_MODES, PRODUCT_LATENCY, ROM_LATENCY, PipeUnit, RegisteredProduct,
-                             RegisteredROM, dp16kd_rom_block)
+from bumprtl.rtl.pipe import (DP16KD_MODES, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
+                             PipeUnit, RegisteredROM, dp16kd_rom_block)
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
@@ -62,8 +62,7 @@ from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_ma
                      lee_reciprocal_bits, lee_reciprocal_table, quarter_sine)
 
 __all__ = ["LeeRotation", "LeeIllumination", "rotated_layout", "BlockROM", "block_rom", "rom_read",
-           "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value", "WideProduct",
-           "WIDE_PRODUCT_LATENCY", "wide_multiply",
+           "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value",
            "below_horizon", "quarter_address", "ratio_index", "asin_address", "prop_address",
            "phi_quadrant",
            "magnitude", "prop_term", "theta_from_prop"]
@@ -173,7 +172,7 @@ def rotated_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-# --- ECP5 forms of the tables and products RegisteredROM / RegisteredProduct leave to Yosys --
+# --- ECP5 form of the tables RegisteredROM leaves to Yosys ------------------------------------
 
 class BlockROM(RegisteredROM):
     """A :class:`pipe.RegisteredROM`: the same read ports, ROM_LATENCY, and the same generic
@@ -188,7 +187,8 @@ class BlockROM(RegisteredROM):
     def elaborate(self, platform):
         target = self.target
         mode = next((md for md in DP16KD_MODES if md[1] >= self.depth - 1), None)
-        if getattr(target, "bram", None) != "DP16KD" or self._fits(target) or mode is None:
+        if (getattr(target, "bram", None) != "DP16KD" or self.mode(target) is not None
+                or mode is None):
             return super().elaborate(platform)
         m = Module()
         bits, words, shift = mode
@@ -222,57 +222,6 @@ def block_rom(pipe, init, shape, name, ports):
     rom = pipe.memory(name, BlockROM(init, shape, ports, name, target=pipe.target))
     pipe.m.d.comb += rom.en.eq(pipe.adv)
     return rom
-
-
-# Stages of a WideProduct: a RegisteredProduct, then one more register.
-WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 1
-
-
-class WideProduct(Elaboratable):
-    """``p = a * b`` WIDE_PRODUCT_LATENCY ``en`` cycles after ``a``/``b``, for a ``b`` wider than
-    one DSP input. Generic form: a :class:`pipe.RegisteredProduct`, then a register (one
-    product in the counts). ECP5 form (``target`` with a MULT18X18D and ``a`` fitting one
-    input): ``b`` in 17-bit limbs, one RegisteredProduct per limb (a MULT18X18D with its
-    input and output registers), their shifted sum in the register; Yosys would otherwise
-    build the product from DSP blocks without their registers and a carry chain, all in
-    one cycle."""
-
-    def __init__(self, a_shape, b_shape, name, target=None):
-        self.target = target
-        self.a = Signal(a_shape, name=f"{name}_a")
-        self.b = Signal(b_shape, name=f"{name}_b")
-        self.en = Signal(name=f"{name}_en")
-        self.p = Signal((self.a * self.b).shape(), name=name)
-
-    def elaborate(self, platform):
-        m = Module()
-        a, b = self.a.shape(), self.b.shape()
-        width = getattr(self.target, "dsp_width", None)
-        if getattr(self.target, "dsp", None) == "MULT18X18D" and a.width + (not a.signed) <= width:
-            step = width - 1
-            limbs = [(lo, self.b[lo:lo + step]) for lo in range(0, b.width, step)]
-            if b.signed:                                   # the top limb keeps b's sign
-                limbs[-1] = (limbs[-1][0], limbs[-1][1].as_signed())
-        else:
-            limbs = [(0, self.b)]
-        terms = []
-        for n, (lo, limb) in enumerate(limbs):
-            unit = RegisteredProduct(a, limb.shape(), f"limb{n}", target=self.target)
-            m.submodules[f"limb{n}"] = unit
-            m.d.comb += [unit.a.eq(self.a), unit.b.eq(limb), unit.en.eq(self.en)]
-            terms.append(unit.p if lo == 0 else unit.p << lo)
-        with m.If(self.en):
-            m.d.sync += self.p.eq(sum(terms[1:], terms[0]))
-        return m
-
-
-def wide_multiply(pipe, a, b, name):
-    """``a * b`` WIDE_PRODUCT_LATENCY ``adv`` stages later (:class:`WideProduct`)."""
-    a, b = Value.cast(a), Value.cast(b)
-    unit = WideProduct(a.shape(), b.shape(), name, target=pipe.target)
-    pipe.m.submodules[name] = unit
-    pipe.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(pipe.adv)]
-    return unit.p
 
 
 def sine_rom(pipe, cfg: Config, name, ports):
@@ -322,7 +271,7 @@ class LeeRotation(PipeUnit):
     Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Every table read is a
     :class:`BlockROM` (DP16KD blocks with their output registers on ECP5) behind an address
     register, every product registered (``pipe.multiply``; the two by a reciprocal, wider
-    than a DSP input, :func:`wide_multiply`), and at most one carry chain or half a mux
+    than a DSP input, ``StallPipe.wide_multiply``), and at most one carry chain or half a mux
     chain lies between two registers. Per vector, in ``adv`` stages
     (S = SINE_STAGES, R = ROM_STAGES, P = PRODUCT_LATENCY, W = WIDE_PRODUCT_LATENCY):
 
@@ -391,8 +340,8 @@ class LeeRotation(PipeUnit):
         inv_cos = rom_read(pipe, f"{v}_inv_cos_rom", inv, width,
                        quarter_address(z + (1 << k), cfg))                 # S + 5 + 2R
         ay2 = delay(abs(y2), 4 + 2 * R, f"{v}_abs_y2")
-        ratio = wide_multiply(pipe, ay2, inv_sin, f"{v}_ratio") >> (2 * b + 1 - k)
-        product = wide_multiply(pipe, ay2, inv_cos, f"{v}_yk_product")    # S + 5 + 2R + W
+        ratio = pipe.wide_multiply(ay2, inv_sin, f"{v}_ratio") >> (2 * b + 1 - k)
+        product = pipe.wide_multiply(ay2, inv_cos, f"{v}_yk_product")    # S + 5 + 2R + W
         atan = rom_read(pipe, f"{v}_atan_rom", lee_atan_table(cfg), k + 1,
                     ratio_index(ratio, cfg, stage))
         prop = rom_read(pipe, f"{v}_prop_rom", lee_prop_table(cfg), b + 1,

@@ -15,9 +15,9 @@ from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory, ReadPort
 from amaranth.lib.wiring import In, Out
 
-__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "RegisteredROM", "RegisteredRAM", "read_port",
-           "dp16kd_rom_block",
-           "PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
+__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
+           "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp",
+           "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2
@@ -56,14 +56,11 @@ class RegisteredProduct(Elaboratable):
         self.en = Signal(name=f"{name}_en")
         self.p = Signal((self.a * self.b).shape(), name=name)
 
-    def _fits(self, width):
-        """Each operand as a signed 18-bit DSP input (an unsigned one needs a zero bit)."""
-        return all(s.width + (not s.signed) <= width for s in (self.a.shape(), self.b.shape()))
-
     def elaborate(self, platform):
         m = Module()
         target = self.target
-        if getattr(target, "dsp", None) == "MULT18X18D" and self._fits(target.dsp_width):
+        if getattr(target, "dsp", None) == "MULT18X18D" and fits_dsp(self.a.shape(), self.b.shape(),
+                                                                     width=target.dsp_width):
             a, b, p = Signal(signed(18)), Signal(signed(18)), Signal(signed(36))
             m.d.comb += [a.eq(self.a), b.eq(self.b), self.p.eq(p)]       # sign/zero-extend
             ports = {f"i_A{n}": a[n] for n in range(18)}
@@ -85,6 +82,63 @@ class RegisteredProduct(Elaboratable):
             if b is not self.b:
                 m.d.sync += b.eq(self.b)
         return m
+
+
+# Stages of a WideProduct: a RegisteredProduct, then one more register.
+WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 1
+
+
+def _limbs(value, step):
+    """(shift, limb) pairs of ``value`` in ``step``-bit limbs, low first: every limb unsigned
+    but the top one of a signed value, which keeps the sign (sum of limb << shift = value)."""
+    shape = value.shape()
+    limbs = [(lo, value[lo:lo + step]) for lo in range(0, shape.width, step)]
+    if shape.signed:
+        limbs[-1] = (limbs[-1][0], limbs[-1][1].as_signed())
+    return limbs
+
+
+class WideProduct(Elaboratable):
+    """``p = a * b`` WIDE_PRODUCT_LATENCY ``en`` cycles after ``a``/``b``, for operands wider
+    than one DSP input. Generic form: a :class:`RegisteredProduct`, then a register (one
+    product in the counts of gen/flow/resources.py). ECP5 form (``target`` with a
+    MULT18X18D): each operand wider than a DSP input in 17-bit limbs (unsigned, the top limb
+    of a signed operand signed), one RegisteredProduct per pair of limbs (a MULT18X18D with
+    its input and output registers), their shifted sum in the register: exact, since
+    a b = sum_ij a_i b_j 2**(s_i + s_j). Yosys would otherwise build the product from DSP
+    blocks without their registers and a carry chain, all in one cycle."""
+
+    def __init__(self, a_shape, b_shape, name, target=None):
+        self.target = target
+        self.a = Signal(a_shape, name=f"{name}_a")
+        self.b = Signal(b_shape, name=f"{name}_b")
+        self.en = Signal(name=f"{name}_en")
+        self.p = Signal((self.a * self.b).shape(), name=name)
+
+    def elaborate(self, platform):
+        m = Module()
+        width = getattr(self.target, "dsp_width", None)
+        if getattr(self.target, "dsp", None) == "MULT18X18D":
+            split = [[(0, v)] if v.shape().width + (not v.shape().signed) <= width
+                     else _limbs(v, width - 1) for v in (self.a, self.b)]
+        else:
+            split = [[(0, self.a)], [(0, self.b)]]
+        terms = []
+        for (lo_a, limb_a) in split[0]:
+            for (lo_b, limb_b) in split[1]:
+                name = f"limb{len(terms)}"
+                unit = RegisteredProduct(limb_a.shape(), limb_b.shape(), name, target=self.target)
+                m.submodules[name] = unit
+                m.d.comb += [unit.a.eq(limb_a), unit.b.eq(limb_b), unit.en.eq(self.en)]
+                terms.append(unit.p << (lo_a + lo_b))
+        with m.If(self.en):
+            m.d.sync += self.p.eq(sum(terms[1:], terms[0]))
+        return m
+
+
+def fits_dsp(*shapes, width=ECP5.dsp_width):
+    """Every shape is one signed ``width``-bit DSP input (an unsigned one needs a zero bit)."""
+    return all(Shape.cast(s).width + (not Shape.cast(s).signed) <= width for s in shapes)
 
 
 def read_port(addr_bits, shape, name):
@@ -137,14 +191,12 @@ class RegisteredROM(Elaboratable):
             return None
         return mode
 
-    def _fits(self, target):
-        return self.mode(target) is not None
-
     def elaborate(self, platform):
         m = Module()
         target = self.target
-        if getattr(target, "bram", None) == "DP16KD" and self._fits(target):
-            self._dp16kd(m, *self.mode(target))
+        mode = self.mode(target) if getattr(target, "bram", None) == "DP16KD" else None
+        if mode is not None:
+            self._dp16kd(m, *mode)
             return m
         m.submodules.mem = mem = Memory(shape=self.shape, depth=len(self.init), init=self.init)
         for port in self.ports:
@@ -390,6 +442,14 @@ class StallPipe:
         self.m.d.comb += [unit.a.eq(a), unit.en.eq(self.adv)]
         if const is None:
             self.m.d.comb += unit.b.eq(b)
+        return unit.p
+
+    def wide_multiply(self, a, b, name):
+        """``a * b`` WIDE_PRODUCT_LATENCY ``adv`` stages later (:class:`WideProduct`)."""
+        a, b = Value.cast(a), Value.cast(b)
+        unit = WideProduct(a.shape(), b.shape(), name, target=self.target)
+        self.m.submodules[name] = unit
+        self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.adv)]
         return unit.p
 
     def delay(self, value, stages, name):

@@ -15,8 +15,7 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.lee import (WIDE_PRODUCT_LATENCY, BlockROM, LeeIllumination, LeeRotation,
-                             WideProduct, ratio_index)
+from bumprtl.rtl.lee import BlockROM, LeeIllumination, LeeRotation, ratio_index
 from bumprtl.rtl.pipe import ROM_LATENCY
 from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
@@ -168,22 +167,6 @@ def test_block_rom_ecp5_form(depth, width, ports, build_dir):
         filled = [c for c in range(n) if want[c] is not None]
         for form in forms:
             assert [form[f"rom_p{i}_data"][c] for c in filled] == [want[c] for c in filled]
-
-
-def test_wide_product_ecp5_form(build_dir):
-    """|y2| x 1/|sin Z| (16 x 23 bits): two MULT18X18D limbs and their sum equal the product,
-    WIDE_PRODUCT_LATENCY enabled clocks later, in both forms."""
-    rng = np.random.default_rng(7)
-    n = 400
-    a, b = rng.integers(0, 1 << 16, n), rng.integers(0, 1 << 23, n)
-    en = (rng.random(n) < 0.8).astype(int)
-    forms = ecp5_lockstep(lambda t: WideProduct(unsigned(16), unsigned(23), "prod", target=t),
-                          {"prod_a": (16, a), "prod_b": (23, b), "prod_en": (1, en)},
-                          {"prod": 39}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
-    want = enabled_delay([int(x) * int(y) for x, y in zip(a, b)], en, WIDE_PRODUCT_LATENCY - 1)
-    filled = [c for c in range(n) if want[c] is not None]
-    for form in forms:
-        assert [form["prod"][c] for c in filled] == [want[c] for c in filled]
 
 
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------

@@ -12,7 +12,7 @@ import subprocess
 import numpy as np
 import pytest
 from amaranth.back import verilog
-from amaranth.hdl import Fragment, Instance, Module, signed, unsigned
+from amaranth.hdl import Fragment, Instance, Module, Signal, signed, unsigned
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
@@ -21,13 +21,15 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
+from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
+                              RegisteredProduct, RegisteredROM, WideProduct)
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.texture import TextureBlend
+from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -190,6 +192,44 @@ def test_ecp5_forms_only_where_the_block_fits():
     assert len(_instances(RegisteredROM(range(2048), unsigned(36), 2, "r", target=ECP5()))) == 4
     assert not _instances(RegisteredROM(range(2048), unsigned(37), 2, "r", target=ECP5()))
 
+
+
+@pytest.mark.parametrize("a_shape, b_shape, dsps", [
+    (unsigned(16), unsigned(23), 2),     # lee: |y2| x 1/|sin Z|, b in two limbs
+    (signed(21), signed(19), 4),         # exact illumination at B = 16: n''x4 x p2, both split
+    (signed(19), unsigned(12), 2),       # only a split (a signed top limb)
+    (signed(18), signed(16), 1),         # fits: one block
+])
+def test_wide_product_is_the_product_in_both_forms(a_shape, b_shape, dsps, build_dir):
+    """WideProduct = a * b WIDE_PRODUCT_LATENCY enabled clocks later, in the generic form and
+    the ECP5 form (MULT18X18D limbs and their shifted sum, one block per pair of limbs), on
+    random operands and the corners (most negative, largest)."""
+    rng = np.random.default_rng(7)
+    n = 400
+
+    def draw(shape):
+        lo, hi = (-(1 << shape.width - 1), 1 << shape.width - 1) if shape.signed else (0, 1 << shape.width)
+        return np.concatenate([[lo, hi - 1, lo, hi - 1], rng.integers(lo, hi, n - 4)])
+    a, b = draw(a_shape), draw(b_shape)
+    b[:4] = b[[0, 1, 1, 0]]
+    en = (rng.random(n) < 0.8).astype(int)
+    en[:6] = 1
+    width = (Signal(a_shape) * Signal(b_shape)).shape().width
+    mask = lambda x, w: int(x) & ((1 << w) - 1)
+    forms = ecp5_lockstep(lambda t: WideProduct(a_shape, b_shape, "prod", target=t),
+                          {"prod_a": (a_shape.width, [mask(x, a_shape.width) for x in a]),
+                           "prod_b": (b_shape.width, [mask(x, b_shape.width) for x in b]),
+                           "prod_en": (1, en)},
+                          {"prod": width}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
+    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b)], en,
+                         WIDE_PRODUCT_LATENCY - 1)
+    filled = [c for c in range(n) if want[c] is not None]
+    assert len(filled) > n // 2
+    for form in forms:
+        assert [form["prod"][c] for c in filled] == [want[c] for c in filled]
+    found = _instances(WideProduct(a_shape, b_shape, "prod", target=ECP5()))
+    assert [i.type for i in found] == ["MULT18X18D"] * dsps
+    assert not _instances(WideProduct(a_shape, b_shape, "prod"))
 
 
 # --- the stall rule as a throughput property ---------------------------------------------------
