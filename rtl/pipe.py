@@ -16,8 +16,8 @@ from amaranth.lib.memory import Memory, ReadPort
 from amaranth.lib.wiring import In, Out
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
-           "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp",
-           "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
+           "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "limb_products",
+           "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2
@@ -45,7 +45,11 @@ class RegisteredProduct(Elaboratable):
     """``p = a * b`` two ``en`` cycles after ``a``/``b`` (operand registers, product
     register): exactly the registers of an ECP5 MULT18X18D with REG_INPUTA/B and
     REG_OUTPUT, so on ECP5 (``target`` :class:`ECP5`) the whole product is one DSP block
-    and the generic form (plain ``*`` between flip-flops) is what every simulator runs."""
+    and the generic form (plain ``*`` between flip-flops) is what every simulator runs.
+    Operands wider than one DSP input (not a constant) are split on ECP5 as in
+    :class:`WideProduct`, one registered block per pair of limbs, but the limbs' shifted sum
+    is left to the cycle that reads ``p`` (the latency stays PRODUCT_LATENCY; a unit that can
+    spend a stage takes WideProduct instead)."""
 
     def __init__(self, a_shape, b_shape, name, b_const=None, target=None):
         """``b_const``: ``b`` is this constant (no operand register; a constant multiply
@@ -74,6 +78,10 @@ class RegisteredProduct(Elaboratable):
                 i_SIGNEDA=Const(1, 1), i_SIGNEDB=Const(1, 1), i_SOURCEA=Const(0, 1),
                 i_SOURCEB=Const(0, 1), i_CLK0=ClockSignal(), i_CE0=self.en, i_RST0=Const(0, 1),
                 **ports)
+            return m
+        if getattr(target, "dsp", None) == "MULT18X18D" and not isinstance(self.b, Const):
+            terms = limb_products(m, self.a, self.b, self.en, target)
+            m.d.comb += self.p.eq(sum(terms[1:], terms[0]))
             return m
         a = Signal.like(self.a, name="a_r")
         b = self.b if isinstance(self.b, Const) else Signal.like(self.b, name="b_r")
@@ -117,23 +125,32 @@ class WideProduct(Elaboratable):
 
     def elaborate(self, platform):
         m = Module()
-        width = getattr(self.target, "dsp_width", None)
-        if getattr(self.target, "dsp", None) == "MULT18X18D":
-            split = [[(0, v)] if v.shape().width + (not v.shape().signed) <= width
-                     else _limbs(v, width - 1) for v in (self.a, self.b)]
-        else:
-            split = [[(0, self.a)], [(0, self.b)]]
-        terms = []
-        for (lo_a, limb_a) in split[0]:
-            for (lo_b, limb_b) in split[1]:
-                name = f"limb{len(terms)}"
-                unit = RegisteredProduct(limb_a.shape(), limb_b.shape(), name, target=self.target)
-                m.submodules[name] = unit
-                m.d.comb += [unit.a.eq(limb_a), unit.b.eq(limb_b), unit.en.eq(self.en)]
-                terms.append(unit.p << (lo_a + lo_b))
+        terms = limb_products(m, self.a, self.b, self.en, self.target)
         with m.If(self.en):
             m.d.sync += self.p.eq(sum(terms[1:], terms[0]))
         return m
+
+
+def limb_products(m, a, b, en, target):
+    """The partial products of ``a * b`` as submodules of ``m``, each a RegisteredProduct
+    enabled by ``en`` and shifted into place (their sum is the product): on a ``target`` with
+    a MULT18X18D every operand wider than one DSP input in 17-bit limbs (:func:`_limbs`),
+    one block per pair of limbs; elsewhere the one product."""
+    width = getattr(target, "dsp_width", None)
+    if getattr(target, "dsp", None) == "MULT18X18D":
+        split = [[(0, v)] if fits_dsp(v.shape(), width=width) else _limbs(v, width - 1)
+                 for v in (a, b)]
+    else:
+        split = [[(0, a)], [(0, b)]]
+    terms = []
+    for lo_a, limb_a in split[0]:
+        for lo_b, limb_b in split[1]:
+            name = f"limb{len(terms)}"
+            unit = RegisteredProduct(limb_a.shape(), limb_b.shape(), name, target=target)
+            m.submodules[name] = unit
+            m.d.comb += [unit.a.eq(limb_a), unit.b.eq(limb_b), unit.en.eq(en)]
+            terms.append(unit.p << (lo_a + lo_b))
+    return terms
 
 
 def fits_dsp(*shapes, width=ECP5.dsp_width):
@@ -497,3 +514,57 @@ class PipeUnit(wiring.Component):
         self.build(m, pipe)
         self.memories = pipe.memories
         return m
+
+
+# Entries of the output buffer of :func:`lockstep_buffer`. ``run`` is registered and falls
+# the cycle after the buffer fills. Two entries keep the pipe running through a one-cycle
+# stall of the consumer and in the cycle a waiting pixel is taken; with one (``run`` = empty)
+# every stall would also stop the input for a cycle, which only a full pipe (no input gaps)
+# does not notice.
+BUFFER_DEPTH = 2
+
+
+def lockstep_buffer(m, units, last, i, o):
+    """Units chained in lock step on a registered enable, with an output buffer: the stall
+    rule of a chain of units (``BumpPipeline``, the placed rotation -> illumination pipe of
+    gen/flow/fpga.py) without a chain of ``o.valid`` terms across them.
+
+    ``units``: name -> unit (a unit with a ``lockstep`` attribute, run as a
+    :class:`StallPipe` in lock-step mode); ``last``: the stream out of the last unit; ``i``,
+    ``o``: the chain's own streams (``i`` flipped). Every unit is given its own copy of the
+    registered enable ``run`` (as ``lockstep`` and as its ``o.ready``: a pixel leaves a unit
+    whenever the chain runs), so no one flip-flop drives every register of the chain. The
+    last unit feeds a :data:`BUFFER_DEPTH`-entry buffer, bypassed while empty (the latency
+    is the units'). ``i.ready`` = ``run`` = (at most one pixel in the buffer): high whenever
+    ``o.valid`` is low, never a function of ``o.ready`` in the same cycle. The caller feeds
+    the first unit's ``i.valid`` from ``i.valid`` and chains the units' valid and payload.
+    Returns ``{count, entries (oldest first), runs}`` (``runs``: the copies by unit name,
+    ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by sim/formal's lemmas."""
+    count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
+    entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
+    runs = {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
+            for name in ("pipeline", *units)}
+    run = runs["pipeline"]
+    for name, unit in units.items():
+        unit.lockstep = runs[name]
+        m.d.comb += unit.o.ready.eq(runs[name])
+    held = count != 0
+    taken = o.valid & o.ready
+    m.d.comb += [i.ready.eq(run), o.valid.eq(held | last.valid),
+                 o.payload.eq(Mux(held, entries[0], last.payload))]       # bypass when empty
+    # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
+    # last unit with its own value (all copies are equal): the copies' next states differ in
+    # form, so synthesis keeps one register per unit.
+    for copy in runs.values():
+        m.d.sync += copy.eq(count + (last.valid & copy) < BUFFER_DEPTH + taken)
+    left = last.valid & run                      # the pixel in the last stage moves on
+    m.d.sync += count.eq(count + left - taken)
+    pop = held & o.ready
+    with m.If(pop):
+        m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(BUFFER_DEPTH - 1)]
+    slot = Signal.like(count, name="out_slot")   # the first free entry after the pop
+    m.d.comb += slot.eq(count - pop)
+    for n in range(BUFFER_DEPTH):                # kept unless taken directly (count stays 0)
+        with m.If(left & (slot == n if n else ~slot.any())):
+            m.d.sync += entries[n].eq(last.payload)
+    return {"count": count, "entries": entries, "runs": runs}

@@ -17,10 +17,10 @@ texel coordinates + world N, L, H in; shaded pixels out. Only what the scene nee
   the shape of Tarini et al.'s eq. 2), which also sums the lights; palette shading blends it
   in PaletteLUT's eq. 2 as the base colour. Without a texture none of this is built.
 
-Lock step and the output buffer: every unit runs in lock-step mode (rtl/pipe.StallPipe
-``enable``): all of them shift on one registered enable ``run``, bubbles included, so the
-units form one shift register and no unit's ``o.valid`` reaches another unit's clock
-enables. Each unit gets its own copy of the ``run`` register (same next state, so each
+Lock step and the output buffer (rtl/pipe.lockstep_buffer): every unit runs in lock-step
+mode (rtl/pipe.StallPipe ``enable``): all of them shift on one registered enable ``run``,
+bubbles included, so the units form one shift register and no unit's ``o.valid``
+reaches another unit's clock enables. Each unit gets its own copy of the ``run`` register (same next state, so each
 copy drives the clock enables of one unit only). Behind the last unit sits a 2-entry
 output buffer: ``run`` = the buffer holds at most one pixel, a function of registers
 only; ``i.ready`` = ``run``. With the buffer empty the output is the last unit's output
@@ -43,14 +43,14 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
                                  shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipe import BUFFER_DEPTH, StallPipe, lockstep_buffer
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
 
-__all__ = ["BumpPipeline", "VectorTerms", "LightSum"]
+__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "BUFFER_DEPTH"]
 
 
 def _vector_layout(cfg):
@@ -149,13 +149,6 @@ def _lockstep(m, src, dsts):
 def _feed(m, src, dst):
     """``src`` into ``dst`` of the next layer: valid and payload (both run on the enable)."""
     m.d.comb += [dst.valid.eq(src.valid), dst.payload.eq(src.payload)]
-
-
-# Entries of the output buffer. ``run`` is registered and falls the cycle after the buffer
-# fills. Two entries keep the pipe running through a one-cycle stall of the consumer and in
-# the cycle a waiting pixel is taken; with one (``run`` = empty) every stall would also stop
-# the input for a cycle, which only a full pipe (no input gaps) does not notice.
-BUFFER_DEPTH = 2
 
 
 class BumpPipeline(wiring.Component):
@@ -390,38 +383,9 @@ class BumpPipeline(wiring.Component):
         return m
 
     def _output_buffer(self, m):
-        """``run`` (one copy per unit), the lock-step enables, and the output buffer behind
-        the last unit (module docstring). Drives ``i.ready``, ``o``, every unit's
-        ``o.ready`` (its enable: a pixel leaves a unit whenever the pipe runs)."""
-        last, o = self.units[self._last].o, self.o
-        count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
-        entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
-        runs = {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
-                for name in ("pipeline", *self.units)}
-        run = runs["pipeline"]
-        for name, unit in self.units.items():
-            unit.lockstep = runs[name]
-            m.d.comb += unit.o.ready.eq(runs[name])
-        held = count != 0
-        taken = o.valid & o.ready
-        m.d.comb += [self.i.ready.eq(run), o.valid.eq(held | last.valid),
-                     o.payload.eq(Mux(held, entries[0], last.payload))]       # bypass when empty
-        # Next run = (the buffer not full next cycle). Each copy counts the pixel
-        # leaving the last unit with its own value (all copies are equal): the copies' next
-        # states differ in form, so synthesis keeps one register per unit.
-        for copy in runs.values():
-            m.d.sync += copy.eq(count + (last.valid & copy) < BUFFER_DEPTH + taken)
-        left = last.valid & run                  # the pixel in the last stage moves on
-        m.d.sync += count.eq(count + left - taken)
-        pop = held & o.ready
-        with m.If(pop):
-            m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(BUFFER_DEPTH - 1)]
-        slot = Signal.like(count, name="out_slot")   # the first free entry after the pop
-        m.d.comb += slot.eq(count - pop)
-        for n in range(BUFFER_DEPTH):            # kept unless taken directly (count stays 0)
-            with m.If(left & (slot == n if n else ~slot.any())):
-                m.d.sync += entries[n].eq(last.payload)
-        self.buffer = {"count": count, "entries": entries, "runs": runs}
+        """``run`` (one copy per unit), the lock-step enables and the output buffer behind
+        the last unit (``pipe.lockstep_buffer``)."""
+        self.buffer = lockstep_buffer(m, self.units, self.units[self._last].o, self.i, self.o)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg

@@ -24,7 +24,7 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.methods import METHODS
-from bumprtl.rtl.pipe import ECP5
+from bumprtl.rtl.pipe import ECP5, lockstep_buffer
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
@@ -120,22 +120,28 @@ def fpga_unit(name, cfg, device, work_dir, lpf=LPF):
 
 def pipeline_component(cfg, target=None):
     """The rotation unit feeding the illumination unit of ``cfg.method`` (one stream in,
-    one out, 1 pixel per clock): what a scene with one light pays per pixel. ``target``:
-    None (generic) or ``ECP5()`` (:func:`place_component`)."""
+    one out, 1 pixel per clock): what a scene with one light pays per pixel. The two units
+    run in lock step behind an output buffer (``rtl.pipe.lockstep_buffer``, as in a scene's
+    ``BumpPipeline``), so no stall enable is a chain of ``o.valid`` terms across them.
+    ``target``: None (generic) or ``ECP5()`` (:func:`place_component`)."""
     class Pipeline(wiring.Component):
         def __init__(self):
             self.target = target
             self.rotation = VectorRotation(cfg, target)
             self.illumination = Illumination(cfg, target)
+            self.latency = self.rotation.latency + self.illumination.latency
             super().__init__({"i": In(self.rotation.i.signature.flip()),
                               "o": Out(self.illumination.o.signature)})
 
         def elaborate(self, platform):
             m = Module()
+            units = {"rotation": self.rotation, "illumination": self.illumination}
+            self.buffer = lockstep_buffer(m, units, self.illumination.o, self.i, self.o)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
-            wiring.connect(m, wiring.flipped(self.i), self.rotation.i)
-            wiring.connect(m, self.rotation.o, self.illumination.i)
-            wiring.connect(m, self.illumination.o, wiring.flipped(self.o))
+            m.d.comb += [self.rotation.i.valid.eq(self.i.valid),
+                         self.rotation.i.payload.eq(self.i.payload),
+                         self.illumination.i.valid.eq(self.rotation.o.valid),
+                         self.illumination.i.payload.eq(self.rotation.o.payload)]
             return m
 
     return Pipeline()

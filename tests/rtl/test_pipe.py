@@ -176,12 +176,13 @@ def test_ecp5_product_uses_the_dsp_registers():
 
 
 def test_ecp5_forms_only_where_the_block_fits():
-    """Operands wider than 18 bits (signed), tables of up to 1025 words wider than 18 bits and
-    deeper tables that need more than ROM_MAX_BLOCKS blocks keep the generic form (Yosys then
-    splits them as before)."""
-    assert not _instances(RegisteredProduct(signed(19), signed(4), "p", target=ECP5()))
-    assert not _instances(RegisteredProduct(unsigned(18), signed(4), "p", target=ECP5()))
+    """Operands wider than 18 bits (signed) are split into one block per pair of limbs, except
+    by a constant; tables of up to 1025 words wider than 18 bits and deeper tables that need
+    more than ROM_MAX_BLOCKS blocks keep the generic form (Yosys then splits them)."""
+    assert len(_instances(RegisteredProduct(signed(19), signed(4), "p", target=ECP5()))) == 2
+    assert len(_instances(RegisteredProduct(unsigned(18), signed(4), "p", target=ECP5()))) == 2
     assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p", target=ECP5()))) == 1
+    assert not _instances(RegisteredProduct(signed(19), signed(4), "p", b_const=5, target=ECP5()))
     # 1025 words with word 0 != 0: no spill word, two x9 blocks
     assert len(_instances(RegisteredROM(range(1, 1026), unsigned(12), 2, "r", target=ECP5()))) == 2
     assert not _instances(RegisteredROM(range(16), unsigned(19), 2, "r", target=ECP5()))
@@ -200,10 +201,14 @@ def test_ecp5_forms_only_where_the_block_fits():
     (signed(19), unsigned(12), 2),       # only a split (a signed top limb)
     (signed(18), signed(16), 1),         # fits: one block
 ])
-def test_wide_product_is_the_product_in_both_forms(a_shape, b_shape, dsps, build_dir):
-    """WideProduct = a * b WIDE_PRODUCT_LATENCY enabled clocks later, in the generic form and
-    the ECP5 form (MULT18X18D limbs and their shifted sum, one block per pair of limbs), on
-    random operands and the corners (most negative, largest)."""
+@pytest.mark.parametrize("unit, latency", [(WideProduct, WIDE_PRODUCT_LATENCY),
+                                           (RegisteredProduct, PRODUCT_LATENCY)])
+def test_wide_products_are_the_product_in_both_forms(unit, latency, a_shape, b_shape, dsps,
+                                                     build_dir):
+    """WideProduct = a * b WIDE_PRODUCT_LATENCY enabled clocks later, RegisteredProduct
+    PRODUCT_LATENCY later, in the generic form and the ECP5 form (MULT18X18D limbs and
+    their shifted sum, one block per pair of limbs), on random operands and the corners
+    (most negative, largest)."""
     rng = np.random.default_rng(7)
     n = 400
 
@@ -216,20 +221,19 @@ def test_wide_product_is_the_product_in_both_forms(a_shape, b_shape, dsps, build
     en[:6] = 1
     width = (Signal(a_shape) * Signal(b_shape)).shape().width
     mask = lambda x, w: int(x) & ((1 << w) - 1)
-    forms = ecp5_lockstep(lambda t: WideProduct(a_shape, b_shape, "prod", target=t),
+    forms = ecp5_lockstep(lambda t: unit(a_shape, b_shape, "prod", target=t),
                           {"prod_a": (a_shape.width, [mask(x, a_shape.width) for x in a]),
                            "prod_b": (b_shape.width, [mask(x, b_shape.width) for x in b]),
                            "prod_en": (1, en)},
                           {"prod": width}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
-    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b)], en,
-                         WIDE_PRODUCT_LATENCY - 1)
+    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b)], en, latency - 1)
     filled = [c for c in range(n) if want[c] is not None]
     assert len(filled) > n // 2
     for form in forms:
         assert [form["prod"][c] for c in filled] == [want[c] for c in filled]
-    found = _instances(WideProduct(a_shape, b_shape, "prod", target=ECP5()))
+    found = _instances(unit(a_shape, b_shape, "prod", target=ECP5()))
     assert [i.type for i in found] == ["MULT18X18D"] * dsps
-    assert not _instances(WideProduct(a_shape, b_shape, "prod"))
+    assert not _instances(unit(a_shape, b_shape, "prod"))
 
 
 # --- the stall rule as a throughput property ---------------------------------------------------

@@ -1,13 +1,17 @@
 """The ECP5 flow: one small unit in make test, every design behind `make fpga`."""
 
+import numpy as np
 import pytest
+from amaranth.sim import Simulator
 
 from bumprtl.gen.flow import fpga
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import PER_PIXEL
-from bumprtl.rtl.pipe import ECP5
+from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.rtl.pipe import BUFFER_DEPTH, ECP5
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
 
 
 def test_sincos_places_on_the_smallest_device(build_dir):
@@ -114,3 +118,41 @@ def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
     assert "| exact_pipeline | 1 | 2 | 0 | 0 | 102.0 |" in text          # min over seeds 2, 3
     assert "| exact_setup | not placed: nextpnr-ecp5 failed (status 1): ERROR: no room |" in text
     assert "--seeds 3,2" in text and "a -> b seed 2" in text
+
+
+@pytest.mark.parametrize("method", ["exact", "lee"])
+def test_placed_pipeline_runs_in_lock_step_bit_exact(method):
+    """pipeline_component (the rotation -> illumination pipe report fpga places): bit-exact
+    with the golden datapath under input gaps and backpressure, i.ready high whenever
+    o.valid is low and never a function of o.ready in the cycle, and with o.ready held low
+    it takes exactly latency + BUFFER_DEPTH pixels (the lock-step buffer)."""
+    cfg = TINY.replace(method=method)
+    codes = random_codes(300, cfg, np.random.default_rng(3))
+    inputs = as_payloads(codes, cfg)
+    dut = fpga.pipeline_component(cfg)
+    out, _ = simulate_stream(dut, inputs, "both", seed=5)
+    want = datapath_fixed(codes, cfg)
+    assert_bit_exact(out, want, inputs)
+    assert dut.buffer["runs"].keys() == {"pipeline", "rotation", "illumination"}
+    dut = fpga.pipeline_component(cfg)
+    taken, seen = 0, []
+
+    async def bench(ctx):
+        nonlocal taken
+        for cycle in range(dut.latency + 10):
+            ctx.set(dut.i.valid, 1)
+            ctx.set(dut.o.ready, 0)
+            ready0 = ctx.get(dut.i.ready)
+            ctx.set(dut.o.ready, 1)                 # the same cycle: i.ready must not change
+            ready1 = ctx.get(dut.i.ready)
+            ctx.set(dut.o.ready, 0)
+            seen.append((ready0, ready1, ctx.get(dut.o.valid)))
+            taken += ready0
+            await ctx.tick()
+    sim = Simulator(dut)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    assert all(r0 == r1 for r0, r1, _ in seen)
+    assert all(r0 for r0, _, valid in seen if not valid)
+    assert taken == dut.latency + BUFFER_DEPTH
