@@ -55,13 +55,13 @@ class Config:
     Parameters
     ----------
     angle_bits : int
-        Binary-angle width ``k + 2`` (full circle = ``2**angle_bits``); 4 to 16.
+        Binary-angle width ``k + 2`` (full circle = ``2**angle_bits``); 4 to 16. The default,
+        13, is the coarsest angle grid whose rounding keeps the specular term (n = 16) within
+        1 LSB of float64 on unquantized inputs (docs/fixed_point.md, ``bumprtl bench accuracy``).
     frac_bits : int
-        Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24. The defaults (12-bit
-        angles, B = 13) keep every product inside one ECP5 MULT18X18D; ``angle_bits=13,
-        frac_bits=16`` brings every output channel within 1 LSB of float64 end to end, the
-        input angle grid included, but its exact illumination products (21 x 19 bits) no longer
-        fit one DSP block (docs/fixed_point.md, docs/report.md).
+        Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24. The default, 16,
+        is the fewest that reach 1 LSB on every channel with 13-bit angles, and its
+        ``B + 2 = 18``-bit sin/cos values are one ECP5 DSP operand.
     method : str
         A name of the method registry (rtl/methods.py, :data:`METHOD_NAMES`): ``"exact"``
         (the exact angular method of docs/architecture.md), ``"lee"`` (Lee et al., errata
@@ -92,8 +92,8 @@ class Config:
         Whether PaletteLUT has the eq. 2 blend stage (Tarini Sec. 7.2) with a base-colour input.
     """
 
-    angle_bits: int = 12
-    frac_bits: int = 13
+    angle_bits: int = 13
+    frac_bits: int = 16
     method: str = "exact"
     tag_bits: int = 16
     out_bits: int = 8

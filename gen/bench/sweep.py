@@ -63,7 +63,7 @@ class Grid:
 
 GRIDS = {
     "quick": Grid((10, 12), (11, 13), (16, 256), 20_000, ("bricks",), 64),
-    "default": Grid((8, 10, 12, 14), (9, 11, 13, 16), (16, 64, 256, 1024, 4096, 16384),
+    "default": Grid((8, 10, 12, 13, 14), (9, 11, 13, 16), (16, 64, 256, 1024, 4096, 16384),
                     100_000, ("bricks", "wood", "globe"), 128),
 }
 # PER_PIXEL and BASELINES (Lee Table 1's designs as RTL, rtl/baselines/) come from the

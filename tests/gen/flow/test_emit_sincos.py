@@ -46,5 +46,5 @@ def test_cli_bad_input_is_one_line_and_exit_2(tmp_path):
     r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "sincos", "--frac-bits", "3",
                         "--out", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 2
-    assert "frac_bits" in r.stderr and "[9, 24]" in r.stderr
+    assert "frac_bits" in r.stderr and "[10, 24]" in r.stderr
     assert "Traceback" not in r.stderr

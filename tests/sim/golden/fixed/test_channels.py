@@ -44,15 +44,22 @@ def default_random():
     return cfg, worst(term_errors_lsb(exact_fixed, PixelInputs.random(100_000, np.random.default_rng(11)), cfg))
 
 
-def test_default_random_within_each_bound_and_1_lsb_in_diffuse_and_colour(default_random):
+def test_default_random_within_each_bound_and_1_lsb_on_every_channel(default_random):
     cfg, got = default_random
     bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
-    assert bounds == {"diffuse": 1, "specular": 4, "color": 2}
     for c in CHANNELS:
         assert got[c] <= bounds[c] <= 2 * got[c], (c, got, bounds)      # held, and tight
-    assert got["diffuse"] <= 1 and got["color"] <= 1
-    # the angle grid of 12-bit angles costs the default n = 16 a second LSB of specular
-    assert got["specular"] == 2
+    assert got == {"diffuse": 1, "specular": 1, "color": 1}, got
+
+
+def test_12_bit_angles_cost_the_specular_term_a_second_lsb():
+    """Why the default has 13-bit angles: on the 12-bit grid (B = 13) the arithmetic is within
+    1 LSB on every channel, but rounding the inputs to the grid moves cos^16 by up to 2.2
+    LSB (docs/fixed_point.md), so end to end the specular term misses 1 LSB."""
+    cfg = Config(angle_bits=12, frac_bits=13)
+    px = adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular")
+    assert worst(term_errors_lsb(exact_fixed, px, cfg))["specular"] >= 2
+    assert max(worst(grid_errors_lsb(exact_fixed, px, cfg)).values()) <= 1
 
 
 @pytest.mark.parametrize("exponent", [16, 1024])
@@ -60,8 +67,7 @@ def test_bounds_hold_and_are_tight(exponent):
     """Per channel: max over random, the adversarial searches aimed at the specular term and
     at the colour, and the dot-error search, <= bound and >= bound / 2. The arithmetic alone
     (float64 on the angles the hardware receives) is under the bound too, and at the default
-    n = 16 within 1 LSB on every channel: the specular term's further LSBs end to end are the
-    12-bit angle grid's."""
+    n = 16 both are within 1 LSB on every channel."""
     cfg = Config(spec_exponent=exponent)
     bounds = error_bounds(cfg)
     sets = [PixelInputs.random(50_000, np.random.default_rng(11)),
@@ -80,20 +86,21 @@ def test_bounds_hold_and_are_tight(exponent):
     assert all(arithmetic[c] <= bounds[c] for c in CHANNELS), (arithmetic, bounds)
     if exponent == 16:
         assert arithmetic == {"diffuse": 1, "specular": 1, "color": 1}, arithmetic
-        assert measured["specular"] >= 2, measured
+        assert measured == {"diffuse": 1, "specular": 1, "color": 1}, measured
 
 
-@pytest.mark.parametrize("exponent", [1, 2, 3])
+@pytest.mark.parametrize("exponent", [1, 4, 8])
 def test_small_exponents_reach_1_lsb_of_specular(exponent):
-    """At the default widths only n <= 3 keep the specular term within 1 LSB: the angle
-    grid alone moves a steeper cos^n by more (docs/fixed_point.md)."""
+    """At the default widths every n up to 16 keeps the specular term within 1 LSB (n = 16:
+    test_bounds_hold_and_are_tight); from n = 64 the angle grid and the dot product's
+    rounding times the slope of cos^n exceed it (docs/fixed_point.md)."""
     cfg = Config(spec_exponent=exponent)
     for px in (PixelInputs.random(50_000, np.random.default_rng(11)),
                adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular")):
         assert worst(term_errors_lsb(exact_fixed, px, cfg))["specular"] <= 1
 
 
-@pytest.mark.parametrize("exponent, frac_bits", [(1, 13), (16, 13), (64, 13), (1024, 13), (3, 9),
+@pytest.mark.parametrize("exponent, frac_bits", [(1, 13), (16, 13), (64, 13), (1024, 13), (3, 10),
                                                  (700, 16)])
 def test_specular_term_within_the_table_error_on_every_dot(exponent, frac_bits):
     """Every N'.H on the B-bit grid: the interpolated table against 255 x**n within
@@ -108,7 +115,7 @@ def test_specular_term_within_the_table_error_on_every_dot(exponent, frac_bits):
 def test_wide_exponent_still_emits_with_its_larger_bound():
     """Widths that cannot reach 1 LSB are not refused: the sidecar states the larger bound."""
     _, sidecar, _ = build_unit("illumination", Config(spec_exponent=1024))
-    assert sidecar["error_bounds_lsb"]["specular"] > 50 and sidecar["error_bound_lsb"] == 1
+    assert sidecar["error_bounds_lsb"]["specular"] > 10 and sidecar["error_bound_lsb"] == 1
 
 
 def two_lights(n, seed):
@@ -182,8 +189,8 @@ def test_multi_light_and_texture_sidecars_state_every_channel():
         scene = load_scene_config(spec)
         sidecar = build_unit("pipeline", scene)[1]
         assert sidecar["error_bounds_lsb"] == error_bounds(scene.config, lights, texture)
-    assert error_bounds(Config(), 2) == {"diffuse": 2, "specular": 7, "color": 3}
-    assert error_bounds(Config(), 1, texture=True)["color"] == 2
+    assert error_bounds(Config(), 2) == {"diffuse": 1, "specular": 3, "color": 2}
+    assert error_bounds(Config(), 1, texture=True)["color"] == 1
 
 
 # --- the arithmetic alone: float64 on the angles the hardware receives -----------------------
