@@ -39,7 +39,7 @@ def rotated_layout(cfg: Config):
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
     a value read appears ``latency`` ``adv`` stages after its angle (angle register,
-    address register, read, block-RAM output register, sign)."""
+    address register, read, block-RAM output register, data register, sign)."""
 
     latency = REGISTERED_SINE_LATENCY
 
@@ -89,8 +89,8 @@ class ExactRotation(PipeUnit):
       4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
-    Latency 8: the input sums (a, b, D), SineBank.latency (read angle, ROM address, ROM
-    read, block-RAM output register, sign), two adder levels; 1 pixel per clock.
+    Latency 9: the input sums (a, b, D), SineBank.latency (read angle, ROM address, ROM
+    read, block-RAM output register, data register, sign), two adder levels; 1 pixel per clock.
     """
 
     latency = 1 + SineBank.latency + 2

@@ -242,23 +242,17 @@ def rom_read(pipe, name, table, width, address):
 
 # rom_read: the address register, the ROM read and its output register, the data register.
 ROM_STAGES = 2 + ROM_LATENCY
-# sine_value: sincos.sine_read(registered=True) and the data register.
-SINE_STAGES = REGISTERED_SINE_LATENCY + 1
+# sine_value: sincos.sine_read(registered=True), whose data register before the sign is
+# rom_read's.
+SINE_STAGES = REGISTERED_SINE_LATENCY
 
 
 def sine_value(m, pipe, port, angle, cfg: Config, name):
     """``sin(angle)`` through ``port`` of a :func:`sine_rom`, SINE_STAGES ``adv`` stages later:
-    sincos.sine_read(registered=True) (angle, mirrored address, read, output register,
-    sign; bit-exact with tables.sin_lookup) with the word registered once more before the
-    sign's carry chain, as :func:`rom_read` does. ``cos(a)`` is ``sin(a + 2**k)``."""
-    k = cfg.k
-    a = pipe.register(angle[:cfg.angle_bits], f"{name}_angle")
-    quadrant, index = a[k:], a[:k]
-    m.d.comb += port.addr.eq(pipe.register(Mux(quadrant[0], (1 << k) - index, index),
-                                           f"{name}_address"))
-    negative = pipe.delay(quadrant[1], 2 + ROM_LATENCY, f"{name}_negative")
-    value = pipe.register(port.data, f"{name}_word")
-    return pipe.register(Mux(negative, -value, value), name)
+    sincos.sine_read(registered=True) (angle, mirrored address, read, output register, the
+    word registered once more before the sign's carry chain as :func:`rom_read` does, sign;
+    bit-exact with tables.sin_lookup). ``cos(a)`` is ``sin(a + 2**k)``."""
+    return sine_read(m, pipe, port, angle, cfg, name, registered=True)
 
 
 S, P, W = SINE_STAGES, PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
@@ -364,7 +358,7 @@ class LeeIllumination(IlluminationDatapath):
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``. Each cosine table is a
     one-port :func:`sine_rom` (one DP16KD with its output register on ECP5) read
-    by sincos.sine_read (angle sum, address, read, output register, sign:
+    by sincos.sine_read (angle sum, address, read, output register, data register, sign:
     REGISTERED_SINE_LATENCY stages); then c- + c+ and c- - c+ (1), the registered product
     (PRODUCT_LATENCY), the sum and its rounding (1): ``dot_latency``, plus SHADE_LATENCY;
     1 pixel per clock.

@@ -13,8 +13,8 @@ __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_re
            "REGISTERED_SINE_LATENCY"]
 
 # sine_read(registered=True): angle register, address register, ROM read, block-RAM
-# output register, sign.
-REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 1
+# output register, data register, sign.
+REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 2
 
 
 def quarter_wave_rom(cfg: Config):
@@ -33,10 +33,12 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
-    ``registered`` (the angle, the address, ROM read, block-RAM output register, then
-    sign: the angle's adder, the mirrored address ``2**k - i``, the route to the block
-    RAM's address pins and its clock-to-out each get a cycle of their own; ``angle_stage=False`` when the caller registered ``angle``
-    itself and counts that stage). ``cos(a)`` is ``sin(a + 2**k)``.
+    ``registered`` (the angle, the address, ROM read, block-RAM output register, a data
+    register, then sign: the angle's adder, the mirrored address ``2**k - i``, the route to
+    the block RAM's address pins, its clock-to-out and the route from its data pins, which
+    is long where a table spans two blocks side by side, each get a cycle of their own;
+    ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
+    stage). ``cos(a)`` is ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
@@ -49,11 +51,12 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     address = Mux(quadrant[0], (1 << k) - index, index)
     if registered:             # the block RAM's address pins straight from a flip-flop
         m.d.comb += port.addr.eq(pipe.register(address, f"{name}_address"))
-        negative = pipe.delay(quadrant[1], 1 + ROM_LATENCY, f"{name}_negative")
+        negative = pipe.delay(quadrant[1], 2 + ROM_LATENCY, f"{name}_negative")
+        value = pipe.register(port.data, f"{name}_data")
     else:
         m.d.comb += [port.addr.eq(address), port.en.eq(pipe.adv)]
         negative = pipe.register(quadrant[1], f"{name}_negative")
-    value = port.data
+        value = port.data
     return pipe.register(Mux(negative, -value, value), name)
 
 
@@ -74,8 +77,8 @@ class SinCos(wiring.Component):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency REGISTERED_SINE_LATENCY = 5 cycles (angle, address, ROM read, block-RAM
-    output register, sign); throughput 1 angle per clock when not stalled.
+    Latency REGISTERED_SINE_LATENCY = 6 cycles (angle, address, ROM read, block-RAM
+    output register, data register, sign); throughput 1 angle per clock when not stalled.
     """
 
     def __init__(self, cfg: Config, target=None):
