@@ -92,8 +92,8 @@ class RegisteredProduct(Elaboratable):
         return m
 
 
-# Stages of a WideProduct: a RegisteredProduct, then one more register.
-WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 1
+# Stages of a WideProduct: a RegisteredProduct, then two more registers (the limbs' sums).
+WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 2
 
 
 def _limbs(value, step):
@@ -108,12 +108,13 @@ def _limbs(value, step):
 
 class WideProduct(Elaboratable):
     """``p = a * b`` WIDE_PRODUCT_LATENCY ``en`` cycles after ``a``/``b``, for operands wider
-    than one DSP input. Generic form: a :class:`RegisteredProduct`, then a register (one
+    than one DSP input. Generic form: a :class:`RegisteredProduct`, then two registers (one
     product in the counts of gen/flow/resources.py). ECP5 form (``target`` with a
     MULT18X18D): each operand wider than a DSP input in 17-bit limbs (unsigned, the top limb
     of a signed operand signed), one RegisteredProduct per pair of limbs (a MULT18X18D with
-    its input and output registers), their shifted sum in the register: exact, since
-    a b = sum_ij a_i b_j 2**(s_i + s_j). Yosys would otherwise build the product from DSP
+    its input and output registers), their shifted sum in the two registers, pairs first:
+    exact, since a b = sum_ij a_i b_j 2**(s_i + s_j), and no more than one 2-operand carry
+    chain follows a DSP output in a cycle. Yosys would otherwise build the product from DSP
     blocks without their registers and a carry chain, all in one cycle."""
 
     def __init__(self, a_shape, b_shape, name, target=None):
@@ -126,8 +127,14 @@ class WideProduct(Elaboratable):
     def elaborate(self, platform):
         m = Module()
         terms = limb_products(m, self.a, self.b, self.en, self.target)
+        pairs = []
+        for n in range(0, len(terms), 2):
+            pair = Signal(self.p.shape(), name=f"pair{n // 2}")
+            with m.If(self.en):
+                m.d.sync += pair.eq(sum(terms[n + 1:n + 2], terms[n]))
+            pairs.append(pair)
         with m.If(self.en):
-            m.d.sync += self.p.eq(sum(terms[1:], terms[0]))
+            m.d.sync += self.p.eq(sum(pairs[1:], pairs[0]))
         return m
 
 

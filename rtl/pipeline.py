@@ -43,7 +43,7 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
                                  shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import BUFFER_DEPTH, StallPipe, lockstep_buffer
+from bumprtl.rtl.pipe import BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
@@ -103,9 +103,14 @@ class LightSum(wiring.Component):
     diffuse = min(255, round(255 D)), specular = min(255, round(S / 2**F)),
     color = min(255, round((KA + floor(KD D / 2**B) + floor(KS S / 2**16)) / 2**G))
     (rtl/shade.py's Phong sum). Output ``shade_layout(cfg, fine=False)``.
-    Latency 3 (sums, products, clamp); bit-exact with ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
+    Latency 5 (products, each product sum alone, the Phong terms' sum, its rounding and
+    clamp: the two 2-operand stages of rtl/shade.shade_stages; the 8-bit sums rounded, then
+    clamped); bit-exact with
+    ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
 
-    latency = 3
+    # Registers: the products' operands and outputs (PRODUCT_LATENCY), the sums of the split
+    # products (kd, ks), the terms' sum, the colour.
+    latency = PRODUCT_LATENCY + 3
     lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
     def __init__(self, scene: SceneConfig, target=None):
@@ -130,13 +135,22 @@ class LightSum(wiring.Component):
         ks_term = sum_product([px.s[j] for j in range(self.lights)], 8 + SPEC_FRAC_BITS, ks,
                               pipe.multiply, "ks_sum")
         sat = lambda x: Mux(x > 255, 255, x)[:8]
-        d8 = pipe.register(sat(round_shift((d << 8) - d, b)), "diffuse8")
-        s8 = pipe.register(sat(round_shift(s, SPEC_FRAC_BITS)), "specular8")
-        terms = (kd_term >> (KD_FRAC_BITS + b - g)) + (ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - g))
+        # the 8-bit sums: the rounding, then the clamp (one carry chain a cycle)
+        d8 = pipe.register(round_shift((d << 8) - d, b), "diffuse8_round")         # stage 2
+        s8 = pipe.register(round_shift(s, SPEC_FRAC_BITS), "specular8_round")
+        d8, s8 = pipe.register(sat(d8), "diffuse8"), pipe.register(sat(s8), "specular8")  # 3
+        # KD d, KS s: stage PRODUCT_LATENCY = 2
+        # round_shift(KA + kd + ks, G) as in shade_stages: the terms' sum, then KA and the
+        # rounding half (one constant), the shift and the clamp.
+        # (a DSP output feeds one adder a cycle: kd and ks, each a sum of up to MAX_SPLIT
+        # products, are registered before their sum)
+        kd_term = pipe.register(kd_term >> (KD_FRAC_BITS + b - g), "kd_phong")      # stage 3
+        ks_term = pipe.register(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - g), "ks_phong")
+        terms = pipe.register(kd_term + ks_term, "phong_terms")                    # stage 4
         total = (terms + (ka + (1 << (g - 1)))) >> g
-        m.d.comb += [self.o.payload.color.eq(pipe.register(sat(total), "color")),
-                     self.o.payload.diffuse.eq(pipe.register(d8, "diffuse")),
-                     self.o.payload.specular.eq(pipe.register(s8, "specular")),
+        m.d.comb += [self.o.payload.color.eq(pipe.register(sat(total), "color")),  # 5
+                     self.o.payload.diffuse.eq(pipe.delay(d8, self.latency - 3, "diffuse")),
+                     self.o.payload.specular.eq(pipe.delay(s8, self.latency - 3, "specular")),
                      self.o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
         return m
 

@@ -36,13 +36,17 @@ from bumprtl.rtl.tables import (KS_FRAC_BITS, LIT_FRAC_BITS, SPEC_FRAC_BITS, ble
                                 coefficient_error_lsb)
 
 __all__ = ["RGB", "rgb_layout", "texture_blend", "sum_product", "blend_error_bound_lsb",
-           "TextureBlend", "TexelDelay", "BLEND_LATENCY"]
+           "TextureBlend", "TexelDelay", "BLEND_LATENCY", "SUMS8_STAGE"]
 
 RGB = ("r", "g", "b")
 
-# Registers of texture_blend: light sums, coefficient products, lit/spec, the texel
-# product, the output sum and its rounding.
-BLEND_LATENCY = 5
+# Registers of texture_blend: light sums, coefficient products, their sums (kd's shifted,
+# and spec), lit (registered before it is the albedo product's operand), the texel product
+# (operand and product registers), the output sum (taken from the DSP's output alone), its
+# rounding and clamp.
+BLEND_LATENCY = 8
+# The stage texture_blend's 8-bit light sums leave at (rounded at 2, clamped at 3).
+SUMS8_STAGE = 3
 
 
 def rgb_layout(cfg: Config):
@@ -104,9 +108,10 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     called after each stage (a pipeline register in the RTL, identity in the golden model).
     ``mul(value, other, name)`` is value * other two stages after its operands (default
     reg(reg(value) * reg(other)); the RTL's StallPipe.multiply: one DSP block whose operand
-    registers stand for the stage-1 (stage-3) registers the products read).
+    registers stand for the stage-1 (stage-5) registers the products read).
     Returns ``(out, diffuse8, specular8)``: {r, g, b} and the light sums rounded to 8 bits,
-    min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)).
+    min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)), these two
+    :data:`SUMS8_STAGE` stages after the input (out: BLEND_LATENCY).
     """
     if mul is None:
         def mul(value, other, name):
@@ -119,14 +124,23 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     tex = {c: reg(texel[c], f"texel_{c}_d1") for c in RGB}
     kd_term = sum_product(diffuse, b + 1, kd, mul, "kd_sum")                    # stage 2
     ks_term = sum_product(specular, 8 + SPEC_FRAC_BITS, ks, mul, "ks_sum")
-    d8 = reg(_sat(round_shift((d << 8) - d, b), u8), "diffuse8")
-    s8 = reg(_sat(round_shift(s, SPEC_FRAC_BITS), u8), "specular8")
+    d8 = reg(round_shift((d << 8) - d, b), "diffuse8_round")                    # the 8-bit sums:
+    s8 = reg(round_shift(s, SPEC_FRAC_BITS), "specular8_round")                 # rounded, then
     tex = {c: reg(tex[c], f"texel_{c}_d2") for c in RGB}
-    lit = _sat(ka + (kd_term >> b), 1 << gl)                                    # stage 3
+    # The products' sums (of up to MAX_SPLIT products) alone in a cycle after the products'
+    # registers, then ka and the clamp: lit is registered before it is the albedo product's
+    # operand, so no DSP output reaches another DSP's input within a cycle.
+    kd_sum = reg(kd_term >> b, "kd_lit")                                        # stage 3
     spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
-    prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 4
-    spec = reg(spec, "spec_d4")
-    out = {c: reg(_sat(round_shift(prod[c] + spec, gl), u8), f"color_{c}") for c in RGB}  # 5
+    d8, s8 = reg(_sat(d8, u8), "diffuse8"), reg(_sat(s8, u8), "specular8")      # clamped
+    lit = reg(_sat(ka + kd_sum, 1 << gl), "lit")                                # stage 4
+    for n in (3, 4):
+        tex = {c: reg(tex[c], f"texel_{c}_d{n}") for c in RGB}
+    prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 6
+    for n in (4, 5, 6):
+        spec = reg(spec, f"spec_d{n}")
+    shade = {c: reg(prod[c] + spec, f"shade_{c}") for c in RGB}                  # stage 7
+    out = {c: reg(_sat(round_shift(shade[c], gl), u8), f"color_{c}") for c in RGB}  # 8
     return out, d8, s8
 
 
@@ -171,8 +185,8 @@ class TextureBlend(wiring.Component):
                                     pipe.multiply)
         o = self.o.payload
         m.d.comb += [o.color[c].eq(color[c]) for c in RGB]
-        m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - 2, "diffuse")),
-                     o.specular.eq(pipe.delay(s, self.latency - 2, "specular")),
+        m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - SUMS8_STAGE, "diffuse")),
+                     o.specular.eq(pipe.delay(s, self.latency - SUMS8_STAGE, "specular")),
                      o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
         return m
 
