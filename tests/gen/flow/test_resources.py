@@ -128,10 +128,10 @@ def test_zero_initialised_ram_counts_the_same_without_its_init(tmp_path):
     v, _ = emit_unit("palette", Config(palette_size=64), tmp_path / "pal")
     text = v.read_text()
     stripped = strip_zero_init(text)
-    init = "\\table [127] = 32'd0;"                  # the last zero of the init block
+    init = "mem[127] = 32'd0;"                     # the last zero of the init block
     assert init in text and init not in stripped
     counts = count_verilog(v, "palette", tmp_path / "a")
-    assert counts.rams == [{"name": "table", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
+    assert counts.rams == [{"name": "table.mem", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
     rom, _ = emit_unit("sincos", Config(angle_bits=6, frac_bits=5), tmp_path / "rom")
     assert strip_zero_init(rom.read_text()) == rom.read_text()       # non-zero contents stay
 

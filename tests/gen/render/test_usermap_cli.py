@@ -94,14 +94,14 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     words = scene_memories(scene)[0]
     hexwords = [int(x, 16) for x in (out / "pipeline_map.hex").read_text().split()]
     assert hexwords == words.tolist() and len(hexwords) == 32 * 32
-    assert all(len(x) == 6 for x in (out / "pipeline_map.hex").read_text().split())   # 24 bits
+    assert all(len(x) == 7 for x in (out / "pipeline_map.hex").read_text().split())   # 26 bits
     v = (out / "pipeline.v").read_text()
     init = _initial_contents(v)
     assert [init.get(a, 0) for a in range(len(words))] == words.tolist()
     meta = json.loads((out / "pipeline.json").read_text())
     img = meta["memory_images"]["map"]
-    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 24
-    assert "phi in bits [11:0], theta in bits [23:12]" in img["layout"]
+    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 26
+    assert "phi in bits [12:0], theta in bits [25:13]" in img["layout"]     # 13-bit angles
     assert img["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
     assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
     assert meta["block_ram"]["device"] == "LFE5U-85F"
@@ -132,16 +132,16 @@ def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsy
 
 
 def test_a_map_too_large_for_the_device_says_bits_needed_and_available(tmp_path, capsys):
-    """512^2 x 24 bits = 384 DP16KD (4096 x 4 tiles) + 13 tables > 208 on the LFE5U-85F;
+    """512^2 x 26 bits = 384 DP16KD (8192 x 2 tiles) + 13 tables > 208 on the LFE5U-85F;
     256^2 = 96 + 13 fits it but not the LFE5U-25F's 56."""
     path = _png(tmp_path / "big.png", craters(512, n=40))
     line = _one_line_exit_2(capsys, ["emit", "pipeline", "--height-map", str(path), "--out",
                                      str(tmp_path / "o")],
-                            "big.png", "6,291,456 bits", "384 DP16KD", "LFE5U-85F has 208 DP16KD of 18 kbit")
+                            "big.png", "6,815,744 bits", "384 DP16KD", "LFE5U-85F has 208 DP16KD of 18 kbit")
     assert "3,833,856 bits" in line
     small = _png(tmp_path / "s.png", craters(256, n=20))
     _one_line_exit_2(capsys, ["render", "--rtl", "--height-map", str(small), "--device", "LFE5U-25F",
-                              "--out", str(tmp_path / "r.png")], "s.png", "1,572,864 bits",
+                              "--out", str(tmp_path / "r.png")], "s.png", "1,703,936 bits",
                      "LFE5U-25F has 56 DP16KD")
     assert not (tmp_path / "o").exists() and not (tmp_path / "r.png").exists()
     scene = load_scene_config("default", {"height_map": str(small)})

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from amaranth.hdl import signed, unsigned
 
-from bumprtl.rtl.pipe import ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM
+from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, RegisteredProduct, RegisteredROM,
+                              fits_dsp)
 from bumprtl.rtl.tables import quarter_sine
 from bumprtl.rtl.config import Config
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay, model_sources, run_vectors
@@ -144,7 +145,7 @@ def test_registered_rom_ecp5_form_every_word(depth, nports, build_dir):
     init = [0] + rng.integers(0, 1 << 18, depth - 1).tolist()
     if depth in (1025, 2049):
         init[-1] = (1 << 18) - 1                 # the spill word: every bit set
-    assert RegisteredROM(init, unsigned(18), nports, "rom")._fits(ECP5())
+    assert RegisteredROM(init, unsigned(18), nports, "rom").mode(ECP5()) is not None
     n = int(depth / 0.6) + 200
     en, addrs, generic, ecp5 = _rom_lockstep(init, nports, build_dir, n, seed=depth)
     for p in range(nports):
@@ -173,7 +174,7 @@ def test_quarter_sine_table_ecp5_form(build_dir):
 def test_registered_product_ecp5_form(a_shape, b_shape, build_dir):
     """RegisteredProduct as a MULT18X18D (REG_INPUTA/B, REG_OUTPUT on CLK0/CE0) equals the
     generic form and a x b, PRODUCT_LATENCY enabled clocks later, under a random enable."""
-    assert RegisteredProduct(a_shape, b_shape, "m")._fits(18)
+    assert fits_dsp(a_shape, b_shape)
     rng = np.random.default_rng(a_shape.width * 31 + b_shape.width)
     n = 600
     lo = lambda s: -(1 << (s.width - 1)) if s.signed else 0
