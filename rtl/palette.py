@@ -13,16 +13,19 @@ colour by eq. 2 (Sec. 7.2).
 
 from amaranth.hdl import Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
-from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q, mul_round, round_shift, saturate
-from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe
 
-__all__ = ["PaletteLUT", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
+__all__ = ["PaletteLUT", "READ_LATENCY", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
 
 CHANNELS = ("r", "g", "b", "a")
+
+# Stages of a lookup: the synchronous RAM read and the register of its data
+# (rtl/pipe.RegisteredRAM).
+READ_LATENCY = RAM_LATENCY
 
 
 def index_bits(cfg: Config):
@@ -112,8 +115,10 @@ class PaletteLUT(wiring.Component):
         The current front bank.
 
     Memory: one block RAM of ``2 * sN`` entries of ``4 * color_bits`` bits (bank b at
-    offset ``b * sN``). Latency 1 cycle (RAM read), 2 with the blend stage; throughput 1
-    pixel per clock when not stalled.
+    offset ``b * sN``). Latency :data:`READ_LATENCY` = 2 cycles (RAM read, then the read
+    data's register: on ECP5 the block RAM's output register, so its clock-to-out is not in
+    the blend's or the output's cycle), 3 with the blend stage; throughput 1 pixel per clock
+    when not stalled.
     """
 
     lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
@@ -140,7 +145,7 @@ class PaletteLUT(wiring.Component):
 
     @property
     def latency(self):
-        return 2 if self.cfg.palette_blend else 1
+        return READ_LATENCY + self.cfg.palette_blend
 
     @property
     def memory_bits(self):
@@ -150,32 +155,32 @@ class PaletteLUT(wiring.Component):
         cfg, size = self.cfg, self.cfg.palette_size
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
-        table = pipe.memory("table", Memory(shape=unsigned(4 * cfg.color_bits), depth=2 * size, init=[]))
+        # The table's read data is registered (on ECP5 in the block RAM's own output register):
+        # the RAM's clock-to-out alone takes most of a cycle.
+        table = pipe.ram("table", 2 * size, unsigned(4 * cfg.color_bits))
         self.memories = pipe.memories
         front = Signal(name="front")
         with m.If(self.swap):
             m.d.sync += front.eq(~front)
         m.d.comb += self.bank.eq(front)
 
-        wp = table.write_port()
-        m.d.comb += [wp.en.eq(self.w_en & (self.w_addr < size)),
-                     wp.addr.eq(self.w_addr + Mux(front, 0, size)),     # the back bank
-                     wp.data.eq(self.w_data.as_value())]
+        m.d.comb += [table.w_en.eq(self.w_en & (self.w_addr < size)),
+                     table.w_addr.eq(self.w_addr + Mux(front, 0, size)),     # the back bank
+                     table.w_data.eq(self.w_data.as_value())]
 
         index = self.i.payload.index
         oor_in = index >= size
         read_bank = self.i.payload.bank if self.bank_in else front
-        rp = table.read_port(domain="sync")
-        m.d.comb += [rp.en.eq(pipe.adv),
-                     rp.addr.eq(Mux(oor_in, 0, index) + Mux(read_bank, size, 0))]
-        oor = pipe.register(oor_in, "oor_d1")
-        word = Mux(oor, 0, rp.data)
-        entry = _channels(word, cfg)
+        m.d.comb += table.r_addr.eq(Mux(oor_in, 0, index) + Mux(read_bank, size, 0))
+        # stage 1: the RAM read, stage 2: its output register; the out-of-range zero after it
+        word = table.r_data
+        oor = pipe.delay(oor_in, READ_LATENCY, "oor")
+        entry = _channels(Mux(oor, 0, word), cfg)
         if cfg.palette_blend:
-            base = _channels(pipe.register(self.i.payload.base.as_value(), "base_d1"), cfg)
+            base = _channels(pipe.delay(self.i.payload.base.as_value(), READ_LATENCY, "base"), cfg)
             blended = blend_eq2(entry, base, cfg)
             color = {c: pipe.register(blended[c], f"blend_{c}") for c in CHANNELS}
-            oor = pipe.register(oor, "oor_d2")
+            oor = pipe.register(oor, f"oor_d{READ_LATENCY + 1}")
         else:
             color = entry
         m.d.comb += [getattr(self.o.payload.color, c).eq(color[c]) for c in CHANNELS]

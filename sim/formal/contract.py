@@ -59,7 +59,7 @@ __all__ = ["PROPERTIES", "StreamContract", "observe_pipes", "pipeline_layers"]
 
 PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
 
-_TAG_REG = re.compile(r"(tag|bank)_d(\d+)$")
+_TAG_REG = re.compile(r"(tag|bank|oor)_d(\d+)$")
 
 
 @contextlib.contextmanager
@@ -67,17 +67,19 @@ def observe_pipes(read_ports=0):
     """Record every :class:`StallPipe` built while the block runs: yields a dict
     ``id(input valid signal) -> {"valid": [i.valid, stage1, ...], "adv": adv,
     "tags": {n: tag register of stage n}, "banks": {n: bank register of stage n},
-    "memories": {name: [comb read port, ...]}}``; ``read_ports``: that many asynchronous
-    read ports are added to every memory a pipe adds with ``StallPipe.memory`` (before it
-    elaborates), for assertions about its contents. StallPipe itself is restored
-    afterwards."""
+    "oors": {n: oor register of stage n}, "memories": {name: [comb read port, ...]},
+    "reads": {name: [read data 1, 2 stages after the address]}}``; ``read_ports``: that
+    many asynchronous read ports are added to every memory a pipe adds with
+    ``StallPipe.memory`` or ``StallPipe.ram`` (generic form; before it elaborates), for
+    assertions about its contents. StallPipe itself is restored afterwards."""
     seen = {}
-    init, register, memory = StallPipe.__init__, StallPipe.register, StallPipe.memory
+    init, register = StallPipe.__init__, StallPipe.register
+    memory, ram = StallPipe.memory, StallPipe.ram
 
     def observed_init(self, *args, **kwargs):
         init(self, *args, **kwargs)
         self._formal = {"valid": list(self.valid), "adv": self.adv, "tags": {}, "banks": {},
-                        "memories": {}}
+                        "oors": {}, "memories": {}, "reads": {}}
         seen[id(self.valid[0])] = self._formal
 
     def observed_register(self, value, name, *args, **kwargs):
@@ -94,12 +96,29 @@ def observe_pipes(read_ports=0):
                                               for _ in range(read_ports)]
         return out
 
-    StallPipe.__init__, StallPipe.register, StallPipe.memory = \
-        observed_init, observed_register, observed_memory
+    def observed_ram(self, name, *args, **kwargs):
+        unit = ram(self, name, *args, **kwargs)
+        if hasattr(self, "_formal") and read_ports:
+            ports = self._formal["memories"][name] = []
+            reads = self._formal["reads"][name] = []
+            elaborate = unit.elaborate
+
+            def observed_elaborate(platform):
+                m = elaborate(platform)            # the generic form: Memory ``mem``
+                mem = m.submodules.mem
+                reads.extend([mem.read_ports[0].data, unit.r_data])
+                ports.extend(mem.read_port(domain="comb") for _ in range(read_ports))
+                return m
+            unit.elaborate = observed_elaborate
+        return unit
+
+    StallPipe.__init__, StallPipe.register, StallPipe.memory, StallPipe.ram = \
+        observed_init, observed_register, observed_memory, observed_ram
     try:
         yield seen
     finally:
-        StallPipe.__init__, StallPipe.register, StallPipe.memory = init, register, memory
+        StallPipe.__init__, StallPipe.register, StallPipe.memory, StallPipe.ram = \
+            init, register, memory, ram
 
 
 def pipeline_layers(dut):
@@ -423,10 +442,30 @@ class StreamContract(Elaboratable):
         for b, port in enumerate(ports):
             m.d.comb += port.addr.eq(sel + b * size)
             self._lemma(m, shadow[b] == port.data, "the shadow of the watched entry is the table's")
-        color = o.payload.color.as_value()
+        # The LUT's stages, input -> output, with the entry each holds: the table is read
+        # at the LUT's input, so stage n < depth holds its n-th read register (an in-range
+        # index: oor low), the last stage (depth) the output colour.
+        unit = dut if lut is None else lut
+        reads = rec["reads"].get("table", [])
+        depth = len(rec["valid"]) - 1
+        lut_stages = [(rec["valid"][n], ~rec["oors"][n] & (reads[n - 1] == expected))
+                      for n in range(1, min(depth - 1, len(reads)) + 1)]
+        if len(lut_stages) != depth - 1:
+            return                       # a stage whose entry is not known: no lemmas
+        lut_stages.append((rec["valid"][-1], unit.o.payload.color.as_value() == expected))
+
+        def in_lut(offset, matched):
+            """The watched pixel is in a LUT stage with ``offset`` + (valid stages downstream)
+            pixels ahead of it, holding its entry if ``matched``."""
+            found, downstream = Const(0), Const(0, len(occ))
+            for v, holds in reversed(lut_stages):
+                found = found | (v & (offset + downstream == ahead) & (~matched | holds))
+                downstream = downstream + v
+            return found
+
         if lut is None:
-            self._lemma(m, ~watching | (o.valid & (ahead == 0) & (color == expected)),
-                        "the watched pixel waits at the output with its entry")
+            self._lemma(m, ~watching | in_lut(0, Const(1)),
+                        "the watched pixel waits in the LUT with its entry")
             return
         fetch = self._pipes[id(dut.units["fetch"].i.valid)]
         valid = fetch["valid"][1:]
@@ -445,14 +484,16 @@ class StreamContract(Elaboratable):
         self._lemma(m, ~waiting_f | (Mux(wbank, ports[1].data, ports[0].data) == expected),
                     "its entry is unchanged while it waits")
         count, entries = self.buffer["count"], self.buffer["entries"]
-        self._lemma(m, ~waiting_f | (ahead == ahead_f + lut.o.valid + count), "pixels ahead of it")
-        # Past the LUT: in the output buffer (entry ``ahead``) or in the LUT's last stage
-        # behind the buffered pixels.
-        there = lut.o.payload.color.as_value()
+        in_flight = Const(0, len(occ))
+        for v, _ in lut_stages:
+            in_flight = in_flight + v
+        self._lemma(m, ~waiting_f | (ahead == ahead_f + in_flight + count), "pixels ahead of it")
+        # Past the LUT: in the output buffer (entry ``ahead``) or in a LUT stage behind the
+        # buffered pixels.
+        there = Const(0, word)
         for n in reversed(range(len(entries))):
-            there = Mux((ahead == n) & (count > n), entries[n].color.as_value(), there)
-        self._lemma(m, ~(watching & ~before) | ((ahead < count + lut.o.valid) &
-                                                ((ahead < count) | lut.o.valid) &
-                                                (~match | (there == expected))),
+            there = Mux(ahead == n, entries[n].color.as_value(), there)
+        self._lemma(m, ~(watching & ~before) | (((ahead < count) & (~match | (there == expected))) |
+                                                ((ahead >= count) & in_lut(count, match))),
                     "past the LUT it waits in the output buffer or the LUT with its entry")
         self._lemma(m, watching | ~before, "only the watched pixel is followed")

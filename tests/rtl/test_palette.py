@@ -12,7 +12,8 @@ from amaranth.sim import Simulator
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.palette import CHANNELS, PaletteLUT, blend_eq1, blend_eq2, index_bits, mul8
+from bumprtl.rtl.palette import (CHANNELS, READ_LATENCY, PaletteLUT, blend_eq1, blend_eq2,
+                                 index_bits, mul8)
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, unpack_rgba
@@ -138,7 +139,7 @@ def test_emit_lint_and_sidecar(cfg, build_dir):
     v, _ = emit_unit("palette", cfg, build_dir)
     assert lint(v) == []
     dut, side, command = build_unit("palette", cfg)
-    assert side["latency"] == dut.latency == 1 + cfg.palette_blend
+    assert side["latency"] == dut.latency == READ_LATENCY + cfg.palette_blend
     assert side["memory_bits"] == 2 * cfg.palette_size * 32
     assert side["roms"]["table"]["depth"] == 2 * cfg.palette_size
     assert f"--palette-size {cfg.palette_size}" in command
