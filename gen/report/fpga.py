@@ -199,10 +199,14 @@ FPGA_NOTES = """
   own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
   about 1 ns clock-to-out instead of 5.8 ns; the last word of a 2^n + 1-word table is kept
   in a flip-flop, so the specular table is one 1024 x 18 block and each quarter-wave
-  table of 13-bit angles two 2048 x 9 blocks side by side); every
-  product uses the DSP's input and output registers (`rtl/pipe.RegisteredProduct`:
-  MULT18X18D with REG_INPUTA/B and REG_OUTPUT, about 3.9 ns of DSP delay taken out of
-  the cycle); the n'' sums are two registered adder levels; the dot N'.A' and the Phong
+  table of 13-bit angles two 2048 x 9 blocks side by side, whose word gets a data register
+  of its own before the sign: the route from two blocks side by side ended the exact
+  pipeline's cycle at 146.7 MHz); every product uses the DSP's input and output registers
+  (`rtl/pipe.RegisteredProduct`: MULT18X18D with REG_INPUTA/B and REG_OUTPUT, about 3.9 ns
+  of DSP delay taken out of the cycle), and a product whose operands are wider than one
+  18-bit DSP input (the exact illumination's n''x4 p2 at B = 16: 21 x 19 bits) is split
+  into 17-bit limbs, one registered MULT18X18D per pair, their sum registered in a stage of
+  its own (`rtl/pipe.WideProduct`); the n'' sums are two registered adder levels; the dot N'.A' and the Phong
   sum of eq. 2 each run as two 2-operand carry-chain stages (the rounding half is folded
   into an operand); 255 x diffuse is a shift-and-subtract.
 - Yosys `synth_ecp5` infers neither block-RAM output registers nor DSP registers, so
@@ -233,15 +237,18 @@ FPGA_NOTES = """
   reads are registered like the ROMs (`rtl/pipe.RegisteredRAM`: DP16KD blocks with the
   write port on port A and REGMODE OUTREG on the read port; the fetch's latency is 3).
   The units of a BumpPipeline run in lock step on a registered `run` enable, one copy per
-  unit, with a 2-entry output buffer behind the last unit (`rtl/pipeline.py`), so no
-  combinational stall enable crosses the design; before, `adv = ~o.valid | o.ready` fanned
-  out from the last unit's `o.valid` to every clock enable of the whole pipeline and held
-  scene_full at 97.8 MHz (mostly routing delay).
-- The `<method>_pipeline` rows connect the method's two units with `wiring.connect`
-  (`gen/flow/fpga.pipeline_component`): each unit's `adv = ~o.valid | o.ready` chains
-  through both, so where a unit carries thousands of delay-line flip-flops (the baselines'
-  N', tag and |a| riding through the square root and divider) that fan-out is their limit
-  (critical-path list). Lee and Kim are pipelined with registers only (`rtl/lee.py`,
+  unit, with a 2-entry output buffer behind the last unit (`rtl/pipe.lockstep_buffer`), so
+  no combinational stall enable crosses the design; before, `adv = ~o.valid | o.ready`
+  fanned out from the last unit's `o.valid` to every clock enable of the whole pipeline and
+  held scene_full at 97.8 MHz (mostly routing delay). The blend registers `lit` before its
+  albedo products, the light sum registers the Phong terms' sum before the rounding and
+  clamp, and the palette table's read is registered (each one more stage).
+- The `<method>_pipeline` rows chain the method's two units the same way, in lock step
+  behind a 2-entry output buffer (`gen/flow/fpga.pipeline_component`); with
+  `wiring.connect` each unit's `adv = ~o.valid | o.ready` chained through both, and where
+  a unit carries thousands of delay-line flip-flops (the baselines' N', tag and |a| riding
+  through the square root and divider) that fan-out was their limit (lee 132.8, Kim 117.3,
+  Peercy and Ernst 122.1 MHz at 12-bit angles, B = 13). Lee and Kim are pipelined with registers only (`rtl/lee.py`,
   `rtl/baselines/kim.py`: every table read registered before and after its block RAM,
   long mux chains cut); Peercy and Ernst with a pipelined restoring square root and
   divider, one bit per stage (`rtl/baselines/peercy.py`).
