@@ -17,7 +17,8 @@ from amaranth.lib.wiring import In, Out
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "limb_products",
-           "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
+           "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY",
+           "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2

@@ -20,8 +20,8 @@ texel coordinates + world N, L, H in; shaded pixels out. Only what the scene nee
 Lock step and the output buffer (rtl/pipe.lockstep_buffer): every unit runs in lock-step
 mode (rtl/pipe.StallPipe ``enable``): all of them shift on one registered enable ``run``,
 bubbles included, so the units form one shift register and no unit's ``o.valid``
-reaches another unit's clock enables. Each unit gets its own copy of the ``run`` register (same next state, so each
-copy drives the clock enables of one unit only). Behind the last unit sits a 2-entry
+reaches another unit's clock enables. Each unit gets its own copy of the ``run`` register
+(same next state, so each copy drives the clock enables of one unit only). Behind the last unit sits a 2-entry
 output buffer: ``run`` = the buffer holds at most one pixel, a function of registers
 only; ``i.ready`` = ``run``. With the buffer empty the output is the last unit's output
 itself (bypass), so with ``o.ready`` held high the buffer stays empty and the latency is
