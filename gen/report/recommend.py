@@ -96,7 +96,8 @@ def _evidence(p):
         f = cost["fpga"]
         lines.append(f"    {f['device']}: {f['LUT4']} LUT4, {f['DSP']} DSP, {f['BRAM']} BRAM, "
                      f"Fmax {f['fmax_mhz']} MHz")
-    lines.append("  speed: " + ", ".join(f"{k} {v}" for k, v in speed.items() if not k.endswith("note")))
+    lines.append("  speed: " + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
+                                     for k, v in speed.items() if not k.endswith("note")))
     return lines
 
 
