@@ -38,23 +38,25 @@ and the tables are the golden model's): every table read is registered before an
 the block RAM (:func:`rom_read`, :func:`sine_value`, sincos.sine_read), every product is a
 registered DSP product, and long carry and mux chains are cut by the ``stage`` hooks of the
 shared helpers (identity in the golden model). The tables wider or deeper than one DP16KD,
-the sin & cos ROM with four reads and the products by a 1/sin, 1/cos word (wider than a DSP
-input) have ECP5 forms of their own here (:class:`BlockROM`; ``pipe.WideProduct``) with the
-same generic form, so gen/flow/resources.py counts them as before. Each unit's ``latency``
-is the sum of its stages (the class docstrings list them); the tables' addresses depend on
+the sin & cos ROM with four reads and every product whose operands are wider than a DSP input
+(the two by a 1/sin, 1/cos word always; eq. 19's and eq. 24's when the widths outgrow 18
+bits) have ECP5 forms of their own here (:class:`BlockROM`; ``pipe.WideProduct``, whose limbs'
+sum is registered) with the same generic form, so gen/flow/resources.py counts them as
+before. Each unit's ``latency`` is the sum of its stages (the class docstrings list them; a
+product's stages follow the widths, ``pipe.product_latency``); the tables' addresses depend on
 the previous table's output within the pixel, which makes the setup deep, not slow.
 """
 
 import numpy as np
-from amaranth.hdl import Cat, Module, Mux, Signal, Value, ValueCastable, unsigned
+from amaranth.hdl import Cat, Module, Mux, Signal, Value, ValueCastable, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
-from bumprtl.rtl.pipe import (DP16KD_MODES, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
-                             PipeUnit, RegisteredROM, dp16kd_rom_block)
+from bumprtl.rtl.pipe import (DP16KD_MODES, ROM_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit,
+                             RegisteredROM, dp16kd_rom_block, fits_dsp, product_latency)
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
@@ -62,7 +64,7 @@ from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_ma
                      lee_reciprocal_bits, lee_reciprocal_table, quarter_sine)
 
 __all__ = ["LeeRotation", "LeeIllumination", "rotated_layout", "BlockROM", "block_rom", "rom_read",
-           "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value",
+           "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value", "prop_operands", "dot_operands",
            "below_horizon", "quarter_address", "ratio_index", "asin_address", "prop_address",
            "phi_quadrant",
            "magnitude", "prop_term", "theta_from_prop"]
@@ -255,7 +257,27 @@ def sine_value(m, pipe, port, angle, cfg: Config, name):
     return sine_read(m, pipe, port, angle, cfg, name, registered=True)
 
 
-S, P, W = SINE_STAGES, PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
+S, W = SINE_STAGES, WIDE_PRODUCT_LATENCY
+
+
+def _multiplier(pipe, *shapes):
+    """``pipe.multiply`` (PRODUCT_LATENCY) for operands of ``shapes`` that fit one DSP input,
+    else ``pipe.wide_multiply`` (WIDE_PRODUCT_LATENCY): ``pipe.product_latency(*shapes)``
+    stages either way."""
+    return pipe.multiply if fits_dsp(*shapes) else pipe.wide_multiply
+
+
+def prop_operands(cfg: Config):
+    """Shapes of eq. 19's product operands, 90 - |Z| (|Z| of :func:`magnitude`) and a T_prop
+    word (B + 1 bits), as :class:`LeeRotation` builds them."""
+    abs_z = magnitude(Signal(cfg.angle_bits), cfg)[1]
+    return ((1 << cfg.k) - abs_z).shape(), unsigned(cfg.frac_bits + 1)
+
+
+def dot_operands(cfg: Config):
+    """Shapes of eq. 24's product operands, c- - c+ and c_phi (cosines: signed B + 2 bits),
+    as :class:`LeeIllumination` builds them."""
+    return signed(cfg.sincos_width + 1), signed(cfg.sincos_width)
 
 
 class LeeRotation(PipeUnit):
@@ -265,9 +287,11 @@ class LeeRotation(PipeUnit):
     Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Every table read is a
     :class:`BlockROM` (DP16KD blocks with their output registers on ECP5) behind an address
     register, every product registered (``pipe.multiply``; the two by a reciprocal, wider
-    than a DSP input, ``StallPipe.wide_multiply``), and at most one carry chain or half a mux
-    chain lies between two registers. Per vector, in ``adv`` stages
-    (S = SINE_STAGES, R = ROM_STAGES, P = PRODUCT_LATENCY, W = WIDE_PRODUCT_LATENCY):
+    than a DSP input, ``StallPipe.wide_multiply``, and eq. 19's as well when its operands,
+    :func:`prop_operands`, outgrow a DSP input), and at most one carry chain or half a mux
+    chain lies between two registers. Per vector, in ``adv`` stages (S = SINE_STAGES,
+    R = ROM_STAGES, W = WIDE_PRODUCT_LATENCY, P = ``pipe.product_latency`` of
+    :func:`prop_operands`: PRODUCT_LATENCY up to angle_bits 15 and B = 16, else W):
 
     ======================  ======================================================
     stage                   what is registered
@@ -294,9 +318,9 @@ class LeeRotation(PipeUnit):
     reads is sequential; every link of it has a register of its own.
     """
 
-    latency = S + 8 + 3 * ROM_STAGES + W + P
-
     def __init__(self, cfg: Config, target=None):
+        self.prop_latency = product_latency(*prop_operands(cfg))              # P
+        self.latency = S + 8 + 3 * ROM_STAGES + W + self.prop_latency
         super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
 
     def build(self, m, pipe):
@@ -309,7 +333,8 @@ class LeeRotation(PipeUnit):
 
     def _rotate(self, m, pipe, v, a, n):
         cfg, k, b = self.cfg, self.cfg.k, self.cfg.frac_bits
-        reg, delay, R = pipe.register, pipe.delay, ROM_STAGES
+        reg, delay, R, P = pipe.register, pipe.delay, ROM_STAGES, self.prop_latency
+        mul = _multiplier(pipe, *prop_operands(cfg))                      # P stages
         stage = lambda value, name: reg(value, f"{v}_{name}")
         d = a.phi - n.phi                                                  # adder 1
         x, y = a.theta + d, a.theta - d                                    # adders 2, 3 (eq. 6)
@@ -344,7 +369,7 @@ class LeeRotation(PipeUnit):
                              for x, nm in zip(magnitude(z, cfg), ("z_negative", "abs_z")))
         y_negative = delay(y2[-1], 5 + 3 * R + W, f"{v}_y_negative")      # S + 6 + 3R + W
         phi = reg(phi_quadrant(atan, z_negative, y_negative, cfg, stage), f"{v}_phi")
-        term = reg(prop_term(abs_z, prop, cfg, lambda x, w: pipe.multiply(x, w, f"{v}_theta_prop")),
+        term = reg(prop_term(abs_z, prop, cfg, lambda x, w: mul(x, w, f"{v}_theta_prop")),
                    f"{v}_theta_term")                                      # S + 7 + 3R + W + P
         theta = reg(_wrap(delay(abs_z, P + 1, f"{v}_abs_z_sum") + term, cfg),  # theta_from_prop's sum
                     f"{v}_theta")
@@ -360,13 +385,14 @@ class LeeIllumination(IlluminationDatapath):
     one-port :func:`sine_rom` (one DP16KD with its output register on ECP5) read
     by sincos.sine_read (angle sum, address, read, output register, data register, sign:
     REGISTERED_SINE_LATENCY stages); then c- + c+ and c- - c+ (1), the registered product
-    (PRODUCT_LATENCY), the sum and its rounding (1): ``dot_latency``, plus SHADE_LATENCY;
-    1 pixel per clock.
+    (``pipe.product_latency`` of :func:`dot_operands`: PRODUCT_LATENCY up to B = 15, else a
+    ``pipe.WideProduct``, WIDE_PRODUCT_LATENCY, on every target), the sum and its rounding
+    (1): ``dot_latency``, plus SHADE_LATENCY; 1 pixel per clock.
     """
 
-    dot_latency = REGISTERED_SINE_LATENCY + P + 2
-
     def __init__(self, cfg: Config, target=None):
+        self.product_latency = product_latency(*dot_operands(cfg))
+        self.dot_latency = REGISTERED_SINE_LATENCY + self.product_latency + 2
         super().__init__(cfg, rotated_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
@@ -382,7 +408,8 @@ class LeeIllumination(IlluminationDatapath):
                                 f"{v}_cos_{name}", registered=True)
         first = pipe.register(c["minus"] + c["plus"], f"{v}_first")
         diff = pipe.register(c["minus"] - c["plus"], f"{v}_diff")
-        second = pipe.multiply(diff, pipe.register(c["phi"], f"{v}_cos_phi"), f"{v}_second")
-        first = pipe.delay(first, P, f"{v}_first")
+        mul = _multiplier(pipe, *dot_operands(cfg))
+        second = mul(diff, pipe.register(c["phi"], f"{v}_cos_phi"), f"{v}_second")
+        first = pipe.delay(first, self.product_latency, f"{v}_first")
         return pipe.register(round_shift((first << cfg.frac_bits) + second, cfg.frac_bits + 1),
                              f"{v}_dot")

@@ -16,9 +16,9 @@ from amaranth.lib.memory import Memory, ReadPort
 from amaranth.lib.wiring import In, Out
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
-           "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "limb_products",
-           "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY",
-           "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
+           "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
+           "limb_products", "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY",
+           "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals"]
 
 # Stages of StallPipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2
@@ -164,6 +164,13 @@ def limb_products(m, a, b, en, target):
 def fits_dsp(*shapes, width=ECP5.dsp_width):
     """Every shape is one signed ``width``-bit DSP input (an unsigned one needs a zero bit)."""
     return all(Shape.cast(s).width + (not Shape.cast(s).signed) <= width for s in shapes)
+
+
+def product_latency(*shapes):
+    """Stages of a registered product of operands of ``shapes``: PRODUCT_LATENCY
+    (:meth:`StallPipe.multiply`) when they fit one DSP input (:func:`fits_dsp`), else
+    WIDE_PRODUCT_LATENCY (:meth:`StallPipe.wide_multiply`, which registers the limbs' sum)."""
+    return PRODUCT_LATENCY if fits_dsp(*shapes) else WIDE_PRODUCT_LATENCY
 
 
 def read_port(addr_bits, shape, name):

@@ -36,18 +36,22 @@ square), s < 2**(2B+9), r < 2**(B+6), and |q'| <= sqrt(2) 2**B + 1 (2|a|/r <= 2 
 floor(2 sqrt(s)) <= sqrt 2 for s >= 1), which fits the signed(B + 2) output.
 
 Timing: every product is a ``StallPipe.multiply`` (operand and product registers, one
-MULT18X18D on ECP5 when both operands fit 18 bits: all 30 of them at B = 13). The square
-root and the dividers are pipelined by hand, one result bit per stage with a register
-after each, every register enabled by the pipe's ``adv`` (B. Parhami, Computer Arithmetic:
-Algorithms and Hardware Designs, ch. 13, restoring division, and ch. 21, the restoring
-shift/subtract square root): :func:`sqrt_stages` = B + 6 stages of at most a (B + 8)-bit
-subtractor, :func:`quotient_bits` = B + 2 stages of a (B + 7)-bit one. B + 2 quotient bits
-are exact: r = isqrt(4 s) >= isqrt(4 a**2) = 2 |a|, so q <= 2**(B+1). Each is a submodule
-whose name ends in ``sqrt`` or ``_div``, which gen/flow/resources.py keeps as a black box and
-counts as one square root or one divider (Table 1's "SQRt" and "division units"). Latency
-:func:`rotation_latency` (43 at B = 13); 1 pixel per clock. Every sum of three products (the
-transform and the dots N'.A_n, :func:`sum3_rounded`, and |A_t|**2) is two registered
-2-operand adders, not one 3-operand adder behind the DSP blocks' outputs.
+MULT18X18D on ECP5) when both operands fit one 18-bit DSP input (all 30 of them at B = 13),
+else a ``StallPipe.wide_multiply`` (a ``pipe.WideProduct``: on ECP5 17-bit limbs, one
+MULT18X18D per pair, their sum in two registers of its own), two stages more on every
+target: the squares of the (B + 5)-bit components from B = 14, the transform and the dots of
+the (B + 2)-bit inputs from B = 17 (:func:`product_latencies`). The square root and the
+dividers are pipelined by hand, one result bit per stage with a register after each, every
+register enabled by the pipe's ``adv`` (B. Parhami, Computer Arithmetic: Algorithms and
+Hardware Designs, ch. 13, restoring division, and ch. 21, the restoring shift/subtract
+square root): :func:`sqrt_stages` = B + 6 stages of at most a (B + 8)-bit subtractor,
+:func:`quotient_bits` = B + 2 stages of a (B + 7)-bit one. B + 2 quotient bits are exact:
+r = isqrt(4 s) >= isqrt(4 a**2) = 2 |a|, so q <= 2**(B+1). Each is a submodule whose name
+ends in ``sqrt`` or ``_div``, which gen/flow/resources.py keeps as a black box and counts as
+one square root or one divider (Table 1's "SQRt" and "division units"). Latency
+:func:`rotation_latency` (43 at B = 13, 51 at B = 16); 1 pixel per clock. Every sum of three
+products (the transform and the dots N'.A_n, :func:`sum3_rounded`, and |A_t|**2) is two
+registered 2-operand adders, not one 3-operand adder behind the DSP blocks' outputs.
 
 Illumination (:class:`PeercyIllumination`): N'.L_n and N'.H_n (6 multipliers, 4 adders, one
 rounding each), then the shared Phong back end of eq. (2) with the same cos^n specular
@@ -61,17 +65,16 @@ from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, PipeUnit
+from bumprtl.rtl.pipe import PipeUnit, fits_dsp, product_latency
 from bumprtl.rtl.shade import IlluminationDatapath
 
 __all__ = ["PeercyRotation", "PeercyIllumination", "PeercySqrt", "PeercyDivider", "vectors",
            "cartesian_layout", "setup_input_layout", "setup_output_layout", "component_width",
-           "square_bits", "sqrt_stages", "quotient_bits", "rotation_latency", "sum3_rounded",
-           "DOT_LATENCY"]
+           "square_bits", "sqrt_stages", "quotient_bits", "product_latencies",
+           "rotation_latency", "dot_latency", "sum3_rounded"]
 
 AXES = ("x", "y", "z")
 FRAME = ("t", "b", "n")       # tangent, binormal, normal: the rows of the 3x3 transform
-DOT_LATENCY = PRODUCT_LATENCY + 2     # products, two sum stages (then rtl/shade.SHADE_LATENCY)
 
 
 def vectors(cfg: Config):
@@ -118,11 +121,38 @@ def quotient_bits(cfg: Config):
     return cfg.frac_bits + 2
 
 
+def _multiplier(pipe, *shapes):
+    """``pipe.multiply`` for operands of ``shapes`` that fit one DSP input, else
+    ``pipe.wide_multiply``: ``pipe.product_latency(*shapes)`` stages either way."""
+    return pipe.multiply if fits_dsp(*shapes) else pipe.wide_multiply
+
+
+def _operands(cfg: Config):
+    """Operand shapes: "product" (the transform and the dots: two input components, B + 2
+    bits) and "square" (a transformed component, :func:`component_width`)."""
+    return {"product": (signed(cfg.sincos_width),) * 2,
+            "square": (signed(component_width(cfg)),) * 2}
+
+
+def product_latencies(cfg: Config):
+    """Stages of the transform and dot products ("product") and of the squares ("square"):
+    ``pipe.product_latency`` of their operands, PRODUCT_LATENCY when they fit one DSP input,
+    else WIDE_PRODUCT_LATENCY."""
+    return {name: product_latency(*shapes) for name, shapes in _operands(cfg).items()}
+
+
 def rotation_latency(cfg: Config):
-    """Registers of the setup: products (PRODUCT_LATENCY: operand and product registers, one
-    DSP block on ECP5), transformed sums (2), squares (PRODUCT_LATENCY; |a| rides along),
-    |A_t|**2 (2), the square root's stages, the divider's stages, signed result."""
-    return 2 * PRODUCT_LATENCY + 5 + sqrt_stages(cfg) + quotient_bits(cfg)
+    """Registers of the setup: products (:func:`product_latencies`), transformed sums (2),
+    squares (likewise; |a| rides along), |A_t|**2 (2), the square root's stages, the
+    divider's stages, signed result."""
+    lat = product_latencies(cfg)
+    return lat["product"] + lat["square"] + 5 + sqrt_stages(cfg) + quotient_bits(cfg)
+
+
+def dot_latency(cfg: Config):
+    """Registers of the illumination's dots: products (:func:`product_latencies`), two sum
+    stages (:func:`sum3_rounded`); then rtl/shade.SHADE_LATENCY."""
+    return product_latencies(cfg)["product"] + 2
 
 
 def sum3_rounded(reg, p, b, name):
@@ -231,8 +261,10 @@ class PeercyRotation(PipeUnit):
     ``wiring.Component``).
 
     Input :func:`setup_input_layout`; output :func:`setup_output_layout` (L_n, H_n in tangent
-    space, N' passed through). Latency :func:`rotation_latency` (2 PRODUCT_LATENCY + 5 +
-    (B + 6) + (B + 2) = 43 at B = 13); 1 pixel per clock.
+    space, N' passed through). Latency :func:`rotation_latency` (the two products' stages
+    + 5 + (B + 6) + (B + 2): 2 PRODUCT_LATENCY + 5 + 15 + 11 = 35 at B = 9,
+    2 PRODUCT_LATENCY + 5 + 19 + 15 = 43 at B = 13, PRODUCT_LATENCY + WIDE_PRODUCT_LATENCY
+    + 5 + 22 + 18 = 51 at B = 16); 1 pixel per clock.
     """
 
     def __init__(self, cfg: Config, target=None):
@@ -244,16 +276,18 @@ class PeercyRotation(PipeUnit):
         reg = pipe.register
         px, out = self.i.payload, self.o.payload
         cw, ns, nq = component_width(cfg), sqrt_stages(cfg), quotient_bits(cfg)
+        ops, sq_lat = _operands(cfg), product_latencies(cfg)["square"]
+        mul, square = _multiplier(pipe, *ops["product"]), _multiplier(pipe, *ops["square"])
         for v in vectors(cfg):
             a = px[v]
             comps = {}
             for row, axis in zip(FRAME, AXES):             # A_t = (T.A, B.A, N.A)
-                p = [pipe.multiply(px[row][c], a[c], f"{v}_{row}{c}") for c in AXES]  # + P
+                p = [mul(px[row][c], a[c], f"{v}_{row}{c}") for c in AXES]          # + P
                 comps[axis] = sum3_rounded(reg, p, b, f"{v}t_{axis}")[:cw].as_signed()  # + 2
-            sq = [pipe.multiply(comps[c], comps[c], f"{v}t_{c}_sq") for c in AXES]   # + P
+            sq = [square(comps[c], comps[c], f"{v}t_{c}_sq") for c in AXES]         # + P
             mag = {c: pipe.delay(Mux(comps[c] < 0, -comps[c], comps[c])[:cw - 1],
-                                 PRODUCT_LATENCY, f"{v}t_{c}_mag") for c in AXES}
-            neg = {c: pipe.delay(comps[c][-1], PRODUCT_LATENCY + 2 + ns + nq, f"{v}t_{c}_neg")
+                                 sq_lat, f"{v}t_{c}_mag") for c in AXES}
+            neg = {c: pipe.delay(comps[c][-1], sq_lat + 2 + ns + nq, f"{v}t_{c}_neg")
                    for c in AXES}
             # x**2 >= 0 and < 2**(2B+8): the low 2B+8 bits of each signed square are exact
             sq = [q[:square_bits(cfg) - 1] for q in sq]
@@ -280,20 +314,20 @@ class PeercyIllumination(IlluminationDatapath):
     table, Phong sum of eq. 2).
 
     Input :func:`setup_output_layout`; output ``shade_layout(cfg)``.
-    Latency DOT_LATENCY = PRODUCT_LATENCY (operand and product registers) + 2 (the sum,
-    :func:`sum3_rounded`) + SHADE_LATENCY;
-    1 pixel per clock.
+    Latency :func:`dot_latency` = the products' stages (PRODUCT_LATENCY, operand and product
+    registers, up to B = 16; WIDE_PRODUCT_LATENCY beyond) + 2 (the sum,
+    :func:`sum3_rounded`), then SHADE_LATENCY; 1 pixel per clock.
     """
 
-    dot_latency = DOT_LATENCY
-
     def __init__(self, cfg: Config, target=None):
+        self.dot_latency = dot_latency(cfg)
         super().__init__(cfg, setup_output_layout(cfg), target)
 
     def dots(self, m, pipe, payload):
         n, dots = payload.np, {}
+        mul = _multiplier(pipe, *_operands(self.cfg)["product"])
         for v in vectors(self.cfg):
             a = payload[v]
-            p = [pipe.multiply(n[c], a[c], f"{v}_dot_{c}") for c in AXES]            # + P
+            p = [mul(n[c], a[c], f"{v}_dot_{c}") for c in AXES]                      # + P
             dots[v] = sum3_rounded(pipe.register, p, self.cfg.frac_bits, f"{v}_dot")   # + 2
         return dots

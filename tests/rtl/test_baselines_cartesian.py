@@ -16,7 +16,7 @@ from bumprtl.gen.flow.resources import count_component, count_verilog, multiplie
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.config import Config
 from bumprtl.rtl import methods
-from bumprtl.rtl.pipe import PRODUCT_LATENCY
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
 from bumprtl.rtl.shade import SHADE_LATENCY, BackEnd
 from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
 from bumprtl.sim.golden.fixed import peercy as fixed_peercy
@@ -86,13 +86,19 @@ def test_narrow_and_wide_configurations(specular):
         check_illumination(cfg, codes, "backpressure")
 
 
-@pytest.mark.parametrize("cfg", [Config(), NARROW], ids=["default", "narrow"])
-def test_latencies_follow_the_structure(cfg):
-    """Setup: products and squares are registered products (PRODUCT_LATENCY each), plus the
-    transformed sum and |A_t|**2 (two 2-operand adder stages each), the signed result, the
-    square root's B + 6 stages (one per root bit of 4 s) and the divider's B + 2 (one per
-    quotient bit). Illumination: the dot's products, its sum (two stages), then the shared
-    back end."""
+P, W = PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
+
+
+@pytest.mark.parametrize("cfg, product, square, rotation_latency", [
+    (NARROW, P, P, 35), (Config(frac_bits=13), P, P, 43), (Config(), P, W, 51),
+    (Config(angle_bits=14, frac_bits=20), W, W, 61)], ids=["narrow", "b13", "default", "b20"])
+def test_latencies_follow_the_structure(cfg, product, square, rotation_latency):
+    """Setup: the transform's products and the squares are registered products
+    (PRODUCT_LATENCY while their operands, B + 2 and B + 5 bits, fit one 18-bit DSP input,
+    else WideProducts, WIDE_PRODUCT_LATENCY), plus the transformed sum and |A_t|**2 (two
+    2-operand adder stages each), the signed result, the square root's B + 6 stages (one per
+    root bit of 4 s) and the divider's B + 2 (one per quotient bit). Illumination: the dot's
+    products (as the transform's), its sum (two stages), then the shared back end."""
     b = cfg.frac_bits
     for method in METHODS:
         cfg = cfg.replace(method=method)
@@ -100,8 +106,8 @@ def test_latencies_follow_the_structure(cfg):
                                                        methods.get(method).illumination))
         for unit in (rotation, illumination):
             unit._MustUse__silence = True          # read for its latency only, never elaborated
-        assert rotation.latency == 2 * PRODUCT_LATENCY + 5 + (b + 6) + (b + 2)
-        assert illumination.latency == PRODUCT_LATENCY + 2 + SHADE_LATENCY
+        assert rotation.latency == product + square + 5 + (b + 6) + (b + 2) == rotation_latency
+        assert illumination.latency == product + 2 + SHADE_LATENCY
 
 
 # --- emission -------------------------------------------------------------------------------
@@ -134,8 +140,9 @@ def test_cli_emit_rotation_method_peercy(tmp_path):
         f"{Config().angle_bits} --frac-bits {b}")
     meta = json.loads((tmp_path / "rotation.json").read_text())
     assert meta["method"] == "peercy"
-    # products, sums, the divider (B + 6 stages: a bit a stage) and the square root (B + 2)
-    assert meta["latency"] == 2 * PRODUCT_LATENCY + 5 + (b + 6) + (b + 2)
+    # products, squares (B + 5 bits: WideProducts at B = 16), sums, the square root (B + 6
+    # stages: a bit a stage) and the divider (B + 2)
+    assert meta["latency"] == PRODUCT_LATENCY + WIDE_PRODUCT_LATENCY + 5 + (b + 6) + (b + 2)
     assert meta["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
     assert sorted(meta["ports"]["i__payload"]["fields"]) == sorted(
         fixed_peercy.input_keys(Config()) + ["tag"])

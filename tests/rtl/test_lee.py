@@ -15,8 +15,11 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.lee import BlockROM, LeeIllumination, LeeRotation, ratio_index
-from bumprtl.rtl.pipe import ROM_LATENCY
+from bumprtl.rtl.lee import (ROM_STAGES, SINE_STAGES, BlockROM, LeeIllumination, LeeRotation,
+                             ratio_index)
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY
+from bumprtl.rtl.shade import SHADE_LATENCY
+from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY
 from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simulate_stream
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.golden.fixed import lee as fixed_lee
@@ -90,6 +93,25 @@ def test_latency_and_one_pixel_per_clock():
     codes = random_codes(300, cfg, seed=5)
     rot_cycles, ill_cycles = check_datapath(cfg, codes, "no_stall")
     assert rot_cycles == ill_cycles == 300
+
+
+@pytest.mark.parametrize("cfg, prop, dot, rotation, illumination", [
+    (Config(angle_bits=12, frac_bits=12), PRODUCT_LATENCY, PRODUCT_LATENCY, 32, 22),
+    (Config(frac_bits=13), PRODUCT_LATENCY, PRODUCT_LATENCY, 32, 22),
+    (Config(), PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 32, 24),
+    (Config(angle_bits=16, frac_bits=24), WIDE_PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 34, 24)],
+    ids=["a12b12", "b13", "default", "a16b24"])
+def test_latencies_follow_the_product_widths(cfg, prop, dot, rotation, illumination):
+    """A product whose operands outgrow one 18-bit DSP input is a WideProduct, two stages
+    more: eq. 19's (90 - |Z|, angle_bits + 3 bits, x T_prop, B + 1 bits) from angle_bits 16
+    or B = 17, eq. 24's (c- - c+, B + 3 bits, x c_phi) from B = 16."""
+    cfg = cfg.replace(method="lee")
+    rot, ill = LeeRotation(cfg), LeeIllumination(cfg)
+    for unit in (rot, ill):
+        unit._MustUse__silence = True          # read for its latency only, never elaborated
+    assert (rot.latency, ill.latency) == (rotation, illumination)
+    assert rot.latency == SINE_STAGES + 8 + 3 * ROM_STAGES + WIDE_PRODUCT_LATENCY + prop
+    assert ill.latency == REGISTERED_SINE_LATENCY + dot + 2 + SHADE_LATENCY
 
 
 # --- bit-exact against the golden model -----------------------------------------------------

@@ -12,7 +12,7 @@ import subprocess
 import numpy as np
 import pytest
 from amaranth.back import verilog
-from amaranth.hdl import Fragment, Instance, Module, Signal, signed, unsigned
+from amaranth.hdl import Const, Fragment, Instance, Module, Signal, signed, unsigned
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
@@ -22,7 +22,8 @@ from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
-                              RegisteredProduct, RegisteredROM, WideProduct)
+                              RegisteredProduct, RegisteredROM, WideProduct, fits_dsp,
+                              product_latency)
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import load_scene_config
@@ -234,6 +235,47 @@ def test_wide_products_are_the_product_in_both_forms(unit, latency, a_shape, b_s
     found = _instances(unit(a_shape, b_shape, "prod", target=ECP5()))
     assert [i.type for i in found] == ["MULT18X18D"] * dsps
     assert not _instances(unit(a_shape, b_shape, "prod"))
+
+
+def test_product_latency_follows_the_dsp_input():
+    """PRODUCT_LATENCY while every operand is one signed 18-bit DSP input, else the
+    WideProduct's WIDE_PRODUCT_LATENCY."""
+    assert product_latency(signed(18), signed(18)) == PRODUCT_LATENCY
+    assert product_latency(unsigned(17), signed(4)) == PRODUCT_LATENCY
+    assert product_latency(unsigned(18), signed(4)) == WIDE_PRODUCT_LATENCY
+    assert product_latency(signed(18), signed(19)) == WIDE_PRODUCT_LATENCY
+
+
+def _split_products(dut):
+    """Names and operand shapes of the RegisteredProducts of ``dut`` (outside a WideProduct,
+    by a variable) whose operands do not fit one DSP input: on ECP5 their limbs' sum is left
+    to the cycle that reads the product."""
+    found = []
+
+    def walk(frag, path):
+        unit = frag.origins[0] if frag.origins else None
+        if isinstance(unit, WideProduct):
+            return
+        if (isinstance(unit, RegisteredProduct) and not isinstance(unit.b, Const)
+                and not fits_dsp(unit.a.shape(), unit.b.shape())):
+            found.append((path, unit.a.shape(), unit.b.shape()))
+        for sub, name, _ in frag.subfragments:
+            walk(sub, f"{path}.{name}")
+    walk(Fragment.get(dut, None), "")
+    return found
+
+
+@pytest.mark.parametrize("cfg", [Config(method="exact"), Config(method="lee"),
+                                 Config(method="peercy"),
+                                 Config(method="peercy", angle_bits=14, frac_bits=20)],
+                         ids=["exact", "lee", "peercy", "peercy-b20"])
+def test_units_register_the_limb_sums_of_wide_products(cfg):
+    """Every product of a method's units whose operands outgrow one DSP input is a
+    WideProduct (its latency, pipe.product_latency, follows the widths): at the default
+    B = 16 lee's eq. 24 product and Peercy's squares, at B = 20 Peercy's transform and dots
+    as well."""
+    for unit in (VectorRotation(cfg), Illumination(cfg)):
+        assert _split_products(unit) == []
 
 
 # --- the stall rule as a throughput property ---------------------------------------------------
