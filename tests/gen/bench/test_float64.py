@@ -1,6 +1,7 @@
 import subprocess
 import sys
 
+from bumprtl.gen.cli.main import main
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 
 CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
@@ -26,8 +27,9 @@ def test_bench_float64_prints_every_model():
     assert "closed-form worst case: 8.61 deg" in r.stdout
 
 
-def test_bench_float64_bad_samples_exit_2_one_line():
+def test_bench_float64_bad_samples_exit_2_one_line(capsys):
+    """In process (the command line's own parsing is the test above's)."""
     for argv, word in ((["--samples", "0"], "samples"), (["--seed", "-3"], "seed")):
-        r = subprocess.run(CLI + ["bench", "float64"] + argv, capture_output=True, text=True)
-        assert r.returncode == 2, r.stderr
-        assert word in r.stderr and "Traceback" not in r.stderr and len(r.stderr.splitlines()) == 1
+        assert main(["bench", "float64"] + argv) == 2
+        err = capsys.readouterr().err
+        assert word in err and "Traceback" not in err and len(err.splitlines()) == 1

@@ -44,10 +44,11 @@ def test_datapath_cocotb(sim, unit, method, build_dir):
 # each unit on one of them; the Amaranth-simulator tests cover the rest (tests/rtl/test_baselines_*,
 # the setups bit-exact under stalls in make test), so the setups' Icarus runs (their square-root,
 # divider and reciprocal pipelines: thousands of flip-flops an event-driven simulator steps one
-# by one) are make regress.
+# by one) are make regress, and so is Kim's illumination (the shared back end of Peercy's, which
+# make test runs, behind eqs (3)/(4)).
 @pytest.mark.parametrize("sim,unit,method", [
     pytest.param("icarus", "rotation", "kim", marks=pytest.mark.regress),
-    ("verilator", "illumination", "kim"),
+    pytest.param("verilator", "illumination", "kim", marks=pytest.mark.regress),
     pytest.param("icarus", "rotation", "peercy", marks=pytest.mark.regress),
     ("verilator", "illumination", "peercy")])
 def test_baseline_cocotb(sim, unit, method, build_dir):
