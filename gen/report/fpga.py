@@ -251,7 +251,17 @@ FPGA_NOTES = """
   Peercy and Ernst 122.1 MHz at 12-bit angles, B = 13). Lee and Kim are pipelined with registers only (`rtl/lee.py`,
   `rtl/baselines/kim.py`: every table read registered before and after its block RAM,
   long mux chains cut); Peercy and Ernst with a pipelined restoring square root and
-  divider, one bit per stage (`rtl/baselines/peercy.py`).
+  divider, one bit per stage (`rtl/baselines/peercy.py`). Every product of Lee, Peercy and
+  Ernst whose operands outgrow one DSP input (at B = 16: lee's eq. 24 product, Peercy's
+  squares; `rtl/pipe.product_latency`) is a `pipe.WideProduct` like the exact
+  illumination's, its limbs' sum in registers of its own: summed in the cycle after the
+  DSP blocks (`RegisteredProduct`'s ECP5 form, one stage less) it held lee at 108.7 and
+  Peercy and Ernst at 103.1 MHz. Kim's products still sum their limbs in that cycle; its
+  limit is elsewhere (the critical-path list). What stops the baselines short of 150 MHz
+  now is named there: Peercy's divider's last quotient bit into the rounded, signed output;
+  in lee's pipeline the route from the cos^n table's block RAM to the interpolation (5.1 ns
+  of routing in the larger design), in lee's setup alone the atan-table address after the
+  reciprocal product; Kim's l_p -> l_qn stage.
 - Units are placed out of context: no I/O buffers, ports are internal nets, so paths
   from a unit's input ports are not timed (the pipelines time them between units).
 """
