@@ -223,8 +223,10 @@ FPGA_NOTES = """
   two models, bit-exact against the golden model on 10^4 pixels under random
   backpressure and input gaps. Both pass under cocotb on Icarus; `make fpga
   PYTEST_ARGS="tests/sim/ecp5/test_postsynth.py -k bit_exact -s"` prints the wall times
-  (2 x 10^4 pixels each, 2 shared cores): exact pipeline synthesis 19.0 s, Icarus build
-  5.6 s, simulation 597 s; scene_default 8.6 s, 4.1 s, 227 s. Verilator lints the exact
+  (2 x 10^4 pixels each, at the 13 / 16 default, 2 cores shared with two nextpnr runs and
+  then the formal proofs): exact pipeline synthesis 24.3 s, Icarus build 13.3 s, simulation
+  1076 s; scene_default 19.1 s, 8.5 s, 629 s (`make fpga PYTEST_ARGS=
+  "tests/sim/ecp5/test_postsynth.py -s"`: 5 passed in 30 min 22 s). Verilator lints the exact
   pipeline's netlist, but its C++ (81 MB, 93 classes) had 7 classes compiled after 14
   minutes, longer than the whole Icarus run. The MULT18X18D model is tested alone
   against plain products in eight register modes (none, input, input + output, input +
