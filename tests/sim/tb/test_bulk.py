@@ -27,7 +27,7 @@ from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_s
 from bumprtl.sim.tb.bulk_sources import pipeline_map
 
 # Icarus is ~1000x slower than Verilator on the pipeline: a smaller frame, the same patterns.
-FRAME = {"icarus": 32, "verilator": 64}
+FRAME = {"icarus": 16, "verilator": 64}
 
 
 def _frame(size):

@@ -27,7 +27,9 @@ SCENE = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8
 ICARUS_HERE = [pytest.param(s, marks=pytest.mark.regress if s == "verilator" else ()) for s in SIMULATORS]
 
 
-@pytest.mark.parametrize("sim,unit", [("icarus", "rotation"),
+# make test: the wrapper (one generic gasket, gen/flow/axis.py) around the illumination here and
+# around a scene pipeline below; around the rotation in make regress.
+@pytest.mark.parametrize("sim,unit", [pytest.param("icarus", "rotation", marks=pytest.mark.regress),
                                       pytest.param("verilator", "rotation",
                                                    marks=pytest.mark.regress),
                                       ("icarus", "illumination"),
