@@ -56,7 +56,7 @@ from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
 from bumprtl.rtl.pipe import (DP16KD_MODES, ROM_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit,
-                             RegisteredROM, dp16kd_rom_block, fits_dsp, product_latency)
+                             RegisteredROM, dp16kd_rom_block, product_latency)
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
@@ -260,13 +260,6 @@ def sine_value(m, pipe, port, angle, cfg: Config, name):
 S, W = SINE_STAGES, WIDE_PRODUCT_LATENCY
 
 
-def _multiplier(pipe, *shapes):
-    """``pipe.multiply`` (PRODUCT_LATENCY) for operands of ``shapes`` that fit one DSP input,
-    else ``pipe.wide_multiply`` (WIDE_PRODUCT_LATENCY): ``pipe.product_latency(*shapes)``
-    stages either way."""
-    return pipe.multiply if fits_dsp(*shapes) else pipe.wide_multiply
-
-
 def prop_operands(cfg: Config):
     """Shapes of eq. 19's product operands, 90 - |Z| (|Z| of :func:`magnitude`) and a T_prop
     word (B + 1 bits), as :class:`LeeRotation` builds them."""
@@ -334,7 +327,7 @@ class LeeRotation(PipeUnit):
     def _rotate(self, m, pipe, v, a, n):
         cfg, k, b = self.cfg, self.cfg.k, self.cfg.frac_bits
         reg, delay, R, P = pipe.register, pipe.delay, ROM_STAGES, self.prop_latency
-        mul = _multiplier(pipe, *prop_operands(cfg))                      # P stages
+        mul = pipe.multiplier(*prop_operands(cfg))                      # P stages
         stage = lambda value, name: reg(value, f"{v}_{name}")
         d = a.phi - n.phi                                                  # adder 1
         x, y = a.theta + d, a.theta - d                                    # adders 2, 3 (eq. 6)
@@ -408,7 +401,7 @@ class LeeIllumination(IlluminationDatapath):
                                 f"{v}_cos_{name}", registered=True)
         first = pipe.register(c["minus"] + c["plus"], f"{v}_first")
         diff = pipe.register(c["minus"] - c["plus"], f"{v}_diff")
-        mul = _multiplier(pipe, *dot_operands(cfg))
+        mul = pipe.multiplier(*dot_operands(cfg))
         second = mul(diff, pipe.register(c["phi"], f"{v}_cos_phi"), f"{v}_second")
         first = pipe.delay(first, self.product_latency, f"{v}_first")
         return pipe.register(round_shift((first << cfg.frac_bits) + second, cfg.frac_bits + 1),

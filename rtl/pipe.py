@@ -484,6 +484,12 @@ class StallPipe:
         self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.adv)]
         return unit.p
 
+    def multiplier(self, *shapes):
+        """The registered product for operands of ``shapes``: :meth:`multiply` when they fit
+        one DSP input (:func:`fits_dsp`), else :meth:`wide_multiply`;
+        :func:`product_latency` ``(*shapes)`` stages either way."""
+        return self.multiply if fits_dsp(*shapes) else self.wide_multiply
+
     def delay(self, value, stages, name):
         """``value`` delayed by ``stages`` ``adv``-enabled registers (0 returns it as is)."""
         for n in range(stages):

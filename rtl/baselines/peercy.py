@@ -65,7 +65,7 @@ from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.pipe import PipeUnit, fits_dsp, product_latency
+from bumprtl.rtl.pipe import PipeUnit, product_latency
 from bumprtl.rtl.shade import IlluminationDatapath
 
 __all__ = ["PeercyRotation", "PeercyIllumination", "PeercySqrt", "PeercyDivider", "vectors",
@@ -119,12 +119,6 @@ def sqrt_stages(cfg: Config):
 def quotient_bits(cfg: Config):
     """Quotient bits (= divider stages) of q = floor(|a| 2**(B+2) / r) <= 2**(B+1): B + 2."""
     return cfg.frac_bits + 2
-
-
-def _multiplier(pipe, *shapes):
-    """``pipe.multiply`` for operands of ``shapes`` that fit one DSP input, else
-    ``pipe.wide_multiply``: ``pipe.product_latency(*shapes)`` stages either way."""
-    return pipe.multiply if fits_dsp(*shapes) else pipe.wide_multiply
 
 
 def _operands(cfg: Config):
@@ -277,7 +271,7 @@ class PeercyRotation(PipeUnit):
         px, out = self.i.payload, self.o.payload
         cw, ns, nq = component_width(cfg), sqrt_stages(cfg), quotient_bits(cfg)
         ops, sq_lat = _operands(cfg), product_latencies(cfg)["square"]
-        mul, square = _multiplier(pipe, *ops["product"]), _multiplier(pipe, *ops["square"])
+        mul, square = pipe.multiplier(*ops["product"]), pipe.multiplier(*ops["square"])
         for v in vectors(cfg):
             a = px[v]
             comps = {}
@@ -325,7 +319,7 @@ class PeercyIllumination(IlluminationDatapath):
 
     def dots(self, m, pipe, payload):
         n, dots = payload.np, {}
-        mul = _multiplier(pipe, *_operands(self.cfg)["product"])
+        mul = pipe.multiplier(*_operands(self.cfg)["product"])
         for v in vectors(self.cfg):
             a = payload[v]
             p = [mul(n[c], a[c], f"{v}_dot_{c}") for c in AXES]                      # + P
