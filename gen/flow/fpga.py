@@ -8,6 +8,7 @@ carry chains), flip-flops (TRELLIS_FF), DSP multipliers (MULT18X18D), block RAM 
 and the achieved Fmax of ``clk``.
 """
 
+import fcntl
 import hashlib
 import json
 import re
@@ -170,14 +171,18 @@ def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):
     key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
     work = Path(cache) / device / key
     row_path = work / "row.json"
-    if row_path.is_file():
-        return {**json.loads(row_path.read_text()), "unit": label}
     work.mkdir(parents=True, exist_ok=True)
-    v_path = work / f"{label}.v"
-    v_path.write_text(text)
-    row = place_and_route(v_path, label, device, work, lpf, seed)
-    report = json.loads((work / f"{label}.pnr.json").read_text())["utilization"]
-    row["available"] = {k: report.get(n, {}).get("available") for k, n in
-                        (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
-    row_path.write_text(json.dumps(row, indent=1))
-    return row
+    # One placement per key at a time: a parallel job with the same hardware waits for it
+    # and reads its row instead of placing it again.
+    with open(work / ".lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if row_path.is_file():
+            return {**json.loads(row_path.read_text()), "unit": label}
+        v_path = work / f"{label}.v"
+        v_path.write_text(text)
+        row = place_and_route(v_path, label, device, work, lpf, seed)
+        report = json.loads((work / f"{label}.pnr.json").read_text())["utilization"]
+        row["available"] = {k: report.get(n, {}).get("available") for k, n in
+                            (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
+        row_path.write_text(json.dumps(row, indent=1))
+        return row

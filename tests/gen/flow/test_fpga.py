@@ -158,3 +158,32 @@ def test_placed_pipeline_runs_in_lock_step_bit_exact(method):
     assert all(r0 == r1 for r0, r1, _ in seen)
     assert all(r0 for r0, _, valid in seen if not valid)
     assert taken == dut.latency + BUFFER_DEPTH
+
+
+def test_the_same_hardware_placed_in_parallel_is_placed_once(tmp_path, monkeypatch):
+    """Two jobs at once with the same hardware under two labels (Peercy's and Ernst's
+    pipelines): the second waits for the first's placement and reads its row."""
+    import json
+    import threading
+    import time
+    from bumprtl.gen.flow.units import build_unit
+    calls = []
+
+    def fake(v_path, top, device, work, lpf=fpga.LPF, seed=1):
+        calls.append(top)
+        time.sleep(0.5)                         # long enough for the other job to arrive
+        (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
+        return {"unit": top, "fmax_mhz": 1.0}
+
+    monkeypatch.setattr(fpga, "place_and_route", fake)
+    units = {label: build_unit("sincos", Config(angle_bits=6, frac_bits=5), ECP5())[0]
+             for label in ("peercy_like", "ernst_like")}
+    rows = {}
+    jobs = [threading.Thread(target=lambda lb=label: rows.update(
+        {lb: fpga.place_component(units[lb], lb, "LFE5U-25F", tmp_path)})) for label in units]
+    for job in jobs:
+        job.start()
+    for job in jobs:
+        job.join()
+    assert len(calls) == 1 and set(rows) == set(units)
+    assert {r["unit"] for r in rows.values()} == set(units)
