@@ -49,7 +49,7 @@ def full_range_codes(cfg, n, seed):
 
 # --- bit-exact in the Amaranth simulator -----------------------------------------------------
 
-@pytest.mark.parametrize("method,n", [("peercy", 1000), ("ernst", 300)])
+@pytest.mark.parametrize("method,n", [("peercy", 500), ("ernst", 150)])
 def test_bit_exact_no_stall_one_pixel_per_clock(method, n):
     """Edge cases + n random pixels (Ernst's datapath is Peercy's: fewer)."""
     cfg = Config(method=method)
@@ -63,7 +63,7 @@ def test_bit_exact_no_stall_one_pixel_per_clock(method, n):
 @pytest.mark.parametrize("pattern", [p for p in PATTERNS if p != "no_stall"])
 def test_bit_exact_under_stalls(pattern):
     cfg = Config(method="peercy")
-    codes = stimulus(cfg, 400, seed=2)
+    codes = stimulus(cfg, 200, seed=2)
     check_rotation(cfg, codes, pattern)
     check_illumination(cfg, codes, pattern)
 
@@ -81,7 +81,7 @@ def test_narrow_and_wide_configurations(specular):
     for cfg in (NARROW.replace(specular=specular),
                 Config(method="ernst", angle_bits=14, frac_bits=20, specular=specular,
                        spec_exponent=128)):
-        codes = concat_codes(stimulus(cfg, 100, seed=4), full_range_codes(cfg, 60, seed=5))
+        codes = concat_codes(stimulus(cfg, 60, seed=4), full_range_codes(cfg, 40, seed=5))
         check_rotation(cfg, codes, "input_gaps")
         check_illumination(cfg, codes, "backpressure")
 

@@ -82,11 +82,13 @@ def _initial_contents(v_text, mem="fetch.map.mem"):
 
 def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     """Paths in a TOML are relative to it; the map file is the Verilog's initial contents
-    word for word (load initial) or absent from it (load port); lint-clean, deterministic."""
+    word for word (load initial) or absent from it (load port); lint-clean, deterministic.
+    At 10-bit angles, B = 11 (the default widths' ROMs would double the time)."""
     (tmp_path / "maps").mkdir()
     _png(tmp_path / "maps" / "c.png", craters(32))
     toml = tmp_path / "maps" / "scene.toml"
-    toml.write_text('height_map = "c.png"\nheight_scale = 3.0\ngeometry = "sphere"\n')
+    toml.write_text('height_map = "c.png"\nheight_scale = 3.0\ngeometry = "sphere"\n'
+                    'angle_bits = 10\nfrac_bits = 11\n')
     out = tmp_path / "a"
     assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(out)]) == 0
     scene = load_scene_config(toml)
@@ -94,14 +96,14 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     words = scene_memories(scene)[0]
     hexwords = [int(x, 16) for x in (out / "pipeline_map.hex").read_text().split()]
     assert hexwords == words.tolist() and len(hexwords) == 32 * 32
-    assert all(len(x) == 7 for x in (out / "pipeline_map.hex").read_text().split())   # 26 bits
+    assert all(len(x) == 5 for x in (out / "pipeline_map.hex").read_text().split())   # 20 bits
     v = (out / "pipeline.v").read_text()
     init = _initial_contents(v)
     assert [init.get(a, 0) for a in range(len(words))] == words.tolist()
     meta = json.loads((out / "pipeline.json").read_text())
     img = meta["memory_images"]["map"]
-    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 26
-    assert "phi in bits [12:0], theta in bits [25:13]" in img["layout"]     # 13-bit angles
+    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 20
+    assert "phi in bits [9:0], theta in bits [19:10]" in img["layout"]      # 10-bit angles
     assert img["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
     assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
     assert meta["block_ram"]["device"] == "LFE5U-85F"
