@@ -12,12 +12,15 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 
 from dataclasses import dataclass, fields, asdict
 
-__all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES"]
+__all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RANGE",
+           "FRAC_BITS_MAX"]
 
 # The names of the method registry (rtl/methods.py: what each method is and builds), in its
 # order. Config validates ``method`` against them here because the registry imports the
 # datapaths, which import Config; rtl/methods.py refuses to load if its keys differ.
 METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
+ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
+FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
 
 
 class BumpError(ValueError):
@@ -109,9 +112,9 @@ class Config:
     palette_blend: bool = False
 
     def __post_init__(self):
-        _check_int("angle_bits", self.angle_bits, 4, 16, "k = angle_bits - 2 must be >= 2")
+        _check_int("angle_bits", self.angle_bits, *ANGLE_BITS_RANGE, "k = angle_bits - 2 must be >= 2")
         k = self.angle_bits - 2
-        _check_int("frac_bits", self.frac_bits, max(4, k - 1), 24,
+        _check_int("frac_bits", self.frac_bits, max(4, k - 1), FRAC_BITS_MAX,
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
                    f"half an LSB; B <= 24 keeps every product inside 64 bits")
         if self.method not in METHOD_NAMES:

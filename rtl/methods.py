@@ -97,7 +97,11 @@ class Method:
         The float64 model ``(PixelInputs, cfg) -> Result`` (sim/golden/float/).
     not_placed : str or None
         Why the ECP5 flow (gen/flow/fpga.py) does not place this method's units; None: it
-        is placed.
+        is placed.    faithful_widths : callable or None
+        ``(cfg) -> (angle_bits, frac_bits) or None``: the narrowest widths at which the
+        method's bound proves every output channel within 1 LSB of float64 end to end (the
+        sidecar's ``faithful_widths``). None here: not searched (lee: its approximations, not
+        its widths, set the error; the baselines are measured, not tuned).
     """
 
     name: str
@@ -117,6 +121,7 @@ class Method:
     error_note: str
     reference: Optional[Callable] = None
     not_placed: Optional[str] = None
+    faithful_widths: Optional[Callable] = None
 
     @property
     def per_pixel(self):
@@ -149,7 +154,7 @@ METHODS = {m.name: m for m in (
            rotates_normal=True,
            predicted_error_bound_lsb=fixed_exact.predicted_error_bound_lsb,
            error_note=f"{_UNQUANTIZED} (proof: sim/golden/fixed/exact.predicted_error_bound_lsb)",
-           reference=exact),
+           reference=exact, faithful_widths=fixed_exact.faithful_widths),
     Method("lee", "Lee et al. 2003 (errata fixed)", baseline=False, table1_column=5,
            rotation=LeeRotation, illumination=LeeIllumination,
            rotated_layout=rtl_lee.rotated_layout,

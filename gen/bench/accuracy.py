@@ -86,6 +86,34 @@ def _grid_cell(row):
     return "—" if g is None else " / ".join(str(g[k]["max"]) for k in KINDS)
 
 
+def _width_points(args):
+    """The Configs to measure: every valid (angle bits, frac bits, n) of the grid, or with
+    ``--faithful-widths`` each n at the widths the method's bound proves within 1 LSB (the
+    sidecar's ``faithful_widths``; a line saying so for an n that has none)."""
+    base = Config(method=args.method, spec_index_bits=args.spec_index_bits)
+    if args.faithful_widths:
+        rule = get(args.method).faithful_widths
+        if rule is None:
+            raise BumpError(f"--faithful-widths: method {args.method} has no faithful widths "
+                            f"(only exact searches them)")
+        points = []
+        for n in args.spec_exponent:
+            widths = rule(base.replace(spec_exponent=n))
+            points.append(f"n = {n}: no widths in the Config's range prove every channel within "
+                          f"1 LSB" if widths is None else
+                          base.replace(angle_bits=widths[0], frac_bits=widths[1], spec_exponent=n))
+        return points
+    points = []
+    for a in args.angle_bits:
+        for b in args.frac_bits:
+            for n in args.spec_exponent:
+                try:
+                    points.append(base.replace(angle_bits=a, frac_bits=b, spec_exponent=n))
+                except ConfigError:
+                    continue
+    return points
+
+
 def run(args):
     for n in args.spec_exponent:                 # a bad exponent is an error, not a skipped row
         Config(spec_exponent=n, spec_index_bits=args.spec_index_bits)
@@ -93,8 +121,10 @@ def run(args):
     size = args.scene_size
     if size and not (16 <= size <= 4096 and size & (size - 1) == 0):
         raise BumpError(f"scene_size must be 0 or a power of two in [16, 4096], got {size}")
-    print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} "
-          f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))} "
+    points = _width_points(args)
+    widths = ("--faithful-widths" if args.faithful_widths else
+              f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))}")
+    print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} {widths} "
           f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits} "
           f"--scene-size {args.scene_size}"
           + (f" --scene-widths {' '.join(map(str, args.scene_widths))}" if args.scene_widths else ""))
@@ -111,30 +141,27 @@ def run(args):
     print("|---|---|---|---|---|---|---|---|---|---|")
     px = PixelInputs.random(args.samples, np.random.default_rng(11))
     failures, summary = [], []
-    for a in args.angle_bits:
-        for b in args.frac_bits:
-            for n in args.spec_exponent:
-                try:
-                    cfg = Config(method=args.method, angle_bits=a, frac_bits=b, spec_exponent=n,
-                                 spec_index_bits=args.spec_index_bits)
-                except ConfigError:
-                    continue
-                result, sets = measure(cfg, px)
-                for channel, row in result.items():
-                    top = max(row[k]["max"] for k in KINDS)
-                    if row["grid"] is not None:
-                        top = max(top, *(row["grid"][k]["max"] for k in KINDS))
-                    ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
-                    print(f"| {a} | {b} | {n} | {channel} | {row['random']['max']} / "
-                          f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
-                          f"{row['adversarial']['mean']:.4f} | {row['search']['max']} | "
-                          f"{_grid_cell(row)} | {row['bound']} | {ratio} |", flush=True)
-                    failures += [_failure(cfg, channel, k, row, sets) for k in KINDS
-                                 if row[k]["max"] > row["bound"]]
-                    if row["grid"] is not None:
-                        failures += [_failure(cfg, channel, k, row, sets, grid=True) for k in KINDS
-                                     if row["grid"][k]["max"] > row["bound"]]
-                summary.append(_summary(cfg, result))
+    for cfg in points:
+        if isinstance(cfg, str):                 # an exponent without faithful widths
+            summary.append(cfg)
+            continue
+        a, b, n = cfg.angle_bits, cfg.frac_bits, cfg.spec_exponent
+        result, sets = measure(cfg, px)
+        for channel, row in result.items():
+            top = max(row[k]["max"] for k in KINDS)
+            if row["grid"] is not None:
+                top = max(top, *(row["grid"][k]["max"] for k in KINDS))
+            ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
+            print(f"| {a} | {b} | {n} | {channel} | {row['random']['max']} / "
+                  f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
+                  f"{row['adversarial']['mean']:.4f} | {row['search']['max']} | "
+                  f"{_grid_cell(row)} | {row['bound']} | {ratio} |", flush=True)
+            failures += [_failure(cfg, channel, k, row, sets) for k in KINDS
+                         if row[k]["max"] > row["bound"]]
+            if row["grid"] is not None:
+                failures += [_failure(cfg, channel, k, row, sets, grid=True) for k in KINDS
+                             if row["grid"][k]["max"] > row["bound"]]
+        summary.append(_summary(cfg, result))
     print("\n" + "\n".join(summary))
     failures += _lights(args, px)
     if args.scene_size:
@@ -286,6 +313,10 @@ def add_parser(sub):
     p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
                    help="Phong exponents n (default: 16)")
     p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
+    p.add_argument("--faithful-widths", action="store_true",
+                   help="measure each --spec-exponent at the narrowest widths the bound proves "
+                        "within 1 LSB on every channel (the sidecar's faithful_widths) instead of "
+                        "the --angle-bits x --frac-bits grid")
     p.add_argument("--scene-size", type=int, default=128,
                    help="also shade every built-in scene at this size, default widths (0: no scenes)")
     p.add_argument("--scene-widths", type=int, nargs=2, metavar=("ANGLE_BITS", "FRAC_BITS"),

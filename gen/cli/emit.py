@@ -2,6 +2,7 @@
 ``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
 import json
+import sys
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
@@ -13,7 +14,7 @@ from bumprtl.gen.flow.fusesoc import write_core
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, DEVICE_BRAM, LOADS, emit_scene_unit,
                                        memory_images, scene_command)
 from bumprtl.gen.render.rtl import scene_memories
-from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, emit_unit
+from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, emit_unit, faithful_note
 
 
 def run(args):
@@ -38,6 +39,9 @@ def run(args):
         v_path, j_path = emit_unit(args.unit, cfg, args.out)
     for path in (v_path, j_path, *hexes):
         print(f"wrote {path}")
+    note = _faithful_note(args.unit, cfg)
+    if note:
+        print(note, file=sys.stderr)
     if args.fusesoc:
         print(f"wrote {write_core(v_path, json.loads(j_path.read_text())['command'])}")
     if args.lint:
@@ -47,6 +51,16 @@ def run(args):
         print(f"lint: {'clean' if not problems else f'{len(problems)} problem(s)'}")
         return 1 if problems else 0
     return 0
+
+
+def _faithful_note(unit, cfg):
+    """The widths that keep every channel within 1 LSB, when the emitted ones are narrower
+    (a rotation or illumination unit, or a per-pixel scene)."""
+    if unit in ("rotation", "illumination"):
+        return faithful_note(cfg)
+    if unit == "pipeline" and cfg.shading == "per-pixel":
+        return faithful_note(cfg.config, cfg.lights, cfg.texture)
+    return None
 
 
 def _scene_images(unit, scene, args):

@@ -11,7 +11,7 @@ from amaranth.hdl import Fragment
 
 from bumprtl.gen.flow.emit import emit
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
-from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.methods import METHODS, get
 from bumprtl.rtl.palette import PaletteLUT, index_bits
@@ -20,7 +20,7 @@ from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 
 __all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command",
-           "error_bounds"]
+           "error_bounds", "faithful_widths", "faithful_note"]
 
 
 @dataclass(frozen=True)
@@ -44,7 +44,7 @@ def _method_sidecar(cfg, dut):
     method = get(cfg.method)
     return {"latency": dut.latency, "throughput": 1, "method": cfg.method, "roms": _roms(dut),
             "error_bound_lsb": method.predicted_error_bound_lsb(cfg),
-            "error_bounds_lsb": error_bounds(cfg),
+            "error_bounds_lsb": error_bounds(cfg), **faithful_widths(cfg),
             "error_note": method.error_note}
 
 
@@ -60,6 +60,39 @@ def error_bounds(cfg, lights=1, texture=False):
         out["specular"] = 0
     out["color"] = bound(cfg, "blend" if texture else "color", lights)
     return out
+
+
+def faithful_widths(cfg):
+    """``{"faithful_widths": {"angle_bits", "frac_bits"} or None}``: the narrowest widths at
+    which the method's bound proves every output channel within 1 LSB of float64 at
+    ``cfg``'s other fields (the registry's ``faithful_widths``; None: no widths in the
+    Config's range do; without specular the exponent plays no part); ``{}`` for a method
+    that does not search them."""
+    rule = get(cfg.method).faithful_widths
+    if rule is None:
+        return {}
+    widths = rule(cfg if cfg.specular else cfg.replace(spec_exponent=1))
+    return {"faithful_widths": None if widths is None else
+            {"angle_bits": widths[0], "frac_bits": widths[1]}}
+
+
+def faithful_note(cfg, lights=1, texture=False):
+    """One line for the command line when a proven bound of ``cfg`` exceeds 1 LSB: the
+    channels over it and the widths that prove every channel within it (or that none in
+    the Config's range do). None when every bound is 1 or the method searches no widths."""
+    found = faithful_widths(cfg)
+    over = {c: b for c, b in error_bounds(cfg, lights, texture).items() if b > 1}
+    if not found or not over:
+        return None
+    bounds = ", ".join(f"{c} {b} LSB" for c, b in over.items())
+    want = found["faithful_widths"]
+    fix = (f"angle_bits {want['angle_bits']}, frac_bits {want['frac_bits']} prove every "
+           f"channel within 1 LSB" if want else
+           f"no widths up to the Config's angle_bits {ANGLE_BITS_RANGE[1]}, frac_bits "
+           f"{FRAC_BITS_MAX} prove 1 LSB at spec_exponent {cfg.spec_exponent}")
+    return (f"note: proven error bounds at angle_bits {cfg.angle_bits}, frac_bits "
+            f"{cfg.frac_bits}: {bounds} (sidecar error_bounds_lsb; measured errors: "
+            f"bumprtl bench accuracy); {fix}")
 
 
 def _roms(dut):
@@ -84,6 +117,7 @@ def _pipeline_sidecar(scene, dut):
            "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
     if scene.shading == "per-pixel":
         out["error_bounds_lsb"] = error_bounds(scene.config, scene.lights, scene.texture)
+        out.update(faithful_widths(scene.config))
     return out
 
 

@@ -6,9 +6,11 @@ Scales (all integers carry ``frac_bits`` = B fractional bits; no rounding until 
   N'.A' = (n.x4 a.p2 + 2 n.y2 a.y2 + 2 n.z4 a.z) / 8, one rounding back to B bits.
 """
 
+import functools
+
 import numpy as np
 
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config
 from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
@@ -61,6 +63,34 @@ def dot_error_bound(cfg: Config):
     and the dot's one rounding adds u/2."""
     u = 2.0 ** -cfg.frac_bits
     return (1.5 + np.sqrt(3) / 2 + 0.5 + 1.3 * u) * u
+
+
+@functools.lru_cache(maxsize=64)
+def faithful_widths(cfg: Config):
+    """``(angle_bits, frac_bits)``: the narrowest widths (fewest angle bits, then fewest
+    fractional bits) at which :func:`predicted_error_bound_lsb` proves every output channel
+    (diffuse, specular, colour; one light) within 1 LSB of float64 end to end, ``cfg``'s
+    other fields kept; None if no widths in the Config's range do.
+
+    Two errors of the specular term grow with the Phong exponent n (docs/fixed_point.md):
+    the inputs' rounding to the angle grid moves 255 cos^n by up to about
+    255 n cos^(n-1)(a) sin(a) D, largest at sin a = 1 / sqrt(n), so it grows as sqrt(n) (each
+    factor 4 in n halves the step D must have: one more angle bit), and the dot product's
+    own error (a few 2^-B) times the slope 255 n of cos^n near N'.H' = 1 grows as n (each
+    factor 2: one more fractional bit). The bound falls as either width grows, so an angle
+    width that does not reach 1 LSB at the widest B reaches it at none."""
+    lo, hi = ANGLE_BITS_RANGE
+    for angle_bits in range(lo, hi + 1):
+        if not _faithful(cfg.replace(angle_bits=angle_bits, frac_bits=FRAC_BITS_MAX)):
+            continue
+        first = max(4, angle_bits - 3)                # Config's frac_bits floor: B >= k - 1
+        return angle_bits, next(b for b in range(first, FRAC_BITS_MAX + 1)
+                                if _faithful(cfg.replace(angle_bits=angle_bits, frac_bits=b)))
+    return None
+
+
+def _faithful(cfg: Config):
+    return all(predicted_error_bound_lsb(cfg, c) <= 1 for c in ("diffuse", "specular", "color"))
 
 
 def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):

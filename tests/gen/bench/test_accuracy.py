@@ -11,6 +11,7 @@ from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.methods import datapath_fixed, encode_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
+from bumprtl.sim.golden.fixed.exact import faithful_widths
 from bumprtl.sim.golden.float.conventional import conventional
 
 DEFAULT = Config()
@@ -167,3 +168,24 @@ def test_bad_scene_widths_is_one_line_exit_2(capsys):
     assert main(["bench", "accuracy", "--scene-widths", "3", "16", "--scene-size", "0"]) == 2
     err = capsys.readouterr().err.strip()
     assert "angle_bits" in err and "[4, 16]" in err and len(err.splitlines()) == 1
+
+
+def test_faithful_widths_measure_each_exponent_at_its_proven_widths(small_searches, capsys):
+    """``--faithful-widths``: each n at the narrowest widths whose bound is 1 LSB on every
+    channel (the sidecar's), measured within it; an n with none says so in one line; a
+    method that searches none is refused in one line."""
+    args = ["bench", "accuracy", "--samples", "2000", "--faithful-widths", "--spec-exponent",
+            "64", "1024", "--scene-size", "0"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    a, b = faithful_widths(Config(spec_exponent=64))
+    assert "--faithful-widths --spec-exponent 64 1024" in out
+    for channel in ("diffuse", "specular", "color"):
+        row = re.search(rf"\| {a} \| {b} \| 64 \| {channel} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ "
+                        r"\| (\d+) \| .+? \| (\d+) \|", out)
+        assert row and max(int(g) for g in row.groups()[:3]) <= 1 == int(row.group(4)), (channel, out)
+    assert "n = 1024: no widths in the Config's range prove every channel within 1 LSB" in out
+    assert "| 1024 |" not in out
+    assert main(args[:-2] + ["--method", "lee", "--scene-size", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "faithful" in err and "lee" in err and len(err.splitlines()) == 1

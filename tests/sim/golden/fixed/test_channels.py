@@ -15,8 +15,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.units import build_unit, error_bounds
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config
 from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
@@ -26,6 +27,7 @@ from bumprtl.sim.golden.accuracy import (adversarial_pixels, arithmetic_pixels, 
                                          term_errors_lsb)
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
 from bumprtl.sim.golden.fixed.common import specular_fine_fixed
+from bumprtl.sim.golden.fixed.exact import faithful_widths
 from bumprtl.sim.golden.fixed.pipeline import combine_lights_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.scenes import SCENES, load_scene
@@ -113,9 +115,52 @@ def test_specular_term_within_the_table_error_on_every_dot(exponent, frac_bits):
 
 
 def test_wide_exponent_still_emits_with_its_larger_bound():
-    """Widths that cannot reach 1 LSB are not refused: the sidecar states the larger bound."""
+    """Widths that cannot reach 1 LSB are not refused: the sidecar states the larger bound,
+    and at n = 1024 no widths in the Config's range prove 1 LSB (16-bit angles are the
+    widest: the angle grid's error alone stays above it)."""
     _, sidecar, _ = build_unit("illumination", Config(spec_exponent=1024))
     assert sidecar["error_bounds_lsb"]["specular"] > 10 and sidecar["error_bound_lsb"] == 1
+    assert sidecar["faithful_widths"] is None
+    widest = Config(angle_bits=ANGLE_BITS_RANGE[1], frac_bits=FRAC_BITS_MAX, spec_exponent=1024)
+    assert error_bounds(widest)["specular"] == 2
+
+
+@pytest.mark.parametrize("exponent", [16, 64, 256, 512])
+def test_faithful_widths_are_the_narrowest_proven_and_measure_within_1_lsb(exponent):
+    """The sidecar's faithful_widths: every channel's bound is 1 there, one angle bit fewer
+    (at any B) or one fractional bit fewer proves more, and the measurement (random, the
+    adversarial searches aimed at the specular term and at the colour) is within 1 LSB on
+    every channel -- the proof checked against float64 at widths far from the default."""
+    angle_bits, frac_bits = faithful_widths(Config(spec_exponent=exponent))
+    cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits, spec_exponent=exponent)
+    assert build_unit("illumination", Config(spec_exponent=exponent))[1]["faithful_widths"] == \
+        {"angle_bits": angle_bits, "frac_bits": frac_bits}
+    assert error_bounds(cfg) == {"diffuse": 1, "specular": 1, "color": 1}
+    assert max(error_bounds(cfg.replace(frac_bits=frac_bits - 1)).values()) > 1
+    assert max(error_bounds(cfg.replace(angle_bits=angle_bits - 1, frac_bits=FRAC_BITS_MAX)).values()) > 1
+    measured = {c: 0 for c in CHANNELS}
+    for px in (PixelInputs.random(20_000, np.random.default_rng(11)),
+               adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular"),
+               adversarial_pixels(cfg, candidates=40_000, keep=200, channel="color")):
+        for c, v in worst(term_errors_lsb(exact_fixed, px, cfg)).items():
+            measured[c] = max(measured[c], v)
+    assert measured == {"diffuse": 1, "specular": 1, "color": 1}, measured
+
+
+def test_emit_names_the_faithful_widths_when_a_bound_exceeds_1_lsb(tmp_path, capsys):
+    """bumprtl emit says on stderr which bounds exceed 1 LSB and which widths prove 1 LSB;
+    at those widths it says nothing."""
+    assert main(["emit", "illumination", "--spec-exponent", "256", "--out", str(tmp_path)]) == 0
+    note = capsys.readouterr().err.strip().splitlines()
+    want = faithful_widths(Config(spec_exponent=256))
+    bounds = error_bounds(Config(spec_exponent=256))
+    assert len(note) == 1 and f"specular {bounds['specular']} LSB" in note[0], note
+    assert f"angle_bits {want[0]}, frac_bits {want[1]} prove every channel within 1 LSB" in note[0]
+    assert main(["emit", "illumination", "--spec-exponent", "256", "--angle-bits", str(want[0]),
+                 "--frac-bits", str(want[1]), "--out", str(tmp_path)]) == 0
+    assert capsys.readouterr().err == ""
+    assert main(["emit", "illumination", "--spec-exponent", "1024", "--out", str(tmp_path)]) == 0
+    assert "no widths up to the Config's angle_bits 16, frac_bits 24" in capsys.readouterr().err
 
 
 def two_lights(n, seed):
