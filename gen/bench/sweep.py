@@ -59,6 +59,7 @@ class Grid:
     samples: int          # random vectors per point
     scenes: tuple
     size: int             # scene images are size x size
+    adversarial: int = 200_000   # candidates of each adversarial search (the 1 / 200 kept)
 
 
 GRIDS = {
@@ -135,7 +136,9 @@ class Context:
         angle_bits and channel."""
         key = (cfg.angle_bits, cfg.spec_exponent, channel)
         if key not in self._adversarial:
-            self._adversarial[key] = adversarial_pixels(cfg, channel=channel)
+            self._adversarial[key] = adversarial_pixels(
+                cfg, candidates=self.grid.adversarial, keep=max(20, self.grid.adversarial // 200),
+                channel=channel)
         return self._adversarial[key]
 
 

@@ -193,11 +193,17 @@ def test_block_rom_ecp5_form(depth, width, ports, build_dir):
 
 # --- emission and cocotb on the emitted Verilog ----------------------------------------------
 
-@pytest.mark.parametrize("unit", ["rotation", "illumination"])
-def test_emitted_verilog_lint_clean(unit, build_dir):
-    v, j = emit_unit(unit, Config(method="lee"), build_dir)
+@pytest.mark.parametrize("unit, widths", [
+    ("rotation", {"angle_bits": 10, "frac_bits": 11}), ("illumination", {}),
+    pytest.param("rotation", {}, marks=pytest.mark.regress)])
+def test_emitted_verilog_lint_clean(unit, widths, build_dir):
+    """Lint-clean at the default widths; the rotation's twelve ROMs at 10-bit angles in make
+    test (the default widths' in make regress: 2049-word ROMs triple the lint time)."""
+    cfg = Config(method="lee", **widths)
+    v, j = emit_unit(unit, cfg, build_dir)
     assert lint(v) == []
     assert v.read_text().splitlines()[0].find("--method lee") > 0   # the command that made it
+    assert f"--angle-bits {cfg.angle_bits} --frac-bits {cfg.frac_bits}" in v.read_text().splitlines()[0]
 
 
 def test_widest_config_bit_exact_on_stress_cases():

@@ -70,7 +70,7 @@ def test_write_section_keeps_other_sections(tmp_path):
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
     grid = Grid(angle_bits=(6, 14), frac_bits=(5,), palette_sizes=(16,), samples=300,
-                scenes=("bumps",), size=16)
+                scenes=("bumps",), size=16, adversarial=4000)
     opts = SimpleNamespace(methods=("exact", "palette", "baselines"), fpga=False, sim=False,
                            device="LFE5U-85F")
     work = tmp_path_factory.mktemp("sweep")
