@@ -48,6 +48,7 @@ units of :mod:`bumprtl.sim.formal.mutants`, whose failure must be the property i
 
 import contextlib
 import re
+import threading
 
 from amaranth.hdl import (Assert, Assume, Const, Cover, Elaboratable, Fragment, Module, Mux,
                           Signal, Value, ValueCastable)
@@ -71,7 +72,30 @@ def observe_pipes(read_ports=0):
     "reads": {name: [read data 1, 2 stages after the address]}}``; ``read_ports``: that
     many asynchronous read ports are added to every memory a pipe adds with
     ``StallPipe.memory`` or ``StallPipe.ram`` (generic form; before it elaborates), for
-    assertions about its contents. StallPipe itself is restored afterwards."""
+    assertions about its contents. StallPipe itself is restored afterwards. The patch is
+    process-wide, so one block at a time observes (the runner elaborates in parallel
+    threads, ``make formal -j 2``): a second thread waits until the first has restored
+    StallPipe."""
+    with _OBSERVING:
+        with _observed(read_ports) as seen:
+            yield seen
+
+
+# StallPipe's methods are patched for the whole process while a block observes its pipes:
+# one elaboration at a time, or a second thread would save the first one's patches as the
+# originals and lose its own pipes when the first one restores them.
+_OBSERVING = threading.RLock()
+
+
+@contextlib.contextmanager
+def _serialized():
+    """Elaborate without observing, but never while another thread observes."""
+    with _OBSERVING:
+        yield {}
+
+
+@contextlib.contextmanager
+def _observed(read_ports):
     seen = {}
     init, register = StallPipe.__init__, StallPipe.register
     memory, ram = StallPipe.memory, StallPipe.ram
@@ -238,7 +262,7 @@ class StreamContract(Elaboratable):
         m = Module()
         dut = self.dut
         ports = 2 if self.prop == "bank" else 0          # the watched entry of both banks
-        with observe_pipes(ports) if self.lemmas else contextlib.nullcontext({}) as pipes:
+        with observe_pipes(ports) if self.lemmas else _serialized() as pipes:
             fragment = Fragment.get(dut, platform)
         self._pipes = pipes
         m.submodules.dut = _Built(fragment)

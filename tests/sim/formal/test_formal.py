@@ -4,13 +4,16 @@ two broken units caught (the stall enable of the issue, and the palette pipeline
 bank wiring), and the runner's failure report. The rest (the other broken units here,
 marked ``formal``; every unit and scene pipeline in the table) is `make formal`."""
 
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 from amaranth.back import rtlil
 
 from bumprtl.sim.formal import run as formal_run
-from bumprtl.sim.formal.contract import StreamContract
+from bumprtl.sim.formal.contract import StreamContract, observe_pipes
 from bumprtl.sim.formal.mutants import MUTANTS, Glitcher
 from bumprtl.sim.formal.run import check, check_mutant
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
@@ -65,3 +68,39 @@ def test_lemmas_come_from_the_units_own_registers():
     rtlil.convert(top, name="top", ports=top.free_inputs())
     latency = top.dut.latency
     assert top.lemma_count == latency + 1
+
+
+def test_parallel_elaborations_each_observe_every_stage():
+    """make formal elaborates in parallel threads (-j 2) and observe_pipes patches StallPipe
+    for the whole process: two contracts built at once must both get every stage's lemma
+    (the textured pipeline once lost its illumination's tags, and with them the induction
+    of its order), and the second thread waits while the first observes."""
+    def lemmas(name):
+        top = StreamContract(TARGETS[name].unit(), "order")
+        rtlil.convert(top, name="top", ports=top.free_inputs())
+        return top.lemma_count
+
+    names = ["pipeline_default", "sincos", "rotation_exact", "illumination_exact"]
+    serial = {n: lemmas(n) for n in set(names)}
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        parallel = list(pool.map(lemmas, names))
+    assert parallel == [serial[n] for n in names], (parallel, serial)
+
+    inside, order = threading.Event(), []
+
+    def first():
+        with observe_pipes():
+            inside.set()
+            time.sleep(0.3)
+            order.append("first leaves")
+
+    def second():
+        inside.wait()
+        with observe_pipes():
+            order.append("second enters")
+    threads = [threading.Thread(target=f) for f in (first, second)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert order == ["first leaves", "second enters"]
