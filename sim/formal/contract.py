@@ -61,6 +61,7 @@ __all__ = ["PROPERTIES", "StreamContract", "observe_pipes", "pipeline_layers"]
 PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
 
 _TAG_REG = re.compile(r"(tag|bank|oor)_d(\d+)$")
+CHUNK = 12          # stages per ghost counter of one long pipe (quiet's occupancy lemma)
 
 
 @contextlib.contextmanager
@@ -202,6 +203,7 @@ class StreamContract(Elaboratable):
         (oldest last: nearest the output) as the last layer's stages."""
         stages, lockstep = [], []
         self._layer_stages, self._layer_takes, self._buffer_stages = [], [], 0
+        self._lead_pipes = []
         for layer in self.layers:
             recs = [pipes.get(id(unit.i.valid)) for unit in layer]
             lead = recs[0]
@@ -210,6 +212,7 @@ class StreamContract(Elaboratable):
             for n in range(1, len(lead["valid"])):
                 stages.append((lead["valid"][n], lead["tags"].get(n)))
             self._layer_stages.append(len(lead["valid"]) - 1)
+            self._lead_pipes.append(lead)
             unit = layer[0]
             self._layer_takes.append((unit.i.valid & unit.i.ready, unit.o.valid & unit.o.ready))
             for rec in recs[1:]:
@@ -328,6 +331,25 @@ class StreamContract(Elaboratable):
             for part in parts:
                 total = (total + part)[:width]
             self._lemma(m, occ == total, "pixels in flight = sum over the layers")
+        elif self.lemmas and stages and len(stages) > CHUNK and len(self._lead_pipes) == 1:
+            # One long StallPipe (Kim's setup: 46 stages at the formal widths): one ghost
+            # counter per run of CHUNK stages, as the layers above. Every stage moves on adv
+            # (valid[n] <= valid[n - 1]), so a run gains valid[first - 1] and loses
+            # valid[last] on each adv; valid[0] is i.valid and adv is i.ready.
+            pipe = self._lead_pipes[0]
+            valid, adv = pipe["valid"], pipe["adv"]
+            parts = []
+            for first in range(1, len(valid), CHUNK):
+                last = min(first + CHUNK, len(valid)) - 1
+                occ_c = Signal(width, name=f"in_flight_stages{first}_{last}")
+                m.d.sync += occ_c.eq(occ_c + (adv & valid[first - 1]) - (adv & valid[last]))
+                _ahead, total = self._ahead(m, width, stages[first - 1:last], f"c{first}_")
+                self._lemma(m, occ_c == total, "valid stages of a run = its pixels in flight")
+                parts.append(occ_c)
+            total = Const(0, width)
+            for part in parts:
+                total = (total + part)[:width]
+            self._lemma(m, occ == total, "pixels in flight = sum over the runs")
         elif self.lemmas and stages:
             _ahead, total = self._ahead(m, width, stages)
             self._lemma(m, occ == total, "valid stages = pixels in flight")

@@ -13,7 +13,7 @@ import pytest
 from amaranth.back import rtlil
 
 from bumprtl.sim.formal import run as formal_run
-from bumprtl.sim.formal.contract import StreamContract, observe_pipes
+from bumprtl.sim.formal.contract import CHUNK, StreamContract, observe_pipes
 from bumprtl.sim.formal.mutants import MUTANTS, Glitcher
 from bumprtl.sim.formal.run import check, check_mutant
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
@@ -104,3 +104,19 @@ def test_parallel_elaborations_each_observe_every_stage():
     for t in threads:
         t.join()
     assert order == ["first leaves", "second enters"]
+
+
+def test_a_long_pipe_counts_its_pixels_in_runs():
+    """quiet's occupancy lemma on one long StallPipe (Kim's setup, 46 stages at the formal
+    widths) is a ghost counter per run of CHUNK stages plus their sum: one count over all
+    46 stages made the induction run past its 600 s limit."""
+    top = StreamContract(TARGETS["rotation_kim"].unit(), "quiet")
+    rtlil.convert(top, name="top", ports=top.free_inputs())
+    stages = top.dut.latency
+    assert stages > CHUNK and top.lemma_count == -(-stages // CHUNK) + 1
+
+
+@pytest.mark.formal
+def test_kim_setup_is_quiet_by_induction(build_dir):
+    row = check(TARGETS["rotation_kim"], "quiet", build_dir)
+    assert row.result == "proved" and row.depth == 2, row
