@@ -13,7 +13,7 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 from dataclasses import dataclass, fields, asdict
 
 __all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RANGE",
-           "FRAC_BITS_MAX"]
+           "FRAC_BITS_MAX", "frac_bits_floor"]
 
 # The names of the method registry (rtl/methods.py: what each method is and builds), in its
 # order. Config validates ``method`` against them here because the registry imports the
@@ -21,6 +21,11 @@ __all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RAN
 METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
 ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
 FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
+
+
+def frac_bits_floor(angle_bits):
+    """The fewest fractional bits a Config with ``angle_bits`` accepts: B >= k - 1 (and 4)."""
+    return max(4, angle_bits - 3)
 
 
 class BumpError(ValueError):
@@ -114,9 +119,9 @@ class Config:
     def __post_init__(self):
         _check_int("angle_bits", self.angle_bits, *ANGLE_BITS_RANGE, "k = angle_bits - 2 must be >= 2")
         k = self.angle_bits - 2
-        _check_int("frac_bits", self.frac_bits, max(4, k - 1), FRAC_BITS_MAX,
+        _check_int("frac_bits", self.frac_bits, frac_bits_floor(self.angle_bits), FRAC_BITS_MAX,
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
-                   f"half an LSB; B <= 24 keeps every product inside 64 bits")
+                   f"half an LSB; B <= {FRAC_BITS_MAX} keeps every product inside 64 bits")
         if self.method not in METHOD_NAMES:
             raise ConfigError(f"method must be one of {', '.join(METHOD_NAMES)}, got {self.method!r}",
                               "method")

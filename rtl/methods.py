@@ -97,7 +97,8 @@ class Method:
         The float64 model ``(PixelInputs, cfg) -> Result`` (sim/golden/float/).
     not_placed : str or None
         Why the ECP5 flow (gen/flow/fpga.py) does not place this method's units; None: it
-        is placed.    faithful_widths : callable or None
+        is placed.
+    faithful_widths : callable or None
         ``(cfg) -> (angle_bits, frac_bits) or None``: the narrowest widths at which the
         method's bound proves every output channel within 1 LSB of float64 end to end (the
         sidecar's ``faithful_widths``). None here: not searched (lee: its approximations, not

@@ -313,47 +313,47 @@ class StreamContract(Elaboratable):
         width = (max(len(stages), self.latency) + 2).bit_length() + 1
         occ = Signal(width, name="in_flight")
         m.d.sync += occ.eq(occ + take_in - take_out)
-        if self.lemmas and stages and len(self._layer_takes) > 1:
-            # A pipeline: one ghost counter per layer (its lead unit's handshakes; the output
-            # buffer's: the last unit's output and the pipeline's) equal to that layer's
-            # valid stages, and their sum equal to the whole count. Small sums per unit
-            # instead of one long one (counting is what SAT solvers find hard).
-            parts, first = [], 0
-            for n, (took, gave) in enumerate(self._layer_takes):
-                count = self._layer_stages[n]
-                occ_u = Signal(width, name=f"in_flight_layer{n}")
-                m.d.sync += occ_u.eq(occ_u + took - gave)
-                _ahead, total = self._ahead(m, width, stages[first:first + count], f"l{n}_")
-                self._lemma(m, occ_u == total, "valid stages of a layer = its pixels in flight")
-                parts.append(occ_u)
-                first += count
+        runs = self._runs(stages) if self.lemmas and stages else []
+        if runs:
+            # One ghost counter per run of stages equal to its valid stages, and their sum
+            # equal to the whole count: small sums instead of one long one (counting is what
+            # SAT solvers find hard).
             total = Const(0, width)
-            for part in parts:
-                total = (total + part)[:width]
-            self._lemma(m, occ == total, "pixels in flight = sum over the layers")
-        elif self.lemmas and stages and len(stages) > CHUNK and len(self._lead_pipes) == 1:
-            # One long StallPipe (Kim's setup: 46 stages at the formal widths): one ghost
-            # counter per run of CHUNK stages, as the layers above. Every stage moves on adv
-            # (valid[n] <= valid[n - 1]), so a run gains valid[first - 1] and loses
-            # valid[last] on each adv; valid[0] is i.valid and adv is i.ready.
-            pipe = self._lead_pipes[0]
-            valid, adv = pipe["valid"], pipe["adv"]
-            parts = []
-            for first in range(1, len(valid), CHUNK):
-                last = min(first + CHUNK, len(valid)) - 1
-                occ_c = Signal(width, name=f"in_flight_stages{first}_{last}")
-                m.d.sync += occ_c.eq(occ_c + (adv & valid[first - 1]) - (adv & valid[last]))
-                _ahead, total = self._ahead(m, width, stages[first - 1:last], f"c{first}_")
-                self._lemma(m, occ_c == total, "valid stages of a run = its pixels in flight")
-                parts.append(occ_c)
-            total = Const(0, width)
-            for part in parts:
-                total = (total + part)[:width]
+            for name, took, gave, first, count, what in runs:
+                occ_r = Signal(width, name=f"in_flight_{name}")
+                m.d.sync += occ_r.eq(occ_r + took - gave)
+                _ahead, in_run = self._ahead(m, width, stages[first:first + count], f"{name}_")
+                self._lemma(m, occ_r == in_run, what)
+                total = (total + occ_r)[:width]
             self._lemma(m, occ == total, "pixels in flight = sum over the runs")
         elif self.lemmas and stages:
             _ahead, total = self._ahead(m, width, stages)
             self._lemma(m, occ == total, "valid stages = pixels in flight")
         return occ
+
+    def _runs(self, stages):
+        """The runs of the occupancy lemma, ``(name, took, gave, first stage, stages, what)``:
+        a pipeline's layers (each counted by its lead unit's handshakes; the output buffer's
+        by the last unit's output and the pipeline's); one long StallPipe (Kim's setup: 46
+        stages at the formal widths) in runs of CHUNK stages, each gaining valid[first - 1]
+        and losing valid[last] on every adv (valid[n] <= valid[n - 1]; valid[0] is i.valid
+        and adv is i.ready). None of them (one count over every stage) for a short pipe."""
+        if len(self._layer_takes) > 1:
+            starts = [sum(self._layer_stages[:n]) for n in range(len(self._layer_stages))]
+            return [(f"layer{n}", took, gave, first, count,
+                     "valid stages of a layer = its pixels in flight")
+                    for n, ((took, gave), first, count)
+                    in enumerate(zip(self._layer_takes, starts, self._layer_stages))]
+        if len(stages) > CHUNK and len(self._lead_pipes) == 1:
+            valid, adv = self._lead_pipes[0]["valid"], self._lead_pipes[0]["adv"]
+            runs = []
+            for first in range(1, len(valid), CHUNK):
+                last = min(first + CHUNK, len(valid)) - 1
+                runs.append((f"stages{first}_{last}", adv & valid[first - 1], adv & valid[last],
+                             first - 1, last - first + 1,
+                             "valid stages of a run = its pixels in flight"))
+            return runs
+        return []
 
     def _quiet(self, m, i, o, take_in, take_out, stages):
         occ = self._occupancy(m, take_in, take_out, stages)

@@ -10,7 +10,7 @@ import functools
 
 import numpy as np
 
-from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config
+from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config, frac_bits_floor
 from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
@@ -83,8 +83,7 @@ def faithful_widths(cfg: Config):
     for angle_bits in range(lo, hi + 1):
         if not _faithful(cfg.replace(angle_bits=angle_bits, frac_bits=FRAC_BITS_MAX)):
             continue
-        first = max(4, angle_bits - 3)                # Config's frac_bits floor: B >= k - 1
-        return angle_bits, next(b for b in range(first, FRAC_BITS_MAX + 1)
+        return angle_bits, next(b for b in range(frac_bits_floor(angle_bits), FRAC_BITS_MAX + 1)
                                 if _faithful(cfg.replace(angle_bits=angle_bits, frac_bits=b)))
     return None
 
