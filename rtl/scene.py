@@ -12,7 +12,7 @@ import tomllib
 from dataclasses import dataclass, fields, asdict
 from pathlib import Path
 
-from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL, get
 from bumprtl.sim.scenes import GEOMETRIES, SCENES
 from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE, map_size
@@ -174,7 +174,7 @@ class SceneConfig:
         h = self.height_scale
         if isinstance(h, bool) or not isinstance(h, (int, float)) or not 0 < h < math.inf:
             raise SceneError(f"height_scale must be a positive finite number (texels of relief "
-                             f"for height 1.0), got {h!r}")
+                             f"for height 1.0), got {h!r}", "height_scale")
         if maps and self.bump_map == "flat" and self.shading != "palette":
             raise SceneError(f"{maps[0]} needs bump_map = 'varying': a flat bump map (one N' "
                              f"per polygon) stores no map")
@@ -248,12 +248,15 @@ def flag_name(key):
 
 _KEYS = tuple(f.name for f in fields(SceneConfig))
 
+# The two-light scenes take the widths that prove 1 LSB on every channel with two lights.
+_TWO_LIGHTS = dict(zip(("angle_bits", "frac_bits"), TWO_LIGHT_WIDTHS))
+
 # The scene classes of docs/scenes.md.
 BUILTIN = {
     "default": {"name": "default"},
-    "full": {"name": "full", "lights": 2, "texture": True, "mip_levels": 2},
+    "full": {"name": "full", "lights": 2, "texture": True, "mip_levels": 2, **_TWO_LIGHTS},
     "diffuse": {"name": "diffuse", "specular": False},
-    "two-lights": {"name": "two-lights", "lights": 2},
+    "two-lights": {"name": "two-lights", "lights": 2, **_TWO_LIGHTS},
     "flat": {"name": "flat", "bump_map": "flat"},
     "palette": {"name": "palette", "shading": "palette"},
     "textured": {"name": "textured", "texture": True, "image": "bricks"},

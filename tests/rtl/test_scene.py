@@ -1,6 +1,7 @@
 """SceneConfig: built-in scenes, TOML files, and bad input naming the key."""
 
 import dataclasses
+import math
 
 import pytest
 
@@ -117,3 +118,47 @@ def test_bad_choice_names_the_key(key, value):
     with pytest.raises(BumpError) as e:
         load_scene_config({"name": "t", key: value})
     assert e.value.field == key
+
+
+# Every numeric scene key at both ends of its documented range (SceneConfig's docstring;
+# the Config keys a scene passes on: Config's), each end accepted and one step past it
+# refused with the key named; floats also at the nearest float outside. The lower end of
+# frac_bits depends on angle_bits (k - 1 for k = angle_bits - 2, at least 4), so angle_bits
+# is given. height_scale is the open range (0, inf): the ends themselves are refused.
+SCENE_ENDS = [
+    ("lights", 1, 8, [0, 9], {}),
+    ("angle_bits", 4, 16, [3, 17], {}),
+    ("frac_bits", 9, 24, [8, 25], {"angle_bits": 12}),
+    ("frac_bits", 13, 24, [12, 25], {"angle_bits": 16}),
+    ("frac_bits", 4, 24, [3, 25], {"angle_bits": 4}),
+    ("tag_bits", 0, 32, [-1, 33], {}),
+    ("spec_exponent", 1, 1024, [0, 1025], {}),
+    ("spec_index_bits", 4, 16, [3, 17], {}),
+    ("palette_size", 16, 16384, [15, 16385], {}),
+    *[(k, 0.0, 1.0, [-1e-9, 1 + 1e-9, math.nextafter(0.0, -1), math.nextafter(1.0, 2)], {})
+      for k in ("ka", "kd", "ks")],
+    *[("mip_levels", 1, t.bit_length(), [0, t.bit_length() + 1], {"texture_size": t})
+      for t in (16, 32, 64, 128, 256, 512, 1024, 2048, 4096)],
+]
+
+
+@pytest.mark.parametrize("key, lo, hi, outside, base", SCENE_ENDS,
+                         ids=[f"{r[0]}-{r[1]}-{r[2]}" for r in SCENE_ENDS])
+def test_every_scene_parameter_at_both_ends(key, lo, hi, outside, base):
+    for value in (lo, hi):
+        assert getattr(SceneConfig(name="t", **base, **{key: value}), key) == value
+    for value in outside:
+        with pytest.raises(BumpError) as e:
+            SceneConfig(name="t", **base, **{key: value})
+        assert e.value.field == key and "\n" not in str(e.value), (value, str(e.value))
+
+
+def test_height_scale_is_an_open_range():
+    """(0, inf): the smallest positive float and the largest finite one are accepted; 0,
+    -0.0, a negative number, infinity and NaN are refused, naming height_scale."""
+    for h in (math.nextafter(0.0, 1), 1e-9, 4, 1e300, math.nextafter(math.inf, 0)):
+        assert SceneConfig(name="t", height_scale=h).height_scale == h
+    for h in (0, 0.0, -0.0, -1e-300, -4, math.inf, -math.inf, math.nan, True):
+        with pytest.raises(BumpError) as e:
+            SceneConfig(name="t", height_scale=h)
+        assert e.value.field == "height_scale" and "\n" not in str(e.value), (h, str(e.value))
