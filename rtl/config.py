@@ -13,7 +13,7 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 from dataclasses import dataclass, fields, asdict
 
 __all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RANGE",
-           "FRAC_BITS_MAX", "frac_bits_floor"]
+           "FRAC_BITS_MAX", "TWO_LIGHT_WIDTHS", "frac_bits_floor"]
 
 # The names of the method registry (rtl/methods.py: what each method is and builds), in its
 # order. Config validates ``method`` against them here because the registry imports the
@@ -21,6 +21,11 @@ __all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RAN
 METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
 ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
 FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
+# (angle_bits, frac_bits) of the built-in two-light scenes: with two lights their specular
+# terms add, and the narrowest widths whose proven bound is 1 LSB on every channel at n = 16
+# are these (one light: Config's defaults). tests/sim/golden/fixed/test_channels.py checks
+# both against sim/golden/fixed/exact.faithful_widths.
+TWO_LIGHT_WIDTHS = (15, 16)
 
 
 def frac_bits_floor(angle_bits):
@@ -64,12 +69,14 @@ class Config:
     ----------
     angle_bits : int
         Binary-angle width ``k + 2`` (full circle = ``2**angle_bits``); 4 to 16. The default,
-        13, is the coarsest angle grid whose rounding keeps the specular term (n = 16) within
-        1 LSB of float64 on unquantized inputs (docs/fixed_point.md, ``bumprtl bench accuracy``).
+        14, with ``frac_bits`` 15, are the narrowest widths whose proven bound
+        (``predicted_error_bound_lsb``, docs/fixed_point.md) is 1 LSB against float64 on every
+        output channel (diffuse, specular, colour, texture blend) of one light at n = 16;
+        13-bit angles cannot prove it (their rounding alone can move the specular term by
+        1.08 LSB, and measured 2 LSB end to end). Two lights need :data:`TWO_LIGHT_WIDTHS`.
     frac_bits : int
-        Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24. The default, 16,
-        is the fewest that reach 1 LSB on every channel with 13-bit angles, and its
-        ``B + 2 = 18``-bit sin/cos values are one ECP5 DSP operand.
+        Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24. The default, 15,
+        is the fewest that prove 1 LSB on every channel with 14-bit angles.
     method : str
         A name of the method registry (rtl/methods.py, :data:`METHOD_NAMES`): ``"exact"``
         (the exact angular method of docs/architecture.md), ``"lee"`` (Lee et al., errata
@@ -100,8 +107,8 @@ class Config:
         Whether PaletteLUT has the eq. 2 blend stage (Tarini Sec. 7.2) with a base-colour input.
     """
 
-    angle_bits: int = 13
-    frac_bits: int = 16
+    angle_bits: int = 14
+    frac_bits: int = 15
     method: str = "exact"
     tag_bits: int = 16
     out_bits: int = 8

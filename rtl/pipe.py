@@ -289,8 +289,10 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
     return outs
 
 
-# Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5.
-ROM_MAX_BLOCKS = 4
+# Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5:
+# the 8193 x 17 quarter-wave table of 15-bit angles is nine x2 blocks (no output multiplexer;
+# the generic form, which Yosys maps with one, ran at 72 MHz).
+ROM_MAX_BLOCKS = 9
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
 DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))

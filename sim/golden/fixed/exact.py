@@ -14,7 +14,7 @@ from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config, frac_bit
 from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.golden.fixed.common import channel_bound, input_angle_error, shade_fixed
+from bumprtl.sim.golden.fixed.common import BOUND_CHANNELS, channel_bound, input_angle_error, shade_fixed
 
 __all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors", "dot_error_bound",
            "predicted_error_bound_lsb"]
@@ -69,8 +69,9 @@ def dot_error_bound(cfg: Config):
 def faithful_widths(cfg: Config):
     """``(angle_bits, frac_bits)``: the narrowest widths (fewest angle bits, then fewest
     fractional bits) at which :func:`predicted_error_bound_lsb` proves every output channel
-    (diffuse, specular, colour; one light) within 1 LSB of float64 end to end, ``cfg``'s
-    other fields kept; None if no widths in the Config's range do.
+    (diffuse, specular, colour, the texture blend; summed over ``cfg.lights`` lights) within
+    1 LSB of float64 end to end, ``cfg``'s other fields kept; None if no widths in the
+    Config's range do.
 
     Two errors of the specular term grow with the Phong exponent n (docs/fixed_point.md):
     the inputs' rounding to the angle grid moves 255 cos^n by up to about
@@ -89,7 +90,7 @@ def faithful_widths(cfg: Config):
 
 
 def _faithful(cfg: Config):
-    return all(predicted_error_bound_lsb(cfg, c) <= 1 for c in ("diffuse", "specular", "color"))
+    return all(predicted_error_bound_lsb(cfg, c, cfg.lights) <= 1 for c in BOUND_CHANNELS)
 
 
 def predicted_error_bound_lsb(cfg: Config, channel="diffuse", lights=1):
