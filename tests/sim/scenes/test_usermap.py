@@ -205,3 +205,35 @@ def test_normal_map_round_trip_within_the_png_quantization(tmp_path):
             worst = max(worst, int(np.abs(ia - ib).max()))
     print(f"normal-map round trip: max |difference| {worst} LSB (bound {bound})")
     assert 0 < worst <= bound
+
+
+@pytest.mark.parametrize("bad, where", [((0.6, 0.8, 0.0), "in the surface"),
+                                        ((0.6, 0.8, -0.0), "in the surface, -0.0"),
+                                        ((0.2, -0.1, -0.5), "below the surface"),
+                                        ((0.0, 0.0, 0.0), "no direction")])
+def test_npy_normal_in_or_below_the_surface_is_refused(tmp_path, bad, where):
+    """A (T, T, 3) .npy normal map with one texel whose z <= 0 (or of length 0) is refused
+    with one line naming the file and the texel, as a PNG's blue < 128 is; a texel just
+    above the surface is accepted."""
+    n = displacement_to_normals(hex_tiles(32), 4.0)          # x right, y up, z out: rgb order
+    n[5, 11] = bad
+    np.save(tmp_path / "bad.npy", n)
+    with pytest.raises(BumpError) as e:
+        load_bump_map(tmp_path / "bad.npy", "normal")
+    msg = str(e.value)
+    assert "\n" not in msg and all(w in msg for w in ("bad.npy", "into the surface",
+                                                      "row 5, column 11")), (where, msg)
+    n[5, 11] = (0.6, 0.8, 1e-6)
+    np.save(tmp_path / "ok.npy", n)
+    assert read_normals(tmp_path / "ok.npy")[5, 11, 2] > 0
+
+
+def test_npy_normal_below_the_surface_exits_2_in_one_line(tmp_path, capsys):
+    from bumprtl.gen.cli.main import main
+    n = displacement_to_normals(hex_tiles(16), 4.0)
+    n[2, 3] = (0.0, 0.6, -0.8)
+    np.save(tmp_path / "under.npy", n)
+    rc = main(["emit", "pipeline", "--normal-map", str(tmp_path / "under.npy"),
+               "--out", str(tmp_path / "rtl")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "under.npy" in err[0] and "into the surface" in err[0], err
