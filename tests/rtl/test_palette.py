@@ -16,7 +16,7 @@ from bumprtl.rtl.palette import (CHANNELS, READ_LATENCY, PaletteLUT, blend_eq1, 
                                  index_bits, mul8)
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import load_scene_config
-from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, unpack_rgba
+from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs, random_map
 from bumprtl.sim.traffic import PATTERNS
 
@@ -132,6 +132,49 @@ def test_blend_integer_vs_float():
         assert np.max(np.abs(blend_eq2(entry, base)["r"] - eq2)) <= 1.0
         assert np.max(np.abs(blend_eq1(entry, base)["r"] - eq1)) <= 1.5
         assert np.array_equal(blend_eq2(entry, base)["a"], ro)
+
+
+
+def test_blend_every_channel_its_own_closed_form():
+    """Eq. 2 and eq. 1 with a different value in every channel of the entry and the base
+    colour (the test above uses one value for all three), each output channel against its
+    own float64 closed form written out here: a channel read from its neighbour (r's entry
+    blended into g, g's base into b, ...) is off by far more than the rounding allows."""
+    rng = np.random.default_rng(2)
+    n = 20000
+    entry = {c: rng.integers(0, 256, n) for c in CHANNELS}
+    base = {c: rng.integers(0, 256, n) for c in CHANNELS}
+    edges = np.array([0, 1, 127, 128, 254, 255])
+    for k, c in enumerate(CHANNELS):               # every channel at the edges, apart
+        entry[c][:216] = np.repeat(edges, 36)[(np.arange(216) + 7 * k) % 216]
+        base[c][:216] = np.tile(edges, 36)[(np.arange(216) + 11 * k) % 216]
+    got2, got1 = blend_eq2(entry, base), blend_eq1(entry, base)
+    a_in = entry["a"] / 255
+    for c in ("r", "g", "b"):
+        ro, ri = base[c] / 255, entry[c] / 255
+        assert np.max(np.abs(got2[c] - (ro * a_in + (1 - ro) * ri) * 255)) <= 1.0, c
+        assert np.max(np.abs(got1[c] - (ro * a_in + (1 - ro * a_in) * ri) * 255)) <= 1.5, c
+    assert np.array_equal(got2["a"], base["a"]) and np.array_equal(got1["a"], base["a"])
+    assert all(np.mean(entry[c] != entry[d]) > 0.9 for c in CHANNELS for d in CHANNELS if c < d)
+
+
+def test_lut_model_blend_every_channel_its_own_closed_form():
+    """The table word's channel order (r low) and the blend, through the cycle model the
+    RTL is held to, against the closed form with distinct values per channel."""
+    cfg = CONFIGS[1]
+    model = PaletteLUTModel(cfg)
+    rng = np.random.default_rng(5)
+    rgba = rng.integers(0, 256, (cfg.palette_size, 4))
+    for i, word in enumerate(pack_rgba(rgba, cfg)):
+        model.clock((i, int(word)))
+    model.clock(None, swap=True)
+    for i in range(cfg.palette_size):
+        base = {c: int(v) for c, v in zip(CHANNELS, rng.integers(0, 256, 4))}
+        got = model.lookup(i, base, blend=True)
+        for k, c in enumerate("rgb"):
+            ro, ri, ai = base[c] / 255, rgba[i, k] / 255, rgba[i, 3] / 255
+            assert abs(got[f"color.{c}"] - (ro * ai + (1 - ro) * ri) * 255) <= 1.0, (i, c)
+        assert got["color.a"] == base["a"]
 
 
 @pytest.mark.parametrize("cfg", CONFIGS, ids=["lookup200", "blend100"])
