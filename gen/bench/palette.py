@@ -14,10 +14,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.palette import color_table, palette_rgb, render_palette
+from bumprtl.sim.golden.float.palette import color_table, distinct_normals, palette_rgb, render_palette
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 
@@ -64,17 +64,16 @@ def accuracy(cfg, scenes, palettes, size, plot=None):
     for name in scenes:
         scene = load_scene(name, size=size)
         ref = compose(scene, conventional(scene.px, cfg).color)
+        n_distinct = distinct_normals(scene)
         for quantizer in ("median-cut", "kmeans"):
             cells, curve = [], []
             for sn in palettes:
-                try:
-                    img = compose(scene, render_palette(scene, cfg, sn, quantizer).color)
-                except BumpError:          # sN > distinct normals of this map
-                    cells.append("—")
-                    continue
+                img = compose(scene, render_palette(scene, cfg, sn, quantizer).color)
                 p = psnr(ref, img)
                 curve.append((sn, p))
-                cells.append(f"{p:.1f} dB / {max_diff(ref, img)}")
+                # sN >= the map's distinct normals: each normal its own entry, nothing quantized
+                exact = f" (all {n_distinct} normals)" if sn >= n_distinct else ""
+                cells.append(f"{p:.1f} dB / {max_diff(ref, img)}{exact}")
             curves[(name, quantizer)] = curve
             print(f"| {name} | {quantizer} | " + " | ".join(cells) + " |", flush=True)
     if plot:

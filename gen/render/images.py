@@ -54,6 +54,18 @@ def _render_palette(scene, cfg, palette_opts):
                                              **palette_opts).color, dtype=np.float64)
 
 
+def palette_note(scene, cfg):
+    """The line ``render`` prints when the palette holds every distinct normal of the map
+    (``cfg.palette_size`` >= their number: each normal its own entry, nothing quantized),
+    else None."""
+    palette = importlib.import_module("bumprtl.sim.golden.float.palette")
+    n = palette.distinct_normals(scene)
+    if cfg.palette_size < n:
+        return None
+    return (f"palette: sN = {cfg.palette_size} >= the map's {n} distinct normals: every normal "
+            f"has its own entry (no quantization)")
+
+
 def shade_scene(scene, method, cfg, progress=True, **palette_opts):
     """Per-pixel float intensity of ``scene`` by ``method``.
 
@@ -183,6 +195,8 @@ def run(args):
     print(f"{args.render_method} ({args.model}): {args.size}x{args.size} {scene.picture} (map "
           f"{scene.texture_size}^2, {base.geometry}) in {elapsed:.2f} s "
           f"({args.size ** 2 / elapsed / 1e6:.2f} Mpix/s) -> {out}")
+    if args.render_method == PALETTE and (note := palette_note(base, scene.config)):
+        print(note)
     if args.compare:
         ref = compose(base, shade_scene(base, "conventional", scene.config))
         cmp_path = save_png(out.with_name(out.stem + "_compare.png"), panel(ref, img))

@@ -21,11 +21,12 @@ from scipy.spatial import cKDTree
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.common import (Result, cartesian_to_polar, polar_to_cartesian, shade, tangent_rotation,
                      to_8bit)
-from bumprtl.sim.golden.float.palette_quantize import (QUANTIZERS, bayer_offsets, check_palette_size, distinct, nearest)
+from bumprtl.sim.golden.float.palette_quantize import (QUANTIZERS, bayer_offsets, check_palette_size, distinct, nearest,
+                                                       stores_every_normal)
 
 __all__ = ["LIGHTING_MODELS", "Material", "QuantizedNormalMap", "displacement_to_normals",
            "check_normal_map", "quantize_normal_map", "mipmap_indices", "lookup",
-           "color_table", "world_normal_map", "render_palette", "palette_rgb"]
+           "color_table", "world_normal_map", "distinct_normals", "render_palette", "palette_rgb"]
 
 LIGHTING_MODELS = ("lambert", "phong", "chrome", "toon")
 MATERIAL_SCALE = 4.0     # > 2 = the sphere's diameter: a material step outweighs any normal
@@ -67,10 +68,15 @@ def check_normal_map(normals, name="normals"):
 @dataclass(frozen=True)
 class QuantizedNormalMap:
     """``indices (T, T)`` into ``table (sN, 3)``; with materials, ``materials (sN,)`` gives
-    each entry's material and the table is sorted by material (Sec. 6)."""
+    each entry's material and the table is sorted by material (Sec. 6). ``distinct``: the
+    number of distinct (normal, material) vectors the used texels had; when the palette
+    size was at least that, ``exact`` is True and the table is those vectors themselves
+    (fewer rows than the palette size: the rest of a hardware table is unused)."""
     indices: np.ndarray
     table: np.ndarray
     materials: np.ndarray | None = None
+    distinct: int | None = None
+    exact: bool = False
 
     @property
     def size(self):
@@ -109,22 +115,29 @@ def quantize_normal_map(normals, palette_size, quantizer="median-cut", dither=Fa
                         weights=None, materials=None, seed=0):
     """Sec. 4: replace each normal of a ``(T, T, 3)`` map by the index of one of
     ``palette_size`` representatives. ``weights (T, T)``: texel use counts (0 = unused,
-    does not shape the table but still gets an index); ``materials (T, T)``: Sec. 6."""
+    does not shape the table but still gets an index); ``materials (T, T)``: Sec. 6.
+    A ``palette_size`` at least the number of distinct normals of the used texels is valid
+    and exact: the table is those normals (``exact`` = True, ``len(table)`` = their number),
+    each used texel indexes its own normal, and dithering is not applied."""
     if quantizer not in QUANTIZERS:
         raise BumpError(f"quantizer must be one of {', '.join(QUANTIZERS)}, got {quantizer!r}")
     n = check_normal_map(normals)
     vectors = _vectors(n, materials)
     w = None if weights is None else np.asarray(weights, dtype=np.float64).ravel()
     points, counts = distinct(vectors.reshape(-1, vectors.shape[-1]), w)
-    check_palette_size(palette_size, len(points))
-    kwargs = {"seed": seed} if quantizer == "kmeans" else {}
-    table = QUANTIZERS[quantizer](points, counts, palette_size, **kwargs)
+    check_palette_size(palette_size)
+    exact = stores_every_normal(palette_size, len(points))
+    if exact:       # every distinct vector its own entry: the table is the vectors, unchanged
+        table = points
+    else:
+        kwargs = {"seed": seed} if quantizer == "kmeans" else {}
+        table = QUANTIZERS[quantizer](points, counts, palette_size, **kwargs)
     if materials is not None:     # Sec. 6: sort by material, keep only the intervals
         table = table[np.lexsort((np.arange(len(table)), table[:, 3]))]
     flat = vectors.reshape(-1, vectors.shape[-1])
-    idx = _dithered(vectors, table) if dither else nearest(flat, table)
+    idx = _dithered(vectors, table) if dither and not exact else nearest(flat, table)
     mats = None if materials is None else np.rint(table[:, 3] / MATERIAL_SCALE).astype(np.int64)
-    return QuantizedNormalMap(idx.reshape(n.shape[:2]), table[:, :3].copy(), mats)
+    return QuantizedNormalMap(idx.reshape(n.shape[:2]), table[:, :3].copy(), mats, len(points), exact)
 
 
 def mipmap_indices(qmap: QuantizedNormalMap):
@@ -254,6 +267,13 @@ def world_normal_map(scene):
     fallback = polar_to_cartesian(scene.b_phi_map, scene.b_theta_map) @ mean_frame
     normals = np.where(counts.reshape(t, t)[..., None] > 0, sums.reshape(t, t, 3), fallback)
     return normals, counts.reshape(t, t)
+
+
+def distinct_normals(scene):
+    """Number of distinct object-space normals among the texels some pixel of ``scene`` uses:
+    the palette size from which on :func:`quantize_normal_map` stores every normal."""
+    normals, counts = world_normal_map(scene)
+    return len(distinct(check_normal_map(normals).reshape(-1, 3), counts.ravel())[0])
 
 
 def frame_directions(scene):

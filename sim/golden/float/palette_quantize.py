@@ -18,7 +18,7 @@ from scipy.spatial import cKDTree
 from bumprtl.rtl.config import BumpError
 
 __all__ = ["QUANTIZERS", "PALETTE_MIN", "PALETTE_MAX", "distinct", "median_cut", "kmeans",
-           "nearest", "check_palette_size", "bayer_offsets"]
+           "nearest", "check_palette_size", "stores_every_normal", "bayer_offsets"]
 
 PALETTE_MIN, PALETTE_MAX = 16, 16384
 
@@ -32,13 +32,19 @@ def distinct(vectors, weights=None):
     return uniq, np.bincount(inverse.ravel(), weights=w[keep], minlength=len(uniq))
 
 
-def check_palette_size(size, n_distinct):
+def check_palette_size(size):
+    """``size`` must be an integer in [PALETTE_MIN, PALETTE_MAX]. A palette at least as large
+    as a map's number of distinct normals is valid: every normal gets its own entry
+    (:func:`stores_every_normal`), nothing is quantized."""
     if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or \
             not PALETTE_MIN <= size <= PALETTE_MAX:
         raise BumpError(f"palette_size must be an integer in [{PALETTE_MIN}, {PALETTE_MAX}], got {size!r}")
-    if size > n_distinct:
-        raise BumpError(f"palette_size = {size} is larger than the number of distinct normals "
-                        f"({n_distinct}): allowed [{PALETTE_MIN}, {n_distinct}]")
+
+
+def stores_every_normal(size, n_distinct):
+    """True when a palette of ``size`` entries holds each of ``n_distinct`` normals as its own
+    entry: the quantizer is not needed and the table is the distinct normals themselves."""
+    return size >= n_distinct
 
 
 def _renormalize(table):

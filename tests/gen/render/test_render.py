@@ -66,13 +66,38 @@ def test_palette_flags_reach_render_palette(tmp_path, monkeypatch):
         calls.append((scene.name, cfg.kd, kwargs))
         return types.SimpleNamespace(color=np.full(scene.mask.shape, 0.5))
 
-    monkeypatch.setitem(sys.modules, PALETTE_MODULE, types.SimpleNamespace(render_palette=render_palette))
+    stand_in = types.SimpleNamespace(render_palette=render_palette,
+                                     distinct_normals=lambda scene: scene.mask.size)
+    monkeypatch.setitem(sys.modules, PALETTE_MODULE, stand_in)
     out = tmp_path / "p.png"
     assert main(["render", "--scene", "moon", "--method", "palette", "--size", "32", "--kd", "0.5",
                  "--palette-size", "64", "--quantizer", "kmeans", "--lighting", "lambert",
                  "--out", str(out)]) == 0
     assert calls == [("moon", 0.5, {"palette_size": 64, "quantizer": "kmeans", "lighting": "lambert"})]
     assert np.all(np.asarray(Image.open(out)) == 128)     # 0.5 -> 127.5 -> 128
+
+
+def test_palette_holding_every_normal_renders_with_a_one_line_note(tmp_path, capsys):
+    """A palette at least as large as the map's distinct normals is valid: the render runs,
+    prints one line saying every normal has its own entry, and equals the reference within
+    the colour table's 8-bit rounding (a plane, one directional light); one entry fewer
+    quantizes and prints no such line."""
+    def render(size, *extra):
+        out = tmp_path / f"p{size}.png"
+        assert main(["render", "--scene", "moon", "--method", "palette", "--size", "32",
+                     "--palette-size", str(size), "--out", str(out), *extra]) == 0
+        return [line for line in capsys.readouterr().out.splitlines()
+                if "every normal has its own entry" in line], out
+    notes, _ = render(16384)
+    assert len(notes) == 1
+    n = int(notes[0].split("the map's ")[1].split()[0])
+    assert 16 < n <= 32 * 32 and "sN = 16384" in notes[0]
+    notes, out = render(n, "--compare")
+    assert len(notes) == 1
+    ref, img = (np.asarray(Image.open(out.with_name(out.stem + "_compare.png")))[:, c:c + 32]
+                for c in (0, 36))
+    assert np.abs(ref.astype(int) - img.astype(int)).max() <= 1
+    assert render(n - 1)[0] == []
 
 
 def test_palette_missing_is_a_clear_error(tmp_path, monkeypatch, capsys):
