@@ -2,6 +2,7 @@
 ``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -11,14 +12,25 @@ from bumprtl.gen.cli.flags import (add_config_flags, add_map_flags, config_from_
 from bumprtl.gen.flow.axis import emit_axis
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.fusesoc import write_core
+from bumprtl.gen.flow.named import named_module, named_ports, write_named
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, DEVICE_BRAM, LOADS, emit_scene_unit,
                                        memory_images, scene_command)
 from bumprtl.gen.render.rtl import scene_memories
-from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, emit_unit, faithful_note
+from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, default_module, emit_unit, faithful_note
+
+
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 def run(args):
     hexes = []
+    module = args.name or default_module(args.unit)
+    if not _IDENT.fullmatch(module) or len(module) > 200:
+        raise BumpError(f"--name must be a Verilog identifier (letters, digits, _; not starting "
+                        f"with a digit), got {module!r}")
+    if args.ports == "named" and args.interface == "axis":
+        raise BumpError("--ports named applies to --interface stream (AXI4-Stream ports are "
+                        "already named)")
     if args.unit in SCENE_UNITS:                     # built from a SceneConfig, not flags
         cfg = scene_from_args(args, args.scene)
     else:
@@ -30,22 +42,33 @@ def run(args):
         cfg = config_from_args(args)
     if args.interface == "axis":
         images = _scene_images(args.unit, cfg, args) if args.unit in SCENE_UNITS else None
-        v_path, j_path, hexes = emit_axis(args.unit, cfg, args.out, args.tdata_width, images)
+        v_path, j_path, hexes = emit_axis(args.unit, cfg, args.out, args.tdata_width, images,
+                                          module=module)
     elif args.tdata_width is not None:
         raise BumpError("--tdata-width needs --interface axis")
     elif args.unit in SCENE_UNITS:
-        v_path, j_path, hexes = _emit_scene(args.unit, cfg, args)
+        v_path, j_path, hexes = _emit_scene(args.unit, cfg, args, module)
     else:
-        v_path, j_path = emit_unit(args.unit, cfg, args.out)
-    for path in (v_path, j_path, *hexes):
+        v_path, j_path = emit_unit(args.unit, cfg, args.out, module=module)
+    meta = json.loads(j_path.read_text())
+    extra = []
+    if args.ports == "named":
+        command = meta["command"] + " --ports named"
+        extra.append(write_named(v_path, meta, command))
+        meta["named_ports"] = {"module": named_module(v_path.stem), "command": command,
+                               "ports": named_ports(meta)}
+        j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    for path in (v_path, *extra, j_path, *hexes):
         print(f"wrote {path}")
     note = _faithful_note(args.unit, cfg)
     if note:
         print(note, file=sys.stderr)
     if args.fusesoc:
-        print(f"wrote {write_core(v_path, json.loads(j_path.read_text())['command'])}")
+        print(f"wrote {write_core(v_path, meta['command'], extra=extra, data=[j_path, *hexes])}")
     if args.lint:
         problems = lint(v_path)
+        for wrapper in extra:
+            problems += lint(wrapper, sources=[v_path])
         for line in problems:
             print(line)
         print(f"lint: {'clean' if not problems else f'{len(problems)} problem(s)'}")
@@ -69,11 +92,12 @@ def _scene_images(unit, scene, args):
     return memory_images(unit, scene, words, texels, table, args.load or "initial")
 
 
-def _emit_scene(unit, scene, args):
+def _emit_scene(unit, scene, args, module):
     """The scene unit with its memory contents: built in, or for the host write port."""
     images = _scene_images(unit, scene, args)
     return emit_scene_unit(unit, scene, args.out, images, args.device or DEFAULT_DEVICE,
-                           scene_command(unit, scene, args.load or "initial"))
+                           scene_command(unit, scene, args.load or "initial", module),
+                           module=module)
 
 
 def add_parser(sub):
@@ -86,6 +110,15 @@ def add_parser(sub):
                        formatter_class=__import__("argparse").RawDescriptionHelpFormatter)
     p.add_argument("unit", choices=sorted(UNITS), metavar="UNIT", help="unit to emit (see above)")
     p.add_argument("--out", type=Path, default=Path("build/emit"), help="output directory (default: build/emit)")
+    p.add_argument("--name", default=None, metavar="PREFIX",
+                   help="top module and file name; every submodule is named PREFIX.<path>, so "
+                        "units emitted under different names sit in one design (default: "
+                        "bumprtl_UNIT)")
+    p.add_argument("--ports", choices=("payload", "named"), default="payload",
+                   help="payload: the stream payloads as packed vectors i__payload/o__payload "
+                        "(default); named: also write PREFIX_named.v, a wrapper with one port "
+                        "per payload field (in_n_phi, ..., out_color), from the sidecar's "
+                        "field table (gen/flow/named.py)")
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only -Wall (with the three generator-artefact waivers) afterwards")
     p.add_argument("--scene", default="default", metavar="FILE|NAME",
                    help="pipeline/fetch: a scene TOML file or built-in scene (default: default)")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.memories import hex_text, scene_command
-from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, canonical_command
+from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, canonical_command, name_flag
 from bumprtl.rtl.axis import AxisWrapper
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import BumpError
@@ -38,9 +38,10 @@ def _builder(name, images):
     return lambda scene: cls(scene, init=init("map"), texture=init("texture"))
 
 
-def build_axis(name, cfg, tdata_width=None, images=None):
+def build_axis(name, cfg, tdata_width=None, images=None, module=None):
     """``(wrapper, sidecar, command)`` for unit ``name`` in AXI4-Stream ports; ``images``:
-    a scene unit's memory images (``memory_images``), None for empty memories."""
+    a scene unit's memory images (``memory_images``), None for empty memories; ``module``:
+    the name the wrapper is emitted under is ``<module>_axis`` (default ``name``)."""
     if name not in UNITS:
         raise BumpError(f"unit must be one of {', '.join(UNITS)}, got {name!r}")
     unit = UNITS[name]
@@ -53,24 +54,25 @@ def build_axis(name, cfg, tdata_width=None, images=None):
     if images:
         sidecar["memory_images"] = {
             n: {**{k: v for k, v in img.items() if k != "words"},
-                "file": f"{axis_name(name)}_{n}.hex"} for n, img in images.items()}
+                "file": f"{axis_name(module or name)}_{n}.hex"} for n, img in images.items()}
     command = (canonical_command(unit, cfg) if name not in SCENE_UNITS or not images
                else scene_command(name, cfg, _load(images))) + " --interface axis"
     if tdata_width is not None:
         command += f" --tdata-width {tdata_width}"
-    return wrapper, sidecar, command
+    return wrapper, sidecar, command + name_flag(name, module)
 
 
 def _load(images):
     return images["map"]["load"] if "map" in images else "initial"
 
 
-def emit_axis(name, cfg, out_dir, tdata_width=None, images=None):
+def emit_axis(name, cfg, out_dir, tdata_width=None, images=None, module=None):
     """Write ``<out_dir>/<name>_axis.v`` and ``.json`` (one flattened module) and, for a
     scene unit with ``images``, one ``$readmemh`` file per image; returns ``(v, json,
     [hex...])``."""
-    wrapper, sidecar, command = build_axis(name, cfg, tdata_width, images)
-    v_path, j_path = emit(wrapper, axis_name(name), command, out_dir, sidecar, flatten=True)
+    wrapper, sidecar, command = build_axis(name, cfg, tdata_width, images, module)
+    v_path, j_path = emit(wrapper, axis_name(name), command, out_dir, sidecar, flatten=True,
+                          module=axis_name(module) if module else None)
     meta = json.loads(j_path.read_text())
     for port in ("clk", "rst"):                 # aclk/aresetn instead (port_table adds these)
         meta["ports"].pop(port, None)

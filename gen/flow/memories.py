@@ -26,7 +26,7 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.fpga import DEVICES
-from bumprtl.gen.flow.units import UNITS
+from bumprtl.gen.flow.units import UNITS, name_flag
 
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks",
            "check_fits", "check_scene_fits", "hex_text", "memory_images", "emit_scene_unit", "host_writes",
@@ -166,7 +166,7 @@ _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "
                   "resample")
 
 
-def scene_command(unit, scene, load="initial"):
+def scene_command(unit, scene, load="initial", module=None):
     """The ``bumprtl emit`` line that reproduces ``unit``'s Verilog for ``scene``: ``--scene
     NAME`` plus a flag for every key with a flag that differs from the named scene's. With
     ``load = "port"`` the Verilog holds no map, so the keys that only shape the map's
@@ -189,15 +189,17 @@ def scene_command(unit, scene, load="initial"):
             parts += [flag, str(value)]
     if load != "initial":
         parts += ["--load", load]
-    return " ".join(parts)
+    return " ".join(parts) + name_flag(unit, module)
 
 
-def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command=None):
+def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command=None,
+                    module=None):
     """Build ``unit`` (``pipeline`` or ``fetch``) of ``scene`` with the ``images`` of
     :func:`memory_images` (built-in initial contents where ``load = "initial"``), check its
     memories fit ``device`` (``None``: no check), then write ``<unit>.v``, ``<unit>.json``
     (with ``memory_images``) and one ``$readmemh`` file per image. Returns the paths
-    ``(v, json, [hex...])``; nothing is written when a check fails."""
+    ``(v, json, [hex...])``; nothing is written when a check fails. ``module`` (default
+    ``unit``) names the top module and every file, the images ``<module>_<memory>.hex``."""
     init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
     spec = UNITS[unit]
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
@@ -210,12 +212,14 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
         sidecar["block_ram"] = {"device": device, "dp16kd_needed": fit[0],
                                 "dp16kd_available": fit[1],
                                 "note": "maps tiled into DP16KD shapes, one block per other table"}
+    if module is not None:
+        images = {n: {**img, "file": f"{module}_{n}.hex"} for n, img in images.items()}
     sidecar["memory_images"] = {n: {k: v for k, v in img.items() if k != "words"}
                                 for n, img in images.items()}
     texts = {img["file"]: hex_text(img["words"], img["width"]) for img in images.values()}
     load = images["map"]["load"] if "map" in images else "initial"
-    v, j = emit(dut, unit, command or scene_command(unit, scene, load), out_dir, sidecar,
-                flatten=True)
+    v, j = emit(dut, unit, command or scene_command(unit, scene, load, module), out_dir, sidecar,
+                flatten=True, module=module)
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name

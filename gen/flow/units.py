@@ -20,7 +20,18 @@ from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 
 __all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command",
-           "error_bounds", "faithful_widths", "faithful_note"]
+           "default_module", "name_flag", "error_bounds", "faithful_widths", "faithful_note"]
+
+
+def default_module(unit):
+    """The top module (and file) name ``bumprtl emit UNIT`` writes without ``--name``."""
+    return f"bumprtl_{unit}"
+
+
+def name_flag(unit, module):
+    """``--name MODULE`` for the command line that reproduces a unit emitted as ``module``
+    (empty for :func:`default_module` and for None, the unit's bare name the tests use)."""
+    return "" if module in (None, default_module(unit)) else f" --name {module}"
 
 
 @dataclass(frozen=True)
@@ -154,8 +165,9 @@ UNITS = {
 SCENE_UNITS = ("pipeline", "fetch")
 
 
-def canonical_command(unit, cfg):
-    """The ``bumprtl emit`` line that reproduces a unit: its name and its Config flags."""
+def canonical_command(unit, cfg, module=None):
+    """The ``bumprtl emit`` line that reproduces a unit: its name and its Config flags
+    (and ``--name`` when ``module`` is neither None nor the default)."""
     parts = ["bumprtl", "emit", unit.name]
     for field in unit.flags:
         value = getattr(cfg, field)
@@ -164,7 +176,7 @@ def canonical_command(unit, cfg):
             parts.append(flag if value else "--no-" + field.replace("_", "-"))
         else:
             parts += [flag, str(value)]
-    return " ".join(parts)
+    return " ".join(parts) + name_flag(unit.name, module)
 
 
 def build_unit(name, cfg: Config, target=None):
@@ -178,7 +190,9 @@ def build_unit(name, cfg: Config, target=None):
     return dut, sidecar, canonical_command(unit, cfg)
 
 
-def emit_unit(name, cfg, out_dir):
-    """Emit ``<out_dir>/<name>.v`` and ``.json``; returns the two paths."""
-    dut, sidecar, command = build_unit(name, cfg)
-    return emit(dut, name, command, out_dir, sidecar, flatten=name in SCENE_UNITS)
+def emit_unit(name, cfg, out_dir, module=None):
+    """Emit ``<out_dir>/<module>.v`` and ``.json`` (``module`` default: ``name``); returns
+    the two paths."""
+    dut, sidecar, _ = build_unit(name, cfg)
+    command = canonical_command(UNITS[name], cfg, module)
+    return emit(dut, name, command, out_dir, sidecar, flatten=name in SCENE_UNITS, module=module)

@@ -94,29 +94,29 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     scene = load_scene_config(toml)
     assert scene.texture_size == 32 and scene.height_map == str(tmp_path / "maps" / "c.png")
     words = scene_memories(scene)[0]
-    hexwords = [int(x, 16) for x in (out / "pipeline_map.hex").read_text().split()]
+    hexwords = [int(x, 16) for x in (out / "bumprtl_pipeline_map.hex").read_text().split()]
     assert hexwords == words.tolist() and len(hexwords) == 32 * 32
-    assert all(len(x) == 5 for x in (out / "pipeline_map.hex").read_text().split())   # 20 bits
-    v = (out / "pipeline.v").read_text()
+    assert all(len(x) == 5 for x in (out / "bumprtl_pipeline_map.hex").read_text().split())   # 20 bits
+    v = (out / "bumprtl_pipeline.v").read_text()
     init = _initial_contents(v)
     assert [init.get(a, 0) for a in range(len(words))] == words.tolist()
-    meta = json.loads((out / "pipeline.json").read_text())
+    meta = json.loads((out / "bumprtl_pipeline.json").read_text())
     img = meta["memory_images"]["map"]
-    assert img["file"] == "pipeline_map.hex" and img["load"] == "initial" and img["width"] == 20
+    assert img["file"] == "bumprtl_pipeline_map.hex" and img["load"] == "initial" and img["width"] == 20
     assert "phi in bits [9:0], theta in bits [19:10]" in img["layout"]      # 10-bit angles
     assert img["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
     assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
     assert meta["block_ram"]["device"] == "LFE5U-85F"
-    assert lint(out / "pipeline.v") == []
+    assert lint(out / "bumprtl_pipeline.v") == []
     port = tmp_path / "b"
     assert main(["emit", "pipeline", "--scene", str(toml), "--load", "port", "--out", str(port)]) == 0
-    pv = (port / "pipeline.v").read_text()
+    pv = (port / "bumprtl_pipeline.v").read_text()
     assert not any(_initial_contents(pv).values())          # no map in the Verilog
     assert pv.splitlines()[0].endswith(f"--scene {toml} --load port")
-    assert (port / "pipeline_map.hex").read_text() == (out / "pipeline_map.hex").read_text()
+    assert (port / "bumprtl_pipeline_map.hex").read_text() == (out / "bumprtl_pipeline_map.hex").read_text()
     again = tmp_path / "c"
     assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(again)]) == 0
-    for name in ("pipeline.v", "pipeline_map.hex"):
+    for name in ("bumprtl_pipeline.v", "bumprtl_pipeline_map.hex"):
         assert (again / name).read_bytes() == (out / name).read_bytes()
 
 
@@ -125,9 +125,9 @@ def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsy
     write_png(tmp_path / "n.png", normals_to_rgb(polar_to_cartesian(bm.b_phi_map, bm.b_theta_map)))
     assert main(["emit", "fetch", "--normal-map", str(tmp_path / "n.png"), "--out",
                  str(tmp_path / "f")]) == 0
-    meta = json.loads((tmp_path / "f" / "fetch.json").read_text())
+    meta = json.loads((tmp_path / "f" / "bumprtl_fetch.json").read_text())
     assert meta["memory_images"]["map"]["port"] == ["w_en", "w_addr", "w_data"]
-    assert len((tmp_path / "f" / "fetch_map.hex").read_text().split()) == 32 * 32
+    assert len((tmp_path / "f" / "bumprtl_fetch_map.hex").read_text().split()) == 32 * 32
     _one_line_exit_2(capsys, ["emit", "fetch", "--scene", "flat", "--out", str(tmp_path / "g")],
                      "flat", "nothing to fetch")
     assert not (tmp_path / "g").exists()
