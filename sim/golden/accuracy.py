@@ -1,11 +1,13 @@
 """Accuracy of the fixed-point golden models against float64 on unquantized inputs:
 random valid inputs, and an adversarial search for the worst case."""
 
+import itertools
 from dataclasses import fields, replace
 
 import numpy as np
 
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import texture_blend
 from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to_cartesian,
                                        tangent_rotation, to_8bit)
@@ -16,7 +18,8 @@ from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.heightfields import height_to_normals
 
 __all__ = ["diffuse_error_lsb", "term_errors_lsb", "on_grid", "grid_errors_lsb",
-           "adversarial_pixels", "arithmetic_pixels",
+           "adversarial_pixels", "arithmetic_pixels", "worst_case_pixels", "steep_pixels",
+           "unrounded_lsb",
            "highlight_pixels", "reference_blend", "scene_error", "crater_scene", "ANGLES_OF_NDOTL", "ANGLES_OF",
            "CHANNELS"]
 
@@ -210,6 +213,99 @@ def adversarial_pixels(cfg: Config, candidates=200_000, keep=1_000, seed=7, chan
         out.append(_with(px, **changes))
     return PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in out])
                           for f in fields(px)})
+
+
+def _around(nw, cos_lo, cos_hi, rng):
+    """Unit vectors at a random angle from ``nw`` (unit, world coordinates) whose cosine is
+    uniform in [cos_lo, cos_hi], in a random direction around it: (phi, theta)."""
+    n = len(nw)
+    helper = np.where(np.abs(nw[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    e1 = np.cross(nw, helper)
+    e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
+    e2 = np.cross(nw, e1)
+    c = rng.uniform(cos_lo, cos_hi, n)[:, None]
+    turn = rng.uniform(0, 2 * np.pi, n)[:, None]
+    return cartesian_to_polar(c * nw + np.sqrt(1 - c * c) * (np.cos(turn) * e1 + np.sin(turn) * e2))
+
+
+# Where each channel's slope is largest: the cosine of the angle between N' and L (diffuse:
+# 255 cos, steepest near cos = 0 where it is not yet clamped) and between N' and H (specular:
+# 255 cos^n, steepest at sin = 1 / sqrt(n), i.e. cos in [1 - 4 / n, 1] for n >= 4).
+STEEP_DIFFUSE = (0.02, 0.6)
+
+
+def steep_pixels(n, rng, cfg: Config, channel):
+    """``n`` random valid pixels with L (diffuse, colour) and H (specular, colour) placed
+    where the channel's slope is largest (:data:`STEEP_DIFFUSE`; N'.H in [1 - 4 / n, 1])."""
+    px = PixelInputs.random(n, rng)
+    nw = _world_bump_normal(px)
+    changes = {}
+    if channel in ("specular", "color"):
+        changes["h_phi"], changes["h_theta"] = _around(nw, max(0.0, 1 - 4 / cfg.spec_exponent), 1.0, rng)
+    if channel in ("diffuse", "color"):
+        changes["l_phi"], changes["l_theta"] = _around(nw, *STEEP_DIFFUSE, rng)
+    return _with(px, **changes)
+
+
+def unrounded_lsb(out, cfg: Config, channel):
+    """A fixed-point model's channel before its 8-bit rounding, in 8-bit LSB: 255 clamp(N'.L)
+    (diffuse), 255 cos^n (specular), eq. 2 of the two (colour)."""
+    d = 255.0 * np.asarray(out["diffuse_fine"]) / cfg.one
+    s = np.asarray(out["specular_fine"]) / 2.0 ** SPEC_FRAC_BITS
+    return {"diffuse": d, "specular": s,
+            "color": 255 * cfg.ka + cfg.kd * d + (cfg.ks if cfg.specular else 0.0) * s}[channel]
+
+
+def worst_case_pixels(model, cfg: Config, channel="specular", candidates=100_000, keep=2_000,
+                      seed=3):
+    """The search aimed at the proof's worst case (predicted_error_bound_lsb): the inputs'
+    rounding to the angle grid and the datapath's arithmetic error at their largest and in
+    the same direction, where the channel's slope is largest.
+
+    1. ``candidates`` pixels where the slope is largest (:func:`steep_pixels`).
+    2. Every angle the channel depends on (:data:`ANGLES_OF`) put 0.4999 of a grid step off
+       its grid point, on the side its partial derivative points, in both polarities (all
+       angles with the derivative, all against it): the rounding then moves the output by
+       about the sum of |slope| x half a step, up in one copy and down in the other.
+    3. The model on those inputs (the same grid point in both copies, so the same
+       arithmetic error) against float64 before the 8-bit rounding (:func:`unrounded_lsb`):
+       the copy where the arithmetic error adds to the rounding's has the larger error; keep
+       the ``keep`` largest.
+    4. Each of those moved by one grid step in one or two of its angles (each sign), so the
+       same near-worst error falls at many fractional positions of float64's value: where it
+       sits just above a half, an error above 1 before the rounding of both sides is 2 after.
+    ``model(codes, cfg)`` is a fixed-point golden model (rtl/methods.datapath_fixed).
+    Returns PixelInputs of keep x (1 + 2 n (n + 1)) pixels, n = len(ANGLES_OF[channel])."""
+    if channel not in CHANNELS:
+        raise BumpError(f"channel must be one of {', '.join(CHANNELS)}, got {channel!r}")
+    angles = ANGLES_OF[channel]
+    rng = np.random.default_rng(seed)
+    step = 2 * np.pi / cfg.full_circle
+    px = steep_pixels(candidates, rng, cfg, channel)
+    value = lambda p: 255 * getattr(conventional(p, cfg), channel)
+    side = {}
+    for name in angles:
+        x = getattr(px, name)
+        side[name] = np.sign(value(_with(px, **{name: _clip_angles(name, x + 1e-6)}))
+                             - value(_with(px, **{name: _clip_angles(name, x - 1e-6)})))
+    grid = {name: np.rint(getattr(px, name) / step) for name in angles}
+    both = [_with(px, **{name: _clip_angles(name, (grid[name] + 0.4999 * pol * side[name]) * step)
+                         for name in angles}) for pol in (1, -1)]
+    both = _concat(both)
+    error = np.abs(unrounded_lsb(model(encode_pixels(both, cfg), cfg), cfg, channel) - value(both))
+    top = both.subset(np.argsort(error)[-keep:])
+    out = [top]
+    for i, j in itertools.combinations_with_replacement(range(len(angles)), 2):
+        for di, dj in itertools.product((-1, 1), repeat=2):
+            move = {angles[i]: di * step}
+            move[angles[j]] = move.get(angles[j], 0.0) + dj * step
+            out.append(_with(top, **{k: _clip_angles(k, getattr(top, k) + d) for k, d in move.items()}))
+    return _concat(out)
+
+
+def _concat(sets):
+    return PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in sets])
+                          for f in fields(sets[0])})
 
 
 def arithmetic_pixels(model, cfg: Config, candidates=400_000, keep=2_000, seed=5, reach=3):

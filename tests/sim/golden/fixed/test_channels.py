@@ -17,14 +17,14 @@ import pytest
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.units import build_unit, error_bounds
-from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config
+from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, TWO_LIGHT_WIDTHS, Config
 from bumprtl.rtl.methods import METHODS
 from bumprtl.rtl.scene import load_scene_config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (adversarial_pixels, arithmetic_pixels, crater_scene,
                                          grid_errors_lsb, on_grid, reference_blend, scene_error,
-                                         term_errors_lsb)
+                                         term_errors_lsb, worst_case_pixels)
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
 from bumprtl.sim.golden.fixed.common import specular_fine_fixed
 from bumprtl.sim.golden.fixed.exact import faithful_widths
@@ -54,14 +54,29 @@ def test_default_random_within_each_bound_and_1_lsb_on_every_channel(default_ran
     assert got == {"diffuse": 1, "specular": 1, "color": 1}, got
 
 
-def test_12_bit_angles_cost_the_specular_term_a_second_lsb():
-    """Why the default has 13-bit angles: on the 12-bit grid (B = 13) the arithmetic is within
-    1 LSB on every channel, but rounding the inputs to the grid moves cos^16 by up to 2.2
-    LSB (docs/fixed_point.md), so end to end the specular term misses 1 LSB."""
-    cfg = Config(angle_bits=12, frac_bits=13)
-    px = adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular")
+def test_worst_case_search_finds_the_proven_2_lsb_of_13_bit_angles():
+    """Pins the search aimed at the proof's worst case (sim/golden/accuracy.worst_case_pixels):
+    at 13-bit angles, B = 16 (the old default) the proven specular bound is 2 LSB and the
+    search must reach it -- the inputs' rounding (up to 0.97 LSB where 255 cos^16 is
+    steepest) and the arithmetic (a few hundredths) add to more than 1 LSB before the two
+    8-bit roundings. A weaker search (or a weakened datapath model) fails here. Its
+    arithmetic alone stays within 1 LSB: the angle grid, not the datapath, is what 13 bits
+    lack."""
+    cfg = Config(angle_bits=13, frac_bits=16)
+    assert error_bounds(cfg)["specular"] == 2
+    px = worst_case_pixels(exact_fixed, cfg, "specular")
     assert worst(term_errors_lsb(exact_fixed, px, cfg))["specular"] >= 2
     assert max(worst(grid_errors_lsb(exact_fixed, px, cfg)).values()) <= 1
+
+
+@pytest.mark.parametrize("channel", CHANNELS)
+def test_worst_case_search_finds_nothing_above_1_lsb_at_the_default(channel):
+    """At the default widths every channel's proven bound is 1 LSB, and the search aimed at
+    the proof's worst case for that channel finds nothing above it."""
+    cfg = Config()
+    assert error_bounds(cfg)[channel] == 1
+    px = worst_case_pixels(exact_fixed, cfg, channel, candidates=40_000, keep=500)
+    assert worst(term_errors_lsb(exact_fixed, px, cfg))[channel] == 1
 
 
 @pytest.mark.parametrize("exponent", [16, 1024])
@@ -75,7 +90,8 @@ def test_bounds_hold_and_are_tight(exponent):
     sets = [PixelInputs.random(50_000, np.random.default_rng(11)),
             adversarial_pixels(cfg, candidates=40_000, keep=200, channel="specular"),
             adversarial_pixels(cfg, candidates=40_000, keep=200, channel="color"),
-            arithmetic_pixels(exact_fixed, cfg, candidates=60_000, keep=300, reach=2)]
+            arithmetic_pixels(exact_fixed, cfg, candidates=60_000, keep=300, reach=2),
+            worst_case_pixels(exact_fixed, cfg, "specular", candidates=40_000, keep=300)]
     measured, arithmetic = {c: 0 for c in CHANNELS}, {c: 0 for c in CHANNELS}
     for px in sets:
         for c, v in worst(term_errors_lsb(exact_fixed, px, cfg)).items():
@@ -102,7 +118,7 @@ def test_small_exponents_reach_1_lsb_of_specular(exponent):
         assert worst(term_errors_lsb(exact_fixed, px, cfg))["specular"] <= 1
 
 
-@pytest.mark.parametrize("exponent, frac_bits", [(1, 13), (16, 13), (64, 13), (1024, 13), (3, 10),
+@pytest.mark.parametrize("exponent, frac_bits", [(1, 13), (16, 13), (64, 13), (1024, 13), (3, 11),
                                                  (700, 16)])
 def test_specular_term_within_the_table_error_on_every_dot(exponent, frac_bits):
     """Every N'.H on the B-bit grid: the interpolated table against 255 x**n within
@@ -234,8 +250,26 @@ def test_multi_light_and_texture_sidecars_state_every_channel():
         scene = load_scene_config(spec)
         sidecar = build_unit("pipeline", scene)[1]
         assert sidecar["error_bounds_lsb"] == error_bounds(scene.config, lights, texture)
-    assert error_bounds(Config(), 2) == {"diffuse": 1, "specular": 3, "color": 2}
     assert error_bounds(Config(), 1, texture=True)["color"] == 1
+
+
+def test_default_widths_are_the_faithful_ones_for_one_light_and_two():
+    """Config's default widths are the narrowest the bound proves within 1 LSB on every
+    channel (diffuse, specular, colour, blend) of one light at n = 16; with two lights the
+    specular terms add and 14-bit angles prove 2 LSB, so the built-in two-light scenes take
+    TWO_LIGHT_WIDTHS, the narrowest that prove 1 LSB with two lights."""
+    cfg = Config()
+    assert faithful_widths(cfg) == (cfg.angle_bits, cfg.frac_bits)
+    assert faithful_widths(cfg.replace(lights=2)) == TWO_LIGHT_WIDTHS
+    assert error_bounds(cfg, 2)["specular"] == 2
+    two = cfg.replace(angle_bits=TWO_LIGHT_WIDTHS[0], frac_bits=TWO_LIGHT_WIDTHS[1])
+    for texture in (False, True):
+        assert set(error_bounds(two, 2, texture).values()) == {1}
+        assert set(error_bounds(cfg, 1, texture).values()) == {1}
+    for name in ("two-lights", "full"):
+        scene = load_scene_config(name)
+        assert scene.lights == 2 and (scene.angle_bits, scene.frac_bits) == TWO_LIGHT_WIDTHS
+        assert set(build_unit("pipeline", scene)[1]["error_bounds_lsb"].values()) == {1}
 
 
 # --- the arithmetic alone: float64 on the angles the hardware receives -----------------------
