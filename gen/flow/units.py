@@ -20,7 +20,7 @@ from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 
 __all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command",
-           "default_module", "name_flag", "error_bounds", "faithful_widths", "faithful_note"]
+           "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]
 
 
 def default_module(unit):
@@ -54,9 +54,14 @@ def _method_sidecar(cfg, dut):
     """A rotation or illumination unit: its method's error bound and note (rtl/methods.py)."""
     method = get(cfg.method)
     return {"latency": dut.latency, "throughput": 1, "method": cfg.method, "roms": _roms(dut),
-            "error_bound_lsb": method.predicted_error_bound_lsb(cfg),
-            "error_bounds_lsb": error_bounds(cfg), **faithful_widths(cfg),
+            **bound_fields(error_bounds(cfg)), **faithful_widths(cfg),
             "error_note": method.error_note}
+
+
+def bound_fields(bounds):
+    """The sidecar's bound fields: ``error_bounds_lsb`` (per channel) and ``error_bound_lsb``,
+    the largest of them: the bound of the unit as a whole."""
+    return {"error_bound_lsb": max(bounds.values()), "error_bounds_lsb": bounds}
 
 
 def error_bounds(cfg, lights=1, texture=False):
@@ -127,7 +132,7 @@ def _pipeline_sidecar(scene, dut):
     out = {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
            "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
     if scene.shading == "per-pixel":
-        out["error_bounds_lsb"] = error_bounds(scene.config, scene.lights, scene.texture)
+        out.update(bound_fields(error_bounds(scene.config, scene.lights, scene.texture)))
         out.update(faithful_widths(scene.config))
     return out
 

@@ -158,7 +158,8 @@ def test_cli_emit_rotation_method_peercy(peercy_rotation, tmp_path):
     # products, squares (B + 5 bits: WideProducts at B = 16), sums, the square root (B + 6
     # stages: a bit a stage) and the divider (B + 2)
     assert meta["latency"] == PRODUCT_LATENCY + WIDE_PRODUCT_LATENCY + 5 + (b + 6) + (b + 2)
-    assert meta["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
+    assert meta["error_bound_lsb"] == max(fixed_peercy.predicted_error_bound_lsb(Config(), c)
+                                          for c in ("diffuse", "specular", "color"))
     assert sorted(meta["ports"]["i__payload"]["fields"]) == sorted(
         fixed_peercy.input_keys(Config()) + ["tag"])
     bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
@@ -205,4 +206,5 @@ def test_illumination_counts_are_the_back_end_plus_two_dots(build_dir):
 def test_sidecar_of_ernst_names_its_method():
     _, sidecar, command = build_unit("illumination", Config(method="ernst"))
     assert sidecar["method"] == "ernst" and "--method ernst" in command
-    assert sidecar["error_bound_lsb"] == fixed_peercy.predicted_error_bound_lsb(Config())
+    assert sidecar["error_bound_lsb"] == max(fixed_peercy.predicted_error_bound_lsb(Config(), c)
+                                             for c in ("diffuse", "specular", "color"))
