@@ -6,8 +6,12 @@ For each method (``exact`` and ``lee`` over a grid of angle bits and value bits,
 * **error** against float64 (``conventional``): max / mean LSB of the bit-exact model's
   diffuse, specular and colour outputs on random valid vectors and on the adversarial
   search aimed at each channel (unquantized inputs), and PSNR / max LSB of the shaded
-  image (eq. 2's 8-bit colour) on the scenes. ``error_lsb`` = the worst max LSB of the
-  colour over all of them: the number ``bumprtl recommend --max-error-lsb`` compares;
+  image (eq. 2's 8-bit colour) on the maps (``--maps NAME:SIZE``: a scene of
+  sim/scenes at SIZE x SIZE texels, drawn at one pixel per texel). ``error_lsb`` = the
+  worst max LSB of the colour over all of them: the number ``bumprtl recommend
+  --max-error-lsb`` compares. The output records each map's name, size and number of
+  distinct normals, and marks each palette measurement whose palette held every distinct
+  normal of the map (``quantized: false``: nothing was quantized there);
 * **cost** from the Yosys netlist of the method's per-pixel units (gen/flow/resources.py:
   multipliers, ROM bits, RAM bits, adders) and, with ``--fpga``, ECP5 LUT4/FF/DSP/BRAM and
   Fmax of the unit(s) placed by gen/flow/fpga.py;
@@ -24,7 +28,7 @@ import hashlib
 import json
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import matplotlib
@@ -39,8 +43,9 @@ from bumprtl.rtl.pipe import ECP5
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.palette import palette_rgb, quantize_normal_map, world_normal_map
-from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.golden.float.palette import (distinct_normals, palette_rgb, quantize_normal_map,
+                                               world_normal_map)
+from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 from bumprtl.gen.bench.golden import _sim_rate
 from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, pipeline_component,
@@ -48,7 +53,8 @@ from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, pipeline
 from bumprtl.gen.flow.resources import count_verilog, SynthesisError
 from bumprtl.gen.flow.units import build_unit, emit_unit
 
-__all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot"]
+__all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot",
+           "parse_maps", "map_key", "MAP_SIZES"]
 
 
 @dataclass(frozen=True)
@@ -57,16 +63,41 @@ class Grid:
     frac_bits: tuple
     palette_sizes: tuple
     samples: int          # random vectors per point
-    scenes: tuple
-    size: int             # scene images are size x size
+    maps: tuple           # (scene name, size): a size x size map drawn at size x size pixels
     adversarial: int = 200_000   # candidates of each adversarial search (the 1 / 200 kept)
 
 
+# Maps with many more texels (and distinct normals) than the largest palette, the photo-derived
+# scenes among them: a palette holding every normal of a map quantizes nothing there.
+DEFAULT_MAPS = (("bricks", 512), ("brick-photo", 512), ("moon", 512), ("globe", 512), ("gravel", 1024))
 GRIDS = {
-    "quick": Grid((10, 12), (11, 13), (16, 256), 20_000, ("bricks",), 64),
-    "default": Grid((8, 10, 12, 13, 14), (9, 11, 13, 16), (16, 64, 256, 1024, 4096, 16384),
-                    100_000, ("bricks", "wood", "globe"), 128),
+    "quick": Grid((10, 12), (11, 13), (16, 256), 20_000, (("bricks", 64),)),
+    "default": Grid((8, 10, 12, 13, 14), (9, 11, 13, 15, 16), (16, 64, 256, 1024, 4096, 16384),
+                    100_000, DEFAULT_MAPS),
 }
+MAP_SIZES = (16, 2048)      # --maps sizes: powers of two in this range
+
+
+def map_key(name, size):
+    """How a map is named in the sweep's per-map results: ``gravel 1024²``."""
+    return f"{name} {size}\N{SUPERSCRIPT TWO}"
+
+
+def parse_maps(specs):
+    """``["gravel:1024", ...]`` -> ``(("gravel", 1024), ...)``; a bad entry is a BumpError
+    naming ``--maps`` and what is allowed."""
+    lo, hi = MAP_SIZES
+    out = []
+    for spec in specs:
+        name, _, size = str(spec).partition(":")
+        ok = name in SCENES and size.isdigit() and lo <= int(size) <= hi and not int(size) & (int(size) - 1)
+        if not ok:
+            raise BumpError(f"--maps must be NAME:SIZE with NAME one of {', '.join(SCENES)} and SIZE a "
+                            f"power of two in [{lo}, {hi}], got {spec!r}")
+        if (name, int(size)) in out:
+            raise BumpError(f"--maps names {spec!r} twice: each map once")
+        out.append((name, int(size)))
+    return tuple(out)
 # PER_PIXEL and BASELINES (Lee Table 1's designs as RTL, rtl/baselines/) come from the
 # method registry, rtl/methods.py.
 COST_FIELDS = ("multipliers", "const_multipliers", "dividers", "sqrts", "adders", "table_bits", "ram_bits",
@@ -127,8 +158,9 @@ class Context:
     def __init__(self, grid, seed, work):
         self.grid, self.work = grid, Path(work)
         self.px = PixelInputs.random(grid.samples, np.random.default_rng(seed))
-        self.scenes = {name: load_scene(name, size=grid.size) for name in grid.scenes}
+        self.scenes = {map_key(name, size): load_scene(name, size=size) for name, size in grid.maps}
         self.refs = {name: to_8bit(conventional(s.px, Config()).color) for name, s in self.scenes.items()}
+        self.maps = [map_record(name, size, self.scenes[map_key(name, size)]) for name, size in grid.maps]
         self._adversarial = {}
 
     def adversarial(self, cfg, channel="diffuse"):
@@ -140,6 +172,17 @@ class Context:
                 cfg, candidates=self.grid.adversarial, keep=max(20, self.grid.adversarial // 200),
                 channel=channel)
         return self._adversarial[key]
+
+
+def map_record(name, size, scene):
+    """What the sweep says about a map it measured on: name, size, geometry, texels (all /
+    used by some pixel) and distinct normals (object-space, of the used texels: a palette of
+    at least that many entries stores every one and quantizes nothing)."""
+    used = int(np.count_nonzero(np.bincount((scene.v * scene.texture_size + scene.u)[scene.mask],
+                                            minlength=scene.texture_size ** 2)))
+    return {"key": map_key(name, size), "name": name, "size": size, "geometry": scene.geometry,
+            "texels": scene.texture_size ** 2, "texels_used": used,
+            "distinct_normals": int(distinct_normals(scene))}
 
 
 def _stats(err):
@@ -301,21 +344,21 @@ def _hardware(point, cfg, component_fn, label, ctx, opts):
 
 
 def palette_point(ctx, size, opts):
+    """The palette of ``size`` entries on every map. Per map ``quantized``: False when the
+    palette held each of the map's distinct normals (quantize_normal_map's exact table), so
+    that map measured no quantization; the point's ``quantizes`` is False when no map did."""
     cfg = Config(palette_size=size)
     scenes, speeds = {}, []
     for name, scene in ctx.scenes.items():
         normals, counts = world_normal_map(scene)
-        try:
-            qmap = quantize_normal_map(normals, size, "median-cut", weights=counts)
-        except BumpError as e:         # sN above the map's distinct normals
-            scenes[name] = {"reason": str(e)}
-            continue
+        qmap = quantize_normal_map(normals, size, "median-cut", weights=counts)
         rgb, _ = palette_rgb(scene, cfg, qmap=qmap)
-        scenes[name] = _scene_stats(ctx, name, to_8bit(rgb.mean(-1)))
+        scenes[name] = {**_scene_stats(ctx, name, to_8bit(rgb.mean(-1))), "quantized": not qmap.exact,
+                        "distinct_normals": qmap.distinct}
         speeds.append(scene.mask.size / _best_time(lambda: palette_rgb(scene, cfg, qmap=qmap)))
-    if not speeds:
-        return _invalid("palette", {"palette_size": size}, "; ".join(s["reason"] for s in scenes.values()))
+    exact = [name for name, s in scenes.items() if not s["quantized"]]
     point = {"method": "palette", "palette_size": size, "status": "ok", "config": cfg.to_dict(),
+             "quantizes": len(exact) < len(scenes), "stores_every_normal_of": exact,
              "error": {"scenes": scenes, "note": "a palette shades a normal map: scenes only, "
                                                   "no independent random/adversarial vectors"},
              "speed": {"golden_mpix_s": round(min(speeds) / 1e6, 3),
@@ -341,8 +384,8 @@ def sweep(grid, opts, work, seed=11, progress=True):
             bar.set_postfix_str(" ".join(map(str, args[:-1])))
             points.append(fn(ctx, *args))
     reference = len(ctx.px) / _best_time(lambda: _conventional(ctx)) / 1e6
-    return {"grid": grid.__dict__, "seed": seed, "float64_conventional_mpix_s": round(reference, 3),
-            "points": points}
+    return {"grid": grid.__dict__, "maps": ctx.maps, "seed": seed,
+            "float64_conventional_mpix_s": round(reference, 3), "points": points}
 
 
 def _conventional(ctx):
@@ -353,6 +396,52 @@ def _conventional(ctx):
 
 def ok_points(data):
     return [p for p in data["points"] if p["status"] == "ok"]
+
+
+def maps_of(data):
+    """The maps a sweep measured on: its ``maps`` records; for a sweep made before they were
+    recorded, the grid's scenes at its size (distinct normals None: not recorded)."""
+    if data.get("maps"):
+        return data["maps"]
+    g = data.get("grid") or {}
+    size = g.get("size")
+    return [{"key": n, "name": n, "size": size, "texels": size * size if size else None,
+             "distinct_normals": None} for n in g.get("scenes", ())]
+
+
+def describe_map(m):
+    """``gravel (1024², 82838 distinct normals)``."""
+    size = f"{m['size']}\N{SUPERSCRIPT TWO}" if m.get("size") else "size not recorded"
+    n = m.get("distinct_normals")
+    return f"{m['name']} ({size}, {'distinct normals not recorded' if n is None else f'{n} distinct normals'})"
+
+
+def unquantized_maps(point, data):
+    """Keys of the maps on which palette ``point`` held every distinct normal, so quantized
+    nothing: as the sweep recorded it per map; for an older sweep without that record, where
+    the palette has at least as many entries as the map has texels (more distinct normals
+    than texels there cannot be). Empty for the per-pixel methods."""
+    if point.get("method") != "palette":
+        return []
+    maps = {m["key"]: m for m in maps_of(data)}
+    out = []
+    for key, s in point.get("error", {}).get("scenes", {}).items():
+        if "max_lsb" not in s:
+            continue
+        if "quantized" in s:
+            exact = not s["quantized"]
+        else:
+            m = maps.get(key, {})
+            bound = m.get("distinct_normals") or m.get("texels")
+            exact = bound is not None and point["palette_size"] >= bound
+        if exact:
+            out.append(key)
+    return out
+
+
+def measured_maps(point):
+    """Keys of the maps a point has a scene measurement on."""
+    return [k for k, s in point.get("error", {}).get("scenes", {}).items() if "max_lsb" in s]
 
 
 def _ns_per_pixel(p):
@@ -401,13 +490,15 @@ def markdown(data, command, plot_paths=()):
     pts = ok_points(data)
     front = {id(pts[i]) for i in pareto_front(pts, _memory_bits, error_lsb)}
     g = data["grid"]
-    lines = [f"Generated by `{command}` (grid: angle bits {g['angle_bits']}, frac bits "
-             f"{g['frac_bits']}, palette sizes {g['palette_sizes']}; {g['samples']} random valid "
+    lines = [f"Generated by `{command}` (grid: angle bits {tuple(g['angle_bits'])}, frac bits "
+             f"{tuple(g['frac_bits'])}, palette sizes {tuple(g['palette_sizes'])}; {g['samples']} random valid "
              f"vectors, seed {data['seed']}; adversarial vectors of sim/golden/accuracy.py per "
-             f"angle width; scenes {', '.join(g['scenes'])} at {g['size']}x{g['size']}).", "",
+             f"angle width; maps (scenes of sim/scenes, one pixel per texel; distinct normals = "
+             f"object-space normals of the texels the geometry uses): "
+             f"{', '.join(describe_map(m) for m in maps_of(data))}).", "",
              "Errors are 8-bit LSB against float64 `conventional` on unquantized inputs: per "
              "output channel, max on the random vectors / max on the adversarial search aimed at "
-             "that channel; eq. 2's colour image on the scenes, PSNR (worst scene, dB) / max LSB "
+             "that channel; eq. 2's colour image on the maps, PSNR (worst map, dB) / max LSB "
              "over the pixels the geometry covers. **error** = the worst colour max over all "
              "sets (what `bumprtl recommend` ranks on). "
              "Cost: Yosys coarse netlist of the per-pixel units (rotation + illumination, or the "
@@ -416,7 +507,7 @@ def markdown(data, command, plot_paths=()):
              "log2 sN for a palette index. Speed: golden model Mpix/s in this run (numpy, best "
              f"of 3; float64 `conventional` ran at {data['float64_conventional_mpix_s']:.2f} Mpix/s "
              "on the same vectors). `pareto` = on the front of error against ROM+RAM bits.", "",
-             "| point | diffuse rnd / adv | specular rnd / adv | colour rnd / adv | scenes PSNR / max "
+             "| point | diffuse rnd / adv | specular rnd / adv | colour rnd / adv | maps PSNR / max "
              "| error | mult | div / sqrt | adders | ROM bits | RAM bits | map bits | LUT4 | DSP | BRAM "
              "| Fmax MHz | golden Mpix/s | sim pix/s | hw Mpix/s | pareto |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -425,6 +516,18 @@ def markdown(data, command, plot_paths=()):
     if other:
         lines += ["", "Not measured:", ""]
         lines += [f"- {point_label(p)}: **{p['status']}** — {p['reason']}" for p in other]
+    exact = [(p, unquantized_maps(p, data)) for p in pts]
+    exact = [(p, keys) for p, keys in exact if keys]
+    if exact:
+        by_key = {m["key"]: m for m in maps_of(data)}
+        lines += ["", "Palette points that held every distinct normal of a map quantized nothing "
+                      "there (the error on that map is the colour table's rounding only); "
+                      "`bumprtl recommend` does not count a point that quantized on no map:", ""]
+        for p, keys in exact:
+            everywhere = len(keys) == len(measured_maps(p))
+            lines.append(f"- {point_label(p)}: every normal of "
+                         f"{', '.join(describe_map(by_key[k]) if k in by_key else k for k in keys)}"
+                         f"{' (every map measured: not evidence of quantization)' if everywhere else ''}")
     failed = [p for p in pts if p["cost"].get("fpga_error")]
     if failed:
         lines += ["", "FPGA flow failed (the point keeps its other columns):", ""]
@@ -479,6 +582,8 @@ def command_line(args):
     parts = ["bumprtl bench sweep"] + (["--quick"] if args.quick else [])
     if set(args.methods) != set(METHOD_CHOICES):
         parts += ["--methods", *args.methods]
+    if getattr(args, "maps", None):
+        parts += ["--maps", *args.maps]
     if args.fpga:
         parts += ["--fpga", "--device", args.device, "--fpga-points", args.fpga_points]
     if args.sim:
@@ -493,6 +598,8 @@ def run(args):
     if args.fpga:
         check_device(args.device)
     grid = GRIDS["quick" if args.quick else "default"]
+    if args.maps:
+        grid = replace(grid, maps=parse_maps(args.maps))
     command = command_line(args)
     print(command)
     data = sweep(grid, args, args.work, progress=not args.no_progress)
@@ -521,6 +628,11 @@ def add_parser(sub):
                                    "Pareto plot, markdown table.")
     p.add_argument("--quick", action="store_true", help="small grid (angle 10,12 x frac 11,13; sN 16,256)")
     p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
+    p.add_argument("--maps", nargs="+", default=None, metavar="NAME:SIZE",
+                   help="the maps the scene errors are measured on, each a scene of `bumprtl render "
+                        f"--help` at SIZE x SIZE texels (a power of two in [{MAP_SIZES[0]}, "
+                        f"{MAP_SIZES[1]}]), one pixel per texel (default: "
+                        f"{' '.join(f'{n}:{z}' for n, z in DEFAULT_MAPS)}; --quick: bricks:64)")
     p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
     p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
     p.add_argument("--fpga-points", default="default", choices=FPGA_POINTS,

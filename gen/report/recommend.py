@@ -5,15 +5,23 @@ evidence: its error sets, its cost, its speed, the runners-up and the command th
 the numbers. Nothing is re-measured or estimated here. Without ``--sweep`` and without a local
 sweep (``build/bench/sweep.json``), it reads the sweep that ships in ``docs/data/sweep.json``
 (the one docs/bench.md shows) and says so.
+
+It names the maps its evidence covers (each map's size and number of distinct normals, as
+the sweep recorded them), and does not count a palette point that quantized on none of the
+maps: a palette holding every distinct normal of the maps measured stores them exactly, so
+its error there says nothing about a larger map, where the palette must quantize. A palette
+point that held every normal of some maps is counted on the others, and says which.
 """
 
 import json
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.gen.bench.sweep import point_label, cost_key, error_lsb, ok_points
+from bumprtl.gen.bench.sweep import (cost_key, describe_map, error_lsb, maps_of, measured_maps,
+                                     ok_points, point_label, unquantized_maps)
 
-__all__ = ["recommend", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path"]
+__all__ = ["recommend", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
+           "evidence_line"]
 
 LOCAL_SWEEP = Path("build/bench/sweep.json")          # what `bumprtl bench sweep` writes
 # The sweep docs/bench.md was made from, in the checkout (gen/report/ -> the repository root).
@@ -56,12 +64,30 @@ def _fits(point, device):
     return all(avail.get(k) is None or f[k] <= avail[k] for k in ("LUT4", "DSP", "BRAM"))
 
 
+def not_evidence(data):
+    """The palette points that quantized on none of the maps they were measured on (they held
+    every distinct normal of each): ``recommend`` does not count them."""
+    return [p for p in ok_points(data) if p["method"] == "palette" and measured_maps(p)
+            and len(unquantized_maps(p, data)) == len(measured_maps(p))]
+
+
+def evidence_line(data):
+    """``evidence: maps bricks (512², 262104 distinct normals), ...``: what the sweep's
+    scene errors cover."""
+    maps = maps_of(data)
+    if not maps:
+        return "evidence: no maps recorded in this sweep (random and adversarial vectors only)"
+    return "evidence: maps " + ", ".join(describe_map(m) for m in maps)
+
+
 def recommend(data, max_error_lsb, device=None):
     """``(best, candidates)``: the points meeting the bound (and fitting ``device``), cheapest
-    first by :func:`cost_key`; raises BumpError when none does."""
+    first by :func:`cost_key`; raises BumpError when none does. A palette point in
+    :func:`not_evidence` is never a candidate."""
     if isinstance(max_error_lsb, bool) or not isinstance(max_error_lsb, (int, float)) or max_error_lsb < 0:
         raise BumpError(f"max_error_lsb must be a number >= 0, got {max_error_lsb!r}")
-    points = [p for p in ok_points(data) if error_lsb(p) is not None]
+    skipped = {id(p) for p in not_evidence(data)}
+    points = [p for p in ok_points(data) if error_lsb(p) is not None and id(p) not in skipped]
     if device:
         placed = [p for p in points if p["cost"].get("fpga", {}).get("device") == device]
         if not placed:
@@ -74,7 +100,9 @@ def recommend(data, max_error_lsb, device=None):
         best = min((error_lsb(p) for p in points), default=None)
         raise BumpError(f"no configuration in the sweep meets max_error_lsb = {max_error_lsb}"
                         f"{' on ' + device if device else ''}: the smallest measured error is "
-                        f"{best} LSB (allowed bounds: >= {best})")
+                        f"{best} LSB (allowed bounds: >= {best})"
+                        + (f"; not counted, no quantization on the maps measured: "
+                           f"{', '.join(point_label(p) for p in not_evidence(data))}" if skipped else ""))
     return meeting[0], meeting
 
 
@@ -121,11 +149,20 @@ def run(args):
           f"(cheapest by {order}):\n")
     print(f"  {point_label(best)}: {_flags(best)}")
     print("\n".join(_evidence(best)))
+    exact = unquantized_maps(best, data)
+    if exact:
+        print(f"  note: this palette held every distinct normal of {', '.join(exact)} (no "
+              f"quantization there); its error comes from "
+              f"{', '.join(k for k in measured_maps(best) if k not in exact)}")
     if len(meeting) > 1:
         print("\nnext cheapest meeting the bound:")
         for p in meeting[1:4]:
             print(f"  {point_label(p)}: error {error_lsb(p)}, cost key {cost_key(p, args.device)}")
-    print(f"\nevidence from {args.sweep}, made by `{data.get('command', 'bumprtl bench sweep')}`")
+    print("\n" + evidence_line(data))
+    for p in not_evidence(data):
+        print(f"not counted: {point_label(p)} held every distinct normal of the maps measured "
+              f"(no quantization happened: not evidence for a larger map)")
+    print(f"evidence from {args.sweep}, made by `{data.get('command', 'bumprtl bench sweep')}`")
     return 0
 
 

@@ -9,7 +9,9 @@ import pytest
 
 from bumprtl.gen.bench import skip as bench_skip
 from bumprtl.gen.bench import sweep as bench_sweep
-from bumprtl.gen.bench.sweep import Grid, error_lsb, pareto_front, sweep, write_section
+from bumprtl.gen.bench.sweep import Grid, error_lsb, map_key, pareto_front, parse_maps, sweep, write_section
+from bumprtl.gen.cli.main import main
+from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs
@@ -70,7 +72,7 @@ def test_write_section_keeps_other_sections(tmp_path):
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
     grid = Grid(angle_bits=(6, 14), frac_bits=(5,), palette_sizes=(16,), samples=300,
-                scenes=("bumps",), size=16, adversarial=4000)
+                maps=(("bumps", 16),), adversarial=4000)
     opts = SimpleNamespace(methods=("exact", "palette", "baselines"), fpga=False, sim=False,
                            device="LFE5U-85F")
     work = tmp_path_factory.mktemp("sweep")
@@ -107,7 +109,11 @@ def test_tiny_sweep_invalid_and_missing(tiny):
     assert by[("kim", 6)]["cost"]["dividers"] == 0 == by[("exact", 6)]["cost"]["sqrts"]
     palette = by[("palette", None)]
     assert palette["status"] == "ok" and "random" not in palette["error"]
-    assert palette["error"]["scenes"]["bumps"]["max_lsb"] == error_lsb(palette)
+    assert palette["error"]["scenes"][map_key("bumps", 16)]["max_lsb"] == error_lsb(palette)
+    (record,) = tiny["maps"]                          # the map it measured on, named and counted
+    assert (record["name"], record["size"], record["texels"]) == ("bumps", 16, 256)
+    assert 16 < record["distinct_normals"] <= 256
+    assert palette["quantizes"] and palette["error"]["scenes"][map_key("bumps", 16)]["quantized"]
     json.dumps(tiny)                                  # the sweep is JSON-serializable
 
 
@@ -117,6 +123,46 @@ def test_markdown_and_plot(tiny, tmp_path):
     assert "exact a6 b5" in text and "invalid" in text
     png = bench_sweep.plot(tiny, tmp_path / "p.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_palette_point_storing_every_normal_is_marked_not_quantizing(tmp_path, monkeypatch):
+    """At sN = the map's distinct normals the palette stores each one (``quantized`` false on
+    that map, ``quantizes`` false for the point, listed under the table) and its image is
+    the reference's within the colour table's rounding; one entry fewer quantizes."""
+    monkeypatch.setattr(bench_sweep, "unit_cost", lambda units, cfg, work: {
+        "multipliers": 0, "adders": 0, "table_bits": 0, "ram_bits": 0})
+    grid = Grid(angle_bits=(), frac_bits=(), palette_sizes=(), samples=10, maps=(("moon", 32),))
+    ctx = bench_sweep.Context(grid, 0, tmp_path)
+    (record,) = ctx.maps
+    n, key = record["distinct_normals"], map_key("moon", 32)
+    opts = SimpleNamespace(fpga=False)
+    exact, fewer = bench_sweep.palette_point(ctx, n, opts), bench_sweep.palette_point(ctx, n - 1, opts)
+    assert not exact["quantizes"] and exact["stores_every_normal_of"] == [key]
+    assert exact["error"]["scenes"][key]["quantized"] is False and exact["error"]["scenes"][key]["max_lsb"] <= 1
+    assert fewer["quantizes"] and fewer["stores_every_normal_of"] == []
+    assert fewer["error"]["scenes"][key]["quantized"] is True
+    data = {"grid": grid.__dict__, "maps": ctx.maps, "seed": 0, "float64_conventional_mpix_s": 1.0,
+            "points": [exact, fewer]}
+    for p in data["points"]:
+        p["cost"]["map_bits_per_texel"] = 10
+    text = bench_sweep.markdown(data, "bumprtl bench sweep --test")
+    assert f"moon (32\N{SUPERSCRIPT TWO}, {n} distinct normals)" in text
+    assert f"- palette sN={n}: every normal of moon" in text and f"palette sN={n - 1}: every" not in text
+
+
+@pytest.mark.parametrize("spec", ["nope:512", "moon:500", "moon:8", "moon:4096", "moon", "moon:x"])
+def test_bad_maps_exit_2_naming_the_flag(spec, capsys):
+    with pytest.raises(BumpError, match="--maps must be NAME:SIZE"):
+        parse_maps([spec])
+    assert main(["bench", "sweep", "--maps", spec, "--out", "/nonexistent/x.json"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--maps" in err and "[16, 2048]" in err and len(err.splitlines()) == 1
+
+
+def test_parse_maps():
+    assert parse_maps(["gravel:1024", "moon:512"]) == (("gravel", 1024), ("moon", 512))
+    with pytest.raises(BumpError, match="twice"):
+        parse_maps(["moon:512", "moon:512"])
 
 
 def test_stress_rows_and_markdown():

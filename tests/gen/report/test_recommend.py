@@ -101,6 +101,66 @@ def test_device_ranking_uses_fpga_and_capacity():
         recommend(data, 1, "LFE5U-85F")
 
 
+def _palette(size, scenes):
+    """A palette sweep point measured on ``scenes``: {map key: (max LSB, quantized)}."""
+    return {"method": "palette", "palette_size": size, "status": "ok",
+            "config": {"palette_size": size},
+            "error": {"scenes": {k: {"psnr_db": None if m == 0 else 50.0, "max_lsb": m, "quantized": q}
+                                 for k, (m, q) in scenes.items()}},
+            "cost": {"multipliers": 0, "adders": 2, "table_bits": 0, "ram_bits": 32 * size,
+                     "map_bits_per_texel": 14},
+            "speed": {"golden_mpix_s": 3.0}}
+
+
+MAPS = [{"key": "gravel 1024\u00b2", "name": "gravel", "size": 1024, "texels": 1 << 20,
+         "distinct_normals": 82838},
+        {"key": "moon 512\u00b2", "name": "moon", "size": 512, "texels": 1 << 18,
+         "distinct_normals": 8328}]
+
+
+def test_names_the_maps_and_does_not_count_a_palette_that_quantized_nowhere(tmp_path, capsys):
+    """A palette holding every distinct normal of every map measured (error 0, and cheapest)
+    is no evidence for a larger map: not a candidate, named as not counted; the evidence
+    line names each map with its size and distinct normals."""
+    exact_everywhere = _palette(16384, {"moon 512\u00b2": (0, False)})
+    data = {"command": "bumprtl bench sweep --toy", "maps": MAPS[1:],
+            "points": [exact_everywhere, _point((12, 13), 1, 180_000)]}
+    best, meeting = recommend(data, 1)
+    assert best["method"] == "exact" and len(meeting) == 1
+    path = tmp_path / "sweep.json"
+    path.write_text(json.dumps(data))
+    assert main(["recommend", "--max-error-lsb", "1", "--sweep", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "evidence: maps moon (512\u00b2, 8328 distinct normals)" in out
+    assert "not counted: palette sN=16384" in out
+    with pytest.raises(BumpError, match="not counted.*palette sN=16384"):
+        recommend({"maps": MAPS[1:], "points": [exact_everywhere]}, 1)
+
+
+def test_a_palette_that_quantized_on_some_maps_counts_and_says_where(tmp_path, capsys):
+    partly = _palette(16384, {"gravel 1024\u00b2": (1, True), "moon 512\u00b2": (0, False)})
+    data = {"command": "toy", "maps": MAPS, "points": [partly, _point((12, 13), 1, 180_000)]}
+    assert recommend(data, 1)[0] is partly                     # 0 multipliers: cheapest
+    path = tmp_path / "sweep.json"
+    path.write_text(json.dumps(data))
+    assert main(["recommend", "--max-error-lsb", "1", "--sweep", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "evidence: maps gravel (1024\u00b2, 82838 distinct normals), moon (512\u00b2, 8328 distinct normals)" in out
+    assert "held every distinct normal of moon 512\u00b2" in out and "comes from gravel 1024\u00b2" in out
+    assert "not counted" not in out
+
+
+def test_an_older_sweep_without_map_records_is_judged_by_texels(capsys):
+    """Sweeps made before the maps were recorded: a palette with at least as many entries as
+    a map has texels held every normal of it."""
+    old = lambda size: {**_palette(size, {}), "error": {"scenes": {"bricks": {"psnr_db": None, "max_lsb": 0}}}}
+    data = {"grid": {"scenes": ["bricks"], "size": 128}, "points": [old(16384), old(4096)]}
+    best, meeting = recommend(data, 1)
+    assert [p["palette_size"] for p in meeting] == [4096]
+    from bumprtl.gen.report.recommend import evidence_line
+    assert evidence_line(data) == "evidence: maps bricks (128\u00b2, distinct normals not recorded)"
+
+
 @pytest.mark.parametrize("bad", [-1, True, "1"])
 def test_bad_bound(bad):
     with pytest.raises(BumpError, match="max_error_lsb"):
