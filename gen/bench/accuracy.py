@@ -18,12 +18,14 @@ from dataclasses import fields, replace
 
 import numpy as np
 
-from bumprtl.rtl.config import BumpError, Config, ConfigError
+from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config, ConfigError
+from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.methods import METHODS, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
                                          crater_scene, grid_errors_lsb, on_grid, reference_blend,
-                                         scene_error, term_errors_lsb)
+                                         scene_error, term_errors_lsb, worst_case_pixels)
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import phong_sum_fixed
 from bumprtl.sim.golden.float.conventional import conventional
@@ -37,24 +39,27 @@ def _stats(err):
     return {"max": int(err.max()), "mean": float(err.mean()), "worst": int(np.argmax(err))}
 
 
-KINDS = ("random", "adversarial", "search")       # the three pixel sets of a channel's row
+KINDS = ("random", "adversarial", "search", "worst")   # the pixel sets of a channel's row
 
 
 def measure(cfg: Config, px: PixelInputs):
     """Per channel, on the random pixels ``px``, on the adversarial search aimed at that
-    channel and on the search aimed at the dot product's arithmetic error (``search``):
-    the end-to-end errors (8-bit LSB; ``random``, ``adversarial``, ``search``) and the
+    channel, on the search aimed at the dot product's arithmetic error (``search``) and on
+    the search aimed at the proof's worst case for that channel (``worst``,
+    sim/golden/accuracy.worst_case_pixels): the end-to-end errors (8-bit LSB) and the
     arithmetic errors (``grid``: {kind: stats}, None for a Cartesian-input method); the
     bound; and the pixel sets, so that a failure can be shown."""
     sets = {"random": px, "search": arithmetic_pixels(datapath_fixed, cfg)}
     for channel in CHANNELS:
         sets[f"adversarial {channel}"] = adversarial_pixels(cfg, channel=channel)
+        sets[f"worst {channel}"] = worst_case_pixels(datapath_fixed, cfg, channel)
     bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
     errors = {name: term_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
     grid = {name: grid_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
     out = {}
     for channel in CHANNELS:
-        names = {"random": "random", "adversarial": f"adversarial {channel}", "search": "search"}
+        names = {"random": "random", "adversarial": f"adversarial {channel}", "search": "search",
+                 "worst": f"worst {channel}"}
         out[channel] = {**{k: _stats(errors[names[k]][channel]) for k in KINDS},
                         "grid": None if grid["random"] is None else
                         {k: _stats(grid[names[k]][channel]) for k in KINDS},
@@ -130,15 +135,18 @@ def run(args):
           + (f" --scene-widths {' '.join(map(str, args.scene_widths))}" if args.scene_widths else ""))
     print(f"\nerror in 8-bit LSB per output channel, on {args.samples} random valid pixels (seed "
           f"11), the adversarial search aimed at the channel (seed 7) and the search aimed at "
-          f"the dot product's arithmetic error (on-grid N', H near N', seed 5). end-to-end = "
+          f"the dot product's arithmetic error (on-grid N', H near N', seed 5), and the worst-"
+          f"case search aimed at the proof's bound (every angle just under half a grid step off on "
+          f"its derivative's side where the channel is steepest, the arithmetic adding; seed 3). "
+          f"end-to-end = "
           f"against float64 on the unquantized inputs (input rounding + arithmetic); "
           f"arithmetic = against float64 on the angles the hardware receives (the inputs "
           f"rounded to the angle grid; — for Cartesian inputs). bound = the sidecar's "
           f"error_bounds_lsb (end-to-end; proof: predicted_error_bound_lsb)\n")
     print("| angle bits | frac bits | n | channel | end-to-end random max / mean "
-          "| end-to-end adversarial max / mean | end-to-end search max "
-          "| arithmetic max (random / adversarial / search) | bound | worst / bound |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "| end-to-end adversarial max / mean | end-to-end search max | end-to-end worst-case max "
+          "| arithmetic max (random / adversarial / search / worst-case) | bound | worst / bound |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     px = PixelInputs.random(args.samples, np.random.default_rng(11))
     failures, summary = [], []
     for cfg in points:
@@ -155,7 +163,7 @@ def run(args):
             print(f"| {a} | {b} | {n} | {channel} | {row['random']['max']} / "
                   f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
                   f"{row['adversarial']['mean']:.4f} | {row['search']['max']} | "
-                  f"{_grid_cell(row)} | {row['bound']} | {ratio} |", flush=True)
+                  f"{row['worst']['max']} | {_grid_cell(row)} | {row['bound']} | {ratio} |", flush=True)
             failures += [_failure(cfg, channel, k, row, sets) for k in KINDS
                          if row[k]["max"] > row["bound"]]
             if row["grid"] is not None:
@@ -181,15 +189,20 @@ def _summary(cfg, result):
     if any(r["grid"] is None for r in result.values()):
         return f"{head} end-to-end max {e2e} LSB (Cartesian inputs: no arithmetic-only measure)"
     arith = ", ".join(f"{c} {worst(r, True)}" for c, r in result.items())
+    below = [f"{c} measured {worst(r)}, proven {r['bound']}" for c, r in result.items()
+             if worst(r) < r["bound"]]
     return (f"{head} arithmetic max {arith} LSB; end-to-end max {e2e} LSB "
-            f"(end to end adds the inputs' rounding to the {cfg.angle_bits}-bit angle grid)")
+            f"(end to end adds the inputs' rounding to the {cfg.angle_bits}-bit angle grid)"
+            + (f"; below the proven bound: {', '.join(below)}" if below else ""))
 
 
 def _outputs(pxs, cfg, texels, grid=False):
-    """Eq. 2's colour of the lights ``pxs`` (one PixelInputs a light, the same N and N')
-    and the texture blend on ``texels``: the fixed-point model's (the lights' unrounded
-    terms summed and rounded once, LightSum / TextureBlend) and float64's, on the
-    unquantized inputs or (``grid``) on the angles the hardware receives."""
+    """The pipeline's outputs over the lights ``pxs`` (one PixelInputs a light, the same N
+    and N'): the summed diffuse and specular ports, eq. 2's colour and the texture blend on
+    ``texels`` -- the fixed-point model's (the lights' unrounded terms summed and rounded
+    once: LightSum, TextureBlend, sim/golden/fixed/pipeline.combine_lights_fixed) against
+    float64's, on the unquantized inputs or (``grid``) on the angles the hardware receives:
+    {output: |error| per pixel}."""
     outs = [datapath_fixed(encode_pixels(p, cfg), cfg) for p in pxs]
     refs = [conventional(on_grid(p, cfg) if grid else p, cfg) for p in pxs]
     d, s = sum(o["diffuse_fine"] for o in outs), sum(o["specular_fine"] for o in outs)
@@ -200,30 +213,44 @@ def _outputs(pxs, cfg, texels, grid=False):
                           texels, cfg)[0]
     want_blend = reference_blend(refs, texels, cfg)
     err = lambda a, b: np.abs(np.asarray(a, np.int64) - np.asarray(b, np.int64))
-    return {"color": err(phong_sum_fixed(d, s, cfg), want),
+    ports = {"diffuse": np.minimum(round_shift(255 * d, cfg.frac_bits), 255),
+             "specular": np.minimum(round_shift(s, SPEC_FRAC_BITS), 255)}
+    return {"diffuse": err(ports["diffuse"], to_8bit(np.clip(sum(np.clip(r.ndotl, 0, 1)
+                                                                 for r in refs), 0, 1))),
+            "specular": err(ports["specular"], to_8bit(np.clip(sum(r.specular for r in refs), 0, 1))),
+            "color": err(phong_sum_fixed(d, s, cfg), want),
             "blend": np.max([err(blend[c], want_blend[c]) for c in RGB], axis=0)}
 
 
-def light_sums(cfg: Config, px: PixelInputs):
-    """Eq. 2 summed over m = 1 and 2 lights and the texture blend (random texels, seed 3),
-    per output: {(m, output): {random, adversarial, grid: {random, adversarial} | None,
-    bound, sets}}. Random: ``px`` and, for the second light, L and H of other random pixels
-    (seed 12) on the same N and N'. Adversarial: the search aimed at the colour with every
-    light the same (the lights' errors then add up). The bounds are the pipeline sidecar's
-    (error_bounds with ``lights`` and ``texture``)."""
+LIGHT_OUTPUTS = ("diffuse", "specular", "color", "blend")
+LIGHT_KINDS = ("random", "adversarial", "worst")
+
+
+def light_sums(cfg: Config, px: PixelInputs, lights=(1, 2)):
+    """The outputs summed over m lights (m in ``lights``) and the texture blend (random
+    texels, seed 3): {(m, output): {random, adversarial, worst, grid: {kind} | None, bound,
+    sets}}. Random: ``px`` and, for further lights, L and H of other random pixels (seed 12)
+    on the same N and N'. Adversarial: the search aimed at the colour; worst: the searches
+    aimed at the proof's worst case of the specular term and of the colour; in both every
+    light is the same (the lights' errors then add up). The bounds are the pipeline
+    sidecar's (error_bounds with ``lights`` and ``texture``)."""
     other = PixelInputs.random(len(px), np.random.default_rng(12))
     other = replace(other, n_phi=px.n_phi, n_theta=px.n_theta, b_phi=px.b_phi, b_theta=px.b_theta)
     adv = adversarial_pixels(cfg, channel="color")
+    worst = [worst_case_pixels(datapath_fixed, cfg, c) for c in ("specular", "color")]
+    worst = PixelInputs(**{f.name: np.concatenate([getattr(w, f.name) for w in worst])
+                           for f in fields(px)})
     rng = np.random.default_rng(3)
     out = {}
-    for m in (1, 2):
-        sets = {"random": [px, other][:m], "adversarial": [adv] * m}
+    for m in lights:
+        sets = {"random": ([px] + [other] * (m - 1)), "adversarial": [adv] * m, "worst": [worst] * m}
         texels = {k: {c: rng.integers(0, 256, len(p[0])) for c in RGB} for k, p in sets.items()}
         e2e = {k: _outputs(p, cfg, texels[k]) for k, p in sets.items()}
         grid = (None if get(cfg.method).cartesian else
                 {k: _outputs(p, cfg, texels[k], grid=True) for k, p in sets.items()})
-        for output in ("color", "blend"):
-            bound = error_bounds(cfg, m, texture=output == "blend")["color"]
+        for output in LIGHT_OUTPUTS:
+            bounds = error_bounds(cfg, m, texture=output == "blend")
+            bound = bounds["color" if output == "blend" else output]
             out[(m, output)] = {**{k: _stats(e2e[k][output]) for k in sets},
                                 "grid": None if grid is None else
                                 {k: _stats(grid[k][output]) for k in sets},
@@ -232,42 +259,57 @@ def light_sums(cfg: Config, px: PixelInputs):
 
 
 def _lights(args, px):
-    """The light-sum and blend table at the default widths of ``args.method``; returns the
-    failure lines."""
+    """The light-sum and blend table: one and two lights at the default widths of
+    ``args.method`` (or ``--scene-widths``), and two lights at the two-light scenes' widths
+    (rtl/config.TWO_LIGHT_WIDTHS); returns the failure lines."""
     cfg = _scene_config(args)
-    print(f"\neq. 2's colour summed over m lights (LightSum) and the texture blend (TextureBlend, "
-          f"random texels), rounded once, at angle bits {cfg.angle_bits}, frac bits "
-          f"{cfg.frac_bits}, n = {cfg.spec_exponent}: random = the {len(px)} pixels (a second "
-          f"light: random L, H on the same N, N', seed 12); adversarial = the search aimed at "
-          f"the colour, every light the same; bound = the pipeline sidecar's error_bounds_lsb "
-          f"color of an m-light (textured) scene\n")
-    print("| lights | output | end-to-end random max / mean | end-to-end adversarial max / mean "
-          "| arithmetic max (random / adversarial) | bound | worst / bound |")
-    print("|---|---|---|---|---|---|---|")
+    two = cfg.replace(angle_bits=TWO_LIGHT_WIDTHS[0], frac_bits=TWO_LIGHT_WIDTHS[1])
+    print(f"\nthe outputs summed over m lights (LightSum) and the texture blend (TextureBlend, "
+          f"random texels), rounded once, n = {cfg.spec_exponent}: random = the {len(px)} pixels "
+          f"(a further light: random L, H on the same N, N', seed 12); adversarial = the search "
+          f"aimed at the colour, worst-case = the searches aimed at the proof's worst case of "
+          f"the specular term and the colour, every light the same; bound = the pipeline "
+          f"sidecar's error_bounds_lsb of an m-light (textured) scene\n")
+    print("| angle bits | frac bits | lights | output | end-to-end random max / mean "
+          "| end-to-end adversarial max / mean | end-to-end worst-case max "
+          "| arithmetic max (random / adversarial / worst-case) | bound | worst / bound |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     failures = []
-    for (m, output), row in light_sums(cfg, px).items():
-        kinds = ("random", "adversarial")
-        grid = row["grid"]
-        top = max([row[k]["max"] for k in kinds] + ([grid[k]["max"] for k in kinds] if grid else []))
-        cell = "—" if grid is None else " / ".join(str(grid[k]["max"]) for k in kinds)
-        ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
-        print(f"| {m} | {'colour' if output == 'color' else 'blend'} | {row['random']['max']} / "
-              f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
-              f"{row['adversarial']['mean']:.4f} | {cell} | {row['bound']} | "
-              f"{ratio} |", flush=True)
-        for k in kinds:
-            for measure, stats in (("end-to-end", row[k]), ("arithmetic", grid and grid[k])):
-                if stats and stats["max"] > row["bound"]:
-                    i = stats["worst"]
-                    lights = "; ".join(
-                        f"light {j + 1}: " + ", ".join(f"{f.name}={float(getattr(p, f.name)[i])!r}"
-                                                       for f in fields(p))
-                        for j, p in enumerate(row["sets"][k]))
-                    tex = (f", texel {tuple(int(row['texels'][k][c][i]) for c in RGB)}"
-                           if output == "blend" else "")
-                    failures.append(f"FAIL {cfg.method} lights={m} {output} ({k}, {measure}): "
-                                    f"error {stats['max']} LSB > bound {row['bound']} at pixel "
-                                    f"{i} ({lights}) [radians]{tex}")
+    points = [(cfg, (1, 2))] + ([(two, (2,))] if (two.angle_bits, two.frac_bits) !=
+                                (cfg.angle_bits, cfg.frac_bits) else [])
+    for c, lights in points:
+        for (m, output), row in light_sums(c, px, lights).items():
+            failures += _light_row(c, m, output, row)
+    return failures
+
+
+def _light_row(cfg, m, output, row):
+    """Print one row of the light-sum table; its failure lines."""
+    grid = row["grid"]
+    top = max([row[k]["max"] for k in LIGHT_KINDS] +
+              ([grid[k]["max"] for k in LIGHT_KINDS] if grid else []))
+    cell = "—" if grid is None else " / ".join(str(grid[k]["max"]) for k in LIGHT_KINDS)
+    ratio = f"{top / row['bound']:.2f}" if row["bound"] else "—"
+    name = {"color": "colour"}.get(output, output)
+    print(f"| {cfg.angle_bits} | {cfg.frac_bits} | {m} | {name} | {row['random']['max']} / "
+          f"{row['random']['mean']:.4f} | {row['adversarial']['max']} / "
+          f"{row['adversarial']['mean']:.4f} | {row['worst']['max']} | {cell} | {row['bound']} | "
+          f"{ratio} |", flush=True)
+    failures = []
+    for k in LIGHT_KINDS:
+        for measure, stats in (("end-to-end", row[k]), ("arithmetic", grid and grid[k])):
+            if stats and stats["max"] > row["bound"]:
+                i = stats["worst"]
+                lights = "; ".join(
+                    f"light {j + 1}: " + ", ".join(f"{f.name}={float(getattr(p, f.name)[i])!r}"
+                                                   for f in fields(p))
+                    for j, p in enumerate(row["sets"][k]))
+                tex = (f", texel {tuple(int(row['texels'][k][c][i]) for c in RGB)}"
+                       if output == "blend" else "")
+                failures.append(f"FAIL {cfg.method} angle_bits={cfg.angle_bits} frac_bits="
+                                f"{cfg.frac_bits} lights={m} {output} ({k}, {measure}): "
+                                f"error {stats['max']} LSB > bound {row['bound']} at pixel "
+                                f"{i} ({lights}) [radians]{tex}")
     return failures
 
 
@@ -308,8 +350,8 @@ def add_parser(sub):
                                    "offending input, if an error exceeds its bound.")
     p.add_argument("--method", default="exact", choices=tuple(METHODS))
     p.add_argument("--samples", type=int, default=1_000_000)
-    p.add_argument("--angle-bits", type=int, nargs="+", default=[10, 11, 12, 13])
-    p.add_argument("--frac-bits", type=int, nargs="+", default=[10, 13, 16])
+    p.add_argument("--angle-bits", type=int, nargs="+", default=[12, 13, 14, 15])
+    p.add_argument("--frac-bits", type=int, nargs="+", default=[13, 15, 16])
     p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
                    help="Phong exponents n (default: 16)")
     p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")

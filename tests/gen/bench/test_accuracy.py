@@ -8,7 +8,7 @@ import pytest
 
 from bumprtl.gen.bench import accuracy
 from bumprtl.gen.cli.main import main
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, Config
 from bumprtl.rtl.methods import datapath_fixed, encode_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.exact import faithful_widths
@@ -23,27 +23,31 @@ ARGS = ["bench", "accuracy", "--samples", "3000", "--angle-bits", str(DEFAULT.an
 def small_searches(monkeypatch):
     """The searches on a few hundred pixels (their own tests are in sim/golden)."""
     real_adv, real_arith = accuracy.adversarial_pixels, accuracy.arithmetic_pixels
+    real_worst = accuracy.worst_case_pixels
     monkeypatch.setattr(accuracy, "adversarial_pixels",
                         lambda cfg, channel: real_adv(cfg, candidates=4000, keep=30, channel=channel))
     monkeypatch.setattr(accuracy, "arithmetic_pixels",
                         lambda model, cfg: real_arith(model, cfg, candidates=4000, keep=20, reach=1))
+    monkeypatch.setattr(accuracy, "worst_case_pixels",
+                        lambda model, cfg, channel: real_worst(model, cfg, channel, candidates=3000,
+                                                               keep=10))
 
 
-ROW = rf"\| {DEFAULT.angle_bits} \| {DEFAULT.frac_bits} \| 16 \| {{}} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \| (.+?) \| (\d+) \|"
+ROW = rf"\| {DEFAULT.angle_bits} \| {DEFAULT.frac_bits} \| 16 \| {{}} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \| (\d+) \| (.+?) \| (\d+) \|"
 
 
 def test_rows_per_channel_within_the_bounds(small_searches, capsys):
-    """Both measures per channel at the default: end-to-end under the bound and within 1 LSB
-    (the 13-bit angle grid included), and the arithmetic alone (float64 on the received
-    angles) within 1 LSB on every channel."""
+    """Both measures per channel at the default: a proven bound of 1 on every channel, the
+    end-to-end error of every set (the worst-case search included) within it, and the
+    arithmetic alone (float64 on the received angles) within 1 LSB on every channel."""
     assert main(ARGS) == 0
     out = capsys.readouterr().out
-    for channel, bound in (("diffuse", 1), ("specular", 2), ("color", 1)):
+    for channel in ("diffuse", "specular", "color"):
         row = re.search(ROW.format(channel), out)
-        assert row and int(row.group(5)) == bound, (channel, out)
-        assert max(int(g) for g in row.groups()[:3]) <= min(bound, 1), (channel, row.group(0))
-        arithmetic = [int(v) for v in row.group(4).split(" / ")]
-        assert len(arithmetic) == 3 and max(arithmetic) <= 1, (channel, row.group(0))
+        assert row and int(row.group(6)) == 1, (channel, out)
+        assert max(int(g) for g in row.groups()[:4]) <= 1, (channel, row.group(0))
+        arithmetic = [int(v) for v in row.group(5).split(" / ")]
+        assert len(arithmetic) == 4 and max(arithmetic) <= 1, (channel, row.group(0))
     summary = re.search(rf"angle bits {DEFAULT.angle_bits}, frac bits {DEFAULT.frac_bits}, n = 16: arithmetic max diffuse (\d), "
                         r"specular (\d), color (\d) LSB; end-to-end max diffuse (\d), specular "
                         r"(\d), color (\d) LSB \(end to end adds the inputs' rounding to the "
@@ -110,20 +114,26 @@ def test_an_arithmetic_error_above_its_bound_prints_the_received_angles(small_se
     assert int(datapath_fixed(encode_pixels(grid, cfg), cfg)["specular"][0]) == got
 
 
-LIGHT_ROW = (r"\| {} \| {} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) / (\d+) \| (\d+) \| "
-             r"[\d.]+ \|")
+LIGHT_ROW = (r"\| {} \| {} \| {} \| {} \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \| "
+             r"(\d+) / (\d+) / (\d+) \| (\d+) \| [\d.]+ \|")
 
 
 def test_light_sums_and_blend_rows(small_searches, capsys):
-    """Eq. 2 over one and two lights and the texture blend at the default widths: under the
-    pipeline sidecar's bound, end to end and in the arithmetic within 1 LSB."""
+    """The outputs over one and two lights and the texture blend: at the default widths
+    every bound is 1 but two lights' specular sum (2: their specular terms add), and at the
+    two-light scenes' widths every bound is 1; every measure within its bound, and the
+    arithmetic within 1 LSB."""
     assert main(ARGS[:-1] + ["0"]) == 0
     out = capsys.readouterr().out
-    for lights, output, bound in ((1, "colour", 1), (1, "blend", 1), (2, "colour", 2), (2, "blend", 2)):
-        row = re.search(LIGHT_ROW.format(lights, output), out)
-        assert row, (lights, output, out)
-        rnd, adv, ar_rnd, ar_adv, b = (int(g) for g in row.groups())
-        assert b == bound and max(rnd, adv) <= 1 and max(ar_rnd, ar_adv) <= 1
+    a, b = DEFAULT.angle_bits, DEFAULT.frac_bits
+    rows = [(a, b, m, o, 2 if (m, o) == (2, "specular") else 1)
+            for m in (1, 2) for o in ("diffuse", "specular", "colour", "blend")]
+    rows += [(*TWO_LIGHT_WIDTHS, 2, o, 1) for o in ("diffuse", "specular", "colour", "blend")]
+    for angle_bits, frac_bits, lights, output, bound in rows:
+        row = re.search(LIGHT_ROW.format(angle_bits, frac_bits, lights, output), out)
+        assert row, (angle_bits, frac_bits, lights, output, out)
+        *measured, got_bound = (int(g) for g in row.groups())
+        assert got_bound == bound and max(measured[:3]) <= bound and max(measured[3:]) <= 1, row.group(0)
 
 
 def test_a_light_sum_above_its_bound_exits_1(small_searches, monkeypatch, capsys):
@@ -145,23 +155,24 @@ def test_bad_input_is_one_line_exit_2(capsys, flag, value, name):
     assert name in err and len(err.splitlines()) == 1 and "|" not in captured.out
 
 
-def test_scene_widths_13_16_bring_light_sums_and_blend_to_1_lsb(small_searches, capsys):
-    """The light-sum and blend table at 13-bit angles, B = 16 (``--scene-widths``): eq. 2's
-    colour and the texture blend with one and two lights within 1 LSB end to end, the angle
-    grid included (at the default widths two aligned lights reach 2, the table above)."""
+def test_scene_widths_set_the_light_table_widths(small_searches, capsys):
+    """``--scene-widths 13 16`` (the old default): the light-sum table is measured there, each
+    row under the proven bound of those widths (two lights' specular sum: 3), and the
+    two-light scenes' widths keep their own rows."""
     args = ["bench", "accuracy", "--samples", "3000", "--angle-bits", "13", "--frac-bits", "16",
             "--scene-size", "0", "--scene-widths", "13", "16"]
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert "at angle bits 13, frac bits 16, n = 16" in out and "--scene-widths 13 16" in out
-    for lights, output in ((1, "colour"), (1, "blend"), (2, "colour"), (2, "blend")):
-        row = re.search(LIGHT_ROW.format(lights, output), out)
-        assert row, (lights, output, out)
-        rnd, adv, ar_rnd, ar_adv, bound = (int(g) for g in row.groups())
-        assert max(rnd, adv, ar_rnd, ar_adv) <= 1 <= bound, row.group(0)
-    for channel in ("diffuse", "specular", "color"):
-        row = re.search(r"\| 13 \| 16 \| 16 \| " + channel + r" \| (\d+) / [\d.]+ \| (\d+) / [\d.]+ \| (\d+) \|", out)
-        assert row and max(int(g) for g in row.groups()) <= 1, (channel, out)
+    assert "--scene-widths 13 16" in out
+    old = Config(angle_bits=13, frac_bits=16)
+    for lights in (1, 2):
+        bounds = accuracy.error_bounds(old, lights)
+        for output, key in (("diffuse", "diffuse"), ("specular", "specular"), ("colour", "color")):
+            row = re.search(LIGHT_ROW.format(13, 16, lights, output), out)
+            assert row and int(row.group(7)) == bounds[key], (lights, output, out)
+            assert max(int(g) for g in row.groups()[:3]) <= bounds[key]
+    assert accuracy.error_bounds(old, 2)["specular"] == 3
+    assert re.search(LIGHT_ROW.format(*TWO_LIGHT_WIDTHS, 2, "specular"), out)
 
 
 def test_bad_scene_widths_is_one_line_exit_2(capsys):
