@@ -239,7 +239,7 @@ def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
     first = bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert bench_sweep.unit_cost(("sincos",), cfg, tmp_path) == first and len(calls) == 1
     from bumprtl.gen.flow import units          # same Config, different Verilog text: counted anew
-    monkeypatch.setattr(units, "canonical_command", lambda unit, c: "changed datapath")
+    monkeypatch.setattr(units, "canonical_command", lambda unit, c, module=None: "changed datapath")
     bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert len(calls) == 2
 
