@@ -34,7 +34,7 @@ __all__ = ["BULK_BUILDS", "rtl_sim_rows", "markdown", "add_parser"]
 # The bulk builds measured per simulator, in order (build options of sim/tb/bulk.py;
 # {} = the simulator's default). Verilator: the first bulk build, then one change a row
 # (the clock into the C++ main, DPI I/O, g++ -Os = the default), then the options tried
-# and not kept (g++ -O3 -march=native; two Verilator threads; cocotb's Clock).
+# and not kept (g++ -O3 -march=native; two Verilator threads).
 BULK_BUILDS = {
     "icarus": ({},),
     "verilator": ({"clock": "verilog", "io": "file", "opt_fast": "-O2"},
@@ -42,8 +42,7 @@ BULK_BUILDS = {
                   {"clock": "cxx", "io": "dpi", "opt_fast": "-O2"},
                   {},
                   {"opt_fast": "-O3", "extra": ("-CFLAGS", "-march=native")},
-                  {"extra": ("--threads", "2")},
-                  {"clock": "cocotb"}),
+                  {"extra": ("--threads", "2")}),
 }
 
 

@@ -241,8 +241,8 @@ def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir
     and the clock runs in the simulator; the build is cached under build/sim_cache by the
     Verilog's digest. ``expected`` (golden output arrays) makes cocotb compare every pixel.
     ``build``: the bulk build's ``clock``, ``io``, ``opt_fast``, ``extra``
-    (sim/tb/bulk.build_options; by default the simulator's fastest), e.g. ``clock="cocotb"``
-    drives the clock with cocotb's Clock. ``load = "port"``: the memories are written
+    (sim/tb/bulk.build_options; by default the simulator's fastest), e.g. ``clock="verilog"``
+    runs the wrapper's own Verilog clock on Verilator. ``load = "port"``: the memories are written
     through the host ports in the set-up.
     Returns ({pattern: {field: array}}, {pattern: cycles}, :class:`BulkResult`)."""
     build_dir = Path(build_dir).resolve()

@@ -1,4 +1,4 @@
-"""cocotb side of the bulk path (sim/tb/bulk.py): stream chunks of stimulus through the
+"""cocotb side of the bulk path (sim/tb/bulk.py, wrapper sim/tb/bulk_wrapper.v): stream chunks of stimulus through the
 bulk wrapper and compare the outputs with the golden model.
 
 Per chunk it writes ``bulk_in.bin``, sets the count, the traffic seeds and densities,
@@ -20,11 +20,11 @@ from pathlib import Path
 
 import cocotb
 import numpy as np
-from cocotb.clock import Clock
 from cocotb.triggers import Timer
 
-from bumprtl.sim.tb.bulk import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, SETUP_FILE,
-                                 decode_words, encode_words, host_fields, setup_arrays)
+from bumprtl.sim.tb.bulk_codec import decode_words, encode_words
+from bumprtl.sim.tb.bulk_wrapper import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, SETUP_FILE,
+                                         host_fields, setup_arrays)
 
 DENSITY_ONE = 1 << DENSITY_BITS
 
@@ -49,14 +49,9 @@ async def _reset_and_setup(dut, meta, setup, chunk):
     """Reset, then the host set-up cycles (``[{port: int}]``, one per clock), played by the
     wrapper from ``bulk_setup.bin`` in chunks: a map written through its port costs one
     clock a word, not one cocotb wake-up."""
-    host = [p for p, d in meta["ports"].items() if d["dir"] == "in" and
-            p not in ("clk", "rst", "i__valid", "i__payload", "o__ready")]
-    for p in host:
-        getattr(dut, p).value = 0          # the wrapper ORs them with the set-up word
     dut.start.value = 0
     dut.count.value = 0
-    if host:
-        dut.setup_mode.value = 0
+    dut.setup_mode.value = 0
     dut.rst.value = 1
     await Timer(PERIOD // 2, "ns")
     await _cycle(4)
@@ -114,8 +109,6 @@ async def _run(dut, job, meta, summary, make_source):
     fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
     iw, ow = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
     patterns = job["patterns"]
-    if job["clock"] == "cocotb":
-        cocotb.start_soon(Clock(dut.clk, PERIOD, unit="ns").start())
     setup, chunks = make_source(meta, job["source"], job["chunk"])
     await _reset_and_setup(dut, meta, job["setup"] + setup, job["chunk"])
     dut.idle_limit.value = job["idle_limit"]

@@ -78,10 +78,17 @@ def emit_all(out):
     (out / "notes.txt").write_text("\n".join(notes) + "\n")
     lines = []
     for p in sorted(out.rglob("*")):
-        if p.is_file() and p.name != "sha256.txt":
-            lines.append(f"{hashlib.sha256(p.read_bytes()).hexdigest()}  {p.relative_to(out)}")
+        if p.is_file() and p.name not in ("sha256.txt", "notes.txt"):
+            lines.append(f"{hashlib.sha256(_normal(p.read_bytes())).hexdigest()}  "
+                         f"{_normal(str(p.relative_to(out)).encode()).decode()}")
     (out / "sha256.txt").write_text("\n".join(lines) + "\n")
     return len(lines)
+
+
+def _normal(data):
+    """The emitted names without the ``bumprtl_`` prefix of ``bumprtl emit``'s default
+    ``--name``, so that the hashes compare the hardware across that naming change."""
+    return data.replace(b"bumprtl_", b"")
 
 
 def _table(path):

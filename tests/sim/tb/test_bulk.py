@@ -126,7 +126,7 @@ def test_bulk_build_options_are_checked_before_the_build(build_dir, monkeypatch)
                                           r"icarus clock must be 'verilog'"),
              ("icarus", {"io": "dpi"}, r"io 'dpi' needs Verilator's C\+\+ build"),
              ("icarus", {"opt_fast": "-O2"}, r"opt_fast and extra are Verilator build options"),
-             ("verilator", {"clock": "vpi"}, r"clock must be one of verilog, cocotb, cxx, got 'vpi'"),
+             ("verilator", {"clock": "vpi"}, r"clock must be one of verilog, cxx, got 'vpi'"),
              ("verilator", {"io": "mmap"}, r"io must be one of file, dpi, got 'mmap'"),
              ("verilator", {"opt_fast": "-O3 -march=native"}, r"opt_fast must be one g\+\+ flag")]
     for sim, opts, message in cases:
