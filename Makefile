@@ -24,8 +24,10 @@ help:
 
 $(STAMP): pyproject.toml | icarus
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e .
+	@mkdir -p build
+	@echo "installing the pinned packages (pip install -e '.[dev]'; log: build/pip.log)"
+	@{ $(PY) -m pip install --upgrade pip && $(PY) -m pip install -e '.[dev]'; } \
+	  > build/pip.log 2>&1 || { cat build/pip.log; echo "pip failed: build/pip.log" >&2; exit 1; }
 	@touch $@
 
 # Icarus Verilog: apt-get install when missing and we run as root, else stop and say so.

