@@ -371,7 +371,7 @@ def main(argv=None):
         results.append(r)
     seconds = time.perf_counter() - t0
     print(f"total {seconds / 60:.1f} min wall")
-    command = "make mutate-rtl MUTATE_RTL_ARGS=\"" + " ".join(argv if argv is not None else sys.argv[1:]) + "\""
+    command = "python tests/mutants/netlist.py " + " ".join(argv if argv is not None else sys.argv[1:])
     (a.out / "netlist_results.json").write_text(json.dumps(results, indent=1))
     if a.doc:
         write_doc(a.doc, report(results, a.sample, a.seed, seconds, a.jobs, command))
