@@ -50,11 +50,12 @@ test: $(STAMP)
 regress: $(STAMP)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m regress $(PYTEST_ARGS)
 
-# Each curated mutant applied in place, its guarding tests run (gen/flow/mutate.py; exit 1 if
-# one survives or no longer applies). MUTATE_ARGS="--copy build/mutate/tree" mutates a copy;
-# "--check" only checks that every mutant applies; "-k ID" picks mutants; "--doc docs/mutation.md".
+# Each curated mutant applied to a copy of the tree (build/mutate/tree), its guarding tests
+# run (tests/mutants/curated.py; exit 1 if one survives or no longer applies).
+# MUTATE_ARGS="--in-place" mutates the working tree itself; "--check" only checks that every
+# mutant applies; "-k ID" picks mutants; "--doc docs/mutation.md".
 mutate: $(STAMP)
-	$(RUN) $(PY) -m bumprtl.gen.flow.mutate $(MUTATE_ARGS)
+	$(RUN) $(PY) -m tests.mutants.curated $(MUTATE_ARGS)
 
 # Netlist mutation (the mcy method, tests/mutants/netlist.py): yosys mutate -list on every
 # unit's and built-in scene pipeline's emitted Verilog, all mutants in one Verilator build of

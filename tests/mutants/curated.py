@@ -1,4 +1,5 @@
-"""The standing mutation check (``make mutate``; ``python -m bumprtl.gen.flow.mutate``).
+"""The standing mutation check (``make mutate``; ``python -m tests.mutants.curated`` from the
+repository). Test tooling: it lives beside the tests, not in the product.
 
 A curated list of small, realistic bugs (``tests/mutants/mutants.toml``) is put into the
 code one at a time, and the tests that guard each one are run against it: a mutant the
@@ -13,11 +14,13 @@ once is an error that names the file and the text to update. A mutant that chang
 nothing observable is listed with ``equivalent = "why"``: its text is still checked, its
 guards are not run.
 
-For each mutant: apply it in place (every file's content hash recorded first), run its
-guards (``pytest -x -q -n 0``, bytecode writing off so no stale ``.pyc`` outlives it),
-restore in a ``finally`` and verify each file's content hash against the one recorded.
-``--copy DIR`` first copies the working tree (git's tracked and untracked, non-ignored
-files) to DIR and mutates the copy instead: other people may keep working in the tree.
+By default the working tree (git's tracked and untracked, non-ignored files) is first
+copied to ``build/mutate/tree`` (``--copy DIR`` elsewhere) and the copy is mutated, so
+other people may keep working in the tree; ``--in-place`` mutates the working tree itself.
+For each mutant: apply it (every file's content hash recorded first), run its guards
+(``pytest -x -q -n 0``, bytecode writing off so no stale ``.pyc`` outlives it), restore in
+a ``finally`` and verify each file's content hash against the one recorded. ``--check``
+reads the working tree and copies nothing.
 
 Exit status: 0 when every mutant was killed, 1 when one survived, did not apply or its
 guards failed on the unmutated code (the baseline run), 2 on a bad mutant list.
@@ -42,7 +45,8 @@ __all__ = ["Edit", "Mutant", "MutantError", "RestoreError", "Outcome", "ROOT", "
            "load_mutants", "check_applies", "applied", "run_guards", "run_mutants", "markdown",
            "copy_tree", "main"]
 
-ROOT = Path(__file__).resolve().parents[2]          # the repository (gen/flow/mutate.py)
+ROOT = Path(__file__).resolve().parents[2]          # the repository (tests/mutants/curated.py)
+DEFAULT_COPY = Path("build/mutate/tree")
 DEFAULT_LIST = Path("tests/mutants/mutants.toml")
 DEFAULT_TIMEOUT = 1800                               # seconds per mutant's guard run
 _KEYS = {"id", "file", "original", "replacement", "models", "guards", "also", "equivalent"}
@@ -379,16 +383,20 @@ def copy_tree(dest, root=ROOT):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m bumprtl.gen.flow.mutate",
+    p = argparse.ArgumentParser(prog="python -m tests.mutants.curated",
                                 description="Apply each curated mutant, run the tests that guard "
                                             "it, report killed or survived (make mutate).")
     p.add_argument("--list", type=Path, default=DEFAULT_LIST,
                    help=f"the mutant list, relative to the tree (default: {DEFAULT_LIST})")
     p.add_argument("-k", dest="select", action="append", default=[],
                    help="run only mutants whose id contains this text (repeatable)")
-    p.add_argument("--copy", type=Path, default=None,
-                   help="copy the working tree here and mutate the copy (others may keep "
-                        "working in the tree)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--copy", type=Path, default=DEFAULT_COPY,
+                       help=f"copy the working tree here and mutate the copy, so others may "
+                            f"keep working in the tree (default: {DEFAULT_COPY})")
+    where.add_argument("--in-place", action="store_true",
+                       help="mutate the working tree itself (each file restored and its "
+                            "content hash checked after each mutant)")
     p.add_argument("--timeout", type=int, default=DEFAULT_TIMEOUT,
                    help=f"seconds per mutant's guard run (default: {DEFAULT_TIMEOUT})")
     p.add_argument("--no-baseline", action="store_true",
@@ -410,7 +418,7 @@ def main(argv=None):
             mutants = [m for m in mutants if any(s in m.id for s in args.select)]
             if not mutants:
                 raise MutantError(f"-k {' '.join(args.select)}: no mutant id matches")
-        if args.copy is not None:
+        if not args.in_place and not args.check:
             env = copy_tree(args.copy)
             root = args.copy.resolve()
             print(f"mutating a copy of the tree in {root}")

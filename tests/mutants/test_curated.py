@@ -1,4 +1,4 @@
-"""The mutation check's own tests (gen/flow/mutate.py, ``make mutate``): the curated list
+"""The mutation check's own tests (tests/mutants/curated.py, ``make mutate``): the curated list
 parses and every mutant still applies to the code as it stands, every unit and shared helper
 has one, a mutant is restored byte for byte (also after an exception), and the runner tells a
 killed mutant from a survivor on a tiny project of its own."""
@@ -8,8 +8,8 @@ import re
 
 import pytest
 
-from bumprtl.gen.flow import mutate
-from bumprtl.gen.flow.mutate import (Edit, Mutant, MutantError, RestoreError, applied,
+from tests.mutants import curated as mutate
+from tests.mutants.curated import (Edit, Mutant, MutantError, RestoreError, applied,
                                      check_applies, load_mutants, markdown, run_mutants)
 
 ROOT = mutate.ROOT
