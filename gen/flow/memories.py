@@ -22,8 +22,9 @@ from amaranth.hdl import Fragment
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.palette import index_bits
+from bumprtl.rtl.pipe import DP16KD_MODES
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag
@@ -33,6 +34,7 @@ __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES",
            "scene_command"]
 
 LOADS = ("initial", "port")
+
 DEFAULT_DEVICE = "LFE5U-85F"
 # ECP5 block RAM: DP16KD blocks of 18 kbit per device (Lattice ECP5 family data sheet,
 # "EBR SRAM blocks"; nextpnr-ecp5's utilization report lists the same counts).
@@ -57,16 +59,27 @@ def _is_map(name):
     return name.split(".")[-1] in ("map", "texture")
 
 
+def table_blocks(depth, width):
+    """DP16KD blocks of a table as rtl/pipe.RegisteredROM lays it out on ECP5: a table of
+    2**n + 1 words keeps its last word in a flip-flop, the rest sits in the widest DP16KD
+    mode that holds every word in one block, blocks side by side for the width."""
+    n = depth - 1
+    words = n if n > 1 and n & (n - 1) == 0 else depth
+    bits = next((b for b, d, _ in DP16KD_MODES if d >= words), None)
+    return bram_blocks(words, width) if bits is None else math.ceil(width / bits)
+
+
 def check_fits(roms, device, what):
     """Raise a BumpError (naming ``what``, the bits it needs and the device's block RAM) when
-    the maps of ``roms`` (the sidecar's memories) and one block per other memory do not fit
-    ``device``. Returns ``(blocks needed, blocks available)``."""
+    the maps of ``roms`` (the sidecar's memories) and the pipeline's tables (each in the
+    cheapest tiling of its words, :func:`table_blocks`) do not fit ``device``. Returns
+    ``(blocks needed, blocks available)``."""
     if device not in DEVICE_BRAM:
         raise BumpError(f"device must be one of {', '.join(DEVICE_BRAM)}, got {device!r}")
     maps = {k: v for k, v in roms.items() if _is_map(k)}
     map_bits = sum(v["bits"] for v in maps.values())
     map_blocks = sum(bram_blocks(v["depth"], v["width"]) for v in maps.values())
-    other = len(roms) - len(maps)                 # tables: at least one block each
+    other = sum(table_blocks(v["depth"], v["width"]) for k, v in roms.items() if k not in maps)
     have = DEVICE_BRAM[device]
     if map_blocks + other > have:
         raise BumpError(f"{what}: the map needs {map_bits:,} bits of block RAM ({map_blocks} "

@@ -19,7 +19,8 @@ from bumprtl.gen.render import images, rtl
 from bumprtl.gen.render.images import fixed_image
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.report import recommend as rec
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.rtl.config import Config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.scenes import heightfields
 from bumprtl.sim.scenes.usermap import load_bump_map, normals_to_rgb, write_png
@@ -134,20 +135,24 @@ def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsy
 
 
 def test_a_map_too_large_for_the_device_says_bits_needed_and_available(tmp_path, capsys):
-    """512^2 x 26 bits = 384 DP16KD (8192 x 2 tiles) + 13 tables > 208 on the LFE5U-85F;
-    256^2 = 96 + 13 fits it but not the LFE5U-25F's 56."""
+    """A 512^2 map of two angles (2 x 14 bits a texel at the default) needs 112 x 4 DP16KD
+    (16384 x 1 ... 4096 x 4 tiles) beside the tables: over the LFE5U-85F's 208; 256^2 (112
+    blocks) fits beside the twelve 4097-word sine ROMs (four x4 blocks each, the last word in
+    a flip-flop) and the cos^n table (one x18 block), but not in the LFE5U-25F's 56."""
+    bits = 2 * Config().angle_bits
     path = _png(tmp_path / "big.png", craters(512, n=40))
     line = _one_line_exit_2(capsys, ["emit", "pipeline", "--height-map", str(path), "--out",
                                      str(tmp_path / "o")],
-                            "big.png", "6,815,744 bits", "384 DP16KD", "LFE5U-85F has 208 DP16KD of 18 kbit")
-    assert "3,833,856 bits" in line
+                            "big.png", f"{512 * 512 * bits:,} bits", f"{bram_blocks(512 * 512, bits)} DP16KD",
+                            "LFE5U-85F has 208 DP16KD of 18 kbit")
+    assert "3,833,856 bits" in line and bram_blocks(512 * 512, bits) == 448
     small = _png(tmp_path / "s.png", craters(256, n=20))
     _one_line_exit_2(capsys, ["render", "--rtl", "--height-map", str(small), "--device", "LFE5U-25F",
-                              "--out", str(tmp_path / "r.png")], "s.png", "1,703,936 bits",
+                              "--out", str(tmp_path / "r.png")], "s.png", f"{256 * 256 * bits:,} bits",
                      "LFE5U-25F has 56 DP16KD")
     assert not (tmp_path / "o").exists() and not (tmp_path / "r.png").exists()
     scene = load_scene_config("default", {"height_map": str(small)})
-    assert check_scene_fits(scene, "LFE5U-85F") == (96 + 13, 208)
+    assert check_scene_fits(scene, "LFE5U-85F") == (112 + 12 * 4 + 1, 208)
     assert bram_blocks(4096, 24) == 6 and bram_blocks(1025, 14) == 2 and bram_blocks(512, 36) == 1
 
 
