@@ -19,10 +19,10 @@ import matplotlib.pyplot as plt
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.methods import METHODS
+from bumprtl.sim.golden.methods import METHODS
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import BUILTIN, load_scene_config
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, check_device,
                                    lpf_mhz, pipeline_component, place_component)
@@ -59,7 +59,7 @@ def _component(design, row, cfg):
     """The ECP5 form (``target=ECP5()``) of row ``row`` of ``design`` (a method name)."""
     target = ECP5()
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
-        return BumpPipeline(row.split(":", 1)[1], target=target)
+        return BumpPipeline(load_scene_config(row.split(":", 1)[1]), target=target)
     cfg = cfg.replace(method=design)
     if row == "pipeline":
         return pipeline_component(cfg, target)
@@ -199,12 +199,13 @@ FPGA_NOTES = """
   own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
   about 1 ns clock-to-out instead of 5.8 ns; the last word of a 2^n + 1-word table is kept
   in a flip-flop, so the specular table is one 1024 x 18 block and each quarter-wave
-  table of 13-bit angles two 2048 x 9 blocks side by side, whose word gets a data register
-  of its own before the sign: the route from two blocks side by side ended the exact
-  pipeline's cycle at 146.7 MHz); every product uses the DSP's input and output registers
+  table of the default 14-bit angles four 4096 x 4 blocks side by side (15-bit angles: nine
+  8192 x 2 blocks, no output multiplexer), whose word gets a data register of its own
+  before the sign: the route from two blocks side by side ended the exact pipeline's cycle
+  at 146.7 MHz at 13-bit angles); every product uses the DSP's input and output registers
   (`rtl/pipe.RegisteredProduct`: MULT18X18D with REG_INPUTA/B and REG_OUTPUT, about 3.9 ns
   of DSP delay taken out of the cycle), and a product whose operands are wider than one
-  18-bit DSP input (the exact illumination's n''x4 p2 at B = 16: 21 x 19 bits) is split
+  18-bit DSP input (the exact illumination's n''x4 p2 at B = 15: 20 x 18 bits) is split
   into 17-bit limbs, one registered MULT18X18D per pair, their sum registered in a stage of
   its own (`rtl/pipe.WideProduct`); the n'' sums are two registered adder levels; the dot N'.A' and the Phong
   sum of eq. 2 each run as two 2-operand carry-chain stages (the rounding half is folded
@@ -223,7 +224,7 @@ FPGA_NOTES = """
   two models, bit-exact against the golden model on 10^4 pixels under random
   backpressure and input gaps. Both pass under cocotb on Icarus; `make fpga
   PYTEST_ARGS="tests/sim/ecp5/test_postsynth.py -k bit_exact -s"` prints the wall times
-  (2 x 10^4 pixels each, at the 13 / 16 default, 2 cores shared with two nextpnr runs and
+  (2 x 10^4 pixels each, measured at the earlier 13 / 16 default, 2 cores shared with two nextpnr runs and
   then the formal proofs): exact pipeline synthesis 24.3 s, Icarus build 13.3 s, simulation
   1076 s; scene_default 19.1 s, 8.5 s, 629 s (`make fpga PYTEST_ARGS=
   "tests/sim/ecp5/test_postsynth.py -s"`: 5 passed in 30 min 22 s). Verilator lints the exact
@@ -254,7 +255,7 @@ FPGA_NOTES = """
   `rtl/baselines/kim.py`: every table read registered before and after its block RAM,
   long mux chains cut); Peercy and Ernst with a pipelined restoring square root and
   divider, one bit per stage (`rtl/baselines/peercy.py`). Every product of Lee, Peercy and
-  Ernst whose operands outgrow one DSP input (at B = 16: lee's eq. 24 product, Peercy's
+  Ernst whose operands outgrow one DSP input (at B = 15 or 16: lee's eq. 24 product, Peercy's
   squares; `rtl/pipe.product_latency`) is a `pipe.WideProduct` like the exact
   illumination's, its limbs' sum in registers of its own: summed in the cycle after the
   DSP blocks (`RegisteredProduct`'s ECP5 form, one stage less) it held lee at 108.7 and
