@@ -1,0 +1,227 @@
+"""Python mutation with mutmut 3.8.1 on a random sample (``make mutate-py``).
+
+Mutated: the golden models (sim/golden/), the configuration (rtl/config.py, sim/scenes/config.py),
+the scenes and user maps (sim/scenes/) and the command line's validation (gen/cli/flags.py,
+gen/cli/main.py). mutmut, not cosmic-ray: it generates every mutant of a file in one
+copy (trampolines switched by an environment variable, no re-import per mutant), records
+which tests reach each function (its own coverage: a first run of the selected tests with
+the trampolines counting calls) and runs each mutant only against those tests.
+
+mutmut derives a mutant's module name from its file's path and refuses to run when the
+tests import the code under another name. This repository installs ``rtl/`` as
+``bumprtl.rtl`` (pyproject's ``[tool.setuptools.package-dir]``), so the runner lays out a
+copy of the working tree as mutmut expects, ``bumprtl/{rtl,sim,gen,constraints}`` beside
+``tests/``, with mutmut's configuration in the copy's ``setup.cfg`` (the repository's
+pyproject.toml is not touched); mutmut then makes its ``mutants/`` copy of that and the
+tests import ``bumprtl.*`` from there (it is first on sys.path, before the editable
+install's finder).
+
+A run: generate every mutant and record the tests per function (the tests of
+:data:`TESTS`, the fast tiers that exercise these files), draw a sample of ``--sample``
+mutant names with ``random.Random(--seed)``, run mutmut on exactly those, and read each
+one's result. Killed = a test failed (or timed out / crashed); survived = every test that
+reaches the function passed; no tests = no selected test calls the function (counted as a
+survivor: nothing guards it). Prints the kill ratio per area with the seed; ``--doc``
+writes the table between ``pymut:begin`` / ``pymut:end``.
+"""
+
+import argparse
+import json
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGES = {"rtl": "rtl", "sim": "sim", "gen": "gen", "constraints": "constraints"}
+MUTATE = ["bumprtl/sim/golden/*", "bumprtl/rtl/config.py", "bumprtl/sim/scenes/config.py",
+          "bumprtl/sim/scenes/*", "bumprtl/gen/cli/flags.py", "bumprtl/gen/cli/main.py"]
+AREAS = {"sim/golden": "bumprtl.sim.golden.", "rtl/config.py": "bumprtl.rtl.config.",
+         "sim/scenes/config.py": "bumprtl.sim.scenes.config.", "sim/scenes": "bumprtl.sim.scenes.",
+         "gen/cli": "bumprtl.gen.cli."}
+TESTS = ["tests/rtl/test_config.py", "tests/sim/scenes/test_config.py", "tests/rtl/test_fixed.py",
+         "tests/rtl/test_tables.py", "tests/rtl/test_methods.py", "tests/sim/golden",
+         "tests/sim/scenes", "tests/gen/cli"]
+BEGIN, END = "<!-- pymut:begin -->", "<!-- pymut:end -->"
+# mutmut 3's exit codes per mutant (mutmut/__main__.py status_by_exit_code)
+KILLED = {1, 3, -24, 24, 152, 255, 36, -9, 9, 37}     # test failed, timeout, killed, type check
+SURVIVED, NO_TESTS = {0, 5}, {33}
+
+
+def committed_tree(dest):
+    """The committed tree (git archive HEAD) in ``dest``: others may be editing the working
+    tree meanwhile, and a sample is only reproducible on a commit."""
+    if dest.exists():
+        shutil.rmtree(dest)
+    dest.mkdir(parents=True)
+    archive = subprocess.run(["git", "archive", "HEAD"], cwd=ROOT, capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True, check=True).stdout.strip()
+    return [str(f.relative_to(dest)) for f in dest.rglob("*") if f.is_file()], commit
+
+
+def lay_out(dest, src, files):
+    """The copy mutmut expects: bumprtl/<package>/..., tests/, setup.cfg."""
+    if dest.exists():
+        shutil.rmtree(dest)
+    for name in files:
+        top = name.split("/", 1)[0]
+        if top in PACKAGES:
+            target = dest / "bumprtl" / PACKAGES[top] / name.split("/", 1)[1]
+        elif top in ("tests", "pyproject.toml"):
+            target = dest / name
+        else:
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(src / name, target)
+    (dest / "bumprtl" / "__init__.py").write_text("")
+    # tests/mutants is this tooling, not tests to run
+    shutil.rmtree(dest / "tests" / "mutants", ignore_errors=True)
+    cfg = ["[mutmut]", "source_paths = bumprtl", "only_mutate ="]
+    cfg += [f"    {p}" for p in MUTATE]
+    cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in TESTS]
+    cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
+            "    -m", "    not regress and not fpga and not formal",
+            "use_git_change_detection = false", "timeout_multiplier = 5.0", ""]
+    (dest / "setup.cfg").write_text("\n".join(cfg))
+    # pyproject's [tool.pytest] stays (markers, test paths); mutmut reads setup.cfg only
+    # when pyproject has no [tool.mutmut]
+
+
+def mutmut(args, cwd, env, log):
+    exe = str(Path(sys.executable).parent / "mutmut")
+    with open(log, "a") as f:
+        f.write(f"\n$ mutmut {' '.join(args[:8])}{' ...' if len(args) > 8 else ''}\n")
+        f.flush()
+        return subprocess.run([exe, *args], cwd=cwd, env=env, stdout=f, stderr=subprocess.STDOUT).returncode
+
+
+def all_results(tree):
+    """{mutant name: exit code or None} from mutmut's .meta files."""
+    out = {}
+    for meta in (tree / "mutants").rglob("*.meta"):
+        data = json.loads(meta.read_text())
+        out.update(data.get("exit_code_by_key", {}))
+    return out
+
+
+def area(name):
+    for label, prefix in AREAS.items():
+        if name.startswith(prefix):
+            return label
+    return "other"
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="python tests/mutants/pymut.py", description=__doc__.split("\n")[0])
+    p.add_argument("--sample", type=int, default=100, help="mutants drawn (default 100)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the draw (default 1)")
+    p.add_argument("-j", "--jobs", type=int, default=2, help="mutmut --max-children (default 2)")
+    p.add_argument("--out", type=Path, default=ROOT / "build" / "pymut")
+    p.add_argument("--doc", type=Path, default=None)
+    a = p.parse_args(argv)
+    for name, value in (("--sample", a.sample), ("--jobs", a.jobs)):
+        if value < 1:
+            print(f"error: {name} must be at least 1, got {value}", file=sys.stderr)
+            return 2
+    t0 = time.perf_counter()
+    tree = a.out / "tree"
+    a.out.mkdir(parents=True, exist_ok=True)
+    log = a.out / "mutmut.log"
+    log.write_text("")
+    files, commit = committed_tree(a.out / "head")
+    lay_out(tree, a.out / "head", files)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    # 1. generate every mutant and record which tests reach each function; the name filter
+    #    matches none, so no mutant runs yet (mutmut stops there with an error we expect)
+    mutmut(["run", "--max-children", str(a.jobs), "bumprtl.no_such_module.x__mutmut_1"], tree, env, log)
+    results = all_results(tree)
+    if not results or not (tree / "mutants" / "mutmut-stats.json").exists():
+        print(f"error: mutmut generated no mutants or no test statistics; see {log}", file=sys.stderr)
+        return 1
+    names = sorted(results)
+    rng = random.Random(a.seed)
+    sample = sorted(rng.sample(names, min(a.sample, len(names))))
+    print(f"python mutation (mutmut 3.8.1) at commit {commit}: {len(names)} mutants generated, "
+          f"a sample of {len(sample)} drawn with seed {a.seed}")
+    # 2. run exactly the sample, each against the tests that reach its function
+    mutmut(["run", "--max-children", str(a.jobs), *sample], tree, env, log)
+    results = all_results(tree)
+    stats = json.loads((tree / "mutants" / "mutmut-stats.json").read_text())
+    per = defaultdict(lambda: {"killed": 0, "survived": 0, "no tests": 0, "not run": 0})
+    survivors = []
+    for name in sample:
+        code = results.get(name)
+        kind = ("not run" if code is None else "killed" if code in KILLED else
+                "no tests" if code in NO_TESTS else "survived" if code in SURVIVED else "killed")
+        per[area(name)][kind] += 1
+        if kind in ("survived", "no tests", "not run"):
+            survivors.append((name, kind, code))
+    seconds = time.perf_counter() - t0
+    rows = []
+    tot = defaultdict(int)
+    for label in [*AREAS, "other"]:
+        if label not in per:
+            continue
+        c = per[label]
+        n = sum(c.values())
+        for k, v in c.items():
+            tot[k] += v
+        rows.append((label, n, c))
+    print(f"{'area':14} {'sample':>6} {'killed':>6} {'survived':>8} {'no tests':>8}  kill ratio")
+    for label, n, c in rows:
+        print(f"{label:14} {n:6} {c['killed']:6} {c['survived']:8} {c['no tests']:8}  "
+              f"{100 * c['killed'] / n:.1f}%")
+    n_all = sum(tot.values())
+    print(f"{'all':14} {n_all:6} {tot['killed']:6} {tot['survived']:8} {tot['no tests']:8}  "
+          f"{100 * tot['killed'] / max(1, n_all):.1f}%  ({seconds / 60:.1f} min wall, seed {a.seed})")
+    for name, kind, code in survivors:
+        print(f"  {kind}: {name} (exit {code})")
+    diffs = {}
+    for name, kind, _ in survivors:
+        r = subprocess.run([str(Path(sys.executable).parent / "mutmut"), "show", name], cwd=tree,
+                           env=env, capture_output=True, text=True)
+        diffs[name] = "\n".join(l for l in r.stdout.splitlines()
+                                if l.startswith(("+", "-")) and not l.startswith(("+++", "---")))[:400]
+    (a.out / "pymut_results.json").write_text(json.dumps(
+        {"seed": a.seed, "sample": sample, "results": {k: results.get(k) for k in sample},
+         "survivors": [[n, k, c, diffs.get(n, "")] for n, k, c in survivors],
+         "seconds": seconds, "generated": len(names)}, indent=1))
+    if a.doc:
+        command = "python tests/mutants/pymut.py " + " ".join(argv if argv is not None else sys.argv[1:])
+        block = [BEGIN, "", f"Generated by `{command}` at commit {commit} (mutmut 3.8.1; {len(names)} mutants generated, "
+                 f"a sample of {len(sample)} drawn with seed {a.seed}; {seconds / 60:.1f} min wall "
+                 f"on the 2-core machine).", "",
+                 "| area | sample | killed | survived | no test reaches it | kill ratio |",
+                 "|---|---|---|---|---|---|"]
+        for label, n, c in rows:
+            block.append(f"| `{label}` | {n} | {c['killed']} | {c['survived']} | {c['no tests']} | "
+                         f"{100 * c['killed'] / n:.1f}% |")
+        block.append(f"| all | {n_all} | {tot['killed']} | {tot['survived']} | {tot['no tests']} | "
+                     f"{100 * tot['killed'] / max(1, n_all):.1f}% |")
+        block += ["", "Survivors (mutant, what it changes):", ""]
+        for name, kind, _ in survivors:
+            d = diffs.get(name, "").replace("\n", " / ").replace("|", "\\|")
+            block.append(f"* `{name}` ({kind}): `{d}`")
+        if not survivors:
+            block.append("* none")
+        block += ["", END]
+        text = a.doc.read_text() if a.doc.exists() else ""
+        if BEGIN in text and END in text:
+            head, rest = text.split(BEGIN, 1)
+            text = head + "\n".join(block) + rest.split(END, 1)[1]
+        else:
+            text += "\n" + "\n".join(block) + "\n"
+        a.doc.write_text(text)
+    return 0 if tot["killed"] >= 0.9 * n_all else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
