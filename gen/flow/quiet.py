@@ -1,0 +1,72 @@
+"""Quiet by default: the external tools' output (Verilator's make and g++, cocotb's banners,
+Yosys, nextpnr) goes to a log under build/ whose path is printed; the terminal gets a
+progress line and the result. The log is shown in full when the work fails, and
+``--verbose`` lets everything through.
+
+:func:`tool_log` redirects the process's file descriptors 1 and 2, so the tools that run
+as child processes (and cocotb's runner, and Python's own prints) all land in the log.
+"""
+
+import os
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+__all__ = ["tool_log"]
+
+
+def _ticker(term, label, stop):
+    """``label ... N s`` on the terminal, rewritten every second until ``stop``."""
+    t0 = time.perf_counter()
+    tty = term.isatty()
+    while not stop.wait(1.0 if tty else 3600):
+        term.write(f"\r{label} {time.perf_counter() - t0:.0f} s")
+        term.flush()
+    term.write(f"\r{label} done in {time.perf_counter() - t0:.0f} s\n")
+    term.flush()
+
+
+@contextmanager
+def tool_log(path, label, verbose=False):
+    """Everything written to stdout/stderr inside the block (by this process and its
+    children) goes to ``path``; the terminal shows ``label`` with the elapsed seconds. On an
+    exception the log is copied to stderr in full, then the exception propagates.
+    ``verbose``: no redirection, the tools print as they run."""
+    if verbose:
+        yield None
+        return
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = os.dup(1), os.dup(2)
+    term = os.fdopen(os.dup(saved[1]), "w", buffering=1)
+    term.write(f"{label} (tool output: {path})\n")
+    stop = threading.Event()
+    ticker = threading.Thread(target=_ticker, args=(term, label, stop), daemon=True)
+    failed = False
+    with open(path, "w") as log:
+        os.dup2(log.fileno(), 1)
+        os.dup2(log.fileno(), 2)
+        ticker.start()
+        try:
+            yield path
+        except BaseException:
+            failed = True
+            raise
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            os.close(saved[0])
+            os.close(saved[1])
+            stop.set()
+            ticker.join()
+            term.close()
+            if failed:
+                sys.stderr.write(f"--- {path} ---\n{path.read_text(errors='replace')}--- end of "
+                                 f"{path} ---\n")
+                sys.stderr.flush()
