@@ -1,0 +1,74 @@
+"""``bumprtl report integration``: docs/integration.md's generated blocks from the sidecar
+of a pipeline emitted with named ports, and the page's Amaranth example."""
+
+import re
+from pathlib import Path
+
+import pytest
+from amaranth.hdl import Fragment
+
+from bumprtl.gen.report.integration import blocks, emit_for_integration, write_doc
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.scenes.config import load_scene_config
+
+ROOT = Path(__file__).resolve().parents[3]
+DOC = ROOT / "docs" / "integration.md"
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    scene = load_scene_config("default", {"texture_size": 16, "angle_bits": 10, "frac_bits": 11})
+    return emit_for_integration(scene, tmp_path_factory.mktemp("integration"))
+
+
+def test_blocks_cover_every_port_field_and_unit(small):
+    out = blocks(small)
+    assert out["made-at"].startswith("Made at: angle_bits=10, frac_bits=11 ")
+    rows = [r for r in out["ports"].splitlines()[2:]]
+    named = small["named_ports"]["ports"]
+    assert len(rows) == len(named)
+    for field, (off, width, _) in small["ports"]["i__payload"]["fields"].items():
+        port = "in_" + re.sub(r"\W", "_", field)
+        assert any(r.startswith(f"| `{port}` | in | {width} | `i__payload[{off + width - 1}:{off}]`")
+                   for r in rows), port
+    for field, (off, width, _) in small["ports"]["o__payload"]["fields"].items():
+        assert f"`o__payload[{off + width - 1}:{off}]`" in out["ports"], field
+    assert "see rtl/layouts.py" not in out["ports"]          # every port has its meaning
+    for b in small["built"]:
+        assert f'{b["unit"]}: {b["class"]}<br/>latency {b["latency"]}' in out["diagram"]
+    assert f"**{small['latency']} cycles**" in out["timing"]
+    assert all(f".{p}" in out["verilog"] for p in named)
+    assert "$readmemh(\"bumprtl_pipeline_map.hex\"" in out["load"]
+
+
+def test_write_doc_rewrites_only_the_blocks(small, tmp_path):
+    doc = tmp_path / "page.md"
+    text = "intro\n" + "".join(f"<!-- generated: {n} -->\nold\n<!-- end: {n} -->\nprose {n}\n"
+                               for n in blocks(small))
+    doc.write_text(text)
+    write_doc(doc, blocks(small))
+    once = doc.read_text()
+    assert "old" not in once and all(f"prose {n}" in once for n in blocks(small))
+    write_doc(doc, blocks(small))
+    assert doc.read_text() == once                        # idempotent
+    doc.write_text("no blocks here\n")
+    with pytest.raises(BumpError, match="has no '<!-- generated: made-at -->' block"):
+        write_doc(doc, blocks(small))
+
+
+def test_the_page_has_every_block_filled():
+    text = DOC.read_text()
+    for name in ("made-at", "diagram", "ports", "timing", "load", "verilog"):
+        body = re.search(rf"<!-- generated: {name} -->\n(.*?)<!-- end: {name} -->", text, re.S)
+        assert body and body.group(1).strip(), name
+    assert "bumprtl report integration" in text
+
+
+def test_the_pages_amaranth_example_elaborates():
+    code = re.search(r"## Instantiation in Amaranth.*?```python\n(.*?)```", DOC.read_text(), re.S).group(1)
+    scope = {}
+    exec(compile(code, str(DOC), "exec"), scope)
+    bump = scope["bump"]
+    assert len(scope["shade"]) == 8
+    Fragment.get(scope["m"], None)
+    assert bump.i.payload.shape().size == 0 or len(bump.i.payload.as_value()) > 0
