@@ -53,15 +53,15 @@ KILLED = {1, 3, -24, 24, 152, 255, 36, -9, 9, 37}     # test failed, timeout, ki
 SURVIVED, NO_TESTS = {0, 5}, {33}
 
 
-def committed_tree(dest):
-    """The committed tree (git archive HEAD) in ``dest``: others may be editing the working
+def committed_tree(dest, rev="HEAD"):
+    """The committed tree (git archive REV) in ``dest``: others may be editing the working
     tree meanwhile, and a sample is only reproducible on a commit."""
     if dest.exists():
         shutil.rmtree(dest)
     dest.mkdir(parents=True)
-    archive = subprocess.run(["git", "archive", "HEAD"], cwd=ROOT, capture_output=True, check=True).stdout
+    archive = subprocess.run(["git", "archive", rev], cwd=ROOT, capture_output=True, check=True).stdout
     subprocess.run(["tar", "-x", "-C", str(dest)], input=archive, check=True)
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+    commit = subprocess.run(["git", "rev-parse", "--short", rev], cwd=ROOT, capture_output=True,
                             text=True, check=True).stdout.strip()
     return [str(f.relative_to(dest)) for f in dest.rglob("*") if f.is_file()], commit
 
@@ -125,6 +125,7 @@ def main(argv=None):
     p.add_argument("-j", "--jobs", type=int, default=2, help="mutmut --max-children (default 2)")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "pymut")
     p.add_argument("--doc", type=Path, default=None)
+    p.add_argument("--commit", default="HEAD", help="the commit to mutate (default HEAD)")
     a = p.parse_args(argv)
     for name, value in (("--sample", a.sample), ("--jobs", a.jobs)):
         if value < 1:
@@ -135,7 +136,7 @@ def main(argv=None):
     a.out.mkdir(parents=True, exist_ok=True)
     log = a.out / "mutmut.log"
     log.write_text("")
-    files, commit = committed_tree(a.out / "head")
+    files, commit = committed_tree(a.out / "head", a.commit)
     lay_out(tree, a.out / "head", files)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     env["PYTHONDONTWRITEBYTECODE"] = "1"
