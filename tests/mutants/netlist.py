@@ -51,14 +51,25 @@ SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "data
 PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
 BEGIN, END = "<!-- netlist:begin -->", "<!-- netlist:end -->"
 VERILATOR_EXTRA = ("-Wno-UNOPTFLAT", "-Wno-fatal")
+# g++ -O0 for the model: one build, short runs (a few thousand pixels a mutant), so the
+# compile time is what counts (the bulk path's default -Os compiles several times longer)
 
 
 class NetlistError(Exception):
     """A step of the flow failed (the message names the target and the step)."""
 
 
+def _scenes():
+    """The scene configuration module (rtl/scene.py before it moved to sim/scenes/config.py)."""
+    try:
+        from bumprtl.sim.scenes import config
+    except ImportError:
+        from bumprtl.rtl import scene as config
+    return config
+
+
 def targets():
-    from bumprtl.rtl.scene import BUILTIN
+    BUILTIN = _scenes().BUILTIN
     return [*UNITS, *(f"pipeline:{name}" for name in BUILTIN)]
 
 
@@ -97,7 +108,7 @@ def emit_target(target, out, n, seed):
     run_bulk besides the paths (stimulus or source, expected outputs, set-up cycles)."""
     from bumprtl.gen.flow.units import emit_unit
     from bumprtl.rtl.config import Config
-    from bumprtl.rtl.scene import load_scene_config
+    load_scene_config = _scenes().load_scene_config
     out.mkdir(parents=True, exist_ok=True)
     if target in SOURCE_KIND:
         v, j = emit_unit(target, Config(), out)
@@ -195,7 +206,8 @@ def run_one(v, j, job, work, idx):
     try:
         # a mutant that ties one bit to another can form a loop Verilator sees as combinational
         # (UNOPTFLAT); it is still a design to simulate, not a build error
-        run_bulk("verilator", v, j, work, PATTERNS, keep=False, extra=VERILATOR_EXTRA, **job)
+        run_bulk("verilator", v, j, work, PATTERNS, keep=False, extra=VERILATOR_EXTRA,
+                 opt_fast="-O0", **job)
     except SimulationTimeout as e:
         return "killed: timeout " + str(e).splitlines()[0][:120]
     except AssertionError as e:
