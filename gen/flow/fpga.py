@@ -8,12 +8,12 @@ carry chains), flip-flops (TRELLIS_FF), DSP multipliers (MULT18X18D), block RAM 
 and the achieved Fmax of ``clk``.
 """
 
-import fcntl
 import hashlib
 import json
 import re
 import shutil
 import subprocess
+import tempfile
 from importlib.resources import files
 from pathlib import Path
 
@@ -31,7 +31,8 @@ from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.sim.toolchain import require, tool_env
 
-__all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit"]
+__all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",
+           "Placement", "place_text", "place_component", "placement_key"]
 
 # Device name -> nextpnr-ecp5 flag. All three come in the CABGA381 package.
 DEVICES = {"LFE5U-25F": "--25k", "LFE5U-45F": "--45k", "LFE5U-85F": "--85k"}
@@ -155,34 +156,81 @@ CACHE = Path("build/fpga_cache")
 NOT_PLACED = {name: m.not_placed for name, m in METHODS.items() if m.not_placed}
 
 
-def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):
-    """Elaborate ``component`` as module ``label`` and place it; the row is cached under
-    ``cache`` by the digest of the Verilog, the device and the constraints, so ``report
-    fpga`` and ``bench sweep --fpga`` share every placement and a changed datapath is placed
-    anew. ``component`` must be built with ``target=ECP5()`` (``rtl.pipe.ECP5``: DSP and
-    block-RAM registers), e.g. ``build_unit(name, cfg, ECP5())[0]``."""
+def placement_key(text, label, device, lpf_text, seed=1):
+    """The cache key of a placement: the digest of the Verilog (module name ``label``
+    ignored: the same hardware under another label, Ernst's datapath is Peercy's
+    (rtl/baselines/ernst.py), is placed once), the device and the constraints."""
+    parts = (text.replace(label, "\0top"), device, lpf_text)
+    parts += (f"seed {seed}",) if seed != 1 else ()           # seed 1 keeps the older keys
+    return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
+
+
+def elaborate(component, label):
+    """The Verilog text of ``component`` as module ``label`` (built with ``target=ECP5()``,
+    ``rtl.pipe.ECP5``: DSP and block-RAM registers)."""
     if not isinstance(getattr(component, "target", None), ECP5):
         raise ValueError(f"{label}: build the component with target=ECP5() to place it")
-    text = verilog.convert(component, name=label, emit_src=False)
-    # The key ignores the module name: the same hardware under another label (Ernst's
-    # datapath is Peercy's, rtl/baselines/ernst.py) is placed once.
-    parts = (text.replace(label, "\0top"), device, Path(lpf).read_text())
-    parts += (f"seed {seed}",) if seed != 1 else ()           # seed 1 keeps the older keys
-    key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]
-    work = Path(cache) / device / key
-    row_path = work / "row.json"
-    work.mkdir(parents=True, exist_ok=True)
-    # One placement per key at a time: a parallel job with the same hardware waits for it
-    # and reads its row instead of placing it again.
-    with open(work / ".lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if row_path.is_file():
-            return {**json.loads(row_path.read_text()), "unit": label}
+    return verilog.convert(component, name=label, emit_src=False)
+
+
+def place_text(text, label, device, lpf_text, seed=1):
+    """A placement job (sim/jobs.py): place Verilog ``text`` (top ``label``) with the
+    constraints ``lpf_text`` in a temporary directory of the machine it runs on; returns
+    ``{"row": the report row with the device's available resources, "files": the Yosys and
+    nextpnr logs and report by name, "log": both logs}``. Needs no file of the client."""
+    with tempfile.TemporaryDirectory(prefix=f"bumprtl-place-{label}-") as tmp:
+        work = Path(tmp)
+        (work / "constraints.lpf").write_text(lpf_text)
         v_path = work / f"{label}.v"
         v_path.write_text(text)
-        row = place_and_route(v_path, label, device, work, lpf, seed)
+        row = place_and_route(v_path, label, device, work, work / "constraints.lpf", seed)
         report = json.loads((work / f"{label}.pnr.json").read_text())["utilization"]
         row["available"] = {k: report.get(n, {}).get("available") for k, n in
                             (("LUT4", "TRELLIS_COMB"), ("DSP", "MULT18X18D"), ("BRAM", "DP16KD"))}
-        row_path.write_text(json.dumps(row, indent=1))
-        return row
+        files = {name: (work / name).read_text(errors="replace")
+                 for name in (f"{label}.synth.log", f"{label}.pnr.log", f"{label}.pnr.json")
+                 if (work / name).is_file()}
+    log = "\n".join(f"==== {n}\n{t}" for n, t in files.items() if n.endswith(".log"))
+    return {"row": row, "files": files, "log": log}
+
+
+class Placement:
+    """One placement as the client sees it: the Verilog, its cache directory under
+    ``cache/<device>/<key>/`` and, when placed before, the cached row."""
+
+    def __init__(self, component, label, device, cache=CACHE, lpf=LPF, seed=1):
+        self.label, self.device, self.seed = label, device, seed
+        self.text = elaborate(component, label)
+        self.lpf_text = Path(lpf).read_text()
+        self.key = placement_key(self.text, label, device, self.lpf_text, seed)
+        self.work = Path(cache) / device / self.key
+        row_path = self.work / "row.json"
+        self.cached = ({**json.loads(row_path.read_text()), "unit": label}
+                       if row_path.is_file() else None)
+
+    def args(self):
+        """The arguments of :func:`place_text`."""
+        return (self.text, self.label, self.device, self.lpf_text, self.seed)
+
+    def store(self, result):
+        """Keep ``place_text``'s result in the cache (the Verilog, the logs, row.json);
+        returns the row."""
+        self.work.mkdir(parents=True, exist_ok=True)
+        (self.work / f"{self.label}.v").write_text(self.text)
+        for name, text in result.get("files", {}).items():
+            (self.work / name).write_text(text)
+        (self.work / "row.json").write_text(json.dumps(result["row"], indent=1))
+        return {**result["row"], "unit": self.label}
+
+
+def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):
+    """Elaborate ``component`` as module ``label`` and place it here, now; the row is
+    cached under ``cache`` by the digest of the Verilog, the device and the constraints
+    (:func:`placement_key`), so ``report fpga`` and ``bench sweep --fpga`` share every
+    placement and a changed datapath is placed anew. ``component`` must be built with
+    ``target=ECP5()``, e.g. ``build_unit(name, cfg, ECP5())[0]``. ``report fpga`` runs the
+    same steps as jobs (:class:`Placement`, :func:`place_text` on sim/jobs.py's workers)."""
+    p = Placement(component, label, device, cache, lpf, seed)
+    if p.cached is not None:
+        return p.cached
+    return p.store(place_text(*p.args()))

@@ -10,13 +10,11 @@ critical paths and a cost-against-error plot.
 import argparse
 import json
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.methods import METHODS
@@ -24,8 +22,10 @@ from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, check_device,
-                                   lpf_mhz, pipeline_component, place_component)
+from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, Placement,
+                                   check_device, lpf_mhz, pipeline_component, place_text)
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 
@@ -45,6 +45,7 @@ def fpga_units(cfg):
 
 def run_fpga(args):
     check_device(args.device)
+    scheduler_address(args.scheduler)           # a malformed address: one line, exit 2
     check_samples(args.samples)
     cfg = config_from_args(args)
     names = [n for n, _, _ in fpga_units(cfg)]
@@ -68,16 +69,10 @@ def _component(design, row, cfg):
 
 def fpga_report(cfg, args, units):
     """Place ``units`` ((label, design, row) triples of :func:`fpga_units`) on ``args.device``
-    and write ``args.out`` (markdown table + cost-against-error plot)."""
-    jobs = max(1, getattr(args, "jobs", None) or 1)
-    tasks = [(u, seed) for u in units for seed in _row_seeds(args, u[2])]
-    placed = {}
-    with ProcessPoolExecutor(jobs) as pool:
-        futures = {pool.submit(_place, u, cfg, args.device, args.work, seed): (u, seed)
-                   for u, seed in tasks}
-        for fut in tqdm(as_completed(futures), total=len(futures), desc="place", unit="run",
-                        disable=os.environ.get("BUMPRTL_PROGRESS", "1") == "0"):
-            placed[futures[fut]] = fut.result()
+    and write ``args.out`` (markdown table + cost-against-error plot). Each placement not in
+    the cache (``args.work``, by Verilog digest) is a job of sim/jobs.py: a local cluster of
+    ``args.jobs`` workers, or ``args.scheduler``'s."""
+    placed = place_all(cfg, args, [(u, seed) for u in units for seed in _row_seeds(args, u[2])])
     rows = []
     for label, design, row in units:
         runs = [placed[((label, design, row), s)] for s in _row_seeds(args, row)]
@@ -93,22 +88,55 @@ def fpga_report(cfg, args, units):
     write_report(args, rows, acc)
 
 
+def place_all(cfg, args, tasks):
+    """``{(unit, seed): row or {"error": reason, "seed": seed}}`` for ``tasks``: the cached
+    rows read here, the others placed as jobs (one job per distinct Verilog: Ernst's
+    pipeline is Peercy's hardware and is placed once). The client elaborates each design
+    and submits it at once, so elaboration overlaps the placements already running."""
+    placed, waiting = {}, {}           # waiting: job name -> [(task, Placement)]
+    timeout = getattr(args, "job_timeout", None)
+
+    def jobs():
+        by_key = {}
+        for task in tasks:
+            (label, design, row), seed = task
+            try:
+                p = Placement(_component(design, row, cfg), label, args.device, args.work, seed=seed)
+            except FpgaError as e:
+                placed[task] = {"error": str(e), "seed": seed}
+                continue
+            if p.cached is not None:
+                placed[task] = {**p.cached, "seed": seed}
+                continue
+            name = job_name("place", args.device, label, f"seed{seed}")
+            if p.key in by_key:                     # the same hardware: placed once
+                waiting[by_key[p.key]].append((task, p))
+                continue
+            by_key[p.key] = name
+            waiting[name] = [(task, p)]
+            yield Job(name, place_text, p.args(), timeout)
+
+    with Runner(scheduler_address(getattr(args, "scheduler", None)),
+                getattr(args, "jobs", None) or 1) as runner:
+        outcomes = runner.run(jobs(), desc="place")
+    for name, outcome in outcomes.items():
+        for n, (task, p) in enumerate(waiting[name]):
+            seed = task[1]
+            if not outcome.ok:
+                placed[task] = {"error": outcome.error, "seed": seed}
+            elif n == 0:
+                placed[task] = {**p.store(outcome.value), "seed": seed}
+            else:
+                placed[task] = {**outcome.value["row"], "unit": p.label, "seed": seed}
+    return placed
+
+
 def _row_seeds(args, row):
     """The nextpnr seeds of a row: ``--scene-seeds`` for the scene pipelines when given,
     else ``--seeds``."""
     seeds = list(getattr(args, "seeds", None) or [1])
     scene = getattr(args, "scene_seeds", None)
     return list(scene) if scene and row.startswith("scene:") else seeds
-
-
-def _place(unit, cfg, device, work, seed):
-    """One placement (a worker process): the row, or {"error": reason} when the tools fail."""
-    label, design, row = unit
-    try:
-        return {**place_component(_component(design, row, cfg), label, device, work, seed=seed),
-                "seed": seed}
-    except FpgaError as e:
-        return {"error": str(e), "seed": seed}
 
 
 def write_report(args, rows, acc):
@@ -295,6 +323,10 @@ def add_parser(kinds):
     f.add_argument("--scene-seeds", type=_seeds, default=None,
                    help="nextpnr seeds of the scene pipelines' rows (default: --seeds)")
     f.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                   help="placements run in parallel (default: the number of cores)")
+                   help="local worker processes, one placement each at a time (default: the "
+                        "number of cores; ignored with --scheduler)")
+    f.add_argument("--job-timeout", type=float, default=None, metavar="SECONDS",
+                   help="a placement running longer fails with a timeout on its row (default: none)")
+    add_job_arguments(f)
     add_config_flags(f, ("angle_bits", "frac_bits", "specular"))
     f.set_defaults(func=run_fpga)

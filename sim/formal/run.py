@@ -11,19 +11,20 @@ exits 1. The broken units of :mod:`bumprtl.sim.formal.mutants` must each fail th
 import argparse
 import json
 import sys
-import threading
+import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
+from bumprtl.sim.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.formal.contract import StreamContract
 from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
 from bumprtl.sim.formal.sby import run_sby
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
 
-__all__ = ["Row", "check", "check_mutant", "run", "table", "main", "INDUCTION_DEPTH"]
+__all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
 BMC_MARGIN = 6               # BMC depth = latency + this (every pixel reaches the output)
@@ -111,42 +112,67 @@ def check_mutant(name, root, cfg=None):
                0, detail, str(res.trace or ""))
 
 
-def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print, save=None):
-    """Every requested check; returns the rows (in order). ``save(rows_so_far)`` is called
-    after each check (results.json is written as the run goes). A check that raises (a unit
-    that does not elaborate) is an ERROR row, not the end of the run."""
+def formal_job(kind, name, prop):
+    """One check as a job (sim/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`) or
+    "mutant" (of :data:`MUTANTS`), checked in a temporary directory of the worker. Returns
+    ``{"row": Row as a dict, "files": {path under the work root: text} (each sby run's
+    log and the counterexample trace), "log": the sby logs}``; the client writes the files
+    under its ``--out`` and points ``trace`` at its copy."""
+    with tempfile.TemporaryDirectory(prefix=f"bumprtl-formal-{name}-") as tmp:
+        row = check(TARGETS[name], prop, tmp) if kind == "target" else check_mutant(name, tmp)
+        root = Path(tmp).resolve()
+        keep = [p for p in root.rglob("*") if p.is_file() and
+                (p.name == "logfile.txt" or (row.trace and p.resolve() == Path(row.trace).resolve()))]
+        files = {str(p.relative_to(root)): p.read_text(errors="replace") for p in keep}
+        if row.trace:
+            row.trace = str(Path(row.trace).resolve().relative_to(root))
+    log = "\n".join(f"==== {n}\n{t}" for n, t in sorted(files.items()) if n.endswith("logfile.txt"))
+    return {"row": asdict(row), "files": files, "log": log}
+
+
+def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print, save=None,
+        scheduler=None, timeout=None):
+    """Every requested check; returns the rows (in order). Each check is a job of
+    sim/jobs.py: a local cluster of ``jobs`` worker processes, or ``scheduler``'s workers.
+    ``save(rows_so_far)`` is called after each check (results.json is written as the run
+    goes). A check that raises (a unit that does not elaborate), a tool missing on a worker
+    or a ``timeout`` is an ERROR row, not the end of the run."""
     names = list(names or TARGETS)
     jobs_list = []
     for name in names:
-        target = TARGETS[name]
-        for prop in target.props:
+        for prop in TARGETS[name].props:
             if props is None or prop in props:
-                jobs_list.append((name, prop, lambda t=target, p=prop: check(t, p, root)))
+                jobs_list.append((name, prop, ("target", name, prop)))
     if mutants:
         for name, (_cls, prop) in MUTANTS.items():
             if props is None or prop in props:
-                jobs_list.append((f"mutant {name}", prop, lambda n=name: check_mutant(n, root)))
-    done, lock = {}, threading.Lock()
+                jobs_list.append((f"mutant {name}", prop, ("mutant", name, prop)))
+    root = Path(root)
+    order = {job_name("formal", unit, prop): n for n, (unit, prop, _) in enumerate(jobs_list)}
+    units = {job_name("formal", unit, prop): (unit, prop) for unit, prop, _ in jobs_list}
+    done = {}
 
-    def one(n_job):
-        n, (unit, prop, job) = n_job
-        t0 = time.perf_counter()
-        try:
-            row = job()
-        except Exception as e:          # noqa: BLE001 - reported as a failed row
-            row = Row(unit, prop, "ERROR", 0, time.perf_counter() - t0, 0, 0,
-                      f"{type(e).__name__}: {e}")
+    def finished(outcome):
+        unit, prop = units[outcome.name]
+        if outcome.ok:
+            row = Row(**outcome.value["row"])
+            for rel, text in outcome.value["files"].items():
+                (root / rel).parent.mkdir(parents=True, exist_ok=True)
+                (root / rel).write_text(text)
+            if row.trace:
+                row.trace = str((root / row.trace).resolve())
+        else:
+            row = Row(unit, prop, "ERROR", 0, outcome.seconds, 0, 0, outcome.error)
         log(f"{row.unit:<24} {row.prop:<10} {row.result:<18} depth {row.depth:<3} "
             f"{row.seconds:6.1f} s {row.detail}")
-        with lock:
-            done[n] = row
-            if save is not None:
-                save([done[k] for k in sorted(done)])
-        return row
+        done[order[outcome.name]] = row
+        if save is not None:
+            save([done[k] for k in sorted(done)])
 
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        rows = list(pool.map(one, enumerate(jobs_list)))
-    return rows
+    with Runner(scheduler, jobs) as runner:
+        runner.run((Job(name, formal_job, args, timeout) for name, (_u, _p, args)
+                    in zip(order, jobs_list)), desc="formal", on_done=finished)
+    return [done[k] for k in sorted(done)]
 
 
 def failures(rows):
@@ -185,7 +211,12 @@ def add_arguments(p):
     p.add_argument("--no-mutants", dest="mutants", action="store_false",
                    help="skip the broken units that must fail")
     p.add_argument("--quick", action="store_true", help="leave out the slow targets (baselines, pipelines)")
-    p.add_argument("-j", "--jobs", type=int, default=1, help="sby jobs in parallel (default 1)")
+    p.add_argument("-j", "--jobs", type=int, default=1,
+                   help="local worker processes, one sby job each at a time (default 1; "
+                        "ignored with --scheduler)")
+    p.add_argument("--job-timeout", type=float, default=None, metavar="SECONDS",
+                   help="a check running longer is an ERROR row naming the timeout (default: none)")
+    add_job_arguments(p)
     p.add_argument("--out", type=Path, default=Path("build/formal"), help="work directory")
     p.add_argument("--merge", action="store_true",
                    help="update the rows of OUT/results.json that this run checked, keep the rest")
@@ -200,6 +231,11 @@ def execute(args):
     if unknown:
         print(f"error: unknown formal target {unknown[0]!r}: allowed {', '.join(TARGETS)}",
               file=sys.stderr)
+        return 2
+    try:
+        scheduler = scheduler_address(args.scheduler)
+    except SchedulerError as e:
+        print(f"error: {e}", file=sys.stderr)
         return 2
     names = args.units or [n for n, t in TARGETS.items() if not (args.quick and t.slow)]
     t0 = time.perf_counter()
@@ -218,7 +254,12 @@ def execute(args):
     if args.from_results:
         rows = base
     else:
-        rows = merged(run(names, args.props, args.mutants, args.out, args.jobs, save=save))
+        try:
+            rows = merged(run(names, args.props, args.mutants, args.out, args.jobs, save=save,
+                              scheduler=scheduler, timeout=args.job_timeout))
+        except SchedulerError as e:             # unreachable: one line, exit 2
+            print(f"error: {e}", file=sys.stderr)
+            return 2
     print()
     print(table(rows))
     print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")

@@ -98,28 +98,41 @@ def test_critical_path_names_the_endpoints_and_splits_the_delay():
     assert fpga.critical_path({}) is None
 
 
+def _fake_place_and_route(calls):
+    """A stand-in for the tools: exact_setup fails, the others get Fmax 100 + seed."""
+    import json
+
+    def fake(v_path, top, device, work, lpf=fpga.LPF, seed=1):
+        calls.append(top)
+        if top == "exact_setup":
+            raise fpga.FpgaError("nextpnr-ecp5 failed (status 1): ERROR: no room")
+        (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
+        return {"unit": top, "LUT4": 1, "FF": 2, "DSP": 0, "BRAM": 0, "fmax_mhz": 100.0 + seed,
+                "target_mhz": 150.0, "met": False, "seed": seed,
+                "critical_path": f"a -> b seed {seed}"}
+    return fake
+
+
 def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
     """--seeds: each row's Fmax is the minimum over the seeds; a placement that fails is
-    written on its row with the reason, the other rows still placed (worker processes
-    inherit the patched flow through fork)."""
+    written on its row with the reason, the other rows still placed (the job layer's local
+    cluster in threads of this process, so the patched tools are the ones it runs)."""
     from bumprtl.gen.report import fpga as report
-    from bumprtl.gen.report import table1
+    from bumprtl.sim import jobs
 
-    def fake(component, label, device, work, seed=1):
-        if label == "exact_setup":
-            raise fpga.FpgaError("nextpnr-ecp5 failed (status 1): ERROR: no room")
-        return {"unit": label, "LUT4": 1, "FF": 2, "DSP": 0, "BRAM": 0, "fmax_mhz": 100.0 + seed,
-                "target_mhz": 150.0, "met": False, "critical_path": f"a -> b seed {seed}"}
-
-    monkeypatch.setattr(report, "place_component", fake)
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route([]))
     monkeypatch.setattr(report, "accuracy", lambda d, cfg, n: {"max": 1, "mean": 0.1})
     out = tmp_path / "report.md"
     assert main(["report", "fpga", "--seeds", "3,2", "--unit", "exact_setup", "--unit",
-                 "exact_pipeline", "--out", str(out), "--work", str(tmp_path), "--jobs", "2"]) == 0
+                 "exact_pipeline", "--out", str(out), "--work", str(tmp_path), "--jobs", "2",
+                 "--angle-bits", "8", "--frac-bits", "9"]) == 0
     text = out.read_text()
     assert "| exact_pipeline | 1 | 2 | 0 | 0 | 102.0 |" in text          # min over seeds 2, 3
     assert "| exact_setup | not placed: nextpnr-ecp5 failed (status 1): ERROR: no room |" in text
     assert "--seeds 3,2" in text and "a -> b seed 2" in text
+    assert "result error: nextpnr-ecp5 failed" in (
+        jobs.LOG_DIR / "place-LFE5U-85F-exact_setup-seed3.log").read_text()
 
 
 @pytest.mark.parametrize("method", ["exact", "lee"])
@@ -160,30 +173,23 @@ def test_placed_pipeline_runs_in_lock_step_bit_exact(method):
     assert taken == dut.latency + BUFFER_DEPTH
 
 
-def test_the_same_hardware_placed_in_parallel_is_placed_once(tmp_path, monkeypatch):
-    """Two jobs at once with the same hardware under two labels (Peercy's and Ernst's
-    pipelines): the second waits for the first's placement and reads its row."""
-    import json
-    import threading
-    import time
+def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
+    """Two rows with the same hardware under two labels (Peercy's and Ernst's pipelines) in
+    one run are one placement job; each row gets its own label; a second run reads the cache
+    and starts no job."""
     from bumprtl.gen.flow.units import build_unit
+    from bumprtl.gen.report import fpga as report
+    from bumprtl.sim import jobs
+    from types import SimpleNamespace
+
     calls = []
-
-    def fake(v_path, top, device, work, lpf=fpga.LPF, seed=1):
-        calls.append(top)
-        time.sleep(0.5)                         # long enough for the other job to arrive
-        (work / f"{top}.pnr.json").write_text(json.dumps({"utilization": {}}))
-        return {"unit": top, "fmax_mhz": 1.0}
-
-    monkeypatch.setattr(fpga, "place_and_route", fake)
-    units = {label: build_unit("sincos", Config(angle_bits=6, frac_bits=5), ECP5())[0]
-             for label in ("peercy_like", "ernst_like")}
-    rows = {}
-    jobs = [threading.Thread(target=lambda lb=label: rows.update(
-        {lb: fpga.place_component(units[lb], lb, "LFE5U-25F", tmp_path)})) for label in units]
-    for job in jobs:
-        job.start()
-    for job in jobs:
-        job.join()
-    assert len(calls) == 1 and set(rows) == set(units)
-    assert {r["unit"] for r in rows.values()} == set(units)
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
+    monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
+        "sincos", Config(angle_bits=6, frac_bits=5), ECP5())[0])
+    args = SimpleNamespace(device="LFE5U-25F", work=tmp_path, jobs=2, scheduler=None)
+    tasks = [((label, "x", "pipeline"), 1) for label in ("peercy_like", "ernst_like")]
+    rows = report.place_all(Config(), args, tasks)
+    assert calls == ["peercy_like"]
+    assert {r["unit"] for r in rows.values()} == {"peercy_like", "ernst_like"}
+    assert report.place_all(Config(), args, tasks) == rows and len(calls) == 1

@@ -51,8 +51,10 @@ def test_broken_unit_fails_its_property(name, build_dir):
 
 
 def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir, capsys):
+    from bumprtl.sim import jobs
     broken = Target("broken", lambda bits: Glitcher(Config(**SMALL)), ("hold",))
     monkeypatch.setitem(formal_run.TARGETS, "broken", broken)
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)    # the job sees the patched TARGETS
     rc = formal_run.main(["broken", "--no-mutants", "--out", str(build_dir)])
     err = capsys.readouterr().err
     assert rc == 1
