@@ -19,7 +19,6 @@ from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe
-from bumprtl.rtl.scene import SceneConfig
 from bumprtl.rtl.texture import rgb_layout
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
@@ -29,37 +28,37 @@ __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coor
 TEXEL_BITS = 24               # one colour texel: r, g, b 8 bits each (Config.color_bits)
 
 
-def coord_bits(scene: SceneConfig):
+def coord_bits(scene):
     """Signed texel coordinates of level 0: [-2T, 2T), so two map widths either side of the
     map reach the wrap/clamp logic instead of wrapping silently in the port."""
     return scene.texture_bits + 2
 
 
-def level_bits(scene: SceneConfig):
+def level_bits(scene):
     return (scene.mip_levels - 1).bit_length()
 
 
-def level_bases(scene: SceneConfig):
+def level_bases(scene):
     """Word offset of each mip level: level l (T >> l squared texels) follows level l-1."""
     sizes = [(scene.texture_size >> n) ** 2 for n in range(scene.mip_levels)]
     return [int(x) for x in np.concatenate([[0], np.cumsum(sizes)[:-1]])]
 
 
-def memory_depth(scene: SceneConfig):
+def memory_depth(scene):
     return sum((scene.texture_size >> n) ** 2 for n in range(scene.mip_levels))
 
 
-def fetched_field(scene: SceneConfig):
+def fetched_field(scene):
     """The output field the fetch fills: ``b`` (N' angles) or ``index`` (palette)."""
     return "index" if scene.shading == "palette" else "b"
 
 
-def has_map(scene: SceneConfig):
+def has_map(scene):
     """The scene stores a per-texel map (N' angles or palette indices) in block RAM."""
     return scene.shading == "palette" or scene.bump_map == "varying"
 
 
-def fetched_fields(scene: SceneConfig):
+def fetched_fields(scene):
     """Every field the fetch fills: the map's (:func:`fetched_field`) and ``texel``."""
     return ([fetched_field(scene)] if has_map(scene) else []) + (["texel"] if scene.texture else [])
 
@@ -70,13 +69,13 @@ def pack_rgb(rgb):
     return v[..., 0] | (v[..., 1] << 8) | (v[..., 2] << 16)
 
 
-def texel_shape(scene: SceneConfig):
+def texel_shape(scene):
     """One stored texel: N' as polar angles (phi low, theta high) or a palette index."""
     cfg = scene.config
     return unsigned(index_bits(cfg)) if scene.shading == "palette" else polar_layout(cfg)
 
 
-def pack_texels(scene: SceneConfig, phi=None, theta=None, index=None):
+def pack_texels(scene, phi=None, theta=None, index=None):
     """Texel words (int64) from angle codes or palette indices, as the memory stores them."""
     if scene.shading == "palette":
         return np.asarray(index, np.int64)
@@ -91,7 +90,7 @@ def _wrap(x, bits):
     return x[:bits] if _is_hdl(x) else np.asarray(x, np.int64) & ((1 << bits) - 1)
 
 
-def texel_address(u, v, level, scene: SceneConfig):
+def texel_address(u, v, level, scene):
     """Word address of texel (u, v) (level-0 coordinates, signed) at constant mip ``level``:
     u_l = floor(u / 2**l), then wrap (modulo T_l) or clamp (to [0, T_l - 1]), then
     base_l + v_l T_l + u_l."""
@@ -151,7 +150,7 @@ class BumpMapFetch(wiring.Component):
     latency = 1 + RAM_LATENCY
     lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, scene: SceneConfig, out_layout=None, init=None, texture=None, target=None):
+    def __init__(self, scene, out_layout=None, init=None, texture=None, target=None):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
         self.fetched = fetched_fields(scene)
         if not self.fetched:

@@ -12,13 +12,12 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 
 from dataclasses import dataclass, fields, asdict
 
-__all__ = ["Config", "ConfigError", "BumpError", "METHOD_NAMES", "ANGLE_BITS_RANGE",
-           "FRAC_BITS_MAX", "TWO_LIGHT_WIDTHS", "frac_bits_floor"]
+from bumprtl.rtl.errors import BumpError, ConfigError
+from bumprtl.rtl.methods import METHODS
 
-# The names of the method registry (rtl/methods.py: what each method is and builds), in its
-# order. Config validates ``method`` against them here because the registry imports the
-# datapaths, which import Config; rtl/methods.py refuses to load if its keys differ.
-METHOD_NAMES = ("exact", "lee", "peercy", "ernst", "kim")
+__all__ = ["Config", "ConfigError", "BumpError", "ANGLE_BITS_RANGE", "FRAC_BITS_MAX",
+           "TWO_LIGHT_WIDTHS", "frac_bits_floor"]
+
 ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
 FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
 # (angle_bits, frac_bits) of the built-in two-light scenes: with two lights their specular
@@ -31,21 +30,6 @@ TWO_LIGHT_WIDTHS = (15, 16)
 def frac_bits_floor(angle_bits):
     """The fewest fractional bits a Config with ``angle_bits`` accepts: B >= k - 1 (and 4)."""
     return max(4, angle_bits - 3)
-
-
-class BumpError(ValueError):
-    """Bad input to bumprtl. The message is one line that names the parameter and its
-    allowed range; the CLI prints it and exits with status 2, never a traceback. ``field``
-    is the parameter's name (None when the error is not about one parameter), so tests and
-    callers can tell which value was refused without parsing the wording."""
-
-    def __init__(self, message, field=None):
-        super().__init__(message)
-        self.field = field
-
-
-class ConfigError(BumpError):
-    """A configuration value out of its allowed range. The message names the field."""
 
 
 def _check_int(name, value, lo, hi, why=""):
@@ -78,7 +62,7 @@ class Config:
         Fractional bits ``B`` of sin/cos and dot products; ``k - 1`` to 24. The default, 15,
         is the fewest that prove 1 LSB on every channel with 14-bit angles.
     method : str
-        A name of the method registry (rtl/methods.py, :data:`METHOD_NAMES`): ``"exact"``
+        A name of the method registry (rtl/methods.py, ``METHODS``): ``"exact"``
         (the exact angular method of docs/architecture.md), ``"lee"`` (Lee et al., errata
         fixed) or a Table 1 baseline, ``"peercy"``, ``"ernst"``, ``"kim"`` (cost comparison
         only, not in scenes).
@@ -129,8 +113,8 @@ class Config:
         _check_int("frac_bits", self.frac_bits, frac_bits_floor(self.angle_bits), FRAC_BITS_MAX,
                    f"B >= k - 1 = {k - 1} so that sin of one angle step is at least "
                    f"half an LSB; B <= {FRAC_BITS_MAX} keeps every product inside 64 bits")
-        if self.method not in METHOD_NAMES:
-            raise ConfigError(f"method must be one of {', '.join(METHOD_NAMES)}, got {self.method!r}",
+        if self.method not in METHODS:
+            raise ConfigError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}",
                               "method")
         _check_int("tag_bits", self.tag_bits, 0, 32)
         _check_int("out_bits", self.out_bits, 8, 8, "outputs are 8-bit intensities")

@@ -45,7 +45,6 @@ from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.scene import SceneConfig, load_scene_config
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
@@ -113,7 +112,7 @@ class LightSum(wiring.Component):
     latency = PRODUCT_LATENCY + 3
     lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, scene: SceneConfig, target=None):
+    def __init__(self, scene, target=None):
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
         fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
                   "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), self.lights),
@@ -170,8 +169,9 @@ class BumpPipeline(wiring.Component):
 
     Parameters
     ----------
-    scene : SceneConfig, str or path
-        What to build (rtl/scene.py); a name or TOML path is loaded.
+    scene : SceneConfig
+        What to build (sim/scenes/config.py's ``SceneConfig``; the hardware reads only its
+        switches and its ``config``).
     init : sequence of int, optional
         Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
     texture : sequence of int, optional
@@ -224,7 +224,7 @@ class BumpPipeline(wiring.Component):
     """
 
     def __init__(self, scene, init=None, texture=None, target=None):
-        self.scene = scene = load_scene_config(scene)
+        self.scene = scene
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []

@@ -14,7 +14,7 @@ from amaranth.sim import Simulator
 
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads
 from bumprtl.sim.traffic import PATTERNS
 

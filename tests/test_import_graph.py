@@ -5,8 +5,9 @@
 (b) no import cycle among the bumprtl modules (module-level imports; ``from bumprtl.x
     import y`` counts as importing ``bumprtl.x.y`` when that is a module, and importing a
     module also runs its packages' ``__init__``);
-(c) the layers point one way: nothing in rtl/ or sim/ imports bumprtl.gen (function-level
-    imports and ``importlib.import_module("bumprtl.gen...")`` included).
+(c) the layers point one way: nothing in rtl/ imports bumprtl.sim or bumprtl.gen, nothing
+    in sim/ imports bumprtl.gen (function-level imports and
+    ``importlib.import_module("bumprtl.gen...")`` included).
 
 Each check names the offending module, file and line. The ``*_is_caught`` tests run the
 same checks on a small package with one planted offence each, so every check is shown to
@@ -169,19 +170,30 @@ def _dynamic_imports(tree):
                 yield node, arg.value
 
 
+# The layers point one way: rtl/ (the hardware) imports neither the models that check it
+# nor the tools above; sim/ (models, testbenches, formal) does not import gen/.
+FORBIDDEN = {"bumprtl.rtl": ("bumprtl.sim", "bumprtl.gen"), "bumprtl.sim": ("bumprtl.gen",)}
+
+
+def _forbidden(name, target):
+    for layer, above in FORBIDDEN.items():
+        if name == layer or name.startswith(layer + "."):
+            return any(target == a or target.startswith(a + ".") for a in above)
+    return False
+
+
 def wrong_way_imports(mods, root=ROOT):
-    """Lines where a module of bumprtl.rtl or bumprtl.sim imports bumprtl.gen."""
+    """Lines where a module imports a layer above its own (:data:`FORBIDDEN`): rtl imports
+    bumprtl.sim or bumprtl.gen, sim imports bumprtl.gen."""
     bad = []
-    lower = tuple(f"bumprtl.{layer}" for layer in ("rtl", "sim"))
     for name, (path, tree, _) in mods.items():
-        if not name.startswith(lower):
-            continue
         for node, _ in imports(tree):
             for target in targets(node, name, path, mods):
-                if target == "bumprtl.gen" or target.startswith("bumprtl.gen."):
-                    bad.append(f"{name} ({_where(path, node, root)}) imports {target}")
+                line = f"{name} ({_where(path, node, root)}) imports {target}"
+                if _forbidden(name, target) and line not in bad:
+                    bad.append(line)
         for node, target in _dynamic_imports(tree):
-            if target.startswith("bumprtl.gen"):
+            if _forbidden(name, target.rstrip(".")) or _forbidden(name, target):
                 bad.append(f"{name} ({_where(path, node, root)}) imports {target} dynamically")
     return bad
 
@@ -206,9 +218,10 @@ def test_no_import_cycle():
     assert not found, "import cycles:\n  " + "\n  ".join(found)
 
 
-def test_rtl_and_sim_do_not_import_gen():
+def test_layers_point_one_way():
     bad = wrong_way_imports(MODULES)
-    assert not bad, "rtl/ and sim/ must not depend on gen/:\n  " + "\n  ".join(bad)
+    assert not bad, ("rtl/ must not depend on sim/ or gen/, sim/ not on gen/:\n  "
+                     + "\n  ".join(bad))
 
 
 # ---- the checks fail when they should -----------------------------------------------
@@ -262,3 +275,17 @@ def test_a_wrong_way_import_is_caught(tmp_path):
         "bumprtl.sim.stress (sim/stress.py:5) imports bumprtl.gen.flow.emit",
         "bumprtl.sim.stress (sim/stress.py:6) imports bumprtl.gen.flow. dynamically",
         "bumprtl.sim.tb.runner (sim/tb/runner.py:1) imports bumprtl.gen.flow.emit"]
+
+
+def test_rtl_importing_sim_is_caught(tmp_path):
+    """The hardware layer importing a golden model or a scene generator, statically, inside
+    a function or by name, is an offence; sim importing rtl is the allowed direction."""
+    mods = _tree(tmp_path, {
+        "rtl/methods.py": "from bumprtl.sim.golden.fixed import exact\n",
+        "rtl/scene.py": "import importlib\n\n\ndef f():\n    from bumprtl.sim import scenes\n"
+                        "    return importlib.import_module('bumprtl.sim.scenes.usermap')\n",
+        "sim/golden.py": "from bumprtl.rtl import methods\n"})
+    assert wrong_way_imports(mods, tmp_path) == [
+        "bumprtl.rtl.methods (rtl/methods.py:1) imports bumprtl.sim.golden.fixed",
+        "bumprtl.rtl.scene (rtl/scene.py:5) imports bumprtl.sim",
+        "bumprtl.rtl.scene (rtl/scene.py:6) imports bumprtl.sim.scenes.usermap dynamically"]

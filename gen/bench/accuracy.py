@@ -21,7 +21,7 @@ import numpy as np
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config, ConfigError
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
-from bumprtl.rtl.methods import METHODS, datapath_fixed, encode_pixels, get
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
                                          crater_scene, grid_errors_lsb, on_grid, reference_blend,

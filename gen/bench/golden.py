@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
 from bumprtl.sim.tb.runner import run_cocotb, SIMULATORS
 from bumprtl.gen.flow.units import emit_unit

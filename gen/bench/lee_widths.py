@@ -10,7 +10,7 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import quantize_pixels
-from bumprtl.rtl.methods import datapath_fixed
+from bumprtl.sim.golden.methods import datapath_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.lee import lee_corrected
 

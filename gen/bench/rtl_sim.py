@@ -25,7 +25,7 @@ import numpy as np
 from bumprtl.gen.bench.sweep import write_section
 from bumprtl.gen.render.rtl import run_pipeline, run_pipeline_bulk, scene_stimulus, scene_texels
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 

@@ -23,7 +23,7 @@ import numpy as np
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.methods import datapath_fixed, encode_pixels
+from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_index_bits, specular_step_bits
 from bumprtl.sim.golden.accuracy import adversarial_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit

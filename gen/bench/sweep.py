@@ -38,7 +38,7 @@ import numpy as np
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError, Config, ConfigError
-from bumprtl.rtl.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
+from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs, to_8bit

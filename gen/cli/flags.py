@@ -5,7 +5,7 @@ import argparse
 import dataclasses
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.scene import SceneConfig, flag_name, load_scene_config
+from bumprtl.sim.scenes.config import SceneConfig, flag_name, load_scene_config
 from bumprtl.sim.scenes import GEOMETRIES
 from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE
 
@@ -46,7 +46,7 @@ def config_from_args(args, base=None):
 
 def add_map_flags(parser):
     """``--height-map``, ``--normal-map`` and the keys that go with a user's map (the scene
-    keys of rtl/scene.py; defaults None so a flag that contradicts a scene file is caught)."""
+    keys of sim/scenes/config.py; defaults None so a flag that contradicts a scene file is caught)."""
     g = parser.add_argument_group("your own bump map (sim/scenes/usermap.py)")
     g.add_argument("--height-map", default=None, metavar="FILE",
                    help="height map: 8- or 16-bit greyscale PNG (white = 1.0) or .npy array "
@@ -90,6 +90,6 @@ def scene_from_args(args, source, extra=None, defaults=None, flags=None):
     for key in given:
         if key not in _SCENE_KEYS:
             raise BumpError(f"{flag_name(key)} does not apply to a scene: the scene decides it "
-                            f"({source!r}); its keys are in rtl/scene.py")
+                            f"({source!r}); its keys are in sim/scenes/config.py")
     return load_scene_config(source, {**given, **map_overrides(args), **(extra or {})},
                              flags=flags, defaults=defaults)

@@ -32,7 +32,7 @@ from amaranth.back import rtlil, verilog
 from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
 from bumprtl.sim.toolchain import require, tool_env

@@ -24,7 +24,7 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.methods import METHODS
+from bumprtl.sim.golden.methods import METHODS
 from bumprtl.rtl.pipe import ECP5, lockstep_buffer
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, yosys_input

@@ -13,7 +13,7 @@ from bumprtl.gen.flow.emit import emit
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.methods import METHODS, get
+from bumprtl.sim.golden.methods import METHODS, get
 from bumprtl.rtl.palette import PaletteLUT, index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation

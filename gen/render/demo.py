@@ -3,7 +3,7 @@
 1. The demo scenes with every float64 model (and palette), PSNR against ``conventional``,
    and beside it the PSNR of the method's bit-exact fixed-point model (the picture the
    hardware makes; ``bumprtl render --model fixed``) where the method has hardware.
-2. Unless ``--no-rtl``: the pipeline of the default scene class (rtl/scene.py) with the
+2. Unless ``--no-rtl``: the pipeline of the default scene class (sim/scenes/config.py) with the
    largest bump map (at most the image size) that fits the block RAM of DEMO_DEVICE, emitted
    to ``<out>/pipeline/pipeline.v`` + ``pipeline.json`` + ``pipeline_map.hex`` (the map's
    ``$readmemh`` file, written through the host write port before the first pixel),
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, check_scene_fits

@@ -12,8 +12,8 @@ import numpy as np
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.methods import METHODS, PER_PIXEL, datapath_fixed, encode_pixels
-from bumprtl.rtl.scene import SceneConfig
+from bumprtl.sim.golden.methods import METHODS, PER_PIXEL, datapath_fixed, encode_pixels
+from bumprtl.sim.scenes.config import SceneConfig
 from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
@@ -36,7 +36,7 @@ MODELS = ("float64", "fixed")
 # PaletteLUT. conventional and lee_printed have no hardware.
 _FLOAT_NAMES = {model: name for name, model in FLOAT_MODELS.items()}
 FIXED_METHODS = {**{_FLOAT_NAMES[m.reference]: m.name for m in METHODS.values()
-                    if m.reference in _FLOAT_NAMES}, PALETTE: PALETTE}
+                    if m.reference in _FLOAT_NAMES and m.hardware_of is None}, PALETTE: PALETTE}
 
 
 def render_methods():
@@ -248,7 +248,7 @@ def add_parser(sub):
                    help="with --rtl: drive every pixel from cocotb, clock by clock, instead of the "
                         "bulk path (sim/tb/bulk.py: arrays in, arrays out, cached build)")
     p.add_argument("--pipeline", default=None, metavar="FILE|NAME",
-                   help="the scene class (rtl/scene.py built-in or TOML) to build with --rtl and "
+                   help="the scene class (sim/scenes/config.py built-in or TOML) to build with --rtl and "
                         "to model with --model fixed (default: default)")
     p.add_argument("--load", default=None, choices=LOADS,
                    help="with --rtl: the map as the Verilog's initial contents, or written "

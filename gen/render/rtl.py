@@ -22,7 +22,7 @@ from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import SceneConfig, load_scene_config, BUILTIN
+from bumprtl.sim.scenes.config import SceneConfig, load_scene_config, BUILTIN
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
 from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba

@@ -16,7 +16,7 @@ import numpy as np
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.rtl.methods import METHODS, datapath_fixed
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.resources import count_unit
 

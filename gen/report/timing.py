@@ -1,5 +1,5 @@
 """``bumprtl report timing``: WaveDrom timing diagrams of the default pipeline from a real
-simulation trace (the Amaranth simulator on ``BumpPipeline("default")``).
+simulation trace (the Amaranth simulator on ``BumpPipeline(load_scene_config("default"))``).
 
 Three diagrams, each sampled cycle by cycle (clk, i.valid, i.ready, i.tag, o.valid,
 o.ready, o.tag), written as WaveDrom JSON and rendered to SVG with ``yowasp-wavedrom``:
@@ -18,6 +18,7 @@ from pathlib import Path
 from amaranth.sim import Simulator
 from yowasp_wavedrom import render
 
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.pipeline import BumpPipeline
 
 __all__ = ["simulate", "wavedrom", "scenarios", "write_timing", "add_parser"]
@@ -102,7 +103,7 @@ def wavedrom(trace, start, stop, title, foot="", nodes=None, edges=()):
     return out
 
 
-def scenarios(dut_factory=lambda: BumpPipeline("default")):
+def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default"))):
     """``{name: (wavedrom source, facts)}`` of the three diagrams, from real traces."""
     out = {}
     dut = dut_factory()

@@ -12,11 +12,11 @@ from typing import Callable
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.methods import BASELINES, PER_PIXEL
+from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.scene import BUILTIN, load_scene_config
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.texture import TextureBlend
 

@@ -13,7 +13,7 @@ from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to
                                        tangent_rotation, to_8bit)
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.rtl.methods import encode_pixels, get
+from bumprtl.sim.golden.methods import encode_pixels, get
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.heightfields import height_to_normals
 

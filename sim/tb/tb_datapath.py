@@ -8,7 +8,7 @@ import cocotb
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import get, illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
 from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, run_stream, samples
 

@@ -17,7 +17,7 @@ ROOT = mutate.ROOT
 COVERED = ("rtl/sincos.py", "rtl/exact.py", "rtl/lee.py", "rtl/baselines/peercy.py",
            "rtl/baselines/kim.py", "rtl/palette.py", "rtl/bumpfetch.py", "rtl/texture.py",
            "rtl/pipeline.py", "rtl/shade.py", "rtl/pipe.py", "rtl/fixed.py", "rtl/tables.py",
-           "gen/flow/resources.py", "rtl/config.py", "rtl/scene.py")
+           "gen/flow/resources.py", "rtl/config.py", "sim/scenes/config.py")
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, level_bases, level_bits, memory_depth
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, random_inputs, random_map
 from bumprtl.sim.traffic import PATTERNS
@@ -128,7 +128,7 @@ def test_texture_words_need_a_textured_scene():
                                            ("textured", ["b", "texel"])])
 def test_fetch_sidecar_lists_every_output(name, outputs):
     from bumprtl.gen.flow.units import build_unit
-    from bumprtl.rtl.scene import load_scene_config
+    from bumprtl.sim.scenes.config import load_scene_config
     dut, sidecar, _ = build_unit("fetch", load_scene_config(name))
     dut._MustUse__silence = True                   # only its ports are read
     assert sidecar["outputs"] == outputs

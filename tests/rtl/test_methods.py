@@ -1,23 +1,28 @@
-"""The method registry (rtl/methods.py): it covers every method name Config accepts, each
-record's classes are wiring.Components that elaborate with the stream ports and layouts the
-record states, and a bad name is a one-line ConfigError naming ``method``."""
+"""The method registry (rtl/methods.py, the hardware; sim/golden/methods.py, the models of
+the same names): the hardware registry is the list of names Config accepts and the models'
+registry has one record per name, each record's classes are wiring.Components that
+elaborate with the stream ports and layouts the record states, and a bad name is a
+one-line ConfigError naming ``method``."""
 
 import numpy as np
 import pytest
 from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
-from bumprtl.rtl import methods
-from bumprtl.rtl.config import METHOD_NAMES, Config, ConfigError
+from bumprtl.rtl import methods as hardware
+from bumprtl.rtl.config import Config, ConfigError
+from bumprtl.sim.golden import methods
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import shade_layout
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.vectors import TINY
 
+METHOD_NAMES = tuple(hardware.METHODS)
+
 
 def test_registry_covers_every_method_name_once():
-    assert tuple(methods.METHODS) == METHOD_NAMES
+    assert tuple(methods.METHODS) == METHOD_NAMES == ("exact", "lee", "peercy", "ernst", "kim")
     assert all(name == m.name for name, m in methods.METHODS.items())
     assert len({m.title for m in methods.METHODS.values()}) == len(methods.METHODS)
     assert set(methods.PER_PIXEL) | set(methods.BASELINES) == set(METHOD_NAMES)
@@ -26,6 +31,18 @@ def test_registry_covers_every_method_name_once():
         {m.table1_column for m in methods.METHODS.values()})
     for name in METHOD_NAMES:
         assert methods.get(name) is methods.METHODS[name]
+        assert methods.get(name).title == hardware.get(name).title      # the joined view
+
+
+def test_ernst_builds_peercys_hardware_under_its_own_name():
+    """Ernst is an alias: its own name and Table 1 column, Peercy's components and models;
+    the distinct hardware (placed, proved, rendered) lists Peercy's once."""
+    ernst, peercy = hardware.get("ernst"), hardware.get("peercy")
+    assert ernst.hardware == "peercy" and peercy.hardware == "peercy"
+    assert (ernst.rotation, ernst.illumination) == (peercy.rotation, peercy.illumination)
+    assert ernst.table1_column != peercy.table1_column and ernst.title != peercy.title
+    assert "ernst" not in hardware.HARDWARE and "peercy" in hardware.HARDWARE
+    assert methods.get("ernst").reference is methods.get("peercy").reference
 
 
 def test_unknown_method_names_method_and_the_choices():

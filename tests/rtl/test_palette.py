@@ -15,7 +15,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import (CHANNELS, READ_LATENCY, PaletteLUT, blend_eq1, blend_eq2,
                                  index_bits, mul8)
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs, random_map
 from bumprtl.sim.traffic import PATTERNS

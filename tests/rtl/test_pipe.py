@@ -26,7 +26,7 @@ from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_L
                               product_latency)
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.texture import TextureBlend

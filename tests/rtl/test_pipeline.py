@@ -19,7 +19,7 @@ from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline
-from bumprtl.rtl.scene import SceneConfig, load_scene_config
+from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
                                                random_inputs, random_map, random_texture,

@@ -20,6 +20,7 @@ import argparse
 import contextlib
 import hashlib
 import io
+import json
 import sys
 from pathlib import Path
 
@@ -46,7 +47,7 @@ def _ecp5_text(name, cfg_or_scene):
 
 def emit_all(out):
     from bumprtl.rtl.config import BumpError, Config
-    from bumprtl.rtl.scene import BUILTIN, load_scene_config
+    from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
     out.mkdir(parents=True, exist_ok=True)
     notes = []
     for a, f in WIDTHS:
@@ -54,10 +55,18 @@ def emit_all(out):
         jobs = [(u, [u]) for u in PLAIN]
         jobs += [(f"{u}-{m}", [u, "--method", m]) for u in ("rotation", "illumination")
                  for m in METHODS]
-        jobs += [(f"{u}-{s}", [u, "--scene", s]) for u in ("pipeline", "fetch") for s in BUILTIN]
+        scenes = out / "scenes"
+        scenes.mkdir(parents=True, exist_ok=True)
+        for s in BUILTIN:       # the built-in scene's keys with these widths over its own
+            keys = {**BUILTIN[s], "angle_bits": a, "frac_bits": f}
+            (scenes / f"{s}-a{a}f{f}.toml").write_text(
+                "".join(f"{k} = {json.dumps(v)}\n" for k, v in keys.items()))
+        jobs += [(f"{u}-{s}", [u, "--scene", str(scenes / f"{s}-a{a}f{f}.toml")])
+                 for u in ("pipeline", "fetch") for s in BUILTIN]
         for label, argv in jobs:
             d = out / f"a{a}f{f}" / label
-            rc, err = _cli(["emit", *argv, *widths, "--out", str(d)])
+            rc, err = _cli(["emit", *argv, *([] if "--scene" in argv else widths),
+                            "--out", str(d)])
             notes.append(f"{label} a{a}f{f}: rc {rc} {err}")
             print(f"{label} a{a}f{f}: rc {rc}", flush=True)
         ecp = out / f"a{a}f{f}" / "ecp5"
@@ -72,7 +81,7 @@ def emit_all(out):
                     text = f"error: {e}\n"
                 (ecp / f"{u}-{m}.il").write_text(text)
         for s in BUILTIN:
-            scene = load_scene_config(s, {"angle_bits": a, "frac_bits": f})
+            scene = load_scene_config({**BUILTIN[s], "angle_bits": a, "frac_bits": f})
             (ecp / f"pipeline-{s}.il").write_text(_ecp5_text("pipeline", scene))
         print(f"ecp5 a{a}f{f}: done", flush=True)
     (out / "notes.txt").write_text("\n".join(notes) + "\n")

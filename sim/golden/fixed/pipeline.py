@@ -27,9 +27,9 @@ from bumprtl.rtl.bumpfetch import (has_map, level_bases, pack_texels, texel_addr
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.scene import SceneConfig
+from bumprtl.sim.scenes.config import SceneConfig
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
-from bumprtl.rtl.methods import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.fixed import exact
 from bumprtl.sim.golden.fixed.common import phong_sum_fixed

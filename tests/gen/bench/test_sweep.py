@@ -15,8 +15,8 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.rtl.methods import BASELINES, datapath_fixed
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.golden.methods import BASELINES, datapath_fixed
+from bumprtl.sim.scenes.config import load_scene_config
 
 DEFAULT_WIDTHS = (Config().angle_bits, Config().frac_bits)
 
@@ -186,7 +186,7 @@ def test_skip_off_pipeline_renders_the_same_image(monkeypatch, tmp_path):
     """Skipping must not change the picture: the unskipped diffuse and flat scenes give the
     same colour bytes; so does the full scene (texture, two lights, mipmaps)."""
     from bumprtl.gen.bench import skip as bench_skip
-    from bumprtl.rtl.scene import load_scene_config
+    from bumprtl.sim.scenes.config import load_scene_config
     monkeypatch.setattr(bench_skip, "_cost", lambda scene, work: {"multipliers": 0})
     rows = {r["scene"]: r for r in bench_skip.skip_rows(["diffuse", "flat", "full"], 16, tmp_path)}
     assert rows["diffuse"]["same_image"] and rows["flat"]["same_image"]

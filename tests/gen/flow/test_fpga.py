@@ -8,7 +8,7 @@ from bumprtl.gen.flow import fpga
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.rtl.pipe import BUFFER_DEPTH, ECP5
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes

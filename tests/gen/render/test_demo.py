@@ -9,7 +9,7 @@ from PIL import Image
 from bumprtl.gen.render.demo import DEMO_SCENES, demo_map_size, demo_methods, rtl_mismatch
 from bumprtl.gen.render.images import FIXED_METHODS, float_image
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.heightfields import brick_lines
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 

@@ -10,7 +10,7 @@ from bumprtl.gen.report import table1 as report
 from bumprtl.gen.flow import resources
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import BASELINES
+from bumprtl.sim.golden.methods import BASELINES
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.toolchain import ToolMissing
 

@@ -10,7 +10,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.exact import exact
-from bumprtl.rtl.methods import PER_PIXEL, datapath_fixed
+from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.exact import predicted_error_bound_lsb
 from bumprtl.sim.golden.float.lee import lee_corrected, lee_printed
@@ -130,7 +130,7 @@ def test_printed_lee_nan_is_counted():
 def test_pipeline_stimulus_reaches_the_datapath():
     """The pipeline golden model on the stress stimulus equals the datapath model on the
     same codes: every N' went through the map to its pixel."""
-    from bumprtl.rtl.scene import load_scene_config
+    from bumprtl.sim.scenes.config import load_scene_config
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus, stress_codes
     scene = load_scene_config("default")
@@ -150,7 +150,7 @@ def test_pipeline_1e6_stress_vectors_verilator(build_dir):
     """10^6 stress vectors (all cases) through the emitted pipeline on Verilator, 250k per
     traffic pattern, bit-exact against the pipeline golden model, in order (bulk path)."""
     from bumprtl.gen.render.rtl import run_pipeline_bulk
-    from bumprtl.rtl.scene import load_scene_config
+    from bumprtl.sim.scenes.config import load_scene_config
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus
     scene = load_scene_config("default")

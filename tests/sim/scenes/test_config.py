@@ -8,7 +8,7 @@ import pytest
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl import methods
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.scene import BUILTIN, SceneConfig, load_scene_config
+from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 
 
 @pytest.mark.parametrize("name", list(BUILTIN))

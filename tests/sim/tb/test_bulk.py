@@ -19,7 +19,7 @@ from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline_bulk,
                                     scene_stimulus, scene_texels, emit_pipeline)
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.tb import bulk
 from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,

@@ -11,7 +11,7 @@ from bumprtl.gen.flow.axis import emit_axis
 from bumprtl.gen.flow.memories import memory_images
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.scene import BUILTIN, load_scene_config
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
 SMALL = Config(angle_bits=8, frac_bits=8, tag_bits=6)

@@ -7,7 +7,7 @@ import pytest
 
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.sim.golden.methods import PER_PIXEL
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 from bumprtl.sim.traffic import PATTERNS
 

@@ -7,7 +7,7 @@ import pytest
 
 from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline, scene_stimulus,
                                     scene_texels)
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.traffic import PATTERNS
 

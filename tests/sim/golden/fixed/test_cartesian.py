@@ -11,12 +11,10 @@ from hypothesis import given, strategies as st
 
 from bumprtl.rtl.baselines.peercy import component_width, square_bits
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.fixed import ernst as fixed_ernst
 from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.rtl.methods import datapath_fixed
-from bumprtl.sim.golden.float.models import FLOAT_MODELS
+from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels, get
 
 
 def _errors(cfg, samples=20_000, seed=11):
@@ -50,11 +48,11 @@ def test_the_bound_is_not_vacuous_at_narrow_widths():
 def test_ernst_is_peercy_per_pixel():
     px = PixelInputs.random(500, np.random.default_rng(3))
     cfg = Config(method="ernst")
-    a = datapath_fixed(fixed_ernst.encode(px, cfg), cfg)
+    a = datapath_fixed(encode_pixels(px, cfg), cfg)
     peercy = Config(method="peercy")
     b = datapath_fixed(fixed_peercy.encode(px, peercy), peercy)
     assert all(np.array_equal(a[k], b[k]) for k in b)
-    ref, ern = conventional(px, cfg), FLOAT_MODELS["ernst"](px, cfg)
+    ref, ern = conventional(px, cfg), get("ernst").reference(px, cfg)
     assert np.abs(ern.ndotl - ref.ndotl).max() < 1e-12
     assert np.abs(ern.ndoth - ref.ndoth).max() < 1e-12
 

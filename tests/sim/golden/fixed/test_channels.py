@@ -18,8 +18,8 @@ import pytest
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.units import build_unit, error_bounds
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, TWO_LIGHT_WIDTHS, Config
-from bumprtl.rtl.methods import METHODS
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.golden.methods import METHODS
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (adversarial_pixels, arithmetic_pixels, crater_scene,

@@ -8,7 +8,7 @@ from bumprtl.gen.flow.units import build_unit
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.rtl.methods import METHODS
+from bumprtl.sim.golden.methods import METHODS
 
 exact_fixed = METHODS["exact"].datapath_fixed       # rotation then illumination, bit-exact
 

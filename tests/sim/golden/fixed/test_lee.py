@@ -18,7 +18,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.tables import lee_asin_index_bits, lee_prop_index_bits
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.rtl.methods import METHODS, datapath_fixed
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.lee import illuminate_fixed, rotate_fixed
 from bumprtl.sim.golden.float.lee import lee_corrected

@@ -29,7 +29,7 @@ from bumprtl.rtl.palette import mul8
 from bumprtl.rtl.tables import (SPEC_FRAC_BITS, blend_coefficients, cos_lookup,
                                 lee_asin_index_bits, lee_prop_index_bits, phong_coefficients)
 from bumprtl.rtl.texture import texture_blend
-from bumprtl.rtl.scene import load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.golden.fixed import lee as fixed_lee
