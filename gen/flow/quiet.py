@@ -29,11 +29,13 @@ def _ticker(term, label, stop):
 
 
 @contextmanager
-def tool_log(path, label, verbose=False):
+def tool_log(path, label, verbose=False, python=False):
     """Everything written to stdout/stderr inside the block (by this process and its
     children) goes to ``path``; the terminal shows ``label`` with the elapsed seconds. On an
     exception the log is copied to stderr in full, then the exception propagates.
-    ``verbose``: no redirection, the tools print as they run."""
+    ``verbose``: no redirection, the tools print as they run. ``python``: this process's
+    ``print`` and progress bars (``sys.stdout``/``sys.stderr``) still reach the terminal
+    (a bench's table); only the child processes' output goes to the log, and no ticker."""
     if verbose:
         yield None
         return
@@ -47,10 +49,15 @@ def tool_log(path, label, verbose=False):
     stop = threading.Event()
     ticker = threading.Thread(target=_ticker, args=(term, label, stop), daemon=True)
     failed = False
+    streams = sys.stdout, sys.stderr
+    if python:
+        sys.stdout = os.fdopen(os.dup(saved[0]), "w", buffering=1)
+        sys.stderr = term
     with open(path, "w") as log:
         os.dup2(log.fileno(), 1)
         os.dup2(log.fileno(), 2)
-        ticker.start()
+        if not python:
+            ticker.start()
         try:
             yield path
         except BaseException:
@@ -63,8 +70,12 @@ def tool_log(path, label, verbose=False):
             os.dup2(saved[1], 2)
             os.close(saved[0])
             os.close(saved[1])
-            stop.set()
-            ticker.join()
+            if python:
+                sys.stdout.close()
+                sys.stdout, sys.stderr = streams
+            else:
+                stop.set()
+                ticker.join()
             term.close()
             if failed:
                 sys.stderr.write(f"--- {path} ---\n{path.read_text(errors='replace')}--- end of "
