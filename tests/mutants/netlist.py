@@ -345,7 +345,18 @@ def main(argv=None):
     p.add_argument("--equiv-timeout", type=int, default=30, help="seconds per equivalence proof")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "netlist_mutants")
     p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
+    p.add_argument("--doc-from", type=Path, default=None, metavar="JSON",
+                   help="only write --doc from a run's netlist_results.json (targets it finished)")
     a = p.parse_args(argv)
+    if a.doc_from is not None:
+        saved = json.loads(a.doc_from.read_text())
+        if a.doc is None:
+            print("error: --doc-from needs --doc", file=sys.stderr)
+            return 2
+        command = f"python tests/mutants/netlist.py --sample {saved['sample']} --seed {saved['seed']} -j {saved['jobs']}"
+        write_doc(a.doc, report(saved["results"], saved["sample"], saved["seed"], saved["seconds"],
+                                saved["jobs"], command))
+        return 0
     for name, value, lo in (("--sample", a.sample, 1), ("--jobs", a.jobs, 1),
                             ("--stimulus", a.stimulus, 16), ("--equiv-timeout", a.equiv_timeout, 1)):
         if value < lo:
@@ -384,10 +395,16 @@ def main(argv=None):
         for s in r["survivors"]:
             print(f"    survivor #{s['index']}: {s['mutation']} -> {s['verdict']}")
         results.append(r)
+        # saved after every target: a run stopped part way still has its finished targets
+        (a.out / "netlist_results.json").write_text(json.dumps(
+            {"sample": a.sample, "seed": a.seed, "jobs": a.jobs, "results": results,
+             "seconds": time.perf_counter() - t0}, indent=1))
     seconds = time.perf_counter() - t0
     print(f"total {seconds / 60:.1f} min wall")
     command = "python tests/mutants/netlist.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    (a.out / "netlist_results.json").write_text(json.dumps(results, indent=1))
+    (a.out / "netlist_results.json").write_text(json.dumps(
+        {"sample": a.sample, "seed": a.seed, "jobs": a.jobs, "results": results,
+         "seconds": seconds}, indent=1))
     if a.doc:
         write_doc(a.doc, report(results, a.sample, a.seed, seconds, a.jobs, command))
     bad = [r for r in results if "error" in r or r["killed"] < 0.95 * r["counted"]]
