@@ -31,7 +31,6 @@ import threading
 import time
 import traceback
 import uuid
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -52,9 +51,6 @@ CONNECT_TIMEOUT = 10          # seconds to reach a --scheduler before giving up
 # LocalCluster workers are processes (a tool run holds the GIL-free CPU of one core each);
 # tests that monkeypatch a job's function set this to False (threads in this process).
 LOCAL_PROCESSES = True
-# A LocalCluster's scheduler starts an HTTP server (health, metrics) even without a
-# dashboard, and says so when another one holds port 8787.
-warnings.filterwarnings("ignore", message="Port .* is already in use", category=UserWarning)
 ADDRESS = re.compile(r"^(tcp|tls)://[A-Za-z0-9._\-\[\]:]+:\d{1,5}$")
 
 
@@ -209,7 +205,8 @@ class Runner:
         if self.client is None:
             self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
                                         processes=LOCAL_PROCESSES, dashboard_address=None,
-                                        silence_logs=logging.ERROR)
+                                        silence_logs=logging.ERROR,
+                                        scheduler_kwargs={"dashboard_address": ":0"})
             self.client = Client(self.cluster)
         return self.client
 

@@ -1,0 +1,84 @@
+"""The job layer (sim/jobs.py) without a scheduler process: its local cluster in threads of
+this process (LOCAL_PROCESSES = False), so each test runs in a second or two. The real
+scheduler and worker processes are tests/gen/test_cluster.py's."""
+
+import subprocess
+import sys
+import time
+
+import pytest
+
+from bumprtl.gen.cli.main import main
+from bumprtl.sim import jobs
+
+
+def _sleeper(seconds):
+    """A job whose tool (a child process) runs ``seconds``."""
+    subprocess.run([sys.executable, "-c", f"import time; time.sleep({seconds})"], check=True)
+    return {"slept": seconds, "log": "slept"}
+
+
+def _fails():
+    raise ValueError("no such thing\nsecond line")
+
+
+@pytest.fixture
+def threads(monkeypatch, tmp_path):
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    return tmp_path
+
+
+def test_values_errors_timeouts_and_logs(threads):
+    """A value, an exception (its first line) and a timeout (the tool process killed, the
+    job's error names it); every job has its log with its worker and result."""
+    t0 = time.perf_counter()
+    with jobs.Runner(None, 2, log_dir=threads / "jobs", progress=False) as r:
+        out = r.run([jobs.Job("ok", _sleeper, (0,)), jobs.Job("bad", _fails),
+                     jobs.Job("slow", _sleeper, (60,), timeout=1.0)])
+    assert time.perf_counter() - t0 < 40                  # the 60 s tool did not run out
+    assert out["ok"].ok and out["ok"].value == {"slept": 0}
+    assert out["bad"].error == "ValueError: no such thing"
+    assert out["slow"].error == "timeout after 1 s"
+    log = (threads / "jobs" / "ok.log").read_text()
+    assert "result ok" in log and log.endswith("slept")
+    assert "result error: ValueError: no such thing" in (threads / "jobs" / "bad.log").read_text()
+    assert "Traceback" in (threads / "jobs" / "bad.log").read_text()
+
+
+def test_a_tool_missing_on_a_worker_names_the_worker_and_the_tool(threads, monkeypatch, capsys):
+    """bumprtl formal with the solver missing where the job runs: the row says which tool
+    and which worker, the table is still printed, exit 1."""
+    from bumprtl.sim.formal import run as formal_run
+    from bumprtl.sim.formal import sby
+
+    monkeypatch.setattr(sby, "_bin_dirs", lambda: [str(threads / "nothing")])
+    monkeypatch.setenv("PATH", str(threads / "nothing"))
+    assert formal_run.main(["sincos", "--prop", "order", "--no-mutants", "--out",
+                            str(threads / "f")]) == 1
+    text = capsys.readouterr()
+    line = [ln for ln in text.out.splitlines() if ln.startswith("sincos ")][0]
+    assert "ERROR" in line and "worker " in line and "yowasp-sby not found" in line, line
+    assert "| sincos | order | ERROR |" in text.out
+
+
+@pytest.mark.parametrize("command", [["report", "fpga", "--unit", "scene_palette"],
+                                     ["formal", "sincos", "--prop", "order", "--no-mutants"]])
+def test_a_misspelled_or_unreachable_scheduler_is_one_line_exit_2(command, capsys, monkeypatch, tmp_path):
+    monkeypatch.setattr(jobs, "CONNECT_TIMEOUT", 2)
+    out = ["--out", str(tmp_path / ("r.md" if command[0] == "report" else "f"))]
+    assert main(command + out + ["--scheduler", "tpc://127.0.0.1:8786"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--scheduler must be tcp://HOST:PORT" in err[0] and "tpc://" in err[0]
+    assert main(command + out + (["--work", str(tmp_path / "c")] if command[0] == "report" else [])
+                + ["--scheduler", "tcp://127.0.0.1:9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "tcp://127.0.0.1:9: cannot reach the scheduler" in err[0], err
+
+
+def test_the_environment_names_the_scheduler(monkeypatch):
+    monkeypatch.setenv(jobs.ENV, "tcp://10.0.0.1:8786")
+    assert jobs.scheduler_address(None) == "tcp://10.0.0.1:8786"
+    assert jobs.scheduler_address("tcp://h:1") == "tcp://h:1"          # the flag wins
+    monkeypatch.setenv(jobs.ENV, "10.0.0.1")
+    with pytest.raises(jobs.SchedulerError, match="BUMPRTL_SCHEDULER must be tcp://HOST:PORT"):
+        jobs.scheduler_address(None)
