@@ -18,7 +18,7 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe
+from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
 from bumprtl.rtl.texture import rgb_layout
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
@@ -195,7 +195,8 @@ class BumpMapFetch(wiring.Component):
     def elaborate(self, platform):
         scene = self.scene
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         self.memories = pipe.memories
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):

@@ -55,8 +55,9 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout, polar_layout
-from bumprtl.rtl.pipe import (DP16KD_MODES, ROM_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit,
-                             RegisteredROM, dp16kd_rom_block, product_latency)
+from bumprtl.rtl.pipe import (ROM_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit, RegisteredROM,
+                             product_latency)
+from bumprtl.rtl.targets import dp16kd_rom_block, form
 from bumprtl.rtl.shade import IlluminationDatapath
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, sine_read
 from bumprtl.rtl.tables import (lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
@@ -182,18 +183,18 @@ class BlockROM(RegisteredROM):
     ECP5 form also covers the tables RegisteredROM leaves to Yosys' block-RAM inference (more
     than two read ports, wider than 18 bits, deeper than 1024 words), which maps them without
     the block RAM's output register: here each pair of read ports gets the table in the
-    widest DP16KD mode (pipe.DP16KD_MODES) that holds ``depth - 1`` words, blocks side by side
+    widest DP16KD mode (rtl/targets.DP16KD_MODES) that holds ``depth - 1`` words, blocks side by side
     for the width, each with its output register (REGMODE OUTREG); a last word past the
     mode's depth sits in a flip-flop, as in RegisteredROM."""
 
     def elaborate(self, platform):
-        target = self.target
-        mode = next((md for md in DP16KD_MODES if md[1] >= self.depth - 1), None)
-        if (getattr(target, "bram", None) != "DP16KD" or self.mode(target) is not None
-                or mode is None):
-            return super().elaborate(platform)
         m = Module()
-        bits, words, shift = mode
+        form(self.target).block_rom(m, self)
+        return m
+
+    def dp16kd_pairs(self, m, bits, words, shift):
+        """The ECP5 form (``ECP5.block_rom``): each pair of read ports in DP16KD mode
+        (``bits``, ``words``, ``shift``)."""
         for group in range(0, len(self.ports), 2):
             ports = self.ports[group:group + 2]
             columns = [[] for _ in ports]
@@ -215,7 +216,6 @@ class BlockROM(RegisteredROM):
                         m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
                     data = Mux(last_d, self.init[words], data)
                 m.d.comb += port.data.eq(data)
-        return m
 
 
 def block_rom(pipe, init, shape, name, ports):

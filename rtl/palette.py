@@ -17,7 +17,7 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q, mul_round, round_shift, saturate
-from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe
+from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
 
 __all__ = ["PaletteLUT", "READ_LATENCY", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
 
@@ -154,7 +154,8 @@ class PaletteLUT(wiring.Component):
     def elaborate(self, platform):
         cfg, size = self.cfg, self.cfg.palette_size
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         # The table's read data is registered (on ECP5 in the block RAM's own output register):
         # the RAM's clock-to-out alone takes most of a cycle.
         table = pipe.ram("table", 2 * size, unsigned(4 * cfg.color_bits))

@@ -43,7 +43,8 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
                                  shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer
+from bumprtl.rtl.pipe import (BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer,
+                              pipe_observer)
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
@@ -80,7 +81,8 @@ class VectorTerms(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         self.memories = pipe.memories
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
@@ -122,7 +124,8 @@ class LightSum(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")

@@ -6,7 +6,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe
+from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe, pipe_observer
 from bumprtl.rtl.tables import quarter_sine
 
 __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
@@ -102,7 +102,8 @@ class SinCos(wiring.Component):
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target,
+                         observer=pipe_observer(platform))
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
         self.memories = pipe.memories
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both

@@ -31,7 +31,7 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.pipe import ECP5, StallPipe
+from bumprtl.rtl.pipe import ECP5, StallPipe, pipe_observer
 from bumprtl.rtl.tables import (KS_FRAC_BITS, LIT_FRAC_BITS, SPEC_FRAC_BITS, blend_coefficients,
                                 coefficient_error_lsb)
 
@@ -177,7 +177,8 @@ class TextureBlend(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         px = self.i.payload
         color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
                                     [px.s[j] for j in range(self.lights)],
@@ -205,6 +206,7 @@ class TexelDelay(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep)
+        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
+                         pipe_observer(platform))
         m.d.comb += self.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))
         return m

@@ -39,24 +39,22 @@ follow the order (with ``o.ready`` held high, ``latency``: the buffer stays empt
 (``bank``) the shadows are the table's watched entries (two
 asynchronous read ports added to the memory while it elaborates), the bank bits in flight
 are what the pipeline's ``lut_w_ready`` counters count, and the watched pixel sits where
-its position says with the bank of its acceptance. It finds those registers by observing
-:class:`bumprtl.rtl.pipe.StallPipe` while the unit elaborates (:func:`observe_pipes`:
-the valid chain and the ``tag`` delay line of every pipe, keyed by its input valid), so no
-unit carries formal-only code. ``lemmas=False`` leaves them out (plain BMC, and the broken
+its position says with the bank of its acceptance. It finds those registers through the
+observer every :class:`bumprtl.rtl.pipe.StallPipe` takes (:class:`PipeObserver`, passed
+in with the elaboration's platform by :func:`observe_pipes`: the valid chain and the
+``tag`` delay line of every pipe, keyed by its input valid), so no unit carries
+formal-only code and nothing is patched. ``lemmas=False`` leaves them out (plain BMC, and the broken
 units of :mod:`bumprtl.sim.formal.mutants`, whose failure must be the property itself).
 """
 
-import contextlib
 import re
-import threading
 
 from amaranth.hdl import (Assert, Assume, Const, Cover, Elaboratable, Fragment, Module, Mux,
                           Signal, Value, ValueCastable)
 from amaranth.lib import wiring
 
-from bumprtl.rtl.pipe import StallPipe
 
-__all__ = ["PROPERTIES", "StreamContract", "observe_pipes", "pipeline_layers"]
+__all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers"]
 
 PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
 
@@ -64,86 +62,65 @@ _TAG_REG = re.compile(r"(tag|bank|oor)_d(\d+)$")
 CHUNK = 12          # stages per ghost counter of one long pipe (quiet's occupancy lemma)
 
 
-@contextlib.contextmanager
-def observe_pipes(read_ports=0):
-    """Record every :class:`StallPipe` built while the block runs: yields a dict
-    ``id(input valid signal) -> {"valid": [i.valid, stage1, ...], "adv": adv,
-    "tags": {n: tag register of stage n}, "banks": {n: bank register of stage n},
-    "oors": {n: oor register of stage n}, "memories": {name: [comb read port, ...]},
-    "reads": {name: [read data 1, 2 stages after the address]}}``; ``read_ports``: that
-    many asynchronous read ports are added to every memory a pipe adds with
-    ``StallPipe.memory`` or ``StallPipe.ram`` (generic form; before it elaborates), for
-    assertions about its contents. StallPipe itself is restored afterwards. The patch is
-    process-wide, so one block at a time observes (the runner elaborates in parallel
-    threads, ``make formal -j 2``): a second thread waits until the first has restored
-    StallPipe."""
-    with _OBSERVING:
-        with _observed(read_ports) as seen:
-            yield seen
+class PipeObserver:
+    """What the contract learns of a unit's pipes while it elaborates: passed to every
+    :class:`~bumprtl.rtl.pipe.StallPipe` as its ``observer`` (through the elaboration's
+    platform, :func:`bumprtl.rtl.pipe.pipe_observer`). ``seen`` maps ``id(input valid
+    signal) -> {"valid": [i.valid, stage1, ...], "adv": adv, "tags": {n: tag register of
+    stage n}, "banks": {n: bank register of stage n}, "oors": {n: oor register of stage n},
+    "memories": {name: [comb read port, ...]}, "reads": {name: [read data 1, 2 stages after
+    the address]}}``; ``read_ports``: that many asynchronous read ports are added to every
+    memory a pipe adds with ``StallPipe.memory`` or ``StallPipe.ram`` (generic form), for
+    assertions about its contents. One observer per elaboration: nothing process-wide, so
+    elaborations may run in parallel threads (``make formal -j 2``)."""
 
+    def __init__(self, read_ports=0):
+        self.read_ports, self.seen, self._rams = read_ports, {}, {}
 
-# StallPipe's methods are patched for the whole process while a block observes its pipes:
-# one elaboration at a time, or a second thread would save the first one's patches as the
-# originals and lose its own pipes when the first one restores them.
-_OBSERVING = threading.RLock()
+    def pipe(self, pipe):
+        pipe_rec = {"valid": list(pipe.valid), "adv": pipe.adv, "tags": {}, "banks": {},
+                    "oors": {}, "memories": {}, "reads": {}}
+        self.seen[id(pipe.valid[0])] = pipe_rec
 
+    def _record(self, pipe):
+        return self.seen[id(pipe.valid[0])]
 
-@contextlib.contextmanager
-def _serialized():
-    """Elaborate without observing, but never while another thread observes."""
-    with _OBSERVING:
-        yield {}
-
-
-@contextlib.contextmanager
-def _observed(read_ports):
-    seen = {}
-    init, register = StallPipe.__init__, StallPipe.register
-    memory, ram = StallPipe.memory, StallPipe.ram
-
-    def observed_init(self, *args, **kwargs):
-        init(self, *args, **kwargs)
-        self._formal = {"valid": list(self.valid), "adv": self.adv, "tags": {}, "banks": {},
-                        "oors": {}, "memories": {}, "reads": {}}
-        seen[id(self.valid[0])] = self._formal
-
-    def observed_register(self, value, name, *args, **kwargs):
-        reg = register(self, value, name, *args, **kwargs)
+    def register(self, pipe, name, reg):
         match = _TAG_REG.match(str(name))
-        if match and hasattr(self, "_formal"):
-            self._formal[match.group(1) + "s"][int(match.group(2))] = reg
-        return reg
+        if match:
+            self._record(pipe)[match.group(1) + "s"][int(match.group(2))] = reg
 
-    def observed_memory(self, name, mem):
-        out = memory(self, name, mem)
-        if hasattr(self, "_formal") and read_ports:
-            self._formal["memories"][name] = [mem.read_port(domain="comb")
-                                              for _ in range(read_ports)]
-        return out
+    def memory(self, pipe, name, mem):
+        if self.read_ports:
+            self._record(pipe)["memories"][name] = [mem.read_port(domain="comb")
+                                                    for _ in range(self.read_ports)]
 
-    def observed_ram(self, name, *args, **kwargs):
-        unit = ram(self, name, *args, **kwargs)
-        if hasattr(self, "_formal") and read_ports:
-            ports = self._formal["memories"][name] = []
-            reads = self._formal["reads"][name] = []
-            elaborate = unit.elaborate
+    def ram(self, pipe, name, unit):
+        if self.read_ports:
+            rec = self._record(pipe)
+            self._rams[id(unit)] = (rec["memories"].setdefault(name, []),
+                                    rec["reads"].setdefault(name, []))
 
-            def observed_elaborate(platform):
-                m = elaborate(platform)            # the generic form: Memory ``mem``
-                mem = m.submodules.mem
-                reads.extend([mem.read_ports[0].data, unit.r_data])
-                ports.extend(mem.read_port(domain="comb") for _ in range(read_ports))
-                return m
-            unit.elaborate = observed_elaborate
-        return unit
+    def ram_built(self, unit, mem):
+        """The generic form of a RAM a pipe added has elaborated: its Memory ``mem``."""
+        if id(unit) in self._rams:
+            ports, reads = self._rams[id(unit)]
+            reads.extend([mem.read_ports[0].data, unit.r_data])
+            ports.extend(mem.read_port(domain="comb") for _ in range(self.read_ports))
 
-    StallPipe.__init__, StallPipe.register, StallPipe.memory, StallPipe.ram = \
-        observed_init, observed_register, observed_memory, observed_ram
-    try:
-        yield seen
-    finally:
-        StallPipe.__init__, StallPipe.register, StallPipe.memory, StallPipe.ram = \
-            init, register, memory, ram
+
+class _Observing:
+    """The platform an observed elaboration is given: it carries the observer only."""
+
+    def __init__(self, observer):
+        self.pipe_observer = observer
+
+
+def observe_pipes(dut, read_ports=0):
+    """Elaborate ``dut`` with a :class:`PipeObserver`: ``(fragment, seen)``."""
+    observer = PipeObserver(read_ports)
+    fragment = Fragment.get(dut, _Observing(observer))
+    return fragment, observer.seen
 
 
 def pipeline_layers(dut):
@@ -265,8 +242,10 @@ class StreamContract(Elaboratable):
         m = Module()
         dut = self.dut
         ports = 2 if self.prop == "bank" else 0          # the watched entry of both banks
-        with observe_pipes(ports) if self.lemmas else _serialized() as pipes:
-            fragment = Fragment.get(dut, platform)
+        if self.lemmas:
+            fragment, pipes = observe_pipes(dut, ports)
+        else:
+            fragment, pipes = Fragment.get(dut, platform), {}
         self._pipes = pipes
         m.submodules.dut = _Built(fragment)
         i, o = dut.i, dut.o

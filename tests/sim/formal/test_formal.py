@@ -4,19 +4,20 @@ two broken units caught (the stall enable of the issue, and the palette pipeline
 bank wiring), and the runner's failure report. The rest (the other broken units here,
 marked ``formal``; every unit and scene pipeline in the table) is `make formal`."""
 
-import threading
-import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 from amaranth.back import rtlil
 
+from bumprtl.rtl.pipe import StallPipe
 from bumprtl.sim.formal import run as formal_run
 from bumprtl.sim.formal.contract import CHUNK, StreamContract, observe_pipes
 from bumprtl.sim.formal.mutants import MUTANTS, Glitcher
 from bumprtl.sim.formal.run import check, check_mutant
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
+
+_REGISTER = StallPipe.register
 
 
 @pytest.mark.parametrize("prop", ["order", "latency"])
@@ -73,10 +74,10 @@ def test_lemmas_come_from_the_units_own_registers():
 
 
 def test_parallel_elaborations_each_observe_every_stage():
-    """make formal elaborates in parallel threads (-j 2) and observe_pipes patches StallPipe
-    for the whole process: two contracts built at once must both get every stage's lemma
-    (the textured pipeline once lost its illumination's tags, and with them the induction
-    of its order), and the second thread waits while the first observes."""
+    """make formal elaborates in parallel threads (-j 2): each contract's observer is passed
+    to its own elaboration's pipes (no process-wide patch, no lock), so contracts built at
+    once get every stage's lemma, as many as built one by one (the textured pipeline once
+    lost its illumination's tags, and with them the induction of its order)."""
     def lemmas(name):
         top = StreamContract(TARGETS[name].unit(), "order")
         rtlil.convert(top, name="top", ports=top.free_inputs())
@@ -88,24 +89,19 @@ def test_parallel_elaborations_each_observe_every_stage():
         parallel = list(pool.map(lemmas, names))
     assert parallel == [serial[n] for n in names], (parallel, serial)
 
-    inside, order = threading.Event(), []
 
-    def first():
-        with observe_pipes():
-            inside.set()
-            time.sleep(0.3)
-            order.append("first leaves")
-
-    def second():
-        inside.wait()
-        with observe_pipes():
-            order.append("second enters")
-    threads = [threading.Thread(target=f) for f in (first, second)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    assert order == ["first leaves", "second enters"]
+def test_the_observer_sees_only_its_own_elaboration():
+    """Two units elaborated at once in two threads: each observer records exactly its own
+    unit's pipes (keyed by their input valid), none of the other's; without an observer the
+    unit builds the same pipes and nobody records them."""
+    a, b = TARGETS["rotation_exact"].unit(), TARGETS["sincos"].unit()
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        (_, seen_a), (_, seen_b) = pool.map(observe_pipes, (a, b))
+    assert id(a.i.valid) in seen_a and id(a.i.valid) not in seen_b
+    assert id(b.i.valid) in seen_b and id(b.i.valid) not in seen_a
+    assert len(seen_a[id(a.i.valid)]["valid"]) == a.latency + 1
+    assert seen_a[id(a.i.valid)]["tags"] and not StallPipe.__dict__.get("_formal")
+    assert StallPipe.register is _REGISTER            # StallPipe itself is never replaced
 
 
 def test_a_long_pipe_counts_its_pixels_in_runs():
