@@ -27,6 +27,7 @@ from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, check_scene_fits
+from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.render.images import (FIXED_METHODS, PALETTE, fixed_image, float_image,
                                        render_methods, shade_scene)
@@ -88,6 +89,17 @@ def demo_map_size(size, device=DEMO_DEVICE, scene=DEMO_PIPELINE):
             t //= 2
 
 
+def side_by_side(left, right, width=256, gap=8):
+    """``left | right`` (8-bit RGB), each scaled to ``width`` pixels (nearest), on white: the
+    README's picture (float64 conventional beside the RTL render, ``make docs`` copies it)."""
+    def scaled(img):
+        img = np.asarray(img)
+        idx = (np.arange(width) * img.shape[0]) // width
+        return img[idx][:, idx]
+    pad = np.full((width, gap, 3), 255, np.uint8)
+    return np.concatenate([scaled(left), pad, scaled(right)], axis=1).astype(np.uint8)
+
+
 def rtl_mismatch(rtl, golden):
     """None when the two 8-bit images are equal byte for byte, else a one-line message."""
     rtl, golden = np.asarray(rtl), np.asarray(golden)
@@ -106,13 +118,17 @@ def _rtl_section(args, out):
     scene = load_scene_config(DEMO_PIPELINE).replace(texture_size=t)
     blocks, have = check_scene_fits(scene, DEMO_DEVICE)
     n = args.size * args.size
-    print(f"rtl: rendering {args.size}x{args.size} {scene.image} ({t}^2 map) through the emitted "
-          f"pipeline of scene {scene.name!r} on {args.simulator}", flush=True)
-    r = render_rtl(scene, args.size, args.simulator, out / "sim", progress=True,
-                   rtl_dir=out / "pipeline", load=DEMO_LOAD)
+    label = (f"rtl: {args.size}x{args.size} {scene.image} ({t}^2 map) through the emitted "
+             f"pipeline of scene {scene.name!r} on {args.simulator}")
+    if args.verbose:
+        print(label, flush=True)
+    with tool_log(out / "sim" / "tools.log", label, args.verbose):
+        r = render_rtl(scene, args.size, args.simulator, out / "sim", progress=args.verbose,
+                       rtl_dir=out / "pipeline", load=DEMO_LOAD)
     reference, _ = float_image(scene, "conventional", args.size, progress=False)
     save_png(out / "rtl.png", r.image)
     save_png(out / "golden.png", r.golden)
+    save_png(out / "rtl_vs_float64.png", side_by_side(reference, r.image))
     diff = np.abs(r.image.astype(int) - r.golden.astype(int))
     save_png(out / "diff.png", np.clip(diff * DIFF_GAIN, 0, 255))
     error = rtl_mismatch(r.image, r.golden)
@@ -144,7 +160,9 @@ def _rtl_section(args, out):
              f"; diff.png = |rtl - golden| x {DIFF_GAIN}",
              f"  rtl.png vs float64 conventional (same scene and map): PSNR "
              f"{psnr(reference, r.image):.2f} dB, max difference {max_diff(reference, r.image)}"]
-    for line in lines:
+    # the terminal: units and latency, resources, speed and the two comparisons (all of it
+    # in report.txt; every line with --verbose)
+    for line in (lines if args.verbose else [lines[4], *lines[6:]]):
         print(line, flush=True)
     return lines, error
 
@@ -161,6 +179,7 @@ def run(args):
              "",
              f"{'scene':<8} {'method':<13} {'PSNR dB':>8} {'max diff':>9} {'fixed dB':>9} "
              f"{'fixed max':>9} {'seconds':>8} {'Mpix/s':>8}  file"]
+    print(lines[-1], flush=True)                      # the table's header, then its rows
     for name in DEMO_SCENES:
         for line in _render_scene(name, args.size, methods, cfg, out):
             lines.append(line)
@@ -175,7 +194,7 @@ def run(args):
     if args.rtl:
         rtl_lines, error = _rtl_section(args, out)
         lines += rtl_lines
-        pngs += 3
+        pngs += 4
     lines.append(f"total {time.perf_counter() - start:.1f} s")
     report = out / "report.txt"
     report.write_text("\n".join(lines) + "\n")
@@ -201,4 +220,8 @@ def add_parser(sub):
                    help="skip the render through the emitted pipeline")
     p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"],
                    help="simulator of the RTL render (default: verilator)")
+    p.add_argument("--verbose", action="store_true",
+                   help="print the simulator's build and run output (by default it goes to "
+                        "OUT/sim/tools.log, shown in full only on a failure) and the whole "
+                        "RTL section of the report")
     p.set_defaults(func=run)

@@ -244,6 +244,9 @@ def add_parser(sub):
     p.add_argument("--rtl", action="store_true",
                    help="render through the emitted BumpPipeline with cocotb; checks it equals the golden render")
     p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"], help="with --rtl")
+    p.add_argument("--verbose", action="store_true",
+                   help="with --rtl: print the simulator's build and run output (by default it "
+                        "goes to build/render_rtl/<scene>/tools.log, shown in full on a failure)")
     p.add_argument("--per-cycle", action="store_true",
                    help="with --rtl: drive every pixel from cocotb, clock by clock, instead of the "
                         "bulk path (sim/tb/bulk.py: arrays in, arrays out, cached build)")

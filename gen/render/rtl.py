@@ -34,6 +34,7 @@ from bumprtl.sim.scenes.usermap import load_bump_map
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
                                        host_writes, memory_images)
+from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.gen.flow.units import build_unit
 
@@ -292,8 +293,12 @@ def cli_render(args, scene=None):
     t0 = time.perf_counter()
     per_cycle = getattr(args, "per_cycle", False)
     load = getattr(args, "load", None) or "initial"
-    r = render_rtl(scene, args.size, args.simulator, Path("build/render_rtl") / _dir_name(scene),
-                   progress=True, per_cycle=per_cycle, load=load, **light)
+    build_dir = Path("build/render_rtl") / _dir_name(scene)
+    verbose = getattr(args, "verbose", False)
+    with tool_log(build_dir / "tools.log", f"rtl: {args.size}x{args.size} through the "
+                  f"{scene.name} pipeline on {args.simulator}", verbose):
+        r = render_rtl(scene, args.size, args.simulator, build_dir, progress=verbose,
+                       per_cycle=per_cycle, load=load, **light)
     out = save_png(args.out, r.image)
     same = r.image.tobytes() == r.golden.tobytes()
     n = args.size ** 2

@@ -60,6 +60,15 @@ def test_demo_writes_pngs_and_a_report_that_matches_them(tmp_path):
     assert rows["bricks", "exact"][:2] == (float("inf"), 0)
     assert rows["bricks", "exact"][3] <= 2 and rows["globe", "exact"][3] <= 2
     _check_rtl_section(tmp_path, (tmp_path / "report.txt").read_text())
+    # quiet: the table with its header, the RTL summary; the simulator's output in the log
+    shown = r.stdout.splitlines() + r.stderr.splitlines()
+    assert len(shown) < 30, shown
+    assert shown[0].split()[:3] == ["scene", "method", "PSNR"], shown[0]
+    assert not any("g++" in line or "cocotb" in line.lower() for line in shown), shown
+    log = tmp_path / "sim" / "tools.log"
+    assert f"tool output: {log}" in r.stderr and log.stat().st_size > 0
+    pic = np.asarray(Image.open(tmp_path / "rtl_vs_float64.png"))
+    assert pic.shape == (256, 2 * 256 + 8, 3)
 
 
 def _check_rtl_section(out, report):
