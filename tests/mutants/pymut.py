@@ -85,7 +85,9 @@ def lay_out(dest, src, files):
     shutil.rmtree(dest / "tests" / "mutants", ignore_errors=True)
     cfg = ["[mutmut]", "source_paths = bumprtl", "only_mutate ="]
     cfg += [f"    {p}" for p in MUTATE]
-    cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in TESTS]
+    # the tests of TESTS that the commit has (the scene tests moved with the scene module)
+    tests = [t for t in TESTS + ["tests/rtl/test_scene.py"] if (dest / t).exists()]
+    cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in tests]
     cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
             "    -m", "    not regress and not fpga and not formal",
             "use_git_change_detection = false", "timeout_multiplier = 5.0", ""]
