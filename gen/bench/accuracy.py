@@ -20,14 +20,14 @@ import numpy as np
 
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config, ConfigError
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.tables import SPEC_FRAC_BITS
+from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
 from bumprtl.sim.golden.methods import METHODS, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
                                          crater_scene, grid_errors_lsb, on_grid, reference_blend,
                                          scene_error, term_errors_lsb, worst_case_pixels)
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
-from bumprtl.sim.golden.fixed.common import phong_sum_fixed
+from bumprtl.sim.golden.fixed.common import input_angle_error, phong_sum_fixed, term_bounds_lsb
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.gen.flow.units import build_unit, error_bounds
@@ -191,8 +191,12 @@ def _summary(cfg, result):
     arith = ", ".join(f"{c} {worst(r, True)}" for c, r in result.items())
     below = [f"{c} measured {worst(r)}, proven {r['bound']}" for c, r in result.items()
              if worst(r) < r["bound"]]
+    grid = term_bounds_lsb(cfg, input_angle_error(cfg), 0.0)     # exact dot of rounded angles
+    grid["specular"] -= specular_table_error_lsb(cfg) if cfg.specular else 0.0
     return (f"{head} arithmetic max {arith} LSB; end-to-end max {e2e} LSB "
-            f"(end to end adds the inputs' rounding to the {cfg.angle_bits}-bit angle grid)"
+            f"(end to end adds the inputs' rounding to the {cfg.angle_bits}-bit angle grid, "
+            f"which alone the proof bounds by diffuse {grid['diffuse']:.3f}, specular "
+            f"{grid['specular']:.3f} LSB before any arithmetic)"
             + (f"; below the proven bound: {', '.join(below)}" if below else ""))
 
 

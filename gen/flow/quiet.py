@@ -28,6 +28,14 @@ def _ticker(term, label, stop):
     term.flush()
 
 
+def _on_fd(stream, fd):
+    """Whether ``stream`` writes to file descriptor ``fd``."""
+    try:
+        return stream.fileno() == fd
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
 @contextmanager
 def tool_log(path, label, verbose=False, python=False):
     """Everything written to stdout/stderr inside the block (by this process and its
@@ -50,8 +58,12 @@ def tool_log(path, label, verbose=False, python=False):
     ticker = threading.Thread(target=_ticker, args=(term, label, stop), daemon=True)
     failed = False
     streams = sys.stdout, sys.stderr
-    if python:
+    # Python's own streams follow the redirection only when they write to fds 1 and 2 (not
+    # when a caller captures them, as pytest's capsys does): only then are they replaced.
+    swap = python and _on_fd(sys.stdout, 1)
+    if swap:
         sys.stdout = os.fdopen(os.dup(saved[0]), "w", buffering=1)
+    if python and _on_fd(sys.stderr, 2):
         sys.stderr = term
     with open(path, "w") as log:
         os.dup2(log.fileno(), 1)
@@ -70,8 +82,9 @@ def tool_log(path, label, verbose=False, python=False):
             os.dup2(saved[1], 2)
             os.close(saved[0])
             os.close(saved[1])
-            if python:
+            if swap:
                 sys.stdout.close()
+            if python:
                 sys.stdout, sys.stderr = streams
             else:
                 stop.set()
