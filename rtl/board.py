@@ -205,7 +205,7 @@ class ULX3STop(Elaboratable):
         m.domains.shift = ClockDomain("shift")
         clk25 = platform.request("clk25", 0)
         locked = Signal()
-        shift_clk, pixel_clk = Signal(), Signal()
+        shift_clk, pixel_clk = Signal(name="pll_clkop"), Signal(name="pll_clkos")
         m.submodules.pll = Instance(
             "EHXPLLL", i_CLKI=clk25.i, i_CLKFB=shift_clk, i_RST=0, i_STDBY=0,
             i_PHASESEL0=0, i_PHASESEL1=0, i_PHASEDIR=0, i_PHASESTEP=0, i_PHASELOADREG=0,
@@ -217,8 +217,7 @@ class ULX3STop(Elaboratable):
         m.d.comb += [ClockSignal("sync").eq(pixel_clk), ClockSignal("shift").eq(shift_clk)]
         m.submodules.rst_sync = ResetSynchronizer(~locked, domain="sync")
         m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
-        platform.add_clock_constraint(pixel_clk, self.core.mode.pixel_hz)
-        platform.add_clock_constraint(shift_clk, 5 * self.core.mode.pixel_hz)
+        # nextpnr derives both clocks' constraints from clk25's through the PLL
         m.submodules.core = core
         hdmi = platform.request("hdmi", 0, xdr={"clk": 2, "d": 2})
         m.d.comb += [hdmi.clk.o_clk.eq(ClockSignal("shift")), hdmi.d.o_clk.eq(ClockSignal("shift")),

@@ -47,14 +47,19 @@ class TMDSEncoder(Elaboratable):
         d = self.data
         n1d = _ones(d)
         use_xnor = (n1d > 4) | ((n1d == 4) & ~d[0])
-        qm = [d[0]]
+        # the XOR and XNOR chains apart (each bit names the one before it once), then the choice
+        q_xor, q_xnor = [d[0]], [d[0]]
         for i in range(1, 8):
-            qm.append(Mux(use_xnor, ~(qm[-1] ^ d[i]), qm[-1] ^ d[i]))
+            q_xor.append(q_xor[-1] ^ d[i])
+            q_xnor.append(~(q_xnor[-1] ^ d[i]))
+        chain_xor, chain_xnor = Signal(8, name="chain_xor"), Signal(8, name="chain_xnor")
+        m.d.comb += [chain_xor.eq(Cat(*q_xor)), chain_xnor.eq(Cat(*q_xnor))]
+        qm = Mux(use_xnor, chain_xnor, chain_xor)
         # stage 1: q_m, its ones count, and the control path
         q_m = Signal(9, name="q_m")
         n1 = Signal(range(9), name="q_m_ones")
         de1, ctl1 = Signal(name="de1"), Signal(2, name="ctl1")
-        m.d.sync += [q_m.eq(Cat(*qm, ~use_xnor)), n1.eq(_ones(Cat(*qm))), de1.eq(self.de),
+        m.d.sync += [q_m.eq(Cat(qm, ~use_xnor)), n1.eq(_ones(qm)), de1.eq(self.de),
                      ctl1.eq(Cat(self.c0, self.c1))]
         # stage 2: DC balance on the running disparity (ones minus zeros sent so far)
         cnt = Signal(signed(5), name="disparity")

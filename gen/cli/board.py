@@ -32,19 +32,15 @@ def run(args):
     out = Path(args.out)
     summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name}
     if mode.name != "test" and not args.no_bitstream:
-        rows = []
-        for seed in seeds:
-            t0 = time.perf_counter()
-            r = build_bitstream(scene, mode, out / f"seed{seed}" if len(seeds) > 1 and
-                                seed != seeds[0] else out, args.board, seed)
-            rows.append(r)
+        rows = build_bitstream(scene, mode, out, args.board, seeds)
+        for r in rows:
             res = ", ".join(f"{k} {u}/{a}" for k, (u, a) in r["resources"].items())
             fmax = ", ".join(f"{d} {a:.1f} MHz (constraint {c:.1f})" for d, (a, c) in
                              sorted(r["fmax"].items()))
-            print(f"seed {seed}: {res}; Fmax {fmax}; {time.perf_counter() - t0:.0f} s")
+            print(f"seed {r['seed']}: {res}; Fmax {fmax}; {r['seconds']:.0f} s")
         print(f"wrote {out / 'ulx3s_85f.bit'}")
         print(f"wrote {out / 'ulx3s_85f.svf'}")
-        summary["builds"] = [{k: v for k, v in r.items() if k != "dir"} for r in rows]
+        summary["builds"] = rows
         worst = {}
         for r in rows:
             for d, (a, c) in r["fmax"].items():

@@ -108,52 +108,66 @@ def _tool_environ():
     return env
 
 
-def build_bitstream(scene, mode, out_dir, board="ulx3s", seed=1, name="ulx3s_85f"):
-    """Synthesize, place (nextpnr seed ``seed``) and pack the board top into
-    ``out_dir``/``name``.bit and .svf. Returns a dict: resources (LUT4, FF, DSP, BRAM used
-    and available), ``fmax`` {domain: (achieved MHz, constraint MHz)}, seconds."""
+def build_bitstream(scene, mode, out_dir, board="ulx3s", seeds=(1,), name="ulx3s_85f"):
+    """Synthesize, place (nextpnr seed ``seeds[0]``) and pack the board top into
+    ``out_dir``/``name``.bit and .svf with Amaranth's ECP5 flow; place the same netlist again
+    with each further seed (report ``seed<N>.report.json``). Returns one dict a seed:
+    resources (LUT4, FF, DSP, BRAM used and available), ``fmax`` {domain: (achieved MHz,
+    constraint MHz)}, seed, seconds."""
     platform_name, device, mode = check_board(board, mode.name, scene)
     platform = _platform(platform_name)
     top = ULX3STop(board_core(scene, mode, ECP5()))
     out_dir = Path(out_dir).resolve()
     t0 = time.perf_counter()
-    plan = platform.prepare(top, name=name, nextpnr_opts=f"--seed {seed} --timing-allow-fail "
+    first, *more = seeds
+    plan = platform.prepare(top, name=name, nextpnr_opts=f"--seed {first} --timing-allow-fail "
                                                           f"--report {name}.report.json")
+    env = _tool_environ()
     saved = dict(os.environ)
-    os.environ.update(_tool_environ())
+    os.environ.update(env)
     try:
         plan.execute_local(str(out_dir))
     finally:
         os.environ.clear()
         os.environ.update(saved)
-    return {**read_report(out_dir / f"{name}.report.json", mode), "seed": seed,
-            "seconds": time.perf_counter() - t0, "dir": str(out_dir)}
+    rows = [{**read_report(out_dir / f"{name}.report.json"), "seed": first,
+             "seconds": time.perf_counter() - t0}]
+    for seed in more:
+        t1 = time.perf_counter()
+        out = subprocess.run([env["NEXTPNR_ECP5"], "--quiet", "--seed", str(seed),
+                              "--timing-allow-fail", "--report", f"seed{seed}.report.json",
+                              "--log", f"seed{seed}.tim", "--85k", "--package", "CABGA381",
+                              "--speed", "6", "--json", f"{name}.json", "--lpf", f"{name}.lpf"],
+                             cwd=out_dir, capture_output=True, text=True, env=env)
+        if out.returncode != 0:
+            raise BumpError(f"nextpnr-ecp5 seed {seed} failed: {out.stderr.strip()[-300:]}")
+        rows.append({**read_report(out_dir / f"seed{seed}.report.json"), "seed": seed,
+                     "seconds": time.perf_counter() - t1})
+    return rows
 
 
 _RESOURCES = {"LUT4": "TRELLIS_COMB", "FF": "TRELLIS_FF", "DSP": "MULT18X18D", "BRAM": "DP16KD"}
 
 
-def read_report(path, mode):
+def read_report(path):
     rep = json.loads(Path(path).read_text())
     util = rep["utilization"]
     res = {k: (util.get(n, {}).get("used", 0), util.get(n, {}).get("available")) for k, n in
            _RESOURCES.items()}
     fmax = {}
     for clock, row in rep.get("fmax", {}).items():
-        fmax[_domain(clock, mode)] = (round(row["achieved"], 1), round(row["constraint"], 1))
+        fmax[_domain(clock)] = (round(row["achieved"], 1), round(row["constraint"], 1))
     return {"resources": res, "fmax": fmax}
 
 
-def _domain(clock, mode):
+def _domain(clock):
     """nextpnr's clock net name -> the design's domain name."""
-    low = clock.lower()
-    if "shift" in low:
+    net = clock.replace("$glbnet$", "")
+    if net.endswith("shift_clk"):
         return "shift"
-    if "pixel" in low or low.endswith("sync") or "sync_clk" in low or low == "clk":
+    if net in ("clk", "pll_clkos") or net.endswith(".clk"):
         return "sync (pixel)"
-    if "clk25" in low:
-        return "clk25"
-    return clock
+    return net
 
 
 _PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",),

@@ -1,0 +1,134 @@
+"""The board top (rtl/board.py, docs/board.md): TMDS words decoded by cocotbext-dvi's own
+tables, the sync/blanking checker, the reduced-mode frames through the whole top captured
+by cocotbext-dvi's DVISink and compared with the golden frames, and bad input.
+
+The frame check here runs the reduced mode (32 x 24, short blanking) on a scene with
+10-bit angles and a 16 x 16 map (the default's 13-bit angles make 12 sine ROMs of 4097
+words whose Verilator build takes minutes); ``make board`` checks whole 640 x 480 frames of
+the default scene.
+"""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from amaranth.sim import Simulator
+from cocotbext.dvi.tmds import TMDS
+
+from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.rtl.tmds import CONTROL, TMDSEncoder
+from bumprtl.rtl.video import MODES
+from bumprtl.gen.flow.board import board_data, check_board, check_frames
+from bumprtl.sim.golden.board import golden_frame, light_table
+from bumprtl.sim.tb.tb_board import timing_errors
+
+SMALL = {"angle_bits": 10, "texture_size": 16}
+
+
+def _encode(values, de):
+    """Run TMDSEncoder on (value, de, c0, c1) tuples; the 10-bit words in order."""
+    enc = TMDSEncoder()
+    words = []
+
+    async def bench(ctx):
+        for v, d, c0, c1 in values + [(0, 0, 0, 0)] * enc.latency:
+            ctx.set(enc.data, v)
+            ctx.set(enc.de, d)
+            ctx.set(enc.c0, c0)
+            ctx.set(enc.c1, c1)
+            await ctx.tick()
+            words.append(ctx.get(enc.q))
+
+    sim = Simulator(enc)
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    return words[enc.latency - 1:enc.latency - 1 + len(values)]
+
+
+def test_tmds_words_decode_with_cocotbext_tables_and_stay_dc_balanced():
+    rng = np.random.default_rng(1)
+    data = [int(x) for x in rng.integers(0, 256, 2000)] + [0, 255] * 50 + [0x10] * 40
+    values = [(v, 1, 0, 0) for v in data]
+    values += [(0, 0, c & 1, c >> 1) for c in range(4)]
+    words = _encode(values, 1)
+    dec = TMDS()
+    disparity, worst = 0, 0
+    for (v, d, c0, c1), w in zip(values, words):
+        out, de, vs, hs = dec.decode(w)
+        if d:
+            assert de == 1 and out == v, f"{v:#04x} -> {w:#05x} decoded {out:#04x}"
+            ones = bin(w).count("1")
+            disparity += ones - (10 - ones)
+            worst = max(worst, abs(disparity))
+        else:
+            assert w == CONTROL[c1 << 1 | c0] and (de, hs, vs) == (0, c0, c1)
+    assert worst <= 20, f"running disparity reached {worst}: no DC balance"
+
+
+def test_timing_checker_catches_a_wrong_porch():
+    t = MODES["test"]
+    args = (t.h_active, t.h_front, t.h_sync, t.h_back, t.v_active, t.v_front, t.v_sync,
+            t.v_back, 1, 1)
+
+    def raster(hb):
+        de, hs, vs = [], [], []
+        for frame in range(3):
+            for y in range(t.v_total):
+                for x in range(t.h_total):
+                    de.append(int(x < t.h_active and y < t.v_active))
+                    hs.append(int(not (t.h_active + t.h_front <= x < t.h_active + t.h_front + t.h_sync)))
+                    vs.append(int(not (t.v_active + t.v_front <= y < t.v_active + t.v_front + t.v_sync)))
+        return de, hs, vs
+
+    assert timing_errors(*raster(t.h_back), args) == []
+    de, hs, vs = raster(t.h_back)
+    de = de[1:] + [0]                           # active video one pixel early
+    assert any("porch" in e for e in timing_errors(de, hs, vs, args))
+
+
+def test_reduced_mode_frames_match_the_golden_frames_through_the_dvi_sink(build_dir):
+    scene = load_scene_config("default", SMALL)
+    mode = MODES["test"]
+    r = check_frames(scene, mode, build_dir / "board", frames=3)
+    assert r["timing_errors"] == []
+    assert r["underflow"] == 0 and r["order_error"] == 0
+    for k, (c, g) in enumerate(zip(r["captured"], r["golden"])):
+        assert c.shape == g.shape == (mode.v_active, mode.h_active, 3), k
+        assert np.array_equal(c, g), f"frame {k}: {np.count_nonzero(np.any(c != g, -1))} pixels differ"
+    # the light turns: consecutive frames differ, so the comparison sees the light step
+    assert not np.array_equal(r["golden"][0], r["golden"][1])
+
+
+def test_golden_frames_follow_the_light_table():
+    scene = load_scene_config("default", SMALL)
+    table = light_table(scene)
+    assert len({tuple(sorted(t.items())) for t in table}) > len(table) // 2
+    words, texels, _, table = board_data(scene)
+    a = golden_frame(scene, MODES["test"], 0, table, words)
+    b = golden_frame(scene, MODES["test"], len(table), table, words)
+    assert np.array_equal(a, b)                 # one turn later: the same light
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["board", "nosuch"], "board must be one of"),
+    (["board", "ulx3s", "--mode", "1024x768"], "mode must be one of"),
+    (["board", "ulx3s", "--scene", "palette"], "scene 'palette'"),
+    (["board", "ulx3s", "--texture-size", "4096"], "block RAM"),
+])
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, argv, word):
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", *argv, "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], r.stderr
+    assert not out.exists()
+
+
+def test_check_board_names_the_block_ram_overrun():
+    scene = load_scene_config("default", {"texture_size": 1024})
+    with pytest.raises(Exception) as e:
+        check_board("ulx3s", "640x480", scene)
+    assert "too many" in str(e.value) and "DP16KD" in str(e.value)
