@@ -148,10 +148,11 @@ class BumpMapFetch(wiring.Component):
     """
 
     latency = 1 + RAM_LATENCY
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, scene, out_layout=None, init=None, texture=None, target=None):
+    def __init__(self, scene, out_layout=None, init=None, texture=None, target=None,
+                 lockstep=None):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
+        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         self.fetched = fetched_fields(scene)
         if not self.fetched:
             self._MustUse__silence = True

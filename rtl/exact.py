@@ -95,8 +95,8 @@ class ExactRotation(PipeUnit):
 
     latency = 1 + SineBank.latency + 2
 
-    def __init__(self, cfg: Config, target=None):
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
+    def __init__(self, cfg: Config, target=None, lockstep=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
 
     def build(self, m, pipe):
         cfg = self.cfg
@@ -136,8 +136,8 @@ class ExactIllumination(IlluminationDatapath):
     SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None):
-        super().__init__(cfg, rotated_layout(cfg), target)
+    def __init__(self, cfg: Config, target=None, lockstep=None):
+        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
 
     @property
     def wide(self):

@@ -311,10 +311,10 @@ class LeeRotation(PipeUnit):
     reads is sequential; every link of it has a register of its own.
     """
 
-    def __init__(self, cfg: Config, target=None):
+    def __init__(self, cfg: Config, target=None, lockstep=None):
         self.prop_latency = product_latency(*prop_operands(cfg))              # P
         self.latency = S + 8 + 3 * ROM_STAGES + W + self.prop_latency
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
 
     def build(self, m, pipe):
         px, o = self.i.payload, self.o.payload
@@ -383,10 +383,10 @@ class LeeIllumination(IlluminationDatapath):
     (1): ``dot_latency``, plus SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None):
+    def __init__(self, cfg: Config, target=None, lockstep=None):
         self.product_latency = product_latency(*dot_operands(cfg))
         self.dot_latency = REGISTERED_SINE_LATENCY + self.product_latency + 2
-        super().__init__(cfg, rotated_layout(cfg), target)
+        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
 
     def dots(self, m, pipe, payload):
         return {v: self._dot(m, pipe, v, payload[v], payload.b) for v in vectors(self.cfg)}

@@ -27,7 +27,7 @@ from typing import Optional
 
 from bumprtl.rtl.errors import ConfigError
 
-__all__ = ["Method", "METHODS", "PER_PIXEL", "BASELINES", "HARDWARE", "get"]
+__all__ = ["Method", "METHODS", "PER_PIXEL", "BASELINES", "HARDWARE", "get", "register"]
 
 _LAYER = "bumprtl.rtl."
 
@@ -145,9 +145,29 @@ _RECORDS["kim"] = Method(
     layout_path="bumprtl.rtl.lee:rotated_layout", cartesian=False, rotates_normal=False)
 
 METHODS = dict(_RECORDS)
-PER_PIXEL = tuple(n for n, m in METHODS.items() if m.per_pixel)    # scenes and pipelines
-BASELINES = tuple(n for n, m in METHODS.items() if m.baseline)     # Table 1 cost comparison
-HARDWARE = tuple(n for n, m in METHODS.items() if m.hardware_of is None)   # distinct hardware
+PER_PIXEL = BASELINES = HARDWARE = ()
+
+
+def _derive():
+    """The lists every consumer reads, derived from :data:`METHODS`."""
+    global PER_PIXEL, BASELINES, HARDWARE
+    PER_PIXEL = tuple(n for n, m in METHODS.items() if m.per_pixel)    # scenes and pipelines
+    BASELINES = tuple(n for n, m in METHODS.items() if m.baseline)     # Table 1 cost comparison
+    HARDWARE = tuple(n for n, m in METHODS.items() if m.hardware_of is None)  # distinct hardware
+
+
+_derive()
+
+
+def register(method: Method):
+    """Add ``method`` to :data:`METHODS` (after the built-in ones) and derive the lists again;
+    modules that read the lists take them when they are imported, so a method added this
+    way (tests/tools/toy_method.py) is registered before they are. Returns it."""
+    if method.name in METHODS:
+        raise ConfigError(f"method {method.name!r} is registered already", "method")
+    METHODS[method.name] = method
+    _derive()
+    return method
 
 
 def get(name) -> Method:

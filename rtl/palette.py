@@ -121,10 +121,10 @@ class PaletteLUT(wiring.Component):
     when not stalled.
     """
 
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, cfg: Config, target=None, bank_in=False):
+    def __init__(self, cfg: Config, target=None, bank_in=False, lockstep=None):
         self.cfg, self.target, self.memories, self.bank_in = cfg, target, {}, bank_in
+        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         ib = index_bits(cfg)
         fields = {"index": unsigned(ib)}
         if cfg.palette_blend:

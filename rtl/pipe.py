@@ -22,7 +22,7 @@ from bumprtl.rtl.targets import (DP16KD_MODES, ECP5, PRODUCT_LATENCY, RAM_LATENC
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
-           "limb_products", "lockstep_buffer", "BUFFER_DEPTH", "PRODUCT_LATENCY",
+           "limb_products", "lockstep_buffer", "lockstep_enables", "BUFFER_DEPTH", "PRODUCT_LATENCY",
            "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals",
            "DP16KD_MODES", "pipe_observer"]
 
@@ -174,15 +174,14 @@ class PipeUnit(wiring.Component):
     ``memories`` holds the pipe's record of the memories built (name -> depth, width, bits).
     1 pixel per clock when not stalled.
 
-    ``lockstep``: None (the default: the unit stalls on its own) or a 1-bit enable set
-    before elaboration (the :class:`StallPipe` ``enable``: lock-step mode, used by
-    ``BumpPipeline``).
+    lockstep : None or Value
+        None (the default: the unit stalls on its own) or a 1-bit enable (the
+        :class:`StallPipe` ``enable``: lock-step mode; ``BumpPipeline`` gives each unit its
+        copy of ``run``, :func:`lockstep_enables`).
     """
 
-    lockstep = None
-
-    def __init__(self, cfg, in_layout, out_layout, target=None):
-        self.cfg, self.target, self.memories = cfg, target, {}
+    def __init__(self, cfg, in_layout, out_layout, target=None, lockstep=None):
+        self.cfg, self.target, self.memories, self.lockstep = cfg, target, {}, lockstep
         super().__init__({"i": In(stream.Signature(in_layout)),
                           "o": Out(stream.Signature(out_layout))})
 
@@ -206,16 +205,25 @@ class PipeUnit(wiring.Component):
 BUFFER_DEPTH = 2
 
 
-def lockstep_buffer(m, units, last, i, o):
+def lockstep_enables(names):
+    """The registered enables ``run`` of a lock-step chain of units ``names``: one copy per
+    unit (given to its constructor as ``lockstep``) and ``"pipeline"`` for the buffer's and
+    ``i.ready``'s own; :func:`lockstep_buffer` drives them."""
+    return {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
+            for name in ("pipeline", *names)}
+
+
+def lockstep_buffer(m, units, runs, last, i, o):
     """Units chained in lock step on a registered enable, with an output buffer: the stall
     rule of a chain of units (``BumpPipeline``, the placed rotation -> illumination pipe of
     gen/flow/fpga.py) without a chain of ``o.valid`` terms across them.
 
-    ``units``: name -> unit (a unit with a ``lockstep`` attribute, run as a
-    :class:`StallPipe` in lock-step mode); ``last``: the stream out of the last unit; ``i``,
-    ``o``: the chain's own streams (``i`` flipped). Every unit is given its own copy of the
-    registered enable ``run`` (as ``lockstep`` and as its ``o.ready``: a pixel leaves a unit
-    whenever the chain runs), so no one flip-flop drives every register of the chain. The
+    ``units``: name -> unit, each built with ``lockstep=runs[name]`` (run as a
+    :class:`StallPipe` in lock-step mode); ``runs``: :func:`lockstep_enables` of the units;
+    ``last``: the stream out of the last unit; ``i``, ``o``: the chain's own streams (``i``
+    flipped). Every unit has its own copy of the registered enable ``run`` (as ``lockstep``
+    and as its ``o.ready``: a pixel leaves a unit whenever the chain runs), so no one
+    flip-flop drives every register of the chain. The
     last unit feeds a :data:`BUFFER_DEPTH`-entry buffer, bypassed while empty (the latency
     is the units'). ``i.ready`` = ``run`` = (at most one pixel in the buffer): high whenever
     ``o.valid`` is low, never a function of ``o.ready`` in the same cycle. The caller feeds
@@ -224,11 +232,11 @@ def lockstep_buffer(m, units, last, i, o):
     ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by sim/formal's lemmas."""
     count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
     entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
-    runs = {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
-            for name in ("pipeline", *units)}
+    runs = {name: runs[name] for name in ("pipeline", *units)}
     run = runs["pipeline"]
     for name, unit in units.items():
-        unit.lockstep = runs[name]
+        if unit.lockstep is not runs[name]:
+            raise ValueError(f"unit {name!r} must be built with lockstep=runs[{name!r}]")
         m.d.comb += unit.o.ready.eq(runs[name])
     held = count != 0
     taken = o.valid & o.ready

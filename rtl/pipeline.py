@@ -44,7 +44,7 @@ from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_
                                  shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer,
-                              pipe_observer)
+                              lockstep_enables, pipe_observer)
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
                                 phong_coefficients)
@@ -68,10 +68,10 @@ class VectorTerms(wiring.Component):
     registers are named ``l_*``, ``l1_*``, ... after the pipeline's lights)."""
 
     latency = ExactRotation.latency
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, cfg, count, first=0, target=None):
+    def __init__(self, cfg, count, first=0, target=None, lockstep=None):
         self.cfg, self.count, self.first, self.target, self.memories = cfg, count, first, target, {}
+        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         terms = data.StructLayout({v: _vector_layout(cfg) for v, _ in light_layout(cfg)})
         fields_in = {"n_phi": angle_shape(cfg), "lights": data.ArrayLayout(light_layout(cfg), count),
                      "tag": unsigned(cfg.tag_bits)}
@@ -112,10 +112,10 @@ class LightSum(wiring.Component):
     # Registers: the products' operands and outputs (PRODUCT_LATENCY), the sums of the split
     # products (kd, ks), the terms' sum, the colour.
     latency = PRODUCT_LATENCY + 3
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, scene, target=None):
+    def __init__(self, scene, target=None, lockstep=None):
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
+        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
                   "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), self.lights),
                   "tag": unsigned(self.cfg.tag_bits)}
@@ -231,6 +231,7 @@ class BumpPipeline(wiring.Component):
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
+        self._runs = lockstep_enables([])     # run: the buffer's and i.ready's own, then one per unit
         self._texture = texture
         ports = {}
         if scene.shading == "palette":
@@ -264,6 +265,10 @@ class BumpPipeline(wiring.Component):
         super().__init__(ports)
 
     # --- planning: which units, and why -----------------------------------------------------
+    def _run(self, name):
+        """Unit ``name``'s copy of the registered enable ``run`` (its ``lockstep``)."""
+        return self._runs.setdefault(name, lockstep_enables([name])[name])
+
     def _add(self, name, unit, why):
         self.units[name] = unit
         self.built.append({"unit": name, "class": type(unit).__name__, "latency": unit.latency,
@@ -277,12 +282,13 @@ class BumpPipeline(wiring.Component):
                                             "tag": out_layout["tag"].shape})
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
             (["texture = true: the RGB colour texel"] if s.texture else [])
-        self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target),
+        self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target,
+                                        lockstep=self._run("fetch")),
                   f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):
-        lut = PaletteLUT(self.cfg, self.target, bank_in=True)
+        lut = PaletteLUT(self.cfg, self.target, bank_in=True, lockstep=self._run("palette"))
         self._fetch(lut.i.payload.shape(), init, "a palette index")
         if self.scene.texture:
             self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
@@ -301,7 +307,7 @@ class BumpPipeline(wiring.Component):
             tag = fields.pop("tag")
             fields.update(light_fields(cfg))   # l, h stay in place; extra_lights after b
             self._fetch(data.StructLayout({**fields, "tag": tag}), init, "N' (polar angles)")
-            self._add("rotation", VectorRotation(cfg, self.target),
+            self._add("rotation", VectorRotation(cfg, self.target, self._run("rotation")),
                       f"rotation = 'per-pixel': N' rotated into N's frame every pixel ({spec})")
             rot_layer.append("rotation")
             first = 1                          # light 0 rides in the rotation
@@ -314,30 +320,31 @@ class BumpPipeline(wiring.Component):
             why = ("bump_map = 'flat': n'' written once per polygon, per pixel only the light "
                    "terms" if s.rotation == "per-polygon" else
                    f"lights = {s.lights}: lights 1..{s.lights - 1} share light 0's rotated normal")
-            self._add("terms", VectorTerms(cfg, s.lights - first, first, self.target), why)
+            self._add("terms", VectorTerms(cfg, s.lights - first, first, self.target,
+                                          self._run("terms")), why)
             rot_layer.append("terms")
         ill = []
         for j in range(s.lights):
-            self._add(f"illumination{j}" if s.lights > 1 else "illumination",
-                      Illumination(cfg, self.target),
+            name = f"illumination{j}" if s.lights > 1 else "illumination"
+            self._add(name, Illumination(cfg, self.target, self._run(name)),
                       f"light {j}: N'.L' (and N'.H') and the shade of eq. 2 ({spec})")
             ill.append(self.built[-1]["unit"])
         if s.texture:                          # the texel rides beside both layers
             for name, layer in (("texel_r", rot_layer), ("texel_i", ill)):
                 latency = self.units[layer[0]].latency
-                self._add(name, TexelDelay(cfg, latency, self.target),
+                self._add(name, TexelDelay(cfg, latency, self.target, self._run(name)),
                           f"texture = true: the texel waits {latency} stages beside {layer[0]}")
                 layer.append(name)
         self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
         self._rot_layer, self._ill_layer = rot_layer, ill
         if s.texture:
-            self._add("blend", TextureBlend(cfg, s.lights, self.target),
+            self._add("blend", TextureBlend(cfg, s.lights, self.target, self._run("blend")),
                       "texture = true: out_c = tex_c min(1, ka + kd d) + ks s (Lee eq. 2 with a "
                       "textured albedo, Tarini eq. 2's shape)" +
                       (f", summed over the {s.lights} lights" if s.lights > 1 else ""))
             self._layers.append(["blend"])
         elif s.lights > 1:
-            self._add("lightsum", LightSum(s, self.target),
+            self._add("lightsum", LightSum(s, self.target, self._run("lightsum")),
                       f"lights = {s.lights}: eq. 2 summed over the lights")
             self._layers.append(["lightsum"])
         self._first, self._last = self._layers[0][0], self._layers[-1][0]
@@ -402,7 +409,8 @@ class BumpPipeline(wiring.Component):
     def _output_buffer(self, m):
         """``run`` (one copy per unit), the lock-step enables and the output buffer behind
         the last unit (``pipe.lockstep_buffer``)."""
-        self.buffer = lockstep_buffer(m, self.units, self.units[self._last].o, self.i, self.o)
+        self.buffer = lockstep_buffer(m, self.units, self._runs, self.units[self._last].o,
+                                      self.i, self.o)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg

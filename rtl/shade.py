@@ -110,8 +110,8 @@ class IlluminationDatapath(PipeUnit):
 
     dot_latency = None
 
-    def __init__(self, cfg: Config, in_layout, target=None):
-        super().__init__(cfg, in_layout, shade_layout(cfg), target)
+    def __init__(self, cfg: Config, in_layout, target=None, lockstep=None):
+        super().__init__(cfg, in_layout, shade_layout(cfg), target, lockstep)
 
     @property
     def latency(self):
@@ -132,10 +132,10 @@ class BackEnd(IlluminationDatapath):
 
     dot_latency = 1
 
-    def __init__(self, cfg: Config, target=None):
+    def __init__(self, cfg: Config, target=None, lockstep=None):
         b = cfg.frac_bits
         super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
-                                                 "tag": unsigned(cfg.tag_bits)}), target)
+                                                 "tag": unsigned(cfg.tag_bits)}), target, lockstep)
 
     def dots(self, m, pipe, payload):
         return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}

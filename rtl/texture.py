@@ -163,10 +163,11 @@ class TextureBlend(wiring.Component):
     """
 
     latency = BLEND_LATENCY
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, cfg: Config, lights=1, target=None):
+    def __init__(self, cfg: Config, lights=1, target=None, lockstep=None):
+        # lockstep: None or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
         self.cfg, self.lights, self.target, self.memories = cfg, lights, target, {}
+        self.lockstep = lockstep
         u8, tag = unsigned(8), unsigned(cfg.tag_bits)
         fields = {"d": data.ArrayLayout(unsigned(cfg.frac_bits + 1), lights),
                   "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), lights),
@@ -197,10 +198,10 @@ class TexelDelay(wiring.Component):
     illumination) in lock step, so it meets that pixel's shade at the blend.
     Input/output {texel: rgb}."""
 
-    lockstep = None              # or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
 
-    def __init__(self, cfg: Config, latency, target=None):
+    def __init__(self, cfg: Config, latency, target=None, lockstep=None):
         self.cfg, self.latency, self.target, self.memories = cfg, latency, target, {}
+        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         layout = data.StructLayout({"texel": rgb_layout(cfg)})
         super().__init__({"i": In(stream.Signature(layout)), "o": Out(stream.Signature(layout))})
 

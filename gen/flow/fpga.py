@@ -25,7 +25,7 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.sim.golden.methods import METHODS
-from bumprtl.rtl.pipe import ECP5, lockstep_buffer
+from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
@@ -129,8 +129,9 @@ def pipeline_component(cfg, target=None):
     class Pipeline(wiring.Component):
         def __init__(self):
             self.target = target
-            self.rotation = VectorRotation(cfg, target)
-            self.illumination = Illumination(cfg, target)
+            self.runs = lockstep_enables(["rotation", "illumination"])
+            self.rotation = VectorRotation(cfg, target, self.runs["rotation"])
+            self.illumination = Illumination(cfg, target, self.runs["illumination"])
             self.latency = self.rotation.latency + self.illumination.latency
             super().__init__({"i": In(self.rotation.i.signature.flip()),
                               "o": Out(self.illumination.o.signature)})
@@ -138,7 +139,7 @@ def pipeline_component(cfg, target=None):
         def elaborate(self, platform):
             m = Module()
             units = {"rotation": self.rotation, "illumination": self.illumination}
-            self.buffer = lockstep_buffer(m, units, self.illumination.o, self.i, self.o)
+            self.buffer = lockstep_buffer(m, units, self.runs, self.illumination.o, self.i, self.o)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
             m.d.comb += [self.rotation.i.valid.eq(self.i.valid),
                          self.rotation.i.payload.eq(self.i.payload),

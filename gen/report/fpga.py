@@ -36,9 +36,12 @@ def fpga_units(cfg):
     """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
     pipeline (setup -> illumination only: their per-unit numbers are Table 1's Yosys counts,
     and with their pipelined square roots and dividers they are the largest netlists to
-    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``)."""
+    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``). A
+    method whose hardware is another's (Ernst's is Peercy's, rtl/methods.py) is placed once,
+    under that other name (the report's notes say so)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
-    return ([(f"{d}_{row}", d, row) for d in TABLE1_ORDER if d not in NOT_PLACED for row in rows(d)]
+    placed = [d for d in TABLE1_ORDER if d not in NOT_PLACED and METHODS[d].hardware_of is None]
+    return ([(f"{d}_{row}", d, row) for d in placed for row in rows(d)]
             + [(f"scene_{s.replace('-', '_')}", load_scene_config(s).method, f"scene:{s}")
                for s in BUILTIN])
 
@@ -185,8 +188,9 @@ def write_report(args, rows, acc):
                   f"({r['fmax_mhz']} MHz, speed grade 6, out of context)."]
     skipped = [d for d in NOT_PLACED if d in TABLE1_ORDER]
     if skipped:
-        lines += [f"- {', '.join(skipped)}: {NOT_PLACED[skipped[0]]} (rtl/baselines/ernst.py "
-                  "is Peercy's hardware)."]
+        lines += [f"- {', '.join(skipped)}: {NOT_PLACED[skipped[0]]}."]
+    lines += [f"- {d}: {METHODS[d].hardware_of}'s hardware (rtl/methods.py), placed once as "
+              f"{METHODS[d].hardware_of}." for d in TABLE1_ORDER if METHODS[d].hardware_of]
     out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
     print(f"wrote {out}")
     data = out.parent / "data" / "fpga.json"         # read by report table1

@@ -308,8 +308,8 @@ class KimRotation(PipeUnit):
 
     latency = 2 * S + 4 * P + 14 + 3 * R
 
-    def __init__(self, cfg: Config, target=None):
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target)
+    def __init__(self, cfg: Config, target=None, lockstep=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
 
     def build(self, m, pipe):
         cfg, k = self.cfg, self.cfg.k
@@ -381,8 +381,8 @@ class KimIllumination(IlluminationDatapath):
 
     dot_latency = REGISTERED_SINE_LATENCY + 2 * P + 2
 
-    def __init__(self, cfg: Config, target=None):
-        super().__init__(cfg, rotated_layout(cfg), target)
+    def __init__(self, cfg: Config, target=None, lockstep=None):
+        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
 
     def dots(self, m, pipe, payload):
         cfg, k = self.cfg, self.cfg.k

@@ -261,9 +261,9 @@ class PeercyRotation(PipeUnit):
     + 5 + 22 + 18 = 51 at B = 16); 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None):
+    def __init__(self, cfg: Config, target=None, lockstep=None):
         self.latency = rotation_latency(cfg)
-        super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target)
+        super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target, lockstep)
 
     def build(self, m, pipe):
         cfg, b = self.cfg, self.cfg.frac_bits
@@ -313,9 +313,9 @@ class PeercyIllumination(IlluminationDatapath):
     :func:`sum3_rounded`), then SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None):
+    def __init__(self, cfg: Config, target=None, lockstep=None):
         self.dot_latency = dot_latency(cfg)
-        super().__init__(cfg, setup_output_layout(cfg), target)
+        super().__init__(cfg, setup_output_layout(cfg), target, lockstep)
 
     def dots(self, m, pipe, payload):
         n, dots = payload.np, {}

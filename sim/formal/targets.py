@@ -12,7 +12,7 @@ from typing import Callable
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL
+from bumprtl.sim.golden.methods import BASELINES, HARDWARE, PER_PIXEL
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
@@ -102,10 +102,11 @@ def _pipeline(name):
 
 def _targets():
     out = [Target("sincos", _sincos)]
-    for method in PER_PIXEL:
+    # each distinct hardware once (HARDWARE: Ernst's is Peercy's, proved as peercy)
+    for method in (m for m in PER_PIXEL if m in HARDWARE):
         out.append(Target(f"rotation_{method}", _rotation(method)))
         out.append(Target(f"illumination_{method}", _illumination(method)))
-    for method in BASELINES:
+    for method in (m for m in BASELINES if m in HARDWARE):
         out.append(Target(f"rotation_{method}", _rotation(method), slow=True, note="baseline"))
         out.append(Target(f"illumination_{method}", _illumination(method), slow=True,
                           note="baseline"))

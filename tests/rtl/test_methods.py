@@ -32,6 +32,7 @@ def test_registry_covers_every_method_name_once():
     for name in METHOD_NAMES:
         assert methods.get(name) is methods.METHODS[name]
         assert methods.get(name).title == hardware.get(name).title      # the joined view
+    assert tuple(methods.MODELS) == tuple(hardware.METHODS)    # one models' record per name
 
 
 def test_ernst_builds_peercys_hardware_under_its_own_name():

@@ -26,6 +26,7 @@ from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, 
                                                unpack_rgb)
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel
 from bumprtl.sim.traffic import PATTERNS
+from bumprtl.rtl.methods import PER_PIXEL
 
 SWITCHES = {"lights": (1, 2), "specular": (True, False), "bump_map": ("varying", "flat"),
             "shading": ("per-pixel", "palette"), "addressing": ("wrap", "clamp"),
@@ -308,7 +309,7 @@ def test_textured_scene_the_texture_reaches_the_output():
     assert (colors["black"] <= golden["specular"]).all() and colors["white"].mean() > 80
 
 
-@pytest.mark.parametrize("method", ["exact", "lee"])
+@pytest.mark.parametrize("method", PER_PIXEL)
 def test_no_specular_builds_no_h_path_and_no_table(method, build_dir):
     """specular = false checked on the elaborated design (not on the built/skipped lists,
     which are computed from the SceneConfig): the emitted pipeline's memories and Verilog have

@@ -135,7 +135,7 @@ def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
         jobs.LOG_DIR / "place-LFE5U-85F-exact_setup-seed3.log").read_text()
 
 
-@pytest.mark.parametrize("method", ["exact", "lee"])
+@pytest.mark.parametrize("method", PER_PIXEL)
 def test_placed_pipeline_runs_in_lock_step_bit_exact(method):
     """pipeline_component (the rotation -> illumination pipe report fpga places): bit-exact
     with the golden datapath under input gaps and backpressure, i.ready high whenever

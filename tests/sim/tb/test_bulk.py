@@ -25,6 +25,7 @@ from bumprtl.sim.tb import bulk
 from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
                                  decode_words, encode_words, run_bulk)
 from bumprtl.sim.tb.bulk_sources import pipeline_map
+from bumprtl.rtl.methods import PER_PIXEL
 
 # Icarus is ~1000x slower than Verilator on the pipeline: a smaller frame, the same patterns.
 FRAME = {"icarus": 16, "verilator": 64}
@@ -168,7 +169,7 @@ def _regress(unit_v, unit_j, source, build_dir):
 
 @pytest.mark.regress
 @pytest.mark.parametrize("unit", ["rotation", "illumination"])
-@pytest.mark.parametrize("method", ["exact", "lee"])
+@pytest.mark.parametrize("method", PER_PIXEL)
 def test_bulk_regress_datapath_1e7_verilator(unit, method, build_dir):
     """The edge cases, then random pixels, bit-exact against the unit's golden model."""
     v, j = emit_unit(unit, Config(method=method), build_dir / "rtl")
