@@ -53,7 +53,7 @@ def test_every_method_renders_the_unseen_map(crater_scene):
     for m, (fp, fm, xp, xm) in rows.items():
         print(f"{m:<14} {fp:>8.2f} / {fm:<4d}    " +
               ("-" if xp is None else f"{xp:>8.2f} / {xm}"))
-    for m in ("conventional", "exact", "peercy", "kim", "ernst"):
+    for m in ("conventional", "exact", "peercy", "kim"):     # Ernst's model is Peercy's
         assert rows[m][:2] == (float("inf"), 0), m            # float64: the same picture
     assert rows["exact"][3] <= EXACT_COLOUR_LSB
     for m in FIXED_METHODS:
