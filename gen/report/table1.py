@@ -219,7 +219,7 @@ is classified cell by cell:
   2 square roots, 16 adders. Signs and rounding of the quotient are constant adders.
   Illumination: the paper has none ("Not Available"); we give Peercy Ernst's
   straightforward Phong so that its output can be measured.
-- **ernst** (`rtl/baselines/ernst.py`): the same setup hardware as Peercy (Ernst et al.
+- **ernst** (an alias of Peercy's hardware in `rtl/methods.py`): the same setup hardware as Peercy (Ernst et al.
   differ in how the bump map is built, k = -1, a preprocessing step). Illumination: the
   two dot products N'.L_n, N'.H_n (6 multipliers) and the Phong back end with the power
   (specular) table; the paper's 7th multiplier is our `KD x diffuse` constant product, and
@@ -327,7 +327,7 @@ STATUS = """
 ## Status
 
 Peercy, Ernst and Kim are real RTL (`rtl/baselines/`) with bit-exact golden models
-(`sim/golden/fixed/peercy.py`, `ernst.py`, `kim.py`), checked bit for bit in
+(`sim/golden/fixed/peercy.py`, Ernst's being Peercy's, `kim.py`), checked bit for bit in
 `tests/rtl/test_baselines_*.py` and under cocotb in `tests/sim/tb/test_tb_datapath.py`.
 Kugler's scheme (3 MB of light maps) is taken from the paper's description only.
 """
