@@ -90,7 +90,7 @@ def tool_log(path, label, verbose=False, python=False):
                 stop.set()
                 ticker.join()
             term.close()
-            if failed:
+            if failed and path.stat().st_size:
                 sys.stderr.write(f"--- {path} ---\n{path.read_text(errors='replace')}--- end of "
                                  f"{path} ---\n")
                 sys.stderr.flush()

@@ -31,7 +31,7 @@ from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.render.images import (FIXED_METHODS, PALETTE, fixed_image, float_image,
                                        render_methods, shade_scene)
-from bumprtl.gen.render.rtl import render_rtl
+from bumprtl.gen.render.rtl import render_rtl, require_sim
 
 DEMO_SCENES = ("bricks", "globe")
 REFERENCE = "conventional"
@@ -118,6 +118,7 @@ def _rtl_section(args, out):
     scene = load_scene_config(DEMO_PIPELINE).replace(texture_size=t)
     blocks, have = check_scene_fits(scene, DEMO_DEVICE)
     n = args.size * args.size
+    require_sim()
     label = (f"rtl: {args.size}x{args.size} {scene.image} ({t}^2 map) through the emitted "
              f"pipeline of scene {scene.name!r} on {args.simulator}")
     if args.verbose:

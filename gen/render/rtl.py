@@ -207,7 +207,7 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, table, writes)
-    from bumprtl.sim.tb.runner import run_cocotb     # the [sim] extra: not needed to emit
+    from bumprtl.sim.tb.runner import run_cocotb  # optional dependency: the [sim] extra
     run = run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
                       "BUMPRTL_PATTERNS": ",".join(patterns), "BUMPRTL_PROGRESS": int(progress)})
@@ -248,7 +248,7 @@ def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir
     build_dir = Path(build_dir).resolve()
     v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
     meta = json.loads(Path(j).read_text())
-    from bumprtl.sim.tb.bulk import run_bulk, setup_writes    # the [sim] extra
+    from bumprtl.sim.tb.bulk import run_bulk, setup_writes  # optional dependency: [sim]
     r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
                  expected=expected, setup=writes + setup_writes(meta, polygon, table), **build)
     return r.outputs, r.cycles, r
@@ -281,6 +281,12 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
                      cycles["no_stall"], *times)
 
 
+def require_sim():
+    """Import the simulator path (cocotb, the [sim] extra) before any work: without it the
+    ImportError reaches gen/cli/main.py, which names the extra in one line."""
+    import bumprtl.sim.tb.bulk  # optional dependency: the [sim] extra
+
+
 def cli_render(args, scene=None):
     """``bumprtl render --rtl``: the scene (``--pipeline``, a built-in scene class or TOML,
     with the flags that were given: ``gen/render/images.render_scene``) rendered through its
@@ -290,6 +296,7 @@ def cli_render(args, scene=None):
     check_scene_fits(scene, getattr(args, "device", None) or DEFAULT_DEVICE)
     light = {"azimuth": args.light_azimuth, "light_elevation": args.light_elevation,
              "light": args.light}
+    require_sim()
     t0 = time.perf_counter()
     per_cycle = getattr(args, "per_cycle", False)
     load = getattr(args, "load", None) or "initial"

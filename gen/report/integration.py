@@ -26,6 +26,7 @@ from pathlib import Path
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, emit_scene_unit, memory_images, scene_command
 from bumprtl.gen.flow.named import named_module, named_ports, write_named
 from bumprtl.gen.flow.units import default_module
+from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.scenes.config import load_scene_config
 
@@ -93,7 +94,6 @@ def _meaning(port, p):
 def emit_for_integration(scene, out_dir, device=DEFAULT_DEVICE):
     """Emit ``scene``'s pipeline as ``bumprtl emit pipeline --load port --ports named`` does
     (top module ``bumprtl_pipeline``); returns its sidecar with ``named_ports``."""
-    from bumprtl.gen.render.rtl import scene_memories
     scene = load_scene_config(scene)
     module = default_module("pipeline")
     words, texels, table = scene_memories(scene)
