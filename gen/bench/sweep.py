@@ -26,6 +26,7 @@ Output: ``build/bench/sweep.json`` (``--out``), Pareto plots and a markdown tabl
 
 import hashlib
 import json
+import os
 import sys
 import time
 from dataclasses import dataclass, replace
@@ -48,8 +49,10 @@ from bumprtl.sim.golden.float.palette import (distinct_normals, palette_rgb, qua
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 from bumprtl.gen.bench.golden import _sim_rate
-from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, pipeline_component,
-                                   place_component)
+from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, Placement,
+                                   pipeline_component, place_component, place_text)
 from bumprtl.gen.flow.resources import count_verilog, SynthesisError
 from bumprtl.gen.flow.units import build_unit, emit_unit
 
@@ -162,6 +165,7 @@ class Context:
         self.refs = {name: to_8bit(conventional(s.px, Config()).color) for name, s in self.scenes.items()}
         self.maps = [map_record(name, size, self.scenes[map_key(name, size)]) for name, size in grid.maps]
         self._adversarial = {}
+        self.pending = []          # (point, Placement) placed as jobs after the points
 
     def adversarial(self, cfg, channel="diffuse"):
         """Adversarial vectors depend on the angle grid (and the exponent) only: one set per
@@ -258,10 +262,33 @@ def unit_cost(units, cfg, work):
 
 
 def fpga_cost(component_fn, label, cfg, device, work):
-    """Place ``component_fn(cfg, ECP5())`` on ``device``: gen/flow/fpga.py's ECP5 form (DSP and
-    block-RAM registers, as ``report fpga``), cached per emitted Verilog in the cache both
-    share."""
+    """Place ``component_fn(cfg, ECP5())`` on ``device`` here, now: gen/flow/fpga.py's ECP5
+    form (DSP and block-RAM registers, as ``report fpga``), cached per emitted Verilog in the
+    cache both share. ``sweep`` itself places as jobs (:func:`place_pending`)."""
     return place_component(component_fn(cfg, ECP5()), label, device)
+
+
+def place_pending(ctx, opts, progress=True):
+    """The placements the points asked for (``ctx.pending``: (point, Placement)) as jobs of
+    sim/jobs.py (a local cluster of ``opts.jobs`` workers, or ``opts.scheduler``'s), one
+    job per distinct Verilog; each point gets its row or its ``fpga_error``."""
+    by_key = {}
+    for point, p in ctx.pending:
+        by_key.setdefault(p.key, []).append((point, p))
+    if not by_key:
+        return
+    names = {key: job_name("place", p.device, p.label, key) for key, ((_, p), *_) in by_key.items()}
+    with Runner(scheduler_address(getattr(opts, "scheduler", None)),
+                getattr(opts, "jobs", None) or 1, progress=progress) as runner:
+        out = runner.run((Job(names[key], place_text, group[0][1].args())
+                          for key, group in by_key.items()), desc="place")
+    for key, group in by_key.items():
+        o = out[names[key]]
+        for n, (point, p) in enumerate(group):
+            if not o.ok:
+                point["cost"]["fpga_error"] = o.error[:300]
+                continue
+            _fill(point, p.store(o.value) if n == 0 else {**o.value["row"], "unit": p.label})
 
 
 def _pipeline(cfg, target=None):
@@ -334,10 +361,17 @@ def _hardware(point, cfg, component_fn, label, ctx, opts):
         point["cost"]["fpga_error"] = NOT_PLACED[point["method"]]
         return
     try:
-        row = fpga_cost(component_fn, f"{point['method']}_{label}", cfg, opts.device, ctx.work)
+        p = Placement(component_fn(cfg, ECP5()), f"{point['method']}_{label}", opts.device)
     except (FpgaError, SynthesisError) as e:      # e.g. does not fit: recorded, not fatal
         point["cost"]["fpga_error"] = str(e).splitlines()[0][:300]
         return
+    if p.cached is None:
+        ctx.pending.append((point, p))            # placed as a job after the points
+    else:
+        _fill(point, p.cached)
+
+
+def _fill(point, row):
     point["cost"]["fpga"] = row
     if row.get("fmax_mhz"):
         point["speed"]["hw_pix_s"] = row["fmax_mhz"] * 1e6     # 1 pixel per clock (docs/architecture.md, Interfaces)
@@ -383,6 +417,7 @@ def sweep(grid, opts, work, seed=11, progress=True):
         for fn, args in bar:
             bar.set_postfix_str(" ".join(map(str, args[:-1])))
             points.append(fn(ctx, *args))
+    place_pending(ctx, opts, progress)
     reference = len(ctx.px) / _best_time(lambda: _conventional(ctx)) / 1e6
     return {"grid": grid.__dict__, "maps": ctx.maps, "seed": seed,
             "float64_conventional_mpix_s": round(reference, 3), "points": points}
@@ -597,6 +632,7 @@ METHOD_CHOICES = (*PER_PIXEL, "palette", "baselines")
 def run(args):
     if args.fpga:
         check_device(args.device)
+        scheduler_address(args.scheduler)        # a malformed address: one line, exit 2
     grid = GRIDS["quick" if args.quick else "default"]
     if args.maps:
         grid = replace(grid, maps=parse_maps(args.maps))
@@ -641,6 +677,10 @@ def add_parser(sub):
                         "(diagonal; baselines at the default widths), or all; palette sizes always")
     p.add_argument("--sim", action="store_true",
                    help="cocotb/Verilator pixels/s for the points at the default widths")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="with --fpga: local worker processes, one placement each at a time "
+                        "(default: the number of cores; ignored with --scheduler)")
+    add_job_arguments(p)
     p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
     p.add_argument("--work", type=Path, default=Path("build/bench/sweep"),
                    help="netlists and cached cost per config")
