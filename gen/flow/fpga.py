@@ -160,7 +160,7 @@ NOT_PLACED = {name: m.not_placed for name, m in METHODS.items() if m.not_placed}
 def placement_key(text, label, device, lpf_text, seed=1):
     """The cache key of a placement: the digest of the Verilog (module name ``label``
     ignored: the same hardware under another label, Ernst's datapath is Peercy's
-    (rtl/baselines/ernst.py), is placed once), the device and the constraints."""
+    (rtl/methods.py), is placed once), the device and the constraints."""
     parts = (text.replace(label, "\0top"), device, lpf_text)
     parts += (f"seed {seed}",) if seed != 1 else ()           # seed 1 keeps the older keys
     return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:16]

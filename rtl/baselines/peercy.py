@@ -57,7 +57,7 @@ Illumination (:class:`PeercyIllumination`): N'.L_n and N'.H_n (6 multipliers, 4 
 rounding each), then the shared Phong back end of eq. (2) with the same cos^n specular
 (power) table as ours (rtl/shade.py ``shade_stages``), so outputs are comparable.
 The paper gives no illumination row for Peercy ("Not Available"); this is Ernst's
-"straightforward Phong" (rtl/baselines/ernst.py), used for Peercy too.
+"straightforward Phong" (Ernst is an alias of this hardware, rtl/methods.py), used for Peercy too.
 """
 
 from amaranth.hdl import Cat, Const, Elaboratable, Module, Mux, Signal, Value, signed, unsigned
