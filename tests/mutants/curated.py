@@ -20,7 +20,10 @@ other people may keep working in the tree; ``--in-place`` mutates the working tr
 For each mutant: apply it (every file's content hash recorded first), run its guards
 (``pytest -x -q -n 0``, bytecode writing off so no stale ``.pyc`` outlives it), restore in
 a ``finally`` and verify each file's content hash against the one recorded. ``--check``
-reads the working tree and copies nothing.
+reads the working tree and copies nothing. ``--jobs N`` or ``--scheduler tcp://HOST:PORT``
+runs the baseline and each mutant as a job of bumprtl's job layer (sim/jobs.py, Dask): the
+tree travels with the job as a tar archive and each job mutates its own unpacked copy in a
+temporary directory of its worker, so mutants run side by side, on this machine or a cluster.
 
 Exit status: 0 when every mutant was killed, 1 when one survived, did not apply or its
 guards failed on the unmutated code (the baseline run), 2 on a bad mutant list.
@@ -28,18 +31,24 @@ guards failed on the unmutated code (the baseline run), 2 on a bad mutant list.
 
 import argparse
 import hashlib
+import io
 import os
 import shutil
 import signal
 import subprocess
 import sys
+import tarfile
+import tempfile
 import time
 import tomllib
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import cloudpickle
+
 from bumprtl.rtl.config import BumpError
+from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 
 __all__ = ["Edit", "Mutant", "MutantError", "RestoreError", "Outcome", "ROOT", "DEFAULT_LIST",
            "load_mutants", "check_applies", "applied", "run_guards", "run_mutants", "markdown",
@@ -382,6 +391,74 @@ def copy_tree(dest, root=ROOT):
     return env
 
 
+def tree_archive(root=ROOT):
+    """The working tree's files (:func:`tree_files`) as gzip'd tar bytes: what a mutant job
+    carries to a worker that may not share this machine's filesystem."""
+    buf = io.BytesIO()
+    with tarfile.open(fileobj=buf, mode="w:gz") as tar:
+        for name in tree_files(root):
+            tar.add(Path(root) / name, arcname=name)
+    return buf.getvalue()
+
+
+def unpack_tree(archive, dest):
+    """Unpack :func:`tree_archive`'s bytes into ``dest`` with ``import bumprtl`` resolving
+    there (the same shim as :func:`copy_tree`); returns the environment that runs it."""
+    dest = Path(dest).resolve()
+    dest.mkdir(parents=True, exist_ok=True)
+    with tarfile.open(fileobj=io.BytesIO(archive), mode="r:gz") as tar:
+        tar.extractall(dest, filter="data")
+    with open(dest / "pyproject.toml", "rb") as f:
+        mapping = tomllib.load(f)["tool"]["setuptools"]["package-dir"]
+    shim = dest / ".mutate-path" / "bumprtl"
+    shim.mkdir(parents=True)
+    for pkg, folder in mapping.items():
+        (shim / pkg.split(".", 1)[1]).symlink_to(dest / folder, target_is_directory=True)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(dest / ".mutate-path")] +
+                                        ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
+    return env
+
+
+def mutant_job(archive, mutant, timeout, guards=()):
+    """One mutant as a job of bumprtl's job layer (sim/jobs.py): the tree unpacked in a
+    temporary directory of the worker, the mutant applied there and its guards run; with
+    ``mutant`` None, ``guards`` run on the unmutated tree (the baseline). Returns
+    ``{"outcome": Outcome or (status, seconds, output), "log": pytest's output}``."""
+    with tempfile.TemporaryDirectory(prefix="bumprtl-mutate-") as tmp:
+        root = Path(tmp) / "tree"
+        env = unpack_tree(archive, root)
+        if mutant is None:
+            status, seconds, out = run_guards(guards, root, timeout, env)
+            return {"outcome": (status, seconds, out), "log": out}
+        outcome = run_mutant(mutant, root, timeout, env)
+    return {"outcome": outcome, "log": outcome.log}
+
+
+def run_as_jobs(mutants, archive, args):
+    """The baseline (unless ``--no-baseline``) and every mutant as jobs: a local cluster of
+    ``args.jobs`` workers or ``args.scheduler``'s. Returns ``(baseline or None, outcomes)``;
+    a job that fails (a worker lost each time, a timeout) is an ``error`` outcome."""
+    if __name__ != "__main__":       # (__main__'s functions travel by value anyway)
+        cloudpickle.register_pickle_by_value(sys.modules[__name__])   # workers need no tests/
+    jobs = []
+    if not args.no_baseline:
+        guards = sorted({g for m in mutants if not m.equivalent for g in m.guards})
+        jobs.append(Job("mutate-baseline", mutant_job, (archive, None, args.timeout * 4, guards)))
+    jobs += [Job(job_name("mutate", m.id), mutant_job, (archive, m, args.timeout)) for m in mutants]
+    with Runner(scheduler_address(args.scheduler), args.jobs) as runner:
+        out = runner.run(jobs, desc="mutate")
+    baseline = None
+    if not args.no_baseline:
+        o = out["mutate-baseline"]
+        baseline = o.value["outcome"] if o.ok else (None, o.seconds, o.error)
+    outcomes = []
+    for m in mutants:
+        o = out[job_name("mutate", m.id)]
+        outcomes.append(o.value["outcome"] if o.ok else Outcome(m, "error", o.seconds, o.error))
+    return baseline, outcomes
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m tests.mutants.curated",
                                 description="Apply each curated mutant, run the tests that guard "
@@ -397,6 +474,12 @@ def main(argv=None):
     where.add_argument("--in-place", action="store_true",
                        help="mutate the working tree itself (each file restored and its "
                             "content hash checked after each mutant)")
+    where.add_argument("--jobs", type=int, default=None, metavar="N",
+                       help="run the mutants as jobs of bumprtl's job layer on N local worker "
+                            "processes, each mutating its own unpacked copy of the tree")
+    where.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                       help="run the mutants as jobs on this Dask scheduler's workers (the tree "
+                            "travels with each job; the workers need bumprtl's [dev] packages)")
     p.add_argument("--timeout", type=int, default=DEFAULT_TIMEOUT,
                    help=f"seconds per mutant's guard run (default: {DEFAULT_TIMEOUT})")
     p.add_argument("--no-baseline", action="store_true",
@@ -418,6 +501,8 @@ def main(argv=None):
             mutants = [m for m in mutants if any(s in m.id for s in args.select)]
             if not mutants:
                 raise MutantError(f"-k {' '.join(args.select)}: no mutant id matches")
+        if (args.jobs or args.scheduler) and not args.check:
+            return _main_jobs(mutants, args, t0, argv)
         if not args.in_place and not args.check:
             env = copy_tree(args.copy)
             root = args.copy.resolve()
@@ -453,6 +538,34 @@ def main(argv=None):
     except RestoreError as e:
         print(f"\nmutate: error: {e}", file=sys.stderr)
         return 1
+    return _finish(outcomes, args, t0, argv)
+
+
+def _main_jobs(mutants, args, t0, argv):
+    """main's --jobs / --scheduler path: every mutant a job (:func:`run_as_jobs`)."""
+    if args.jobs is not None and args.jobs < 1:
+        raise MutantError(f"--jobs must be >= 1, got {args.jobs}")
+    try:
+        scheduler_address(args.scheduler)
+        baseline, outcomes = run_as_jobs(mutants, tree_archive(), args)
+    except SchedulerError as e:
+        print(f"mutate: error: {e}", file=sys.stderr)
+        return 2
+    if baseline is not None:
+        status, seconds, out = baseline
+        print(f"baseline: {'passed' if status == 0 else 'FAILED'} ({seconds:.1f} s)")
+        if status != 0:
+            print(out[-4000:], file=sys.stderr)
+            print("mutate: error: the guards fail on the unmutated code; fix them first",
+                  file=sys.stderr)
+            return 1
+    for o in outcomes:
+        tail = f" {o.detail}" if o.status in ("survived", "error") else ""
+        print(f"{o.mutant.id} {o.status} ({o.seconds:.1f} s){tail}")
+    return _finish(outcomes, args, t0, argv)
+
+
+def _finish(outcomes, args, t0, argv):
     wall = time.perf_counter() - t0
     killed, counted = kill_ratio(outcomes)
     given = sys.argv[1:] if argv is None else list(argv)
