@@ -165,6 +165,7 @@ class StreamContract(Elaboratable):
         self.layers = layers if layers is not None else pipeline_layers(dut)
         self.lemma_count = 0
         self.messages = {}
+        self.exercised = []          # what each property's covers show (_exercise)
         self._free = []
         if prop == "bank":
             if getattr(dut, "cfg", None) is None or dut.cfg.palette_blend:
@@ -234,6 +235,13 @@ class StreamContract(Elaboratable):
         self.lemma_count += 1
         self._check(m, test, f"lemma ({what})", src_loc_at=2)
 
+    def _exercise(self, m, test, what):
+        """A cover of the property's own model (its assumptions in force): the trace that
+        shows the property is exercised, not vacuous (run.py's ``<prop>_cover`` checks, in
+        sby's cover mode). Ignored by the proofs."""
+        self.exercised.append(what)
+        m.d.comb += Cover(test)
+
     def describe(self, location):
         """The message of the assertion sby reports at ``location`` (``file:line ...``)."""
         return self.messages.get(location.split(" ")[0], location)
@@ -271,9 +279,11 @@ class StreamContract(Elaboratable):
         # ``stalled`` is reset with the unit: a reset in the stalled cycle clears the check.
         self._check(m, ~stalled | (o.valid & (o.payload.as_value() == payload)),
                            "hold: o.valid/o.payload changed while stalled")
+        self._exercise(m, stalled & o.valid, "hold: a pixel held through a stall")
 
     def _ready(self, m, i, o, take_in, take_out, stages):
         self._check(m, o.valid | i.ready, "ready: i.ready low while o.valid low")
+        self._exercise(m, ~o.valid & take_in, "ready: a pixel taken while the output is empty")
 
     def _ahead(self, m, width, stages, prefix=""):
         """``ahead[j]``: valid stages downstream of stage ``j``, as comb signals summed from
@@ -337,6 +347,7 @@ class StreamContract(Elaboratable):
     def _quiet(self, m, i, o, take_in, take_out, stages):
         occ = self._occupancy(m, take_in, take_out, stages)
         self._check(m, ~o.valid | (occ != 0), "quiet: o.valid with nothing in flight")
+        self._exercise(m, take_out, "quiet: a pixel leaves")
 
     def _order(self, m, i, o, take_in, take_out, stages):
         bits = len(i.payload.tag)
@@ -344,6 +355,7 @@ class StreamContract(Elaboratable):
         m.d.sync += [n_in.eq(n_in + take_in), n_out.eq(n_out + take_out)]
         m.d.comb += Assume(~i.valid | (i.payload.tag == n_in))
         self._check(m, ~o.valid | (o.payload.tag == n_out), "order: output tag out of sequence")
+        self._exercise(m, take_out & (n_out == 1), "order: two pixels enter and leave in order")
         if self.lemmas and stages:
             # Consecutive valid stages hold consecutive tags, the one nearest the output
             # holds n_out and the next input gets one past the youngest: a chain of muxes
@@ -372,6 +384,7 @@ class StreamContract(Elaboratable):
         self._check(m, o.valid == valid[-1], "latency: o.valid is not i.valid delayed by latency")
         self._check(m, ~o.valid | (o.payload.tag == tag[-1]),
                            "latency: o.tag is not i.tag delayed by latency")
+        self._exercise(m, take_out, "latency: a pixel enters and leaves")
         if self.buffer is not None and stages:
             self._lemma(m, self.buffer["count"] == 0, "the output buffer stays empty")
             stages = stages[:len(stages) - self._buffer_stages]

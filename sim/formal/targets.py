@@ -26,7 +26,8 @@ __all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "target"]
 SMALL = {"angle_bits": 6, "frac_bits": 6, "tag_bits": 4, "spec_index_bits": 4, "palette_size": 16}
 SMALL_SCENE = {**SMALL, "texture_size": 16}
 
-STREAM = ("hold", "ready", "order", "quiet", "latency", "cover")
+STREAM = ("hold", "ready", "order", "quiet", "latency", "cover", "hold_cover", "ready_cover",
+          "order_cover", "quiet_cover", "latency_cover")
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,9 @@ def test_sincos_contract_is_proved_by_induction(prop, build_dir):
         assert row.lemmas > 0          # the pipeline-register lemmas were found and asserted
 
 
-QUICK_MUTANTS = ("eager_stall", "uncarried_bank")
+# the dropping unit is here so that a weakened order assumption (no pixel ever enters: the
+# proofs pass vacuously) fails make test too: its order no longer fails
+QUICK_MUTANTS = ("eager_stall", "uncarried_bank", "drop")
 
 
 @pytest.mark.parametrize("prop", ["order", "bank"])
@@ -50,6 +52,38 @@ def test_broken_unit_fails_its_property(name, build_dir):
     assert Path(row.trace).is_file()
     assert row.detail.startswith(MUTANTS[name][1]), row.detail    # that property, no other
 
+
+
+# order's cover in make test (with the dropping unit: its assumption is the one that went
+# vacuous); latency's and hold's in make formal (pytest marker formal)
+@pytest.mark.parametrize("prop", ["order", pytest.param("latency", marks=pytest.mark.formal),
+                                  pytest.param("hold", marks=pytest.mark.formal)])
+def test_sincos_properties_are_exercised(prop, build_dir):
+    """Each property's own cover (its assumptions in force) is reached: two pixels enter
+    and leave in order, a pixel goes through the latency, a pixel is held through a stall.
+    A proof of a property whose assumption shuts every pixel out would pass; this fails."""
+    row = check(TARGETS["sincos"], f"{prop}_cover", build_dir)
+    assert row.result == "covered", row
+
+
+@pytest.mark.formal
+def test_a_vacuous_order_assumption_fails_its_cover(build_dir):
+    """The cover can fail: order with an assumption that lets no pixel in (the kind of
+    change that left the order proofs green) does not reach its cover."""
+    from amaranth.hdl import Assume
+
+    from bumprtl.sim.formal.sby import run_sby
+
+    class NoPixelEnters(StreamContract):
+        def _order(self, m, i, o, take_in, take_out, stages):
+            m.d.comb += Assume(~i.valid)
+            super()._order(m, i, o, take_in, take_out, stages)
+
+    dut = TARGETS["sincos"].unit()
+    top = NoPixelEnters(dut, "order", lemmas=False)
+    res = run_sby(top, build_dir, "vacuous_order", mode="cover", depth=dut.latency + 6)
+    assert res.status == "FAIL" and not res.passed, res.status
+    assert top.exercised == ["order: two pixels enter and leave in order"]
 
 def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir, capsys):
     from bumprtl.sim import jobs
