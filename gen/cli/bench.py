@@ -3,12 +3,9 @@
 Each kind lives in its own module with ``add_parser(subparsers)``; register it in BENCHES.
 """
 
-import functools
-from pathlib import Path
-
 from bumprtl.gen.bench import (accuracy, float64, golden, lee_widths, palette, rtl_sim, skip,
                                 specular, stress, sweep)
-from bumprtl.gen.flow.quiet import tool_log
+from bumprtl.gen.flow.quiet import quiet_commands
 
 # kind -> module of gen/bench/ providing add_parser(subparsers); each benchmark module adds
 # its own line here.
@@ -33,20 +30,4 @@ def add_parser(sub):
     kinds.required = True
     for module in BENCHES.values():
         module.add_parser(kinds)
-    for kind, parser in kinds.choices.items():       # quiet: the tools' output to a log
-        parser.add_argument("--verbose", action="store_true",
-                            help="let the simulators' and Yosys' output through (by default it "
-                                 f"goes to build/bench/{kind}.log, shown in full on a failure)")
-        parser.set_defaults(func=_quiet(parser.get_default("func"), kind))
-
-
-def _quiet(func, kind):
-    """``func`` with the child processes' output (Verilator's make and g++, cocotb, Yosys)
-    in build/bench/KIND.log; the bench's own table and progress bars reach the terminal."""
-    @functools.wraps(func)
-    def run(args):
-        if args.verbose:
-            return func(args)
-        with tool_log(Path("build/bench") / f"{kind}.log", f"bench {kind}", python=True):
-            return func(args)
-    return run
+    quiet_commands(kinds, "build/bench")      # the tools' output to build/bench/KIND.log

@@ -4,6 +4,7 @@ Each kind lives in its own module of gen/report/ with ``add_parser(subparsers)``
 it in REPORTS.
 """
 
+from bumprtl.gen.flow.quiet import quiet_commands
 from bumprtl.gen.report import fpga, integration, table1, timing
 
 # kind -> module of gen/report/ providing add_parser(subparsers), in `--help` order.
@@ -25,3 +26,4 @@ def add_parser(sub):
     kinds.required = True
     for module in REPORTS.values():
         module.add_parser(kinds)
+    quiet_commands(kinds, "build/report")     # Yosys', nextpnr's output to build/report/KIND.log

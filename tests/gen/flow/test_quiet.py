@@ -73,3 +73,26 @@ def test_python_mode_keeps_the_table_on_the_terminal(tmp_path):
     assert "progress" in r.stderr and "g++" not in r.stdout + r.stderr and "banner" not in r.stderr
     log = (tmp_path / "b.log").read_text()
     assert "g++ -O2 from a child" in log and "banner" in log and "header" not in log
+
+
+_CMD = """
+import argparse, subprocess, sys
+from bumprtl.gen.flow.quiet import quiet_commands
+p = argparse.ArgumentParser()
+kinds = p.add_subparsers(dest="kind")
+k = kinds.add_parser("work")
+k.set_defaults(func=lambda a: print("| table |") or subprocess.run(["sh", "-c", "echo yosys says"]).returncode)
+quiet_commands(kinds, sys.argv[1])
+args = p.parse_args(sys.argv[2:])
+sys.exit(args.func(args))
+"""
+
+
+@pytest.mark.parametrize("verbose", [False, True])
+def test_quiet_commands_wrap_every_subcommand(tmp_path, verbose):
+    r = subprocess.run([sys.executable, "-c", _CMD, str(tmp_path / "logs"), "work",
+                        *(["--verbose"] if verbose else [])], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "| table |" in r.stdout
+    assert ("yosys says" in r.stdout) == verbose
+    assert (tmp_path / "logs" / "work.log").exists() != verbose
