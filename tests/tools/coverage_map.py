@@ -100,7 +100,7 @@ def verilator_run(out):
     try:
         from bumprtl.sim.scenes.config import load_scene_config
     except ImportError:                     # before the scene configuration moved to sim/
-        from bumprtl.rtl.scene import load_scene_config
+        from bumprtl.sim.scenes.config import load_scene_config
     scene = load_scene_config("default")
     inputs, words, polygon, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
