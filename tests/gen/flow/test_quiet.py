@@ -96,3 +96,13 @@ def test_quiet_commands_wrap_every_subcommand(tmp_path, verbose):
     assert "| table |" in r.stdout
     assert ("yosys says" in r.stdout) == verbose
     assert (tmp_path / "logs" / "work.log").exists() != verbose
+
+
+def test_python_mode_leaves_a_tests_capture_alone(tmp_path, capsys):
+    """Under pytest's capsys (sys.stdout not on fd 1) the table still reaches the capture."""
+    with tool_log(tmp_path / "c.log", "bench y", python=True):
+        print("| captured |")
+        subprocess.run(["sh", "-c", "echo child"])
+    out = capsys.readouterr()
+    assert "| captured |" in out.out and "child" not in out.out
+    assert "child" in (tmp_path / "c.log").read_text()
