@@ -10,6 +10,7 @@ and the achieved Fmax of ``clk``.
 
 import hashlib
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -220,7 +221,9 @@ class Placement:
         (self.work / f"{self.label}.v").write_text(self.text)
         for name, text in result.get("files", {}).items():
             (self.work / name).write_text(text)
-        (self.work / "row.json").write_text(json.dumps(result["row"], indent=1))
+        tmp = self.work / f"row.json.{os.getpid()}"
+        tmp.write_text(json.dumps(result["row"], indent=1))
+        os.replace(tmp, self.work / "row.json")     # a reader never sees half a row
         return {**result["row"], "unit": self.label}
 
 
