@@ -169,9 +169,9 @@ def port_table(meta):
 
 def timing(meta):
     lat = " + ".join(f"{b['unit']} {b['latency']}" for b in meta["built"])
-    out = [f"* Latency: **{meta['latency']} cycles** from the edge that takes a pixel (in_valid "
-           f"and in_ready high) to the edge its result is first offered (out_valid high) with "
-           f"out_ready held high: {lat}.",
+    out = [f"* Latency: **{meta['latency']} cycles**: a pixel taken at rising edge t (in_valid "
+           f"and in_ready high) leaves at edge t + {meta['latency']} (out_valid is high in the "
+           f"cycle before it) when out_ready is held high; {lat}.",
            f"* Throughput: {meta['throughput']} pixel per clock while out_ready is high.",
            f"* Block RAM ({meta.get('block_ram', {}).get('device', DEFAULT_DEVICE)}): "
            f"{meta.get('block_ram', {}).get('dp16kd_needed', '?')} DP16KD of "
