@@ -67,7 +67,7 @@ def committed_tree(dest, rev="HEAD"):
 
 
 def lay_out(dest, src, files):
-    """The copy mutmut expects: bumprtl/<package>/..., tests/, setup.cfg."""
+    """The copy mutmut expects: bumprtl/<package>/..., tests/ (setup.cfg: :func:`configure`)."""
     if dest.exists():
         shutil.rmtree(dest)
     for name in files:
@@ -83,13 +83,31 @@ def lay_out(dest, src, files):
     (dest / "bumprtl" / "__init__.py").write_text("")
     # tests/mutants is this tooling, not tests to run
     shutil.rmtree(dest / "tests" / "mutants", ignore_errors=True)
+
+
+def selected_tests(dest):
+    """The tests of TESTS that the commit has (the scene tests moved with the scene module)."""
+    return [t for t in TESTS + ["tests/rtl/test_scene.py"] if (dest / t).exists()]
+
+
+def failing_tests(dest, env, log):
+    """The selected tests that fail on the unmutated commit (mutmut needs a green run):
+    their node ids, to deselect and to list."""
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rf", "-n", "2", "-p", "no:cacheprovider",
+                        "-m", "not regress and not fpga and not formal", *selected_tests(dest)],
+                       cwd=dest, env={**env, "PYTHONPATH": str(dest)}, capture_output=True, text=True)
+    with open(log, "a") as f:
+        f.write("\n$ baseline pytest\n" + r.stdout[-3000:] + r.stderr[-2000:])
+    return sorted({l.split()[1] for l in r.stdout.splitlines() if l.startswith("FAILED ")})
+
+
+def configure(dest, deselect):
     cfg = ["[mutmut]", "source_paths = bumprtl", "only_mutate ="]
     cfg += [f"    {p}" for p in MUTATE]
-    # the tests of TESTS that the commit has (the scene tests moved with the scene module)
-    tests = [t for t in TESTS + ["tests/rtl/test_scene.py"] if (dest / t).exists()]
-    cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in tests]
+    cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in selected_tests(dest)]
     cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
             "    -m", "    not regress and not fpga and not formal",
+            *[x for d in deselect for x in ("    --deselect", f"    {d}")],
             "use_git_change_detection = false", "timeout_multiplier = 5.0", ""]
     (dest / "setup.cfg").write_text("\n".join(cfg))
     # pyproject's [tool.pytest] stays (markers, test paths); mutmut reads setup.cfg only
@@ -138,10 +156,22 @@ def main(argv=None):
     a.out.mkdir(parents=True, exist_ok=True)
     log = a.out / "mutmut.log"
     log.write_text("")
-    files, commit = committed_tree(a.out / "head", a.commit)
-    lay_out(tree, a.out / "head", files)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     env["PYTHONDONTWRITEBYTECODE"] = "1"
+    head = subprocess.run(["git", "rev-parse", "--short", a.commit], cwd=ROOT, capture_output=True,
+                          text=True, check=True).stdout.strip()
+    stamp = tree / ".commit"
+    if stamp.exists() and stamp.read_text() == head and (tree / "mutants").is_dir():
+        commit = head                    # the same commit laid out before: mutmut reuses its mutants
+    else:
+        files, commit = committed_tree(a.out / "head", a.commit)
+        lay_out(tree, a.out / "head", files)
+        stamp.write_text(commit)
+    deselect = failing_tests(tree, env, log)
+    if deselect:
+        print(f"{len(deselect)} selected test(s) fail on commit {commit} itself and are left out: "
+              + ", ".join(deselect))
+    configure(tree, deselect)
     # 1. generate every mutant and record which tests reach each function; the name filter
     #    matches none, so no mutant runs yet (mutmut stops there with an error we expect)
     mutmut(["run", "--max-children", str(a.jobs), "bumprtl.no_such_module.x__mutmut_1"], tree, env, log)
@@ -209,6 +239,9 @@ def main(argv=None):
                          f"{100 * c['killed'] / n:.1f}% |")
         block.append(f"| all | {n_all} | {tot['killed']} | {tot['survived']} | {tot['no tests']} | "
                      f"{100 * tot['killed'] / max(1, n_all):.1f}% |")
+        if deselect:
+            block += ["", f"Left out: {len(deselect)} selected test(s) that fail on commit {commit} "
+                      f"itself (mutmut needs them green): " + ", ".join(f"`{d}`" for d in deselect) + "."]
         block += ["", "Survivors (mutant, what it changes):", ""]
         for name, kind, _ in survivors:
             d = diffs.get(name, "").replace("\n", " / ").replace("|", "\\|")
