@@ -71,7 +71,10 @@ def markdown(rows, command, n):
              "float64 models, results outside [0, 1] or infinite dot products and, for the "
              "bit-exact models, pixels with a value outside its RTL payload field "
              "(`rotated_layout`, `shade_layout`). Properties checked on every run of `make test`: "
-             "`tests/sim/golden/test_stability.py` (Hypothesis).", "", "## Cases", ""]
+             "`tests/sim/golden/test_stability.py` (Hypothesis).", "",
+             f"Made at: angle_bits={STRESS_CONFIGS['default'].angle_bits}, frac_bits="
+             f"{STRESS_CONFIGS['default'].frac_bits} (the default Config; the other "
+             "configurations below are fixed)", "", "## Cases", ""]
     lines += [f"- `{k}`: {v[1]}" for k, v in CASES.items()]
     lines += ["", "## Configurations", ""]
     lines += [f"- `{k}`: {_cfg_text(c)}" for k, c in STRESS_CONFIGS.items()]
