@@ -6,7 +6,7 @@ import sys
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import FRAC_BITS_MAX, Config, frac_bits_floor
 from bumprtl.rtl.sincos import SinCos
 
 
@@ -46,5 +46,6 @@ def test_cli_bad_input_is_one_line_and_exit_2(tmp_path):
     r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "sincos", "--frac-bits", "3",
                         "--out", str(tmp_path)], capture_output=True, text=True)
     assert r.returncode == 2
-    assert "frac_bits" in r.stderr and "[10, 24]" in r.stderr
+    lo = frac_bits_floor(Config().angle_bits)              # the default's floor, B >= k - 1
+    assert "frac_bits" in r.stderr and f"[{lo}, {FRAC_BITS_MAX}]" in r.stderr
     assert "Traceback" not in r.stderr
