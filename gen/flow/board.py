@@ -32,12 +32,11 @@ from amaranth.back import rtlil, verilog
 from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
 from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS
-from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, unit_memories
+from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, table_blocks, unit_memories
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.pipeline import BumpPipeline
 
@@ -63,13 +62,14 @@ def board_core(scene, mode, target=None, data=None):
 
 def bram_budget(scene, mode, device):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
-    tables (one block each at least, gen/flow/memories.check_fits), the light table, the
+    tables (as gen/flow/memories.check_fits counts them), the light table, the
     elastic buffer; and the device's."""
     p = BumpPipeline(scene)
     mems = unit_memories(p)
     need = {"map": sum(bram_blocks(v["depth"], v["width"]) for k, v in mems.items()
                        if k.split(".")[-1] in ("map", "texture")),
-            "pipeline tables": sum(1 for k in mems if k.split(".")[-1] not in ("map", "texture")),
+            "pipeline tables": sum(table_blocks(v["depth"], v["width"]) for k, v in mems.items()
+                                   if k.split(".")[-1] not in ("map", "texture")),
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(buffer_depth(p.latency), 24 + scene.tag_bits)}
     return need, DEVICE_BRAM[device]
@@ -288,7 +288,8 @@ def _run_verilator(v_path, build_dir, env):
                          build_args=[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
             stamp.write_text(digest)
         t1 = time.perf_counter()
-        results = runner.test(hdl_toplevel=top, test_module="bumprtl.sim.tb.tb_board",
+        results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="verilog",
+                              test_module="bumprtl.sim.tb.tb_board",
                               build_dir=build_dir, test_dir=build_dir, timescale=("1ns", "1ps"),
                               extra_env={k: str(v) for k, v in env.items()})
         t2 = time.perf_counter()

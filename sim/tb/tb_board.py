@@ -100,12 +100,18 @@ async def board_frames(dut):
     cocotb.start_soon(Clock(dut.shift_clk, period / 5, unit="ns").start())
     dut.rst.value = 1
     dut.shift_rst.value = 1
-    sink = DVISink(dut, DVIBus.from_prefix(dut, "tmds"))
-    sink.verification = False                 # the pixels are compared by the caller
-    sink.rgb_out.img.width, sink.rgb_out.img.height = ha, va
     await ClockCycles(dut.clk, 4)
     dut.rst.value = 0
     dut.shift_rst.value = 0
+    # The sink's frame parser must first see a horizontal sync pulse's end while the
+    # vertical sync is inactive (it keeps the pulse it measures in a local variable made at
+    # that edge, and fails on a pulse's start before it). The raster starts at x = 0 of the
+    # first front-porch line, so the sink starts in the middle of that line's hsync pulse
+    # (the wire lags the raster by the encoder's 2 stages and the serializer's few cycles).
+    await ClockCycles(dut.clk, timing[0] + timing[1] + timing[2] // 2)
+    sink = DVISink(dut, DVIBus.from_prefix(dut, "tmds"), height=va, width=ha)
+    sink.verification = False                 # the pixels are compared by the caller
+    sink.rgb_out.img.width, sink.rgb_out.img.height = ha, va
     rec = {"de": [], "hs": [], "vs": []}
 
     async def monitor():
