@@ -147,7 +147,9 @@ def emit_target(target, out, n, seed):
 # --- Yosys: the sample of mutations and the one netlist holding them all ---------------------
 
 def mutation_list(v, unit, n, seed, work):
-    yosys([f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}",
+    # the prepared netlist is kept (prepped.il): the mutated build and the equivalence checks
+    # start from it instead of preparing the Verilog again (minutes for the larger units)
+    yosys([f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}", "write_rtlil prepped.il",
            f"mutate -list {n} -seed {seed} -o mutations.ys"], work)
     lines = [l for l in (work / "mutations.ys").read_text().splitlines() if l.startswith("mutate ")]
     if not lines:
@@ -160,7 +162,7 @@ def mutated_netlist(v, meta, lines, work):
     selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``."""
     unit = meta["unit"]
     width = max(1, len(lines).bit_length())
-    script = [f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}"]
+    script = ["read_rtlil prepped.il"]
     script += [f"mutate -ctrl mutsel {width} {i} " + l[len("mutate "):]
                for i, l in enumerate(lines, 1)]
     script += ["opt_clean", f"rename {unit} {unit}__mutated",
@@ -220,7 +222,7 @@ def run_one(v, j, job, work, idx):
 def equivalence(v, unit, line, work, timeout):
     """``"equivalent"``, ``"not equivalent"`` or ``"undecided: why"`` of one mutation."""
     args = line[len("mutate "):].replace(f"-module {unit} ", "-module gate ")
-    script = [f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}", "memory_map",
+    script = ["read_rtlil prepped.il", "memory_map",
               "opt -fast", f"rename {unit} gold", "copy gold gate", f"mutate {args}",
               "miter -equiv -flatten -make_assert -ignore_gold_x gold gate miter",
               "hierarchy -top miter", "opt -fast",
