@@ -115,7 +115,12 @@ def images(cfg, out_dir, size):
 
 def run(args):
     cfg = Config()
-    print(f"bumprtl bench palette --what {' '.join(args.what)}")
+    command = f"bumprtl bench palette --what {' '.join(args.what)}"
+    if "accuracy" in args.what or "images" in args.what:
+        command += f" --size {args.size}"
+    if "accuracy" in args.what:
+        command += f" --scenes {' '.join(args.scenes)}"
+    print(command)                     # the command that reproduces the tables below
     if "speed" in args.what:
         print("\nPer-frame cost, numpy, best of 3 (Phong, one light):\n")
         speed(cfg, args.sizes, args.palettes)
