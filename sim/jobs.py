@@ -121,7 +121,9 @@ def _worker_address():
 
 def _call(fn, args, timeout):
     """``fn(*args)`` with a timeout: on expiry the tool processes this worker started
-    (its children) are killed and :class:`_Timeout` is raised."""
+    (its children) are killed and :class:`_Timeout` is raised. (A worker runs one job at a
+    time, so its children are this job's; in the tests' in-process cluster they are every
+    job's of the test process.)"""
     if not timeout:
         return fn(*args)
     box = {}
@@ -182,10 +184,10 @@ class Runner:
     LocalCluster of ``workers`` single-threaded worker processes, started here and closed
     on exit."""
 
-    def __init__(self, scheduler=None, workers=1, log_dir=LOG_DIR, progress=None):
+    def __init__(self, scheduler=None, workers=1, log_dir=None, progress=None):
         self.address = scheduler
         self.workers = max(1, int(workers or 1))
-        self.log_dir = Path(log_dir)
+        self.log_dir = Path(log_dir or LOG_DIR)
         self.progress = (os.environ.get("BUMPRTL_PROGRESS", "1") != "0") if progress is None else progress
         self.cluster = self.client = None
 

@@ -20,6 +20,7 @@ import pytest
 from distributed import Client
 
 from bumprtl.gen.cli.main import main
+from bumprtl.sim import jobs
 from bumprtl.sim.formal.run import check
 from bumprtl.sim.formal.targets import TARGETS
 
@@ -98,14 +99,15 @@ def _comparable(row):
     return {k: v for k, v in asdict(row).items() if k not in ("seconds", "trace")}
 
 
-def test_a_formal_check_through_the_scheduler_equals_the_local_check(cluster, tmp_path):
+def test_a_formal_check_through_the_scheduler_equals_the_local_check(cluster, tmp_path, monkeypatch):
     from bumprtl.sim.formal import run as formal_run
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
     remote = formal_run.run(["sincos"], ["order"], mutants=False, root=tmp_path / "remote",
                             scheduler=cluster.address, log=lambda line: None)
     local = check(TARGETS["sincos"], "order", tmp_path / "local")
     assert [_comparable(r) for r in remote] == [_comparable(local)]
     assert remote[0].result == "proved"
-    log = (Path("build/jobs") / "formal-sincos-order.log").read_text()
+    log = (tmp_path / "job_logs" / "formal-sincos-order.log").read_text()
     assert "worker tcp://127.0.0.1:" in log and "result ok" in log
 
 
@@ -113,7 +115,8 @@ SMALL = ["--unit", "scene_palette", "--samples", "1000"]
 
 
 @pytest.mark.fpga
-def test_a_placement_through_the_scheduler_equals_the_local_one(cluster, tmp_path):
+def test_a_placement_through_the_scheduler_equals_the_local_one(cluster, tmp_path, monkeypatch):
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
     outs = {}
     for where, extra in (("local", ["--jobs", "1"]), ("remote", ["--scheduler", cluster.address])):
         out = tmp_path / where / "report.md"
@@ -130,7 +133,7 @@ def test_a_worker_killed_mid_placement_leaves_the_job_to_the_other(cluster, tmp_
     argv = [str(BIN / "bumprtl"), "report", "fpga", *SMALL, "--out", str(out), "--work",
             str(tmp_path / "cache"), "--scheduler", cluster.address]
     client = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                              env={**os.environ, "BUMPRTL_PROGRESS": "0"})
+                              env={**os.environ, "BUMPRTL_PROGRESS": "0"}, cwd=tmp_path)
     killed = None
     try:
         with Client(cluster.address, timeout=30) as c:
@@ -151,6 +154,6 @@ def test_a_worker_killed_mid_placement_leaves_the_job_to_the_other(cluster, tmp_
     row = [ln for ln in out.read_text().splitlines() if ln.startswith("| scene_palette |")][0]
     assert "not placed" not in row, row
     survivor = {"w0": "w1", "w1": "w0"}[killed]
-    log = (Path("build/jobs") / "place-LFE5U-85F-scene_palette-seed1.log").read_text()
+    log = (tmp_path / "build" / "jobs" / "place-LFE5U-85F-scene_palette-seed1.log").read_text()
     worker = log.splitlines()[1].split()[1]
     assert cluster.worker_names()[worker] == survivor

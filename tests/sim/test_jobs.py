@@ -25,6 +25,7 @@ def _fails():
 @pytest.fixture
 def threads(monkeypatch, tmp_path):
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")     # not build/jobs: tests run side by side
     return tmp_path
 
 

@@ -121,12 +121,16 @@ def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
     from bumprtl.sim import jobs
 
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
     monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route([]))
     monkeypatch.setattr(report, "accuracy", lambda d, cfg, n: {"max": 1, "mean": 0.1})
+    # small stand-ins, a different one per row (the same hardware would be one job)
+    from bumprtl.gen.flow.units import build_unit
+    monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
+        "sincos", Config(angle_bits=6, frac_bits=5 if row == "setup" else 6), ECP5())[0])
     out = tmp_path / "report.md"
     assert main(["report", "fpga", "--seeds", "3,2", "--unit", "exact_setup", "--unit",
-                 "exact_pipeline", "--out", str(out), "--work", str(tmp_path), "--jobs", "2",
-                 "--angle-bits", "8", "--frac-bits", "9"]) == 0
+                 "exact_pipeline", "--out", str(out), "--work", str(tmp_path), "--jobs", "2"]) == 0
     text = out.read_text()
     assert "| exact_pipeline | 1 | 2 | 0 | 0 | 102.0 |" in text          # min over seeds 2, 3
     assert "| exact_setup | not placed: nextpnr-ecp5 failed (status 1): ERROR: no room |" in text
@@ -184,6 +188,7 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
 
     calls = []
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
     monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
     monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
         "sincos", Config(angle_bits=6, frac_bits=5), ECP5())[0])
