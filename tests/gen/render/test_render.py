@@ -98,6 +98,11 @@ def test_palette_holding_every_normal_renders_with_a_one_line_note(tmp_path, cap
                 for c in (0, 36))
     assert np.abs(ref.astype(int) - img.astype(int)).max() <= 1
     assert render(n - 1)[0] == []
+    notes, out = render(16384, "--model", "fixed", "--compare")     # the hardware's table too
+    assert len(notes) == 1 and f"the map's {n} distinct normals" in notes[0]
+    ref, img = (np.asarray(Image.open(out.with_name(out.stem + "_compare.png")))[:, c:c + 32]
+                for c in (0, 36))
+    assert np.abs(ref.astype(int) - img.astype(int)).max() <= 1
 
 
 def test_palette_missing_is_a_clear_error(tmp_path, monkeypatch, capsys):
