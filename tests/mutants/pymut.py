@@ -185,7 +185,14 @@ def main(argv=None):
     if not results or not (tree / "mutants" / "mutmut-stats.json").exists():
         print(f"error: mutmut generated no mutants or no test statistics; see {log}", file=sys.stderr)
         return 1
-    names = sorted(results)
+    # only the mutants of the files mutated in this run (the tree may hold other files'
+    # mutants from a wider run of the same commit)
+    import fnmatch
+    globs = a.only or MUTATE
+    names = sorted(n for n in results
+                   if any(fnmatch.fnmatch(n.split(".x")[0].replace(".", "/") + ".py", g)
+                          or fnmatch.fnmatch(n.split(".x")[0].replace(".", "/") + "/__init__.py", g)
+                          for g in globs))
     rng = random.Random(a.seed)
     sample = sorted(rng.sample(names, min(a.sample, len(names))))
     print(f"python mutation (mutmut 3.8.1) at commit {commit}: {len(names)} mutants generated, "
