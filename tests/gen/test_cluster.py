@@ -157,3 +157,24 @@ def test_a_worker_killed_mid_placement_leaves_the_job_to_the_other(cluster, tmp_
     log = (tmp_path / "build" / "jobs" / "place-LFE5U-85F-scene_palette-seed1.log").read_text()
     worker = log.splitlines()[1].split()[1]
     assert cluster.worker_names()[worker] == survivor
+
+
+@pytest.mark.fpga
+def test_bulk_shards_through_the_scheduler_equal_the_local_shards(cluster, tmp_path, monkeypatch):
+    """A bulk regression in 2 shards (sim/tb/bulk_shards.py; sincos on Verilator, 2 x 1500
+    vectors under two traffic patterns) on the cluster's workers, built in their own
+    directory: the same pixels, every shard checked bit for bit, as the shards run here."""
+    from bumprtl.gen.flow.units import emit_unit
+    from bumprtl.rtl.config import Config
+    from bumprtl.sim.tb.bulk_shards import run_bulk_shards
+
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
+    v, j = emit_unit("sincos", Config(), tmp_path / "rtl")
+    source, patterns = {"kind": "sincos", "n": 3000, "seed": 1}, ("no_stall", "both")
+    remote = run_bulk_shards("verilator", v, j, patterns, source, 2, scheduler=cluster.address)
+    local = run_bulk_shards("verilator", v, j, patterns, source, 2)
+    assert remote["checked"] and local["checked"]
+    assert remote["pixels"] == local["pixels"] == {"no_stall": 3000, "both": 3000}
+    assert ([s["source"] for s in remote["shards"]] == [s["source"] for s in local["shards"]]
+            == [{**source, "n": 1500}, {**source, "n": 1500, "seed": 1001}])
+    assert [s["cycles"] for s in remote["shards"]] == [s["cycles"] for s in local["shards"]]

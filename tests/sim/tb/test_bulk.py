@@ -11,6 +11,7 @@ pipeline's stress cases).
 """
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -25,6 +26,7 @@ from bumprtl.sim.tb import bulk
 from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
                                  decode_words, encode_words, run_bulk)
 from bumprtl.sim.tb.bulk_sources import pipeline_map
+from bumprtl.sim.tb.bulk_shards import run_bulk_shards
 from bumprtl.rtl.methods import PER_PIXEL
 
 # Icarus is ~1000x slower than Verilator on the pipeline: a smaller frame, the same patterns.
@@ -159,7 +161,18 @@ REGRESS_VECTORS = 10_000_000
 PER_PATTERN = REGRESS_VECTORS // len(TRAFFIC)          # x 4 patterns = 10^7 through the unit
 
 
+# BUMPRTL_BULK_SHARDS=N splits each run into N jobs of sim/jobs.py (sim/tb/bulk_shards.py),
+# on a local cluster or on $BUMPRTL_SCHEDULER's workers (docs/scale.md); 1 (the default):
+# one run here, as before.
+SHARDS = int(os.environ.get("BUMPRTL_BULK_SHARDS", "1"))
+
+
 def _regress(unit_v, unit_j, source, build_dir):
+    if SHARDS > 1 or os.environ.get("BUMPRTL_SCHEDULER"):
+        r = run_bulk_shards("verilator", unit_v, unit_j, tuple(TRAFFIC), source, SHARDS)
+        assert r["checked"]
+        assert sum(r["pixels"].values()) >= REGRESS_VECTORS
+        return r
     r = run_bulk("verilator", unit_v, unit_j, build_dir / "bulk", patterns=tuple(TRAFFIC),
                  source=source, keep=False)
     assert r.checked
