@@ -8,7 +8,7 @@ from bumprtl.rtl.config import Config, ConfigError
 @pytest.mark.parametrize("field, value, words", [
     ("angle_bits", 3, ["angle_bits", "[4, 16]"]),
     ("angle_bits", 17, ["angle_bits", "[4, 16]"]),
-    ("frac_bits", 9, ["frac_bits", "[10, 24]"]),      # default k = 11 needs B >= 10
+    ("frac_bits", 10, ["frac_bits", "[11, 24]"]),     # default k = 12 needs B >= 11
     ("frac_bits", 33, ["frac_bits", "24"]),
     ("tag_bits", 40, ["tag_bits", "[0, 32]"]),
     ("spec_exponent", 0, ["spec_exponent", "[1, 1024]"]),
@@ -27,8 +27,8 @@ def test_bad_field_is_named_with_its_range(field, value, words):
 def test_derived_widths():
     cfg = Config(angle_bits=12, frac_bits=13)
     assert (cfg.k, cfg.sincos_depth, cfg.sincos_width, cfg.one) == (10, 1025, 15, 8192)
-    cfg = Config()                                # the default: 13-bit angles, B = 16
-    assert (cfg.k, cfg.sincos_depth, cfg.sincos_width, cfg.one) == (11, 2049, 18, 65536)
+    cfg = Config()                                # the default: 14-bit angles, B = 15
+    assert (cfg.k, cfg.sincos_depth, cfg.sincos_width, cfg.one) == (12, 4097, 17, 32768)
 
 
 def test_replace_validates_and_rejects_unknown_fields():
@@ -43,7 +43,7 @@ def test_replace_validates_and_rejects_unknown_fields():
 # not the wording), and accepted at both ends. frac_bits's lower end follows k = angle_bits - 2.
 RANGES = [
     ("angle_bits", 4, 16, {}),
-    ("frac_bits", 10, 24, {}),                                  # default k = 11: B >= k - 1
+    ("frac_bits", 11, 24, {}),                                  # default k = 12: B >= k - 1
     ("frac_bits", 9, 24, {"angle_bits": 12}),                   # k = 10: B >= 9
     ("frac_bits", 4, 24, {"angle_bits": 4}),                    # k = 2: B >= 4
     ("frac_bits", 13, 24, {"angle_bits": 16}),                  # k = 14: B >= 13

@@ -179,7 +179,7 @@ def test_ecp5_product_uses_the_dsp_registers():
 def test_ecp5_forms_only_where_the_block_fits():
     """Operands wider than 18 bits (signed) are split into one block per pair of limbs, except
     by a constant; tables of up to 1025 words wider than 18 bits and deeper tables that need
-    more than ROM_MAX_BLOCKS blocks keep the generic form (Yosys then splits them)."""
+    more than ROM_MAX_BLOCKS (9) blocks keep the generic form (Yosys then splits them)."""
     assert len(_instances(RegisteredProduct(signed(19), signed(4), "p", target=ECP5()))) == 2
     assert len(_instances(RegisteredProduct(unsigned(18), signed(4), "p", target=ECP5()))) == 2
     assert len(_instances(RegisteredProduct(unsigned(17), signed(18), "p", target=ECP5()))) == 1
@@ -190,9 +190,14 @@ def test_ecp5_forms_only_where_the_block_fits():
     assert len(_instances(RegisteredROM(range(1025), unsigned(12), 2, "r", target=ECP5()))) == 1
     # deeper: the widest mode that holds the words, blocks side by side (2049 = 2048 + spill)
     assert len(_instances(RegisteredROM(range(2049), unsigned(17), 2, "r", target=ECP5()))) == 2
-    assert not _instances(RegisteredROM(range(1, 2050), unsigned(17), 2, "r", target=ECP5()))  # 5 x4
+    # 2049 words, word 0 != 0: no spill, x4 mode, 5 blocks; 8193 words (15-bit angles): nine
+    # x2 blocks, ROM_MAX_BLOCKS; ten would be too many
+    assert len(_instances(RegisteredROM(range(1, 2050), unsigned(17), 2, "r", target=ECP5()))) == 5
+    assert len(_instances(RegisteredROM(range(8193), unsigned(17), 2, "r", target=ECP5()))) == 9
+    assert not _instances(RegisteredROM(range(8193), unsigned(19), 2, "r", target=ECP5()))
     assert len(_instances(RegisteredROM(range(2048), unsigned(36), 2, "r", target=ECP5()))) == 4
-    assert not _instances(RegisteredROM(range(2048), unsigned(37), 2, "r", target=ECP5()))
+    assert len(_instances(RegisteredROM(range(2048), unsigned(81), 2, "r", target=ECP5()))) == 9
+    assert not _instances(RegisteredROM(range(2048), unsigned(82), 2, "r", target=ECP5()))
 
 
 
