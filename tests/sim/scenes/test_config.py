@@ -113,7 +113,8 @@ def test_every_scene_range_is_checked_on_both_sides(key, lo, hi, outside, base):
 
 @pytest.mark.parametrize("key, value", [("bump_map", "bumpy"), ("shading", "flat"),
                                         ("addressing", "mirror"), ("specular", "yes"),
-                                        ("texture", 1), ("rotation", "sideways")])
+                                        ("texture", 1), ("rotation", "sideways"),
+                                        ("geometry", "cube"), ("normal_convention", "left")])
 def test_bad_choice_names_the_key(key, value):
     with pytest.raises(BumpError) as e:
         load_scene_config({"name": "t", key: value})
@@ -162,3 +163,10 @@ def test_height_scale_is_an_open_range():
         with pytest.raises(BumpError) as e:
             SceneConfig(name="t", height_scale=h)
         assert e.value.field == "height_scale" and "\n" not in str(e.value), (h, str(e.value))
+
+
+def test_a_user_map_replaces_the_image():
+    """A height or normal map given: the scene's image is None (the map is the picture)."""
+    for key in ("height_map", "normal_map"):
+        scene = SceneConfig(name="t", **{key: "some/map.png"})
+        assert scene.image is None and getattr(scene, key) == "some/map.png"

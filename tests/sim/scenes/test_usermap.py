@@ -237,3 +237,27 @@ def test_npy_normal_below_the_surface_exits_2_in_one_line(tmp_path, capsys):
                "--out", str(tmp_path / "rtl")])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "under.npy" in err[0] and "into the surface" in err[0], err
+
+
+def test_map_size_of_a_2d_npy_height_map_and_a_3d_normal_map(tmp_path):
+    np.save(tmp_path / "h.npy", hex_tiles(32))
+    np.save(tmp_path / "n.npy", displacement_to_normals(hex_tiles(64), 4.0))
+    assert map_size(tmp_path / "h.npy") == 32 and map_size(tmp_path / "n.npy", kind="normal") == 64
+
+
+def test_a_nan_in_a_npy_normal_map_names_the_file(tmp_path):
+    n = displacement_to_normals(hex_tiles(32), 4.0)
+    n[4, 6, 1] = np.nan
+    np.save(tmp_path / "nan_normals.npy", n)
+    with pytest.raises(BumpError) as e:
+        load_bump_map(tmp_path / "nan_normals.npy", "normal")
+    msg = str(e.value)
+    assert "\n" not in msg and "nan_normals.npy" in msg and "NaN" in msg, msg
+
+
+def test_write_png_16_bit_round_trip(tmp_path):
+    """The test helper writes 16-bit samples as 16 bits (the 16-bit refusals rest on it)."""
+    grey = np.arange(32 * 32, dtype=np.int64).reshape(32, 32) * 61
+    write_png(tmp_path / "g16.png", grey, bit_depth=16)
+    img = Image.open(tmp_path / "g16.png")
+    assert img.mode.startswith("I") and np.array_equal(np.asarray(img, dtype=np.int64), grey)
