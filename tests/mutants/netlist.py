@@ -222,8 +222,10 @@ def run_one(v, j, job, work, idx):
 def equivalence(v, unit, line, work, timeout):
     """``"equivalent"``, ``"not equivalent"`` or ``"undecided: why"`` of one mutation."""
     args = line[len("mutate "):].replace(f"-module {unit} ", "-module gate ")
-    script = ["read_rtlil prepped.il", "memory_map",
-              "opt -fast", f"rename {unit} gold", "copy gold gate", f"mutate {args}",
+    # the mutation first: its cell names are those of the prepared netlist, which memory_map
+    # and opt would rename or remove
+    script = ["read_rtlil prepped.il", f"rename {unit} gold", "copy gold gate", f"mutate {args}",
+              "memory_map", "opt -fast",
               "miter -equiv -flatten -make_assert -ignore_gold_x gold gate miter",
               "hierarchy -top miter", "opt -fast",
               f"sat -verify -prove-asserts -set-init-zero -tempinduct -seq 1 -maxsteps 24 "
