@@ -34,6 +34,7 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
+from bumprtl.sim.scenes import SCENES
 from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS
 from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, table_blocks, unit_memories
@@ -85,6 +86,10 @@ def check_board(board, mode_name, scene):
         raise BumpError(f"scene {scene.name!r}: the board renders a varying bump map shaded per "
                         f"pixel (shading = 'per-pixel', bump_map = 'varying'), got shading = "
                         f"{scene.shading!r}, bump_map = {scene.bump_map!r}", "scene")
+    geometry = scene.geometry or (SCENES[scene.image][1] if scene.image else "plane")
+    if geometry != "plane":
+        raise BumpError(f"scene {scene.name!r}: the board renders a plane facing the viewer, "
+                        f"got geometry {geometry!r}", "geometry")
     platform, device = BOARDS[board]
     need, have = bram_budget(scene, mode, device)
     total = sum(need.values())
