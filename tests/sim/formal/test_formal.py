@@ -85,6 +85,8 @@ def test_a_vacuous_order_assumption_fails_its_cover(build_dir):
     assert res.status == "FAIL" and not res.passed, res.status
     assert top.exercised == ["order: two pixels enter and leave in order"]
 
+# make formal (marker formal): its sby run paid for make test's order cover and dropping unit
+@pytest.mark.formal
 def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir, capsys):
     from bumprtl.sim import jobs
     broken = Target("broken", lambda bits: Glitcher(Config(**SMALL)), ("hold",))
