@@ -3,7 +3,7 @@ tables, the sync/blanking checker, the reduced-mode frames through the whole top
 by cocotbext-dvi's DVISink and compared with the golden frames, and bad input.
 
 The frame check here runs the reduced mode (32 x 24, short blanking) on a scene with
-10-bit angles and a 16 x 16 map (the default's 13-bit angles make 12 sine ROMs of 4097
+10-bit angles and a 16 x 16 map (the default's 14-bit angles make 12 sine ROMs of 4097
 words whose Verilator build takes minutes); ``make board`` checks whole 640 x 480 frames of
 the default scene.
 """
