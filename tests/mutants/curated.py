@@ -379,6 +379,12 @@ def copy_tree(dest, root=ROOT):
         target = dest / name
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(Path(root) / name, target)
+    return _import_shim(dest, root)
+
+
+def _import_shim(dest, root):
+    """``import bumprtl`` resolving in the tree at ``dest`` (packages mapped as ``root``'s
+    pyproject.toml maps them); returns the environment that runs it."""
     with open(Path(root) / "pyproject.toml", "rb") as f:
         mapping = tomllib.load(f)["tool"]["setuptools"]["package-dir"]
     shim = dest / ".mutate-path" / "bumprtl"
@@ -408,16 +414,7 @@ def unpack_tree(archive, dest):
     dest.mkdir(parents=True, exist_ok=True)
     with tarfile.open(fileobj=io.BytesIO(archive), mode="r:gz") as tar:
         tar.extractall(dest, filter="data")
-    with open(dest / "pyproject.toml", "rb") as f:
-        mapping = tomllib.load(f)["tool"]["setuptools"]["package-dir"]
-    shim = dest / ".mutate-path" / "bumprtl"
-    shim.mkdir(parents=True)
-    for pkg, folder in mapping.items():
-        (shim / pkg.split(".", 1)[1]).symlink_to(dest / folder, target_is_directory=True)
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(dest / ".mutate-path")] +
-                                        ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
-    return env
+    return _import_shim(dest, dest)
 
 
 def mutant_job(archive, mutant, timeout, guards=()):
