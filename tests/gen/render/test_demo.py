@@ -6,6 +6,7 @@ import sys
 import numpy as np
 from PIL import Image
 
+from bumprtl.gen.flow.memories import bram_blocks
 from bumprtl.gen.render.demo import DEMO_SCENES, demo_map_size, demo_methods, rtl_mismatch
 from bumprtl.gen.render.images import FIXED_METHODS, float_image
 from bumprtl.rtl.config import Config
@@ -100,7 +101,10 @@ def _check_rtl_section(out, report):
 
 def test_demo_map_is_the_largest_that_fits_the_device():
     assert demo_map_size(512) == 256 and demo_map_size(64) == 64
-    assert demo_map_size(512, device="LFE5U-25F") == 128
+    # the LFE5U-25F's 56 DP16KD: the default's tables take 49 (twelve 4097-word sine ROMs in
+    # four x4 blocks each, the cos^n table in one), a 64^2 map of 28-bit texels 7, a 128^2 28
+    assert demo_map_size(512, device="LFE5U-25F") == 64
+    assert bram_blocks(64 * 64, 28) == 7 and bram_blocks(128 * 128, 28) == 28
 
 
 def test_rtl_mismatch_names_the_difference():
