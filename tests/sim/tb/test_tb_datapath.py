@@ -24,10 +24,12 @@ def _cases():
     for method in METHODS:
         for unit in ("rotation", "illumination"):
             for sim in SIMULATORS:
-                # regress: lee on Verilator; exact rotation on Verilator (its Icarus run stays,
+                # regress: lee on Verilator and lee's rotation on Icarus too (make test keeps
+                # its illumination there; tests/rtl/test_lee.py runs the rotation bit-exact in
+                # the Amaranth simulator); exact rotation on Verilator (its Icarus run stays,
                 # and the scene pipelines run it on Verilator in make test)
-                slow = (sim, method) == ("verilator", "lee") or (sim, method, unit) == (
-                    "verilator", "exact", "rotation")
+                slow = (sim, method) == ("verilator", "lee") or (sim, method, unit) in (
+                    ("verilator", "exact", "rotation"), ("icarus", "lee", "rotation"))
                 marks = pytest.mark.regress if slow else ()
                 yield pytest.param(sim, unit, method, marks=marks, id=f"{method}-{unit}-{sim}")
 
