@@ -242,8 +242,7 @@ def light_sums(cfg: Config, px: PixelInputs, lights=(1, 2)):
     other = replace(other, n_phi=px.n_phi, n_theta=px.n_theta, b_phi=px.b_phi, b_theta=px.b_theta)
     adv = adversarial_pixels(cfg, channel="color")
     worst = [worst_case_pixels(datapath_fixed, cfg, c) for c in ("specular", "color")]
-    worst = PixelInputs(**{f.name: np.concatenate([getattr(w, f.name) for w in worst])
-                           for f in fields(px)})
+    worst = PixelInputs.concat(worst)
     rng = np.random.default_rng(3)
     out = {}
     for m in lights:

@@ -154,14 +154,9 @@ def highlight_pixels(n, rng, cfg: Config):
     sqrt(exponent)] rad, where cos^n still has a slope), the region random H seldom reaches."""
     px = PixelInputs.random(n, rng)
     nw = _world_bump_normal(px)
-    helper = np.where(np.abs(nw[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
-    e1 = np.cross(nw, helper)
-    e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
-    e2 = np.cross(nw, e1)
-    turn = rng.uniform(0, 2 * np.pi, n)[:, None]
-    angle = rng.uniform(0, min(np.pi / 2, 4 / np.sqrt(cfg.spec_exponent)), n)[:, None]
-    h = np.cos(angle) * nw + np.sin(angle) * (np.cos(turn) * e1 + np.sin(turn) * e2)
-    h_phi, h_theta = cartesian_to_polar(h)
+    turn = rng.uniform(0, 2 * np.pi, n)
+    angle = rng.uniform(0, min(np.pi / 2, 4 / np.sqrt(cfg.spec_exponent)), n)
+    h_phi, h_theta = _tilted(nw, np.cos(angle), np.sin(angle), turn)
     return _with(px, h_phi=h_phi, h_theta=h_theta)
 
 
@@ -187,8 +182,7 @@ def adversarial_pixels(cfg: Config, candidates=200_000, keep=1_000, seed=7, chan
     px = PixelInputs.random(candidates, rng)
     if channel != "diffuse":
         near = highlight_pixels(candidates // 2, rng, cfg)
-        px = PixelInputs(**{f.name: np.concatenate([getattr(px, f.name)[candidates // 2:],
-                                                    getattr(near, f.name)]) for f in fields(px)})
+        px = PixelInputs.concat([px.subset(slice(candidates // 2, None)), near])
     px = px.subset(_target(channel, conventional(px, cfg))[1])
     step = 2 * np.pi / cfg.full_circle
     h = 1e-6
@@ -211,21 +205,25 @@ def adversarial_pixels(cfg: Config, candidates=200_000, keep=1_000, seed=7, chan
             # rounding back to `grid` moves the angle by -0.4999 step * sign(grad): worst side
             changes[name] = _clip_angles(name, (grid + 0.4999 * np.sign(grads[name])) * step)
         out.append(_with(px, **changes))
-    return PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in out])
-                          for f in fields(px)})
+    return PixelInputs.concat(out)
 
 
-def _around(nw, cos_lo, cos_hi, rng):
-    """Unit vectors at a random angle from ``nw`` (unit, world coordinates) whose cosine is
-    uniform in [cos_lo, cos_hi], in a random direction around it: (phi, theta)."""
-    n = len(nw)
+def _tilted(nw, cos_a, sin_a, turn):
+    """(phi, theta) of the unit vectors at the angle of cosine ``cos_a`` and sine ``sin_a``
+    from ``nw`` (unit, world coordinates), turned by ``turn`` radians around it."""
     helper = np.where(np.abs(nw[..., 2:3]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
     e1 = np.cross(nw, helper)
     e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
     e2 = np.cross(nw, e1)
-    c = rng.uniform(cos_lo, cos_hi, n)[:, None]
-    turn = rng.uniform(0, 2 * np.pi, n)[:, None]
-    return cartesian_to_polar(c * nw + np.sqrt(1 - c * c) * (np.cos(turn) * e1 + np.sin(turn) * e2))
+    c, s, turn = (np.asarray(x)[:, None] for x in (cos_a, sin_a, turn))
+    return cartesian_to_polar(c * nw + s * (np.cos(turn) * e1 + np.sin(turn) * e2))
+
+
+def _around(nw, cos_lo, cos_hi, rng):
+    """Unit vectors at a random angle from ``nw`` whose cosine is uniform in [cos_lo,
+    cos_hi], in a random direction around it: (phi, theta)."""
+    c = rng.uniform(cos_lo, cos_hi, len(nw))
+    return _tilted(nw, c, np.sqrt(1 - c * c), rng.uniform(0, 2 * np.pi, len(nw)))
 
 
 # Where each channel's slope is largest: the cosine of the angle between N' and L (diffuse:
@@ -291,7 +289,7 @@ def worst_case_pixels(model, cfg: Config, channel="specular", candidates=100_000
     grid = {name: np.rint(getattr(px, name) / step) for name in angles}
     both = [_with(px, **{name: _clip_angles(name, (grid[name] + 0.4999 * pol * side[name]) * step)
                          for name in angles}) for pol in (1, -1)]
-    both = _concat(both)
+    both = PixelInputs.concat(both)
     error = np.abs(unrounded_lsb(model(encode_pixels(both, cfg), cfg), cfg, channel) - value(both))
     top = both.subset(np.argsort(error)[-keep:])
     out = [top]
@@ -300,12 +298,7 @@ def worst_case_pixels(model, cfg: Config, channel="specular", candidates=100_000
             move = {angles[i]: di * step}
             move[angles[j]] = move.get(angles[j], 0.0) + dj * step
             out.append(_with(top, **{k: _clip_angles(k, getattr(top, k) + d) for k, d in move.items()}))
-    return _concat(out)
-
-
-def _concat(sets):
-    return PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in sets])
-                          for f in fields(sets[0])})
+    return PixelInputs.concat(out)
 
 
 def arithmetic_pixels(model, cfg: Config, candidates=400_000, keep=2_000, seed=5, reach=3):
@@ -353,8 +346,7 @@ def arithmetic_pixels(model, cfg: Config, candidates=400_000, keep=2_000, seed=5
         for dp in range(-reach, reach + 1):
             grid.append(on_grid(dict(codes, h_theta=np.clip(codes["h_theta"] + dt, 0, full // 2),
                                      h_phi=(codes["h_phi"] + dp) % full)))
-    grid = PixelInputs(**{f.name: np.concatenate([getattr(p, f.name) for p in grid])
-                          for f in fields(px)})
+    grid = PixelInputs.concat(grid)
     sign = np.sign(dot_error(grid))
     shifted = {}
     for name in ANGLES_OF["specular"]:
@@ -365,5 +357,4 @@ def arithmetic_pixels(model, cfg: Config, candidates=400_000, keep=2_000, seed=5
         # then moves it by +sign, the way the arithmetic already does
         shifted[name] = _clip_angles(name, x - 0.4999 * step * sign * np.sign(up - dn))
     shifted = _with(grid, **shifted, l_phi=shifted["h_phi"], l_theta=shifted["h_theta"])
-    return PixelInputs(**{f.name: np.concatenate([getattr(grid, f.name), getattr(shifted, f.name)])
-                          for f in fields(px)})
+    return PixelInputs.concat([grid, shifted])

@@ -63,6 +63,12 @@ class PixelInputs:
         return PixelInputs(**{f.name: getattr(self, f.name)[index] for f in fields(self)})
 
     @classmethod
+    def concat(cls, sets):
+        """One PixelInputs of the pixels of ``sets``, in order."""
+        return cls(**{f.name: np.concatenate([getattr(p, f.name) for p in sets])
+                      for f in fields(cls)})
+
+    @classmethod
     def random(cls, n, rng, valid=True):
         """``n`` random pixels. ``valid``: N' in the upper tangent hemisphere and L, H above
         the surface (N.L > 0, N.H > 0), the inputs a renderer actually produces."""
