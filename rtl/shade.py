@@ -24,10 +24,11 @@ from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPE
 __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 
 # Registers of shade_stages: clamp, table address (and the 8-bit diffuse), table read and
-# table output register (ROM_LATENCY), the word difference, the interpolation product
+# table output register (ROM_LATENCY), the two table words once more (a block RAM placed
+# far from its interpolation spends the cycle on routing alone), the word difference, the interpolation product
 # (PRODUCT_LATENCY), the interpolated specular, the Phong products KS s and KD d
 # (PRODUCT_LATENCY; d waits beside the table), the Phong sum, its rounding and clamp.
-FINE_STAGE = 2 + ROM_LATENCY + 1 + PRODUCT_LATENCY + 1     # specular_fine's register
+FINE_STAGE = 2 + ROM_LATENCY + 2 + PRODUCT_LATENCY + 1     # specular_fine's register
 SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 
 
@@ -69,10 +70,12 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
         # word j + 1; at j = 2**s (h = 1, so the fraction is 0) any word will do: j's low
         # s bits + 1 = word 1 keeps the address inside the table.
         m.d.comb += [rom.ports[0].addr.eq(j), rom.ports[1].addr.eq(j[:s_bits] + 1)]
-        t0 = rom.ports[0].data                                                   # 2 + ROM
+        # both words registered beside the block RAM before any arithmetic
+        t0 = pipe.register(rom.ports[0].data, "spec_word0")                       # 2 + ROM + 1
         if r:
-            frac = pipe.delay(above[:r], ROM_LATENCY + 1, "spec_frac")
-            step = pipe.register(rom.ports[1].data - t0, "spec_step")             # + 1
+            t1 = pipe.register(rom.ports[1].data, "spec_word1")
+            frac = pipe.delay(above[:r], ROM_LATENCY + 2, "spec_frac")
+            step = pipe.register(t1 - t0, "spec_step")                            # + 1
             product = pipe.multiply(step, frac, "spec_interp")                    # + PRODUCT
             t0 = pipe.delay(t0, 1 + PRODUCT_LATENCY, "spec_word")
             fine = pipe.register((t0 + (product >> r))[:8 + f], "specular_fine")  # + 1
