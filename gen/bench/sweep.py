@@ -41,6 +41,7 @@ from tqdm import tqdm
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.pipe import ECP5
+from bumprtl.gen.report import write_section
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
@@ -596,21 +597,6 @@ def plot(data, path):
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
-
-
-def write_section(path, name, text):
-    """Replace the ``name`` section of a generated markdown file (between its markers),
-    appending it when absent; other sections stay as they are."""
-    path = Path(path)
-    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
-    old = path.read_text() if path.is_file() else "# Benchmarks\n"
-    block = f"{begin}\n{text}\n{end}"
-    if begin in old and end in old:
-        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
-    else:
-        new = old.rstrip("\n") + "\n\n" + block + "\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(new)
 
 
 def command_line(args):

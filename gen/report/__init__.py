@@ -1,0 +1,27 @@
+"""Generated pages: their records and sections."""
+
+from pathlib import Path
+
+__all__ = ["made_at", "write_section"]
+
+
+def made_at(cfg, note=""):
+    """The one-line record of the configuration a generated page was made at
+    (tests/test_docs_made_at.py holds every such line to today's default)."""
+    return (f"Made at: angle_bits={cfg.angle_bits}, frac_bits={cfg.frac_bits}"
+            + (f" ({note})" if note else ""))
+
+
+def write_section(path, name, text):
+    """Replace the ``name`` section of a generated markdown file (between its markers),
+    appending it when absent; other sections stay as they are."""
+    path = Path(path)
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    old = path.read_text() if path.is_file() else "# Benchmarks\n"
+    block = f"{begin}\n{text}\n{end}"
+    if begin in old and end in old:
+        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
+    else:
+        new = old.rstrip("\n") + "\n\n" + block + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(new)

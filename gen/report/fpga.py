@@ -27,6 +27,7 @@ from bumprtl.sim.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, Placement,
                                    check_device, lpf_mhz, pipeline_component, place_text)
 from bumprtl.gen.flow.units import build_unit
+from bumprtl.gen.report import made_at
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 
 __all__ = ["fpga_units", "fpga_report", "write_report", "add_parser"]
@@ -88,7 +89,7 @@ def fpga_report(cfg, args, units):
                          "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}})
         print(f"{label}: {rows[-1]}", flush=True)
     acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}
-    write_report(args, rows, acc)
+    write_report(args, rows, acc, cfg)
 
 
 def place_all(cfg, args, tasks):
@@ -142,7 +143,7 @@ def _row_seeds(args, row):
     return list(scene) if scene and row.startswith("scene:") else seeds
 
 
-def write_report(args, rows, acc):
+def write_report(args, rows, acc, cfg):
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot = out.parent / "img" / "cost_vs_error.png"
@@ -163,6 +164,7 @@ def write_report(args, rows, acc):
              "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
              "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
              f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
+             made_at(cfg, _scene_widths(rows)), "",
              "| unit | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | target met | max LSB | mean LSB | Fmax by seed |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -197,6 +199,16 @@ def write_report(args, rows, acc):
     data.parent.mkdir(parents=True, exist_ok=True)
     data.write_text(json.dumps({"command": command, "device": args.device, "rows": rows,
                                 "accuracy": acc}, indent=1, sort_keys=True) + "\n")
+
+
+def _scene_widths(rows):
+    """The scene rows placed at widths of their own (the built-in scenes' TOML decides)."""
+    own = []
+    for r in rows:
+        if r["row"].startswith("scene:"):
+            sc = load_scene_config(r["row"].split(":", 1)[1])
+            own.append(f"{r['unit']} at {sc.angle_bits} / {sc.frac_bits}")
+    return "the scene rows at their scenes' widths: " + ", ".join(own) if own else ""
 
 
 def _plot(rows, acc, path):

@@ -18,6 +18,8 @@ from pathlib import Path
 from amaranth.sim import Simulator
 from yowasp_wavedrom import render
 
+from bumprtl.gen.report import made_at, write_section
+from bumprtl.rtl.config import Config
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.pipeline import BumpPipeline
 
@@ -153,6 +155,10 @@ def run_timing(args):
     facts = write_timing(args.out)
     for name in facts:
         print(f"wrote {args.out / name}.json and .svg")
+    if args.doc is not None and args.doc.is_file():
+        write_section(args.doc, "made-at", made_at(Config(), f"`bumprtl report timing`: the "
+                      f"default pipeline's latency is {facts['latency']['latency']} cycles"))
+        print(f"wrote the record of {args.doc}")
     print(f"default pipeline latency: {facts['latency']['latency']} cycles "
           f"(o.valid in cycle {facts['latency']['first_out']} for i.valid in cycle 1)")
     return 0
@@ -163,4 +169,6 @@ def add_parser(kinds):
     t = kinds.add_parser("timing", help="WaveDrom handshake/stall/latency diagrams of the "
                                         "default pipeline -> docs/timing/")
     t.add_argument("--out", type=Path, default=Path("docs/timing"))
+    t.add_argument("--doc", type=Path, default=Path("docs/timing.md"),
+                   help="the page whose Made-at record is rewritten (when it exists)")
     t.set_defaults(func=run_timing)
