@@ -92,14 +92,18 @@ def palette_table(cfg, seed):
 
 
 def _palette(meta, spec, chunk):
-    """PaletteLUT: a random table written to the back bank and swapped in (set-up), then
-    random indices over the whole index range (out-of-range ones read as zero, oor = 1)
-    with random base colours; golden = the table lookup and Tarini eq. 2."""
+    """PaletteLUT: a decoy table written to the back bank and swapped in, then the random
+    table written to the other bank and swapped in (set-up: two swaps, so a swap that does
+    not alternate the banks reads the decoy), then random indices over the whole index
+    range (out-of-range ones read as zero, oor = 1) with random base colours; golden = the
+    table lookup and Tarini eq. 2."""
     cfg = Config(**meta["config"])
     seed = int(spec.get("seed", 0))
     table = palette_table(cfg, seed)
-    setup = [{"w_en": 1, "w_addr": a, "w_data": int(w)} for a, w in enumerate(table.tolist())]
-    setup.append({"swap": 1})
+    setup = []
+    for t in (palette_table(cfg, seed + 1), table):
+        setup += [{"w_en": 1, "w_addr": a, "w_data": int(w)} for a, w in enumerate(t.tolist())]
+        setup.append({"swap": 1})
     top = 1 << index_bits(cfg)
 
     def chunks():

@@ -176,8 +176,10 @@ def random_inputs(scene: SceneConfig, n, rng):
             if j == 0 and scene.bump_map == "varying":
                 out["n.phi"], out["n.theta"] = codes["n.phi"], codes["n.theta"]
             out.update({key: codes[own] for own, key in keys.items()})
+    # consecutive tags centred on the middle of the tag range, so the top tag bit (and every
+    # bit below it) changes within any run of two or more pixels
     mask = (1 << scene.tag_bits) - 1
-    out["tag"] = np.arange(n) & mask
+    out["tag"] = (np.arange(n) + (mask + 1) // 2 - n // 2) & mask
     return {k: np.asarray(v, np.int64) for k, v in out.items()}
 
 
