@@ -17,7 +17,8 @@ tests import ``bumprtl.*`` from there (it is first on sys.path, before the edita
 install's finder).
 
 A run: generate every mutant and record the tests per function (the tests of
-:data:`TESTS`, the fast tiers that exercise these files), draw a sample of ``--sample``
+:data:`TESTS`, the fast tiers that exercise these files, and the palette unit's tests,
+which guard the palette table's golden model), draw a sample of ``--sample``
 mutant names with ``random.Random(--seed)``, run mutmut on exactly those, and read each
 one's result. Killed = a test failed (or timed out / crashed); survived = every test that
 reaches the function passed; no tests = no selected test calls the function (counted as a
@@ -45,8 +46,13 @@ AREAS = {"sim/golden": "bumprtl.sim.golden.", "rtl/config.py": "bumprtl.rtl.conf
          "sim/scenes/config.py": "bumprtl.sim.scenes.config.", "sim/scenes": "bumprtl.sim.scenes.",
          "gen/cli": "bumprtl.gen.cli."}
 TESTS = ["tests/rtl/test_config.py", "tests/sim/scenes/test_config.py", "tests/rtl/test_fixed.py",
-         "tests/rtl/test_tables.py", "tests/rtl/test_methods.py", "tests/sim/golden",
+         "tests/rtl/test_tables.py", "tests/rtl/test_methods.py", "tests/rtl/test_palette.py",
+         "tests/sim/golden",
          "tests/sim/scenes", "tests/gen/cli"]
+# imported once by the fork server (never the project's own modules: each worker imports
+# those afresh, with the mutant switched on)
+PRELOAD = ["numpy", "pytest", "hypothesis", "amaranth", "amaranth.hdl", "amaranth.sim", "PIL.Image",
+           "scipy.spatial", "_pytest.python", "xdist"]
 BEGIN, END = "<!-- pymut:begin -->", "<!-- pymut:end -->"
 # mutmut 3's exit codes per mutant (mutmut/__main__.py status_by_exit_code)
 KILLED = {1, 3, -24, 24, 152, 255, 36, -9, 9, 37}     # test failed, timeout, killed, type check
@@ -92,10 +98,11 @@ def selected_tests(dest, tests=None):
     return [t for t in tests if (dest / t).exists()]
 
 
-def failing_tests(dest, env, log, tests=None):
+def failing_tests(dest, env, log, tests=None, jobs=1):
     """The selected tests that fail on the unmutated commit (mutmut needs a green run):
-    their node ids, to deselect and to list."""
-    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rf", "-n", "2", "-p", "no:cacheprovider",
+    their node ids, to deselect and to list. ``jobs`` pytest workers (``-j``: no more
+    processes than the mutants themselves get)."""
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rf", "-n", str(jobs), "-p", "no:cacheprovider",
                         "-m", "not regress and not fpga and not formal", *selected_tests(dest, tests)],
                        cwd=dest, env={**env, "PYTHONPATH": str(dest)}, capture_output=True, text=True)
     with open(log, "a") as f:
@@ -110,8 +117,15 @@ def configure(dest, deselect, only=None, tests=None):
     cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
             "    -m", "    not regress and not fpga and not formal",
             *[x for d in deselect for x in ("    --deselect", f"    {d}")],
-            "use_git_change_detection = false", "timeout_multiplier = 5.0", ""]
+            "use_git_change_detection = false", "timeout_multiplier = 5.0",
+            # each mutant's tests run in a process forked from a server that imported the
+            # third-party modules only: forked from mutmut's own process (its default), a
+            # worker inherits what the clean run left there, the lru_caches of the golden
+            # models' bounds among it, and a mutant behind a filled cache passes every test
+            "process_isolation = forkserver", "forkserver_warmup = import",
+            f"preload_modules_file = {dest / 'preload_modules.txt'}", ""]
     (dest / "setup.cfg").write_text("\n".join(cfg))
+    (dest / "preload_modules.txt").write_text("\n".join(PRELOAD) + "\n")
     # pyproject's [tool.pytest] stays (markers, test paths); mutmut reads setup.cfg only
     # when pyproject has no [tool.mutmut]
 
@@ -140,10 +154,39 @@ def area(name):
     return "other"
 
 
+def draw(names, size, seed, min_area):
+    """``size`` mutant names drawn with ``random.Random(seed)``, stratified by area: each
+    area gets ``min_area`` of its mutants (all if it has fewer), the rest of the sample is
+    shared in proportion to the mutants each area has left (largest remainders), and each
+    area's share is a uniform draw from its own mutants. Without the floor the small areas
+    (the command line: about 2 % of the mutants) are often not drawn at all."""
+    rng = random.Random(seed)
+    by_area = defaultdict(list)
+    for n in sorted(names):
+        by_area[area(n)].append(n)
+    labels = [l for l in [*AREAS, "other"] if by_area[l]]
+    size = min(size, len(names))
+    quota = {l: min(len(by_area[l]), min_area) for l in labels}
+    if not min_area or sum(quota.values()) > size:     # no floor (or floors above the sample):
+        # a plain uniform draw
+        return sorted(rng.sample(sorted(names), size))
+    left = {l: len(by_area[l]) - quota[l] for l in labels}
+    rest, pool = size - sum(quota.values()), sum(left.values())
+    if rest and pool:
+        exact = {l: rest * left[l] / pool for l in labels}
+        for l in labels:
+            quota[l] += int(exact[l])
+        for l in sorted(labels, key=lambda l: int(exact[l]) - exact[l])[:rest - sum(int(v) for v in exact.values())]:
+            quota[l] += 1
+    return sorted(n for l in labels for n in rng.sample(by_area[l], quota[l]))
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python tests/mutants/pymut.py", description=__doc__.split("\n")[0])
     p.add_argument("--sample", type=int, default=100, help="mutants drawn (default 100)")
     p.add_argument("--seed", type=int, default=1, help="seed of the draw (default 1)")
+    p.add_argument("--min-area", type=int, default=10,
+                   help="mutants drawn from each area at least (default 10; the rest in proportion)")
     p.add_argument("-j", "--jobs", type=int, default=2, help="mutmut --max-children (default 2)")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "pymut")
     p.add_argument("--doc", type=Path, default=None)
@@ -153,9 +196,9 @@ def main(argv=None):
     p.add_argument("--tests", action="append", default=None, metavar="PATH",
                    help="the tests mutmut selects from (default: TESTS)")
     a = p.parse_args(argv)
-    for name, value in (("--sample", a.sample), ("--jobs", a.jobs)):
-        if value < 1:
-            print(f"error: {name} must be at least 1, got {value}", file=sys.stderr)
+    for name, value, lo in (("--sample", a.sample, 1), ("--jobs", a.jobs, 1), ("--min-area", a.min_area, 0)):
+        if value < lo:
+            print(f"error: {name} must be at least {lo}, got {value}", file=sys.stderr)
             return 2
     t0 = time.perf_counter()
     tree = a.out / "tree"
@@ -173,7 +216,7 @@ def main(argv=None):
         files, commit = committed_tree(a.out / "head", a.commit)
         lay_out(tree, a.out / "head", files)
         stamp.write_text(commit)
-    deselect = failing_tests(tree, env, log, a.tests)
+    deselect = failing_tests(tree, env, log, a.tests, a.jobs)
     if deselect:
         print(f"{len(deselect)} selected test(s) fail on commit {commit} itself and are left out: "
               + ", ".join(deselect))
@@ -193,10 +236,9 @@ def main(argv=None):
                    if any(fnmatch.fnmatch(n.split(".x")[0].replace(".", "/") + ".py", g)
                           or fnmatch.fnmatch(n.split(".x")[0].replace(".", "/") + "/__init__.py", g)
                           for g in globs))
-    rng = random.Random(a.seed)
-    sample = sorted(rng.sample(names, min(a.sample, len(names))))
+    sample = draw(names, a.sample, a.seed, a.min_area)
     print(f"python mutation (mutmut 3.8.1) at commit {commit}: {len(names)} mutants generated, "
-          f"a sample of {len(sample)} drawn with seed {a.seed}")
+          f"a sample of {len(sample)} drawn with seed {a.seed} (at least {a.min_area} an area)")
     # 2. run exactly the sample, each against the tests that reach its function
     mutmut(["run", "--max-children", str(a.jobs), *sample], tree, env, log)
     results = all_results(tree)
@@ -221,12 +263,12 @@ def main(argv=None):
         for k, v in c.items():
             tot[k] += v
         rows.append((label, n, c))
-    print(f"{'area':14} {'sample':>6} {'killed':>6} {'survived':>8} {'no tests':>8}  kill ratio")
+    print(f"{'area':20} {'sample':>6} {'killed':>6} {'survived':>8} {'no tests':>8}  kill ratio")
     for label, n, c in rows:
-        print(f"{label:14} {n:6} {c['killed']:6} {c['survived']:8} {c['no tests']:8}  "
+        print(f"{label:20} {n:6} {c['killed']:6} {c['survived']:8} {c['no tests']:8}  "
               f"{100 * c['killed'] / n:.1f}%")
     n_all = sum(tot.values())
-    print(f"{'all':14} {n_all:6} {tot['killed']:6} {tot['survived']:8} {tot['no tests']:8}  "
+    print(f"{'all':20} {n_all:6} {tot['killed']:6} {tot['survived']:8} {tot['no tests']:8}  "
           f"{100 * tot['killed'] / max(1, n_all):.1f}%  ({seconds / 60:.1f} min wall, seed {a.seed})")
     for name, kind, code in survivors:
         print(f"  {kind}: {name} (exit {code})")
@@ -243,7 +285,8 @@ def main(argv=None):
     if a.doc:
         command = "python tests/mutants/pymut.py " + " ".join(argv if argv is not None else sys.argv[1:])
         block = [BEGIN, "", f"Generated by `{command}` at commit {commit} (mutmut 3.8.1; {len(names)} mutants generated, "
-                 f"a sample of {len(sample)} drawn with seed {a.seed}; {seconds / 60:.1f} min wall "
+                 f"a sample of {len(sample)} drawn with seed {a.seed}, at least {a.min_area} an area; "
+                 f"{seconds / 60:.1f} min wall "
                  f"on the 2-core machine).", "",
                  "Mutated: " + ", ".join(f"`{x}`" for x in (a.only or MUTATE)) + "; tests: "
                  + ", ".join(f"`{x}`" for x in selected_tests(tree, a.tests)) + ".", "",
