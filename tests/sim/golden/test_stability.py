@@ -47,6 +47,21 @@ def test_cases_are_what_they_say():
     assert (np.abs(np.sin(wrap.n_phi)) < 0.03).all() and (np.abs(np.sin(wrap.l_phi)) < 0.03).all()
 
 
+def test_cases_keep_n_prime_a_bump_normal():
+    """N' is a bump normal: every case but grid_extremes (all angles at the grid's ends, on
+    purpose) draws it in the upper tangent hemisphere (th_N' <= 90 deg), as a bump map holds
+    it; and the cases that put H above the surface (all but below_horizon and saturation's
+    -N half) keep N.H >= 0 with it, so each case stresses only the one edge it names."""
+    from bumprtl.sim.golden.common import polar_to_cartesian
+    dot = lambda a, b: np.einsum("...i,...i", polar_to_cartesian(*a), polar_to_cartesian(*b))
+    for name in sorted(CASES):
+        px = stress_case(name, 300, seed=5)
+        if name != "grid_extremes":
+            assert px.b_theta.max() <= np.pi / 2 + 1e-12, name
+        if name not in ("grid_extremes", "below_horizon", "saturation"):
+            assert dot((px.h_phi, px.h_theta), (px.n_phi, px.n_theta)).min() >= -1e-12, name
+
+
 @given(case=cases, seed=seeds, n=exponents)
 def test_exact_and_conventional_never_nan_or_out_of_range(case, seed, n):
     cfg = Config(spec_exponent=n)

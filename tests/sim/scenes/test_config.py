@@ -170,3 +170,18 @@ def test_a_user_map_replaces_the_image():
     for key in ("height_map", "normal_map"):
         scene = SceneConfig(name="t", **{key: "some/map.png"})
         assert scene.image is None and getattr(scene, key) == "some/map.png"
+
+
+@pytest.mark.parametrize("keys, rotation, cause", [
+    ({"bump_map": "flat"}, "per-pixel", "bump_map"),
+    ({"bump_map": "varying"}, "per-polygon", "bump_map"),
+    ({"shading": "palette"}, "per-pixel", "shading"),
+])
+def test_impossible_rotation_names_the_key_that_rules_it_out(keys, rotation, cause):
+    """rotation is derived from shading and bump_map; a rotation that contradicts them is
+    refused in one line naming rotation, the key that rules it out and the allowed value."""
+    allowed = SceneConfig(**keys).rotation
+    with pytest.raises(BumpError) as e:
+        SceneConfig(**keys, rotation=rotation)
+    msg = str(e.value)
+    assert "\n" not in msg and "rotation" in msg and cause in msg and repr(allowed) in msg, msg

@@ -79,6 +79,19 @@ def test_bad_scene_arguments_are_named(kwargs, words):
         assert w in str(e.value)
 
 
+@pytest.mark.parametrize("pname, lo, hi", [("light_elevation", -90, 90),
+                                           ("light_azimuth", -360, 360)])
+def test_light_angles_accepted_at_both_ends_and_refused_past_them(pname, lo, hi):
+    """light_elevation in [-90, 90] and light_azimuth in [-360, 360] degrees, closed ranges:
+    both ends accepted, the nearest floats outside refused naming the parameter."""
+    for val in (lo, hi, float(lo), float(hi)):
+        load_scene("bumps", size=16, **{pname: val})
+    for val in (np.nextafter(lo, -np.inf), np.nextafter(hi, np.inf), float("nan")):
+        with pytest.raises(BumpError) as e:
+            load_scene("bumps", size=16, **{pname: val})
+        assert pname in str(e.value) and f"[{lo}, {hi}]" in str(e.value)
+
+
 def test_bad_height_map():
     with pytest.raises(BumpError, match="square"):
         height_to_normals(np.zeros((4, 5)))

@@ -2,6 +2,8 @@
 conventions, resampling, every bad input refused with one line naming the file, and the
 normal-map round trip held to a bound derived from the PNG's 8-bit quantization."""
 
+import os
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -261,3 +263,38 @@ def test_write_png_16_bit_round_trip(tmp_path):
     write_png(tmp_path / "g16.png", grey, bit_depth=16)
     img = Image.open(tmp_path / "g16.png")
     assert img.mode.startswith("I") and np.array_equal(np.asarray(img, dtype=np.int64), grey)
+
+
+def test_map_size_refuses_every_bad_png_header_naming_the_file(tmp_path):
+    """map_size reads only the header (the CLI sizes a map before loading it): a bad
+    signature, a truncated header or channels that do not fit the map kind are refused there
+    already, in one line naming the file, as load_bump_map refuses them."""
+    header_problems = ("no such file", "not a PNG", "channel", "16-bit")
+    cases = [(name, kind, words) for name, kind, words in _bad_inputs(tmp_path)
+             if name.endswith(".png") and any(h in w for w in words for h in header_problems)]
+    raw = (tmp_path / "grey.png").read_bytes()
+    (tmp_path / "head.png").write_bytes(raw[:20])           # the signature, IHDR cut short
+    cases.append(("head.png", "height", ["head.png", "truncated"]))
+    assert len(cases) == 7
+    for name, kind, words in cases:
+        with pytest.raises(BumpError) as e:
+            map_size(tmp_path / name, kind=kind)
+        msg = str(e.value)
+        assert "\n" not in msg and all(w in msg for w in words), (name, msg)
+
+
+def test_a_rewritten_map_file_is_read_again(tmp_path):
+    """load_bump_map caches by path, modification time and arguments: the same file loaded
+    twice is one map, but a file rewritten in place (a user editing the map between two
+    renders) is read again, not served from the cache."""
+    path = tmp_path / "h.png"
+    _grey_png(path, hex_tiles(32, seed=1))
+    first = load_bump_map(path, "height")
+    assert load_bump_map(path, "height") is first
+    _grey_png(path, hex_tiles(32, seed=2))
+    stamp = path.stat().st_mtime_ns + 10 ** 9           # a later time, whatever the clock's grain
+    os.utime(path, ns=(stamp, stamp))
+    second = load_bump_map(path, "height")
+    assert not np.array_equal(second.b_phi_map, first.b_phi_map)
+    fresh = load_bump_map(_grey_png(tmp_path / "copy.png", hex_tiles(32, seed=2)), "height")
+    assert np.array_equal(second.b_phi_map, fresh.b_phi_map)

@@ -164,6 +164,34 @@ def test_lambert_several_lights_add_up():
     assert np.allclose(c[:, 0], np.clip(want, 0, 1))
 
 
+def test_blend_layout_is_specular_rgb_and_lambert_alpha_sec_7_1():
+    """blend=True (Sec. 7.1/7.2, the table a colour texture is blended with): alpha the
+    Lambert intensity ka + kd sum clamp(N.L), each of R, G, B the specular sum ks sum
+    clamp(N.H)**n with H = normalize(L + V), both clamped to [0, 1]; per material too."""
+    cfg = Config()
+    table = random_normals(4, seed=11).reshape(-1, 3)
+    lights = np.array([[0, 0, 1.0], [0.6, 0, 0.8]])
+    view = np.array([0, 0.6, 0.8])
+    halfway = [(l + view) / np.linalg.norm(l + view) for l in lights]
+
+    def want(m):
+        lambert = m.ka + m.kd * sum(np.clip(table @ l, 0, 1) for l in lights)
+        spec = m.ks * sum(np.clip(table @ h, 0, 1) ** m.spec_exponent for h in halfway)
+        return np.clip(spec, 0, 1), np.clip(lambert, 0, 1)
+
+    c = color_table(table, "phong", lights, view, cfg, blend=True)
+    spec, lambert = want(Material.from_config(cfg))
+    assert np.allclose(c[:, :3], spec[:, None]) and np.allclose(c[:, 3], lambert)
+    mats = np.arange(len(table)) % 2
+    params = [Material(ks=0.0), Material(ka=0.2, kd=0.5, ks=0.6, spec_exponent=4)]
+    c = color_table(table, "phong", lights, view, cfg, materials=mats, material_params=params,
+                    blend=True)
+    for m, p in enumerate(params):
+        spec, lambert = want(p)
+        sel = mats == m
+        assert np.allclose(c[sel, :3], spec[sel, None]) and np.allclose(c[sel, 3], lambert[sel])
+
+
 def test_chrome_reflects_the_viewer_and_toon_has_few_levels():
     table = np.array([[0, -1.0, 0], [0, -0.6, 0.8], [0, -0.6, -0.8]])
     view = np.array([0, -1.0, 0])
