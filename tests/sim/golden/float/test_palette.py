@@ -192,6 +192,26 @@ def test_blend_layout_is_specular_rgb_and_lambert_alpha_sec_7_1():
         assert np.allclose(c[sel, :3], spec[sel, None]) and np.allclose(c[sel, 3], lambert[sel])
 
 
+@pytest.mark.parametrize("model", ["lambert", "phong", "chrome", "toon"])
+def test_every_lighting_model_tints_by_the_material_colour(model):
+    """Sec. 7.3, colour as material: without a highlight (ks = 0) an entry's RGB is the
+    white material's RGB times the material's colour, channel by channel, in every lighting
+    model (Lambert, Phong, chrome's environment, toon's bands); the alpha (Lambert
+    intensity) does not depend on the colour."""
+    table = random_normals(6, seed=12).reshape(-1, 3)
+    lights, view = [[0, 0.6, 0.8]], [0, 0.0, 1.0]
+    colour = (0.9, 0.5, 0.2)
+    white = color_table(table, model, lights, view, material_params=[Material(ks=0.0)],
+                        materials=np.zeros(len(table), np.int64))
+    tinted = color_table(table, model, lights, view,
+                         material_params=[Material(ks=0.0, color=colour)],
+                         materials=np.zeros(len(table), np.int64))
+    unclipped = (white[:, :3] < 1).all(-1)
+    assert unclipped.sum() >= len(table) // 2
+    assert np.allclose(tinted[unclipped, :3], white[unclipped, :3] * colour)
+    assert np.allclose(tinted[:, 3], white[:, 3])
+
+
 def test_chrome_reflects_the_viewer_and_toon_has_few_levels():
     table = np.array([[0, -1.0, 0], [0, -0.6, 0.8], [0, -0.6, -0.8]])
     view = np.array([0, -1.0, 0])
