@@ -141,13 +141,14 @@ class BumpMapFetch(wiring.Component):
     tex_w_en, tex_w_addr, tex_w_data : In
         The colour texture's host write port (``texture = true``).
 
-    Latency 1 + RAM_LATENCY (address register, block-RAM read, the block RAM's output
+    Latency 2 + RAM_LATENCY (address register, block-RAM read, the block RAM's output
     register: rtl/pipe.RegisteredRAM, a DP16KD with REGMODE OUTREG on ECP5, so the RAM's
-    clock-to-out stays out of the next unit's first cycle); 1 texel per clock when not
-    stalled.
+    clock-to-out stays out of the next unit's first cycle; then the word registered once
+    more, so the route to the next unit has a cycle of its own); 1 texel per clock when
+    not stalled.
     """
 
-    latency = 1 + RAM_LATENCY
+    latency = 2 + RAM_LATENCY
 
     def __init__(self, scene, out_layout=None, init=None, texture=None, target=None,
                  lockstep=None):
@@ -225,7 +226,9 @@ class BumpMapFetch(wiring.Component):
         addr_d1 = pipe.register(addr, "texel_addr_d1")                        # stage 1
         for field, (mem, _) in mems.items():        # the same address, the same cycle
             m.d.comb += mem.r_addr.eq(addr_d1)      # stage 2: read; stage 3: output register
-            m.d.comb += self.o.payload[field].eq(mem.r_data)
+            # stage 4: the word once more beside the block RAM, so the route to the next
+            # unit has a cycle of its own wherever the placer puts the RAM
+            m.d.comb += self.o.payload[field].eq(pipe.register(mem.r_data, f"{field}_word"))
         for name, _ in self.out_layout:
             if name not in self.fetched:
                 m.d.comb += self.o.payload[name].eq(pipe.delay(px[name], self.latency, name))

@@ -23,12 +23,13 @@ from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPE
 
 __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp, table address (and the 8-bit diffuse), table read and
-# table output register (ROM_LATENCY), the two table words once more (a block RAM placed
-# far from its interpolation spends the cycle on routing alone), the word difference, the interpolation product
-# (PRODUCT_LATENCY), the interpolated specular, the Phong products KS s and KD d
-# (PRODUCT_LATENCY; d waits beside the table), the Phong sum, its rounding and clamp.
-FINE_STAGE = 2 + ROM_LATENCY + 2 + PRODUCT_LATENCY + 1     # specular_fine's register
+# Registers of shade_stages: clamp, table offset (and the 8-bit diffuse), the two table
+# addresses, table read and table output register (ROM_LATENCY), the two table words once
+# more, the word difference, the interpolation product (PRODUCT_LATENCY), the interpolated
+# specular, the Phong products KS s and KD d (PRODUCT_LATENCY; d waits beside the table),
+# the Phong sum, its rounding and clamp. The registers on both sides of the block RAM let
+# a table placed far from its arithmetic spend a whole cycle on each route.
+FINE_STAGE = 3 + ROM_LATENCY + 2 + PRODUCT_LATENCY + 1     # specular_fine's register
 SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 
 
@@ -69,12 +70,13 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
         j = above[r:]
         # word j + 1; at j = 2**s (h = 1, so the fraction is 0) any word will do: j's low
         # s bits + 1 = word 1 keeps the address inside the table.
-        m.d.comb += [rom.ports[0].addr.eq(j), rom.ports[1].addr.eq(j[:s_bits] + 1)]
+        m.d.comb += [rom.ports[0].addr.eq(pipe.register(j, "spec_addr0")),        # stage 3
+                     rom.ports[1].addr.eq(pipe.register(j[:s_bits] + 1, "spec_addr1"))]
         # both words registered beside the block RAM before any arithmetic
-        t0 = pipe.register(rom.ports[0].data, "spec_word0")                       # 2 + ROM + 1
+        t0 = pipe.register(rom.ports[0].data, "spec_word0")                       # 3 + ROM + 1
         if r:
             t1 = pipe.register(rom.ports[1].data, "spec_word1")
-            frac = pipe.delay(above[:r], ROM_LATENCY + 2, "spec_frac")
+            frac = pipe.delay(above[:r], 1 + ROM_LATENCY + 2, "spec_frac")
             step = pipe.register(t1 - t0, "spec_step")                            # + 1
             product = pipe.multiply(step, frac, "spec_interp")                    # + PRODUCT
             t0 = pipe.delay(t0, 1 + PRODUCT_LATENCY, "spec_word")

@@ -74,7 +74,7 @@ def test_host_write_port_replaces_texels():
             await ctx.tick()
         ctx.set(dut.w_en, 0)
         ctx.set(dut.o.ready, 1)
-        for addr in [*writes, None, None, None]:
+        for addr in [*writes] + [None] * dut.latency:
             ctx.set(dut.i.valid, addr is not None)
             if addr is not None:
                 ctx.set(dut.i.payload.u, addr % 16), ctx.set(dut.i.payload.v, addr // 16)
