@@ -19,12 +19,18 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    patterns; a scene frame with the map, polygon and colour table as make test renders
    it for the pipelines), every output compared bit for bit with the golden model inside
    cocotb. A mismatch or a deadlock (timeout) kills the mutant;
-5. every survivor is checked for equivalence with the unmutated netlist: a Yosys miter
-   (``miter -equiv -flatten -make_assert -ignore_gold_x``) proved with ``sat -verify
-   -prove-asserts -set-init-zero -tempinduct``, as mcy's equivalence test does. A proof
-   makes it *equivalent* (not counted); a counterexample makes it a real survivor; a
-   time-out (or a design too large for ``sat``) leaves it *undecided*, counted as a
-   survivor and listed.
+5. every survivor is checked for equivalence with the unmutated netlist (``equivalence``):
+   first Yosys's structural passes for two near-identical netlists (``equiv_make``,
+   ``equiv_simple``, ``equiv_induct``, ``equiv_status -assert``, plus a bounded check of
+   the first cycles from reset, the base case equiv_induct leaves out), every output in
+   every cycle; then the same with each stream's payload a don't-care while its valid is
+   low (the stream contract: a payload means something only with valid; the verdict says
+   so); then, as the fallback, mcy's miter (``miter -equiv -flatten -make_assert
+   -ignore_gold_x``, payloads masked the same way) with ``sat -verify -prove-asserts
+   -set-init-zero -tempinduct``. A proof makes it *equivalent* (not counted); a
+   counterexample makes it a real survivor; no proof and no counterexample (a time-out, or
+   a design too large for ``sat``) leaves it *undecided*, counted as a survivor and listed.
+   ``--recheck`` runs these checks again on a finished run's survivors.
 
 Prints, per target, the sample size, the seed, killed / non-equivalent, the kill ratio, the
 survivors and the wall time; ``--doc docs/mutation.md`` writes the table between the
@@ -217,19 +223,100 @@ def run_one(v, j, job, work, idx):
     return "passed"
 
 
-# --- equivalence of a survivor: a miter proved by induction ---------------------------------
+# --- equivalence of a survivor: structural passes first, a miter proved by induction after ---
 
-def equivalence(v, unit, line, work, timeout):
-    """``"equivalent"``, ``"not equivalent"`` or ``"undecided: why"`` of one mutation."""
+EQUIV_SEQ = 4   # time steps of equiv_simple / equiv_induct and of the base-case check
+# The stream contract (amaranth.lib.stream): a payload means something only in a cycle its
+# valid is high; the testbench compares transferred payloads only. So the equivalence checked
+# masks every output ``X__payload`` with its ``X__valid`` (0 while valid is low) in gold and
+# gate alike; every other output (valid, ready, host ports) is compared in every cycle. A
+# mutant that changes a payload only while its valid is low is equivalent *under the stream
+# contract* and says so in its verdict; "equivalent" alone means every output, every cycle.
+STREAM_DONT_CARE = "payload don't-care while valid is low"
+
+
+def _wrappers(ports, unit):
+    """Verilog of the modules ``gold_s`` and ``gate_s``: ``gold`` / ``gate`` with each stream
+    payload output masked by its valid (the stream contract's don't-care, made explicit)."""
+    masked = {n for n in ports if n.endswith("__payload") and ports[n]["dir"] == "out"
+              and ports.get(n[:-len("payload")] + "valid", {}).get("dir") == "out"}
+    text = []
+    for core in ("gold", "gate"):
+        decl, conn, body = [], [], []
+        for name, p in sorted(ports.items()):
+            rng = f"[{p['width'] - 1}:0] " if p["width"] > 1 else ""
+            decl.append(f"  {'input' if p['dir'] == 'in' else 'output'} wire {rng}{name};")
+            if name in masked:
+                decl.append(f"  wire {rng}{name}__core;")
+                conn.append(f"    .{name}({name}__core)")
+                valid = name[:-len("payload")] + "valid"
+                body.append(f"  assign {name} = {valid} ? {name}__core : {p['width']}'d0;")
+            else:
+                conn.append(f"    .{name}({name})")
+        text.append(f"module {core}_s({', '.join(sorted(ports))});\n" + "\n".join(decl)
+                    + f"\n  {core} core (\n" + ",\n".join(conn) + "\n  );\n"
+                    + "\n".join(body) + "\nendmodule\n")
+    return "\n".join(text), bool(masked)
+
+
+def _gold_gate(unit, line, stream, memory_map=True):
+    """Yosys commands leaving modules ``a`` (the design) and ``b`` (the mutant), flattened;
+    with ``stream`` their payload outputs are masked by valid (see STREAM_DONT_CARE); with
+    ``memory_map`` the memories turned into registers (what ``sat`` on a miter needs)."""
     args = line[len("mutate "):].replace(f"-module {unit} ", "-module gate ")
     # the mutation first: its cell names are those of the prepared netlist, which memory_map
     # and opt would rename or remove
-    script = ["read_rtlil prepped.il", f"rename {unit} gold", "copy gold gate", f"mutate {args}",
-              "memory_map", "opt -fast",
-              "miter -equiv -flatten -make_assert -ignore_gold_x gold gate miter",
-              "hierarchy -top miter", "opt -fast",
-              f"sat -verify -prove-asserts -set-init-zero -tempinduct -seq 1 -maxsteps 24 "
-              f"-timeout {timeout} miter"]
+    script = ["read_rtlil prepped.il", f"rename {unit} gold", "copy gold gate", f"mutate {args}"]
+    if stream:
+        script += ["read_verilog equiv_wrappers.v", "flatten gold_s gate_s", "delete gold gate",
+                   "rename gold_s a", "rename gate_s b"]
+    else:
+        script += ["rename gold a", "rename gate b"]
+    return script + (["memory_map"] if memory_map else []) + ["opt -fast"]
+
+
+def _structural(unit, line, work, timeout, stream):
+    """The structural equivalence passes (``equiv_make``, ``equiv_simple``, ``equiv_induct``,
+    ``equiv_status -assert``), then the base case equiv_induct leaves to the caller: every
+    signal equiv_make matched is equal in the first EQUIV_SEQ cycles from the initial state.
+    True only with both proofs; False when they do not close (which proves nothing).
+
+    The memories stay memories: equiv_make merges gold's and gate's copy of a memory into one
+    cell when every input of the two (addresses, data, enables) is the same matched signal,
+    whose own $equiv cell must then be proved. The SAT passes have no model of a memory and
+    ignore it (``-ignore-unknown-cells``): its read data is a free variable, one for the
+    merged cell, so a proof holds for any memory contents (sound); two unmerged copies give
+    two free variables and their consumers do not prove (nothing is claimed). memory_map
+    instead would turn the fetch unit's 4096-word map or the palette's 512-word table into
+    as many registers, which the proofs (and the miter before) did not finish."""
+    n = EQUIV_SEQ
+    prove = _gold_gate(unit, line, stream, memory_map=False) + [
+        "equiv_make a b equiv", "hierarchy -top equiv",
+        f"equiv_simple -ignore-unknown-cells -seq {n}",
+        f"equiv_induct -ignore-unknown-cells -seq {n}", "equiv_status -assert"]
+    # equiv_induct proves that gold and gate never diverge once every matched signal has
+    # agreed for n cycles; the base case, those first n cycles from the initial state, is
+    # proved here (the same matched signals as $eqx asserts, n steps of sat from init)
+    base = _gold_gate(unit, line, stream, memory_map=False) + [
+        "equiv_make -make_assert a b equiv", "hierarchy -top equiv", "opt -fast",
+        f"sat -ignore_unknown_cells -verify -prove-asserts -set-init-zero -seq {n} "
+        f"-timeout {timeout} equiv"]
+    for script in (prove, base):
+        try:
+            out = yosys(script, work, timeout=timeout + 60)
+        except subprocess.CalledProcessError:
+            return False
+        if out is None or re.search(r"timeout|interrupted", out, re.I):
+            return False
+    return True
+
+
+def _miter(unit, line, work, timeout, stream):
+    script = _gold_gate(unit, line, stream) + [
+        "miter -equiv -flatten -make_assert -ignore_gold_x a b miter", "hierarchy -top miter",
+        "opt -fast",
+        f"sat -verify -prove-asserts -set-init-zero -tempinduct -seq 1 -maxsteps 24 "
+        f"-timeout {timeout} miter"]
     try:
         out = yosys(script, work, timeout=timeout + 120)
     except subprocess.CalledProcessError as e:
@@ -237,14 +324,40 @@ def equivalence(v, unit, line, work, timeout):
         if "failed" in text.lower() and ("assert" in text.lower() or "proof" in text.lower()):
             return "not equivalent"
         tail = [l for l in text.splitlines() if l.strip()][-1:] or ["yosys error"]
-        return "undecided: " + tail[0][:100]
-    if out is None:
-        return f"undecided: no proof within {timeout} s"
-    if re.search(r"timeout|interrupted", out, re.I):
+        return "undecided: " + " ".join(tail[0].split())[:100]
+    if out is None or re.search(r"timeout|interrupted", out, re.I):
         return f"undecided: no proof within {timeout} s"
     if re.search(r"induction.*(failed|counter)", out, re.I) and "SUCCESS" not in out:
         return "undecided: induction did not close in 24 steps"
     return "equivalent"
+
+
+def equivalence(v, meta, line, work, timeout):
+    """``"equivalent ..."``, ``"not equivalent ..."`` or ``"undecided: why"`` of one mutation.
+
+    1. Yosys's structural passes on the two netlists, every output compared in every cycle:
+       a proof gives ``"equivalent (equiv_simple/equiv_induct)"``;
+    2. the same with the stream payloads masked by valid (STREAM_DONT_CARE): a proof gives
+       ``"equivalent under the stream contract (...)"``;
+    3. otherwise (the structural passes prove nothing when they do not close) mcy's miter,
+       payloads masked: ``sat -tempinduct`` proves it (equivalent under the stream contract),
+       finds a counterexample within 24 cycles of reset (not equivalent, so not equivalent
+       either without the mask), or neither (undecided, counted as a survivor)."""
+    unit = meta["unit"]
+    wrappers, has_stream = _wrappers(meta["ports"], unit)
+    (Path(work) / "equiv_wrappers.v").write_text(wrappers)
+    if _structural(unit, line, work, timeout, False):
+        return "equivalent (equiv_simple/equiv_induct, every output every cycle)"
+    if has_stream and _structural(unit, line, work, timeout, True):
+        return f"equivalent under the stream contract (equiv_simple/equiv_induct, {STREAM_DONT_CARE})"
+    verdict = _miter(unit, line, work, timeout, has_stream)
+    if verdict == "equivalent" and has_stream:
+        return f"equivalent under the stream contract (miter + sat -tempinduct, {STREAM_DONT_CARE})"
+    if verdict == "equivalent":
+        return "equivalent (miter + sat -tempinduct)"
+    if verdict == "not equivalent":
+        return "not equivalent (counterexample from the miter)"
+    return verdict
 
 
 # --- one target, end to end -----------------------------------------------------------------
@@ -275,10 +388,10 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
     survivors = []
     for i, r in sorted(results.items()):
         if r == "passed":
-            verdict = equivalence(v, unit, lines[i - 1], rtl, eq_timeout)
+            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout)
             survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
     killed = sum(r.startswith("killed") for r in results.values())
-    equivalent = sum(s["verdict"] == "equivalent" for s in survivors)
+    equivalent = sum(s["verdict"].startswith("equivalent") for s in survivors)
     for i, r in sorted(results.items()):
         shutil.rmtree(work / f"run{i}", ignore_errors=True)
     return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
@@ -300,10 +413,13 @@ def _stimulus_words(target, n):
     return "the scene's 16 x 16 frame x 4 traffic patterns (map, polygon, table as make test renders it)"
 
 
-def report(results, n, seed, seconds, jobs, command):
-    lines = [BEGIN, "",
-             f"Generated by `{command}` (seed {seed}, a sample of {n} mutations a target, "
-             f"{jobs} parallel simulations; {seconds / 60:.1f} min wall on the 2-core machine).",
+def report(results, runs):
+    """The doc's block: ``runs`` the (command, seed, sample, jobs, wall seconds) of each run
+    whose ``results`` it merges."""
+    said = "; ".join(f"`{c}` (seed {seed}, {n} mutations a target, {jobs} parallel "
+                     f"simulation{'s' if jobs > 1 else ''}, {sec / 60:.1f} min wall)"
+                     for c, seed, n, jobs, sec in runs)
+    lines = [BEGIN, "", f"Generated by {said}, on the 2-core machine.", "",
              "", "| target | sample | killed | equivalent | kill ratio (non-equivalent) | survivors | wall s |",
              "|---|---|---|---|---|---|---|"]
     for r in results:
@@ -312,7 +428,7 @@ def report(results, n, seed, seconds, jobs, command):
             continue
         ratio = r["killed"] / r["counted"] if r["counted"] else 1.0
         surv = "; ".join(f"#{s['index']} {s['verdict']}" for s in r["survivors"]
-                         if s["verdict"] != "equivalent") or "none"
+                         if not s["verdict"].startswith("equivalent")) or "none"
         lines.append(f"| `{r['target']}` | {r['sample']} | {r['killed']} | {r['equivalent']} | "
                      f"{r['killed']}/{r['counted']} = {100 * ratio:.1f}% | {surv} | {r['seconds']:.0f} |")
     lines += ["", "Survivors (the mutation, what the equivalence check said):", ""]
@@ -338,6 +454,33 @@ def write_doc(doc, block):
     doc.write_text(text)
 
 
+def _tally(r):
+    r["equivalent"] = sum(s["verdict"].startswith("equivalent") for s in r["survivors"])
+    r["counted"] = r["sample"] - r["equivalent"]
+
+
+def recheck(path, out, timeout):
+    """The equivalence checks of the survivors in ``path`` (a netlist_results.json) again,
+    each on the netlist its run kept (``out/<target>/rtl``); the JSON is rewritten."""
+    saved = json.loads(path.read_text())
+    for r in saved["results"]:
+        if not r.get("survivors"):
+            continue
+        rtl = out / r["target"].replace(":", "_") / "rtl"
+        meta = next(m for m in (json.loads(p.read_text()) for p in sorted(rtl.glob("*.json")))
+                    if isinstance(m, dict) and "ports" in m and "unit" in m)
+        lines = [l for l in (rtl / "mutations.ys").read_text().splitlines()
+                 if l.startswith("mutate ")]
+        for s in r["survivors"]:
+            t0 = time.perf_counter()
+            s["verdict"] = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout)
+            print(f"  {r['target']} #{s['index']}: {s['verdict']} ({time.perf_counter() - t0:.0f} s)",
+                  flush=True)
+        _tally(r)
+        path.write_text(json.dumps(saved, indent=1))
+    return 0
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python tests/mutants/netlist.py", description=__doc__.split("\n")[0])
     p.add_argument("--sample", type=int, default=20, help="mutations per target (default 20)")
@@ -349,17 +492,27 @@ def main(argv=None):
     p.add_argument("--equiv-timeout", type=int, default=30, help="seconds per equivalence proof")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "netlist_mutants")
     p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
-    p.add_argument("--doc-from", type=Path, default=None, metavar="JSON",
-                   help="only write --doc from a run's netlist_results.json (targets it finished)")
+    p.add_argument("--doc-from", type=Path, action="append", default=[], metavar="JSON",
+                   help="only write --doc from runs' netlist_results.json (repeatable: the "
+                        "runs' tables merged; the targets each finished)")
+    p.add_argument("--recheck", type=Path, default=None, metavar="JSON",
+                   help="only run the equivalence checks of a run's survivors again (on the "
+                        "netlists it kept under --out) and rewrite that JSON")
     a = p.parse_args(argv)
-    if a.doc_from is not None:
-        saved = json.loads(a.doc_from.read_text())
+    if a.recheck is not None:
+        return recheck(a.recheck, a.out, a.equiv_timeout)
+    if a.doc_from:
         if a.doc is None:
             print("error: --doc-from needs --doc", file=sys.stderr)
             return 2
-        command = f"python tests/mutants/netlist.py --sample {saved['sample']} --seed {saved['seed']} -j {saved['jobs']}"
-        write_doc(a.doc, report(saved["results"], saved["sample"], saved["seed"], saved["seconds"],
-                                saved["jobs"], command))
+        results, runs = [], []
+        for path in a.doc_from:
+            saved = json.loads(path.read_text())
+            command = saved.get("command") or (f"python tests/mutants/netlist.py --sample "
+                                               f"{saved['sample']} --seed {saved['seed']} -j {saved['jobs']}")
+            results += saved["results"]
+            runs.append((command, saved["seed"], saved["sample"], saved["jobs"], saved["seconds"]))
+        write_doc(a.doc, report(results, runs))
         return 0
     for name, value, lo in (("--sample", a.sample, 1), ("--jobs", a.jobs, 1),
                             ("--stimulus", a.stimulus, 16), ("--equiv-timeout", a.equiv_timeout, 1)):
@@ -382,6 +535,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     print(f"netlist mutation: {len(chosen)} targets, sample {a.sample}, seed {a.seed}, "
           f"{a.jobs} jobs, {os.cpu_count()} cores")
+    command = "python tests/mutants/netlist.py " + " ".join(argv if argv is not None else sys.argv[1:])
     results = []
     for target in chosen:
         try:
@@ -401,16 +555,15 @@ def main(argv=None):
         results.append(r)
         # saved after every target: a run stopped part way still has its finished targets
         (a.out / "netlist_results.json").write_text(json.dumps(
-            {"sample": a.sample, "seed": a.seed, "jobs": a.jobs, "results": results,
-             "seconds": time.perf_counter() - t0}, indent=1))
+            {"command": command, "sample": a.sample, "seed": a.seed, "jobs": a.jobs,
+             "results": results, "seconds": time.perf_counter() - t0}, indent=1))
     seconds = time.perf_counter() - t0
     print(f"total {seconds / 60:.1f} min wall")
-    command = "python tests/mutants/netlist.py " + " ".join(argv if argv is not None else sys.argv[1:])
     (a.out / "netlist_results.json").write_text(json.dumps(
-        {"sample": a.sample, "seed": a.seed, "jobs": a.jobs, "results": results,
-         "seconds": seconds}, indent=1))
+        {"command": command, "sample": a.sample, "seed": a.seed, "jobs": a.jobs,
+         "results": results, "seconds": seconds}, indent=1))
     if a.doc:
-        write_doc(a.doc, report(results, a.sample, a.seed, seconds, a.jobs, command))
+        write_doc(a.doc, report(results, [(command, a.seed, a.sample, a.jobs, seconds)]))
     bad = [r for r in results if "error" in r or r["killed"] < 0.95 * r["counted"]]
     return 1 if bad else 0
 
