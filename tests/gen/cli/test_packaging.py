@@ -85,3 +85,23 @@ def test_a_missing_extra_is_one_line_exit_2(tmp_path):
     # the same commands with nothing blocked do not say so (the check can fail)
     r = _core("bench", "golden", "--help", block="none")
     assert r.returncode == 0 and "extra" not in r.stderr
+
+
+def test_a_command_whose_extra_is_missing_keeps_its_arguments(monkeypatch, capsys):
+    """In process, with the bench command's module failing to import matplotlib: the
+    command still parses with any arguments after it (they belong to the missing command)
+    and main returns 2 with one line naming the extra, never an argparse error."""
+    import importlib
+    real = importlib.import_module
+
+    def without_matplotlib(name, *args):
+        if name == "bumprtl.gen.cli.bench":
+            raise ImportError("No module named 'matplotlib'", name="matplotlib")
+        return real(name, *args)
+
+    monkeypatch.setattr(importlib, "import_module", without_matplotlib)
+    assert main(["bench", "golden", "--samples", "10"]) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert out == "" and len(lines) == 1, err
+    assert "bumprtl bench needs the [bench] extra" in lines[0] and "matplotlib" in lines[0]

@@ -212,6 +212,18 @@ def test_every_lighting_model_tints_by_the_material_colour(model):
     assert np.allclose(tinted[:, 3], white[:, 3])
 
 
+def test_a_config_without_specular_gives_a_table_without_highlights():
+    """Config(specular=False) builds no H path and no cos^n table; the palette table made
+    from it has no specular term either: phong equals lambert, the blend layout's RGB is 0."""
+    cfg = Config(specular=False)
+    table = random_normals(4, seed=13).reshape(-1, 3)
+    lights, view = [[0, 0.6, 0.8]], [0, 0.0, 1.0]
+    assert Material.from_config(cfg).ks == 0.0
+    phong = color_table(table, "phong", lights, view, cfg)
+    assert np.allclose(phong, color_table(table, "lambert", lights, view, cfg))
+    assert np.allclose(color_table(table, "phong", lights, view, cfg, blend=True)[:, :3], 0)
+
+
 def test_chrome_reflects_the_viewer_and_toon_has_few_levels():
     table = np.array([[0, -1.0, 0], [0, -0.6, 0.8], [0, -0.6, -0.8]])
     view = np.array([0, -1.0, 0])
