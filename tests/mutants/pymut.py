@@ -123,7 +123,11 @@ def configure(dest, deselect, only=None, tests=None):
             # worker inherits what the clean run left there, the lru_caches of the golden
             # models' bounds among it, and a mutant behind a filled cache passes every test
             "process_isolation = forkserver", "forkserver_warmup = import",
-            f"preload_modules_file = {dest / 'preload_modules.txt'}", ""]
+            # a worker imports the project and collects its tests before the first one runs
+            # (seconds of CPU): mutmut's CPU limit, (tests' time + constant) x 2 x multiplier,
+            # with its constant of 1 s timed out mutants on that alone
+            "timeout_constant = 20.0",
+            f"preload_modules_file = {dest.resolve() / 'preload_modules.txt'}", ""]   # read from mutants/
     (dest / "setup.cfg").write_text("\n".join(cfg))
     (dest / "preload_modules.txt").write_text("\n".join(PRELOAD) + "\n")
     # pyproject's [tool.pytest] stays (markers, test paths); mutmut reads setup.cfg only
@@ -272,6 +276,9 @@ def main(argv=None):
           f"{100 * tot['killed'] / max(1, n_all):.1f}%  ({seconds / 60:.1f} min wall, seed {a.seed})")
     for name, kind, code in survivors:
         print(f"  {kind}: {name} (exit {code})")
+    if tot["not run"]:
+        print(f"error: {tot['not run']} mutant(s) of the sample did not run (mutmut stopped "
+              f"early: its fork server crashed?); see {log}", file=sys.stderr)
     diffs = {}
     for name, kind, _ in survivors:
         r = subprocess.run([str(Path(sys.executable).parent / "mutmut"), "show", name], cwd=tree,
