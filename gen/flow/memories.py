@@ -29,7 +29,7 @@ from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag
 
-__all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks",
+__all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
            "check_fits", "check_scene_fits", "hex_text", "memory_images", "emit_scene_unit", "host_writes",
            "scene_command"]
 
@@ -69,23 +69,31 @@ def table_blocks(depth, width):
     return bram_blocks(words, width) if bits is None else math.ceil(width / bits)
 
 
+def map_blocks(depth, width):
+    """DP16KD blocks of a map as rtl/pipe.RegisteredRAM lays it out on ECP5: the widest
+    DP16KD mode that holds every word in one block, blocks side by side for the width; a map
+    deeper than any mode is left to Yosys, counted in its cheapest tiling."""
+    bits = next((b for b, d, _ in DP16KD_MODES if d >= depth), None)
+    return bram_blocks(depth, width) if bits is None else math.ceil(width / bits)
+
+
 def check_fits(roms, device, what):
     """Raise a BumpError (naming ``what``, the bits it needs and the device's block RAM) when
-    the maps of ``roms`` (the sidecar's memories) and the pipeline's tables (each in the
-    cheapest tiling of its words, :func:`table_blocks`) do not fit ``device``. Returns
+    the maps of ``roms`` (the sidecar's memories, :func:`map_blocks`) and the pipeline's
+    tables (:func:`table_blocks`), each counted as laid out on ECP5, do not fit ``device``. Returns
     ``(blocks needed, blocks available)``."""
     if device not in DEVICE_BRAM:
         raise BumpError(f"device must be one of {', '.join(DEVICE_BRAM)}, got {device!r}")
     maps = {k: v for k, v in roms.items() if _is_map(k)}
     map_bits = sum(v["bits"] for v in maps.values())
-    map_blocks = sum(bram_blocks(v["depth"], v["width"]) for v in maps.values())
+    maps_need = sum(map_blocks(v["depth"], v["width"]) for v in maps.values())
     other = sum(table_blocks(v["depth"], v["width"]) for k, v in roms.items() if k not in maps)
     have = DEVICE_BRAM[device]
-    if map_blocks + other > have:
-        raise BumpError(f"{what}: the map needs {map_bits:,} bits of block RAM ({map_blocks} "
+    if maps_need + other > have:
+        raise BumpError(f"{what}: the map needs {map_bits:,} bits of block RAM ({maps_need} "
                         f"DP16KD of 18 kbit) beside {other} for the pipeline's tables; "
                         f"{device} has {have} DP16KD of 18 kbit ({have * BRAM_BITS:,} bits)")
-    return map_blocks + other, have
+    return maps_need + other, have
 
 
 def unit_memories(dut):
