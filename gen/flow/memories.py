@@ -64,9 +64,7 @@ def table_blocks(depth, width):
     2**n + 1 words keeps its last word in a flip-flop, the rest sits in the widest DP16KD
     mode that holds every word in one block, blocks side by side for the width."""
     n = depth - 1
-    words = n if n > 1 and n & (n - 1) == 0 else depth
-    bits = next((b for b, d, _ in DP16KD_MODES if d >= words), None)
-    return bram_blocks(words, width) if bits is None else math.ceil(width / bits)
+    return map_blocks(n if n > 1 and n & (n - 1) == 0 else depth, width)
 
 
 def map_blocks(depth, width):
