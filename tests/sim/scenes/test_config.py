@@ -185,3 +185,44 @@ def test_impossible_rotation_names_the_key_that_rules_it_out(keys, rotation, cau
         SceneConfig(**keys, rotation=rotation)
     msg = str(e.value)
     assert "\n" not in msg and "rotation" in msg and cause in msg and repr(allowed) in msg, msg
+
+
+def test_replace_changes_the_given_keys_only_and_validates_them():
+    scene = load_scene_config("default")
+    before = scene.to_dict()
+    got = scene.replace(texture_size=32, ks=0.25)
+    want = {**before, "texture_size": 32, "ks": 0.25}
+    assert got.to_dict() == want
+    assert scene.to_dict() == before                    # the original is left as it was
+    with pytest.raises(BumpError) as e:
+        scene.replace(texture_size=48)
+    assert e.value.field == "texture_size"
+
+
+def test_replace_derives_the_rotation_again():
+    """The rotation follows bump_map unless given: a flat map's scene turned back to a
+    varying map rotates per pixel again (the old per-polygon value is not carried over)."""
+    flat = load_scene_config("default", {"bump_map": "flat"})
+    assert flat.rotation == "per-polygon"
+    assert flat.replace(bump_map="varying").rotation == "per-pixel"
+    assert load_scene_config("default").replace(bump_map="flat").rotation == "per-polygon"
+
+
+def test_replace_with_a_map_drops_the_scenes_picture_and_other_map(tmp_path):
+    import numpy as np
+
+    heights = tmp_path / "h.npy"
+    np.save(heights, np.add.outer(np.arange(16.0), np.arange(16.0)) % 5 / 4)
+    normals = tmp_path / "n.npy"
+    n = np.zeros((16, 16, 3))
+    n[..., 2] = 1.0
+    n[3, 4] = (0.6, 0.0, 0.8)
+    np.save(normals, n)
+    scene = load_scene_config("default", {"texture_size": 16})
+    assert scene.image == "bricks"
+    mine = scene.replace(height_map=str(heights))
+    assert (mine.image, mine.height_map, mine.normal_map) == (None, str(heights), None)
+    other = mine.replace(normal_map=str(normals))
+    assert (other.image, other.height_map, other.normal_map) == (None, None, str(normals))
+    # a change that is not a map keeps the map
+    assert mine.replace(ks=0.3).height_map == str(heights)

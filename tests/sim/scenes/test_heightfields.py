@@ -1,0 +1,51 @@
+"""The crater height map (sim/scenes/heightfields.craters, the "unseen map" of the channel
+tests) against its closed form: a crater of radius r centred at c is d^2 - 1 inside (d =
+|p - c| / r, wrapped round the tile) and a rim 0.3 exp(-((d - 1) / 0.3)^2) outside, the
+sum scaled to [0, 1]."""
+
+import numpy as np
+import pytest
+
+from bumprtl.sim.scenes.heightfields import craters
+
+
+def _wrapped(a, c, t):
+    return (a - c + t / 2) % t - t / 2
+
+
+@pytest.mark.parametrize("seed", [1, 7])
+def test_one_crater_is_a_bowl_and_a_rim_scaled_to_unit_range(seed):
+    t, frac = 64, 0.2
+    h = craters(t, seed, 1, radius=(frac, frac))
+    assert h.shape == (t, t) and h.min() == 0.0 and h.max() == 1.0
+    r = frac * t
+    # the bowl's bottom: the centre within one texel of the lowest texel centre
+    iy, ix = np.unravel_index(np.argmin(h), h.shape)
+    y, x = np.mgrid[0:t, 0:t] + 0.5
+    best = None
+    for cy in np.linspace(iy, iy + 1, 11):            # search the centre on a 0.1-texel grid
+        for cx in np.linspace(ix, ix + 1, 11):
+            d = np.hypot(_wrapped(x, cx, t), _wrapped(y, cy, t)) / r
+            raw = np.where(d < 1, d ** 2 - 1, 0.3 * np.exp(-((d - 1) / 0.3) ** 2))
+            want = (raw - raw.min()) / np.ptp(raw)
+            ok = np.abs(d - 1) > 0.02                  # the rim's step (0 inside, 0.3 out)
+            err = np.abs(h - want)[ok].max()
+            best = err if best is None else min(best, err)
+    # 0.05 texel from the true centre moves d by 0.05 / r, the height by at most ~2 d' / 1.3
+    assert best < 0.02, best
+
+
+def test_craters_tile():
+    t = 64
+    one, many = craters(t, 3, 1), craters(t, 3, 12)
+    for h in (one, many):
+        assert h.min() == 0.0 and h.max() == 1.0
+        # tiling: the wrapped neighbour across each edge is as close as neighbours inside
+        inside = max(np.abs(np.diff(h, axis=0)).max(), np.abs(np.diff(h, axis=1)).max())
+        assert np.abs(h[0] - h[-1]).max() <= inside and np.abs(h[:, 0] - h[:, -1]).max() <= inside
+    assert not np.array_equal(one, many)
+
+
+def test_the_seed_fixes_the_map():
+    assert np.array_equal(craters(32, 5, 4), craters(32, 5, 4))
+    assert not np.array_equal(craters(32, 5, 4), craters(32, 6, 4))
