@@ -162,3 +162,34 @@ def test_optional_reads_the_top_level_module_of_the_error():
     assert cli_main._optional(ImportError(name="cocotb_tools.runner")) == ("sim", "cocotb_tools")
     assert cli_main._optional(ImportError(name="z3")) == ("formal", "z3")
     assert cli_main._optional(ImportError("no name")) == (None, "")
+
+
+def test_help_names_both_papers_and_lists_every_command_in_order(capsys):
+    with pytest.raises(SystemExit) as e:
+        cli_main.main(["--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith("usage: bumprtl [-h] [--version] COMMAND ...")
+    description = " ".join(out.split("\n\n")[1].split())
+    assert description.startswith("Bump-mapping hardware generator") and description.endswith(".")
+    assert "Lee et al. 2003" in description and "Tarini et al. 2000" in description
+    listed = [l.split()[0] for l in out.split("COMMAND\n", 1)[1].split("\n\n")[0].splitlines()
+              if l.startswith("    ") and not l.startswith("      ")]
+    assert listed == [c for c, _, _ in cli_main.COMMANDS]
+
+
+def test_no_command_is_an_error_naming_command(capsys):
+    with pytest.raises(SystemExit) as e:
+        cli_main.main([])
+    assert e.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.splitlines()[-1] == "bumprtl: error: the following arguments are required: COMMAND"
+
+
+def test_a_command_returning_nothing_exits_0_and_its_status_otherwise(monkeypatch):
+    for value, status in ((None, 0), (0, 0), (3, 3)):
+        class Parser:
+            def parse_args(self, argv):
+                return argparse.Namespace(func=lambda args: value)
+        monkeypatch.setattr(cli_main, "build_parser", Parser)
+        assert cli_main.main(["x"]) == status
