@@ -226,3 +226,41 @@ def test_replace_with_a_map_drops_the_scenes_picture_and_other_map(tmp_path):
     assert (other.image, other.height_map, other.normal_map) == (None, None, str(normals))
     # a change that is not a map keeps the map
     assert mine.replace(ks=0.3).height_map == str(heights)
+
+
+@pytest.mark.parametrize("keys, words", [
+    ({"name": 3}, ["name", "string", "3"]),
+    ({"bump_map": "bumpy"}, ["bump_map", "varying, flat", "'bumpy'"]),
+    ({"shading": "gouraud"}, ["shading", "per-pixel, palette", "'gouraud'"]),
+    ({"addressing": "mirror"}, ["addressing", "wrap, clamp", "'mirror'"]),
+    ({"specular": 1}, ["specular", "true or false", "1"]),
+    ({"texture": None}, ["texture", "true or false", "None"]),
+    ({"resample": "no"}, ["resample", "true or false", "'no'"]),
+    ({"lights": 0}, ["lights", "[1, 8]", "0"]),
+    ({"texture_size": 48}, ["texture_size", "power of two", "[16, 4096]", "48"]),
+    ({"mip_levels": 8}, ["mip_levels", "[1, 7]", "64", "8"]),
+    ({"angle_bits": 40}, ["angle_bits", "[4, 16]", "40"]),
+    ({"method": "kim"}, ["method", "exact, lee", "'kim'"]),
+    ({"method": "lee", "bump_map": "flat"}, ["bump_map = 'flat'", "method = 'exact'", "'lee'"]),
+    ({"method": "lee", "lights": 2}, ["lights = 2", "method = 'exact'", "lee"]),
+    ({"height_map": ""}, ["height_map", "file path", "''"]),
+    ({"height_map": "a.png", "normal_map": "b.png"}, ["height_map", "normal_map", "not both"]),
+    ({"image": "nope"}, ["image", "bricks", "globe", "height_map", "'nope'"]),
+    ({"normal_convention": "up"}, ["normal_convention", "opengl, directx", "'up'"]),
+    ({"geometry": "torus"}, ["geometry", "plane, sphere, cylinder", "'torus'"]),
+    ({"height_scale": 0.0}, ["height_scale", "positive finite", "0.0"]),
+    ({"height_map": "a.png", "bump_map": "flat"}, ["height_map", "bump_map = 'varying'"]),
+    ({"rotation": "per-polygon"}, ["rotation = 'per-polygon'", "bump_map = 'varying'", "'per-pixel'"]),
+    ({"rotation": "diagonal"}, ["rotation", "per-pixel, per-polygon, none", "'diagonal'"]),
+    ({"shading": "palette", "rotation": "per-pixel"}, ["rotation = 'per-pixel'", "shading = 'palette'",
+                                                       "colour table", "'none'"]),
+])
+def test_every_refusal_names_the_key_the_value_and_what_is_allowed(keys, words):
+    """One line naming the parameter, the value given and the allowed values or range (the
+    CLI prints it as it is)."""
+    with pytest.raises(BumpError) as e:
+        SceneConfig(**keys)
+    msg = str(e.value)
+    assert "\n" not in msg
+    for w in words:
+        assert w in msg, (w, msg)
