@@ -1,9 +1,9 @@
 """The bulk path (sim/tb/bulk.py): stimulus and outputs as arrays, the clock inside the
 simulator, the build cached by the Verilog's digest.
 
-`make test`: a small frame of the default pipeline on both simulators under every traffic
-pattern, byte-exact against the golden model; a second run starts from the cached build;
-a wrong golden value fails; bad stimulus is refused before the build; a deadlock ends in
+`make test`: the default pipeline's coverage frame (sim/tb/bulk_frame.py) under every
+traffic pattern, bit-exact against the golden model, and a rendered frame byte-exact from
+the cached build; a wrong golden value fails; bad stimulus is refused before the build; a deadlock ends in
 a timeout that counts the pixels in and out. `make regress`: >= 10^7 vectors through each
 emitted unit and the default pipeline under every traffic pattern on Verilator (this
 replaces the per-cycle 10^6-vector runs, keeping their units, methods, patterns and the
@@ -25,6 +25,7 @@ from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.tb import bulk
 from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
                                  decode_words, encode_words, run_bulk)
+from bumprtl.sim.tb.bulk_frame import coverage_frame
 from bumprtl.sim.tb.bulk_sources import pipeline_map
 from bumprtl.sim.tb.bulk_shards import run_bulk_shards
 from bumprtl.rtl.methods import PER_PIXEL
@@ -47,21 +48,29 @@ ICARUS_HERE = [pytest.param(s, marks=pytest.mark.regress if s == "verilator" els
 
 @pytest.mark.parametrize("sim", ICARUS_HERE)
 def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
-    """A frame of the default scene through its emitted pipeline under all four traffic
-    patterns: every output field equals the golden model's (checked in cocotb and here),
-    the image equals the golden render byte for byte; no stall means one pixel per clock,
-    stalls cost cycles; a second run reuses the build."""
+    """The default scene's emitted pipeline under all four traffic patterns: the coverage
+    frame (sim/tb/bulk_frame.py: map words written through the host port first, then L, H,
+    N and texels over their whole ranges, near +-N'' where cos^n is steep, tags over the
+    whole tag range) has every output field equal to the golden model's (checked in cocotb
+    and here); no stall means one pixel per clock, stalls cost cycles. Then a rendered frame
+    through the same build (a second run reuses it) equals the golden render byte for byte.
+    The netlist mutants of the scene pipelines run this frame (tests/mutants/netlist.py)."""
     size = FRAME[sim]
-    scene, inputs, words, polygon, table, texels = _frame(size)
-    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
-    outs, cycles, r = run_pipeline_bulk(scene, inputs, words, polygon, table, sim, build_dir,
-                                        patterns=tuple(TRAFFIC), texels=texels, expected=golden)
-    assert r.checked
+    scene, _, words, _, _, texels = _frame(size)
+    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    meta = json.loads(j.read_text())
     n = size * size
-    latency = json.loads((build_dir / "rtl" / "pipeline.json").read_text())["latency"]
+    frame = coverage_frame(scene, words, texels, n=n)
+    golden = frame.expected(meta)
+    r = run_bulk(sim, v, j, build_dir / f"bulk_{sim}", tuple(TRAFFIC), inputs=frame.inputs,
+                 expected=golden, setup=frame.setup(meta))
+    outs, cycles = r.outputs, r.cycles
+    assert r.checked
+    assert set(golden) == set(meta["ports"]["o__payload"]["fields"])
+    latency = meta["latency"]
     for pattern in TRAFFIC:
         assert r.pixels[pattern] == n
-        assert np.array_equal(outs[pattern]["tag"], inputs["tag"]), pattern
+        assert np.array_equal(outs[pattern]["tag"], frame.inputs["tag"]), pattern
         for field, want in golden.items():
             assert np.array_equal(outs[pattern][field], want), (pattern, field)
     assert cycles["no_stall"] <= n + latency + 2

@@ -1,0 +1,265 @@
+"""The coverage frame of a scene's pipeline on the bulk path (sim/tb/bulk.py): few pixels,
+each chosen to move a part of the datapath a rendered frame leaves still.
+
+A rendered 16 x 16 frame of a built-in scene has one world normal, one light and one
+halfway vector for every pixel, reads 256 of the map's texels (none of them past the map's
+edge, all at level 0) and tags 0..255: most of the rotation, the dot products, the cos^n
+table and the address logic never see a second value. This frame keeps the scene's
+pipeline as it is emitted (its map, colour texture and tables built in) and, per pixel:
+
+* texel coordinates over the whole signed port range (wrap or clamp, both sides of the
+  map), levels over the whole level port (past the last level too); a third of the pixels
+  on the scene's steepest and flattest texels, a third on words the host wrote through the
+  map's (and the colour texture's) write port before the stream: N' at the poles, at
+  90 degrees, at every quadrant's edge and random, random palette indices and RGB words;
+* world N over the whole sphere and at its poles and quadrant edges (varying map); a flat
+  map's polygon registers hold a tilted N' (every n'' term non-zero);
+* for every light, L and H each drawn from a mix: the whole sphere (both signs of every dot
+  product), theta at or next to 0 and 180 degrees, phi next to 0 / 360, and directions
+  within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
+  where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
+* tags random over the whole tag range (0 and the largest tag included);
+* a palette scene's colour table random, written after a decoy table (two bank swaps).
+
+The golden outputs are sim/golden/fixed/pipeline.py's on the memories as the host left
+them. Deterministic in ``seed``: make test's bulk pipeline test and the netlist mutants of
+tests/mutants/netlist.py run the same frame (:data:`PIXELS`, :data:`SEED`).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from bumprtl.rtl.bumpfetch import (coord_bits, has_map, level_bases, level_bits,
+                                   memory_depth, pack_texels)
+from bumprtl.rtl.layouts import light_keys
+from bumprtl.rtl.palette import CHANNELS, index_bits
+from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian, tangent_rotation
+from bumprtl.sim.golden.fixed.common import angle_codes
+from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
+from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, pipeline_fixed, polygon_fixed,
+                                               unpack_texels)
+from bumprtl.sim.tb.bulk_wrapper import setup_writes
+
+__all__ = ["PIXELS", "SEED", "CoverageFrame", "coverage_frame"]
+
+PIXELS = 256                 # make test's frame (Icarus): as many pixels as the 16 x 16 frame
+SEED = 1
+WRITTEN = 32                 # map (and texture) words the host writes before the stream
+TWO_PI = 2 * np.pi
+
+
+@dataclass
+class CoverageFrame:
+    inputs: dict             # {field: int64 array}, the i__payload fields
+    words: np.ndarray        # the map after the host's writes (None without one)
+    texels: np.ndarray       # the colour texture after the host's writes (None without one)
+    writes: list             # host cycles before the stream: map / texture words
+    polygon: dict            # a flat map's polygon registers (None otherwise)
+    table: np.ndarray        # a palette scene's colour table (None otherwise)
+    decoy: np.ndarray        # the table written and swapped in before ``table``
+    golden: dict             # {field: int64 array}: every output field the model gives
+
+    def setup(self, meta):
+        """The host cycles of the run (``meta``: the emitted pipeline's sidecar)."""
+        cycles = list(self.writes)
+        if self.decoy is not None:
+            cycles += setup_writes(meta, None, self.decoy)
+        return cycles + setup_writes(meta, self.polygon, self.table)
+
+    def expected(self, meta):
+        """The golden outputs of the pipeline's output fields, the tag included."""
+        outs = meta["ports"]["o__payload"]["fields"]
+        return {k: np.asarray(v, np.int64) for k, v in self.golden.items() if k in outs}
+
+
+def _dirs(rng, n):
+    """Uniform directions over the whole sphere: (phi, theta) radians."""
+    return rng.uniform(0, TWO_PI, n), np.arccos(rng.uniform(-1, 1, n))
+
+
+def _perpendicular(rng, axis):
+    """Random unit vectors perpendicular to the unit vectors ``axis`` (n, 3)."""
+    helper = np.where(np.abs(axis[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    e1 = np.cross(axis, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(axis, e1)
+    turn = rng.uniform(0, TWO_PI, len(axis))[:, None]
+    return np.cos(turn) * e1 + np.sin(turn) * e2
+
+
+def _near(rng, axis, spread):
+    """Unit vectors within ``spread`` radians of the unit vectors ``axis`` (n, 3): the
+    angle uniform in [0, spread] (exactly 0 for about one in seven), its direction random."""
+    n = len(axis)
+    tilt = rng.uniform(0, spread, n)
+    tilt[rng.random(n) < 0.15] = 0.0
+    side = _perpendicular(rng, axis)
+    return np.cos(tilt)[:, None] * axis + np.sin(tilt)[:, None] * side
+
+
+def _codes(phi, theta, cfg):
+    return angle_codes(phi, cfg).astype(np.int64), angle_codes(theta, cfg).astype(np.int64)
+
+
+def _edge_angles(rng, n, cfg, theta_top):
+    """Angle codes at the edges: theta at or next to 0 and ``theta_top``, phi at or next to
+    0 / 360 and the quadrant boundaries."""
+    full, q = cfg.full_circle, cfg.full_circle // 4
+    thetas = np.array([0, 1, 2, q - 1, q, q + 1, theta_top - 2, theta_top - 1, theta_top])
+    phis = np.array([0, 1, full - 1, full - 2, q - 1, q, 2 * q, 2 * q + 1, 3 * q, 3 * q - 1])
+    return rng.choice(phis, n), rng.choice(thetas, n)
+
+
+def _light(rng, n, cfg, axis):
+    """L or H of one light for ``n`` pixels whose bumped normal is ``axis`` (world, (n, 3)):
+    each pixel from one of six kinds (module docstring)."""
+    full, half = cfg.full_circle, cfg.full_circle // 2
+    kind = rng.integers(0, 6, n)
+    phi, theta = _codes(*_dirs(rng, n), cfg)                              # 0: whole sphere
+    e_phi, e_theta = _edge_angles(rng, n, cfg, half)                      # 1: poles, edges
+    sign = np.where(rng.random(n) < 0.75, 1.0, -1.0)[:, None]
+    steep = _codes(*cartesian_to_polar(sign * _near(rng, axis, 0.35)), cfg)      # 2: +-N''
+    close = _codes(*cartesian_to_polar(sign * _near(rng, axis, 0.03)), cfg)      # 3: +-N''
+    graze = _codes(*cartesian_to_polar(_near(rng, _perpendicular(rng, axis), 0.05)), cfg)  # 4
+    w_phi = (rng.integers(-3, 4, n)) % full                                       # 5: phi wrap
+    for k, (p, t) in enumerate([(e_phi, e_theta), steep, close, graze, (w_phi, theta)], 1):
+        phi, theta = np.where(kind == k, p, phi), np.where(kind == k, t, theta)
+    return phi, theta
+
+
+def _texel_writes(scene, rng, words, texels):
+    """``WRITTEN`` map addresses (over the whole memory), the words written there (N' at the
+    edges of its range, or random palette indices) and random texture words."""
+    cfg = scene.config
+    depth = memory_depth(scene)
+    addr = rng.choice(depth, min(WRITTEN, depth), replace=False)
+    m = len(addr)
+    new_words = new_texels = None
+    if words is not None:
+        if scene.shading == "palette":
+            word = pack_texels(scene, index=rng.integers(0, 1 << index_bits(cfg), m))
+        else:
+            full, q = cfg.full_circle, cfg.full_circle // 4
+            phi = rng.choice(np.array([0, 1, q - 1, q, 2 * q - 1, 2 * q, 3 * q, full - 1]), m)
+            phi = np.where(rng.random(m) < 0.3, rng.integers(0, full, m), phi)
+            theta = rng.choice(np.array([0, 1, q // 2, q - 2, q - 1, q]), m)
+            theta = np.where(rng.random(m) < 0.3, rng.integers(0, q + 1, m), theta)
+            word = pack_texels(scene, phi=phi, theta=theta)
+        new_words = np.asarray(words, np.int64).copy()
+        new_words[addr] = word
+    if texels is not None:
+        new_texels = np.asarray(texels, np.int64).copy()
+        new_texels[addr] = rng.integers(0, 1 << 24, m)
+    writes = []
+    for k, a in enumerate(addr.tolist()):
+        cycle = {}
+        if new_words is not None:
+            cycle.update({"map_w_en": 1, "map_w_addr": a, "map_w_data": int(new_words[a])})
+        if new_texels is not None:
+            cycle.update({"tex_w_en": 1, "tex_w_addr": a, "tex_w_data": int(new_texels[a])})
+        writes.append(cycle)
+    return addr, new_words, new_texels, writes
+
+
+def _address_coords(scene, addr, rng):
+    """Level-0 texel coordinates (u, v) and the level that read word ``addr``."""
+    bases = level_bases(scene)
+    level = np.searchsorted(bases, addr, side="right") - 1
+    size = scene.texture_size >> level
+    local = addr - np.asarray(bases)[level]
+    u, v = (local % size) << level, (local // size) << level
+    u = u + rng.integers(0, 1 << level)           # the dropped low bits of floor(u / 2**l)
+    v = v + rng.integers(0, 1 << level)
+    if scene.addressing == "wrap":                # a map width further (either side)
+        t = scene.texture_size
+        u = u + t * rng.integers(-2, 2, len(u))
+        v = v + t * rng.integers(-2, 2, len(v))
+    return u, v, level
+
+
+def _texel_inputs(scene, n, rng, words, addr):
+    """u, v (and level) of ``n`` pixels: the whole port range, the written words, the
+    scene's steepest and flattest texels (level 0)."""
+    half = 1 << (coord_bits(scene) - 1)
+    out = {"u": rng.integers(-half, half, n), "v": rng.integers(-half, half, n)}
+    lb = level_bits(scene)
+    level = rng.integers(0, 1 << lb, n) if lb else np.zeros(n, np.int64)
+    kind = np.arange(n) % 3
+    pick = np.nonzero(kind == 1)[0]
+    wu, wv, wl = _address_coords(scene, addr[np.arange(len(pick)) % len(addr)], rng)
+    out["u"][pick], out["v"][pick], level[pick] = wu, wv, wl
+    pick = np.nonzero(kind == 2)[0]
+    if len(pick) and words is not None and scene.shading != "palette":
+        t = scene.texture_size
+        theta = (np.asarray(words[:t * t], np.int64) >> scene.angle_bits)
+        order = np.argsort(theta, kind="stable")
+        ends = np.concatenate([order[::-1][:(len(pick) + 1) // 2], order[:len(pick) // 2]])
+        out["u"][pick], out["v"][pick], level[pick] = ends % t, ends // t, 0
+    elif len(pick) and words is not None:        # palette: every index the map holds
+        t = scene.texture_size
+        first = np.unique(np.asarray(words[:t * t]), return_index=True)[1]
+        texel = rng.choice(first, len(pick), replace=len(first) < len(pick))
+        out["u"][pick], out["v"][pick], level[pick] = texel % t, texel // t, 0
+    if lb:
+        out["level"] = level
+    return out
+
+
+def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
+    """The bumped normal N'' in the world (n, 3) from the codes: M^T N' (Lee Sec. 3.1.1)."""
+    rad = lambda c: np.asarray(c, np.float64) * (TWO_PI / cfg.full_circle)
+    m = tangent_rotation(rad(n_phi), rad(n_theta))
+    return np.einsum("pji,pj->pi", m, polar_to_cartesian(rad(b_phi), rad(b_theta)))
+
+
+def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
+    """The coverage frame of ``scene``'s pipeline emitted with map ``words`` and colour
+    texture ``texels`` (as gen/render/rtl.scene_stimulus gives them; None without one)."""
+    cfg = scene.config
+    rng = np.random.default_rng([seed, n])
+    inputs, writes, polygon, table, decoy = {}, [], None, None, None
+    addr = None
+    if has_map(scene) or scene.texture:
+        addr, words, texels, writes = _texel_writes(scene, rng, words, texels)
+        inputs.update(_texel_inputs(scene, n, rng, words, addr))
+    if scene.shading == "palette":
+        top = cfg.palette_size
+        decoy = pack_rgba(rng.integers(0, 256, (top, 4)), cfg)
+        table = pack_rgba(rng.integers(0, 256, (top, 4)), cfg)
+    else:
+        if scene.bump_map == "varying":
+            fetched = unpack_texels(fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"),
+                                                words, scene), scene)
+            n_phi, n_theta = _codes(*_dirs(rng, n), cfg)
+            e_phi, e_theta = _edge_angles(rng, n, cfg, cfg.full_circle // 2)
+            edge = rng.random(n) < 0.4
+            n_phi, n_theta = np.where(edge, e_phi, n_phi), np.where(edge, e_theta, n_theta)
+            inputs["n.phi"], inputs["n.theta"] = n_phi, n_theta
+            b_phi, b_theta = fetched["b.phi"], fetched["b.theta"]
+        else:                       # a plane facing +z with a tilted N' in its registers
+            q = cfg.full_circle // 4
+            n_phi = np.full(n, int(rng.integers(0, cfg.full_circle)))
+            n_theta = np.zeros(n, np.int64)
+            b_phi = np.full(n, int(rng.integers(0, cfg.full_circle)))
+            b_theta = np.full(n, int(rng.integers(q // 3, 2 * q // 3)))
+            polygon = polygon_fixed(n_phi[0], 0, b_phi[0], b_theta[0], scene)
+        axis = _world_normal(n_phi, n_theta, b_phi, b_theta, cfg)
+        for keys in light_keys(cfg):
+            for own, key in keys.items():
+                if own.endswith(".phi"):
+                    inputs[key], inputs[keys[own[:-4] + ".theta"]] = _light(rng, n, cfg, axis)
+    mask = (1 << scene.tag_bits) - 1
+    tag = rng.integers(0, mask + 1, n)
+    tag[:2] = (0, mask)
+    inputs["tag"] = tag
+    inputs = {k: np.asarray(v, np.int64) for k, v in inputs.items()}
+    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
+    if scene.shading == "palette":
+        entry = unpack_rgba(np.asarray(table)[golden["index"]], cfg)
+        if scene.texture:
+            entry = blend_eq2(entry, unpack_rgba(golden["texel"] | (255 << 24), cfg), cfg)
+        golden = {**golden, **{f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}}
+    golden = {k: np.asarray(v, np.int64) for k, v in golden.items()}
+    golden["tag"] = inputs["tag"]
+    return CoverageFrame(inputs, words, texels, writes, polygon, table, decoy, golden)
