@@ -39,8 +39,9 @@ def _out_fields(meta):
 
 
 def _datapath(meta, spec, chunk):
-    """Rotation or illumination: the edge cases, then random pixels (seed + chunk number);
-    golden = the unit's bit-exact model (rtl/methods.py)."""
+    """Rotation or illumination: the edge cases and (exact method) the pixels whose dot
+    products sit next to a rounding carry (:func:`rounding_codes`), then random pixels
+    (seed + chunk number); golden = the unit's bit-exact model (rtl/methods.py)."""
     cfg = Config(**meta["config"])
     unit, outs = meta["unit"], _out_fields(meta)
     keys = [k for k in meta["ports"]["i__payload"]["fields"] if k != "tag"]
@@ -49,8 +50,11 @@ def _datapath(meta, spec, chunk):
         start = 0
         for k, n in enumerate(_counts(int(spec["n"]), chunk)):
             codes = random_codes(n, cfg, seed=int(spec.get("seed", 0)) * 1000 + k)
-            if k == 0:
+            if k == 0:          # the edge cases and the rounding carries first
                 edges = edge_codes(cfg)
+                near = rounding_codes(cfg, int(spec.get("seed", 0)))
+                if near is not None:
+                    edges = {c: np.concatenate([edges[c], near[c]]) for c in edges}
                 m = min(n, len(edges["n.phi"]))
                 codes = {c: np.concatenate([edges[c][:m], codes[c][:n - m]]) for c in codes}
             codes = get(cfg.method).from_angle_codes(codes, cfg)   # Cartesian: Peercy, Ernst
@@ -64,6 +68,33 @@ def _datapath(meta, spec, chunk):
                    {**{c: np.asarray(want[c], np.int64) for c in outs}, "tag": tag})
             start += n
     return [], chunks()
+
+
+ROUNDING_POOL = 1 << 14      # random pixels searched for the dot products' rounding carries
+ROUNDING_PIXELS = 64         # pixels kept a dot product (L's, and H's with specular)
+
+
+def rounding_codes(cfg, seed=0):
+    """Angle codes of pixels whose exact-method dot products sit next to their one rounding
+    (rtl/exact.py: ``(pair + zz_half) >> (B + 3)``, the rounding half in ``zz_half``): of
+    ROUNDING_POOL random pixels, the ROUNDING_PIXELS per dot whose sum lies nearest to a
+    carry into bit B + 3, either side (a few hundred LSBs at most), so a wrong low bit of
+    either adder operand moves the dot. Random pixels reach such a sum about once in a
+    thousand. None for the other methods (other dot products)."""
+    if cfg.method != "exact":
+        return None
+    codes = random_codes(ROUNDING_POOL, cfg, seed=seed)
+    rot = rotation_fixed(codes, cfg)
+    shift = cfg.frac_bits + 3
+    picks = []
+    for v in ("l", "h") if cfg.specular else ("l",):
+        w = lambda k: np.asarray(rot[k], np.int64)
+        acc = (w("n.x4") * w(f"{v}.p2") + 2 * w("n.y2") * w(f"{v}.y2")
+               + 2 * w("n.z4") * w(f"{v}.z"))
+        d = (acc + (1 << (shift - 1))) & ((1 << shift) - 1)
+        picks.append(np.argsort(np.minimum(d, (1 << shift) - d), kind="stable")[:ROUNDING_PIXELS])
+    keep = np.concatenate(picks)
+    return {k: np.asarray(c)[keep] for k, c in codes.items()}
 
 
 def _sincos(meta, spec, chunk):

@@ -1,7 +1,9 @@
 """cocotb testbench for the emitted rotation.v / illumination.v (either method).
 
-The unit and its Config come from the sidecar; stimulus is the edge cases plus random
-valid pixels (BUMPRTL_SAMPLES of them); the golden model is the method's in sim/golden/fixed/.
+The unit and its Config come from the sidecar; stimulus is the edge cases, (exact method)
+the pixels whose dot products sit next to a rounding carry (sim/tb/bulk_sources.py's
+rounding_codes), then random valid pixels (BUMPRTL_SAMPLES of them); the golden model is
+the method's in sim/golden/fixed/.
 """
 
 import cocotb
@@ -10,6 +12,7 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads, edge_codes, random_codes
+from bumprtl.sim.tb.bulk_sources import rounding_codes
 from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, run_stream, samples
 
 
@@ -17,7 +20,8 @@ def _stimulus(unit, cfg, n, seed, fields):
     """``(payloads, model)``: the input payloads, and the golden model of the output
     ``fields`` (the sidecar's output port fields) for the inputs the DUT accepted."""
     edges, rand = edge_codes(cfg), random_codes(n, cfg, seed=seed)
-    codes = {k: np.concatenate([edges[k], rand[k]]) for k in edges}
+    near = rounding_codes(cfg, seed) or {k: [] for k in edges}    # exact: rounding carries
+    codes = {k: np.concatenate([edges[k], near[k], rand[k]]).astype(np.int64) for k in edges}
     codes = get(cfg.method).from_angle_codes(codes, cfg)   # Cartesian for Peercy, Ernst
     if unit == "rotation":
         return as_payloads(codes, cfg), lambda acc: _golden(acc, cfg, rotation_fixed, fields)
