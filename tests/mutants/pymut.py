@@ -136,7 +136,8 @@ def failing_tests(dest, env, log, tests=None, jobs=1):
     processes than the mutants themselves get)."""
     r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rf", "-n", str(jobs), "-p", "no:cacheprovider",
                         "-m", "not regress and not fpga and not formal", *selected_tests(dest, tests)],
-                       cwd=dest, env={**env, "PYTHONPATH": str(dest)}, capture_output=True, text=True)
+                       cwd=dest, env={**env, "PYTHONPATH": str(dest), "MUTANT_UNDER_TEST": ""},
+                       capture_output=True, text=True)
     with open(log, "a") as f:
         f.write("\n$ baseline pytest\n" + r.stdout[-3000:] + r.stderr[-2000:])
     return sorted({l.split()[1] for l in r.stdout.splitlines() if l.startswith("FAILED ")})
@@ -149,6 +150,9 @@ def configure(dest, deselect, only=None, tests=None):
     cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
             "    -m", "    not regress and not fpga and not formal",
             *[x for d in deselect for x in ("    --deselect", f"    {d}")],
+            # mutmut runs the tests in mutants/, which holds the package and tests/ only:
+            # tests/gen/cli/test_packaging.py::test_version reads the changelog beside them
+            "also_copy =", "    CHANGELOG.md",
             "use_git_change_detection = false", "timeout_multiplier = 5.0",
             # each mutant's tests run in a process forked from a server that imported the
             # third-party modules only: forked from mutmut's own process (its default), a
@@ -422,7 +426,10 @@ def main(argv=None):
         return all_results(tree) if (tree / "mutants" / "mutmut-stats.json").exists() else {}
     results = record()
     if not results and not a.baseline:
-        deselect = failing_tests(tree, env, log, a.tests, a.jobs)
+        # where mutmut ran them: its mutants/ copy (the trampolines switched off), which
+        # holds only what mutmut copies there
+        where = tree / "mutants" if (tree / "mutants").is_dir() else tree
+        deselect = failing_tests(where, env, log, a.tests, a.jobs)
         results = record() if deselect else {}
     if deselect:
         print(f"{len(deselect)} selected test(s) fail on commit {commit} itself and are left out: "
