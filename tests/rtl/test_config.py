@@ -81,3 +81,27 @@ def test_bad_type_or_choice_names_the_field(field, value):
     with pytest.raises(ConfigError) as e:
         Config(**{field: value})
     assert e.value.field == field
+
+
+@pytest.mark.parametrize("angle_bits", [8, 12, 14, 16])
+def test_the_frac_bits_floor_the_message_explains_is_the_range_it_gives(angle_bits):
+    """The explanation's B >= k - 1 (k = angle_bits - 2) is the range's own lower end, and
+    the refused value and both ends are named."""
+    k = angle_bits - 2
+    with pytest.raises(ConfigError) as e:
+        Config(angle_bits=angle_bits, frac_bits=3)
+    msg = str(e.value)
+    lo = max(4, k - 1)
+    assert msg.startswith(f"frac_bits = 3 is out of range: allowed [{lo}, 24] (")
+    assert f"B >= k - 1 = {k - 1} " in msg
+
+
+def test_a_range_without_an_explanation_ends_at_the_range():
+    for kw, text in (({"lights": 9}, "lights = 9 is out of range: allowed [1, 8]"),
+                     ({"spec_index_bits": 3}, "spec_index_bits = 3 is out of range: allowed [4, 16]")):
+        with pytest.raises(ConfigError) as e:
+            Config(**kw)
+        assert str(e.value) == text
+    with pytest.raises(ConfigError) as e:
+        Config(angle_bits=3)
+    assert str(e.value).endswith("allowed [4, 16] (k = angle_bits - 2 must be >= 2)")
