@@ -105,3 +105,21 @@ def test_a_range_without_an_explanation_ends_at_the_range():
     with pytest.raises(ConfigError) as e:
         Config(angle_bits=3)
     assert str(e.value).endswith("allowed [4, 16] (k = angle_bits - 2 must be >= 2)")
+
+
+@pytest.mark.parametrize("field, value", [("ka", True), ("kd", False), ("ks", "0.5"),
+                                          ("palette_blend", 1)])
+def test_a_flag_of_the_wrong_type_is_refused_naming_field_and_value(field, value):
+    """A bool is no coefficient (True == 1 would pass the range), a string no number."""
+    with pytest.raises(ConfigError) as e:
+        Config(**{field: value})
+    assert e.value.field == field
+    assert str(e.value).startswith(field) and repr(value) in str(e.value)
+
+
+def test_to_dict_holds_every_field_by_name():
+    import dataclasses
+    cfg = Config(angle_bits=12, ks=0.25, specular=False)
+    d = cfg.to_dict()
+    assert d == {f.name: getattr(cfg, f.name) for f in dataclasses.fields(Config)}
+    assert Config(**d) == cfg
