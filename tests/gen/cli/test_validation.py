@@ -193,3 +193,17 @@ def test_a_command_returning_nothing_exits_0_and_its_status_otherwise(monkeypatc
                 return argparse.Namespace(func=lambda args: value)
         monkeypatch.setattr(cli_main, "build_parser", Parser)
         assert cli_main.main(["x"]) == status
+
+
+def test_every_map_flag_has_help_and_the_documented_metavar():
+    """docs/scenes.md writes the flags as --height-scale S, --texture-size T; each has a
+    help line of its own, in lower case like argparse's own."""
+    p = argparse.ArgumentParser(prog="t")
+    add_map_flags(p)
+    acts = {a.dest: a for a in p._actions if a.dest in MAP_FLAGS}
+    assert acts["texture_size"].metavar == "T" and acts["height_scale"].metavar == "S"
+    assert acts["height_map"].metavar == acts["normal_map"].metavar == "FILE"
+    for dest, a in acts.items():
+        assert a.help and len(a.help) > 20, dest
+        assert a.help[0].islower() and a.help != a.help.upper(), dest
+    assert "--texture-size T " in " ".join(p.format_help().split())
