@@ -179,3 +179,26 @@ def test_arithmetic_pixels_grid_then_shifted_with_l_equal_to_h():
     # H is the grid point nearest world N' or within `reach` steps of it: N'.H near 1
     assert _cos(grid.subset(slice(0, keep)), "h").min() > np.cos(3 * STEP)
     assert _cos(grid, "h").min() > np.cos(4 * reach * STEP)
+
+
+def test_adversarial_pixels_sit_on_the_side_that_moves_the_channel_most():
+    """Step 2's 'worse side': each angle sits 0.4999 step off its grid point in the direction
+    its partial derivative points (d(255 N'.L')/d angle by central differences here), so the
+    rounding to the grid moves every angle against the output."""
+    from bumprtl.sim.golden.common import PixelInputs
+    from bumprtl.sim.golden.float.conventional import conventional
+
+    keep = 40
+    px = adversarial_pixels(CFG, candidates=3000, keep=keep, seed=11, channel="diffuse").subset(slice(0, keep))
+    keys = {k: getattr(px, k) for k in px.__dataclass_fields__}
+    agree = total = 0
+    for name in ANGLES_OF["diffuse"]:
+        x = keys[name]
+        up = conventional(PixelInputs(**{**keys, name: x + 1e-7}), CFG).ndotl
+        dn = conventional(PixelInputs(**{**keys, name: x - 1e-7}), CFG).ndotl
+        grad = np.sign(up - dn)
+        side = np.sign(x / STEP - np.rint(x / STEP))
+        ok = _interior(name, x) & (np.abs(up - dn) > 1e-9)
+        agree += int(np.sum(side[ok] == grad[ok]))
+        total += int(ok.sum())
+    assert total > 150 and agree >= 0.95 * total, (agree, total)
