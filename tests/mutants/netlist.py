@@ -12,13 +12,16 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    ``create_mutated`` builds it: ``mutate -ctrl mutsel W I <mutation I>`` for I = 1..N
    (mutsel = 0 is the unmutated design), written out as Verilog; a shim module with the
    unit's own name and ports reads ``mutsel`` from ``mutsel.txt`` in the run directory;
-4. ONE Verilator build of the bulk path (sim/tb/bulk.py: the arrays-in/arrays-out wrapper
-   generated from the sidecar) around it, run once with mutsel = 0 (must pass: the shim
-   and the mutated netlist are the design) and once per mutant: the stimulus is the bulk
-   path's (sim/tb/bulk_sources.py for the datapath units and the palette, 4 traffic
-   patterns; a scene frame with the map, polygon and colour table as make test renders
-   it for the pipelines), every output compared bit for bit with the golden model inside
-   cocotb. A mismatch or a deadlock (timeout) kills the mutant;
+4. ONE build of the bulk path (sim/tb/bulk.py: the arrays-in/arrays-out wrapper generated
+   from the sidecar) around it, on Verilator for the units and on Icarus for the scene
+   pipelines (``--pipeline-sim``; Icarus is where make test streams the pipeline, and its
+   build of a pipeline takes seconds where Verilator's takes many minutes), run once with
+   mutsel = 0 (must pass: the shim and the mutated netlist are the design) and once per
+   mutant: the stimulus is the bulk path's (sim/tb/bulk_sources.py for the datapath units
+   and the palette, 4 traffic patterns; for the pipelines the coverage frame of
+   sim/tb/bulk_frame.py, the one make test's bulk pipeline test streams through the default
+   scene, under the 4 patterns), every output compared bit for bit with the golden model
+   inside cocotb. A mismatch or a deadlock (timeout) kills the mutant;
 5. every survivor is checked for equivalence with the unmutated netlist (``equivalence``):
    first Yosys's structural passes for two near-identical netlists (``equiv_make``,
    ``equiv_simple``, ``equiv_induct``, ``equiv_status -assert``, plus a bounded check of
@@ -125,36 +128,20 @@ def emit_target(target, out, n, seed):
         inputs, expected, setup = _fetch_stimulus(scene, n, seed)
         return v, j, {"inputs": inputs, "expected": expected, "setup": setup}
     from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
-    from bumprtl.rtl.palette import CHANNELS
-    from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, unpack_rgba
-    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
-    from bumprtl.sim.tb.bulk import setup_writes
+    from bumprtl.sim.tb.bulk_frame import coverage_frame
     scene = load_scene_config(target.split(":", 1)[1])
-    size = 16
-    inputs, words, polygon, table, base = scene_stimulus(scene, size)
-    # the frame's tags are its pixel indices (0..255 for 16 x 16): tag bits 8 and up would
-    # never move. They are centred on the middle of the tag range as random_inputs' are (the
-    # tags make test's pipeline stall tests send), so every tag bit moves in every pattern
-    mask = (1 << scene.tag_bits) - 1
-    inputs = dict(inputs)
-    n_px = len(inputs["tag"])
-    inputs["tag"] = (np.arange(n_px) + (mask + 1) // 2 - n_px // 2) & mask
+    # the memories as make test's bulk pipeline test emits them (the scene's map, texture and
+    # table built in), and the coverage frame it streams (tests/sim/tb/test_bulk.py)
+    _, words, _, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
     v, j = emit_pipeline(scene, words, texels, out, out, table, "initial")
-    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
-    if scene.shading == "palette":
-        entry = unpack_rgba(np.asarray(table)[golden["index"]], scene.config)
-        if scene.texture:
-            entry = blend_eq2(entry, unpack_rgba(golden["texel"] | (255 << 24), scene.config),
-                              scene.config)
-        golden = {f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}
+    frame = coverage_frame(scene, words, texels)
     meta = json.loads(Path(j).read_text())
-    outs = meta["ports"]["o__payload"]["fields"]
-    expected = {k: np.asarray(x, np.int64) for k, x in golden.items() if k in outs}
-    if not expected:
-        raise NetlistError(f"{target}: no golden field matches the outputs {list(outs)}")
-    return v, j, {"inputs": inputs, "expected": expected,
-                  "setup": setup_writes(meta, polygon, table)}
+    expected = frame.expected(meta)
+    if set(expected) == {"tag"}:
+        raise NetlistError(f"{target}: no golden field matches the outputs "
+                           f"{list(meta['ports']['o__payload']['fields'])}")
+    return v, j, {"inputs": frame.inputs, "expected": expected, "setup": frame.setup(meta)}
 
 
 # --- Yosys: the sample of mutations and the one netlist holding them all ---------------------
@@ -213,16 +200,16 @@ endmodule
     return work / "mutated.v", width
 
 
-def run_one(v, j, job, work, idx):
-    """Run the bulk path with mutsel = ``idx``: ``"passed"`` or ``"killed: why"``."""
+def run_one(v, j, job, work, idx, sim="verilator"):
+    """Run the bulk path on ``sim`` with mutsel = ``idx``: ``"passed"`` or ``"killed: why"``."""
     from bumprtl.sim.tb.bulk import SimulationTimeout, run_bulk
     work.mkdir(parents=True, exist_ok=True)
     (work / "mutsel.txt").write_text(f"{idx}\n")
+    # a mutant that ties one bit to another can form a loop Verilator sees as combinational
+    # (UNOPTFLAT); it is still a design to simulate, not a build error
+    build = {"extra": VERILATOR_EXTRA, "opt_fast": "-O0"} if sim == "verilator" else {}
     try:
-        # a mutant that ties one bit to another can form a loop Verilator sees as combinational
-        # (UNOPTFLAT); it is still a design to simulate, not a build error
-        run_bulk("verilator", v, j, work, PATTERNS, keep=False, extra=VERILATOR_EXTRA,
-                 opt_fast="-O0", **job)
+        run_bulk(sim, v, j, work, PATTERNS, keep=False, **build, **job)
     except SimulationTimeout as e:
         return "killed: timeout " + str(e).splitlines()[0][:120]
     except AssertionError as e:
@@ -369,8 +356,15 @@ def equivalence(v, meta, line, work, timeout):
 
 # --- one target, end to end -----------------------------------------------------------------
 
-def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
+def simulator(target, pipeline_sim):
+    """The units on Verilator; a scene pipeline on ``pipeline_sim`` (default Icarus, the
+    simulator make test's bulk pipeline test runs it on)."""
+    return pipeline_sim if target.startswith("pipeline:") else "verilator"
+
+
+def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeline_sim="icarus"):
     t0 = time.perf_counter()
+    sim = simulator(target, pipeline_sim)
     work = out / target.replace(":", "_")
     if work.exists():
         shutil.rmtree(work)
@@ -381,7 +375,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
     rtl = Path(v).parent
     lines = mutation_list(v, unit, n, seed, rtl)
     mv, width = mutated_netlist(v, meta, lines, rtl)
-    base = run_one(mv, j, job, work / "run0", 0)
+    base = run_one(mv, j, job, work / "run0", 0, sim)
     if base != "passed":
         raise NetlistError(f"{target}: the mutated netlist with mutsel = 0 fails the golden "
                            f"check ({base}); see {work}")
@@ -389,7 +383,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
         f"({time.perf_counter() - t0:.0f} s)")
 
     def one(i):
-        return i, run_one(mv, j, job, work / f"run{i}", i)
+        return i, run_one(mv, j, job, work / f"run{i}", i, sim)
     with ThreadPoolExecutor(max(1, jobs)) as pool:
         results = dict(pool.map(one, range(1, len(lines) + 1)))
     survivors = []
@@ -404,7 +398,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print):
     return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
             "equivalent": equivalent, "counted": len(lines) - equivalent,
             "survivors": survivors, "seconds": time.perf_counter() - t0,
-            "stimulus": _stimulus_words(target, stim_n)}
+            "stimulus": _stimulus_words(target, stim_n, sim)}
 
 
 def _short(line):
@@ -412,13 +406,17 @@ def _short(line):
     return re.sub(r" -src \S+", "", line)
 
 
-def _stimulus_words(target, n):
+def _stimulus_words(target, n, sim="verilator"):
+    on = f", on {'Icarus' if sim == 'icarus' else 'Verilator'}"
     if target in SOURCE_KIND:
-        return f"{n} vectors x 4 traffic patterns (bulk source {SOURCE_KIND[target]})"
+        return f"{n} vectors x 4 traffic patterns (bulk source {SOURCE_KIND[target]}){on}"
     if target == "fetch":
-        return f"{n} random texels x 4 patterns, the default scene's map written through the host port"
-    return ("the scene's 16 x 16 frame x 4 traffic patterns (map, polygon, table as make test "
-            "renders it; tags centred on the middle of the tag range as random_inputs' are)")
+        return (f"{n} random texels x 4 patterns, the default scene's map written through the "
+                f"host port{on}")
+    from bumprtl.sim.tb.bulk_frame import PIXELS, SEED, WRITTEN
+    return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels, seed {SEED}, "
+            f"{WRITTEN} map words written first) x 4 traffic patterns{on}, as make test's "
+            f"bulk pipeline test streams it through the default scene")
 
 
 def report(results, runs):
@@ -497,6 +495,9 @@ def main(argv=None):
     p.add_argument("-k", action="append", default=[], metavar="TARGET",
                    help="only these targets (repeatable): " + ", ".join(targets()))
     p.add_argument("--stimulus", type=int, default=4000, help="vectors a pattern for the units")
+    p.add_argument("--pipeline-sim", choices=("icarus", "verilator"), default="icarus",
+                   help="the simulator of the scene pipelines (default icarus, as make test's "
+                        "bulk pipeline test; the units run on verilator)")
     p.add_argument("--equiv-timeout", type=int, default=30, help="seconds per equivalence proof")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "netlist_mutants")
     p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
@@ -547,7 +548,8 @@ def main(argv=None):
     results = []
     for target in chosen:
         try:
-            r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout)
+            r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout,
+                           pipeline_sim=a.pipeline_sim)
         except (NetlistError, subprocess.CalledProcessError) as e:
             msg = str(e) if isinstance(e, NetlistError) else \
                 f"{target}: {e.cmd} failed: {((e.stderr or '') + (e.stdout or '')).strip().splitlines()[-1:]}"
