@@ -37,7 +37,7 @@ from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_con
 from bumprtl.sim.scenes import SCENES
 from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS
-from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, map_blocks, table_blocks, unit_memories
+from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.pipeline import BumpPipeline
 
@@ -66,11 +66,8 @@ def bram_budget(scene, mode, device):
     tables (as gen/flow/memories.check_fits counts them), the light table, the
     elastic buffer; and the device's."""
     p = BumpPipeline(scene)
-    mems = unit_memories(p)
-    need = {"map": sum(map_blocks(v["depth"], v["width"]) for k, v in mems.items()
-                       if k.split(".")[-1] in ("map", "texture")),
-            "pipeline tables": sum(table_blocks(v["depth"], v["width"]) for k, v in mems.items()
-                                   if k.split(".")[-1] not in ("map", "texture")),
+    maps, tables = memory_blocks(unit_memories(p))
+    need = {"map": maps, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(buffer_depth(p.latency), 24 + scene.tag_bits)}
     return need, DEVICE_BRAM[device]

@@ -30,6 +30,7 @@ from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag
 
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
+           "table_blocks", "memory_blocks",
            "check_fits", "check_scene_fits", "hex_text", "memory_images", "emit_scene_unit", "host_writes",
            "scene_command"]
 
@@ -75,6 +76,15 @@ def map_blocks(depth, width):
     return bram_blocks(depth, width) if bits is None else math.ceil(width / bits)
 
 
+def memory_blocks(roms):
+    """``(map blocks, table blocks)``: the DP16KD blocks of the maps of ``roms`` (the
+    sidecar's memories, :func:`map_blocks`) and of its other memories, the pipeline's tables
+    (:func:`table_blocks`), each counted as laid out on ECP5."""
+    maps = sum(map_blocks(v["depth"], v["width"]) for k, v in roms.items() if _is_map(k))
+    tables = sum(table_blocks(v["depth"], v["width"]) for k, v in roms.items() if not _is_map(k))
+    return maps, tables
+
+
 def check_fits(roms, device, what):
     """Raise a BumpError (naming ``what``, the bits it needs and the device's block RAM) when
     the maps of ``roms`` (the sidecar's memories, :func:`map_blocks`) and the pipeline's
@@ -82,10 +92,8 @@ def check_fits(roms, device, what):
     ``(blocks needed, blocks available)``."""
     if device not in DEVICE_BRAM:
         raise BumpError(f"device must be one of {', '.join(DEVICE_BRAM)}, got {device!r}")
-    maps = {k: v for k, v in roms.items() if _is_map(k)}
-    map_bits = sum(v["bits"] for v in maps.values())
-    maps_need = sum(map_blocks(v["depth"], v["width"]) for v in maps.values())
-    other = sum(table_blocks(v["depth"], v["width"]) for k, v in roms.items() if k not in maps)
+    map_bits = sum(v["bits"] for k, v in roms.items() if _is_map(k))
+    maps_need, other = memory_blocks(roms)
     have = DEVICE_BRAM[device]
     if maps_need + other > have:
         raise BumpError(f"{what}: the map needs {map_bits:,} bits of block RAM ({maps_need} "
