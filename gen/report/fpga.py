@@ -120,11 +120,8 @@ def place_all(cfg, args, tasks):
             waiting[name] = [(task, p)]
             yield Job(name, place_text, p.args(), timeout)
 
-    with Runner(scheduler_address(getattr(args, "scheduler", None)),
-                getattr(args, "jobs", None) or 1) as runner:
-        outcomes = runner.run(jobs(), desc="place")
-    for name, outcome in outcomes.items():
-        for n, (task, p) in enumerate(waiting[name]):
+    def done(outcome):              # stored as each ends: a run stopped early keeps them
+        for n, (task, p) in enumerate(waiting[outcome.name]):
             seed = task[1]
             if not outcome.ok:
                 placed[task] = {"error": outcome.error, "seed": seed}
@@ -132,6 +129,10 @@ def place_all(cfg, args, tasks):
                 placed[task] = {**p.store(outcome.value), "seed": seed}
             else:
                 placed[task] = {**outcome.value["row"], "unit": p.label, "seed": seed}
+
+    with Runner(scheduler_address(getattr(args, "scheduler", None)),
+                getattr(args, "jobs", None) or 1) as runner:
+        runner.run(jobs(), desc="place", on_done=done)
     return placed
 
 
