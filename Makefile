@@ -100,13 +100,14 @@ board: $(STAMP)
 # The generated pages, regenerated at today's default Config (each records it in a "Made at:"
 # line, tests/test_docs_made_at.py): slow (minutes), opt-in. make fpga, make formal and
 # make mutate regenerate their own pages (docs/report.md, docs/formal.md, docs/mutation.md).
-DOCS_REGENERATED = docs/integration.md docs/timing/ docs/table1.md docs/stability.md \
+DOCS_REGENERATED = docs/integration.md docs/timing/ docs/table1.md docs/stability.md docs/scenes.md \
                    docs/img/demo_rtl_vs_float64.png
 docs: $(STAMP)
 	@echo "make docs regenerates: $(DOCS_REGENERATED)"
 	$(RUN) $(VENV)/bin/bumprtl report integration
 	$(RUN) $(VENV)/bin/bumprtl report timing
 	$(RUN) $(VENV)/bin/bumprtl report table1 --samples 100000
+	$(RUN) $(PY) -m bumprtl.gen.render.rtl --doc docs/scenes.md
 	$(RUN) $(VENV)/bin/bumprtl bench stress --samples 100000 --seed 1
 	@$(MAKE) --no-print-directory demo
 	cp build/demo/rtl_vs_float64.png docs/img/demo_rtl_vs_float64.png

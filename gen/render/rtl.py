@@ -356,5 +356,24 @@ def scenes_table(work_dir="build/scenes"):
     return "\n".join(rows)
 
 
-if __name__ == "__main__":            # python -m bumprtl.gen.render.rtl > build/scenes.md
-    print(scenes_table())
+def write_scenes_doc(path="docs/scenes.md", work_dir="build/scenes"):
+    """Write :func:`scenes_table` into ``path`` between its markers, with its record."""
+    from bumprtl.gen.report import made_at, write_section
+    from bumprtl.rtl.config import Config
+    text = (f"Produced by `.venv/bin/python -m bumprtl.gen.render.rtl --doc {path}` in one run. "
+            + made_at(Config(), "the default; each scene at its own widths, "
+                                "sim/scenes/config.BUILTIN") + ".\n\n" + scenes_table(work_dir))
+    write_section(path, "scenes table", text)
+
+
+if __name__ == "__main__":    # python -m bumprtl.gen.render.rtl [--doc docs/scenes.md]
+    import argparse
+    ap = argparse.ArgumentParser(prog="python -m bumprtl.gen.render.rtl",
+                                 description="the table of docs/scenes.md (printed, or --doc)")
+    ap.add_argument("--doc", type=Path, help="write the table into this page (docs/scenes.md)")
+    args = ap.parse_args()
+    if args.doc:
+        write_scenes_doc(args.doc)
+        print(f"wrote {args.doc}")
+    else:
+        print(scenes_table())

@@ -313,15 +313,19 @@ def fpga_section(path):
              "error = diffuse, 8-bit LSB against float64.", "",
              "| design | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | max / mean LSB |",
              "|---|---|---|---|---|---|---|"]
+    missing = []
     for d in TABLE1_ORDER:
         r, a = rows.get(d), data["accuracy"].get(d)
         if r is None or a is None:
+            missing.append(d)
             continue
         if "error" in r:
             lines.append(f"| {d} | not placed: {r['error']} | | | | | {a['max']} / {a['mean']:.4f} |")
             continue
         lines.append(f"| {d} | {r['LUT4']} | {r['FF']} | {r['DSP']} | {r['BRAM']} | "
                      f"{r['fmax_mhz']} | {a['max']} / {a['mean']:.4f} |")
+    if missing:
+        lines += ["", f"Not in that run (its `--unit` list left them out): {', '.join(missing)}."]
     return "\n".join(lines) + "\n"
 
 
