@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import SceneConfig, load_scene_config, BUILTIN
@@ -35,6 +35,7 @@ from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
                                        host_writes, memory_images)
 from bumprtl.gen.flow.quiet import tool_log
+from bumprtl.gen.report import write_section
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.gen.flow.units import build_unit
 
@@ -358,10 +359,8 @@ def scenes_table(work_dir="build/scenes"):
 
 def write_scenes_doc(path="docs/scenes.md", work_dir="build/scenes"):
     """Write :func:`scenes_table` into ``path`` between its markers, with its record."""
-    from bumprtl.gen.report import made_at, write_section
-    from bumprtl.rtl.config import Config
     text = (f"Produced by `.venv/bin/python -m bumprtl.gen.render.rtl --doc {path}` in one run. "
-            + made_at(Config(), "the default; each scene at its own widths, "
+            + Config().made_at("the default; each scene at its own widths, "
                                 "sim/scenes/config.BUILTIN") + ".\n\n" + scenes_table(work_dir))
     write_section(path, "scenes table", text)
 

@@ -6,10 +6,9 @@ __all__ = ["made_at", "write_section"]
 
 
 def made_at(cfg, note=""):
-    """The one-line record of the configuration a generated page was made at
-    (tests/test_docs_made_at.py holds every such line to today's default)."""
-    return (f"Made at: angle_bits={cfg.angle_bits}, frac_bits={cfg.frac_bits}"
-            + (f" ({note})" if note else ""))
+    """``cfg``'s one-line record of the configuration a generated page was made at
+    (:meth:`rtl.config.Config.made_at`)."""
+    return cfg.made_at(note)
 
 
 def write_section(path, name, text):

@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+from bumprtl.rtl.config import Config
+
 __all__ = ["write_doc", "table"]
 
 BEGIN, END = "<!-- formal table: begin -->", "<!-- formal table: end -->"
@@ -28,10 +30,8 @@ def write_doc(path, rows, args=""):
     else:
         how = (f"Produced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
                f"--doc docs/formal.md`; `bumprtl formal` is the same command)")
-    from bumprtl.gen.report import made_at          # the one record of every generated page
-    from bumprtl.rtl.config import Config
-    record = made_at(Config(), "the default; each proof runs at the small widths of "
-                               "sim/formal/targets.py")
+    record = Config().made_at("the default; each proof runs at the small widths of "
+                              "sim/formal/targets.py")
     block = f"{BEGIN}\n{how}.\n{record}:\n\n{table(rows)}\n{END}"
     text = path.read_text() if path.exists() else f"# Formal proofs\n\n{BEGIN}\n{END}\n"
     if BEGIN in text and END in text:
