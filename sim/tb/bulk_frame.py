@@ -19,7 +19,10 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
 * tags random over the whole tag range (0 and the largest tag included);
-* a palette scene's colour table random, written after a decoy table (two bank swaps).
+* the map's (and texture's) word 0 written with every bit a word may set and read back (the
+  write ports idle at address 0 during the stream);
+* a palette scene's colour table random, read from bank 1 with decoy tables around it
+  (:meth:`CoverageFrame.setup`).
 
 The golden outputs are sim/golden/fixed/pipeline.py's on the memories as the host left
 them. Deterministic in ``seed``: make test's bulk pipeline test and the netlist mutants of
@@ -57,15 +60,23 @@ class CoverageFrame:
     writes: list             # host cycles before the stream: map / texture words
     polygon: dict            # a flat map's polygon registers (None otherwise)
     table: np.ndarray        # a palette scene's colour table (None otherwise)
-    decoy: np.ndarray        # the table written and swapped in before ``table``
+    decoys: list             # palette tables written around ``table`` (see :meth:`setup`)
     golden: dict             # {field: int64 array}: every output field the model gives
 
     def setup(self, meta):
         """The host cycles of the run (``meta``: the emitted pipeline's sidecar)."""
         cycles = list(self.writes)
-        if self.decoy is not None:
-            cycles += setup_writes(meta, None, self.decoy)
-        return cycles + setup_writes(meta, self.polygon, self.table)
+        if not self.decoys:
+            return cycles + setup_writes(meta, self.polygon, self.table)
+        # palette: decoy, swap, decoy, swap, table, swap, decoy (front bank 0 after reset):
+        # the table is read from bank 1, two swaps before it must each toggle the bank, the
+        # last decoy must go to the back bank, and a write to bank 1 held back by a wrong
+        # count of the pixels in flight loses the table
+        first, second, last = self.decoys
+        for t in (first, second, self.table):
+            cycles += setup_writes(meta, None, t)
+        cycles += setup_writes(meta, None, last)[:-1]          # written, not swapped in
+        return cycles + setup_writes(meta, self.polygon, None)
 
     def expected(self, meta):
         """The golden outputs of the pipeline's output fields, the tag included."""
@@ -133,24 +144,29 @@ def _texel_writes(scene, rng, words, texels):
     edges of its range, or random palette indices) and random texture words."""
     cfg = scene.config
     depth = memory_depth(scene)
-    addr = rng.choice(depth, min(WRITTEN, depth), replace=False)
+    # address 0 first, with every bit a word may set: the write ports idle at address 0,
+    # data 0 during the stream, so a write enable that fires while idle clears it
+    rest = rng.choice(np.arange(1, depth), min(WRITTEN, depth) - 1, replace=False)
+    addr = np.concatenate([[0], rest])
     m = len(addr)
     new_words = new_texels = None
     if words is not None:
         if scene.shading == "palette":
             word = pack_texels(scene, index=rng.integers(0, 1 << index_bits(cfg), m))
+            word[0] = (1 << index_bits(cfg)) - 1
         else:
             full, q = cfg.full_circle, cfg.full_circle // 4
             phi = rng.choice(np.array([0, 1, q - 1, q, 2 * q - 1, 2 * q, 3 * q, full - 1]), m)
             phi = np.where(rng.random(m) < 0.3, rng.integers(0, full, m), phi)
             theta = rng.choice(np.array([0, 1, q // 2, q - 2, q - 1, q]), m)
             theta = np.where(rng.random(m) < 0.3, rng.integers(0, q + 1, m), theta)
+            phi[0], theta[0] = full - 1, q - 1
             word = pack_texels(scene, phi=phi, theta=theta)
         new_words = np.asarray(words, np.int64).copy()
         new_words[addr] = word
     if texels is not None:
         new_texels = np.asarray(texels, np.int64).copy()
-        new_texels[addr] = rng.integers(0, 1 << 24, m)
+        new_texels[addr] = np.concatenate([[(1 << 24) - 1], rng.integers(0, 1 << 24, m - 1)])
     writes = []
     for k, a in enumerate(addr.tolist()):
         cycle = {}
@@ -218,14 +234,14 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     texture ``texels`` (as gen/render/rtl.scene_stimulus gives them; None without one)."""
     cfg = scene.config
     rng = np.random.default_rng([seed, n])
-    inputs, writes, polygon, table, decoy = {}, [], None, None, None
+    inputs, writes, polygon, table, decoys = {}, [], None, None, []
     addr = None
     if has_map(scene) or scene.texture:
         addr, words, texels, writes = _texel_writes(scene, rng, words, texels)
         inputs.update(_texel_inputs(scene, n, rng, words, addr))
     if scene.shading == "palette":
         top = cfg.palette_size
-        decoy = pack_rgba(rng.integers(0, 256, (top, 4)), cfg)
+        decoys = [pack_rgba(rng.integers(0, 256, (top, 4)), cfg) for _ in range(3)]
         table = pack_rgba(rng.integers(0, 256, (top, 4)), cfg)
     else:
         if scene.bump_map == "varying":
@@ -262,4 +278,4 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
         golden = {**golden, **{f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}}
     golden = {k: np.asarray(v, np.int64) for k, v in golden.items()}
     golden["tag"] = inputs["tag"]
-    return CoverageFrame(inputs, words, texels, writes, polygon, table, decoy, golden)
+    return CoverageFrame(inputs, words, texels, writes, polygon, table, decoys, golden)
