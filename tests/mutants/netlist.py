@@ -14,8 +14,8 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    unit's own name and ports reads ``mutsel`` from ``mutsel.txt`` in the run directory;
 4. ONE build of the bulk path (sim/tb/bulk.py: the arrays-in/arrays-out wrapper generated
    from the sidecar) around it, on Verilator for the units and on Icarus for the scene
-   pipelines (``--pipeline-sim``; Icarus is where make test streams the pipeline, and its
-   build of a pipeline takes seconds where Verilator's takes many minutes), run once with
+   pipelines (``--pipeline-sim``; Icarus is where make test streams the pipeline, and it
+   builds a pipeline in about a minute where Verilator took 19 min), run once with
    mutsel = 0 (must pass: the shim and the mutated netlist are the design) and once per
    mutant: the stimulus is the bulk path's (sim/tb/bulk_sources.py for the datapath units
    and the palette, 4 traffic patterns; for the pipelines the coverage frame of
@@ -33,7 +33,10 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    -set-init-zero -tempinduct``. A proof makes it *equivalent* (not counted); a
    counterexample makes it a real survivor; no proof and no counterexample (a time-out, or
    a design too large for ``sat``) leaves it *undecided*, counted as a survivor and listed.
-   ``--recheck`` runs these checks again on a finished run's survivors.
+   ``--recheck`` runs these checks again on a finished run's survivors; ``--reuse`` keeps
+   a target's mutants and mutated netlist from an earlier run of the same sample and seed
+   when the target emits the same files (the slow ``prep`` of a pipeline), and runs the
+   simulations and checks again on today's stimulus.
 
 Prints, per target, the sample size, the seed, killed / non-equivalent, the kill ratio, the
 survivors and the wall time; ``--doc docs/mutation.md`` writes the table between the
@@ -145,6 +148,12 @@ def emit_target(target, out, n, seed):
 
 
 # --- Yosys: the sample of mutations and the one netlist holding them all ---------------------
+
+def _listed(rtl):
+    """The mutation lines of ``rtl/mutations.ys``."""
+    return [l for l in (Path(rtl) / "mutations.ys").read_text().splitlines()
+            if l.startswith("mutate ")]
+
 
 def mutation_list(v, unit, n, seed, work):
     # the prepared netlist is kept (prepped.il): the mutated build and the equivalence checks
@@ -362,19 +371,61 @@ def simulator(target, pipeline_sim):
     return pipeline_sim if target.startswith("pipeline:") else "verilator"
 
 
-def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeline_sim="icarus"):
+def _same_files(kept, fresh):
+    """Every file emitted into ``fresh`` (Verilog, sidecar, memory images) is in ``kept``,
+    byte for byte."""
+    return all((kept / p.name).is_file() and (kept / p.name).read_bytes() == p.read_bytes()
+               for p in fresh.iterdir() if p.is_file())
+
+
+SAMPLE_STAMP = "sample.json"     # the sample and seed a kept rtl/ directory's mutants were drawn at
+
+
+def _kept_netlist(target, work, n, seed, stim_n, log):
+    """``(v, j, job, rtl)`` from the rtl/ directory an earlier run left in ``work`` when the
+    target emits the same files again and that run drew the same sample and seed (its
+    prepared netlist, mutation list and mutated netlist are kept); the job (stimulus) is
+    made anew. None otherwise."""
+    rtl, stamp = work / "rtl", work / "rtl" / SAMPLE_STAMP
+    if not (stamp.exists() and (rtl / "mutated.v").exists() and (rtl / "prepped.il").exists()):
+        return None
+    if json.loads(stamp.read_text()) != {"sample": n, "seed": seed}:
+        return None
+    fresh = work / "rtl_emitted"
+    shutil.rmtree(fresh, ignore_errors=True)
+    v, j, job = emit_target(target, fresh, stim_n, seed)
+    same = _same_files(rtl, fresh)
+    shutil.rmtree(fresh)
+    if not same:
+        return None
+    log(f"  {target}: the emitted files are those of {rtl}: its mutants and netlists reused")
+    return rtl / Path(v).name, rtl / Path(j).name, job, rtl
+
+
+def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeline_sim="icarus",
+               reuse=False):
     t0 = time.perf_counter()
     sim = simulator(target, pipeline_sim)
     work = out / target.replace(":", "_")
-    if work.exists():
-        shutil.rmtree(work)
-    work.mkdir(parents=True)
-    v, j, job = emit_target(target, work / "rtl", stim_n, seed)
+    kept = _kept_netlist(target, work, n, seed, stim_n, log) if reuse and work.exists() else None
+    if kept is not None:
+        v, j, job, rtl = kept
+        for old in work.glob("run*"):
+            shutil.rmtree(old)
+    else:
+        if work.exists():
+            shutil.rmtree(work)
+        work.mkdir(parents=True)
+        v, j, job = emit_target(target, work / "rtl", stim_n, seed)
+        rtl = Path(v).parent
     meta = json.loads(Path(j).read_text())
     unit = meta["unit"]
-    rtl = Path(v).parent
-    lines = mutation_list(v, unit, n, seed, rtl)
-    mv, width = mutated_netlist(v, meta, lines, rtl)
+    if kept is None:
+        mutation_list(v, unit, n, seed, rtl)
+        (rtl / SAMPLE_STAMP).write_text(json.dumps({"sample": n, "seed": seed}))
+        mutated_netlist(v, meta, _listed(rtl), rtl)
+    lines = _listed(rtl)
+    mv = rtl / "mutated.v"
     base = run_one(mv, j, job, work / "run0", 0, sim)
     if base != "passed":
         raise NetlistError(f"{target}: the mutated netlist with mutsel = 0 fails the golden "
@@ -495,6 +546,10 @@ def main(argv=None):
     p.add_argument("-k", action="append", default=[], metavar="TARGET",
                    help="only these targets (repeatable): " + ", ".join(targets()))
     p.add_argument("--stimulus", type=int, default=4000, help="vectors a pattern for the units")
+    p.add_argument("--reuse", action="store_true",
+                   help="keep a target's mutants and mutated netlist from an earlier run in "
+                        "--out when it emits the same files and drew the same sample and seed "
+                        "(the simulations and checks run again, on today's stimulus)")
     p.add_argument("--pipeline-sim", choices=("icarus", "verilator"), default="icarus",
                    help="the simulator of the scene pipelines (default icarus, as make test's "
                         "bulk pipeline test; the units run on verilator)")
@@ -549,7 +604,7 @@ def main(argv=None):
     for target in chosen:
         try:
             r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout,
-                           pipeline_sim=a.pipeline_sim)
+                           pipeline_sim=a.pipeline_sim, reuse=a.reuse)
         except (NetlistError, subprocess.CalledProcessError) as e:
             msg = str(e) if isinstance(e, NetlistError) else \
                 f"{target}: {e.cmd} failed: {((e.stderr or '') + (e.stdout or '')).strip().splitlines()[-1:]}"
