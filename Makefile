@@ -48,7 +48,7 @@ demo: $(STAMP)
 	@$(RUN) $(VENV)/bin/bumprtl demo --out build/demo $(DEMO_ARGS)
 
 test: $(STAMP)
-	$(RUN) $(PY) -m pytest -n $(JOBS) -m "not regress and not fpga and not formal" $(PYTEST_ARGS)
+	$(RUN) $(PY) -m pytest -n $(JOBS) --dist worksteal -m "not regress and not fpga and not formal" $(PYTEST_ARGS)
 
 regress: $(STAMP)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m regress $(PYTEST_ARGS)
