@@ -298,3 +298,18 @@ def test_a_rewritten_map_file_is_read_again(tmp_path):
     assert not np.array_equal(second.b_phi_map, first.b_phi_map)
     fresh = load_bump_map(_grey_png(tmp_path / "copy.png", hex_tiles(32, seed=2)), "height")
     assert np.array_equal(second.b_phi_map, fresh.b_phi_map)
+
+
+def test_load_bump_map_resamples_to_the_size_asked_for(tmp_path):
+    """load_bump_map at size T gives a T x T map (resampled with resample, refused without);
+    without a size, the file's own size."""
+    from bumprtl.sim.scenes.usermap import MapError, load_bump_map
+
+    path = tmp_path / "h.npy"
+    y, x = np.mgrid[0:16, 0:16]
+    np.save(path, np.sin(2 * np.pi * x / 16) * np.cos(2 * np.pi * y / 16))
+    assert load_bump_map(path, "height").size == 16
+    got = load_bump_map(path, "height", size=32, resample=True)
+    assert got.size == 32 and got.b_phi_map.shape == got.b_theta_map.shape == (32, 32)
+    with pytest.raises(MapError, match="texture_size = 32"):
+        load_bump_map(path, "height", size=32)

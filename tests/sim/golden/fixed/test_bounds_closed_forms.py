@@ -67,3 +67,20 @@ def test_channel_bounds_are_floor_plus_one_of_their_sums_capped_at_255():
     assert set(channel_bounds_lsb(cfg, 3.0, 1.0, 2).values()) == {255}       # 2 lights: past 255
     with pytest.raises(ConfigError, match=r"channel must be one of diffuse, specular, color, blend, got 'alpha'"):
         channel_bound(cfg, "alpha", a, e)
+
+
+def test_peercys_other_channels_are_the_back_ends_bound_for_its_dot_error():
+    """Peercy's dot is within e = (5/2 + 2 sqrt 3) u + 2 u^2 (u = 2**-B) of the true one; its
+    diffuse bound is floor(255 e) + 1, every other channel (and several lights) the shared
+    back end's bound for that e and no angle error."""
+    from bumprtl.sim.golden.fixed.peercy import predicted_error_bound_lsb
+
+    for cfg in (Config(method="peercy"), Config(method="peercy", frac_bits=12)):
+        u = 2.0 ** -cfg.frac_bits
+        e = (2.5 + 2 * np.sqrt(3)) * u + 2 * u * u
+        assert predicted_error_bound_lsb(cfg) == int(np.floor(255 * e)) + 1
+        for channel in ("specular", "color", "blend"):
+            assert predicted_error_bound_lsb(cfg, channel) == channel_bounds_lsb(cfg, 0.0, e)[channel]
+        assert predicted_error_bound_lsb(cfg, "diffuse", 2) == channel_bounds_lsb(cfg, 0.0, e, 2)["diffuse"]
+        with pytest.raises(ConfigError):
+            predicted_error_bound_lsb(cfg, "alpha")

@@ -290,3 +290,15 @@ def test_plane_is_exact_up_to_quantization():
     r = render_palette(scene, cfg, n_distinct, "median-cut")
     ref = compose(scene, conventional(scene.px, cfg).color)
     assert max_diff(ref, compose(scene, r.color)) <= 1
+
+
+@pytest.mark.parametrize("normals, words", [
+    (random_normals(8)[:, :6], "must be a non-empty square (T, T, 3) map, got shape (8, 6, 3)"),
+    (np.where(np.arange(64).reshape(8, 8, 1) == 5, np.nan, random_normals(8)), "contains NaN or infinity"),
+    (np.where(np.arange(64).reshape(8, 8, 1) == 5, 0.0, random_normals(8)), "has a zero-length normal at texel (0, 5)"),
+])
+def test_a_bad_normal_map_is_named_normals(normals, words):
+    """The message starts with the parameter's name, then says what is wrong and where."""
+    with pytest.raises(BumpError) as e:
+        quantize_normal_map(normals, 16)
+    assert str(e.value) == f"normals {words}"
