@@ -86,3 +86,22 @@ def test_stress_codes_interleave_the_cases():
         assert codes["n.theta"][i] == angle_codes(px.n_theta[i // len(CASES)], cfg), i
         assert codes["l.phi"][i] == angle_codes(px.l_phi[i // len(CASES)], cfg), i
     assert all(len(v) == n for v in codes.values())
+
+
+def test_check_fixed_reports_diffuse_and_colour_errors_and_overflow_per_field():
+    """check_fixed's errors recomputed here: |model - round(255 x float64)| of diffuse and
+    colour per pixel, within the default's proven 1 LSB; no field overflows."""
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.float.conventional import conventional
+    from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
+    from bumprtl.sim.golden.stress import check_fixed
+
+    cfg = Config()
+    px = stress_case("random", 300, seed=8)
+    got = check_fixed(datapath_fixed, px, cfg)
+    assert sorted(got) == ["color_lsb", "diffuse_lsb", "overflow"]
+    out, ref = datapath_fixed(encode_pixels(px, cfg), cfg), conventional(px, cfg)
+    for key, channel in (("diffuse_lsb", "diffuse"), ("color_lsb", "color")):
+        want = np.abs(out[channel].astype(int) - to_8bit(getattr(ref, channel)).astype(int))
+        assert np.array_equal(got[key], want) and want.max() <= 1 and want.max() > 0, key
+    assert got["overflow"] and set(got["overflow"].values()) == {0}

@@ -313,3 +313,21 @@ def test_load_bump_map_resamples_to_the_size_asked_for(tmp_path):
     assert got.size == 32 and got.b_phi_map.shape == got.b_theta_map.shape == (32, 32)
     with pytest.raises(MapError, match="texture_size = 32"):
         load_bump_map(path, "height", size=32)
+
+
+def test_an_rgba_normal_map_is_read_only_when_opaque(tmp_path):
+    from PIL import Image
+    from bumprtl.sim.scenes.usermap import MapError, read_normals
+
+    rgba = np.zeros((16, 16, 4), np.uint8)
+    rgba[..., :3] = (128, 128, 255)                      # +z everywhere
+    rgba[..., 3] = 255
+    rgba[3, 4, :3] = (200, 128, 230)
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "opaque.png")
+    n = read_normals(tmp_path / "opaque.png")
+    assert n.shape == (16, 16, 3) and np.allclose(np.linalg.norm(n, axis=-1), 1)
+    rgba[7, 2, 3] = 254                                   # one texel not opaque
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "alpha.png")
+    with pytest.raises(MapError) as e:
+        read_normals(tmp_path / "alpha.png")
+    assert "alpha.png" in str(e.value) and "alpha" in str(e.value).split("alpha.png", 1)[1]
