@@ -18,6 +18,9 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   product), theta at or next to 0 and 180 degrees, phi next to 0 / 360, and directions
   within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
+* (exact method, varying map) a few pixels whose dot products sit within a few tens of
+  LSBs of their rounding carry, their N' written into the map: a wrong low bit of a
+  product moves the dot, which random pixels show about once in ten thousand;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
@@ -222,6 +225,21 @@ def _texel_inputs(scene, n, rng, words, addr):
     return out
 
 
+CARRY_POOL = 1 << 16         # random pixels searched for the rounding carries of the frame
+CARRY_PIXELS = 6             # kept a dot product
+
+
+def _near_carry(scene, seed):
+    """Angle codes (N, N', L, H of light 0) of a few pixels whose exact-method dot products
+    sit within a few tens of LSBs of their rounding carry (sim/tb/bulk_sources.py's
+    rounding_codes over CARRY_POOL pixels), or None (another method, a flat map or palette
+    shading): a wrong low bit of a product moves their dot."""
+    if scene.shading != "per-pixel" or scene.bump_map != "varying":
+        return None
+    from bumprtl.sim.tb.bulk_sources import rounding_codes
+    return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS)
+
+
 def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
     """The bumped normal N'' in the world (n, 3) from the codes: M^T N' (Lee Sec. 3.1.1)."""
     rad = lambda c: np.asarray(c, np.float64) * (TWO_PI / cfg.full_circle)
@@ -235,9 +253,15 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     cfg = scene.config
     rng = np.random.default_rng([seed, n])
     inputs, writes, polygon, table, decoys = {}, [], None, None, []
-    addr = None
+    addr = near = None
     if has_map(scene) or scene.texture:
         addr, words, texels, writes = _texel_writes(scene, rng, words, texels)
+        near = _near_carry(scene, seed)
+        if near is not None:            # their N' in the written words after word 0
+            slots = addr[1:1 + len(near["b.phi"])]
+            words[slots] = pack_texels(scene, phi=near["b.phi"], theta=near["b.theta"])
+            for k, a in enumerate(slots.tolist(), 1):
+                writes[k]["map_w_data"] = int(words[a])
         inputs.update(_texel_inputs(scene, n, rng, words, addr))
     if scene.shading == "palette":
         top = cfg.palette_size
@@ -265,6 +289,15 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
             for own, key in keys.items():
                 if own.endswith(".phi"):
                     inputs[key], inputs[keys[own[:-4] + ".theta"]] = _light(rng, n, cfg, axis)
+    if addr is not None and near is not None:   # the pixels next to a rounding carry
+        pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(slots)]
+        u, v, level = _address_coords(scene, slots[:len(pick)], rng)
+        inputs["u"][pick], inputs["v"][pick] = u, v
+        if "level" in inputs:
+            inputs["level"][pick] = level
+        for key in ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta"):
+            if key in inputs:
+                inputs[key][pick] = near[key][:len(pick)]
     mask = (1 << scene.tag_bits) - 1
     tag = rng.integers(0, mask + 1, n)
     tag[:2] = (0, mask)
