@@ -264,3 +264,22 @@ def test_every_refusal_names_the_key_the_value_and_what_is_allowed(keys, words):
     assert "\n" not in msg
     for w in words:
         assert w in msg, (w, msg)
+
+
+def test_a_users_map_sets_the_texture_size_and_refuses_a_second_picture(tmp_path):
+    """A map without texture_size gives the map's own size (the scene's default 64 does not
+    apply to it); a scene file naming an image and a map, or a height map with
+    normal_convention, is refused naming both keys."""
+    import numpy as np
+
+    path = tmp_path / "h.npy"
+    np.save(path, np.add.outer(np.arange(32.0), np.arange(32.0)) % 7 / 6)
+    assert load_scene_config("default", {"height_map": str(path)}).texture_size == 32
+    f = tmp_path / "both.toml"
+    f.write_text(f'image = "wood"\nheight_map = "{path}"\n')
+    with pytest.raises(BumpError) as e:
+        load_scene_config(f)
+    assert "image = 'wood'" in str(e.value) and "height_map" in str(e.value)
+    with pytest.raises(BumpError) as e:
+        load_scene_config("default", {"height_map": str(path), "normal_convention": "directx"})
+    assert "normal_convention" in str(e.value) and "normal map" in str(e.value)

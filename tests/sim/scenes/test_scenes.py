@@ -308,3 +308,30 @@ def test_larger_maps_keep_the_slopes_of_the_reference_size(t):
     assert bump_strength("bumps", 64) == bump_strength("bumps", 512) == SCENES["bumps"][2]
     relief = [_shade("bumps", n)[1].std() for n in (512, t)]
     assert abs(relief[1] / relief[0] - 1) < 0.05, relief
+
+
+def test_texel_coordinates_of_each_geometry():
+    """u, v of each covered pixel against the geometry's own parametrization (docs/scenes.md):
+    the plane maps the screen once; the globe by longitude phi / 2 pi and colatitude
+    theta / pi of its normal; the cylinder's visible half (phi from 180 to 360 deg) carries
+    the whole map once across, v down its axis."""
+    t, size = 64, 64
+    c = (np.arange(size) + 0.5) / size * 2 - 1
+    sx, sz = np.meshgrid(c, -c)
+
+    def close(got, want, mask):
+        d = np.abs((got - np.floor(want).astype(int)) % t)
+        d = np.minimum(d, t - d)[mask]
+        assert d.max() <= 1 and np.mean(d == 0) > 0.98
+
+    plane = load_scene("bumps", size=size, texture_size=t)
+    close(plane.u, (sx + 1) / 2 * t, plane.mask)
+    close(plane.v, (1 - sz) / 2 * t, plane.mask)
+    cyl = load_scene("cylinder", size=size, texture_size=t)
+    close(cyl.u, t * (1 - np.arccos(np.clip(sx, -1, 1)) / np.pi), cyl.mask)
+    close(cyl.v, (1 - sz) / 2 * t, cyl.mask)
+    assert cyl.u[5, 0] < 8 and cyl.u[5, -1] > t - 8            # the whole map across
+    globe = load_scene("globe", size=size, texture_size=t)
+    ny = -np.sqrt(np.clip(1 - sx ** 2 - sz ** 2, 0, 1))
+    close(globe.u, t * (np.arctan2(ny, sx) % (2 * np.pi)) / (2 * np.pi), globe.mask)
+    close(globe.v, t * np.arccos(np.clip(sz, -1, 1)) / np.pi, globe.mask)
