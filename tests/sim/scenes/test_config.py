@@ -283,3 +283,15 @@ def test_a_users_map_sets_the_texture_size_and_refuses_a_second_picture(tmp_path
     with pytest.raises(BumpError) as e:
         load_scene_config("default", {"height_map": str(path), "normal_convention": "directx"})
     assert "normal_convention" in str(e.value) and "normal map" in str(e.value)
+
+
+def test_a_users_map_at_another_texture_size_is_resampled_or_refused(tmp_path):
+    import numpy as np
+
+    path = tmp_path / "h.npy"
+    np.save(path, np.add.outer(np.arange(16.0), np.arange(16.0)) % 5 / 4)
+    scene = load_scene_config("default", {"height_map": str(path), "texture_size": 32, "resample": True})
+    assert scene.texture_size == 32
+    with pytest.raises(BumpError) as e:
+        load_scene_config("default", {"height_map": str(path), "texture_size": 32})
+    assert "texture_size = 32" in str(e.value) and "16x16" in str(e.value)
