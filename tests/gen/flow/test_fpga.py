@@ -198,3 +198,38 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
     assert calls == ["peercy_like"]
     assert {r["unit"] for r in rows.values()} == {"peercy_like", "ernst_like"}
     assert report.place_all(Config(), args, tasks) == rows and len(calls) == 1
+
+
+def test_a_run_stopped_early_keeps_the_placements_it_finished(tmp_path, monkeypatch):
+    """Each placement is stored as it ends: when the run stops after the first of two jobs
+    (here the Runner raises after reporting it), a second run reads that one from the cache
+    and places only the other."""
+    from types import SimpleNamespace
+
+    from bumprtl.gen.flow.units import build_unit
+    from bumprtl.gen.report import fpga as report
+    from bumprtl.sim import jobs
+
+    calls = []
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
+    monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
+    monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
+        "sincos", Config(angle_bits=6, frac_bits=5 + (design == "b")), ECP5())[0])
+    args = SimpleNamespace(device="LFE5U-25F", work=tmp_path, jobs=1, scheduler=None)
+    tasks = [(("first", "a", "pipeline"), 1), (("second", "b", "pipeline"), 1)]
+    real_run = jobs.Runner.run
+
+    def stopped(self, job_iter, desc="jobs", on_done=None):
+        first = [next(iter(job_iter))]
+        real_run(self, first, desc, on_done)
+        raise KeyboardInterrupt                         # the user stops the run here
+
+    monkeypatch.setattr(jobs.Runner, "run", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        report.place_all(Config(), args, tasks)
+    assert calls == ["first"]
+    monkeypatch.setattr(jobs.Runner, "run", real_run)
+    rows = report.place_all(Config(), args, tasks)
+    assert calls == ["first", "second"]                 # the first came from the cache
+    assert {r["unit"] for r in rows.values()} == {"first", "second"}
