@@ -295,3 +295,15 @@ def test_a_users_map_at_another_texture_size_is_resampled_or_refused(tmp_path):
     with pytest.raises(BumpError) as e:
         load_scene_config("default", {"height_map": str(path), "texture_size": 32})
     assert "texture_size = 32" in str(e.value) and "16x16" in str(e.value)
+
+
+def test_a_scene_files_map_path_is_relative_to_the_file(tmp_path, monkeypatch):
+    import numpy as np
+
+    (tmp_path / "maps").mkdir()
+    np.save(tmp_path / "maps" / "h.npy", np.add.outer(np.arange(16.0), np.arange(16.0)) % 5 / 4)
+    f = tmp_path / "scene.toml"
+    f.write_text('height_map = "maps/h.npy"\n')
+    monkeypatch.chdir(tmp_path / "maps")                    # not where the file is
+    scene = load_scene_config(f)
+    assert scene.height_map == str(tmp_path / "maps" / "h.npy") and scene.texture_size == 16
