@@ -18,8 +18,8 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   product), theta at or next to 0 and 180 degrees, phi next to 0 / 360, and directions
   within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
-* (exact method, varying map) a few pixels whose dot products sit within a few tens of
-  LSBs of their rounding carry, their N' written into the map: a wrong low bit of a
+* (exact method, varying map) 28 pixels whose positive dot products sit within a few tens
+  of LSBs of their rounding carry, their N' written into the map: a wrong low bit of a
   product moves the dot, which random pixels show about once in ten thousand;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
@@ -226,7 +226,7 @@ def _texel_inputs(scene, n, rng, words, addr):
 
 
 CARRY_POOL = 1 << 16         # random pixels searched for the rounding carries of the frame
-CARRY_PIXELS = 6             # kept a dot product
+CARRY_PIXELS = 14            # kept a dot product (positive dots only)
 
 
 def _near_carry(scene, seed):
@@ -237,7 +237,7 @@ def _near_carry(scene, seed):
     if scene.shading != "per-pixel" or scene.bump_map != "varying":
         return None
     from bumprtl.sim.tb.bulk_sources import rounding_codes
-    return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS)
+    return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS, lit=True)
 
 
 def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):

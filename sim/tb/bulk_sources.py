@@ -74,14 +74,15 @@ ROUNDING_POOL = 1 << 14      # random pixels searched for the dot products' roun
 ROUNDING_PIXELS = 64         # pixels kept a dot product (L's, and H's with specular)
 
 
-def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS):
+def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS, lit=False):
     """Angle codes of pixels whose exact-method dot products sit next to their one rounding
     (rtl/exact.py: ``(pair + zz_half) >> (B + 3)``, the rounding half in ``zz_half``): of
     ``pool`` random pixels (ROUNDING_POOL), the ``count`` per dot (ROUNDING_PIXELS) whose
     sum lies nearest to a
     carry into bit B + 3, either side (a few hundred LSBs at most), so a wrong low bit of
     either adder operand moves the dot. Random pixels reach such a sum about once in a
-    thousand. None for the other methods (other dot products)."""
+    thousand. ``lit``: only pixels whose dot is positive (a negative one is clamped to 0
+    before any output shows it). None for the other methods (other dot products)."""
     if cfg.method != "exact":
         return None
     codes = random_codes(pool, cfg, seed=seed)
@@ -93,7 +94,10 @@ def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS):
         acc = (w("n.x4") * w(f"{v}.p2") + 2 * w("n.y2") * w(f"{v}.y2")
                + 2 * w("n.z4") * w(f"{v}.z"))
         d = (acc + (1 << (shift - 1))) & ((1 << shift) - 1)
-        picks.append(np.argsort(np.minimum(d, (1 << shift) - d), kind="stable")[:count])
+        dist = np.minimum(d, (1 << shift) - d)
+        if lit:
+            dist = np.where(acc > 0, dist, 1 << shift)
+        picks.append(np.argsort(dist, kind="stable")[:count])
     keep = np.concatenate(picks)
     return {k: np.asarray(c)[keep] for k, c in codes.items()}
 
