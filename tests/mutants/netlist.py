@@ -464,10 +464,14 @@ def _stimulus_words(target, n, sim="verilator"):
     if target == "fetch":
         return (f"{n} random texels x 4 patterns, the default scene's map written through the "
                 f"host port{on}")
+    from bumprtl.rtl.bumpfetch import has_map
     from bumprtl.sim.tb.bulk_frame import PIXELS, SEED, WRITTEN
-    return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels, seed {SEED}, "
-            f"{WRITTEN} map words written first) x 4 traffic patterns{on}, as make test's "
-            f"bulk pipeline test streams it through the default scene")
+    scene = _scenes().load_scene_config(target.split(":", 1)[1])
+    writes = (f", {WRITTEN} map words written first" if has_map(scene) or scene.texture
+              else ", no map: the polygon registers and the lights")
+    return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels, seed {SEED}{writes}) "
+            f"x 4 traffic patterns{on}, as make test's bulk pipeline test streams it through "
+            f"the default scene")
 
 
 def report(results, runs):
