@@ -86,6 +86,111 @@ KNOWN = [
      "(`BumpError.field`) on purpose, not the wording"),
     ("bumprtl.gen.cli.flags.x_add_map_flags", "SURFACE THE MAP IS WRAPPED ON", "wording",
      "`--geometry`'s help text in capitals: what the help says is unchanged"),
+    ("bumprtl.sim.golden.fixed.peercy.x_predicted_error_bound_lsb", "channel_bound(cfg, None, 0.0, e, lights)",
+     "killed since", "no test asked Peercy's bound for a channel but diffuse; "
+     "tests/sim/golden/fixed/test_bounds_closed_forms.py::test_peercys_other_channels_are_the_back_ends_bound_for_its_dot_error "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.float.palette.x_check_normal_map", 'name="XXnormalsXX"', "killed since",
+     "the default name in an error message; tests/sim/golden/float/test_palette.py::test_a_bad_normal_map_is_named_normals "
+     "reads the whole message (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.float.palette_quantize.x_kmeans", "seed=1):", "equivalent",
+     "the seed only orders the points whose errors tie within the 1e-12 jitter when a centre "
+     "empties; no input of the tests has such a tie, and a tie is equally bad either way"),
+    ("bumprtl.sim.scenes.heightfields.x__skimage", "img = None", "missed by mutmut's record",
+     "the closure is made when heightfields is imported, so mutmut credits _skimage to the test "
+     "that ran then, not to the tests that load an image; "
+     "tests/sim/scenes/test_scenes.py::test_texture_size_is_independent_of_image_size (in the "
+     "selection) fails with the mutant switched on"),
+    ("bumprtl.sim.scenes.usermap.x_load_bump_map", "float(height_scale), None, bool(resample)",
+     "killed since", "no test of the selection asked load_bump_map for another size; "
+     "tests/sim/scenes/test_usermap.py::test_load_bump_map_resamples_to_the_size_asked_for does "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.accuracy.x_crater_scene", "c = (np.arange(size) - 0.5) / size", "equivalent",
+     "the unseen crater map sampled half a texel over: craters at uniform random centres, so "
+     "the same kind of map translated by half a texel; nothing specifies where a crater sits"),
+    ("bumprtl.sim.golden.stress.x_check_fixed", '"XXcolor_lsbXX"', "killed since",
+     "no test read check_fixed's colour errors; "
+     "tests/sim/golden/test_stress_cases.py::test_check_fixed_reports_diffuse_and_colour_errors_and_overflow_per_field "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.usermap.x_read_normals", "if np.any(None):", "killed since",
+     "no test gave an RGBA normal map with a transparent texel; "
+     "tests/sim/scenes/test_usermap.py::test_an_rgba_normal_map_is_read_only_when_opaque does "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", "maps = None", "killed since",
+     "no test of the selection loaded a map without texture_size or with a second picture; "
+     "tests/sim/scenes/test_config.py::test_a_users_map_sets_the_texture_size_and_refuses_a_second_picture "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.x__geometry", "u = phi / (2 * np.pi) / 2 * tex", "killed since",
+     "no test read the cylinder's texel coordinates; "
+     "tests/sim/scenes/test_scenes.py::test_texel_coordinates_of_each_geometry does (checked "
+     "with the mutant switched on)"),
+    ("bumprtl.gen.cli.flags.x_add_map_flags", 'metavar=None', "killed since",
+     "`--texture-size`'s metavar (help only); "
+     "tests/gen/cli/test_validation.py::test_every_map_flag_has_help_and_the_documented_metavar "
+     "checks the T that docs/scenes.md writes (checked with the mutant switched on)"),
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "help=None)", "killed since",
+     "a flag without its help line; "
+     "tests/gen/cli/test_validation.py::test_every_map_flag_has_help_and_the_documented_metavar "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "MAP'S SIZE, OR THE SCENE'S", "wording",
+     "the end of `--texture-size`'s help in capitals: what the help says is unchanged"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", 'keys.get("XXtexture_sizeXX")', "killed since",
+     "no test of the selection gave a map with another texture_size; "
+     "tests/sim/scenes/test_config.py::test_a_users_map_at_another_texture_size_is_resampled_or_refused "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", "(extra[0] == 'height_scale') or True", "killed since",
+     "an error message calling a normal map's key a height map's; "
+     "tests/sim/scenes/test_config.py::test_a_users_map_sets_the_texture_size_and_refuses_a_second_picture "
+     "reads it (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", 'keys.get("TEXTURE_SIZE")', "killed since",
+     "no test of the selection gave a map with another texture_size; "
+     "tests/sim/scenes/test_config.py::test_a_users_map_at_another_texture_size_is_resampled_or_refused "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", "and {maps[1]} in {where}", "killed since",
+     "an image and a map in one scene raised IndexError, not the one-line error; "
+     "tests/sim/scenes/test_config.py::test_a_users_map_sets_the_texture_size_and_refuses_a_second_picture "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.xǁSceneConfigǁ_check_picture", '_choice("geometry", None, GEOMETRIES)',
+     "killed since", "no test of draw 1's commit gave a scene a geometry; "
+     "tests/sim/scenes/test_config.py::test_every_refusal_names_the_key_the_value_and_what_is_allowed "
+     "(the refused 'torus' named in the message) kills it (checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x__source_keys", "is_absolute()) and False", "killed since",
+     "no test of the selection used a relative map path in a scene file; "
+     "tests/sim/scenes/test_config.py::test_a_scene_files_map_path_is_relative_to_the_file "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.accuracy.x_adversarial_pixels", "(grid - 0.4999 * np.sign(grads[name]))",
+     "killed since", "the search on the better side of the grid still finds nothing over the "
+     "bound; tests/sim/golden/test_accuracy_search.py::test_adversarial_pixels_sit_on_the_side_that_moves_the_channel_most "
+     "checks the side (checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.x__check_unit", "isinstance(value, bool) and not isinstance", "killed since",
+     "ka = True passed as 1.0; no test gave a bool coefficient; "
+     "tests/rtl/test_config.py::test_a_flag_of_the_wrong_type_is_refused_naming_field_and_value "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.common.x_term_bounds_lsb", '"XXspecularXX": 0.0', "killed since",
+     "no test of draw 1's commit asked a bound without specular (the key is then missing); "
+     "tests/sim/golden/fixed/test_bounds_closed_forms.py::test_an_angle_error_a_moves_diffuse_255_a_and_specular_by_the_steepest_slope "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.x__check_int", 'why="XXXX"', "killed since",
+     "every range without an explanation would end in '(XXXX)'; the tests read the refused "
+     "field, not the message; tests/rtl/test_config.py::test_a_range_without_an_explanation_ends_at_the_range "
+     "reads it (checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", "B >= k - 1 = {k - 2}", "killed since",
+     "the explanation's floor one below the range's; "
+     "tests/rtl/test_config.py::test_the_frac_bits_floor_the_message_explains_is_the_range_it_gives "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", "*ANGLE_BITS_RANGE, )", "killed since",
+     "angle_bits' range without its explanation; "
+     "tests/rtl/test_config.py::test_a_range_without_an_explanation_ends_at_the_range "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", "==)", "killed since",
+     "frac_bits' range without its explanation (the only mutant of __post_init__ whose whole "
+     "change is a closing parenthesis); "
+     "tests/rtl/test_config.py::test_the_frac_bits_floor_the_message_explains_is_the_range_it_gives "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", "raise ConfigError(None,", "killed since",
+     "palette_blend's error said 'None'; the tests read the refused field only; "
+     "tests/rtl/test_config.py::test_a_flag_of_the_wrong_type_is_refused_naming_field_and_value "
+     "reads the message (checked with the mutant switched on)"),
     ("bumprtl.sim.golden.fixed.peercy.x_normalize_fixed", "np.maximum(r, 2)", "equivalent",
      "r = isqrt(4 s) for an integer s is 0 or at least 2, never 1"),
 ]
@@ -272,7 +377,9 @@ def reason(name, diff):
     func = name.rsplit("__mutmut_", 1)[0]
     changed = "\n".join(l[1:] for l in diff.splitlines() if l.startswith("+"))
     for k_func, needle, cls, why in KNOWN:
-        if func == k_func and needle in changed:
+        # a needle "==text" matches only a changed text that is exactly ``text`` (stripped)
+        hit = changed.strip() == needle[2:] if needle.startswith("==") else needle in changed
+        if func == k_func and hit:
             return cls, why
     return None
 
