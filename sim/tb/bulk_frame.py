@@ -45,6 +45,7 @@ from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, pipeline_fixed, polygon_fixed,
                                                unpack_texels)
+from bumprtl.sim.tb.bulk_sources import rounding_codes
 from bumprtl.sim.tb.bulk_wrapper import setup_writes
 
 __all__ = ["PIXELS", "SEED", "CoverageFrame", "coverage_frame"]
@@ -236,7 +237,6 @@ def _near_carry(scene, seed):
     shading): a wrong low bit of a product moves their dot."""
     if scene.shading != "per-pixel" or scene.bump_map != "varying":
         return None
-    from bumprtl.sim.tb.bulk_sources import rounding_codes
     return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS, lit=True)
 
 
