@@ -1,14 +1,8 @@
-"""Generated pages: their records and sections."""
+"""Generated pages: their sections (each page's record is rtl.config.Config.made_at)."""
 
 from pathlib import Path
 
-__all__ = ["made_at", "write_section"]
-
-
-def made_at(cfg, note=""):
-    """``cfg``'s one-line record of the configuration a generated page was made at
-    (:meth:`rtl.config.Config.made_at`)."""
-    return cfg.made_at(note)
+__all__ = ["write_section"]
 
 
 def write_section(path, name, text):

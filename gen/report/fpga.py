@@ -27,7 +27,6 @@ from bumprtl.sim.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, Placement,
                                    check_device, lpf_mhz, pipeline_component, place_text)
 from bumprtl.gen.flow.units import build_unit
-from bumprtl.gen.report import made_at
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 
 __all__ = ["fpga_units", "fpga_report", "write_report", "add_parser"]
@@ -165,7 +164,7 @@ def write_report(args, rows, acc, cfg):
              "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
              "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
              f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
-             made_at(cfg, _scene_widths(rows)), "",
+             cfg.made_at(_scene_widths(rows)), "",
              "| unit | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | target met | max LSB | mean LSB | Fmax by seed |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
