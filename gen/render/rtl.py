@@ -25,7 +25,7 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import SceneConfig, load_scene_config, BUILTIN
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
-from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
+from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
 from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, polygon_fixed
 from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
                                               quantize_normal_map, world_normal_map)
@@ -176,11 +176,7 @@ def _golden_image(scene, inputs, words, polygon, table, base, texels):
     """:func:`golden_render` of stimulus already made (:func:`scene_stimulus`)."""
     out = pipeline_fixed(inputs, scene, words, polygon, texels)
     if scene.shading == "palette":
-        entry = unpack_rgba(table[out["index"]], scene.config)
-        if scene.texture:                  # Tarini eq. 2, the texel as the base colour
-            rgb = unpack_rgba(out["texel"] | (255 << 24), scene.config)
-            entry = blend_eq2(entry, rgb, scene.config)
-        out = {f"color.{c}": v for c, v in entry.items()}
+        out = palette_colors(out, table, scene)
     return _image(base, out, scene)
 
 

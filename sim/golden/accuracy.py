@@ -9,8 +9,8 @@ import numpy as np
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import texture_blend
-from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to_cartesian,
-                                       tangent_rotation, to_8bit)
+from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, to_8bit,
+                                       world_bump_normal)
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.methods import encode_pixels, get
@@ -144,9 +144,8 @@ def _target(channel, ref):
 
 
 def _world_bump_normal(px):
-    """N' in world coordinates: M^T b, M = R_y(-th_N) R_z(-ph_N) (common.tangent_rotation)."""
-    m = tangent_rotation(px.n_phi, px.n_theta)
-    return np.einsum("...ji,...j->...i", m, polar_to_cartesian(px.b_phi, px.b_theta))
+    """N' in world coordinates (common.world_bump_normal of the pixels' angles)."""
+    return world_bump_normal(px.n_phi, px.n_theta, px.b_phi, px.b_theta)
 
 
 def highlight_pixels(n, rng, cfg: Config):

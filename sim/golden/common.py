@@ -14,7 +14,7 @@ import numpy as np
 from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["PixelInputs", "Result", "polar_to_cartesian", "cartesian_to_polar",
-           "tangent_rotation", "shade", "to_8bit"]
+           "tangent_rotation", "world_bump_normal", "shade", "to_8bit"]
 
 TWO_PI = 2 * np.pi
 
@@ -133,6 +133,13 @@ def tangent_rotation(n_phi, n_theta):
     ry = np.stack([np.stack([ct, zero, -st], -1), np.stack([zero, one, zero], -1),
                    np.stack([st, zero, ct], -1)], -2)             # rotation by -theta about y
     return ry @ rz
+
+
+def world_bump_normal(n_phi, n_theta, b_phi, b_theta):
+    """The bumped normal N' in world coordinates (..., 3): M^T b with M the tangent rotation
+    of the world normal (radians; :func:`tangent_rotation`, Lee Sec. 3.1.1)."""
+    m = tangent_rotation(n_phi, n_theta)
+    return np.einsum("...ji,...j->...i", m, polar_to_cartesian(b_phi, b_theta))
 
 
 def shade(ndotl, ndoth, cfg: Config, l_prime=None):

@@ -39,10 +39,10 @@ import numpy as np
 from bumprtl.rtl.bumpfetch import (coord_bits, has_map, level_bases, level_bits,
                                    memory_depth, pack_texels)
 from bumprtl.rtl.layouts import light_keys
-from bumprtl.rtl.palette import CHANNELS, index_bits
-from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian, tangent_rotation
+from bumprtl.rtl.palette import index_bits
+from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
 from bumprtl.sim.golden.fixed.common import angle_codes
-from bumprtl.sim.golden.fixed.palette_lut import blend_eq2, pack_rgba, unpack_rgba
+from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
 from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, pipeline_fixed, polygon_fixed,
                                                unpack_texels)
 from bumprtl.sim.tb.bulk_sources import rounding_codes
@@ -241,10 +241,9 @@ def _near_carry(scene, seed):
 
 
 def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
-    """The bumped normal N'' in the world (n, 3) from the codes: M^T N' (Lee Sec. 3.1.1)."""
+    """The bumped normal N'' in the world (n, 3) from the angle codes."""
     rad = lambda c: np.asarray(c, np.float64) * (TWO_PI / cfg.full_circle)
-    m = tangent_rotation(rad(n_phi), rad(n_theta))
-    return np.einsum("pji,pj->pi", m, polar_to_cartesian(rad(b_phi), rad(b_theta)))
+    return world_bump_normal(rad(n_phi), rad(n_theta), rad(b_phi), rad(b_theta))
 
 
 def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
@@ -305,10 +304,7 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     inputs = {k: np.asarray(v, np.int64) for k, v in inputs.items()}
     golden = pipeline_fixed(inputs, scene, words, polygon, texels)
     if scene.shading == "palette":
-        entry = unpack_rgba(np.asarray(table)[golden["index"]], cfg)
-        if scene.texture:
-            entry = blend_eq2(entry, unpack_rgba(golden["texel"] | (255 << 24), cfg), cfg)
-        golden = {**golden, **{f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}}
+        golden = {**golden, **palette_colors(golden, table, scene)}
     golden = {k: np.asarray(v, np.int64) for k, v in golden.items()}
     golden["tag"] = inputs["tag"]
     return CoverageFrame(inputs, words, texels, writes, polygon, table, decoys, golden)

@@ -72,7 +72,7 @@ KNOWN = [
                    "name with `_` as `-`)"),
     ("bumprtl.gen.cli.main.x__optional", 'or "XXXX"', "equivalent",
      "the name is used only when OPTIONAL knows it, and it knows neither `\"\"` nor `\"XXXX\"`"),
-    ("bumprtl.sim.golden.accuracy.x__world_bump_normal", '"...JI,...J->...I"', "equivalent",
+    ("bumprtl.sim.golden.common.x_world_bump_normal", '"...JI,...J->...I"', "equivalent",
      "einsum's subscripts in capitals: the same contraction"),
     ("bumprtl.sim.golden.float.lee.x__lee", "np.errstate(invalid=None)", "equivalent",
      "only whether numpy warns changes, never a value (a warnings-as-errors run over 2,400 random "

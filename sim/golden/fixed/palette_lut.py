@@ -14,7 +14,7 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import CHANNELS, blend_eq1, blend_eq2, index_bits, mul8
 
-__all__ = ["index_bits", "mul8", "blend_eq1", "blend_eq2", "pack_rgba", "unpack_rgba",
+__all__ = ["index_bits", "mul8", "blend_eq1", "blend_eq2", "pack_rgba", "unpack_rgba", "palette_colors",
            "PaletteLUTModel", "CHANNELS", "host_op"]
 
 def pack_rgba(rgba, cfg: Config = Config()):
@@ -27,6 +27,16 @@ def unpack_rgba(word, cfg: Config = Config()):
     w = np.asarray(word, dtype=np.int64)
     mask = (1 << cfg.color_bits) - 1
     return {c: (w >> (n * cfg.color_bits)) & mask for n, c in enumerate(CHANNELS)}
+
+
+def palette_colors(out, table, scene):
+    """The colour a palette scene's pipeline sends (``out``: :func:`pipeline.pipeline_fixed`'s
+    ``index`` and ``texel``; ``table``: the packed colour table): each pixel's table entry,
+    blended with its texel by Tarini eq. 2 when the scene has a colour texture."""
+    entry = unpack_rgba(np.asarray(table)[out["index"]], scene.config)
+    if scene.texture:
+        entry = blend_eq2(entry, unpack_rgba(out["texel"] | (255 << 24), scene.config), scene.config)
+    return {f"color.{c}": np.asarray(entry[c], np.int64) for c in CHANNELS}
 
 
 class PaletteLUTModel:
