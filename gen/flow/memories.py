@@ -17,7 +17,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from amaranth.hdl import Fragment
 
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.config import BumpError
@@ -25,7 +24,7 @@ from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import DP16KD_MODES
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.emit import elaborated, emit
 from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag
 
@@ -105,7 +104,7 @@ def check_fits(roms, device, what):
 def unit_memories(dut):
     """Every memory of an elaborated unit (``name`` -> depth, width, bits): the records its
     StallPipes keep while it elaborates (rtl/pipe.py)."""
-    Fragment.get(dut, None)
+    elaborated(dut)
     return dict(sorted(dut.memories.items()))
 
 

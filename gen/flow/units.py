@@ -7,9 +7,8 @@ and the reports elaborate exactly the same hardware from the same Config.
 from dataclasses import dataclass
 from typing import Callable
 
-from amaranth.hdl import Fragment
 
-from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.emit import elaborated, emit
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
@@ -114,8 +113,9 @@ def faithful_note(cfg, lights=1, texture=False):
 def _roms(dut):
     """Every memory of a unit: name -> depth, width, bits (ROM sizes in bits), from the
     ``memories`` each unit records while it elaborates (its StallPipes' records, see
-    rtl/pipe.py; ``unit.name`` inside a pipeline), so the unit is elaborated first."""
-    Fragment.get(dut, None)
+    rtl/pipe.py; ``unit.name`` inside a pipeline), so the unit is elaborated first (once:
+    emission converts the same elaboration)."""
+    elaborated(dut)
     return dict(sorted(dut.memories.items()))
 
 

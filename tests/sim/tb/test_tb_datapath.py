@@ -15,7 +15,7 @@ METHODS = list(PER_PIXEL)              # exact, lee
 # Random vectors per traffic pattern (plus the edge cases): a Verilator run costs little
 # beside its build, an Icarus run more; the volume that reaches ROM entries few vectors hit
 # (10^7 vectors per unit and method) is make regress's bulk path (tests/sim/tb/test_bulk.py).
-SAMPLES = {"icarus": 400, "verilator": 4000}
+SAMPLES = {"icarus": 250, "verilator": 4000}
 
 
 def _cases():

@@ -12,9 +12,13 @@ from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.traffic import PATTERNS
 
 
-# make test: both scene classes on Icarus (a build costs little there); make regress: the full
-# scene's build on Verilator (a minute of C++ compilation for 768 pixels).
-@pytest.mark.parametrize("sim, name", [("icarus", "full"), ("icarus", "default"),
+# make test: the full scene on Icarus (a build costs little there); the default scene's
+# per-cycle run is in make regress, since make test streams that scene's pipeline on Icarus
+# under the same traffic patterns through the bulk path (tests/sim/tb/test_bulk.py: the
+# coverage frame, then this render frame); make regress: the full scene's build on Verilator
+# too (a minute of C++ compilation for 768 pixels).
+@pytest.mark.parametrize("sim, name", [("icarus", "full"),
+                                       pytest.param("icarus", "default", marks=pytest.mark.regress),
                                        pytest.param("verilator", "full", marks=pytest.mark.regress)])
 def test_pipeline_stream_cocotb(sim, name, build_dir):
     """``full``: two lights, mip levels and the colour texture (RGB out)."""
