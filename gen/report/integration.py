@@ -27,7 +27,7 @@ from bumprtl.gen.flow.memories import DEFAULT_DEVICE, emit_scene_unit, memory_im
 from bumprtl.gen.flow.named import named_module, named_ports, write_named
 from bumprtl.gen.flow.units import default_module
 from bumprtl.gen.render.rtl import scene_memories
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes.config import load_scene_config
 
 __all__ = ["emit_for_integration", "blocks", "write_doc", "made_at", "add_parser"]
@@ -110,10 +110,10 @@ def emit_for_integration(scene, out_dir, device=DEFAULT_DEVICE):
 
 
 def made_at(meta):
-    cfg = meta["config"]
-    return (f"Made at: angle_bits={cfg['angle_bits']}, frac_bits={cfg['frac_bits']} (scene "
-            f"`{meta['scene']['name']}`, method {cfg['method']}; `{COMMAND}`, from "
-            f"`{meta['named_ports']['command']}`)")
+    """The page's record (rtl.config.Config.made_at) of the sidecar's Config."""
+    cfg = Config(**meta["config"])
+    return cfg.made_at(f"scene `{meta['scene']['name']}`, method {cfg.method}; `{COMMAND}`, "
+                       f"from `{meta['named_ports']['command']}`")
 
 
 def _unit_memories(meta, unit):
