@@ -226,7 +226,10 @@ def _texel_inputs(scene, n, rng, words, addr):
     return out
 
 
-CARRY_POOL = 1 << 16         # random pixels searched for the rounding carries of the frame
+# Random pixels searched for the rounding carries of the frame: the sum has 2**(B + 3)
+# residues (2**18 at the default), so 2**20 pixels put the 14 nearest a carry within a
+# couple of LSBs of it, where a wrong bit 0 of a product (one LSB of the sum) moves the dot.
+CARRY_POOL = 1 << 20
 CARRY_PIXELS = 14            # kept a dot product (positive dots only)
 
 
