@@ -253,6 +253,24 @@ def test_multi_light_and_texture_sidecars_state_every_channel():
     assert error_bounds(Config(), 1, texture=True)["color"] == 1
 
 
+def test_two_lights_colour_bound_holds_where_the_grid_error_is_large():
+    """At 10-bit angles, B = 11, the angle grid's error is several LSB: two lights in the
+    same direction (the adversarial colour search, their errors aligned) measure more colour
+    error than one light's proven bound, and the two-light bound (the m lights' terms add,
+    sim/golden/fixed/common.channel_bounds_lsb) still holds it. A colour bound proved for
+    one light's terms only would not."""
+    cfg = Config(angle_bits=10, frac_bits=11)
+    px = adversarial_pixels(cfg, candidates=60_000, keep=300, channel="color")
+    out = exact_fixed(METHODS["exact"].encode(px, cfg), cfg)
+    ref = conventional(px, cfg)
+    scene = load_scene_config({"name": "t", "lights": 2, "angle_bits": 10, "frac_bits": 11})
+    color = combine_lights_fixed([out, out], scene)["color"].astype(int)
+    want = to_8bit(np.clip(cfg.ka + 2 * (cfg.kd * np.clip(ref.ndotl, 0, 1) + cfg.ks * ref.specular),
+                           0, 1))
+    measured = int(np.abs(color - want.astype(int)).max())
+    assert error_bounds(cfg, 1)["color"] < measured <= error_bounds(cfg, 2)["color"]
+
+
 def test_default_widths_are_the_faithful_ones_for_one_light_and_two():
     """Config's default widths are the narrowest the bound proves within 1 LSB on every
     channel (diffuse, specular, colour, blend) of one light at n = 16; with two lights the
