@@ -90,7 +90,9 @@ PALETTE_SCENES = {"palette": "palette",
 
 @pytest.mark.parametrize("name", PALETTE_SCENES)
 def test_bulk_palette_frame_equals_golden(name, build_dir):
-    """A palette scene's emitted pipeline (Icarus) streams its coverage frame: a random
+    """A palette scene's emitted pipeline (Icarus) streams its coverage frame under the four
+    traffic patterns (the frame and patterns of the netlist mutants of pipeline:palette,
+    tests/mutants/netlist.py): a random
     colour table read from bank 1 between decoy tables, random indices written through the
     map's host port, and (textured) random texels. Every channel of the colour (r, g, b, a
     each a field of its own) equals the golden model's, so the RTL and the model cannot
@@ -108,11 +110,13 @@ def test_bulk_palette_frame_equals_golden(name, build_dir):
     assert len(channels) == 4, sorted(golden)
     stacked = np.stack([golden[c] for c in channels])
     assert (stacked != stacked[:1]).any(axis=0).mean() > 0.9     # channels differ
-    r = run_bulk("icarus", v, j, build_dir / "bulk", ("both",), inputs=frame.inputs,
+    r = run_bulk("icarus", v, j, build_dir / "bulk", tuple(TRAFFIC), inputs=frame.inputs,
                  expected=golden, setup=frame.setup(meta))
-    assert r.checked and r.pixels["both"] == len(frame.inputs["tag"])
-    for field, want in golden.items():
-        assert np.array_equal(r.outputs["both"][field], want), field
+    assert r.checked
+    for pattern in TRAFFIC:
+        assert r.pixels[pattern] == len(frame.inputs["tag"]), pattern
+        for field, want in golden.items():
+            assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
 
 
 def test_bulk_fails_on_one_wrong_golden_value(build_dir):
