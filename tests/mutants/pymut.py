@@ -193,6 +193,47 @@ KNOWN = [
      "reads the message (checked with the mutant switched on)"),
     ("bumprtl.sim.golden.fixed.peercy.x_normalize_fixed", "np.maximum(r, 2)", "equivalent",
      "r = isqrt(4 s) for an integer s is 0 or at least 2, never 1"),
+    # draw 3 (seed 7)
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "YOUR OWN BUMP MAP (SIM/SCENES/USERMAP.PY)", "wording",
+     "the title of the map flags' group in `--help` in capitals: what the help says is unchanged"),
+    ("bumprtl.gen.cli.main.x_build_parser", "[{extra and need}] extra: ", "killed since",
+     "a command listed with the extra of the missing package instead of its own; no test listed "
+     "a command whose two differ; tests/gen/cli/test_validation.py::test_the_command_list_names_a_commands_own_extra "
+     "does (checked with the mutant switched on)"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", '_check_int("out_bits", self.out_bits, 8, 8, None)',
+     "killed since", "out_bits' refusal without its reason; tests/rtl/test_config.py::test_out_bits_refusal_says_why "
+     "reads it (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.float.palette.x_check_normal_map", "n.shape[0] != n.shape[1] or n.shape[1] == 0",
+     "equivalent", "the clause before it already holds shape[0] == shape[1], so shape[1] == 0 "
+     "is shape[0] == 0"),
+    ("bumprtl.sim.golden.float.palette.x_displacement_to_normals", "h.size == 1:", "killed since",
+     "an empty height map accepted and a 1 x 1 map refused; "
+     "tests/sim/golden/float/test_palette.py::test_height_map_sizes_at_the_edges (checked with the "
+     "mutant switched on)"),
+    ("bumprtl.sim.golden.float.palette.x_quantize_normal_map", "(weights is None) or True", "killed since",
+     "the use counts ignored (unused texels shaped the table); "
+     "tests/sim/golden/float/test_palette.py::test_unused_texels_do_not_shape_the_table (checked "
+     "with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x__source_keys", 'return dict(source), "SCENE"', "killed since",
+     "a scene given as keys named 'SCENE' in its messages; "
+     "tests/sim/scenes/test_config.py::test_messages_name_the_source_of_the_key (checked with the "
+     "mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", "if v is not None}, None,", "killed since",
+     "a contradicting flag's message named the source 'None'; "
+     "tests/sim/scenes/test_config.py::test_messages_name_the_source_of_the_key (checked with the "
+     "mutant switched on)"),
+    ("bumprtl.sim.scenes.imaging.x_compose", "np.asarray(color, None)", "equivalent",
+     "every caller passes float64 intensities (the float references' and golden models' "
+     "results), for which the conversion to float is the identity"),
+    ("bumprtl.sim.scenes.usermap.x_normals_to_rgb", "n = np.asarray(normals, )", "killed since",
+     "float32 normals rounded in float32 arithmetic (one texel in 65,536 of the test's map the "
+     "other way); tests/sim/scenes/test_usermap.py::test_normals_to_rgb_rounds_float32_normals_as_given "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.usermap.x_read_normals", "np.linalg.norm(n, axis=None)", "killed since",
+     "the texels divided by the map's one norm instead of each its own: the interpolation of a "
+     "resampled map weighted by the 8-bit texels' lengths; "
+     "tests/sim/scenes/test_usermap.py::test_resampling_interpolates_unit_normals (checked with "
+     "the mutant switched on)"),
 ]
 
 

@@ -123,3 +123,11 @@ def test_to_dict_holds_every_field_by_name():
     d = cfg.to_dict()
     assert d == {f.name: getattr(cfg, f.name) for f in dataclasses.fields(Config)}
     assert Config(**d) == cfg
+
+
+def test_out_bits_refusal_says_why():
+    """out_bits has one allowed value; its refusal says why (the outputs are 8-bit
+    intensities), not only the one-value range."""
+    with pytest.raises(ConfigError, match=r"out_bits = 9 is out of range: allowed \[8, 8\] "
+                                          r"\(outputs are 8-bit intensities\)"):
+        Config(out_bits=9)

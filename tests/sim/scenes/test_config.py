@@ -307,3 +307,13 @@ def test_a_scene_files_map_path_is_relative_to_the_file(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path / "maps")                    # not where the file is
     scene = load_scene_config(f)
     assert scene.height_map == str(tmp_path / "maps" / "h.npy") and scene.texture_size == 16
+
+
+def test_messages_name_the_source_of_the_key():
+    """An unknown key or a contradicting flag names where the key came from: a scene given
+    as keys, a built-in scene, a TOML file."""
+    with pytest.raises(BumpError, match=r"unknown key 'nosuch' in scene: allowed keys"):
+        load_scene_config({"name": "t", "nosuch": 1})
+    with pytest.raises(BumpError, match=r"--lights 1 contradicts lights = 2 in built-in scene "
+                                        r"'two-lights': drop one"):
+        load_scene_config("two-lights", overrides={"lights": 1}, flags={"lights": "--lights"})

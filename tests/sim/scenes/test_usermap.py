@@ -331,3 +331,30 @@ def test_an_rgba_normal_map_is_read_only_when_opaque(tmp_path):
     with pytest.raises(MapError) as e:
         read_normals(tmp_path / "alpha.png")
     assert "alpha.png" in str(e.value) and "alpha" in str(e.value).split("alpha.png", 1)[1]
+
+
+def test_normals_to_rgb_rounds_float32_normals_as_given():
+    """A float32 normal map (a user's .npy) is rounded to 8 bits from its values as given,
+    exactly as the same values in float64 (float32 arithmetic would round some texels at a
+    half step the other way)."""
+    rng = np.random.default_rng(0)
+    n = rng.normal(size=(256, 256, 3))
+    n[..., 2] = np.abs(n[..., 2])
+    n32 = (n / np.linalg.norm(n, axis=-1, keepdims=True)).astype(np.float32)
+    assert np.array_equal(normals_to_rgb(n32), normals_to_rgb(n32.astype(np.float64)))
+
+
+def test_resampling_interpolates_unit_normals(tmp_path):
+    """A normal map resampled to another size interpolates each texel's unit normal, then
+    normalises: the 8-bit texels' own lengths (each a little off 1) must not weight the
+    interpolation."""
+    from bumprtl.sim.scenes.usermap import _resize
+    rng = np.random.default_rng(4)
+    n = rng.normal(size=(64, 64, 3))
+    n[..., 2] = np.abs(n[..., 2]) + 0.5
+    path = tmp_path / "normals.png"
+    write_png(path, normals_to_rgb(n / np.linalg.norm(n, axis=-1, keepdims=True)))
+    unit = read_normals(path)                                   # 64 x 64, each texel unit
+    want = _resize(unit, 32)
+    want /= np.linalg.norm(want, axis=-1, keepdims=True)
+    assert np.allclose(read_normals(path, size=32, resample=True), want, rtol=0, atol=1e-6)

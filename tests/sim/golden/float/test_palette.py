@@ -302,3 +302,24 @@ def test_a_bad_normal_map_is_named_normals(normals, words):
     with pytest.raises(BumpError) as e:
         quantize_normal_map(normals, 16)
     assert str(e.value) == f"normals {words}"
+
+
+def test_unused_texels_do_not_shape_the_table():
+    """Sec. 4's weights are use counts: a texel of weight 0 still gets an index but does not
+    shape the table. Sixteen used directions and a seventeenth unused one fit a palette of 16
+    exactly (the table is the sixteen used normals); without the weights the 17 would not."""
+    turn = np.arange(17) * 2 * np.pi / 17
+    dirs = np.stack([0.6 * np.cos(turn), 0.6 * np.sin(turn), np.full(17, 0.8)], -1)
+    texel = np.arange(32 * 32).reshape(32, 32) % 17
+    normals, weights = dirs[texel], np.where(texel == 16, 0, 1)
+    q = quantize_normal_map(normals, 16, weights=weights)
+    assert q.exact and len(q.table) == 16
+    assert np.allclose(np.sort(q.table, axis=0), np.sort(dirs[:16], axis=0))
+    assert not quantize_normal_map(normals, 16).exact
+
+
+def test_height_map_sizes_at_the_edges():
+    """An empty height map is refused naming its shape; a 1 x 1 map is one flat texel."""
+    with pytest.raises(BumpError, match=r"non-empty square 2-D map, got shape \(0, 0\)"):
+        displacement_to_normals(np.zeros((0, 0)))
+    assert np.allclose(displacement_to_normals(np.full((1, 1), 0.3)), [[[0.0, 0.0, 1.0]]])
