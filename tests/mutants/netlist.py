@@ -91,6 +91,15 @@ BY_READING = [
      "-portbit 5",
      "the mux is n_s5_angle's reset (pipeline.v line 66542: B is the constant 14'h0000), "
      "and bit 5 of that constant tied to 0 is the constant itself"),
+    ("pipeline:flat", "mutate -mode inv -module pipeline -cell $procmux$67009 -port A -portbit 13 "
+     "-wire terms.l_sy_address -wirebit 13",
+     "bit 13 of the 14-bit register terms.l_sy_address (the mirrored address's width) is read "
+     "by nothing: the ROM's address is l_sy_address[12:0] (pipeline.v lines 26710, 26750)"),
+    ("pipeline:flat", "mutate -mode inv -module pipeline -cell $procmux$66592 -port B -portbit 12",
+     "the mux is the reset of the ROM data register terms.h_cx_data (pipeline.v line 26280: "
+     "B is 16'h0000): the register holds 0x1000 instead of 0 from reset until its first load, "
+     "and no valid pixel reaches it before that load, so only payloads while o.valid is low "
+     "change (equivalent under the stream contract)"),
 ]
 
 
