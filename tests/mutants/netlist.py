@@ -510,10 +510,12 @@ def _stimulus_words(target, n, sim="verilator"):
     writes = (f", {WRITTEN} map words written first" if has_map(scene) or scene.texture
               else ", no map: the polygon registers and the lights")
     name = target.split(":", 1)[1]
-    where = (f"as make test streams it through the {name} scene (tests/sim/tb/test_bulk.py)"
-             if name in MAKE_TEST_FRAMES and sim == "icarus" else
-             f"make test streams this generator's frame through {' and '.join(MAKE_TEST_FRAMES)} "
-             f"only")
+    if name in MAKE_TEST_FRAMES:
+        where = (f"as make test streams it through the {name} scene (tests/sim/tb/test_bulk.py)"
+                 + ("" if sim == "icarus" else ", there on Icarus"))
+    else:
+        where = (f"make test streams this generator's frame through "
+                 f"{' and '.join(MAKE_TEST_FRAMES)} only")
     return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels, seed {SEED}{writes}) "
             f"x 4 traffic patterns{on}, {where}")
 
