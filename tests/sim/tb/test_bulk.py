@@ -1,10 +1,11 @@
 """The bulk path (sim/tb/bulk.py): stimulus and outputs as arrays, the clock inside the
 simulator, the build cached by the Verilog's digest.
 
-`make test`: the default pipeline's coverage frame (sim/tb/bulk_frame.py) under every
-traffic pattern, bit-exact against the golden model, and a rendered frame byte-exact from
-the cached build; a wrong golden value fails; bad stimulus is refused before the build; a deadlock ends in
-a timeout that counts the pixels in and out. `make regress`: >= 10^7 vectors through each
+`make test`: the coverage frame (sim/tb/bulk_frame.py) of the default pipeline and of two
+palette scenes under every traffic pattern, bit-exact against the golden model, and a
+rendered frame byte-exact from the cached build; a wrong golden value fails and a deadlock
+ends in a timeout that counts the pixels in and out (both on the sincos unit, the smallest
+build); bad stimulus is refused before the build. `make regress`: >= 10^7 vectors through each
 emitted unit and the default pipeline under every traffic pattern on Verilator (this
 replaces the per-cycle 10^6-vector runs, keeping their units, methods, patterns and the
 pipeline's stress cases).
@@ -17,15 +18,15 @@ import numpy as np
 import pytest
 
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline_bulk,
-                                    scene_stimulus, scene_texels, emit_pipeline)
+from bumprtl.gen.render.rtl import (golden_render, render_rtl, scene_stimulus, scene_texels,
+                                    emit_pipeline)
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.tb import bulk
 from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
                                  decode_words, encode_words, run_bulk)
 from bumprtl.sim.tb.bulk_frame import coverage_frame
+from bumprtl.rtl.tables import cos_lookup, sin_lookup
 from bumprtl.sim.tb.bulk_sources import pipeline_map
 from bumprtl.sim.tb.bulk_shards import run_bulk_shards
 from bumprtl.rtl.methods import PER_PIXEL
@@ -119,24 +120,34 @@ def test_bulk_palette_frame_equals_golden(name, build_dir):
             assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
 
 
+def _sincos(build_dir, n=256):
+    """The sincos unit (the bulk path's smallest build), ``n`` angles and their golden values."""
+    cfg = Config(angle_bits=12)
+    v, j = emit_unit("sincos", cfg, build_dir / "rtl")
+    angle = np.random.default_rng(5).integers(0, cfg.full_circle, n)
+    tag = np.arange(n) & ((1 << cfg.tag_bits) - 1)
+    golden = {"sin": sin_lookup(cfg, angle), "cos": cos_lookup(cfg, angle), "tag": tag}
+    return v, j, {"angle": angle, "tag": tag}, golden
+
+
 def test_bulk_fails_on_one_wrong_golden_value(build_dir):
     """The check can fail: one corrupted golden value is reported with its pattern, output
-    index and field (Icarus: a one-second build)."""
-    scene, inputs, words, polygon, table, texels = _frame(16)
-    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
-    golden["color"] = golden["color"].copy()
-    golden["color"][77] ^= 1
-    with pytest.raises(AssertionError, match=r"output 77 field color: RTL \d+ != golden \d+"):
-        run_pipeline_bulk(scene, inputs, words, polygon, table, "icarus", build_dir,
-                          patterns=("backpressure",), texels=texels, expected=golden)
+    index and field (the sincos unit on Icarus: a one-second build)."""
+    v, j, inputs, golden = _sincos(build_dir)
+    assert run_bulk("icarus", v, j, build_dir / "bulk", ("backpressure",), inputs=inputs,
+                    expected=golden).checked                       # the true values pass
+    golden["sin"] = golden["sin"].copy()
+    golden["sin"][77] ^= 1
+    with pytest.raises(AssertionError, match=r"output 77 field sin: RTL -?\d+ != golden -?\d+"):
+        run_bulk("icarus", v, j, build_dir / "bulk", ("backpressure",), inputs=inputs,
+                 expected=golden)
 
 
 @pytest.mark.parametrize("sim", ICARUS_HERE)
 def test_bulk_deadlock_ends_in_a_timeout(sim, build_dir):
-    """Output ready never rises: the pipeline fills and stops. The run ends (it never
-    hangs) with a timeout naming the pixels that went in and came out."""
-    scene, inputs, words, polygon, table, texels = _frame(16)
-    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    """Output ready never rises: the unit fills and stops. The run ends (it never hangs)
+    with a timeout naming the pixels that went in and came out."""
+    v, j, inputs, _ = _sincos(build_dir)
     with pytest.raises(SimulationTimeout,
                        match=r"deadlock\): pattern stuck: [1-9]\d* pixels went in, 0 came out of 256"):
         run_bulk(sim, v, j, build_dir / "bulk", patterns=("stuck",), inputs=inputs,
