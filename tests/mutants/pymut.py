@@ -234,6 +234,53 @@ KNOWN = [
      "resampled map weighted by the 8-bit texels' lengths; "
      "tests/sim/scenes/test_usermap.py::test_resampling_interpolates_unit_normals (checked with "
      "the mutant switched on)"),
+    # draw 4 (seed 8)
+    ("bumprtl.gen.cli.flags.x_add_map_flags", '==g.add_argument("--texture-size", type=int, metavar="T",',
+     "equivalent", "argparse's default for an option is None already"),
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "XXof heights; normals by Tarini", "wording",
+     "`--height-map`'s help text with XX around its second half: what the flag does is unchanged"),
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "XXyour own bump map (sim/scenes/usermap.py)XX", "wording",
+     "the title of the map flags' group in `--help` with XX around it"),
+    ("bumprtl.gen.cli.main.x__optional", 'getattr(error, "name", )', "equivalent",
+     "_optional is only given ImportErrors, and every ImportError has a `name` attribute (None "
+     "when unknown), so getattr never needs its default"),
+    ("bumprtl.rtl.config.xǁConfigǁreplace", "==)", "killed since",
+     "replace's refusal of an unknown field without the field; "
+     "tests/rtl/test_config.py::test_replace_names_the_unknown_field (checked with the mutant "
+     "switched on)"),
+    ("bumprtl.sim.golden.common.xǁPixelInputsǁ__post_init__", "if arr.min() < 1 else arr.max()",
+     "killed since", "the message named the array's minimum (in range) instead of the value "
+     "out of range; tests/sim/golden/float/test_models.py::test_bad_angles_are_named reads the "
+     "value now (checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.common.x_angle_codes", "np.asarray(angle_rad, ) *", "killed since",
+     "float32 angles quantized in float32 arithmetic; "
+     "tests/sim/golden/test_stress_cases.py::test_angle_codes_round_float32_angles_as_given "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.common.x_polar_illumination_fixed", '"NDOTH": ndoth', "killed since",
+     "the polar back end's N'.H under another key; no test read it; "
+     "tests/sim/golden/fixed/test_lee.py::test_polar_illumination_reports_the_dots_its_shades_come_from "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.peercy.x_isqrt", "r + 2, r)", "equivalent",
+     "the upward fix never runs below 2**62: float64 rounds x by a relative 2**-53 and its "
+     "sqrt by another 2**-53, so sqrt(float(x)) >= r (1 - 2**-53) with r = isqrt(x), which "
+     "is within half a float64 step below r (2**-53 r) and rounds to r or above: the "
+     "estimate is never low"),
+    ("bumprtl.sim.scenes.config.x__merge", "if key not in _PICTURE_KEYS:", "killed since",
+     "the picture clash checked for every key but the pictures; "
+     "tests/sim/scenes/test_config.py::test_only_a_second_picture_clashes_with_the_scenes_picture "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", '"ROTATION": None', "killed since",
+     "a SceneConfig with overrides refused (an unknown key); "
+     "tests/sim/scenes/test_config.py::test_a_scene_config_loads_as_itself_and_takes_overrides "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.config.xǁSceneConfigǁ__post_init__", "16 <= t <= 4097", "equivalent",
+     "4097 is not a power of two, which the same condition refuses (`t & (t - 1)`)"),
+    ("bumprtl.sim.scenes.imaging.x_max_diff", "np.asarray(img, ))))", "equivalent",
+     "ref is made int, so ref - img is int64 for the 8-bit images every caller passes"),
+    ("bumprtl.sim.scenes.usermap.x_write_png", 'chunk(b"iend", b"")', "killed since",
+     "a PNG ended by an unknown ancillary chunk instead of IEND (Pillow reads it, but its "
+     "check refuses it); tests/sim/scenes/test_usermap.py::test_written_pngs_pass_a_decoders_check "
+     "(checked with the mutant switched on)"),
 ]
 
 

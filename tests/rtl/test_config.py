@@ -131,3 +131,10 @@ def test_out_bits_refusal_says_why():
     with pytest.raises(ConfigError, match=r"out_bits = 9 is out of range: allowed \[8, 8\] "
                                           r"\(outputs are 8-bit intensities\)"):
         Config(out_bits=9)
+
+
+def test_replace_names_the_unknown_field():
+    """Config.replace refuses a field Config does not have, naming it (message and field)."""
+    with pytest.raises(ConfigError, match=r"unknown Config field\(s\): nosuch") as e:
+        Config().replace(nosuch=1)
+    assert e.value.field == "nosuch"

@@ -105,3 +105,12 @@ def test_check_fixed_reports_diffuse_and_colour_errors_and_overflow_per_field():
         want = np.abs(out[channel].astype(int) - to_8bit(getattr(ref, channel)).astype(int))
         assert np.array_equal(got[key], want) and want.max() <= 1 and want.max() > 0, key
     assert got["overflow"] and set(got["overflow"].values()) == {0}
+
+
+def test_angle_codes_round_float32_angles_as_given():
+    """Angles given in float32 (a user's array) are quantized from their values as given,
+    exactly as the same values in float64: float32 arithmetic would put some on the
+    neighbouring code."""
+    cfg = Config()
+    a = np.random.default_rng(0).uniform(0, 2 * np.pi, 100_000).astype(np.float32)
+    assert np.array_equal(angle_codes(a, cfg), angle_codes(a.astype(np.float64), cfg))

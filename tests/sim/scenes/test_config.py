@@ -317,3 +317,25 @@ def test_messages_name_the_source_of_the_key():
     with pytest.raises(BumpError, match=r"--lights 1 contradicts lights = 2 in built-in scene "
                                         r"'two-lights': drop one"):
         load_scene_config("two-lights", overrides={"lights": 1}, flags={"lights": "--lights"})
+
+
+def test_a_scene_config_loads_as_itself_and_takes_overrides():
+    """load_scene_config of a SceneConfig gives the same scene, also with overrides that
+    agree with it (its rotation derived again), and refuses one that contradicts it."""
+    for scene in (load_scene_config("textured"),
+                  load_scene_config({"name": "t", "lights": 2, "addressing": "clamp"})):
+        assert load_scene_config(scene) == scene
+    textured = load_scene_config("textured")
+    assert load_scene_config(textured, overrides={"lights": 1, "image": "bricks"}) == textured
+    with pytest.raises(BumpError, match=r"--lights 2 contradicts lights = 1"):
+        load_scene_config(textured, overrides={"lights": 2})
+
+
+def test_only_a_second_picture_clashes_with_the_scenes_picture(tmp_path):
+    """A flag for any other key leaves a scene's picture alone; a second picture (a map
+    beside the scene's image) is refused, naming both."""
+    assert load_scene_config("textured", overrides={"lights": 2}).lights == 2
+    with pytest.raises(BumpError, match=r"--height-map .* contradicts image = 'bricks' in "
+                                        r"built-in scene 'textured': give the picture once"):
+        load_scene_config("textured", overrides={"height_map": str(tmp_path / "h.png")},
+                          flags={"height_map": "--height-map"})

@@ -358,3 +358,16 @@ def test_resampling_interpolates_unit_normals(tmp_path):
     want = _resize(unit, 32)
     want /= np.linalg.norm(want, axis=-1, keepdims=True)
     assert np.allclose(read_normals(path, size=32, resample=True), want, rtol=0, atol=1e-6)
+
+
+def test_written_pngs_pass_a_decoders_check(tmp_path):
+    """write_png's files pass Pillow's own check of the chunks (each chunk's CRC, IEND last),
+    greyscale and RGB, 8 and 16 bits."""
+    rng = np.random.default_rng(2)
+    for name, pixels, depth in (("g8", rng.integers(0, 256, (5, 7)), 8),
+                                ("g16", rng.integers(0, 65536, (5, 7)), 16),
+                                ("rgb8", rng.integers(0, 256, (5, 7, 3)), 8),
+                                ("rgb16", rng.integers(0, 65536, (5, 7, 3)), 16)):
+        path = tmp_path / f"{name}.png"
+        write_png(path, pixels, bit_depth=depth)
+        Image.open(path).verify()

@@ -199,3 +199,18 @@ def test_saturated_reciprocal_gives_quarter_turns():
 
 if __name__ == "__main__":
     print(json.dumps(measure(), indent=1))
+
+
+def test_polar_illumination_reports_the_dots_its_shades_come_from():
+    """Lee's illumination (the polar back end) reports N'.L and N'.H: the dots its diffuse
+    and specular were made from (the back end again on them gives the same shades), and
+    N'.H follows float64's N'.H."""
+    from bumprtl.sim.golden.fixed.common import shade_fixed
+    from bumprtl.sim.golden.methods import encode_pixels
+    cfg = Config(method="lee")
+    px = PixelInputs.random(5000, np.random.default_rng(3))
+    out = datapath_fixed(encode_pixels(px, cfg), cfg)
+    again = shade_fixed(out["ndotl"], out["ndoth"], cfg)
+    for k in ("diffuse", "specular", "color"):
+        assert np.array_equal(again[k], out[k]), k
+    assert np.corrcoef(out["ndoth"], conventional(px, cfg).ndoth)[0, 1] > 0.9

@@ -47,8 +47,8 @@ def test_phong_sum_of_eq_2():
 
 
 @pytest.mark.parametrize("field, value, words", [
-    ("l_theta", 4.0, ["l_theta", "[0, pi]"]),
-    ("n_phi", -0.1, ["n_phi", "[0, 2*pi]"]),
+    ("l_theta", 4.0, ["l_theta = 4 rad", "[0, pi]"]),          # the offending value named
+    ("n_phi", -0.1, ["n_phi = -0.1 rad", "[0, 2*pi]"]),
     ("b_phi", np.nan, ["b_phi", "NaN"]),
 ])
 def test_bad_angles_are_named(field, value, words):
