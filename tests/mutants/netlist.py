@@ -95,6 +95,10 @@ BY_READING = [
      "-wire terms.l_sy_address -wirebit 13",
      "bit 13 of the 14-bit register terms.l_sy_address (the mirrored address's width) is read "
      "by nothing: the ROM's address is l_sy_address[12:0] (pipeline.v lines 26710, 26750)"),
+    ("pipeline:two-lights", "mutate -mode cnot1 -module pipeline -cell $procdff$445986 -port Q "
+     "-portbit 14 -ctrlbit 6 -wire rotation.h_sx_address -wirebit 14",
+     "bit 14 of the 15-bit register rotation.h_sx_address is read by nothing but its own hold "
+     "path: the ROM's address is h_sx_address[13:0] (pipeline.v lines 159713, 159851)"),
     ("pipeline:flat", "mutate -mode inv -module pipeline -cell $procmux$66592 -port B -portbit 12",
      "the mux is the reset of the ROM data register terms.h_cx_data (pipeline.v line 26280: "
      "B is 16'h0000): the register holds 0x1000 instead of 0 from reset until its first load, "
