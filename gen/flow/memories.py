@@ -24,9 +24,9 @@ from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import DP16KD_MODES
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.gen.flow.emit import elaborated, emit
+from bumprtl.gen.flow.emit import emit
 from bumprtl.gen.flow.fpga import DEVICES
-from bumprtl.gen.flow.units import UNITS, name_flag
+from bumprtl.gen.flow.units import UNITS, name_flag, unit_memories
 
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
            "table_blocks", "memory_blocks",
@@ -99,13 +99,6 @@ def check_fits(roms, device, what):
                         f"DP16KD of 18 kbit) beside {other} for the pipeline's tables; "
                         f"{device} has {have} DP16KD of 18 kbit ({have * BRAM_BITS:,} bits)")
     return maps_need + other, have
-
-
-def unit_memories(dut):
-    """Every memory of an elaborated unit (``name`` -> depth, width, bits): the records its
-    StallPipes keep while it elaborates (rtl/pipe.py)."""
-    elaborated(dut)
-    return dict(sorted(dut.memories.items()))
 
 
 def check_scene_fits(scene, device, unit="pipeline"):

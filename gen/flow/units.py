@@ -7,7 +7,6 @@ and the reports elaborate exactly the same hardware from the same Config.
 from dataclasses import dataclass
 from typing import Callable
 
-
 from bumprtl.gen.flow.emit import elaborated, emit
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
@@ -18,8 +17,8 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 
-__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "canonical_command",
-           "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]
+__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "unit_memories",
+           "canonical_command", "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]
 
 
 def default_module(unit):
@@ -52,7 +51,7 @@ def _sincos_sidecar(cfg, dut):
 def _method_sidecar(cfg, dut):
     """A rotation or illumination unit: its method's error bound and note (rtl/methods.py)."""
     method = get(cfg.method)
-    return {"latency": dut.latency, "throughput": 1, "method": cfg.method, "roms": _roms(dut),
+    return {"latency": dut.latency, "throughput": 1, "method": cfg.method, "roms": unit_memories(dut),
             **bound_fields(error_bounds(cfg)), **faithful_widths(cfg),
             "error_note": method.error_note}
 
@@ -110,7 +109,7 @@ def faithful_note(cfg, lights=1, texture=False):
             f"bumprtl bench accuracy); {fix}")
 
 
-def _roms(dut):
+def unit_memories(dut):
     """Every memory of a unit: name -> depth, width, bits (ROM sizes in bits), from the
     ``memories`` each unit records while it elaborates (its StallPipes' records, see
     rtl/pipe.py; ``unit.name`` inside a pipeline), so the unit is elaborated first (once:
@@ -121,7 +120,7 @@ def _roms(dut):
 
 def _palette_sidecar(cfg, dut):
     return {"latency": dut.latency, "throughput": 1, "index_bits": index_bits(cfg),
-            "blend": "eq2" if cfg.palette_blend else None, "roms": _roms(dut),
+            "blend": "eq2" if cfg.palette_blend else None, "roms": unit_memories(dut),
             "memory_bits": dut.memory_bits, "double_buffered": True,
             "out_of_range_index": "reads as all zeros (rgba = 0) and sets oor = 1; "
                                   "host writes to addresses >= palette_size are ignored"}
@@ -130,7 +129,7 @@ def _palette_sidecar(cfg, dut):
 def _pipeline_sidecar(scene, dut):
     """Which units were built and why, which were skipped, latency, memories."""
     out = {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.latency,
-           "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": _roms(dut)}
+           "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": unit_memories(dut)}
     if scene.shading == "per-pixel":
         out.update(bound_fields(error_bounds(scene.config, scene.lights, scene.texture)))
         out.update(faithful_widths(scene.config))

@@ -18,9 +18,10 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   product), theta at or next to 0 and 180 degrees, phi next to 0 / 360, and directions
   within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
-* (exact method, varying map) 28 pixels whose positive dot products sit within a few tens
-  of LSBs of their rounding carry, their N' written into the map: a wrong low bit of a
-  product moves the dot, which random pixels show about once in ten thousand;
+* (exact method, varying map) 28 pixels whose positive dot products sit within 2 LSBs of
+  their rounding carry (the nearest of CARRY_POOL random pixels), their N' written into the
+  map: a wrong low bit of a product moves the dot, which random pixels show about once in
+  ten thousand;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
