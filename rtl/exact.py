@@ -14,10 +14,11 @@ from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit, fits_dsp
 from bumprtl.rtl.shade import IlluminationDatapath
-from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, registered_quarter_wave_rom, sine_read
+from bumprtl.rtl.sincos import (registered_quarter_wave_rom, registered_sine_latency, sine_read,
+                                spread_sine)
 
-__all__ = ["ExactRotation", "ExactIllumination", "SineBank", "rotated_layout", "vector_terms",
-           "vectors"]
+__all__ = ["ExactRotation", "ExactIllumination", "SineBank", "rotated_layout", "rotation_latency",
+           "vector_terms", "vectors"]
 
 
 def vectors(cfg: Config):
@@ -39,12 +40,12 @@ def rotated_layout(cfg: Config):
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
     a value read appears ``latency`` ``adv`` stages after its angle (angle register,
-    address register, read, block-RAM output register, data register, sign)."""
-
-    latency = REGISTERED_SINE_LATENCY
+    address register, [its near copy for a spread ROM,] read, block-RAM output register,
+    data register, sign: sincos.registered_sine_latency)."""
 
     def __init__(self, m, pipe, cfg):
         self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], []
+        self.near, self.latency = spread_sine(cfg), registered_sine_latency(cfg)
 
     def _port(self):
         if not self.pending:
@@ -54,10 +55,17 @@ class SineBank:
         return self.pending.pop(0)
 
     def sin(self, angle, name):
-        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True)
+        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True,
+                         near=self.near)
 
     def cos(self, angle, name):
         return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)
+
+
+def rotation_latency(cfg: Config):
+    """Stages of :class:`ExactRotation` (and ``pipeline.VectorTerms``, in lock step beside
+    it): the input sums, ``SineBank.latency``, two adder levels."""
+    return 1 + registered_sine_latency(cfg) + 2
 
 
 def vector_terms(pipe, bank, vec, n_phi, name, latency):
@@ -74,7 +82,7 @@ def vector_terms(pipe, bank, vec, n_phi, name, latency):
     terms = {"p2": bank.sin(x, f"{name}_sx") + bank.sin(y, f"{name}_sy"),
              "y2": bank.cos(y, f"{name}_cy") - bank.cos(x, f"{name}_cx"),
              "z": bank.cos(th, f"{name}_cth")}
-    return {k: pipe.delay(v, latency - 1 - SineBank.latency, f"{name}_{k}")
+    return {k: pipe.delay(v, latency - 1 - bank.latency, f"{name}_{k}")
             for k, v in terms.items()}
 
 
@@ -89,13 +97,13 @@ class ExactRotation(PipeUnit):
       4 n''z = -[c(a-t) - c(a+t) + c(b-t) - c(b+t)] + 2[c(th_N'-t) + c(th_N'+t)]
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
-    Latency 9: the input sums (a, b, D), SineBank.latency (read angle, ROM address, ROM
-    read, block-RAM output register, data register, sign), two adder levels; 1 pixel per clock.
+    Latency :func:`rotation_latency`: the input sums (a, b, D), SineBank.latency (read
+    angle, ROM address, ROM read, block-RAM output register, data register, sign: 9 in all,
+    10 where the sine ROM is spread), two adder levels; 1 pixel per clock.
     """
 
-    latency = 1 + SineBank.latency + 2
-
     def __init__(self, cfg: Config, target=None, lockstep=None):
+        self.latency = rotation_latency(cfg)
         super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
 
     def build(self, m, pipe):

@@ -52,6 +52,12 @@ class StallPipe:
         shifts exactly when ``enable`` is high, bubbles included, so units given the same
         enable move as one shift register (``BumpPipeline`` gives every unit a copy of one
         registered enable). ``i.ready`` is ``adv`` in both modes.
+    enable_next : None or callable
+        Lock-step mode only: ``enable_next(copy)`` is the next state of a copy of the
+        registered ``enable`` (:func:`lockstep_buffer` gives it to the units it chains). Given,
+        every spread ROM the pipe builds (:meth:`rom`, ``RegisteredROM.spread``: more than
+        SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its own, so no one
+        flip-flop drives the clock enables of every such block of a unit.
     observer : None or object
         Told what the pipe builds, for assertions about it (the formal contract's lemmas):
         ``pipe(pipe)`` once the valid chain exists, ``register(pipe, name, reg)`` for every
@@ -64,7 +70,7 @@ class StallPipe:
     (the ROM sizes of gen/flow/units.py's sidecar).
     """
 
-    def __init__(self, m, i, o, depth, target=None, enable=None, observer=None):
+    def __init__(self, m, i, o, depth, target=None, enable=None, observer=None, enable_next=None):
         if depth < 1:
             raise ValueError(f"pipeline depth must be >= 1, got {depth}")
         self.m = m
@@ -72,6 +78,8 @@ class StallPipe:
         self.target = target
         self.observer = observer
         self.memories = {}
+        self.enable_next = enable_next if enable is not None else None
+        self.enable_copies = []
         self.adv = Signal(name="adv")
         adv = ~o.valid | o.ready if enable is None else enable
         m.d.comb += [self.adv.eq(adv), i.ready.eq(self.adv)]
@@ -95,6 +103,16 @@ class StallPipe:
             self.observer.register(self, name, reg)
         return reg
 
+    def _memory_enable(self, name):
+        """``adv``, or in lock-step mode with ``enable_next`` a copy of the enable of the
+        memory's own (same initial and next state: equal to ``adv`` in every cycle)."""
+        if self.enable_next is None:
+            return self.adv
+        copy = Signal(init=1, name=f"{name}_run", attrs={"keep": 1})
+        self.m.d.sync += copy.eq(self.enable_next(copy))
+        self.enable_copies.append(copy)
+        return copy
+
     def _record(self, name, depth, width):
         self.memories[name] = {"depth": depth, "width": width, "bits": depth * width}
 
@@ -102,7 +120,7 @@ class StallPipe:
         """A :class:`RegisteredROM` with ``ports`` read ports enabled by ``adv``."""
         unit = RegisteredROM(init, shape, ports, name, target=self.target)
         self.m.submodules[name] = unit
-        self.m.d.comb += unit.en.eq(self.adv)
+        self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
         self._record(name, unit.depth, unit.width)
         return unit
 
@@ -191,9 +209,9 @@ class PipeUnit(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         self.build(m, pipe)
-        self.memories = pipe.memories
+        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         return m
 
 
@@ -245,8 +263,13 @@ def lockstep_buffer(m, units, runs, last, i, o):
     # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
     # last unit with its own value (all copies are equal): the copies' next states differ in
     # form, so synthesis keeps one register per unit.
+    def next_run(copy):
+        return count + (last.valid & copy) < BUFFER_DEPTH + taken
+
     for copy in runs.values():
-        m.d.sync += copy.eq(count + (last.valid & copy) < BUFFER_DEPTH + taken)
+        m.d.sync += copy.eq(next_run(copy))
+    for unit in units.values():     # each block RAM of a unit gets a copy (StallPipe enable_next)
+        unit.lockstep_next = next_run
     left = last.valid & run                      # the pixel in the last stage moves on
     m.d.sync += count.eq(count + left - taken)
     pop = held & o.ready

@@ -37,7 +37,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
-from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, vector_terms
+from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, rotation_latency, vector_terms
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
@@ -67,10 +67,9 @@ class VectorTerms(wiring.Component):
     count), tag}. ``first``: the pipeline's number of the first of these lights (its
     registers are named ``l_*``, ``l1_*``, ... after the pipeline's lights)."""
 
-    latency = ExactRotation.latency
-
     def __init__(self, cfg, count, first=0, target=None, lockstep=None):
         self.cfg, self.count, self.first, self.target, self.memories = cfg, count, first, target, {}
+        self.latency = rotation_latency(cfg)
         self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         terms = data.StructLayout({v: _vector_layout(cfg) for v, _ in light_layout(cfg)})
         fields_in = {"n_phi": angle_shape(cfg), "lights": data.ArrayLayout(light_layout(cfg), count),
@@ -82,8 +81,8 @@ class VectorTerms(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform))
-        self.memories = pipe.memories
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
+        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
         for k in range(self.count):
@@ -125,7 +124,7 @@ class LightSum(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")

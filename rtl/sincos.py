@@ -8,13 +8,27 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe, pipe_observer
 from bumprtl.rtl.tables import quarter_sine
+from bumprtl.rtl.targets import SPREAD_BLOCKS, rom_blocks
 
 __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
-           "REGISTERED_SINE_LATENCY"]
+           "REGISTERED_SINE_LATENCY", "spread_sine", "registered_sine_latency"]
 
 # sine_read(registered=True): angle register, address register, ROM read, block-RAM
 # output register, data register, sign.
 REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 2
+
+
+def spread_sine(cfg: Config):
+    """The quarter-wave ROM (2**k words and the spill word, B + 1 bits) is spread over more
+    than targets.SPREAD_BLOCKS block RAMs (15-bit angles at B = 16: nine 8192 x 2 blocks),
+    so :func:`sine_read` gives its reads a second address register (``near``)."""
+    return rom_blocks(1 << cfg.k, cfg.frac_bits + 1) > SPREAD_BLOCKS
+
+
+def registered_sine_latency(cfg: Config):
+    """Stages of :func:`sine_read` (registered) through the quarter-wave ROM of ``cfg``:
+    REGISTERED_SINE_LATENCY, one more where the ROM is spread (:func:`spread_sine`)."""
+    return REGISTERED_SINE_LATENCY + spread_sine(cfg)
 
 
 def quarter_wave_rom(cfg: Config):
@@ -29,7 +43,8 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
     return pipe.rom(quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
 
 
-def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True):
+def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True,
+              near=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
@@ -38,7 +53,8 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     the block RAM's address pins, its clock-to-out and the route from its data pins, which
     is long where a table spans two blocks side by side, each get a cycle of their own;
     ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
-    stage). ``cos(a)`` is ``sin(a + 2**k)``.
+    stage; ``near``: one more address register, a plain copy the placer puts beside the
+    ROM's blocks, for a spread ROM: :func:`spread_sine`). ``cos(a)`` is ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
@@ -50,8 +66,11 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     quadrant, index = a[k:], a[:k]
     address = Mux(quadrant[0], (1 << k) - index, index)
     if registered:             # the block RAM's address pins straight from a flip-flop
-        m.d.comb += port.addr.eq(pipe.register(address, f"{name}_address"))
-        negative = pipe.delay(quadrant[1], 2 + ROM_LATENCY, f"{name}_negative")
+        address = pipe.register(address, f"{name}_address")
+        if near:
+            address = pipe.register(address, f"{name}_address_near")
+        m.d.comb += port.addr.eq(address)
+        negative = pipe.delay(quadrant[1], 2 + near + ROM_LATENCY, f"{name}_negative")
         value = pipe.register(port.data, f"{name}_data")
     else:
         m.d.comb += [port.addr.eq(address), port.en.eq(pipe.adv)]
@@ -97,7 +116,7 @@ class SinCos(wiring.Component):
 
     @property
     def latency(self):
-        return REGISTERED_SINE_LATENCY
+        return registered_sine_latency(self.cfg)
 
     def elaborate(self, platform):
         cfg, k = self.cfg, self.cfg.k
@@ -108,7 +127,7 @@ class SinCos(wiring.Component):
         self.memories = pipe.memories
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
-                                   registered=True, angle_stage=False)
+                                   registered=True, angle_stage=False, near=spread_sine(cfg))
                    for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)))}
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),

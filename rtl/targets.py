@@ -15,6 +15,7 @@ from amaranth.lib.memory import Memory, ReadPort
 __all__ = ["Generic", "ECP5", "GENERIC", "form", "RegisteredProduct", "WideProduct",
            "RegisteredROM", "RegisteredRAM", "read_port", "dp16kd_rom_block", "dp16kd_initvals",
            "fits_dsp", "product_latency", "limb_products", "DP16KD_MODES", "ROM_MAX_BLOCKS",
+           "SPREAD_BLOCKS", "rom_blocks",
            "DSP_WIDTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY"]
 
 # Width of one signed DSP input (ECP5's MULT18X18D): fits_dsp's default.
@@ -162,6 +163,12 @@ class RegisteredROM(Elaboratable):
         n = self.depth - 1
         return n >= 1 and n & (n - 1) == 0 and self.init[0] == 0
 
+    @property
+    def spread(self):
+        """The ECP5 form spans more than SPREAD_BLOCKS block RAMs side by side (on every
+        target: the generic form is built alike, so both run the same cycles)."""
+        return len(self.ports) <= 2 and rom_blocks(self.depth - self._spills(), self.width) > SPREAD_BLOCKS
+
     def mode(self, target):
         """(data bits, words, address shift) of the DP16KD mode of the ECP5 form: one block
         (x18) up to 1024 words (1025 with the spill word), else the widest mode
@@ -248,9 +255,25 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
 # the 8193 x 17 quarter-wave table of 15-bit angles is nine x2 blocks (no output multiplexer;
 # the generic form, which Yosys maps with one, ran at 72 MHz).
 ROM_MAX_BLOCKS = 9
+# A table of more DP16KD than this side by side is "spread" over the die: its blocks get an
+# enable copy of their own (pipe.StallPipe.rom) and its readers a second address register
+# (sincos.sine_read ``near``), so neither the clock enable nor the address crosses the
+# spread in the cycle that computes it. Measured (docs/report.md): nine 8192 x 2 blocks
+# (15-bit angles) held scene_full at 121.1 MHz; four 4096 x 4 blocks (14-bit) met 150.
+SPREAD_BLOCKS = 4
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
 DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))
+
+
+def rom_blocks(words, width):
+    """DP16KD blocks side by side of a ``words`` x ``width`` table in :meth:`RegisteredROM.mode`'s
+    mode (one x18 block up to 1024 words, else the widest mode that holds the words); 0 when
+    no mode holds it."""
+    if words <= ECP5.bram_words:
+        return 1 if width <= ECP5.bram_width else 0
+    mode = next((m for m in DP16KD_MODES if m[1] >= words), None)
+    return 0 if mode is None else -(-width // mode[0])
 
 
 def dp16kd_initvals(words, width):

@@ -79,7 +79,7 @@ class PipeObserver:
 
     def pipe(self, pipe):
         pipe_rec = {"valid": list(pipe.valid), "adv": pipe.adv, "tags": {}, "banks": {},
-                    "oors": {}, "memories": {}, "reads": {}}
+                    "oors": {}, "memories": {}, "reads": {}, "enables": pipe.enable_copies}
         self.seen[id(pipe.valid[0])] = pipe_rec
 
     def _record(self, pipe):
@@ -211,7 +211,9 @@ class StreamContract(Elaboratable):
         (count < depth): the units run exactly while the buffer has room for two."""
         count, entries = self.buffer["count"], self.buffer["entries"]
         self._lemma(m, count <= len(entries), "the output buffer holds at most its depth")
-        for run in self.buffer["runs"].values():
+        copies = [*self.buffer["runs"].values(),
+                  *(c for rec in self._pipes.values() for c in rec.get("enables", ()))]
+        for run in copies:
             self._lemma(m, run == (count < len(entries)),
                         "every copy of the enable = the output buffer has room")
 

@@ -24,10 +24,11 @@ from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
                               RegisteredProduct, RegisteredROM, WideProduct, fits_dsp,
                               product_latency)
+from bumprtl.rtl.targets import ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.rtl.sincos import SinCos
+from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, SinCos, spread_sine
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.texture import TextureBlend
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
@@ -363,3 +364,62 @@ def test_cycles_within_the_stall_bound(unit):
     held = sum(o_valid and not o_ready for _, _, o_valid, o_ready in samples)
     gaps = sum(not v for v, _, _, _ in samples[:last_in])
     assert len(samples) <= n + dut.latency + held + gaps, (unit, len(samples), held, gaps)
+
+
+@pytest.mark.parametrize("angle_bits,frac_bits", [(a, b) for a in (10, 12, 13, 14, 15, 16)
+                                                  for b in (12, 14, 15, 16, 17) if b >= a - 3])
+def test_spread_rule_follows_the_roms_block_count(angle_bits, frac_bits):
+    """sincos.spread_sine (what sets the sine reads' latency, before any ROM is built) says
+    the same as RegisteredROM.spread of the quarter-wave table, and rom_blocks counts the
+    blocks of the ECP5 form's mode (RegisteredROM.mode): columns of ``width / bits``."""
+    cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
+    rom = RegisteredROM(quarter_sine(cfg).tolist(), unsigned(frac_bits + 1), 2, "r")
+    assert spread_sine(cfg) == rom.spread
+    blocks = rom_blocks(rom.depth - 1, rom.width)
+    mode = rom.mode(ECP5)
+    if mode is None:                 # too many blocks for the DP16KD form: Yosys maps it
+        assert blocks > ROM_MAX_BLOCKS and rom.spread
+    else:
+        assert blocks == -(-rom.width // mode[0])
+        assert rom.spread == (blocks > SPREAD_BLOCKS)
+    assert SinCos(cfg).latency == REGISTERED_SINE_LATENCY + rom.spread
+
+
+def _enable_copies(dut):
+    """A simulator of ``dut`` (its construction elaborates the units' pipes) and every
+    unit's lock-step enable with the block-RAM enable copies its pipe made."""
+    sim = Simulator(dut)
+    return sim, {name: (unit.lockstep, getattr(unit, "enable_copies", []))
+                 for name, unit in dut.units.items()}
+
+
+def test_spread_roms_run_on_enable_copies_equal_to_their_units_enable():
+    """At 15-bit angles and B = 16 the quarter-wave ROMs are spread (nine blocks): in a
+    BumpPipeline each gets a flip-flop enable of its own (rtl/pipe.StallPipe.rom), which
+    must equal its unit's enable in every cycle under traffic on both sides; its sine reads
+    take the extra address register (one more rotation stage). At 14 / 15 none is built."""
+    scene = {"name": "t", "texture_size": 16, "angle_bits": 15, "frac_bits": 16, "lights": 2}
+    dut = BumpPipeline(load_scene_config(scene))
+    sim, units = _enable_copies(dut)
+    copies = [(name, run, c) for name, (run, cs) in units.items() for c in cs]
+    assert len(copies) >= 2, units
+    assert {name for name, _, _ in copies} >= {"rotation"}
+    narrow = BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}))
+    assert not any(cs for _, cs in _enable_copies(narrow)[1].values())
+    assert dut.units["rotation"].latency == narrow.units["rotation"].latency + 1
+
+    gap_p, bp_p = PATTERNS["both"]
+    rng = np.random.default_rng(5)
+    differ = []
+
+    async def bench(ctx):
+        for cycle in range(6 * dut.latency):
+            ctx.set(dut.i.valid, bool(rng.random() >= gap_p))
+            ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
+            await ctx.tick()
+            differ.extend((cycle, name) for name, run, c in copies if ctx.get(c) != ctx.get(run))
+
+    sim.add_clock(1e-6)
+    sim.add_testbench(bench)
+    sim.run()
+    assert not differ, differ[:5]
