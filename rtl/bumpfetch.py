@@ -19,11 +19,12 @@ from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
+from bumprtl.rtl.targets import SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.texture import rgb_layout
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
            "level_bits", "texel_shape", "fetched_field", "fetched_fields", "has_map",
-           "pack_texels", "pack_rgb", "TEXEL_BITS"]
+           "pack_texels", "pack_rgb", "spread_fetch", "fetch_latency", "TEXEL_BITS"]
 
 TEXEL_BITS = 24               # one colour texel: r, g, b 8 bits each (Config.color_bits)
 
@@ -107,6 +108,19 @@ def texel_address(u, v, level, scene):
     return base + (v_l << bits) + u_l
 
 
+def spread_fetch(scene):
+    """A memory of the fetch (the map, the colour texture) is spread over more than
+    targets.SPREAD_BLOCKS block RAMs: every read takes a second address register."""
+    bits = [Shape.cast(texel_shape(scene)).width] if has_map(scene) else []
+    bits += [TEXEL_BITS] if scene.texture else []
+    return any(rom_blocks(memory_depth(scene), b) > SPREAD_BLOCKS for b in bits)
+
+
+def fetch_latency(scene):
+    """Stages of :class:`BumpMapFetch` for ``scene``."""
+    return 2 + RAM_LATENCY + spread_fetch(scene)
+
+
 class BumpMapFetch(wiring.Component):
     """Bump vector map (or palette index map) in block RAM, one texel per clock.
 
@@ -141,14 +155,13 @@ class BumpMapFetch(wiring.Component):
     tex_w_en, tex_w_addr, tex_w_data : In
         The colour texture's host write port (``texture = true``).
 
-    Latency 2 + RAM_LATENCY (address register, block-RAM read, the block RAM's output
-    register: rtl/pipe.RegisteredRAM, a DP16KD with REGMODE OUTREG on ECP5, so the RAM's
-    clock-to-out stays out of the next unit's first cycle; then the word registered once
-    more, so the route to the next unit has a cycle of its own); 1 texel per clock when
-    not stalled.
+    Latency :func:`fetch_latency`: 2 + RAM_LATENCY (address register, block-RAM read, the
+    block RAM's output register: rtl/pipe.RegisteredRAM, a DP16KD with REGMODE OUTREG on
+    ECP5, so the RAM's clock-to-out stays out of the next unit's first cycle; then the word
+    registered once more, so the route to the next unit has a cycle of its own), one more
+    where a memory is spread (a second address register); 1 texel per clock when not
+    stalled.
     """
-
-    latency = 2 + RAM_LATENCY
 
     def __init__(self, scene, out_layout=None, init=None, texture=None, target=None,
                  lockstep=None):
@@ -171,6 +184,7 @@ class BumpMapFetch(wiring.Component):
         fields.update({name: f.shape for name, f in out_layout if name not in self.fetched})
         self.depth = memory_depth(scene)
         self.word_bits = Shape.cast(texel_shape(scene)).width if has_map(scene) else 0
+        self.latency = fetch_latency(scene)
         self.init = [int(w) for w in init] if init is not None else []
         self.texture = [int(w) for w in texture] if texture is not None else []
         for what, words in (("init", self.init), ("texture", self.texture)):
@@ -199,7 +213,7 @@ class BumpMapFetch(wiring.Component):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
                          pipe_observer(platform), getattr(self, "lockstep_next", None))
-        self.memories = pipe.memories
+        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):
             mem = pipe.ram("map", self.depth, unsigned(self.word_bits), self.init)
@@ -224,8 +238,10 @@ class BumpMapFetch(wiring.Component):
                 with m.Default():                         # last level, and past it
                     m.d.comb += addr.eq(texel_address(px.u, px.v, scene.mip_levels - 1, scene))
         addr_d1 = pipe.register(addr, "texel_addr_d1")                        # stage 1
+        if spread_fetch(scene):       # a plain copy the placer puts beside the spread blocks
+            addr_d1 = pipe.register(addr_d1, "texel_addr_near")
         for field, (mem, _) in mems.items():        # the same address, the same cycle
-            m.d.comb += mem.r_addr.eq(addr_d1)      # stage 2: read; stage 3: output register
+            m.d.comb += mem.r_addr.eq(addr_d1)      # then: read; the output register
             # stage 4: the word once more beside the block RAM, so the route to the next
             # unit has a cycle of its own wherever the placer puts the RAM
             m.d.comb += self.o.payload[field].eq(pipe.register(mem.r_data, f"{field}_word"))

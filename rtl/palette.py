@@ -159,7 +159,7 @@ class PaletteLUT(wiring.Component):
         # The table's read data is registered (on ECP5 in the block RAM's own output register):
         # the RAM's clock-to-out alone takes most of a cycle.
         table = pipe.ram("table", 2 * size, unsigned(4 * cfg.color_bits))
-        self.memories = pipe.memories
+        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         front = Signal(name="front")
         with m.If(self.swap):
             m.d.sync += front.eq(~front)

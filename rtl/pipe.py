@@ -55,9 +55,9 @@ class StallPipe:
     enable_next : None or callable
         Lock-step mode only: ``enable_next(copy)`` is the next state of a copy of the
         registered ``enable`` (:func:`lockstep_buffer` gives it to the units it chains). Given,
-        every spread ROM the pipe builds (:meth:`rom`, ``RegisteredROM.spread``: more than
-        SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its own, so no one
-        flip-flop drives the clock enables of every such block of a unit.
+        every spread memory the pipe builds (:meth:`rom`, :meth:`ram`; ``spread``: more than
+        targets.SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its own, so no
+        one flip-flop drives the clock enables of every such block of a unit.
     observer : None or object
         Told what the pipe builds, for assertions about it (the formal contract's lemmas):
         ``pipe(pipe)`` once the valid chain exists, ``register(pipe, name, reg)`` for every
@@ -129,7 +129,7 @@ class StallPipe:
         ``r_addr`` and write port and reads ``r_data`` RAM_LATENCY stages later."""
         unit = RegisteredRAM(depth, shape, name, init, target=self.target)
         self.m.submodules[name] = unit
-        self.m.d.comb += unit.en.eq(self.adv)
+        self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
         self._record(name, depth, unit.width)
         if self.observer is not None:
             self.observer.ram(self, name, unit)

@@ -124,7 +124,7 @@ class SinCos(wiring.Component):
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target,
                          observer=pipe_observer(platform))
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
-        self.memories = pipe.memories
+        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
                                    registered=True, angle_stage=False, near=spread_sine(cfg))

@@ -255,12 +255,14 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
 # the 8193 x 17 quarter-wave table of 15-bit angles is nine x2 blocks (no output multiplexer;
 # the generic form, which Yosys maps with one, ran at 72 MHz).
 ROM_MAX_BLOCKS = 9
-# A table of more DP16KD than this side by side is "spread" over the die: its blocks get an
-# enable copy of their own (pipe.StallPipe.rom) and its readers a second address register
-# (sincos.sine_read ``near``), so neither the clock enable nor the address crosses the
-# spread in the cycle that computes it. Measured (docs/report.md): nine 8192 x 2 blocks
-# (15-bit angles) held scene_full at 121.1 MHz; four 4096 x 4 blocks (14-bit) met 150.
-SPREAD_BLOCKS = 4
+# A memory of more DP16KD than this side by side is "spread" over the die: it gets an enable
+# flip-flop of its own in lock step (pipe.StallPipe.rom / ram) and its reads a second address
+# register (sincos.sine_read ``near``, bumpfetch.BumpMapFetch), so neither the clock enable
+# nor the address crosses the spread in the cycle that computes it. Measured (bumprtl report
+# fpga, docs/report.md): every row whose memories are at most eight blocks wide met 150 MHz
+# on seeds 1-3; scene_full's nine-block sine ROMs (15-bit angles) and its 15-block map held
+# it at 121.1 MHz.
+SPREAD_BLOCKS = 8
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
 DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))
@@ -323,6 +325,11 @@ class RegisteredRAM(Elaboratable):
     def mode(self):
         """(data width, depth, address shift) of the DP16KD mode used on ECP5, or None."""
         return next((m for m in DP16KD_MODES if m[1] >= self.depth), None)
+
+    @property
+    def spread(self):
+        """The ECP5 form spans more than SPREAD_BLOCKS block RAMs side by side."""
+        return rom_blocks(self.depth, self.width) > SPREAD_BLOCKS
 
     def elaborate(self, platform):
         m = Module()

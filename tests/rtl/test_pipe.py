@@ -393,20 +393,26 @@ def _enable_copies(dut):
                  for name, unit in dut.units.items()}
 
 
-def test_spread_roms_run_on_enable_copies_equal_to_their_units_enable():
-    """At 15-bit angles and B = 16 the quarter-wave ROMs are spread (nine blocks): in a
-    BumpPipeline each gets a flip-flop enable of its own (rtl/pipe.StallPipe.rom), which
-    must equal its unit's enable in every cycle under traffic on both sides; its sine reads
-    take the extra address register (one more rotation stage). At 14 / 15 none is built."""
-    scene = {"name": "t", "texture_size": 16, "angle_bits": 15, "frac_bits": 16, "lights": 2}
-    dut = BumpPipeline(load_scene_config(scene))
+def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
+    """The full scene's memories are spread (nine-block sine ROMs at 15-bit angles and
+    B = 16, a 15-block map, a 12-block texture): in its BumpPipeline each gets a flip-flop
+    enable of its own (rtl/pipe.StallPipe.rom / ram), which must equal its unit's enable in
+    every cycle under traffic on both sides, and its reads take the extra address register
+    (one more stage in the rotation, the light terms and the fetch). The default scene's
+    memories (at most seven blocks) get none."""
+    dut = BumpPipeline(load_scene_config("full"))
     sim, units = _enable_copies(dut)
     copies = [(name, run, c) for name, (run, cs) in units.items() for c in cs]
-    assert len(copies) >= 2, units
-    assert {name for name, _, _ in copies} >= {"rotation"}
-    narrow = BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}))
+    per_unit = {name: len(cs) for name, (_, cs) in units.items() if cs}
+    assert per_unit == {"fetch": 2, "rotation": 12, "terms": 5}, per_unit
+    for name, _, copy in copies:           # each copy is named after its memory: "<memory>_run"
+        mem = dut.units[name].memories[copy.name.removesuffix("_run")]
+        words = mem["depth"] - (mem["depth"] % 2 == 1 and mem["depth"] > 1)   # the spill word
+        assert rom_blocks(words, mem["width"]) > SPREAD_BLOCKS, (name, copy.name, mem)
+    narrow = BumpPipeline(load_scene_config("default"))
     assert not any(cs for _, cs in _enable_copies(narrow)[1].values())
-    assert dut.units["rotation"].latency == narrow.units["rotation"].latency + 1
+    for name in ("fetch", "rotation"):
+        assert dut.units[name].latency == narrow.units[name].latency + 1, name
 
     gap_p, bp_p = PATTERNS["both"]
     rng = np.random.default_rng(5)
