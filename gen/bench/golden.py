@@ -30,7 +30,8 @@ def _sim_rate(cfg, sim, unit, samples, work):
     work = Path(work).resolve()          # cocotb runs in its build directory
     v, j = emit_unit(unit, cfg, work / "rtl")
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", work / f"{sim}_{unit}",
-                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": samples})
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": samples},
+                     opt_fast=None)              # the build and rate as Verilator makes them
     pixels = 4 * (samples + len(edge_codes(cfg)["n.phi"]))          # 4 traffic patterns
     return pixels / run.run_s, run.build_s
 

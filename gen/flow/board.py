@@ -240,11 +240,13 @@ def emit_sim(scene, mode, out_dir, data=None):
     return path, top
 
 
-def check_frames(scene, mode, out_dir, frames=2, data=None):
+def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
     """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
     under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
-    golden frame. Returns a dict: captured (list of arrays), golden, timing (the run
-    lengths the testbench measured), seconds, the verdicts."""
+    golden frame. ``opt_fast``: g++'s optimisation of the model's per-cycle code (verilated.mk's
+    OPT_FAST; None: Verilator's -Os), e.g. ``-O0`` for a few reduced-mode frames, whose run
+    is cocotb's and whose build it halves. Returns a dict: captured (list of arrays), golden,
+    timing (the run lengths the testbench measured), seconds, the verdicts."""
     out_dir = Path(out_dir).resolve()
     data = board_data(scene) if data is None else data
     v_path, top = emit_sim(scene, mode, out_dir, data)
@@ -258,7 +260,7 @@ def check_frames(scene, mode, out_dir, frames=2, data=None):
                                                      int(m.h_negative), int(m.v_negative))),
            "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
     t0 = time.perf_counter()
-    build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env)
+    build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env, opt_fast)
     res = dict(np.load(result))
     captured = [res[f"frame{k}"] for k in range(frames)]
     words, texels, _, table = data
@@ -270,16 +272,22 @@ def check_frames(scene, mode, out_dir, frames=2, data=None):
             "run_s": run_s, "build_s": build_s, "seconds": time.perf_counter() - t0}
 
 
-def _run_verilator(v_path, build_dir, env):
-    """Build ``v_path`` with Verilator once per digest of its text (the build directory
-    keeps a ``digest`` file; the board's sine ROMs make a build of minutes on a busy
-    machine) and run tb_board on it. Returns (build seconds, 0 when cached; run seconds)."""
+def _run_verilator(v_path, build_dir, env, opt_fast=None):
+    """Build ``v_path`` with Verilator once per digest of its text and ``opt_fast`` (the
+    build directory keeps a ``digest`` file; the board's sine ROMs make a build of minutes
+    on a busy machine) and run tb_board on it. Returns (build seconds, 0 when cached; run
+    seconds)."""
     build_dir = Path(build_dir).resolve()
     digest = hashlib.sha256(Path(v_path).read_bytes()).hexdigest()
+    if opt_fast is not None:
+        digest += f" OPT_FAST={opt_fast}"
     stamp = build_dir / "digest"
     top = Path(v_path).stem
     saved = dict(os.environ)
-    os.environ.update(tool_env())
+    env_tools = tool_env()
+    if opt_fast is not None:            # a make command-line variable (see tool_env)
+        env_tools["MAKEFLAGS"] = f"{env_tools.get('MAKEFLAGS', '')} OPT_FAST={opt_fast}".strip()
+    os.environ.update(env_tools)
     require("verilator")
     try:
         runner = get_runner("verilator")

