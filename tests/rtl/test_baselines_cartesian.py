@@ -141,7 +141,7 @@ def test_ernst_emits_the_same_setup_hardware(build_dir):
     assert "--method ernst" in ve.read_text().splitlines()[0]
 
 
-def test_cli_emit_rotation_method_peercy(peercy_rotation, tmp_path):
+def test_cli_emit_rotation_method_peercy(peercy_rotation, tmp_path, run_cli):
     """The command line writes what emit_unit writes, byte for byte (deterministic across
     processes), and it is lint-clean."""
     r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
@@ -164,9 +164,7 @@ def test_cli_emit_rotation_method_peercy(peercy_rotation, tmp_path):
                                           for c in ("diffuse", "specular", "color"))
     assert sorted(meta["ports"]["i__payload"]["fields"]) == sorted(
         fixed_peercy.input_keys(Config()) + ["tag"])
-    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
-                          "peercy", "--frac-bits", "40", "--out", str(tmp_path)],
-                         capture_output=True, text=True)
+    bad = run_cli(["emit", "rotation", "--method", "peercy", "--frac-bits", "40", "--out", tmp_path])
     assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr
 
 

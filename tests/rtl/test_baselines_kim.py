@@ -118,7 +118,7 @@ def test_emission_lint_clean_and_deterministic(unit, build_dir):
     assert lint(v1) == []
 
 
-def test_cli_emit_rotation_method_kim(tmp_path):
+def test_cli_emit_rotation_method_kim(tmp_path, run_cli):
     """The command line writes what emit_unit writes, byte for byte (deterministic across
     processes), and it is lint-clean. At 10-bit angles, B = 11: the default widths' ROMs
     would double the time (make regress lints the default's rotation, the test above)."""
@@ -138,9 +138,7 @@ def test_cli_emit_rotation_method_kim(tmp_path):
     assert meta["method"] == "kim" and meta["latency"] == KimRotation.latency
     assert meta["error_bound_lsb"] == max(predicted_error_bound_lsb(cfg, c)
                                           for c in ("diffuse", "specular", "color"))
-    bad = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "rotation", "--method",
-                          "kim", "--frac-bits", "40", "--out", str(tmp_path)],
-                         capture_output=True, text=True)
+    bad = run_cli(["emit", "rotation", "--method", "kim", "--frac-bits", "40", "--out", tmp_path])
     assert bad.returncode == 2 and "frac_bits" in bad.stderr and "Traceback" not in bad.stderr
 
 

@@ -42,9 +42,8 @@ def test_lint_catches_a_real_warning(tmp_path):
     assert any("WIDTHTRUNC" in p for p in problems), problems
 
 
-def test_cli_bad_input_is_one_line_and_exit_2(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "bumprtl.gen.cli.main", "emit", "sincos", "--frac-bits", "3",
-                        "--out", str(tmp_path)], capture_output=True, text=True)
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, run_cli):
+    r = run_cli(["emit", "sincos", "--frac-bits", "3", "--out", tmp_path])   # in this process
     assert r.returncode == 2
     lo = frac_bits_floor(Config().angle_bits)              # the default's floor, B >= k - 1
     assert "frac_bits" in r.stderr and f"[{lo}, {FRAC_BITS_MAX}]" in r.stderr

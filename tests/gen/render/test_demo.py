@@ -127,7 +127,7 @@ def test_demo_flags():
     assert not parser.parse_args(["--no-rtl"]).rtl
 
 
-def test_demo_bad_size_exit_2(tmp_path):
-    r = subprocess.run(CLI + ["demo", "--out", str(tmp_path), "--size", "48"], capture_output=True, text=True)
+def test_demo_bad_size_exit_2(tmp_path, run_cli):
+    r = run_cli(["demo", "--out", tmp_path, "--size", "48"])        # in this process
     assert r.returncode == 2 and "size" in r.stderr and "Traceback" not in r.stderr
     assert not any(tmp_path.iterdir())

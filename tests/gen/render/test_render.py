@@ -131,9 +131,11 @@ def test_methods_are_the_registry_plus_palette():
     (["--quantizer", "octree", "--method", "palette"], "--quantizer"),
     (["--lighting", "sunset", "--method", "palette", "--size", "32"], "lighting"),
 ])
-def test_render_bad_input_exit_2_one_line(tmp_path, argv, word):
-    r = subprocess.run(CLI + ["render", "--out", str(tmp_path / "x.png")] + argv,
-                       capture_output=True, text=True)
+def test_render_bad_input_exit_2_one_line(tmp_path, argv, word, run_cli):
+    # the first case through a real process, the others in this one (tests/conftest.py)
+    args = ["render", "--out", str(tmp_path / "x.png")] + argv
+    real = argv == ["--scene", "marble"]
+    r = subprocess.run(CLI + args, capture_output=True, text=True) if real else run_cli(args)
     assert r.returncode == 2, (argv, r.stderr)
     assert word in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "x.png").exists()
