@@ -11,6 +11,7 @@ from bumprtl.gen.flow import resources
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.methods import BASELINES
+from bumprtl.sim import jobs
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.toolchain import ToolMissing
 
@@ -22,9 +23,15 @@ WIDTHS = {"angle_bits": 10, "frac_bits": 11}
 
 @pytest.fixture(scope="module")
 def table1(tmp_path_factory):
+    # The count jobs on the job layer's local cluster in threads of this process (Yosys runs
+    # as a child process either way), as tests/sim/test_jobs.py runs it: two worker processes
+    # would each import the package again (~6 s of CPU); the real scheduler and worker
+    # processes are tests/gen/test_cluster.py's.
     out = tmp_path_factory.mktemp("table1")
-    assert main(["report", "table1", "--samples", "2000", "--angle-bits", "10", "--frac-bits", "11",
-                 "--out", str(out / "table1.md"), "--work", str(out / "work")]) == 0
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(jobs, "LOCAL_PROCESSES", False)
+        assert main(["report", "table1", "--samples", "2000", "--angle-bits", "10", "--frac-bits", "11",
+                     "--out", str(out / "table1.md"), "--work", str(out / "work")]) == 0
     return (out / "table1.md").read_text()
 
 
