@@ -17,10 +17,10 @@ CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
 PALETTE_MODULE = "bumprtl.sim.golden.float.palette"
 
 
-def test_render_compare_writes_panel_and_prints_psnr(tmp_path):
-    out = tmp_path / "lee.png"
-    r = subprocess.run(CLI + ["render", "--scene", "bumps", "--method", "lee_corrected", "--size", "64",
-                              "--out", str(out), "--compare"], capture_output=True, text=True)
+def test_render_compare_writes_panel_and_prints_psnr(tmp_path, run_cli):
+    out = tmp_path / "lee.png"                  # in this process (tests/conftest.py run_cli)
+    r = run_cli(["render", "--scene", "bumps", "--method", "lee_corrected", "--size", "64",
+                 "--out", out, "--compare"])
     assert r.returncode == 0, r.stderr
     assert "PSNR" in r.stdout and "max difference" in r.stdout
     img = np.asarray(Image.open(out))
