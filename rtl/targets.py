@@ -7,7 +7,7 @@ the ECP5 flow). An element asks its target (:func:`form`) to build it; no elemen
 target names.
 """
 
-from amaranth.hdl import (Cat, ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
+from amaranth.hdl import (ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
                           Value, signed)
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory, ReadPort
@@ -148,11 +148,8 @@ class RegisteredROM(Elaboratable):
     the widest mode that holds them, blocks side by side for the width: :meth:`mode`) with
     both ports and their own output registers (REGMODE OUTREG: the clock-to-out of an
     unregistered block RAM leaves the cycle); a table of 2**n + 1 words whose word 0 is 0
-    keeps its last word in a flip-flop (the address wraps to word 0 and the word is OR'ed in);
-    a top bit that is 0 up to some word and 1 from there on (a monotone table's tail, the
-    quarter-wave sine's 1.0) is a comparator on the address where leaving it out of the
-    blocks saves one (:meth:`tail`). Elsewhere (``target=None``): an Amaranth Memory and a
-    register. ``depth`` and ``width`` are the table's size."""
+    keeps its last word in a flip-flop (the address wraps to word 0 and the word is OR'ed in). Elsewhere (``target=None``): an
+    Amaranth Memory and a register. ``depth`` and ``width`` are the table's size."""
 
     def __init__(self, init, shape, ports, name, target=None):
         self.init, self.shape, self.name, self.target = [int(x) for x in init], shape, name, target
@@ -172,31 +169,18 @@ class RegisteredROM(Elaboratable):
         target: the generic form is built alike, so both run the same cycles)."""
         return len(self.ports) <= 2 and rom_blocks(self.depth - self._spills(), self.width) > SPREAD_BLOCKS
 
-    def tail(self):
-        """The first word whose top bit is set when the top bit of the blocks' words (the
-        spill word aside) is 0 before it and 1 from it on, and the blocks hold the other
-        bits in fewer DP16KD than all of them; else None."""
-        words, top = self.depth - self._spills(), self.width - 1
-        bits = [(x >> top) & 1 for x in self.init[:words]]
-        first = bits.index(1) if 1 in bits else words
-        if top < 1 or 0 in bits[first:]:
-            return None
-        return first if rom_blocks(words, top) < rom_blocks(words, self.width) else None
-
     def mode(self, target):
         """(data bits, words, address shift) of the DP16KD mode of the ECP5 form: one block
         (x18) up to 1024 words (1025 with the spill word), else the widest mode
-        (:data:`DP16KD_MODES`) holding the words, blocks side by side for the width (the
-        top bit left out with a :meth:`tail`), at most :data:`ROM_MAX_BLOCKS`; None: the
-        generic form (more than two ports, or too big)."""
+        (:data:`DP16KD_MODES`) holding the words, blocks side by side for the width, at most
+        :data:`ROM_MAX_BLOCKS`; None: the generic form (more than two ports, or too big)."""
         words = self.depth - self._spills()
-        width = self.width - (self.tail() is not None)
         if len(self.ports) > 2:
             return None
         if words <= target.bram_words:
-            return DP16KD_MODES[0] if width <= target.bram_width else None
+            return DP16KD_MODES[0] if self.width <= target.bram_width else None
         mode = next((m for m in DP16KD_MODES if m[1] >= words), None)
-        if mode is None or -(-width // mode[0]) > ROM_MAX_BLOCKS:
+        if mode is None or -(-self.width // mode[0]) > ROM_MAX_BLOCKS:
             return None
         return mode
 
@@ -218,11 +202,9 @@ class RegisteredROM(Elaboratable):
     def dp16kd(self, m, bits, words, shift):
         """The ECP5 form in mode (``bits``, ``words``, ``shift``) (:meth:`ECP5.rom`)."""
         sides = list(zip("AB", self.ports + self.ports[:1]))[:max(2, len(self.ports))]
-        tail = self.tail()
-        width = self.width - (tail is not None)          # the bits the blocks hold
-        douts = {side: Signal(width, name=f"{port.addr.name}_do{side}") for side, port in sides}
-        for col in range(-(-width // bits)):
-            lo, hi = col * bits, min(width, (col + 1) * bits)
+        douts = {side: Signal(self.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
+        for col in range(-(-self.width // bits)):
+            lo, hi = col * bits, min(self.width, (col + 1) * bits)
             outs = dp16kd_rom_block(m, f"bram{col}" if col else "bram",
                                     [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
                                     bits, shift, self.en,
@@ -232,12 +214,6 @@ class RegisteredROM(Elaboratable):
                 m.d.comb += douts[side][lo:hi].eq(dout[:hi - lo])
         for side, port in sides[:len(self.ports)]:
             data = douts[side]
-            if tail is not None:        # the top bit: words tail .. words - 1, two registers
-                top = Signal(name=f"{port.addr.name}_top")       # like the block's read and
-                top_d = Signal(name=f"{port.addr.name}_top_d")   # output register
-                with m.If(self.en):
-                    m.d.sync += [top.eq((port.addr >= tail) & (port.addr < words)), top_d.eq(top)]
-                data = Cat(data, top_d)
             if self.depth > words:              # the last word: address wrapped to word 0 (= 0)
                 last = Signal(name=f"{port.addr.name}_last")
                 last_d = Signal(name=f"{port.addr.name}_last_d")
