@@ -298,10 +298,7 @@ FPGA_NOTES = """
   beside the blocks (`rtl/sincos.sine_read` `near`, `rtl/bumpfetch.BumpMapFetch`): one more
   stage in the rotation, the light terms and the fetch of those scenes. Without both,
   the rotation's enable fanned out to 108 block RAMs and held scene_full at 121.1 MHz.
-  A ROM whose top bit is 0 up to a word and 1 from it on (the sine's 1.0 at the end of the
-  quarter wave) keeps that bit as a comparator on the address beside the blocks when that
-  saves a block (`rtl/targets.RegisteredROM.tail`): the 8193 x 17 table in eight 8192 x 2
-  blocks, not nine. Rows whose memories are at most eight blocks wide are unchanged.
+  Rows whose memories are at most eight blocks wide are unchanged.
 - The `<method>_pipeline` rows chain the method's two units the same way, in lock step
   behind a 2-entry output buffer (`gen/flow/fpga.pipeline_component`); with
   `wiring.connect` each unit's `adv = ~o.valid | o.ready` chained through both, and where
