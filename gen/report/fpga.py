@@ -315,9 +315,9 @@ FPGA_NOTES = """
   Peercy and Ernst at 103.1 MHz. Kim's products still sum their limbs in that cycle; its
   limit is elsewhere (the critical-path list). What stops the baselines short of 150 MHz
   now is named there: Peercy's divider's last quotient bit into the rounded, signed output;
-  in lee's pipeline the route from the cos^n table's block RAM to the interpolation (5.1 ns
-  of routing in the larger design), in lee's setup alone the atan-table address after the
-  reciprocal product; Kim's l_p -> l_qn stage.
+  in lee's pipeline the proportional table's address after l_y_k (6.4 ns of routing: at
+  14-bit angles its tables take 153 DP16KD, 75 at 13 / 16), in lee's setup alone the
+  atan-table address after the reciprocal product; Kim's l_p -> l_qn stage.
 - Units are placed out of context: no I/O buffers, ports are internal nets, so paths
   from a unit's input ports are not timed (the pipelines time them between units).
 """
