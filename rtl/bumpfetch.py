@@ -19,7 +19,7 @@ from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
-from bumprtl.rtl.targets import SPREAD_BLOCKS, rom_blocks
+from bumprtl.rtl.targets import is_spread
 from bumprtl.rtl.texture import rgb_layout
 
 __all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
@@ -113,7 +113,7 @@ def spread_fetch(scene):
     targets.SPREAD_BLOCKS block RAMs: every read takes a second address register."""
     bits = [Shape.cast(texel_shape(scene)).width] if has_map(scene) else []
     bits += [TEXEL_BITS] if scene.texture else []
-    return any(rom_blocks(memory_depth(scene), b) > SPREAD_BLOCKS for b in bits)
+    return any(is_spread(memory_depth(scene), b) for b in bits)
 
 
 def fetch_latency(scene):

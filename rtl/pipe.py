@@ -268,7 +268,7 @@ def lockstep_buffer(m, units, runs, last, i, o):
 
     for copy in runs.values():
         m.d.sync += copy.eq(next_run(copy))
-    for unit in units.values():     # each block RAM of a unit gets a copy (StallPipe enable_next)
+    for unit in units.values():     # each spread memory of a unit gets a copy (StallPipe enable_next)
         unit.lockstep_next = next_run
     left = last.valid & run                      # the pixel in the last stage moves on
     m.d.sync += count.eq(count + left - taken)

@@ -8,7 +8,7 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe, pipe_observer
 from bumprtl.rtl.tables import quarter_sine
-from bumprtl.rtl.targets import SPREAD_BLOCKS, rom_blocks
+from bumprtl.rtl.targets import is_spread
 
 __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
            "REGISTERED_SINE_LATENCY", "spread_sine", "registered_sine_latency"]
@@ -22,7 +22,7 @@ def spread_sine(cfg: Config):
     """The quarter-wave ROM (2**k words and the spill word, B + 1 bits) is spread over more
     than targets.SPREAD_BLOCKS block RAMs (15-bit angles at B = 16: nine 8192 x 2 blocks),
     so :func:`sine_read` gives its reads a second address register (``near``)."""
-    return rom_blocks(1 << cfg.k, cfg.frac_bits + 1) > SPREAD_BLOCKS
+    return is_spread(1 << cfg.k, cfg.frac_bits + 1)
 
 
 def registered_sine_latency(cfg: Config):

@@ -15,7 +15,7 @@ from amaranth.lib.memory import Memory, ReadPort
 __all__ = ["Generic", "ECP5", "GENERIC", "form", "RegisteredProduct", "WideProduct",
            "RegisteredROM", "RegisteredRAM", "read_port", "dp16kd_rom_block", "dp16kd_initvals",
            "fits_dsp", "product_latency", "limb_products", "DP16KD_MODES", "ROM_MAX_BLOCKS",
-           "SPREAD_BLOCKS", "rom_blocks",
+           "SPREAD_BLOCKS", "rom_blocks", "is_spread",
            "DSP_WIDTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY"]
 
 # Width of one signed DSP input (ECP5's MULT18X18D): fits_dsp's default.
@@ -167,7 +167,7 @@ class RegisteredROM(Elaboratable):
     def spread(self):
         """The ECP5 form spans more than SPREAD_BLOCKS block RAMs side by side (on every
         target: the generic form is built alike, so both run the same cycles)."""
-        return len(self.ports) <= 2 and rom_blocks(self.depth - self._spills(), self.width) > SPREAD_BLOCKS
+        return len(self.ports) <= 2 and is_spread(self.depth - self._spills(), self.width)
 
     def mode(self, target):
         """(data bits, words, address shift) of the DP16KD mode of the ECP5 form: one block
@@ -278,6 +278,13 @@ def rom_blocks(words, width):
     return 0 if mode is None else -(-width // mode[0])
 
 
+def is_spread(words, width):
+    """A ``words`` x ``width`` memory spans more than SPREAD_BLOCKS block RAMs side by side
+    (:func:`rom_blocks`): the rule of ``RegisteredROM.spread`` and ``RegisteredRAM.spread``,
+    and of the latencies that depend on it before any memory is built."""
+    return rom_blocks(words, width) > SPREAD_BLOCKS
+
+
 def dp16kd_initvals(words, width):
     """INITVAL_00..3F of one DP16KD in ``width`` mode holding ``words`` (word w at address w):
     the array is 1024 rows of 18 bits, an x18 word a row, an x9 word half a row (low half
@@ -329,7 +336,7 @@ class RegisteredRAM(Elaboratable):
     @property
     def spread(self):
         """The ECP5 form spans more than SPREAD_BLOCKS block RAMs side by side."""
-        return rom_blocks(self.depth, self.width) > SPREAD_BLOCKS
+        return is_spread(self.depth, self.width)
 
     def elaborate(self, platform):
         m = Module()
