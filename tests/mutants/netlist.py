@@ -379,7 +379,48 @@ def _miter(unit, line, work, timeout, stream):
     return "equivalent"
 
 
-def equivalence(v, meta, line, work, timeout):
+STEPS = ("structural", "stream", "miter", "cone", "cut")
+
+
+def _cone_steps(meta, line, work, timeout, has_stream, steps):
+    """Steps 4 and 5 (tests/mutants/netlist_cone.py), on the mutated cell's cone only:
+    ``(verdict, why)``, the verdict None when neither proves the mutant equivalent."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import netlist_cone as nc
+    try:
+        net = nc.Netlist(nc.load(work, meta["unit"], line))
+    except (subprocess.CalledProcessError, KeyError) as e:
+        return None, f"cone: the -ctrl netlist was not built ({type(e).__name__})"
+    why = []
+    if "cone" in steps:
+        try:
+            reached = nc.cone(net)
+        except nc.Undecided as e:
+            reached = [str(e)]
+        if reached is None:
+            return ("equivalent (cone: no output port bit in the mutated bit's fan-out cone, "
+                    "followed through every register and memory)"), None
+        why.append(f"cone reaches {reached[0]}")
+    if "cut" in steps:
+        for stream in ((False, True) if has_stream else (False,)):
+            try:
+                verdict, R = nc.cut(net, work, nc.yosys_log, timeout, stream)
+            except nc.Undecided as e:
+                verdict, R = "undecided", f"cut: {e}"
+            if verdict == "equivalent":
+                held = ", ".join(nc.names(net, R)) or "none"
+                how = (f"cut: sat proves the invariant 'every register bit equal but R' "
+                       f"inductive on the cut at the registers, R = {held}")
+                if stream:
+                    return f"equivalent under the stream contract ({how}, {STREAM_DONT_CARE})", None
+                return f"equivalent ({how})", None
+            why.append(R)
+            if "__payload" not in R:
+                break
+    return None, "; ".join(why)
+
+
+def equivalence(v, meta, line, work, timeout, steps=STEPS):
     """``"equivalent ..."``, ``"not equivalent ..."`` or ``"undecided: why"`` of one mutation.
 
     1. Yosys's structural passes on the two netlists, every output compared in every cycle:
@@ -389,22 +430,37 @@ def equivalence(v, meta, line, work, timeout):
     3. otherwise (the structural passes prove nothing when they do not close) mcy's miter,
        payloads masked: ``sat -tempinduct`` proves it (equivalent under the stream contract),
        finds a counterexample within 24 cycles of reset (not equivalent, so not equivalent
-       either without the mask), or neither (undecided, counted as a survivor)."""
+       either without the mask), or neither (undecided, counted as a survivor);
+    4. ``cone`` (netlist_cone.py): no output port bit in the mutated bit's fan-out cone,
+       followed bit by bit through every cell, register and memory, conservatively;
+    5. ``cut`` (netlist_cone.py): an inductive invariant "every register bit equal but a set
+       R" proved by sat on the combinational logic the mutation reaches, cut at the
+       registers (every output compared; then, if a payload was what failed, payloads
+       masked by valid), each time within ``timeout`` seconds.
+    Steps 4 and 5 run on every pipeline's survivors where 1-3 time out. ``steps`` chooses
+    among STEPS (``--steps``; ``--recheck --steps cone,cut`` runs only the new ones on a
+    finished run's survivors, whose first three were run then). The verdict names the step
+    that proved it."""
     unit = meta["unit"]
     wrappers, has_stream = _wrappers(meta["ports"], unit)
     (Path(work) / "equiv_wrappers.v").write_text(wrappers)
-    if _structural(unit, line, work, timeout, False):
+    if "structural" in steps and _structural(unit, line, work, timeout, False):
         return "equivalent (equiv_simple/equiv_induct, every output every cycle)"
-    if has_stream and _structural(unit, line, work, timeout, True):
+    if "stream" in steps and has_stream and _structural(unit, line, work, timeout, True):
         return f"equivalent under the stream contract (equiv_simple/equiv_induct, {STREAM_DONT_CARE})"
-    verdict = _miter(unit, line, work, timeout, has_stream)
+    verdict = _miter(unit, line, work, timeout, has_stream) if "miter" in steps else None
     if verdict == "equivalent" and has_stream:
         return f"equivalent under the stream contract (miter + sat -tempinduct, {STREAM_DONT_CARE})"
     if verdict == "equivalent":
         return "equivalent (miter + sat -tempinduct)"
     if verdict == "not equivalent":
         return "not equivalent (counterexample from the miter)"
-    return verdict
+    proved, why = _cone_steps(meta, line, work, timeout, has_stream, steps)
+    if proved:
+        return proved
+    if verdict is None:
+        return f"undecided: {why}" if why else "undecided: no step run"
+    return verdict + (f"; {why}" if why else "")
 
 
 # --- one target, end to end -----------------------------------------------------------------
@@ -447,7 +503,7 @@ def _kept_netlist(target, work, n, seed, stim_n, log):
 
 
 def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeline_sim="icarus",
-               reuse=False):
+               reuse=False, steps=STEPS):
     t0 = time.perf_counter()
     sim = simulator(target, pipeline_sim)
     work = out / target.replace(":", "_")
@@ -484,7 +540,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
     survivors = []
     for i, r in sorted(results.items()):
         if r == "passed":
-            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout)
+            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout, steps)
             survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
     killed = sum(r.startswith("killed") for r in results.values())
     equivalent = sum(s["verdict"].startswith("equivalent") for s in survivors)
@@ -584,9 +640,11 @@ def _tally(r):
     r["counted"] = r["sample"] - r["equivalent"]
 
 
-def recheck(path, out, timeout):
-    """The equivalence checks of the survivors in ``path`` (a netlist_results.json) again,
-    each on the netlist its run kept (``out/<target>/rtl``); the JSON is rewritten."""
+def recheck(path, out, timeout, steps=STEPS):
+    """The equivalence checks ``steps`` of the survivors in ``path`` (a netlist_results.json)
+    again, each on the netlist its run kept (``out/<target>/rtl``); the JSON is rewritten.
+    With only some of the steps, a survivor they leave undecided keeps its earlier verdict
+    (the steps it ran then), what the new ones said appended."""
     saved = json.loads(path.read_text())
     for r in saved["results"]:
         if not r.get("survivors"):
@@ -597,14 +655,22 @@ def recheck(path, out, timeout):
         lines = [l for l in (rtl / "mutations.ys").read_text().splitlines()
                  if l.startswith("mutate ")]
         for s in r["survivors"]:
+            if s["verdict"].startswith(("equivalent", "not equivalent")) and tuple(steps) != STEPS:
+                continue            # decided by an earlier step: the new steps come after it
             t0 = time.perf_counter()
-            s["verdict"] = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout)
+            verdict = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout, steps)
+            if tuple(steps) != STEPS and verdict.startswith("undecided"):
+                new = verdict[len("undecided: "):]
+                old = s["verdict"].split("; cone reaches")[0].split("; cut:")[0]
+                verdict = f"{old}; {new}"
+            s["verdict"] = verdict
             print(f"  {r['target']} #{s['index']}: {s['verdict']} ({time.perf_counter() - t0:.0f} s)",
                   flush=True)
         _tally(r)
         path.write_text(json.dumps(saved, indent=1))
+    only = "" if tuple(steps) == STEPS else f" --steps {','.join(steps)}"
     saved.setdefault("rechecks", []).append(
-        f"python tests/mutants/netlist.py --recheck {path} --equiv-timeout {timeout} --out {out}")
+        f"python tests/mutants/netlist.py --recheck {path} --equiv-timeout {timeout}{only} --out {out}")
     path.write_text(json.dumps(saved, indent=1))
     return 0
 
@@ -625,6 +691,9 @@ def main(argv=None):
                    help="the simulator of the scene pipelines (default icarus, as make test's "
                         "bulk pipeline test; the units run on verilator)")
     p.add_argument("--equiv-timeout", type=int, default=30, help="seconds per equivalence proof")
+    p.add_argument("--steps", default=",".join(STEPS),
+                   help="the equivalence steps to run, in their order (default all: "
+                        + ",".join(STEPS) + "); e.g. --recheck RUN.json --steps cone,cut")
     p.add_argument("--out", type=Path, default=ROOT / "build" / "netlist_mutants")
     p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
     p.add_argument("--doc-from", type=Path, action="append", default=[], metavar="JSON",
@@ -634,8 +703,13 @@ def main(argv=None):
                    help="only run the equivalence checks of a run's survivors again (on the "
                         "netlists it kept under --out) and rewrite that JSON")
     a = p.parse_args(argv)
+    steps = tuple(x for x in a.steps.split(",") if x)
+    if not steps or set(steps) - set(STEPS):
+        print(f"error: --steps takes some of {','.join(STEPS)}, got {a.steps!r}", file=sys.stderr)
+        return 2
+    steps = tuple(x for x in STEPS if x in steps)
     if a.recheck is not None:
-        return recheck(a.recheck, a.out, a.equiv_timeout)
+        return recheck(a.recheck, a.out, a.equiv_timeout, steps)
     if a.doc_from:
         if a.doc is None:
             print("error: --doc-from needs --doc", file=sys.stderr)
@@ -676,7 +750,7 @@ def main(argv=None):
     for target in chosen:
         try:
             r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout,
-                           pipeline_sim=a.pipeline_sim, reuse=a.reuse)
+                           pipeline_sim=a.pipeline_sim, reuse=a.reuse, steps=steps)
         except (NetlistError, subprocess.CalledProcessError) as e:
             msg = str(e) if isinstance(e, NetlistError) else \
                 f"{target}: {e.cmd} failed: {((e.stderr or '') + (e.stdout or '')).strip().splitlines()[-1:]}"
