@@ -1,7 +1,5 @@
 import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 from PIL import Image
@@ -13,9 +11,6 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.heightfields import brick_lines
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
-
-CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]
-
 
 def _report_rows(text):
     """(scene, method) -> (psnr, max diff, fixed psnr, fixed max, seconds, file) from
@@ -35,11 +30,13 @@ def _psnr(ref, img):
     return float("inf") if mse == 0 else 10 * np.log10(255 ** 2 / mse)
 
 
-def test_demo_writes_pngs_and_a_report_that_matches_them(tmp_path):
+def test_demo_writes_pngs_and_a_report_that_matches_them(tmp_path, run_cli):
     """Float renders plus the RTL render of the default scene (Icarus here: one small
-    build; ``make demo`` uses Verilator)."""
-    r = subprocess.run(CLI + ["demo", "--out", str(tmp_path), "--size", "32", "--simulator", "icarus"],
-                       capture_output=True, text=True)
+    build; ``make demo`` uses Verilator). In this process (tests/conftest.py run_cli: its
+    output captured at the file descriptors, the simulator's included), not a second
+    interpreter importing numpy, Amaranth and the package again; tests/gen/render/test_render.py
+    and tests/board/test_board.py keep a bumprtl command through a real process."""
+    r = run_cli(["demo", "--out", tmp_path, "--size", "32", "--simulator", "icarus"])
     assert r.returncode == 0, r.stderr
     rows = _report_rows((tmp_path / "report.txt").read_text())
     methods = demo_methods()
