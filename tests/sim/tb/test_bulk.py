@@ -120,20 +120,31 @@ def test_bulk_palette_frame_equals_golden(name, build_dir):
             assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
 
 
-def _sincos(build_dir, n=256):
+SINCOS = Config(angle_bits=12)
+
+
+@pytest.fixture(scope="module")
+def sincos_rtl(tmp_path_factory):
+    """The sincos unit's Verilog and sidecar, emitted once for the four tests below that
+    read them (each emission is a Yosys run of ~2.5 s; the runs stay in each test's own
+    directory, and the bulk build is cached by the Verilog's digest either way)."""
+    return emit_unit("sincos", SINCOS, tmp_path_factory.mktemp("sincos") / "rtl")
+
+
+def _sincos(sincos_rtl, n=256):
     """The sincos unit (the bulk path's smallest build), ``n`` angles and their golden values."""
-    cfg = Config(angle_bits=12)
-    v, j = emit_unit("sincos", cfg, build_dir / "rtl")
+    cfg = SINCOS
+    v, j = sincos_rtl
     angle = np.random.default_rng(5).integers(0, cfg.full_circle, n)
     tag = np.arange(n) & ((1 << cfg.tag_bits) - 1)
     golden = {"sin": sin_lookup(cfg, angle), "cos": cos_lookup(cfg, angle), "tag": tag}
     return v, j, {"angle": angle, "tag": tag}, golden
 
 
-def test_bulk_fails_on_one_wrong_golden_value(build_dir):
+def test_bulk_fails_on_one_wrong_golden_value(build_dir, sincos_rtl):
     """The check can fail: one corrupted golden value is reported with its pattern, output
     index and field (the sincos unit on Icarus: a one-second build)."""
-    v, j, inputs, golden = _sincos(build_dir)
+    v, j, inputs, golden = _sincos(sincos_rtl)
     assert run_bulk("icarus", v, j, build_dir / "bulk", ("backpressure",), inputs=inputs,
                     expected=golden).checked                       # the true values pass
     golden["sin"] = golden["sin"].copy()
@@ -144,19 +155,19 @@ def test_bulk_fails_on_one_wrong_golden_value(build_dir):
 
 
 @pytest.mark.parametrize("sim", ICARUS_HERE)
-def test_bulk_deadlock_ends_in_a_timeout(sim, build_dir):
+def test_bulk_deadlock_ends_in_a_timeout(sim, build_dir, sincos_rtl):
     """Output ready never rises: the unit fills and stops. The run ends (it never hangs)
     with a timeout naming the pixels that went in and came out."""
-    v, j, inputs, _ = _sincos(build_dir)
+    v, j, inputs, _ = _sincos(sincos_rtl)
     with pytest.raises(SimulationTimeout,
                        match=r"deadlock\): pattern stuck: [1-9]\d* pixels went in, 0 came out of 256"):
         run_bulk(sim, v, j, build_dir / "bulk", patterns=("stuck",), inputs=inputs,
                  traffic={"stuck": (0.0, 1.0)}, idle_limit=500)
 
 
-def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkeypatch):
+def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkeypatch, sincos_rtl):
     """Fields and widths are checked against the sidecar before any build."""
-    v, j = emit_unit("sincos", Config(angle_bits=12), build_dir / "rtl")
+    v, j = sincos_rtl
     monkeypatch.setattr(bulk, "build", lambda *a, **k: pytest.fail("built before the check"))
     n = 10
     good = {"angle": np.arange(n), "tag": np.arange(n)}
@@ -177,10 +188,10 @@ def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkey
     assert check_stimulus(json.loads(j.read_text()), good) == n
 
 
-def test_bulk_build_options_are_checked_before_the_build(build_dir, monkeypatch):
+def test_bulk_build_options_are_checked_before_the_build(build_dir, monkeypatch, sincos_rtl):
     """Verilator's C++ clock and DPI I/O are refused on Icarus, and a bad option on either
     simulator, in one line naming the option, before anything is built."""
-    v, j = emit_unit("sincos", Config(angle_bits=12), build_dir / "rtl")
+    v, j = sincos_rtl
     monkeypatch.setattr(bulk, "build", lambda *a, **k: pytest.fail("built before the check"))
     good = {"angle": np.arange(4), "tag": np.arange(4)}
     cases = [("icarus", {"clock": "cxx"}, r"clock 'cxx' needs Verilator's C\+\+ build; on "
