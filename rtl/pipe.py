@@ -278,16 +278,11 @@ def lockstep_buffer(m, units, runs, last, i, o, early=False):
     left = last.valid & run                      # the pixel in the last stage moves on
     aheads = []
     if early:
-        # ahead = next cycle's run = (count + run < depth): from the next count, compared
-        # once here, and its own value (next cycle's run), one LUT each; every ahead reads
-        # itself, so synthesis keeps each one.
-        fits = {run_next: Signal(name=f"out_fits_{run_next}") for run_next in (0, 1)}
-        for run_next, sig in fits.items():
-            m.d.comb += sig.eq(count + left - taken < depth - run_next)
-
+        # ahead = next cycle's run = (count + run < depth), from the next count and its own
+        # value (next cycle's run); every ahead reads itself, so synthesis keeps each one.
         def drive(mod, copy):
             ahead = Signal(init=1, name=f"{copy.name}_ahead", attrs={"keep": 1})
-            mod.d.sync += [ahead.eq(Mux(ahead, fits[1], fits[0])), copy.eq(ahead)]
+            mod.d.sync += [ahead.eq(count + left - taken + ahead < depth), copy.eq(ahead)]
             aheads.append(ahead)
     else:
         # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
