@@ -212,7 +212,7 @@ class BumpMapFetch(wiring.Component):
         scene = self.scene
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):

@@ -155,7 +155,7 @@ class PaletteLUT(wiring.Component):
         cfg, size = self.cfg, self.cfg.palette_size
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         # The table's read data is registered (on ECP5 in the block RAM's own output register):
         # the RAM's clock-to-out alone takes most of a cycle.
         table = pipe.ram("table", 2 * size, unsigned(4 * cfg.color_bits))

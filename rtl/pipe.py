@@ -22,8 +22,7 @@ from bumprtl.rtl.targets import (DP16KD_MODES, ECP5, PRODUCT_LATENCY, RAM_LATENC
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
-           "limb_products", "lockstep_buffer", "lockstep_enables", "BUFFER_DEPTH",
-           "EARLY_BUFFER_DEPTH", "PRODUCT_LATENCY",
+           "limb_products", "lockstep_buffer", "lockstep_enables", "BUFFER_DEPTH", "PRODUCT_LATENCY",
            "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals",
            "DP16KD_MODES", "pipe_observer"]
 
@@ -53,13 +52,12 @@ class StallPipe:
         shifts exactly when ``enable`` is high, bubbles included, so units given the same
         enable move as one shift register (``BumpPipeline`` gives every unit a copy of one
         registered enable). ``i.ready`` is ``adv`` in both modes.
-    drive_copy : None or callable
-        Lock-step mode only: ``drive_copy(m, copy)`` drives ``copy``, a copy of the
-        registered ``enable`` (same initial value 1), in module ``m`` so that it equals
-        ``enable`` in every cycle (:func:`lockstep_buffer` gives it to the units it chains).
-        Given, every spread memory the pipe builds (:meth:`rom`, :meth:`ram`; ``spread``:
-        more than targets.SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its
-        own, so no one flip-flop drives the clock enables of every such block of a unit.
+    enable_next : None or callable
+        Lock-step mode only: ``enable_next(copy)`` is the next state of a copy of the
+        registered ``enable`` (:func:`lockstep_buffer` gives it to the units it chains). Given,
+        every spread memory the pipe builds (:meth:`rom`, :meth:`ram`; ``spread``: more than
+        targets.SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its own, so no
+        one flip-flop drives the clock enables of every such block of a unit.
     observer : None or object
         Told what the pipe builds, for assertions about it (the formal contract's lemmas):
         ``pipe(pipe)`` once the valid chain exists, ``register(pipe, name, reg)`` for every
@@ -72,7 +70,7 @@ class StallPipe:
     (the ROM sizes of gen/flow/units.py's sidecar).
     """
 
-    def __init__(self, m, i, o, depth, target=None, enable=None, observer=None, drive_copy=None):
+    def __init__(self, m, i, o, depth, target=None, enable=None, observer=None, enable_next=None):
         if depth < 1:
             raise ValueError(f"pipeline depth must be >= 1, got {depth}")
         self.m = m
@@ -80,7 +78,7 @@ class StallPipe:
         self.target = target
         self.observer = observer
         self.memories = {}
-        self.drive_copy = drive_copy if enable is not None else None
+        self.enable_next = enable_next if enable is not None else None
         self.enable_copies = []
         self.adv = Signal(name="adv")
         adv = ~o.valid | o.ready if enable is None else enable
@@ -106,12 +104,12 @@ class StallPipe:
         return reg
 
     def _memory_enable(self, name):
-        """``adv``, or in lock-step mode with ``drive_copy`` a copy of the enable of the
-        memory's own (equal to ``adv`` in every cycle)."""
-        if self.drive_copy is None:
+        """``adv``, or in lock-step mode with ``enable_next`` a copy of the enable of the
+        memory's own (same initial and next state: equal to ``adv`` in every cycle)."""
+        if self.enable_next is None:
             return self.adv
         copy = Signal(init=1, name=f"{name}_run", attrs={"keep": 1})
-        self.drive_copy(self.m, copy)
+        self.m.d.sync += copy.eq(self.enable_next(copy))
         self.enable_copies.append(copy)
         return copy
 
@@ -211,7 +209,7 @@ class PipeUnit(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         self.build(m, pipe)
         self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         return m
@@ -221,10 +219,8 @@ class PipeUnit(wiring.Component):
 # the cycle after the buffer fills. Two entries keep the pipe running through a one-cycle
 # stall of the consumer and in the cycle a waiting pixel is taken; with one (``run`` = empty)
 # every stall would also stop the input for a cycle, which only a full pipe (no input gaps)
-# does not notice. With ``early`` the enable is decided a cycle ahead, and one more entry
-# takes the pixel that enters in that cycle.
+# does not notice.
 BUFFER_DEPTH = 2
-EARLY_BUFFER_DEPTH = BUFFER_DEPTH + 1
 
 
 def lockstep_enables(names):
@@ -235,7 +231,7 @@ def lockstep_enables(names):
             for name in ("pipeline", *names)}
 
 
-def lockstep_buffer(m, units, runs, last, i, o, early=False):
+def lockstep_buffer(m, units, runs, last, i, o):
     """Units chained in lock step on a registered enable, with an output buffer: the stall
     rule of a chain of units (``BumpPipeline``, the placed rotation -> illumination pipe of
     gen/flow/fpga.py) without a chain of ``o.valid`` terms across them.
@@ -245,26 +241,15 @@ def lockstep_buffer(m, units, runs, last, i, o, early=False):
     ``last``: the stream out of the last unit; ``i``, ``o``: the chain's own streams (``i``
     flipped). Every unit has its own copy of the registered enable ``run`` (as ``lockstep``
     and as its ``o.ready``: a pixel leaves a unit whenever the chain runs), so no one
-    flip-flop drives every register of the chain; each spread memory of a unit gets one
-    more (``lockstep_drive``, StallPipe ``drive_copy``). The last unit feeds a
-    :data:`BUFFER_DEPTH`-entry buffer, bypassed while empty (the latency is the units').
-    ``i.ready`` = ``run`` = (at most one pixel in the buffer): high whenever ``o.valid`` is
-    low, never a function of ``o.ready`` in the same cycle.
-
-    ``early`` (the pipelines with spread memories): ``run`` is decided a cycle ahead. Each
-    copy is a plain flip-flop loaded from a register of its own, ``ahead`` = (count + run <
-    depth) = next cycle's ``run``, in an :data:`EARLY_BUFFER_DEPTH`-entry buffer: no logic
-    between the buffer's count and a copy, and the route from the buffer to a far block RAM's
-    clock enable gets two cycles (count -> ahead, ahead -> copy) instead of one.
-
-    The caller feeds the first unit's ``i.valid`` from ``i.valid`` and chains the units'
-    valid and payload. Returns ``{count, entries (oldest first), runs, aheads}`` (``runs``:
-    the copies by unit name, ``"pipeline"`` for the buffer's and ``i.ready``'s own;
-    ``aheads``: every copy's ``ahead`` register with ``early``, filled as the units
-    elaborate), read by sim/formal's lemmas."""
-    depth = EARLY_BUFFER_DEPTH if early else BUFFER_DEPTH
-    count = Signal(range(depth + 1), name="out_count")
-    entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(depth)]
+    flip-flop drives every register of the chain. The
+    last unit feeds a :data:`BUFFER_DEPTH`-entry buffer, bypassed while empty (the latency
+    is the units'). ``i.ready`` = ``run`` = (at most one pixel in the buffer): high whenever
+    ``o.valid`` is low, never a function of ``o.ready`` in the same cycle. The caller feeds
+    the first unit's ``i.valid`` from ``i.valid`` and chains the units' valid and payload.
+    Returns ``{count, entries (oldest first), runs}`` (``runs``: the copies by unit name,
+    ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by sim/formal's lemmas."""
+    count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
+    entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
     runs = {name: runs[name] for name in ("pipeline", *units)}
     run = runs["pipeline"]
     for name, unit in units.items():
@@ -275,35 +260,24 @@ def lockstep_buffer(m, units, runs, last, i, o, early=False):
     taken = o.valid & o.ready
     m.d.comb += [i.ready.eq(run), o.valid.eq(held | last.valid),
                  o.payload.eq(Mux(held, entries[0], last.payload))]       # bypass when empty
-    left = last.valid & run                      # the pixel in the last stage moves on
-    aheads = []
-    if early:
-        # ahead = next cycle's run = (count + run < depth), from the next count and its own
-        # value (next cycle's run); every ahead reads itself, so synthesis keeps each one.
-        def drive(mod, copy):
-            ahead = Signal(init=1, name=f"{copy.name}_ahead", attrs={"keep": 1})
-            mod.d.sync += [ahead.eq(count + left - taken + ahead < depth), copy.eq(ahead)]
-            aheads.append(ahead)
-    else:
-        # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
-        # last unit with its own value (all copies are equal): the copies' next states differ
-        # in form, so synthesis keeps one register per unit.
-        def next_run(copy):
-            return count + (last.valid & copy) < BUFFER_DEPTH + taken
+    # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
+    # last unit with its own value (all copies are equal): the copies' next states differ in
+    # form, so synthesis keeps one register per unit.
+    def next_run(copy):
+        return count + (last.valid & copy) < BUFFER_DEPTH + taken
 
-        def drive(mod, copy):
-            mod.d.sync += copy.eq(next_run(copy))
     for copy in runs.values():
-        drive(m, copy)
-    for unit in units.values():     # each spread memory of a unit gets a copy (StallPipe drive_copy)
-        unit.lockstep_drive = drive
+        m.d.sync += copy.eq(next_run(copy))
+    for unit in units.values():     # each spread memory of a unit gets a copy (StallPipe enable_next)
+        unit.lockstep_next = next_run
+    left = last.valid & run                      # the pixel in the last stage moves on
     m.d.sync += count.eq(count + left - taken)
     pop = held & o.ready
     with m.If(pop):
-        m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(depth - 1)]
+        m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(BUFFER_DEPTH - 1)]
     slot = Signal.like(count, name="out_slot")   # the first free entry after the pop
     m.d.comb += slot.eq(count - pop)
-    for n in range(depth):                       # kept unless taken directly (count stays 0)
+    for n in range(BUFFER_DEPTH):                # kept unless taken directly (count stays 0)
         with m.If(left & (slot == n if n else ~slot.any())):
             m.d.sync += entries[n].eq(last.payload)
-    return {"count": count, "entries": entries, "runs": runs, "aheads": aheads, "early": early}
+    return {"count": count, "entries": entries, "runs": runs}

@@ -27,9 +27,6 @@ only; ``i.ready`` = ``run``. With the buffer empty the output is the last unit's
 itself (bypass), so with ``o.ready`` held high the buffer stays empty and the latency is
 the units' sum; a pixel the consumer does not take in the cycle it leaves the last unit
 waits in the buffer, and two waiting pixels stop the pipe one cycle later (``run`` low).
-Where a unit has a memory spread over more than eight block RAMs (:func:`spread_memory`:
-``full`` and ``two-lights``), ``run`` is decided a cycle early instead and the buffer has
-three entries (``pipe.lockstep_buffer`` ``early``; docs/architecture.md).
 At the ports: ``i.ready`` is high whenever ``o.valid`` is low (the buffer is then empty)
 and never depends on ``o.ready`` in the same cycle; ``o.valid``/``o.payload`` come from
 registers through the bypass mux and never depend on ``o.ready``.
@@ -39,25 +36,21 @@ from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
-from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map, spread_fetch
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
 from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, rotation_latency, vector_terms
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
                                  shade_layout)
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import (BUFFER_DEPTH, EARLY_BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe,
-                              lockstep_buffer, lockstep_enables, pipe_observer)
+from bumprtl.rtl.pipe import (BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer,
+                              lockstep_enables, pipe_observer)
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.sincos import spread_sine
 from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
-                                phong_coefficients, specular_table)
-from bumprtl.rtl.targets import is_spread
+                                phong_coefficients)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
 
-__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "BUFFER_DEPTH", "EARLY_BUFFER_DEPTH",
-           "spread_memory"]
+__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "BUFFER_DEPTH"]
 
 
 def _vector_layout(cfg):
@@ -88,7 +81,7 @@ class VectorTerms(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         rom = SineBank(m, pipe, self.cfg)
         px, out = self.i.payload, self.o.payload
@@ -131,7 +124,7 @@ class LightSum(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
@@ -171,21 +164,6 @@ def _lockstep(m, src, dsts):
 def _feed(m, src, dst):
     """``src`` into ``dst`` of the next layer: valid and payload (both run on the enable)."""
     m.d.comb += [dst.valid.eq(src.valid), dst.payload.eq(src.payload)]
-
-
-def spread_memory(cfg: Config, names, scene=None):
-    """Whether a lock-step chain of the units ``names`` (``BumpPipeline``'s unit names)
-    builds a memory spread over more than targets.SPREAD_BLOCKS block RAMs: a sine ROM at
-    15-bit angles (rotation, light terms), a large map or texture (fetch), palette or
-    specular table. Known before any unit elaborates (tests/rtl/test_pipe.py checks it
-    against the enable copies the units build); it picks ``pipe.lockstep_buffer``'s
-    ``early``."""
-    names = list(names)
-    return bool((spread_sine(cfg) and any(n in names for n in ("rotation", "terms")))
-                or ("fetch" in names and spread_fetch(scene))
-                or ("palette" in names and is_spread(2 * cfg.palette_size, 4 * cfg.color_bits))
-                or (cfg.specular and any(n.startswith("illumination") for n in names)
-                    and is_spread(len(specular_table(cfg)), 8 + SPEC_FRAC_BITS)))
 
 
 class BumpPipeline(wiring.Component):
@@ -247,9 +225,8 @@ class BumpPipeline(wiring.Component):
     sim/formal's lemmas.
     """
 
-    def __init__(self, scene, init=None, texture=None, target=None, early=None):
+    def __init__(self, scene, init=None, texture=None, target=None):
         self.scene = scene
-        self._early = early
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
@@ -428,31 +405,11 @@ class BumpPipeline(wiring.Component):
         self._elaborate_layers(m)
         return m
 
-    @property
-    def spread(self):
-        """Some unit builds a memory spread over more than targets.SPREAD_BLOCKS block RAMs
-        (:func:`spread_memory`), whose clock enables get copies of ``run``: the pipeline
-        then decides ``run`` a cycle early (``pipe.lockstep_buffer`` ``early``)."""
-        return spread_memory(self.cfg, self.units, self.scene)
-
-    @property
-    def early(self):
-        """``run`` decided a cycle early: :attr:`spread`, unless the constructor's ``early``
-        says otherwise (sim/formal proves the small-width pipelines in the mode their
-        full-width scene uses)."""
-        return self.spread if self._early is None else self._early
-
-    @property
-    def buffer_depth(self):
-        """Entries of the output buffer: EARLY_BUFFER_DEPTH where :attr:`early`, else
-        BUFFER_DEPTH."""
-        return EARLY_BUFFER_DEPTH if self.early else BUFFER_DEPTH
-
     def _output_buffer(self, m):
         """``run`` (one copy per unit), the lock-step enables and the output buffer behind
-        the last unit (``pipe.lockstep_buffer``; decided a cycle early where :attr:`early`)."""
+        the last unit (``pipe.lockstep_buffer``)."""
         self.buffer = lockstep_buffer(m, self.units, self._runs, self.units[self._last].o,
-                                      self.i, self.o, early=self.early)
+                                      self.i, self.o)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg

@@ -179,7 +179,7 @@ class TextureBlend(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         px = self.i.payload
         color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
                                     [px.s[j] for j in range(self.lights)],
@@ -208,6 +208,6 @@ class TexelDelay(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_drive", None))
+                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         m.d.comb += self.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))
         return m

@@ -27,7 +27,6 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.sim.golden.methods import METHODS
 from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
-from bumprtl.rtl.pipeline import spread_memory
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
@@ -141,8 +140,7 @@ def pipeline_component(cfg, target=None):
         def elaborate(self, platform):
             m = Module()
             units = {"rotation": self.rotation, "illumination": self.illumination}
-            self.buffer = lockstep_buffer(m, units, self.runs, self.illumination.o, self.i, self.o,
-                                          early=spread_memory(cfg, units))
+            self.buffer = lockstep_buffer(m, units, self.runs, self.illumination.o, self.i, self.o)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
             m.d.comb += [self.rotation.i.valid.eq(self.i.valid),
                          self.rotation.i.payload.eq(self.i.payload),

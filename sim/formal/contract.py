@@ -208,27 +208,14 @@ class StreamContract(Elaboratable):
 
     def _buffer_lemmas(self, m):
         """The output buffer's count is at most its depth and every copy of the enable is
-        (count < depth): the units run exactly while the buffer has room for two. With the
-        enable decided a cycle early (``early``): every copy equals the buffer's own run,
-        count + run fits the buffer, and every copy's ``ahead`` is next cycle's run,
-        (count + run < depth)."""
+        (count < depth): the units run exactly while the buffer has room for two."""
         count, entries = self.buffer["count"], self.buffer["entries"]
-        depth = len(entries)
-        self._lemma(m, count <= depth, "the output buffer holds at most its depth")
+        self._lemma(m, count <= len(entries), "the output buffer holds at most its depth")
         copies = [*self.buffer["runs"].values(),
                   *(c for rec in self._pipes.values() for c in rec.get("enables", ()))]
-        if not self.buffer.get("early"):
-            for run in copies:
-                self._lemma(m, run == (count < depth),
-                            "every copy of the enable = the output buffer has room")
-            return
-        run = self.buffer["runs"]["pipeline"]
-        self._lemma(m, count + run <= depth, "the pixels in the buffer and the one entering fit")
-        for copy in copies:
-            self._lemma(m, copy == run, "every copy of the enable = the buffer's own")
-        for ahead in self.buffer["aheads"]:
-            self._lemma(m, ahead == (count + run < depth),
-                        "every ahead = next cycle's enable (count + run < depth)")
+        for run in copies:
+            self._lemma(m, run == (count < len(entries)),
+                        "every copy of the enable = the output buffer has room")
 
     def free_inputs(self):
         """Every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports) and

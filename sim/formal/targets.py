@@ -96,12 +96,8 @@ def _texture_blend(bits):
 
 
 def _pipeline(name):
-    """Scene ``name`` at the small widths, its lock step in the mode of the full-width scene
-    (``run`` decided a cycle early where the scene's memories are spread: full, two-lights)."""
     def build(bits):
-        wide = BumpPipeline(load_scene_config(name))
-        _discard(wide)
-        return BumpPipeline(_scene(name, bits), early=wide.spread)
+        return BumpPipeline(_scene(name, bits))
     return build
 
 

@@ -25,9 +25,9 @@ from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_L
                               RegisteredProduct, RegisteredROM, WideProduct, fits_dsp,
                               product_latency)
 from bumprtl.rtl.targets import ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
-from bumprtl.rtl.pipeline import BUFFER_DEPTH, EARLY_BUFFER_DEPTH, BumpPipeline, LightSum
+from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, SinCos, spread_sine
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.texture import TextureBlend
@@ -411,54 +411,21 @@ def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
         assert rom_blocks(words, mem["width"]) > SPREAD_BLOCKS, (name, copy.name, mem)
     narrow = BumpPipeline(load_scene_config("default"))
     assert not any(cs for _, cs in _enable_copies(narrow)[1].values())
-    assert not narrow.spread and not narrow.buffer["aheads"]
-    assert narrow.buffer_depth == len(narrow.buffer["entries"]) == BUFFER_DEPTH
     for name in ("fetch", "rotation"):
         assert dut.units[name].latency == narrow.units[name].latency + 1, name
 
-    # run decided a cycle early (rtl/pipe.lockstep_buffer early): every copy, the units' and
-    # the memories', is loaded from an ahead register of its own, next cycle's run
-    assert dut.early and dut.buffer_depth == len(dut.buffer["entries"]) == EARLY_BUFFER_DEPTH
-    aheads = dut.buffer["aheads"]
-    assert len(aheads) == len(dut.buffer["runs"]) + len(copies)
-    run = dut.buffer["runs"]["pipeline"]
-
     gap_p, bp_p = PATTERNS["both"]
     rng = np.random.default_rng(5)
-    differ, early, stalls = [], [], 0
+    differ = []
 
     async def bench(ctx):
-        nonlocal stalls
-        was = None
         for cycle in range(6 * dut.latency):
             ctx.set(dut.i.valid, bool(rng.random() >= gap_p))
             ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
             await ctx.tick()
-            differ.extend((cycle, name) for name, r, c in copies if ctx.get(c) != ctx.get(r))
-            now = ctx.get(run)
-            stalls += not now
-            if was is not None:
-                early.extend((cycle, a.name) for a, v in zip(aheads, was) if v != now)
-            was = [ctx.get(a) for a in aheads]
+            differ.extend((cycle, name) for name, run, c in copies if ctx.get(c) != ctx.get(run))
 
     sim.add_clock(1e-6)
     sim.add_testbench(bench)
     sim.run()
     assert not differ, differ[:5]
-    assert not early, early[:5]
-    assert stalls > 10           # the traffic stopped the pipe: the copies were tested low
-
-
-def test_spread_is_known_before_the_units_elaborate():
-    """BumpPipeline.spread (rtl/pipeline.spread_memory: from the configuration alone) says
-    whether some unit builds a spread memory, i.e. whether the elaborated units made enable
-    copies; the lock step is decided a cycle early exactly there, with the deeper buffer.
-    (full and default: the copies test above.)"""
-    for name in (n for n in BUILTIN if n not in ("full", "default")):
-        dut = BumpPipeline(load_scene_config(name))
-        Fragment.get(dut, None)
-        built = any(getattr(u, "enable_copies", []) for u in dut.units.values())
-        assert dut.spread == built, name
-        assert dut.buffer["early"] == dut.spread, name
-        assert len(dut.buffer["entries"]) == (EARLY_BUFFER_DEPTH if built else BUFFER_DEPTH), name
-        assert bool(dut.buffer["aheads"]) == built, name

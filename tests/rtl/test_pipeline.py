@@ -18,7 +18,7 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipeline import BUFFER_DEPTH, EARLY_BUFFER_DEPTH, BumpPipeline
+from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline
 from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
@@ -256,21 +256,18 @@ def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys
     assert len(tags) > 100 and tags == [n % top for n in range(len(tags))]
 
 
-@pytest.mark.parametrize("early", [False, True])
-def test_one_consumer_stall_does_not_stop_the_input(early):
+def test_one_consumer_stall_does_not_stop_the_input():
     """With the output buffer empty, o.ready low for one cycle parks one pixel in the buffer
     and i.ready stays high (the enable only falls once the buffer is full); held low, the
-    pipe fills up to latency + its buffer's depth and i.ready falls. Also with the enable
-    decided a cycle early (the spread scenes' lock step, one entry deeper)."""
+    pipe fills up to latency + BUFFER_DEPTH pixels and i.ready falls."""
     scene = load_scene_config({"name": "t", "texture_size": 16})
-    dut = BumpPipeline(scene, early=early)
-    n, depth = dut.latency, dut.buffer_depth
-    assert depth == (EARLY_BUFFER_DEPTH if early else BUFFER_DEPTH)
+    dut = BumpPipeline(scene)
+    n = dut.latency
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: c != n + 2)
     assert all(readies) and len(tags) == 3 * n - n - 1
-    dut = BumpPipeline(scene, early=early)
+    dut = BumpPipeline(scene)
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: False)
-    assert tags == [] and sum(readies) == n + depth and not any(readies[n + depth:])
+    assert tags == [] and sum(readies) == n + BUFFER_DEPTH and not any(readies[n + BUFFER_DEPTH:])
 
 
 def _plan(keys):
