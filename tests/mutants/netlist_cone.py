@@ -29,8 +29,16 @@ in R free and separate in each copy, and ``sat -prove`` that the D bit of every 
 bit outside R, every input of every memory and every output port bit are equal. A
 counterexample whose differing points are register D bits adds those bits to R and the
 miter is built again (Houdini's algorithm: R only grows, so the invariant is the strongest
-of this form); a differing memory input or output port, a combinational loop in the cut, a
+of this form). Beside it, K: register bits the cut reads from outside, each candidate "keeps
+its initial value" (true in the initial state); they are held at that constant in the miter
+and their D bit (its combinational fan-in kept) must equal it; a counterexample there drops
+the candidate (a signal the cut leaves free loses a constraint such as "this register is
+always even", which K gives back when the register really keeps it). A differing memory
+input or output port, a combinational loop in the cut, a
 cell the solver has no model of, or the time limit ends the step without a decision.
+Sound: the invariant (R's complement equal, K at its constants) holds initially, the miter
+proves it preserved and every output equal under it, and every signal the miter leaves free
+is the same signal in both copies.
 With ``stream`` the output ``X__payload`` is compared only where ``X__valid`` is high (the
 stream contract of netlist.py's STREAM_DONT_CARE).
 
@@ -108,6 +116,13 @@ class Netlist:
                             self.driver[b] = (name, port, i)
                         else:
                             self.readers.setdefault(b, []).append((name, port, i))
+        self.init = {}         # net -> "0" | "1": the initial value of a register's Q bit
+        for d in mod["netnames"].values():
+            v = d.get("attributes", {}).get("init")
+            if isinstance(v, str) and len(v) == len(d["bits"]):
+                for i, b in enumerate(d["bits"]):
+                    if isinstance(b, int) and v[-1 - i] in "01":
+                        self.init[b] = v[-1 - i]
         self.ports = mod["ports"]
         self.ctrl = self.ports[CTRL]["bits"][0]
         self.out_bits = {}      # net -> [(port, index)]
@@ -240,10 +255,30 @@ def _acyclic(net, comb):
     return True
 
 
-def miter_json(net, R, stream):
-    """The combinational miter of the cut with R free: (json text, the compared points in
-    the order of the output ``d``)."""
+def candidates(net, R, comb):
+    """Register bits the cut reads from outside, with a known initial value: the
+    candidates "this bit keeps its initial value" ({(cell, bit): "0" | "1"})."""
+    diff, comb, _ = reach(net, R, through_ff=False)
+    out = {}
+    for name in comb:
+        c = net.cells[name]
+        for q, bits in c["connections"].items():
+            if c["port_directions"].get(q) == "output":
+                continue
+            for b in _ints(bits):
+                d = net.driver.get(b)
+                if b not in diff and d and d[1] == "Q" and net.kind(d[0]) == "ff" \
+                        and b in net.init:
+                    out[(d[0], d[2])] = net.init[b]
+    return out
+
+
+def miter_json(net, R, stream, K=None):
+    """The combinational miter of the cut with R free and the register bits of K held at
+    their constants: (json text, the compared points in the order of the output ``d``)."""
+    K = K or {}
     diff, comb, points = reach(net, R, through_ff=False)
+    const = {net.cells[c]["connections"]["Q"][i]: v for (c, i), v in K.items()}
     if any(k[0] in ("other",) for k in points):
         raise Undecided("a cell of no known kind in the cut")
     if not _acyclic(net, comb):
@@ -261,6 +296,8 @@ def miter_json(net, R, stream):
             return "0"
         if b == "x":
             return new()
+        if b in const:
+            return const[b]
         return b + off if isinstance(b, int) and b in diff else b
 
     def gate_in(b):
@@ -268,14 +305,18 @@ def miter_json(net, R, stream):
             return "1"
         if b == "x":
             return new()
-        return b
+        return const.get(b, b)
 
     cells = {}
     # the shared fan-in: the combinational cells that compute what the cut reads from
     # outside, nearest first, once (they are the same in both copies): without them those
     # signals are free, and a constraint such as "2 y is even" is lost
-    support, frontier = [], sorted(comb)
-    seen = set(comb)
+    dcone = {net.driver[d][0] for (c, i) in K
+             for d in [net.cells[c]["connections"]["D"][i]]
+             if isinstance(d, int) and d in net.driver and net.kind(net.driver[d][0]) == "comb"
+             and net.driver[d][0] not in comb}
+    support, frontier = sorted(dcone), sorted(comb | dcone)
+    seen = set(comb) | dcone
     while frontier and len(support) < SUPPORT_CELLS:
         nxt = []
         for name in frontier:
@@ -295,7 +336,9 @@ def miter_json(net, R, stream):
         raise Undecided("a combinational loop in the cut")
     for name in support:
         c = net.cells[name]
-        con = {q: [new() if b == "x" else b for b in bits] for q, bits in c["connections"].items()}
+        con = {q: [new() if b == "x" else (b if c["port_directions"].get(q) == "output"
+                                            else const.get(b, b)) for b in bits]
+               for q, bits in c["connections"].items()}
         cells[f"shared:{name}"] = {"type": c["type"], "parameters": c["parameters"],
                                    "port_directions": c["port_directions"], "connections": con}
     for name in sorted(comb):
@@ -336,6 +379,13 @@ def miter_json(net, R, stream):
             gate_bits.append(gate_in(b) if b != "x" else "x")
             mask.append(valid if valid is not None else "1")
             plist.append(pt)
+    for (c, i), v in sorted(K.items()):
+        dbit = net.cells[c]["connections"]["D"][i]
+        for copy, fin in (("gate", gate_in), ("gold", gold_in)):
+            gate_bits.append(fin(dbit) if dbit != "x" else new())
+            gold_bits.append(v)
+            mask.append("1")
+            plist.append(("const", c, i))
     if not plist:
         return None, []
     n = len(plist)
@@ -372,17 +422,22 @@ def _parse_cex(out, n):
 
 
 def cut(net, rtl, yosys_run, timeout, stream, log=None):
-    """("equivalent", R) or ("undecided", why)."""
+    """("equivalent", {"R": the register bits that may differ, "K": the register bits
+    proved to keep their initial value}) or ("undecided", why)."""
     t0 = time.monotonic()
-    R = set()
+    R, K, dropped = set(), {}, set()
     work = Path(rtl)
     for _ in range(MAX_ROUNDS):
+        _, comb, _ = reach(net, R, through_ff=False)
+        for key, v in candidates(net, R, comb).items():
+            if key not in dropped and key not in R:
+                K.setdefault(key, v)
         left = timeout - (time.monotonic() - t0)
         if left <= 1:
             return "undecided", f"no invariant within {timeout} s (R: {len(R)} register bits)"
-        text, plist = miter_json(net, R, stream)
+        text, plist = miter_json(net, R, stream, K)
         if text is None:
-            return "equivalent", R
+            return "equivalent", {"R": R, "K": K}
         (work / "cone_cut.json").write_text(text)
         script = ["read_json cone_cut.json", "hierarchy -top cut",
                   f"sat -prove d {len(plist)}'b0 -show d -timeout {int(left)} cut"]
@@ -394,28 +449,33 @@ def cut(net, rtl, yosys_run, timeout, stream, log=None):
         if out is None:
             return "undecided", f"no proof of the cut within {timeout} s"
         if "SAT proof finished - no model found: SUCCESS!" in out:
-            return "equivalent", R
+            return "equivalent", {"R": R, "K": K}
         if "SAT proof finished - model found: FAIL!" not in out:
             return "undecided", f"no proof of the cut within {timeout} s"
         bits = _parse_cex(out, len(plist))
         if bits is None:
             return "undecided", "cut: no counterexample read"
-        grow = set()
+        grow, drop = set(), set()
         for on, pt in zip(bits, plist):
             if not on:
                 continue
-            if pt[0] == "ff":
+            if pt[0] == "const":
+                drop.add((pt[1], pt[2]))
+            elif pt[0] == "ff":
                 grow.add((pt[1], pt[2]))
             elif pt[0] == "ffctl":
                 grow |= {(pt[1], j) for j in range(len(net.cells[pt[1]]["connections"]["Q"]))}
             else:
                 where = f"output {pt[1]}[{pt[2]}]" if pt[0] == "out" else f"memory {pt[1]} {pt[2]}"
                 return "undecided", f"cut: the invariant does not hold at {where}"
-        if not grow - R:
+        if not grow - R and not drop:
             return "undecided", "cut: no new register bit in the counterexample"
         if log:
-            log(f"    cut: R + {', '.join(names(net, grow - R))} ({time.monotonic() - t0:.0f} s)")
+            log(f"    cut: R + {', '.join(names(net, grow - R))}; {len(drop)} constant "
+                f"candidates dropped, {len(K) - len(drop)} kept ({time.monotonic() - t0:.0f} s)")
         R |= grow
+        dropped |= drop
+        K = {k: v for k, v in K.items() if k not in dropped and k not in R}
     return "undecided", f"cut: R still grew after {MAX_ROUNDS} rounds"
 
 
