@@ -148,8 +148,9 @@ class RegisteredROM(Elaboratable):
     the widest mode that holds them, blocks side by side for the width: :meth:`mode`) with
     both ports and their own output registers (REGMODE OUTREG: the clock-to-out of an
     unregistered block RAM leaves the cycle); a table of 2**n + 1 words whose word 0 is 0
-    keeps its last word in a flip-flop (the address wraps to word 0 and the word is OR'ed in). Elsewhere (``target=None``): an
-    Amaranth Memory and a register. ``depth`` and ``width`` are the table's size."""
+    keeps its last word in a flip-flop (the address wraps to word 0 and the word is OR'ed
+    in). Elsewhere (``target=None``): an Amaranth Memory and a register. ``depth`` and
+    ``width`` are the table's size."""
 
     def __init__(self, init, shape, ports, name, target=None):
         self.init, self.shape, self.name, self.target = [int(x) for x in init], shape, name, target

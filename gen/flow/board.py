@@ -279,7 +279,9 @@ class _TopPortsVerilator(Verilator):
     per-cycle code are then Verilator's optimised ones (the reduced mode's build: ~40 -> ~30
     s of CPU). ``vlt`` is the configuration file that marks them ``public_flat_rw``."""
 
-    vlt = None
+    def __init__(self, vlt):
+        super().__init__()
+        self.vlt = vlt
 
     def _build_command(self):
         cmds = super()._build_command()
@@ -315,8 +317,7 @@ def _run_verilator(v_path, build_dir, env, opt_fast=None):
     os.environ.update(env_tools)
     require("verilator")
     try:
-        runner = _TopPortsVerilator()
-        runner.vlt = _top_ports_vlt(build_dir, top)
+        runner = _TopPortsVerilator(_top_ports_vlt(build_dir, top))
         t0 = time.perf_counter()
         if not (stamp.is_file() and stamp.read_text() == digest):
             runner.build(sources=[Path(v_path).resolve()], hdl_toplevel=top,

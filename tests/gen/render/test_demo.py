@@ -12,6 +12,7 @@ from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.heightfields import brick_lines
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 
+
 def _report_rows(text):
     """(scene, method) -> (psnr, max diff, fixed psnr, fixed max, seconds, file) from
     report.txt's table ('-' fixed columns: None)."""
