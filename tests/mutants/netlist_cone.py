@@ -1,4 +1,4 @@
-"""The equivalence of one netlist mutant limited to the mutated cell's cone (issue 28).
+"""The equivalence of one netlist mutant limited to the mutated cell's cone.
 
 tests/mutants/netlist.py's first three steps (Yosys's structural passes and mcy's miter) work
 on the whole design and do not finish on a scene pipeline. The two steps here look only at

@@ -1,4 +1,4 @@
-"""Search pixels on which a sine-ROM data-register mutant changes a pipeline output (issue 28).
+"""Search pixels on which a sine-ROM data-register mutant changes a pipeline output.
 
 The mutant flips bit ``flip`` of one quarter-wave ROM word read when its bit ``ctrl`` is set
 (``mutate -mode cnot1 ... -port A -portbit flip -ctrlbit ctrl`` on the reset mux in front

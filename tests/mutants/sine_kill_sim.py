@@ -1,6 +1,6 @@
 """Stream pixels found by tests/mutants/sine_kill_search.py through the saved mutated netlist on Icarus
 (tests/mutants/netlist.py's run_one: the bulk path, four traffic patterns, golden compare),
-mutsel = 0 (must pass) and mutsel = the mutant (issue 28).
+mutsel = 0 (must pass) and mutsel = the mutant.
 
 run in the directory of the search's kill_*.npz:
 python tests/mutants/sine_kill_sim.py two-lights l_cy 1 K  |  ... full n_c2 6 K
