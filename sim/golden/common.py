@@ -82,11 +82,14 @@ class PixelInputs:
             phi, theta = uniform_dirs(n, False)
             if valid:   # redraw until above the surface of N
                 nvec = polar_to_cartesian(out["n_phi"], out["n_theta"])
+                bad = np.arange(n)          # the pixels to check: a redrawn one only
                 for _ in range(64):
-                    bad = np.einsum("...i,...i", polar_to_cartesian(phi, theta), nvec) <= 0.02
-                    if not bad.any():
+                    below = np.einsum("...i,...i", polar_to_cartesian(phi[bad], theta[bad]),
+                                      nvec[bad]) <= 0.02
+                    bad = bad[below]
+                    if not bad.size:
                         break
-                    phi[bad], theta[bad] = uniform_dirs(int(bad.sum()), False)
+                    phi[bad], theta[bad] = uniform_dirs(bad.size, False)
             out[f"{v}_phi"], out[f"{v}_theta"] = phi, theta
         return cls(**out)
 
