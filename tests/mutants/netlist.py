@@ -10,7 +10,9 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    port inverted, tied to 0 or 1, or replaced by another bit of the design);
 3. one mutated netlist holding every mutant behind a control input, as mcy's
    ``create_mutated`` builds it: ``mutate -ctrl mutsel W I <mutation I>`` for I = 1..N
-   (mutsel = 0 is the unmutated design), written out as Verilog; a shim module with the
+   (mutsel = 0 is the unmutated design), then ``setundef -zero`` (proc's undefined
+   constants, such as a memory write's address while its enable is low, as 0: Icarus and
+   Verilator then simulate the same defined netlist), written out as Verilog; a shim module with the
    unit's own name and ports reads ``mutsel`` from ``mutsel.txt`` in the run directory;
 4. ONE build of the bulk path (sim/tb/bulk.py: the arrays-in/arrays-out wrapper generated
    from the sidecar) around it, on Verilator for the units and on Icarus for the scene
@@ -35,8 +37,9 @@ For each target (a unit at the default Config, or a built-in scene's pipeline):
    a design too large for ``sat``) leaves it *undecided*, counted as a survivor and listed.
    ``--recheck`` runs these checks again on a finished run's survivors; ``--reuse`` keeps
    a target's mutants and mutated netlist from an earlier run of the same sample and seed
-   when the target emits the same files (the slow ``prep`` of a pipeline), and runs the
-   simulations and checks again on today's stimulus.
+   when the target emits the same files (the slow ``prep`` of a pipeline; the mutated
+   netlist is built again from the kept prepared netlist when today's script differs from
+   the one that built it), and runs the simulations and checks again on today's stimulus.
 
 Prints, per target, the sample size, the seed, killed / non-equivalent, the kill ratio, the
 survivors and the wall time; ``--doc docs/mutation.md`` writes the table between the
@@ -214,17 +217,27 @@ def mutation_list(v, unit, n, seed, work):
     return lines
 
 
-def mutated_netlist(v, meta, lines, work):
+MUTATED_STAMP = "mutated.json"   # the script and shim the kept mutated.v was built from
+
+
+def mutated_netlist(v, meta, lines, work, reuse=False):
     """``mutated.v``: the flattened unit renamed ``<unit>__mutated`` with a ``mutsel`` input
-    selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``."""
+    selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``. With ``reuse``
+    a ``mutated.v`` in ``work`` is kept when MUTATED_STAMP says it was built by this same
+    script and shim (else it is built again from ``prepped.il``).
+
+    ``setundef -zero`` after the mutations: ``proc`` leaves undefined constants in the
+    prepared netlist (a memory write's address and data are ``en ? addr : 'x``), which
+    Icarus simulates as X (a write to an X address is dropped) and Verilator as 0 (the word
+    at address 0 is written); with every x a 0 both simulate the same defined netlist. The
+    mutation list (``mutate -list`` on the prepared netlist) is unchanged."""
     unit = meta["unit"]
     width = max(1, len(lines).bit_length())
     script = ["read_rtlil prepped.il"]
     script += [f"mutate -ctrl mutsel {width} {i} " + l[len("mutate "):]
                for i, l in enumerate(lines, 1)]
-    script += ["opt_clean", f"rename {unit} {unit}__mutated",
+    script += ["setundef -zero", "opt_clean", f"rename {unit} {unit}__mutated",
                "write_verilog -noattr -norename mutated_core.v"]
-    yosys(script, work)
     ports = meta["ports"]
     decl = []
     for name, p in sorted(ports.items()):
@@ -252,8 +265,18 @@ module {unit}({', '.join(sorted(ports))});
   );
 endmodule
 """
+    stamp = json.dumps({"script": script, "shim": shim}, indent=1)
+    if (reuse and (work / "mutated.v").exists() and (work / MUTATED_STAMP).exists()
+            and (work / MUTATED_STAMP).read_text() == stamp):
+        return work / "mutated.v", width
+    if reuse:
+        print(f"  {unit}: the kept mutated netlist was not built by today's script: built again "
+              f"from {work / 'prepped.il'}", flush=True)
+    (work / MUTATED_STAMP).unlink(missing_ok=True)
+    yosys(script, work)
     text = (work / "mutated_core.v").read_text() + shim
     (work / "mutated.v").write_text(text)
+    (work / MUTATED_STAMP).write_text(stamp)
     return work / "mutated.v", width
 
 
@@ -489,10 +512,11 @@ SAMPLE_STAMP = "sample.json"     # the sample and seed a kept rtl/ directory's m
 def _kept_netlist(target, work, n, seed, stim_n, log):
     """``(v, j, job, rtl)`` from the rtl/ directory an earlier run left in ``work`` when the
     target emits the same files again and that run drew the same sample and seed (its
-    prepared netlist, mutation list and mutated netlist are kept); the job (stimulus) is
-    made anew. None otherwise."""
+    prepared netlist and mutation list are kept, and its mutated netlist when today's
+    mutated_netlist would build the same: see MUTATED_STAMP); the job (stimulus) is made
+    anew. None otherwise."""
     rtl, stamp = work / "rtl", work / "rtl" / SAMPLE_STAMP
-    if not (stamp.exists() and (rtl / "mutated.v").exists() and (rtl / "prepped.il").exists()):
+    if not (stamp.exists() and (rtl / "mutations.ys").exists() and (rtl / "prepped.il").exists()):
         return None
     if json.loads(stamp.read_text()) != {"sample": n, "seed": seed}:
         return None
@@ -528,7 +552,9 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
     if kept is None:
         mutation_list(v, unit, n, seed, rtl)
         (rtl / SAMPLE_STAMP).write_text(json.dumps({"sample": n, "seed": seed}))
-        mutated_netlist(v, meta, _listed(rtl), rtl)
+    # a kept mutated.v is used only when today's script and shim built it; else it is built
+    # again from the kept prepared netlist and mutation list
+    mutated_netlist(v, meta, _listed(rtl), rtl, reuse=kept is not None)
     lines = _listed(rtl)
     mv = rtl / "mutated.v"
     base = run_one(mv, j, job, work / "run0", 0, sim)
