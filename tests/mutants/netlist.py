@@ -61,6 +61,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist_cone as nc  # noqa: E402  (steps 4 and 5, beside this file)
+import netlist_pdr as npdr  # noqa: E402  (step 6)
 
 ROOT = Path(__file__).resolve().parents[2]
 UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
@@ -406,7 +407,7 @@ def _miter(unit, line, work, timeout, stream):
     return "equivalent"
 
 
-STEPS = ("structural", "stream", "miter", "cone", "cut")
+STEPS = ("structural", "stream", "miter", "cone", "cut", "pdr")
 
 
 def _cone_steps(meta, line, work, timeout, has_stream, steps):
@@ -445,7 +446,36 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
             why.append(R)
             if "__payload" not in R:
                 break
+    if "pdr" in steps:
+        proved, said = _pdr_step(meta, line, work, timeout, has_stream)
+        if proved:
+            return proved, None
+        why.append(said)
     return None, "; ".join(why)
+
+
+def _pdr_step(meta, line, work, timeout, has_stream):
+    """Step 6 (tests/mutants/netlist_pdr.py): the product machine of design and mutant, the
+    memories cut, proved safe by z3's Spacer (IC3/PDR) within ``timeout`` seconds, payloads
+    masked by valid when the unit has streams: ``(verdict, why)``."""
+    try:
+        net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
+    except (subprocess.CalledProcessError, KeyError) as e:
+        return None, f"pdr: the -ctrl netlist was not built ({type(e).__name__})"
+    try:
+        verdict, how = npdr.pdr(net, work, nc.yosys_log, timeout, has_stream, log=print)
+    except nc.Undecided as e:
+        return None, f"pdr: {e}"
+    except subprocess.CalledProcessError as e:
+        err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
+        return None, "pdr: " + (err[:1] or ["yosys error"])[0][:100]
+    if verdict != "equivalent":
+        return None, how
+    said = (f"pdr: z3 Spacer (IC3/PDR) proves the product machine of design and mutant safe, "
+            f"memories cut to free read data, {how}")
+    if has_stream:
+        return f"equivalent under the stream contract ({said}, {STREAM_DONT_CARE})", None
+    return f"equivalent ({said})", None
 
 
 def equivalence(v, meta, line, work, timeout, steps=STEPS):
@@ -464,10 +494,14 @@ def equivalence(v, meta, line, work, timeout, steps=STEPS):
     5. ``cut`` (netlist_cone.py): an inductive invariant "every register bit equal but a set
        R" proved by sat on the combinational logic the mutation reaches, cut at the
        registers (every output compared; then, if a payload was what failed, payloads
-       masked by valid), each time within ``timeout`` seconds.
-    Steps 4 and 5 run on every pipeline's survivors where 1-3 time out. ``steps`` chooses
-    among STEPS (``--steps``; ``--recheck --steps cone,cut`` runs only the new ones on a
-    finished run's survivors, whose first three were run then). The verdict names the step
+       masked by valid), each time within ``timeout`` seconds;
+    6. ``pdr`` (netlist_pdr.py): the product machine of design and mutant (the cells a
+       difference can reach twice, the rest once, the memories cut to free read data and
+       compared write inputs), payloads masked by valid, proved safe by z3's Spacer
+       (IC3/PDR), which finds relational and range invariants the cut cannot state.
+    Steps 4 to 6 run on every pipeline's survivors where 1-3 time out. ``steps`` chooses
+    among STEPS (``--steps``; ``--recheck --steps cone,cut`` or ``--steps pdr`` runs only
+    those on a finished run's survivors, whose earlier steps were run then). The verdict names the step
     that proved it."""
     unit = meta["unit"]
     wrappers, has_stream = _wrappers(meta["ports"], unit)
@@ -698,7 +732,9 @@ def recheck(path, out, timeout, steps=STEPS):
             verdict = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout, steps)
             if tuple(steps) != STEPS and verdict.startswith("undecided"):
                 new = verdict[len("undecided: "):]
-                old = s["verdict"].split("; cone reaches")[0].split("; cut:")[0]
+                old = s["verdict"].split("; pdr:")[0]
+                if {"cone", "cut"} & set(steps):
+                    old = old.split("; cone reaches")[0].split("; cut:")[0]
                 verdict = f"{old}; {new}"
             s["verdict"] = verdict
             print(f"  {r['target']} #{s['index']}: {s['verdict']} ({time.perf_counter() - t0:.0f} s)",

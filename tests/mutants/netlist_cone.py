@@ -101,12 +101,13 @@ def yosys_log(script, cwd, timeout=None):
     return run_yosys(script, cwd, timeout)
 
 
-def load(rtl, unit, line, yosys=yosys_log):
-    """The -ctrl netlist of ``line`` as Yosys's JSON module (written in ``rtl/cone``)."""
+def load(rtl, unit, line, yosys=yosys_log, passes=()):
+    """The -ctrl netlist of ``line`` as Yosys's JSON module (written in ``rtl/cone``), after
+    the Yosys commands ``passes`` (none for the cone and cut steps)."""
     work = Path(rtl)
     args = line[len("mutate "):]
     args = re.sub(r" -src \S+", "", args)
-    yosys(["read_rtlil prepped.il", f"mutate -ctrl {CTRL} 1 1 {args}",
+    yosys(["read_rtlil prepped.il", f"mutate -ctrl {CTRL} 1 1 {args}", *passes,
            "write_json cone_netlist.json"], work)
     path = work / "cone_netlist.json"
     mod = json.loads(path.read_text())["modules"][unit]

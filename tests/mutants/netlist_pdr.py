@@ -1,0 +1,404 @@
+"""Step 6 of tests/mutants/netlist.py's equivalence check (``pdr``): the mutant's miter proved
+by property-directed reachability (IC3/PDR), which finds the inductive strengthening itself.
+
+The cut step (netlist_cone.py) looks for an invariant of one form only, "every register bit
+equal in design and mutant but a set R, some bits at their initial value". Some survivors
+need another: a relational one ("these registers differ only while the stage's valid bit is
+0") or a range ("this operand stays below 1.0, so its bit 16 is never set"). PDR finds such
+clauses on its own; this step builds the product machine of design and mutant, bit-level,
+and gives it to z3's Spacer (its IC3/PDR engine for constrained Horn clauses).
+
+The product machine. The mutation is applied as the simulation applies it (``mutate -ctrl
+mutsel 1 1 ...`` on ``prepped.il``: mutsel = 0 the design, 1 the mutant). Every net that can
+differ descends from ``mutsel`` (followed as in netlist_cone.reach, conservatively); a cell
+with a differing input is there twice, the design's copy (mutsel = 0) and the mutant's
+(mutsel = 1), every other cell once, shared: so the registers outside the mutation's cone
+are one state, not two. The memories are cut out:
+
+* a memory's contents are the same in both copies as long as its writes are: every write
+  port input that can differ is compared (enable bits always; data bits where enabled;
+  address while any bit is enabled), a difference there is a failure;
+* a read port's data is a free input each cycle, one for both copies (any contents, any
+  value: this drops constraints and adds none); where the read address can differ, the
+  mutant's read data is the design's when the two addresses are equal and a second free
+  input when not (the same contents read at the same address give the same word).
+
+The property: no output port bit differs (with ``stream``, a payload ``X__payload`` only
+while ``X__valid`` is high: netlist.py's STREAM_DONT_CARE), no memory write input differs. The
+initial state is the one netlist's (its registers' init values, the same in both copies).
+Yosys bit-blasts the product (``techmap; aigmap; write_aiger``), and Spacer proves "no
+reachable state fails" (an inductive invariant, its own clauses) or finds a path to one.
+
+Localization: a shared register whose value a proof does not need may be left free (its Q a
+free input each cycle, one for both copies: again fewer constraints, never more). The step
+starts with the duplicated registers and the shared registers ``depth`` register stages
+behind them kept, and deepens: a counterexample of an abstraction that leaves some register
+free proves nothing and the next depth runs; one of the whole design (no register left
+free) is a real difference of design and mutant under any memory contents: *not
+equivalent* only if the memories did not matter, so it is reported as a counterexample of
+the cut-memory model, never as a kill. A proof at any depth is sound: the abstraction
+over-approximates the design.
+"""
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import netlist_cone as nc  # noqa: E402
+
+DEPTHS = (1, 2, 4, 8, None)     # the register stages kept behind the duplicated registers
+# arithmetic cells whose two copies are modelled as one unknown function of their operands
+ARITH = {"$mul", "$add", "$sub", "$neg", "$shl", "$shr", "$sshl", "$sshr", "$shift", "$shiftx",
+         "$div", "$mod", "$divfloor", "$modfloor", "$pow", "$macc", "$alu"}
+
+
+def _w(p, key):
+    v = p.get(key, 0)
+    return int(v, 2) if isinstance(v, str) else int(v)
+
+
+def _diff(net):
+    """The nets that can differ in the product (from mutsel: comb cells as netlist_cone.step,
+    a register's D bit to its Q bit, its other inputs to all of Q; a memory's read address to
+    that port's data only, its write ports to nothing: they are compared instead)."""
+    diff, todo = set(), []
+
+    def differs(b):
+        if isinstance(b, int) and b not in diff:
+            diff.add(b)
+            todo.append(b)
+
+    differs(net.ctrl)
+    while todo:
+        n = todo.pop()
+        for cell, port, i in net.readers.get(n, []):
+            c = net.cells[cell]
+            k = net.kind(cell)
+            if k == "comb":
+                for q, j in net.step(cell, port, i):
+                    differs(c["connections"][q][j])
+            elif k == "ff":
+                if port == "D":
+                    differs(c["connections"]["Q"][i])
+                elif port not in ("CLK", "C"):
+                    for b in c["connections"]["Q"]:
+                        differs(b)
+            elif k == "mem":
+                if c["type"] != "$mem_v2":
+                    raise nc.Undecided(f"memory cell {cell} of type {c['type']}")
+                p = c["parameters"]
+                if port == "RD_ADDR":
+                    w = _w(p, "WIDTH")
+                    k_ = i // _w(p, "ABITS")
+                    for b in c["connections"]["RD_DATA"][k_ * w:(k_ + 1) * w]:
+                        differs(b)
+                elif port.startswith("RD_") and port != "RD_CLK":
+                    raise nc.Undecided(f"memory {cell}: its {port} can differ")
+            else:
+                raise nc.Undecided(f"cell {cell} of type {c['type']} in the cone")
+    return diff
+
+
+def product(net, stream, depth):
+    """The product machine as Yosys JSON text (module ``product``, output ``bad``), the
+    number of shared registers left free, and the number of compared bits."""
+    diff = _diff(net)
+    top = 1 + max(max(net.driver, default=0), max(net.readers, default=0), net.ctrl)
+    off = top
+    fresh = [2 * top + 10]
+
+    def new():
+        fresh[0] += 1
+        return fresh[0]
+
+    def gold_in(b):
+        if b == net.ctrl:
+            return "0"
+        if b == "x":
+            return new()
+        return b + off if isinstance(b, int) and b in diff else b
+
+    def gate_in(b):
+        if b == net.ctrl:
+            return "1"
+        return new() if b == "x" else b
+
+    def shared_in(b):
+        return new() if b == "x" else b
+
+    P = lambda **kw: {k: format(v, "032b") for k, v in kw.items()}
+    cells, names, cmp_g, cmp_t, mask = {}, {}, [], [], []
+
+    def cell(name, type_, params, dirs, con):
+        cells[name] = {"type": type_, "parameters": params, "port_directions": dirs,
+                       "connections": con}
+
+    def inputs_differ(c):
+        return any(b in diff for q, bits in c["connections"].items()
+                   if c["port_directions"].get(q) != "output" and q not in ("CLK", "C")
+                   for b in nc._ints(bits))
+
+    # which shared registers are kept: `depth` register stages behind what the product reads
+    ff_cells = [n for n in net.cells if net.kind(n) == "ff"]
+    dup = {n for n in net.cells if net.kind(n) in ("comb", "ff") and inputs_differ(net.cells[n])}
+    keep = set(n for n in ff_cells if n in dup)
+    if depth is None:
+        keep = set(ff_cells)
+    else:
+        seen, frontier = set(), [b for n in dup for b in nc._input_bits(net.cells[n])]
+        frontier += [b for p, d in net.ports.items() if d["direction"] == "output"
+                     for b in nc._ints(d["bits"])]
+        for _ in range(depth):
+            regs, stack = set(), list(frontier)
+            while stack:
+                b = stack.pop()
+                if b in seen:
+                    continue
+                seen.add(b)
+                d = net.driver.get(b)
+                if not d:
+                    continue
+                k = net.kind(d[0])
+                if k == "ff":
+                    regs.add(d[0])
+                elif k == "comb" or k == "mem":
+                    stack += list(nc._input_bits(net.cells[d[0]]))
+            keep |= regs
+            frontier = [b for r in regs for b in nc._input_bits(net.cells[r])]
+    free = sum(1 for n in ff_cells if n not in keep)
+
+    for name, c in net.cells.items():
+        k = net.kind(name)
+        if k == "ff" and name not in keep:
+            continue                      # its Q a free input, one for both copies
+        if k == "comb" and name in dup and c["type"] in ARITH:
+            # the two copies as one function of their operands: the design's result free,
+            # the mutant's the same where the operands are the same and free where not
+            dirs, con = c["port_directions"], c["connections"]
+            ins = [b for q, bits in sorted(con.items()) if dirs.get(q) != "output" for b in bits]
+            eq = new()
+            cell(f"ufeq:{name}", "$eq", P(A_SIGNED=0, B_SIGNED=0, A_WIDTH=len(ins),
+                                          B_WIDTH=len(ins), Y_WIDTH=1),
+                 {"A": "input", "B": "input", "Y": "output"},
+                 {"A": [gold_in(b) for b in ins], "B": [gate_in(b) for b in ins], "Y": [eq]})
+            for q, bits in sorted(con.items()):
+                if dirs.get(q) == "output":
+                    cell(f"ufmux:{name}:{q}", "$mux", P(WIDTH=len(bits)),
+                         {"A": "input", "B": "input", "S": "input", "Y": "output"},
+                         {"A": [new() for _ in bits],
+                          "B": [b + off if isinstance(b, int) else b for b in bits],
+                          "S": [eq], "Y": list(bits)})
+            continue
+        if k in ("comb", "ff"):
+            dirs = c["port_directions"]
+            copies = ((("gold", gold_in, lambda b: b + off if isinstance(b, int) else b),
+                       ("gate", gate_in, lambda b: b)) if name in dup else
+                      (("shared", shared_in, lambda b: b),))
+            for tag, fin, fout in copies:
+                con = {q: [fout(b) if dirs.get(q) == "output" else fin(b) for b in bits]
+                       for q, bits in c["connections"].items()}
+                cell(f"{tag}:{name}", c["type"], c["parameters"], dirs, con)
+                if k == "ff":
+                    q = [b for b in con["Q"]]
+                    init = "".join(net.init.get(b, "x") for b in reversed(c["connections"]["Q"]))
+                    if set(init) != {"x"}:
+                        names[f"{tag}:{name}:Q"] = {"bits": q, "attributes": {"init": init}}
+        elif k == "mem":
+            p, con = c["parameters"], c["connections"]
+            w, ab = _w(p, "WIDTH"), _w(p, "ABITS")
+            if any(ch == "1" for ch in str(p.get("RD_CLK_ENABLE", "0"))):
+                raise nc.Undecided(f"memory {name}: a synchronous read port")
+            for k_ in range(_w(p, "RD_PORTS")):
+                addr = con["RD_ADDR"][k_ * ab:(k_ + 1) * ab]
+                data = con["RD_DATA"][k_ * w:(k_ + 1) * w]
+                if not any(b in diff for b in nc._ints(addr)):
+                    continue              # shared data: free, undriven
+                eq = new()
+                cell(f"rdeq:{name}:{k_}", "$eq", P(A_SIGNED=0, B_SIGNED=0, A_WIDTH=ab,
+                                                    B_WIDTH=ab, Y_WIDTH=1),
+                     {"A": "input", "B": "input", "Y": "output"},
+                     {"A": [gold_in(b) for b in addr], "B": [gate_in(b) for b in addr],
+                      "Y": [eq]})
+                cell(f"rdmux:{name}:{k_}", "$mux", P(WIDTH=w),
+                     {"A": "input", "B": "input", "S": "input", "Y": "output"},
+                     {"A": [new() for _ in data], "B": [gold_in(b) for b in data],
+                      "S": [eq], "Y": list(data)})
+            for k_ in range(_w(p, "WR_PORTS")):
+                en = con["WR_EN"][k_ * w:(k_ + 1) * w]
+                addr = con["WR_ADDR"][k_ * ab:(k_ + 1) * ab]
+                data = con["WR_DATA"][k_ * w:(k_ + 1) * w]
+                if not any(b in diff for b in nc._ints(en + addr + data)):
+                    continue
+                eg = [gold_in(b) for b in en]
+                anyen = new()
+                cell(f"wren:{name}:{k_}", "$reduce_or", P(A_SIGNED=0, A_WIDTH=w, Y_WIDTH=1),
+                     {"A": "input", "Y": "output"}, {"A": eg, "Y": [anyen]})
+                cmp_g += eg
+                cmp_t += [gate_in(b) for b in en]
+                mask += ["1"] * w
+                cmp_g += [gold_in(b) for b in data]
+                cmp_t += [gate_in(b) for b in data]
+                mask += eg
+                cmp_g += [gold_in(b) for b in addr]
+                cmp_t += [gate_in(b) for b in addr]
+                mask += [anyen] * ab
+        else:
+            raise nc.Undecided(f"cell {name} of type {c['type']}")
+    for p, d in sorted(net.ports.items()):
+        if d["direction"] != "output":
+            continue
+        valid = None
+        if stream and p.endswith("__payload"):
+            v = net.ports.get(p[:-len("payload")] + "valid")
+            if v and v["direction"] == "output":
+                valid = gate_in(v["bits"][0])
+        for b in d["bits"]:
+            if b in diff:
+                cmp_g.append(gold_in(b))
+                cmp_t.append(gate_in(b))
+                mask.append(valid if valid is not None else "1")
+    n = len(cmp_g)
+    if not n:
+        return None, free, 0
+    x, y, bad = [new() for _ in range(n)], [new() for _ in range(n)], new()
+    two = {"A": "input", "B": "input", "Y": "output"}
+    cell("pdr:cmp", "$xor", P(A_SIGNED=0, B_SIGNED=0, A_WIDTH=n, B_WIDTH=n, Y_WIDTH=n), two,
+         {"A": cmp_g, "B": cmp_t, "Y": x})
+    cell("pdr:mask", "$and", P(A_SIGNED=0, B_SIGNED=0, A_WIDTH=n, B_WIDTH=n, Y_WIDTH=n), two,
+         {"A": x, "B": mask, "Y": y})
+    cell("pdr:bad", "$reduce_or", P(A_SIGNED=0, A_WIDTH=n, Y_WIDTH=1),
+         {"A": "input", "Y": "output"}, {"A": y, "Y": [bad]})
+    driven, read = set(), set()
+    for c in cells.values():
+        for q, bits in c["connections"].items():
+            (driven if c["port_directions"].get(q) == "output" else read).update(nc._ints(bits))
+    clk = set()
+    for c in cells.values():
+        for q in ("CLK", "C"):
+            clk.update(nc._ints(c["connections"].get(q, [])))
+    ports = {f"n{b}": {"direction": "input", "bits": [b]} for b in sorted(read - driven)}
+    ports["bad"] = {"direction": "output", "bits": [bad]}
+    mod = {"attributes": {}, "ports": ports, "cells": cells, "netnames": names}
+    return json.dumps({"modules": {"product": mod}}), free, n
+
+
+def _aiger(text, work, yosys_run, timeout):
+    """Bit-blast the product JSON to ASCII AIGER (``pdr_product.aag``); None on the time
+    limit."""
+    (work / "pdr_product.json").write_text(text)
+    out = yosys_run(["read_json pdr_product.json", "hierarchy -top product", "async2sync",
+                     "dffunmap", "techmap", "opt -fast", "dffunmap",
+                     "setundef -undriven -anyseq", "aigmap", "opt_clean",
+                     "write_aiger -ascii -zinit -map pdr_product.aim pdr_product.aag"],
+                    work, timeout=timeout)
+    return None if out is None else work / "pdr_product.aag"
+
+
+def solve(aag):
+    """Spacer on the AIGER file: prints ``proved``, ``cex`` or ``unknown`` (run in a child
+    process, so that a time limit can stop it)."""
+    import z3
+    lines = Path(aag).read_text().splitlines()
+    _, M, I, L, O, A = lines[0].split()[:6]
+    I, L, O, A = int(I), int(L), int(O), int(A)
+    ins = [int(l.split()[0]) for l in lines[1:1 + I]]
+    lat = [l.split() for l in lines[1 + I:1 + I + L]]
+    outs = [int(l.split()[0]) for l in lines[1 + I + L:1 + I + L + O]]
+    ands = [tuple(map(int, l.split()[:3])) for l in lines[1 + I + L + O:1 + I + L + O + A]]
+    var = {}
+    for k, v in enumerate(ins):
+        var[v >> 1] = z3.Bool(f"i{k}")
+    cur = [z3.Bool(f"l{k}") for k in range(L)]
+    for k, l in enumerate(lat):
+        var[int(l[0]) >> 1] = cur[k]
+    defs = {lhs >> 1: (a, b) for lhs, a, b in ands}
+
+    def lit(x):
+        v = x >> 1
+        if v == 0:
+            e = z3.BoolVal(False)
+        elif v in var:
+            e = var[v]
+        else:
+            stack = [v]
+            while stack:
+                u = stack[-1]
+                if u in var:
+                    stack.pop()
+                    continue
+                a, b = defs[u]
+                pend = [w >> 1 for w in (a, b) if (w >> 1) and (w >> 1) not in var]
+                if pend:
+                    stack += pend
+                    continue
+                ea = z3.BoolVal(False) if not (a >> 1) else var[a >> 1]
+                eb = z3.BoolVal(False) if not (b >> 1) else var[b >> 1]
+                var[u] = z3.And(z3.Not(ea) if a & 1 else ea, z3.Not(eb) if b & 1 else eb)
+                stack.pop()
+            e = var[v]
+        return z3.Not(e) if x & 1 else e
+
+    nxt = [lit(int(l[1])) for l in lat]
+    init = []
+    for k, l in enumerate(lat):
+        r = int(l[2]) if len(l) > 2 else 0
+        init.append(z3.BoolVal(bool(r)) if r in (0, 1) else cur[k])
+    bad = z3.Or(*[lit(o) for o in outs]) if outs else z3.BoolVal(False)
+    fp = z3.Fixedpoint()
+    fp.set(engine="spacer")
+    inv = z3.Function("inv", *([z3.BoolSort()] * L), z3.BoolSort())
+    fp.register_relation(inv)
+    fp.declare_var(*cur, *[var[v >> 1] for v in ins])
+    fp.rule(inv(*init))
+    fp.rule(inv(*nxt), inv(*cur))
+    r = fp.query(z3.And(inv(*cur), bad))
+    print("proved" if r == z3.unsat else "cex" if r == z3.sat else "unknown", flush=True)
+
+
+def pdr(net, rtl, yosys_run, timeout, stream, log=None):
+    """("equivalent", how) | ("undecided", why): the product machine at each depth of
+    DEPTHS, Spacer within what is left of ``timeout`` seconds."""
+    t0 = time.monotonic()
+    work = Path(rtl)
+    last = "no depth run"
+    for depth in DEPTHS:
+        left = timeout - (time.monotonic() - t0)
+        if left <= 1:
+            return "undecided", f"pdr: no proof within {timeout} s ({last})"
+        text, free, n = product(net, stream, depth)
+        if text is None:
+            return "equivalent", "no output or memory input can differ"
+        aag = _aiger(text, work, yosys_run, int(left) + 1)
+        if aag is None:
+            return "undecided", f"pdr: no proof within {timeout} s (bit-blasting)"
+        head = aag.read_text().split("\n", 1)[0].split()
+        size = f"{head[3]} latches, {head[5]} and gates, {n} compared bits"
+        left = timeout - (time.monotonic() - t0)
+        try:
+            r = subprocess.run([sys.executable, __file__, "solve", str(aag)], capture_output=True,
+                               text=True, timeout=max(1, left), start_new_session=True)
+            said = (r.stdout.strip().splitlines() or ["error: " + r.stderr.strip()[-200:]])[-1]
+        except subprocess.TimeoutExpired:
+            return "undecided", (f"pdr: no proof within {timeout} s (depth "
+                                 f"{'all' if depth is None else depth}: {size}, {free} registers free)")
+        if log:
+            log(f"    pdr depth {depth}: {said} ({size}, {free} registers free, "
+                f"{time.monotonic() - t0:.0f} s)")
+        if said == "proved":
+            kept = ("every register kept" if not free else
+                    f"{free} shared registers left free, {depth} register stages kept")
+            return "equivalent", f"{kept}; {size}"
+        if said != "cex":
+            return "undecided", f"pdr: {said[:120]}"
+        last = f"a counterexample at depth {'all' if depth is None else depth}"
+        if not free:
+            return "undecided", ("pdr: a counterexample of the whole design with the memories "
+                                 "cut (any contents): not a proof, and not a kill either")
+    return "undecided", f"pdr: {last}"
+
+
+if __name__ == "__main__" and sys.argv[1:2] == ["solve"]:
+    solve(sys.argv[2])
