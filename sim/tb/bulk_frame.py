@@ -22,6 +22,20 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   their rounding carry (the nearest of CARRY_POOL random pixels), their N' written into the
   map: a wrong low bit of a product moves the dot, which random pixels show about once in
   ten thousand;
+* (exact method) the table-sensitivity pixels, after the ``n`` others: a wrong low bit of a
+  quarter-wave sine/cosine ROM word moves a dot product by a fraction of an LSB, which a
+  rendered frame practically never shows. Every ROM read the golden rotation makes
+  (sim/golden/fixed/exact.rotation_fixed, found through its TABLE_READ hook in call order;
+  one read per light, or one for all lights where its angle is the same for every light:
+  n'', computed once) is flipped in turn in each of its word's TABLE_BITS = 4 low bits (the
+  word's magnitude as the ROM holds it, an error of 1 to 8 LSBs, + or - as the bit was clear
+  or set, on a positive or negative sine as the angle's quadrant gives it), on TABLE_POOL =
+  2^15 seeded random pixels (sim/golden/fixed/pipeline.random_inputs) through the memories
+  as the host left them; of the pixels on which the flip changes some output, the frame
+  keeps TABLE_QUOTA = 3 for each read, bit and value of that bit (fewer where the pool has
+  fewer), chosen greedily so that one pixel serves every read it moves: about 60 pixels for
+  the 34 reads of two lights, 14 for the default scene's 24 (whose unrounded outputs show
+  most flips), about 1.5 s of CPU;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
@@ -44,14 +58,16 @@ from bumprtl.rtl.palette import index_bits
 from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
+from bumprtl.sim.golden.fixed import exact
 from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, pipeline_fixed, polygon_fixed,
-                                               unpack_texels)
+                                               random_inputs, unpack_texels)
 from bumprtl.sim.tb.bulk_sources import rounding_codes
 from bumprtl.sim.tb.bulk_wrapper import setup_writes
 
 __all__ = ["PIXELS", "SEED", "CoverageFrame", "coverage_frame"]
 
 PIXELS = 256                 # make test's frame (Icarus): as many pixels as the 16 x 16 frame
+                             # (and the table-sensitivity pixels after them)
 SEED = 1
 WRITTEN = 32                 # map (and texture) words the host writes before the stream
 TWO_PI = 2 * np.pi
@@ -244,6 +260,96 @@ def _near_carry(scene, seed):
     return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS, lit=True)
 
 
+# The table-sensitivity pixels: random pixels searched (a flipped bit 0 of one read's word
+# changes an output on 0.01 to 0.4 % of random pixels of two-lights, so 2**15 find a few for
+# nearly every read; 34 reads x 4 bits = 136 golden runs of the pool, about 1.5 s of CPU), the
+# low bits of a word flipped (errors of 1 to 8 LSBs) and the pixels kept for each read, bit and
+# value of that bit.
+TABLE_POOL = 1 << 15
+TABLE_BITS = 4
+TABLE_QUOTA = 3
+
+
+class _TableReads:
+    """The hook of sim/golden/fixed/exact.rotation_fixed (TABLE_READ): records every
+    quarter-wave ROM read of a golden run, or flips bit ``bit`` of one read's word."""
+
+    def __init__(self, cfg):
+        self.cfg, self.site, self.bit, self.calls = cfg, None, 0, []
+
+    def __call__(self, k, angle, value):
+        if k == 0:
+            self.calls.append([])
+        if self.site is None:                 # recording
+            angle = np.asarray(angle, np.int64) & (self.cfg.full_circle - 1)
+            self.calls[-1].append((angle, np.abs(np.asarray(value, np.int64))))
+            return value
+        light, read = self.site
+        if k != read or light not in (None, len(self.calls) - 1):
+            return value
+        word = np.abs(np.asarray(value, np.int64)) ^ (1 << self.bit)   # the ROM word, unsigned
+        negative = (np.asarray(angle) & (self.cfg.full_circle - 1)) >> self.cfg.k >= 2
+        return np.where(negative, -word, word)                         # quadrants 2, 3
+
+    def run(self, fn, site=None, bit=0):
+        saved, exact.TABLE_READ = exact.TABLE_READ, self
+        self.site, self.bit, self.calls = site, bit, []
+        try:
+            return fn()
+        finally:
+            exact.TABLE_READ = saved
+
+
+def _table_sensitive(scene, words, polygon, texels, seed, keys):
+    """Inputs (``keys``) of the table-sensitivity pixels of ``scene`` (module docstring), or
+    None (no quarter-wave ROM read in its golden model: palette shading, another method).
+
+    Every ROM read of the golden rotation (sim/golden/fixed/exact.rotation_fixed, through its
+    TABLE_READ hook) is a site: one per light, or one for all lights when its angle is the
+    same for every light on every pixel of the pool (n'', which the pipeline computes once).
+    For each site and each of its word's TABLE_BITS low bits, the pool's pixels on which
+    flipping that bit of the word (as the RTL reads it, the magnitude; its sign from the
+    quadrant) changes some output; from those, greedily (fewest pixels, ties in a seeded random
+    order), TABLE_QUOTA pixels whose word has the bit clear and TABLE_QUOTA with it set (an
+    error of +2**b and of -2**b)."""
+    cfg = scene.config
+    rng = np.random.default_rng([seed, TABLE_POOL, 2])
+    pool = random_inputs(scene, TABLE_POOL, rng)
+    golden = lambda: pipeline_fixed(pool, scene, words, polygon, texels)
+    hook = _TableReads(cfg)
+    base = hook.run(golden)
+    calls = hook.calls
+    if not calls:
+        return None
+    shared = [all(np.array_equal(calls[0][k][0], c[k][0]) for c in calls) for k in range(len(calls[0]))]
+    sites = [(None, k) for k, one in enumerate(shared) if one]
+    sites += [(j, k) for j in range(len(calls)) for k, one in enumerate(shared) if not one]
+    groups = []                       # per site, bit and bit value: its sensitive pixels
+    for light, k in sites:
+        word = calls[light or 0][k][1]
+        for b in range(TABLE_BITS):
+            out = hook.run(golden, (light, k), b)
+            moved = np.zeros(TABLE_POOL, bool)
+            for key, want in base.items():
+                moved |= np.asarray(out[key]) != np.asarray(want)
+            for value in (0, 1):
+                groups.append(moved & ((word >> b) & 1 == value))
+    cover = np.stack(groups, axis=1)
+    cand = np.nonzero(cover.any(axis=1))[0]
+    cand = cand[rng.permutation(len(cand))]
+    cover = cover[cand].astype(np.int32)
+    need = np.minimum(cover.sum(axis=0), TABLE_QUOTA)
+    pick = []
+    while need.any():               # the pixel that fills most unfilled places, then the next
+        best = int(np.argmax(cover @ (need > 0)))
+        pick.append(cand[best])
+        need = np.maximum(need - cover[best], 0)
+        cover[best] = 0
+    pick = np.sort(np.asarray(pick, np.int64))
+    assert set(keys) == set(pool) - {"tag"}, (sorted(keys), sorted(pool))
+    return {key: pool[key][pick] for key in keys}
+
+
 def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
     """The bumped normal N'' in the world (n, 3) from the angle codes."""
     rad = lambda c: np.asarray(c, np.float64) * (TWO_PI / cfg.full_circle)
@@ -252,7 +358,8 @@ def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
 
 def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     """The coverage frame of ``scene``'s pipeline emitted with map ``words`` and colour
-    texture ``texels`` (as gen/render/rtl.scene_stimulus gives them; None without one)."""
+    texture ``texels`` (as gen/render/rtl.scene_stimulus gives them; None without one):
+    ``n`` pixels, then the table-sensitivity pixels (none for palette shading)."""
     cfg = scene.config
     rng = np.random.default_rng([seed, n])
     inputs, writes, polygon, table, decoys = {}, [], None, None, []
@@ -301,6 +408,10 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
         for key in ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta"):
             if key in inputs:
                 inputs[key][pick] = near[key][:len(pick)]
+    table_px = _table_sensitive(scene, words, polygon, texels, seed, list(inputs))
+    if table_px is not None:        # after the frame's own pixels
+        inputs = {k: np.concatenate([np.asarray(v, np.int64), table_px[k]]) for k, v in inputs.items()}
+        n += len(next(iter(table_px.values())))
     mask = (1 << scene.tag_bits) - 1
     tag = rng.integers(0, mask + 1, n)
     tag[:2] = (0, mask)

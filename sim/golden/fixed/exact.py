@@ -7,6 +7,7 @@ Scales (all integers carry ``frac_bits`` = B fractional bits; no rounding until 
 """
 
 import functools
+import itertools
 
 import numpy as np
 
@@ -20,9 +21,21 @@ __all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors", "dot_
            "predicted_error_bound_lsb"]
 
 
+# A test hook, None outside sim/tb/bulk_frame.py's search for table-sensitivity pixels (which
+# restores it): ``f(k, angle, value) -> value`` sees the k-th quarter-wave ROM read of a
+# rotation_fixed call (k = 0, 1, ... in the order of the code below), ``angle`` the sine's
+# binary angle (a cosine's plus a quarter circle), ``value`` the signed word read; what it
+# returns replaces the word. None changes nothing.
+TABLE_READ = None
+
+
 def rotation_fixed(codes, cfg: Config):
     """VectorRotation (exact): n'' of the bump normal and p, y, cos th of L and H."""
     s, c = (lambda a: sin_lookup(cfg, a)), (lambda a: cos_lookup(cfg, a))
+    if TABLE_READ is not None:
+        k, q = itertools.count(), 1 << cfg.k
+        s = lambda a: TABLE_READ(next(k), a, sin_lookup(cfg, a))
+        c = lambda a: TABLE_READ(next(k), np.asarray(a) + q, cos_lookup(cfg, a))
     t, bt, bp = codes["n.theta"], codes["b.theta"], codes["b.phi"]
     a, b = bt + bp, bt - bp                   # a = th_N' + ph_N', b = th_N' - ph_N'
     out = {
