@@ -1,8 +1,9 @@
 """The coverage frame (sim/tb/bulk_frame.py) through the pipelines of the built-in scenes
 that no other test of make test streams it through: ``diffuse`` (no specular term),
 ``flat`` (no map: the polygon registers) and ``textured`` (the colour texture blended with
-the shading). The default, palette, two-light and full scenes stream it elsewhere
-(tests/sim/tb/test_bulk.py, tests/sim/tb/test_tb_pipeline.py, tests/sim/tb/test_tb_axis.py).
+the shading). The default and palette scenes stream it in tests/sim/tb/test_bulk.py, the full
+scene in tests/sim/tb/test_tb_pipeline.py (every cycle from cocotb); two-lights, the full
+scene's datapath without its texture and mip levels, is built by no test of make test.
 This is the frame and the four traffic patterns the netlist mutants of these scenes run
 (tests/mutants/netlist.py), so a mutant that frame kills is killed by make test."""
 

@@ -1,14 +1,20 @@
-"""The emitted pipeline under cocotb: a small render equals the fixed-point golden render
-byte for byte, one pixel per clock without stalls, and under random backpressure and input
-gaps every pixel comes out once, in order, bit-exact. One build per simulator."""
+"""The emitted pipeline under cocotb, every cycle driven from Python (sim/tb/tb_pipeline.py):
+the coverage frame (sim/tb/bulk_frame.py) and a small render through one build, one pixel per
+clock without stalls, and under random backpressure and input gaps every pixel comes out
+once, in order, bit-exact with the golden model; render --rtl's image equals the golden
+render byte for byte. One build per simulator."""
+
+import json
 
 import numpy as np
 import pytest
 
-from bumprtl.gen.render.rtl import (golden_render, render_rtl, run_pipeline, scene_stimulus,
-                                    scene_texels)
+from bumprtl.gen.render.rtl import (emit_pipeline, golden_render, render_rtl, scene_stimulus,
+                                    scene_texels, write_stimulus)
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
+from bumprtl.sim.tb.runner import run_cocotb
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -16,33 +22,46 @@ from bumprtl.sim.traffic import PATTERNS
 # per-cycle run is in make regress, since make test streams that scene's pipeline on Icarus
 # under the same traffic patterns through the bulk path (tests/sim/tb/test_bulk.py: the
 # coverage frame, then this render frame); make regress: the full scene's build on Verilator
-# too (a minute of C++ compilation for 768 pixels).
+# too (a minute of C++ compilation).
 @pytest.mark.parametrize("sim, name", [("icarus", "full"),
                                        pytest.param("icarus", "default", marks=pytest.mark.regress),
                                        pytest.param("verilator", "full", marks=pytest.mark.regress)])
 def test_pipeline_stream_cocotb(sim, name, build_dir):
-    """``full``: two lights, mip levels and the colour texture (RGB out)."""
+    """``full``: two lights, mip levels and the colour texture (RGB out). One build and one
+    run of sim/tb/tb_pipeline.py: under each traffic pattern the host writes the coverage
+    frame's map and texture words (sim/tb/bulk_frame.py, the frame the netlist mutants of
+    pipeline:full and pipeline:two-lights stream: two-lights is this datapath without the
+    texture and the mip levels), then the frame's pixels stream, then the rendered 16 x 16
+    frame's; every output field equals the golden model's on the memories as the host left
+    them (2 of the render's 256 pixels read a word the host wrote; the others' outputs are
+    the golden render's)."""
     scene = load_scene_config(name)
     inputs, words, polygon, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
-    outs, cycles, _ = run_pipeline(scene, inputs, words, polygon, table, sim, build_dir,
-                                   patterns=list(PATTERNS), progress=False, texels=texels)
-    golden = pipeline_fixed(inputs, scene, words, polygon, texels)
+    build_dir = build_dir.resolve()
+    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    meta = json.loads(j.read_text())
+    frame = coverage_frame(scene, words, texels)
+    assert sorted(frame.inputs) == sorted(inputs)
+    assert len(frame.inputs["tag"]) > PIXELS                  # the table-sensitivity pixels
+    stream = {k: np.concatenate([frame.inputs[k], inputs[k]]) for k in inputs}
+    stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
+    write_stimulus(stim, stream, polygon, table, frame.setup(meta))
+    run_cocotb(sim, v, "bumprtl.sim.tb.tb_pipeline", build_dir / sim,
+               {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
+                "BUMPRTL_PATTERNS": ",".join(PATTERNS), "BUMPRTL_PROGRESS": 0})
+    res = dict(np.load(result))
+    golden = pipeline_fixed(stream, scene, frame.words, frame.polygon, frame.texels)
     assert ("color.r" in golden) == scene.texture
-    n = len(inputs["tag"])
-    latency = scene_latency(build_dir)
+    assert all(np.array_equal(golden[k][:len(frame.inputs["tag"])], frame.golden[k]) for k in golden)
+    n = len(stream["tag"])
     for pattern in PATTERNS:
-        out = outs[pattern]
-        assert out["tag"].tolist() == inputs["tag"].tolist(), pattern     # each once, in order
+        assert res[f"{pattern}.tag"].tolist() == stream["tag"].tolist(), pattern  # once, in order
         for field, want in golden.items():
-            assert np.array_equal(out[field], want), (pattern, field)
-    assert cycles["no_stall"] / n <= 1 + (latency + 1) / n
-    assert cycles["backpressure"] > n
-
-
-def scene_latency(build_dir):
-    import json
-    return json.loads((build_dir / "rtl" / "pipeline.json").read_text())["latency"]
+            assert np.array_equal(res[f"{pattern}.{field}"], want), (pattern, field)
+    latency = meta["latency"]
+    assert res["no_stall.cycles"] / n <= 1 + (latency + 1) / n
+    assert res["backpressure.cycles"] > n
 
 
 def test_render_rtl_equals_golden_bytes(build_dir):
