@@ -1,11 +1,11 @@
 """The coverage frame (sim/tb/bulk_frame.py) through the pipelines of the built-in scenes
 that no other test of make test streams it through: ``diffuse`` (no specular term),
-``flat`` (no map: the polygon registers) and ``textured`` (the colour texture blended with
-the shading). The default and palette scenes stream it in tests/sim/tb/test_bulk.py, the full
-scene in tests/sim/tb/test_tb_pipeline.py (every cycle from cocotb); two-lights, the full
-scene's datapath without its texture and mip levels, is built by no test of make test.
-This is the frame and the four traffic patterns the netlist mutants of these scenes run
-(tests/mutants/netlist.py), so a mutant that frame kills is killed by make test."""
+``flat`` (no map: the polygon registers), ``textured`` (the colour texture blended with the
+shading) and ``two-lights`` (two illumination units and their sum). The default and palette
+scenes stream it in tests/sim/tb/test_bulk.py, the full scene in
+tests/sim/tb/test_tb_pipeline.py (every cycle from cocotb). This is the frame and the four
+traffic patterns the netlist mutants of these scenes run (tests/mutants/netlist.py), so a
+mutant that frame kills is killed by make test."""
 
 import json
 
@@ -21,7 +21,7 @@ from bumprtl.sim.traffic import PATTERNS
 TRAFFIC = tuple(PATTERNS)
 
 
-@pytest.mark.parametrize("name", ["diffuse", "flat", "textured"])
+@pytest.mark.parametrize("name", ["diffuse", "flat", "textured", "two-lights"])
 def test_scene_coverage_frame_equals_golden(name, build_dir):
     scene = load_scene_config(name)
     _, words, _, table, base = scene_stimulus(scene, 16)
