@@ -61,7 +61,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist_cone as nc  # noqa: E402  (steps 4 and 5, beside this file)
-import netlist_pdr as npdr  # noqa: E402  (step 6)
+import netlist_pdr as npdr  # noqa: E402  (step 8)
+import netlist_rel as nrel  # noqa: E402  (steps 6 and 7)
 
 ROOT = Path(__file__).resolve().parents[2]
 UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
@@ -77,7 +78,7 @@ VERILATOR_EXTRA = ("-Wno-UNOPTFLAT", "-Wno-fatal")
 # compile time is what counts (the bulk path's default -Os compiles several times longer)
 
 
-# Survivors whose equivalence a reading of the netlist shows where the tool's checks (all five
+# Survivors whose equivalence a reading of the netlist shows where the tool's checks (all eight
 # steps) found neither a proof nor a counterexample in their time (an invariant of the
 # datapath's range, a reset value no valid pixel reads): (target, the mutation as listed, the
 # reading). They stay counted as survivors in the kill ratio, since only a tool's proof
@@ -407,7 +408,7 @@ def _miter(unit, line, work, timeout, stream):
     return "equivalent"
 
 
-STEPS = ("structural", "stream", "miter", "cone", "cut", "pdr")
+STEPS = ("structural", "stream", "miter", "cone", "cut", "never", "rel", "pdr")
 
 
 def _cone_steps(meta, line, work, timeout, has_stream, steps):
@@ -446,6 +447,11 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
             why.append(R)
             if "__payload" not in R:
                 break
+    if {"never", "rel"} & set(steps):
+        proved, said = _rel_steps(meta, line, work, timeout, has_stream, steps)
+        if proved:
+            return proved, None
+        why += said
     if "pdr" in steps:
         proved, said = _pdr_step(meta, line, work, timeout, has_stream)
         if proved:
@@ -454,8 +460,48 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
     return None, "; ".join(why)
 
 
+def _rel_steps(meta, line, work, timeout, has_stream, steps):
+    """Steps 6 and 7 (tests/mutants/netlist_rel.py): ``never`` (a cnot mutation's control
+    bit inactive in every reachable state of the design alone, by inductive upper bounds on
+    its registers and memories) and ``rel`` (Houdini on the product machine with the clauses
+    "register equal in design and mutant or valid bit 0"), each within ``timeout`` seconds:
+    ``(verdict, [why])``."""
+    try:
+        net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
+    except (subprocess.CalledProcessError, KeyError) as e:
+        return None, [f"never/rel: the -ctrl netlist was not built ({type(e).__name__})"]
+    why = []
+    for step in ("never", "rel"):
+        if step not in steps:
+            continue
+        try:
+            if step == "never":
+                verdict, how = nrel.never(net, line, work, nc.yosys_log, timeout, log=print)
+            else:
+                verdict, how = nrel.rel(net, work, nc.yosys_log, timeout, has_stream, log=print)
+        except nc.Undecided as e:
+            verdict, how = "undecided", f"{step}: {e}"
+        except subprocess.CalledProcessError as e:
+            err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
+            verdict, how = "undecided", f"{step}: " + (err[:1] or ["yosys error"])[0][:100]
+        if verdict is None:
+            continue                        # never: not a cnot mutation
+        if verdict == "equivalent":
+            if step == "never":
+                return (f"equivalent (never: z3 proves on the design alone, memories cut to "
+                        f"free read data, {how}; the mutant computes what the design does "
+                        f"in every such state)"), why
+            said = (f"rel: z3 proves on the product machine of design and mutant, memories "
+                    f"cut to free read data, {how}")
+            if has_stream:
+                return f"equivalent under the stream contract ({said}, {STREAM_DONT_CARE})", why
+            return f"equivalent ({said})", why
+        why.append(how)
+    return None, why
+
+
 def _pdr_step(meta, line, work, timeout, has_stream):
-    """Step 6 (tests/mutants/netlist_pdr.py): the product machine of design and mutant, the
+    """Step 8 (tests/mutants/netlist_pdr.py): the product machine of design and mutant, the
     memories cut, proved safe by z3's Spacer (IC3/PDR) within ``timeout`` seconds, payloads
     masked by valid when the unit has streams: ``(verdict, why)``."""
     try:
@@ -495,12 +541,19 @@ def equivalence(v, meta, line, work, timeout, steps=STEPS):
        R" proved by sat on the combinational logic the mutation reaches, cut at the
        registers (every output compared; then, if a payload was what failed, payloads
        masked by valid), each time within ``timeout`` seconds;
-    6. ``pdr`` (netlist_pdr.py): the product machine of design and mutant (the cells a
+    6. ``never`` (netlist_rel.py), a cnot0 / cnot1 mutation: its control bit inactive in
+       every reachable state of the design alone (inductive upper bounds on its registers
+       and memories, the memories cut): the mutant computes what the design does;
+    7. ``rel`` (netlist_rel.py): Houdini on the product machine of 8 with the clauses
+       "register equal in design and mutant, or its unit's valid bit v = 0", payloads
+       masked by valid;
+    8. ``pdr`` (netlist_pdr.py): the product machine of design and mutant (the cells a
        difference can reach twice, the rest once, the memories cut to free read data and
        compared write inputs), payloads masked by valid, proved safe by z3's Spacer
        (IC3/PDR), which finds relational and range invariants the cut cannot state.
-    Steps 4 to 6 run on every pipeline's survivors where 1-3 time out. ``steps`` chooses
-    among STEPS (``--steps``; ``--recheck --steps cone,cut`` or ``--steps pdr`` runs only
+    Steps 4 to 8 run on every pipeline's survivors where 1-3 time out. ``steps`` chooses
+    among STEPS (``--steps``; ``--recheck --steps cone,cut``, ``--steps never,rel`` or
+    ``--steps pdr`` runs only
     those on a finished run's survivors, whose earlier steps were run then). The verdict names the step
     that proved it."""
     unit = meta["unit"]
@@ -711,6 +764,19 @@ def _tally(r):
     r["counted"] = r["sample"] - r["equivalent"]
 
 
+# the start of what each of steps 4 to 8 says of a survivor it leaves undecided
+_NOTES = {"cone": ("cone reaches", "cone:"), "cut": ("cut:", "no invariant within",
+                                                       "no proof of the cut"),
+          "never": ("never:",), "rel": ("rel:",), "pdr": ("pdr:",)}
+
+
+def _without_notes(verdict, steps):
+    """``verdict`` without what the steps ``steps`` said in it (they run again)."""
+    parts = verdict.split("; ")
+    drop = tuple(p for st in steps for p in _NOTES.get(st, ()))
+    return "; ".join([parts[0]] + [p for p in parts[1:] if not p.startswith(drop)])
+
+
 def recheck(path, out, timeout, steps=STEPS):
     """The equivalence checks ``steps`` of the survivors in ``path`` (a netlist_results.json)
     again, each on the netlist its run kept (``out/<target>/rtl``); the JSON is rewritten.
@@ -732,10 +798,7 @@ def recheck(path, out, timeout, steps=STEPS):
             verdict = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout, steps)
             if tuple(steps) != STEPS and verdict.startswith("undecided"):
                 new = verdict[len("undecided: "):]
-                old = s["verdict"].split("; pdr:")[0]
-                if {"cone", "cut"} & set(steps):
-                    old = old.split("; cone reaches")[0].split("; cut:")[0]
-                verdict = f"{old}; {new}"
+                verdict = f"{_without_notes(s['verdict'], steps)}; {new}"
             s["verdict"] = verdict
             print(f"  {r['target']} #{s['index']}: {s['verdict']} ({time.perf_counter() - t0:.0f} s)",
                   flush=True)
