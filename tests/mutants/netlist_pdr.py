@@ -1,4 +1,4 @@
-"""Step 6 of tests/mutants/netlist.py's equivalence check (``pdr``): the mutant's miter proved
+"""Step 8 of tests/mutants/netlist.py's equivalence check (``pdr``): the mutant's miter proved
 by property-directed reachability (IC3/PDR), which finds the inductive strengthening itself.
 
 The cut step (netlist_cone.py) looks for an invariant of one form only, "every register bit
