@@ -84,18 +84,25 @@ VERILATOR_EXTRA = ("-Wno-UNOPTFLAT", "-Wno-fatal")
 # reading). They stay counted as survivors in the kill ratio, since only a tool's proof
 # removes one; the doc gives the reading beside each. A mutation of a changed netlist no
 # longer matches and is listed bare. (Diffuse #3, flat #4, textured #10 and two-lights #7,
-# read here before, are proved by the cone and cut steps now.)
-BY_READING = [
+# read here before, are proved by the cone and cut steps now; textured #9 and flat #1 by the
+# never and rel steps: PROVED_READING.)
+BY_READING = []
+
+# Survivors read as equivalent here first and proved by a tool's step since: (target, the
+# mutation as listed, the reading). The doc shows the reading beside the tool's verdict.
+PROVED_READING = [
     ("pipeline:textured", "mutate -mode cnot1 -module pipeline -cell $procmux$181976 -port A "
      "-portbit 7 -ctrlbit 16",
      "the hold input of the albedo_g product's lit operand register, bit 7 flipped while "
      "bit 16 is set; lit = min(ka + kd d, 1) in 16 fractional bits, and with one light and "
-     "the scene's ka = 0.1, kd = 0.7 it stays below 0.81 * 2**16, so bit 16 is never set"),
+     "the scene's ka = 0.1, kd = 0.7 it stays below 0.81 * 2**16, so bit 16 is never set "
+     "(never's bounds carry the clamp's d <= 1.0 down to that register)"),
     ("pipeline:flat", "mutate -mode inv -module pipeline -cell $procmux$66592 -port B -portbit 12",
      "the mux is the reset of the ROM data register terms.h_cx_data (pipeline.v line 26280: "
      "B is 16'h0000): the register holds 0x1000 instead of 0 from reset until its first load, "
      "and no valid pixel reaches it before that load, so only payloads while o.valid is low "
-     "change (equivalent under the stream contract)"),
+     "change (equivalent under the stream contract; rel's clauses 'equal, or the stage's "
+     "valid bit 0')"),
 ]
 
 
@@ -124,7 +131,7 @@ BY_STIMULUS = [
 
 
 def _survivor_note(table, target, mutation):
-    """The reason ``table`` (BY_READING, BY_STIMULUS) gives for a survivor, or None."""
+    """The reason ``table`` (BY_READING, PROVED_READING, BY_STIMULUS) gives for a survivor, or None."""
     return next((why for t, m, why in table if t == target and m == mutation), None)
 
 
@@ -737,7 +744,10 @@ def report(results, runs):
             any_s = True
             why = _survivor_note(BY_READING, r["target"], s["mutation"])
             kill = _survivor_note(BY_STIMULUS, r["target"], s["mutation"])
+            read = _survivor_note(PROVED_READING, r["target"], s["mutation"])
             lines.append(f"* `{r['target']}` #{s['index']}: `{s['mutation']}` — {s['verdict']}"
+                         + (f"; the reading, which the proof confirms: {read}"
+                            if read and s["verdict"].startswith("equivalent") else "")
                          + (f"; **equivalent by reading** (not a tool's proof, still counted): "
                             f"{why}" if why and not s["verdict"].startswith("equivalent") else "")
                          + (f"; **not equivalent** (still counted): {kill}"
