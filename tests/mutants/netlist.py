@@ -47,6 +47,7 @@ survivors and the wall time; ``--doc docs/mutation.md`` writes the table between
 """
 
 import argparse
+import functools
 import json
 import os
 import re
@@ -69,9 +70,12 @@ UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
 SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "datapath",
                "palette": "palette"}
 PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
-# The built-in scenes whose pipeline make test streams the coverage frame through, on Icarus
-# under the four patterns (tests/sim/tb/test_bulk.py)
-MAKE_TEST_FRAMES = ("default", "palette")
+# The test of make test that streams a built-in scene's coverage frame through its pipeline,
+# on Icarus under the four patterns: every built-in scene has one
+MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py", "palette": "tests/sim/tb/test_bulk.py",
+                    "full": "tests/sim/tb/test_tb_pipeline.py, before its 16 x 16 render frame",
+                    **{name: "tests/sim/tb/test_bulk_scene_frames.py"
+                       for name in ("diffuse", "flat", "textured", "two-lights")}}
 BEGIN, END = "<!-- netlist:begin -->", "<!-- netlist:end -->"
 VERILATOR_EXTRA = ("-Wno-UNOPTFLAT", "-Wno-fatal")
 # g++ -O0 for the model: one build, short runs (a few thousand pixels a mutant), so the
@@ -106,32 +110,8 @@ PROVED_READING = [
 ]
 
 
-# Survivors shown NOT equivalent by a stimulus aimed at them (the stimulus of the flow misses
-# them): (target, the mutation as listed, how). A real survivor, counted like any other; the
-# doc says what kills it.
-_AIMED = ("tests/mutants/sine_kill_search.py patches that ROM read in the "
-          "golden model and searches {n} random pixels of the scene (seed 28): {hit} differ; "
-          "tests/mutants/sine_kill_sim.py streams the first {k} of them through the saved mutated netlist on Icarus "
-          "(the bulk path, 4 patterns): mutsel 0 passes, the mutant fails ({fail}); {sim} of "
-          "simulation each")
-BY_STIMULUS = [
-    ("pipeline:two-lights", "mutate -mode cnot1 -module pipeline -cell $procmux$442097 -port A "
-     "-portbit 3 -ctrlbit 5",
-     "bit 3 of light 0's cos(Y) word (rotation.sine_rom8 port 0, read l_cy) flipped when its "
-     "bit 5 is set, an error of 2**-13 in L's 2y; " + _AIMED.format(
-         n=20000, hit=15, k=15, sim="under a second",
-         fail="no_stall: diffuse 133 against 134 on the first, 7 of the 15 pixels differ")),
-    ("pipeline:full", "mutate -mode cnot1 -module pipeline -cell $procmux$462436 -port A "
-     "-portbit 0 -ctrlbit 2",
-     "bit 0 of the cos(a - t) word (rotation.sine_rom4 port 0, read n_c2, the n''z term every "
-     "light shares) flipped when its bit 2 is set, an error of 2**-16; " + _AIMED.format(
-         n=200000, hit=208, k=16, sim="under a second",
-         fail="no_stall: diffuse 8 against 9, 4 of the 16 pixels differ")),
-]
-
-
 def _survivor_note(table, target, mutation):
-    """The reason ``table`` (BY_READING, PROVED_READING, BY_STIMULUS) gives for a survivor, or None."""
+    """The reason ``table`` (BY_READING, PROVED_READING) gives for a survivor, or None."""
     return next((why for t, m, why in table if t == target and m == mutation), None)
 
 
@@ -696,13 +676,24 @@ def _stimulus_words(target, n, sim="verilator"):
               else ", no map: the polygon registers and the lights")
     name = target.split(":", 1)[1]
     if name in MAKE_TEST_FRAMES:
-        where = (f"as make test streams it through the {name} scene (tests/sim/tb/test_bulk.py)"
+        where = (f"as make test streams it through the {name} scene ({MAKE_TEST_FRAMES[name]})"
                  + ("" if sim == "icarus" else ", there on Icarus"))
     else:
-        where = (f"make test streams this generator's frame through "
-                 f"{' and '.join(MAKE_TEST_FRAMES)} only")
-    return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels, seed {SEED}{writes}) "
+        where = "a frame make test streams through no pipeline"
+    extra = _table_pixels(scene)
+    table = f" and {extra} table-sensitivity pixels" if extra else ""
+    return (f"the coverage frame (sim/tb/bulk_frame.py: {PIXELS} pixels{table}, seed {SEED}{writes}) "
             f"x 4 traffic patterns{on}, {where}")
+
+
+@functools.lru_cache(maxsize=None)
+def _table_pixels(scene):
+    """The table-sensitivity pixels the coverage frame of ``scene`` adds to its PIXELS."""
+    from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
+    from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
+    _, words, _, _, base = scene_stimulus(scene, 16)
+    frame = coverage_frame(scene, words, scene_texels(scene, base))
+    return len(frame.inputs["tag"]) - PIXELS
 
 
 def _stimulus_now(r):
@@ -731,8 +722,6 @@ def report(results, runs):
         surv = "; ".join(f"#{s['index']} {s['verdict']}"
                          + (" (equivalent by reading)"
                             if _survivor_note(BY_READING, r["target"], s["mutation"]) else "")
-                         + (" (not equivalent: a stimulus aimed at it kills it)"
-                            if _survivor_note(BY_STIMULUS, r["target"], s["mutation"]) else "")
                          for s in r["survivors"]
                          if not s["verdict"].startswith("equivalent")) or "none"
         lines.append(f"| `{r['target']}` | {r['sample']} | {r['killed']} | {r['equivalent']} | "
@@ -743,15 +732,12 @@ def report(results, runs):
         for s in r.get("survivors", []):
             any_s = True
             why = _survivor_note(BY_READING, r["target"], s["mutation"])
-            kill = _survivor_note(BY_STIMULUS, r["target"], s["mutation"])
             read = _survivor_note(PROVED_READING, r["target"], s["mutation"])
             lines.append(f"* `{r['target']}` #{s['index']}: `{s['mutation']}` — {s['verdict']}"
                          + (f"; the reading, which the proof confirms: {read}"
                             if read and s["verdict"].startswith("equivalent") else "")
                          + (f"; **equivalent by reading** (not a tool's proof, still counted): "
-                            f"{why}" if why and not s["verdict"].startswith("equivalent") else "")
-                         + (f"; **not equivalent** (still counted): {kill}"
-                            if kill and not s["verdict"].startswith("equivalent") else ""))
+                            f"{why}" if why and not s["verdict"].startswith("equivalent") else ""))
     if not any_s:
         lines.append("* none")
     lines += ["", "Stimulus per target:", ""]
