@@ -79,13 +79,19 @@ def _cell_driving(mod, bits):
                        if d == "output"))
 
 
-def test_pdr_proves_a_reset_value_no_valid_payload_reads(tmp_path):
-    mod, meta = _prepare(tmp_path, PIPE)
+def reset_value_mutant(tmp_path, pipe):
+    """``pipe`` prepared, and the mutation inverting bit 2 of ``d``'s reset value: (meta,
+    the mutate line)."""
+    mod, meta = _prepare(tmp_path, pipe)
     # the mux that gives d its reset value 0: input B (rst = 1) is the constant 4'b0000
     d_ff = _cell_driving(mod, _net_name(mod, "d"))
     rst_mux = _cell_driving(mod, mod["cells"][d_ff]["connections"]["D"])
     assert mod["cells"][rst_mux]["connections"]["B"] == ["0"] * 4
-    line = f"mutate -mode inv -module pipe -cell {rst_mux} -port B -portbit 2"
+    return meta, f"mutate -mode inv -module pipe -cell {rst_mux} -port B -portbit 2"
+
+
+def test_pdr_proves_a_reset_value_no_valid_payload_reads(tmp_path):
+    meta, line = reset_value_mutant(tmp_path, PIPE)
     # pdr alone (the cut's invariant "every register bit equal but R" fails at the payload:
     # test_netlist_rel's reset test); pdr finds "d differs only while v is 0, o__payload
     # only while o__valid is 0"

@@ -9,7 +9,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist  # noqa: E402
-from test_netlist_pdr import PIPE, RANGE, _cell_driving, _net_name, _prepare  # noqa: E402
+from test_netlist_pdr import (PIPE, RANGE, _cell_driving, _net_name, _prepare,  # noqa: E402
+                              reset_value_mutant)
 
 # the pipe of test_netlist_pdr with its stage's valid bit named as the step looks for it
 PIPE = PIPE.replace("reg v = 0;", "reg stage1_valid = 0;").replace(
@@ -41,11 +42,7 @@ def test_never_refuses_a_flip_under_a_bit_the_range_sets(tmp_path):
 
 
 def test_rel_proves_a_reset_value_no_valid_payload_reads(tmp_path):
-    mod, meta = _prepare(tmp_path, PIPE)
-    d_ff = _cell_driving(mod, _net_name(mod, "d"))
-    rst_mux = _cell_driving(mod, mod["cells"][d_ff]["connections"]["D"])
-    assert mod["cells"][rst_mux]["connections"]["B"] == ["0"] * 4
-    line = f"mutate -mode inv -module pipe -cell {rst_mux} -port B -portbit 2"
+    meta, line = reset_value_mutant(tmp_path, PIPE)
     # the cut cannot state it: its invariant "every register bit equal but R" fails at the
     # payload, masked or not
     cut = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("cut",))
