@@ -277,6 +277,39 @@ def candidates(net, R, comb):
     return out
 
 
+class CopyBits:
+    """The bits of a miter's two copies of a netlist in one Yosys JSON module: the design
+    (mutsel 0) keeps the netlist's bits except those a difference reaches (``diff``), which
+    move up by ``off``, past every bit of the netlist; the mutant (mutsel 1) keeps them all;
+    each ``'x`` becomes a fresh bit (:meth:`new`); ``const``: bits held at a constant in
+    both copies."""
+
+    def __init__(self, net, diff, const=None):
+        self.net, self.diff, self.const = net, diff, const or {}
+        self.off = 1 + max(max(net.driver, default=0), max(net.readers, default=0), net.ctrl)
+        self._fresh = 2 * self.off + 10
+
+    def new(self):
+        self._fresh += 1
+        return self._fresh
+
+    def gold_in(self, b):
+        if b == self.net.ctrl:
+            return "0"
+        if b == "x":
+            return self.new()
+        if b in self.const:
+            return self.const[b]
+        return b + self.off if isinstance(b, int) and b in self.diff else b
+
+    def gate_in(self, b):
+        if b == self.net.ctrl:
+            return "1"
+        if b == "x":
+            return self.new()
+        return self.const.get(b, b)
+
+
 def miter_json(net, R, stream, K=None):
     """The combinational miter of the cut with R free and the register bits of K held at
     their constants: (json text, the compared points in the order of the output ``d``)."""
@@ -287,29 +320,8 @@ def miter_json(net, R, stream, K=None):
         raise Undecided("a cell of no known kind in the cut")
     if not _acyclic(net, comb):
         raise Undecided("a combinational loop in the cut")
-    top = 1 + max(max(net.driver, default=0), max(net.readers, default=0), net.ctrl)
-    off = top
-    fresh = [2 * top + 10]
-
-    def new():
-        fresh[0] += 1
-        return fresh[0]
-
-    def gold_in(b):
-        if b == net.ctrl:
-            return "0"
-        if b == "x":
-            return new()
-        if b in const:
-            return const[b]
-        return b + off if isinstance(b, int) and b in diff else b
-
-    def gate_in(b):
-        if b == net.ctrl:
-            return "1"
-        if b == "x":
-            return new()
-        return const.get(b, b)
+    bits = CopyBits(net, diff, const)
+    off, new, gold_in, gate_in = bits.off, bits.new, bits.gold_in, bits.gate_in
 
     cells = {}
     # the shared fan-in: the combinational cells that compute what the cut reads from

@@ -106,25 +106,8 @@ def product(net, stream, depth):
     """The product machine as Yosys JSON text (module ``product``, output ``bad``), the
     number of shared registers left free, and the number of compared bits."""
     diff = _diff(net)
-    top = 1 + max(max(net.driver, default=0), max(net.readers, default=0), net.ctrl)
-    off = top
-    fresh = [2 * top + 10]
-
-    def new():
-        fresh[0] += 1
-        return fresh[0]
-
-    def gold_in(b):
-        if b == net.ctrl:
-            return "0"
-        if b == "x":
-            return new()
-        return b + off if isinstance(b, int) and b in diff else b
-
-    def gate_in(b):
-        if b == net.ctrl:
-            return "1"
-        return new() if b == "x" else b
+    bits = nc.CopyBits(net, diff)
+    off, new, gold_in, gate_in = bits.off, bits.new, bits.gold_in, bits.gate_in
 
     def shared_in(b):
         return new() if b == "x" else b

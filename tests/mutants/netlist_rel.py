@@ -198,15 +198,8 @@ def single(net, target):
     ``rd:MEM:K``, each write port's enable and data outputs ``wen:MEM:K``, ``wdata:MEM:K``),
     the output ``target`` the net ``target``. Also {memory: (width, [read data bit lists],
     [(enable bits, data bits)], init words)}."""
-    top = 1 + max(max(net.driver, default=0), max(net.readers, default=0), net.ctrl)
-    fresh = [2 * top + 10]
-
-    def new():
-        fresh[0] += 1
-        return fresh[0]
-
-    def fin(b):
-        return "0" if b == net.ctrl else new() if b == "x" else b
+    bits = nc.CopyBits(net, ())                  # the design's copy alone: nothing moves
+    new, fin = bits.new, bits.gold_in
 
     cells, names, ports, mems = {}, {}, {}, {}
     for name, c in net.cells.items():
