@@ -178,10 +178,9 @@ class Netlist:
         return outs
 
 
-def reach(net, R, through_ff):
-    """Nets a difference can reach from mutsel and the Q bits of R; the comb cells on the
-    way; the points the cut compares (("ff", cell, i) | ("ffctl", cell, port) |
-    ("mem", cell) | ("out", port, i), each with the net(s) that differ there)."""
+def worklist():
+    """A set of nets that can differ, the nets still to follow, and the function that adds a
+    net (a bit number; constants are skipped) to both once."""
     diff, todo = set(), []
 
     def differs(b):
@@ -189,6 +188,14 @@ def reach(net, R, through_ff):
             diff.add(b)
             todo.append(b)
 
+    return diff, todo, differs
+
+
+def reach(net, R, through_ff):
+    """Nets a difference can reach from mutsel and the Q bits of R; the comb cells on the
+    way; the points the cut compares (("ff", cell, i) | ("ffctl", cell, port) |
+    ("mem", cell) | ("out", port, i), each with the net(s) that differ there)."""
+    diff, todo, differs = worklist()
     differs(net.ctrl)
     for cell, i in R:
         differs(net.cells[cell]["connections"]["Q"][i])

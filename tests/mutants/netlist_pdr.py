@@ -64,13 +64,7 @@ def _diff(net):
     """The nets that can differ in the product (from mutsel: comb cells as netlist_cone.step,
     a register's D bit to its Q bit, its other inputs to all of Q; a memory's read address to
     that port's data only, its write ports to nothing: they are compared instead)."""
-    diff, todo = set(), []
-
-    def differs(b):
-        if isinstance(b, int) and b not in diff:
-            diff.add(b)
-            todo.append(b)
-
+    diff, todo, differs = nc.worklist()
     differs(net.ctrl)
     while todo:
         n = todo.pop()

@@ -113,10 +113,16 @@ def test_pdr_proves_a_flip_under_a_bit_a_range_never_sets(tmp_path):
     assert verdict.startswith("equivalent (pdr:"), verdict
 
 
-def test_pdr_refuses_a_mutant_that_changes_a_valid_payload(tmp_path):
-    mod, meta = _prepare(tmp_path, PIPE)
+def payload_mutant(tmp_path, pipe):
+    """``pipe`` prepared, and the mutation inverting bit 0 of its adder's sum, which every
+    valid payload carries: (meta, the mutate line)."""
+    mod, meta = _prepare(tmp_path, pipe)
     add = next(n for n, c in mod["cells"].items() if c["type"] == "$add")
-    line = f"mutate -mode inv -module pipe -cell {add} -port Y -portbit 0"
+    return meta, f"mutate -mode inv -module pipe -cell {add} -port Y -portbit 0"
+
+
+def test_pdr_refuses_a_mutant_that_changes_a_valid_payload(tmp_path):
+    meta, line = payload_mutant(tmp_path, PIPE)
     verdict = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("pdr",))
     assert verdict.startswith("undecided"), verdict
     assert re.search(r"pdr: a counterexample", verdict), verdict

@@ -10,7 +10,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist  # noqa: E402
 from test_netlist_pdr import (PIPE, RANGE, _cell_driving, _net_name, _prepare,  # noqa: E402
-                              reset_value_mutant)
+                              payload_mutant, reset_value_mutant)
 
 # the pipe of test_netlist_pdr with its stage's valid bit named as the step looks for it
 PIPE = PIPE.replace("reg v = 0;", "reg stage1_valid = 0;").replace(
@@ -53,9 +53,7 @@ def test_rel_proves_a_reset_value_no_valid_payload_reads(tmp_path):
 
 
 def test_rel_refuses_a_mutant_that_changes_a_valid_payload(tmp_path):
-    mod, meta = _prepare(tmp_path, PIPE)
-    add = next(n for n, c in mod["cells"].items() if c["type"] == "$add")
-    line = f"mutate -mode inv -module pipe -cell {add} -port Y -portbit 0"
+    meta, line = payload_mutant(tmp_path, PIPE)
     verdict = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("rel",))
     assert verdict.startswith("undecided"), verdict
     assert "rel: the candidate invariant does not imply the property" in verdict, verdict
