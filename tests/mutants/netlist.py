@@ -72,10 +72,10 @@ SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "data
 PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
 # The test of make test that streams a built-in scene's coverage frame through its pipeline,
 # on Icarus under the four patterns: every built-in scene has one
-MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py", "palette": "tests/sim/tb/test_bulk.py",
+MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py, before its 16 x 16 render frame",
                     "full": "tests/sim/tb/test_tb_pipeline.py, before its 16 x 16 render frame",
                     **{name: "tests/sim/tb/test_bulk_scene_frames.py"
-                       for name in ("diffuse", "flat", "textured", "two-lights")}}
+                       for name in ("diffuse", "flat", "textured", "two-lights", "palette")}}
 BEGIN, END = "<!-- netlist:begin -->", "<!-- netlist:end -->"
 VERILATOR_EXTRA = ("-Wno-UNOPTFLAT", "-Wno-fatal")
 # g++ -O0 for the model: one build, short runs (a few thousand pixels a mutant), so the

@@ -90,44 +90,6 @@ def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
         assert np.array_equal(got, render["tag"] if field == "tag" else want[field]), field
 
 
-# The palette scenes: the built-in one (table entry only) and one with a colour texture
-# (the entry blended with the texel by Tarini eq. 2), each channel of the colour its own field.
-PALETTE_SCENES = {"palette": "palette",
-                  "palette-textured": {"name": "palette-textured", "shading": "palette",
-                                       "texture": True, "image": "bricks"}}
-
-
-@pytest.mark.parametrize("name", PALETTE_SCENES)
-def test_bulk_palette_frame_equals_golden(name, build_dir):
-    """A palette scene's emitted pipeline (Icarus) streams its coverage frame under the four
-    traffic patterns (the frame and patterns of the netlist mutants of pipeline:palette,
-    tests/mutants/netlist.py): a random
-    colour table read from bank 1 between decoy tables, random indices written through the
-    map's host port, and (textured) random texels. Every channel of the colour (r, g, b, a
-    each a field of its own) equals the golden model's, so the RTL and the model cannot
-    agree on a channel mix-up of the table entry or of eq. 2 unless both make it; the
-    colours depend on the channel (a test whose every channel carried the same value could
-    not see one swapped)."""
-    scene = load_scene_config(PALETTE_SCENES[name])
-    _, words, _, _, base = scene_stimulus(scene, 16)
-    texels = scene_texels(scene, base)
-    v, j = emit_pipeline(scene, words, texels, build_dir, None)
-    meta = json.loads(j.read_text())
-    frame = coverage_frame(scene, words, texels)
-    golden = frame.expected(meta)
-    channels = [f for f in golden if f.startswith("color.")]
-    assert len(channels) == 4, sorted(golden)
-    stacked = np.stack([golden[c] for c in channels])
-    assert (stacked != stacked[:1]).any(axis=0).mean() > 0.9     # channels differ
-    r = run_bulk("icarus", v, j, build_dir / "bulk", tuple(TRAFFIC), inputs=frame.inputs,
-                 expected=golden, setup=frame.setup(meta))
-    assert r.checked
-    for pattern in TRAFFIC:
-        assert r.pixels[pattern] == len(frame.inputs["tag"]), pattern
-        for field, want in golden.items():
-            assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
-
-
 SINCOS = Config(angle_bits=12)
 
 

@@ -1,11 +1,12 @@
-"""The coverage frame (sim/tb/bulk_frame.py) through the pipelines of the built-in scenes
-that no other test of make test streams it through: ``diffuse`` (no specular term),
-``flat`` (no map: the polygon registers), ``textured`` (the colour texture blended with the
-shading) and ``two-lights`` (two illumination units and their sum). The default and palette
-scenes stream it in tests/sim/tb/test_bulk.py, the full scene in
-tests/sim/tb/test_tb_pipeline.py (every cycle from cocotb). This is the frame and the four
-traffic patterns the netlist mutants of these scenes run (tests/mutants/netlist.py), so a
-mutant that frame kills is killed by make test."""
+"""The coverage frame (sim/tb/bulk_frame.py) through the pipelines of the built-in scenes,
+on Icarus under the four traffic patterns, every output field against the golden model:
+``diffuse`` (no specular term), ``flat`` (no map: the polygon registers), ``textured`` (the
+colour texture blended with the shading), ``two-lights`` (two illumination units and their
+sum) and the palette scenes. The default scene streams it in tests/sim/tb/test_bulk.py
+(before its rendered frame), the full scene in tests/sim/tb/test_tb_pipeline.py (every
+cycle from cocotb). This is the frame and the four traffic patterns the netlist mutants of
+these scenes run (tests/mutants/netlist.py), so a mutant that frame kills is killed by
+make test."""
 
 import json
 
@@ -21,21 +22,54 @@ from bumprtl.sim.traffic import PATTERNS
 TRAFFIC = tuple(PATTERNS)
 
 
-@pytest.mark.parametrize("name", ["diffuse", "flat", "textured", "two-lights"])
-def test_scene_coverage_frame_equals_golden(name, build_dir):
-    scene = load_scene_config(name)
-    _, words, _, table, base = scene_stimulus(scene, 16)
+def _scene_frame(scene, build_dir):
+    """The scene's pipeline emitted with its memories, its coverage frame and the golden
+    outputs of the frame: (verilog, sidecar, frame, golden)."""
+    _, words, _, _, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
     v, j = emit_pipeline(scene, words, texels, build_dir, None)
     meta = json.loads(j.read_text())
     frame = coverage_frame(scene, words, texels)
-    golden = frame.expected(meta)
-    assert set(golden) == set(meta["ports"]["o__payload"]["fields"])
-    r = run_bulk("icarus", v, j, build_dir / "bulk", TRAFFIC, inputs=frame.inputs,
-                 expected=golden, setup=frame.setup(meta))
+    return v, j, meta, frame, frame.expected(meta)
+
+
+def _stream(v, j, meta, frame, golden, work):
+    """The frame through the build: each pixel once, in order, every field the golden one."""
+    r = run_bulk("icarus", v, j, work, TRAFFIC, inputs=frame.inputs, expected=golden,
+                 setup=frame.setup(meta))
     assert r.checked
     for pattern in TRAFFIC:
         assert r.pixels[pattern] == len(frame.inputs["tag"]), pattern
         assert np.array_equal(r.outputs[pattern]["tag"], frame.inputs["tag"]), pattern
         for field, want in golden.items():
             assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
+
+
+@pytest.mark.parametrize("name", ["diffuse", "flat", "textured", "two-lights"])
+def test_scene_coverage_frame_equals_golden(name, build_dir):
+    v, j, meta, frame, golden = _scene_frame(load_scene_config(name), build_dir)
+    assert set(golden) == set(meta["ports"]["o__payload"]["fields"])      # every output
+    _stream(v, j, meta, frame, golden, build_dir / "bulk")
+
+
+# The palette scenes: the built-in one (table entry only) and one with a colour texture
+# (the entry blended with the texel by Tarini eq. 2), each channel of the colour its own field.
+PALETTE_SCENES = {"palette": "palette",
+                  "palette-textured": {"name": "palette-textured", "shading": "palette",
+                                       "texture": True, "image": "bricks"}}
+
+
+@pytest.mark.parametrize("name", PALETTE_SCENES)
+def test_bulk_palette_frame_equals_golden(name, build_dir):
+    """A palette scene's coverage frame: a random colour table read from bank 1 between
+    decoy tables, random indices written through the map's host port, and (textured)
+    random texels. Every channel of the colour (r, g, b, a each a field of its own) equals
+    the golden model's, so the RTL and the model cannot agree on a channel mix-up of the
+    table entry or of eq. 2 unless both make it; the colours depend on the channel (a test
+    whose every channel carried the same value could not see one swapped)."""
+    v, j, meta, frame, golden = _scene_frame(load_scene_config(PALETTE_SCENES[name]), build_dir)
+    channels = [f for f in golden if f.startswith("color.")]
+    assert len(channels) == 4, sorted(golden)
+    stacked = np.stack([golden[c] for c in channels])
+    assert (stacked != stacked[:1]).any(axis=0).mean() > 0.9     # channels differ
+    _stream(v, j, meta, frame, golden, build_dir / "bulk")
