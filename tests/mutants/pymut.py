@@ -281,6 +281,68 @@ KNOWN = [
      "a PNG ended by an unknown ancillary chunk instead of IEND (Pillow reads it, but its "
      "check refuses it); tests/sim/scenes/test_usermap.py::test_written_pngs_pass_a_decoders_check "
      "(checked with the mutant switched on)"),
+    # seed 9
+    ("bumprtl.gen.cli.flags.x_add_map_flags", "opengl = +y up the image", "wording",
+     "`--normal-convention`'s help with the axis +Y written +y: what the help says is unchanged"),
+    ("bumprtl.rtl.config.xǁConfigǁmade_at", 'note="XXXX"', "killed since",
+     "no test of the selection called made_at (tests/test_docs_made_at.py is outside it); "
+     "tests/rtl/test_config.py::test_made_at_records_both_widths_and_a_note_only_when_given "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.accuracy.x__target", "(value > 0.5) | (value < 254.5)", "killed since",
+     "every value counted as unclamped, 0 and 255 too; the searches' tests still found pixels "
+     "under the bound; tests/sim/golden/test_accuracy_search.py::test_the_search_targets_only_channel_values_inside_the_clamps "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.accuracy.x_arithmetic_pixels", "0, full / 2),", "equivalent",
+     "the clip's upper end as a float makes the theta codes float64, of the same integer "
+     "values (below 2**53), and on_grid multiplies them by the step either way"),
+    ("bumprtl.sim.golden.accuracy.x_arithmetic_pixels", "x + 1.000001)", "killed since",
+     "the side of each angle chosen from a difference over 1 rad instead of 1e-6 (the sign of "
+     "d N'.H' / d angle lost); no test read the side; "
+     "tests/sim/golden/test_accuracy_search.py::test_arithmetic_pixels_shift_each_angle_the_way_the_arithmetic_error_goes "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.common.x_to_8bit", "np.asarray(x, ), nan=0.0)", "killed since",
+     "float32 intensities rounded in float32 arithmetic; "
+     "tests/sim/golden/test_stress_cases.py::test_to_8bit_rounds_float32_intensities_as_given "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.common.x_shade_fixed", "fine = np.zeros_like(None)", "killed since",
+     "without specular the specular outputs a 0-d object 0 instead of an integer 0 per pixel; "
+     "no test shaded without specular at this level; "
+     "tests/sim/golden/fixed/test_rounding.py::test_shade_without_specular_is_zero_in_every_pixel "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.golden.fixed.exact.x_rotation_fixed", "c = lambda a: None", "killed outside the selection",
+     "the TABLE_READ hook's cosine reads: only the coverage frame's table-sensitivity search "
+     "(sim/tb/bulk_frame.py) sets the hook, and with the mutant switched on building the frame "
+     "raises TypeError, so make test's tests/sim/tb tests that build a coverage frame "
+     "(test_bulk_scene_frames.py, test_bulk.py::test_bulk_pipeline_frame_equals_golden, "
+     "test_tb_pipeline.py) fail; the fast tiers have no simulator"),
+    ("bumprtl.sim.golden.fixed.lee.x_rotate_fixed", "k + 2 * b - 2 <= 63", "equivalent",
+     "the two guards differ only at k + 2B = 62 (angle_bits 16, frac_bits 24, the largest "
+     "Config allowed), where |y2| <= 2**25 and the reciprocal ROM's words have 38 bits: the "
+     "product |y2| x 1/|sin| is below 2**63 and int64 holds it (200,000 random inputs there "
+     "gave the same codes)"),
+    ("bumprtl.sim.golden.fixed.peercy.x_isqrt", "(r + 2) * (r + 1) <= x", "equivalent",
+     "the upward fix never runs below 2**62 (the float64 estimate is never low: the reason "
+     "given for this line's `r + 2, r)` mutant), so a stricter condition for it changes nothing"),
+    ("bumprtl.sim.golden.float.palette_quantize.x__renormalize", "np.array(table, dtype=None)",
+     "equivalent", "both callers pass float64 tables (np.average of float64 points, and "
+     "bincount sums divided by weights), which np.array copies as float64 anyway"),
+    ("bumprtl.sim.scenes.config.x_load_scene_config", "value is None and not (maps", "killed since",
+     "defaults with a value ignored and None defaults set; no test of the selection passed "
+     "defaults; tests/sim/scenes/test_config.py::test_defaults_fill_only_the_keys_nothing_sets "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.heightfields.x__band_limited", "k = None", "killed since",
+     "no test drew wood or text below 64 texels; "
+     "tests/sim/scenes/test_heightfields.py::test_small_wood_and_text_are_the_64_texel_fields_averaged_over_blocks "
+     "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.heightfields.x__skimage", "img.resize((t, t), )", "missed by mutmut's record",
+     "the closure is made when heightfields is imported, so mutmut credits _skimage to the "
+     "test that ran then; and the mutant is Pillow's default filter (bicubic, also "
+     "antialiased) for Lanczos on scikit-image's pictures, which nothing specifies (docs/scenes.md "
+     "names Lanczos for a user's map, sim/scenes/usermap.py): a test could only repeat the call"),
+    ("bumprtl.sim.scenes.usermap.x_map_size", "_load_npy(None, raw)", "killed since",
+     "a bad .npy's message from map_size named 'None' instead of the file; "
+     "tests/sim/scenes/test_usermap.py::test_map_size_of_a_bad_npy_names_the_file "
+     "(checked with the mutant switched on)"),
 ]
 
 

@@ -138,3 +138,11 @@ def test_replace_names_the_unknown_field():
     with pytest.raises(ConfigError, match=r"unknown Config field\(s\): nosuch") as e:
         Config().replace(nosuch=1)
     assert e.value.field == "nosuch"
+
+
+def test_made_at_records_both_widths_and_a_note_only_when_given():
+    """made_at is the one line a generated page names its configuration with: both widths,
+    then the note in parentheses, and nothing after the widths without a note."""
+    cfg = Config(angle_bits=12, frac_bits=13)
+    assert cfg.made_at() == "Made at: angle_bits=12, frac_bits=13"
+    assert cfg.made_at("palette scene") == "Made at: angle_bits=12, frac_bits=13 (palette scene)"

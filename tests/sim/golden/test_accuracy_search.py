@@ -202,3 +202,45 @@ def test_adversarial_pixels_sit_on_the_side_that_moves_the_channel_most():
         agree += int(np.sum(side[ok] == grad[ok]))
         total += int(ok.sum())
     assert total > 150 and agree >= 0.95 * total, (agree, total)
+
+
+def test_the_search_targets_only_channel_values_inside_the_clamps():
+    """The searches aim at outputs whose slope is not 0: N'.L strictly inside (0.02, 0.98)
+    for diffuse, 255 x the channel strictly inside (0.5, 254.5) for the others (0 and 255,
+    where the channel is clamped, are left out)."""
+    from types import SimpleNamespace
+    from bumprtl.sim.golden.accuracy import _target
+    v = np.array([0.0, 0.001, 0.3, 0.999, 1.0])
+    ref = SimpleNamespace(ndotl=v, specular=v, color=v)
+    want = np.array([False, False, True, False, False])
+    for channel in ("diffuse", "specular", "color"):
+        value, inside = _target(channel, ref)
+        assert np.allclose(value, 255 * v) and np.array_equal(inside, want), channel
+
+
+def test_arithmetic_pixels_shift_each_angle_the_way_the_arithmetic_error_goes():
+    """Step 3: every angle of N'.H' sits off its grid point on the side where the true N'.H'
+    is below the grid's when the model's N'.H' is above the float64 one (and above when
+    below), so that rounding to the grid adds to the arithmetic error: the sign of the side
+    is -sign(error) x sign(d N'.H' / d angle) (central differences here)."""
+    from bumprtl.sim.golden.common import PixelInputs
+    from bumprtl.sim.golden.float.conventional import conventional
+    from bumprtl.sim.golden.methods import encode_pixels
+
+    keep, reach = 10, 1
+    px = arithmetic_pixels(datapath_fixed, CFG, candidates=2000, keep=keep, seed=3, reach=reach)
+    m = keep * (2 * reach + 1) ** 2
+    grid, shifted = px.subset(slice(0, m)), px.subset(slice(m, None))
+    error = np.sign(datapath_fixed(encode_pixels(grid, CFG), CFG)["ndoth"] / CFG.one
+                    - conventional(grid, CFG).ndoth)
+    keys = {k: getattr(grid, k) for k in grid.__dataclass_fields__}
+    agree = total = 0
+    for name in ANGLES_OF["specular"]:
+        x = keys[name]
+        up = conventional(PixelInputs(**{**keys, name: x + 1e-7}), CFG).ndoth
+        dn = conventional(PixelInputs(**{**keys, name: x - 1e-7}), CFG).ndoth
+        side = np.sign(getattr(shifted, name) - x)
+        ok = _interior(name, x) & (np.abs(up - dn) > 1e-14) & (error != 0)
+        agree += int(np.sum(side[ok] == -error[ok] * np.sign(up - dn)[ok]))
+        total += int(ok.sum())
+    assert total > 200 and agree >= 0.95 * total, (agree, total)

@@ -114,3 +114,12 @@ def test_angle_codes_round_float32_angles_as_given():
     cfg = Config()
     a = np.random.default_rng(0).uniform(0, 2 * np.pi, 100_000).astype(np.float32)
     assert np.array_equal(angle_codes(a, cfg), angle_codes(a.astype(np.float64), cfg))
+
+
+def test_to_8bit_rounds_float32_intensities_as_given():
+    """Intensities given in float32 become 8-bit codes from their values as given, exactly
+    as the same values in float64: float32 arithmetic would round some 255 x near a half
+    the other way."""
+    from bumprtl.sim.golden.common import to_8bit
+    x = np.random.default_rng(0).uniform(0, 1, 100_000).astype(np.float32)
+    assert np.array_equal(to_8bit(x), to_8bit(x.astype(np.float64)))

@@ -339,3 +339,15 @@ def test_only_a_second_picture_clashes_with_the_scenes_picture(tmp_path):
                                         r"built-in scene 'textured': give the picture once"):
         load_scene_config("textured", overrides={"height_map": str(tmp_path / "h.png")},
                           flags={"height_map": "--height-map"})
+
+
+def test_defaults_fill_only_the_keys_nothing_sets():
+    """``defaults`` are used where neither the source nor an override sets a key; a default
+    of None sets nothing (the scene's own default holds)."""
+    assert load_scene_config({"name": "t"}, defaults={"texture_size": 32}).texture_size == 32
+    assert load_scene_config({"name": "t", "texture_size": 128},
+                             defaults={"texture_size": 32}).texture_size == 128
+    assert load_scene_config({"name": "t"}, overrides={"texture_size": 16},
+                             defaults={"texture_size": 32}).texture_size == 16
+    own = SceneConfig().texture_size
+    assert load_scene_config({"name": "t"}, defaults={"texture_size": None}).texture_size == own

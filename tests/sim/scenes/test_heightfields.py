@@ -49,3 +49,16 @@ def test_craters_tile():
 def test_the_seed_fixes_the_map():
     assert np.array_equal(craters(32, 5, 4), craters(32, 5, 4))
     assert not np.array_equal(craters(32, 5, 4), craters(32, 6, 4))
+
+
+def test_small_wood_and_text_are_the_64_texel_fields_averaged_over_blocks():
+    """Below 64 texels wood and text are drawn at 64 and box-filtered down (the mean of each
+    (64 / T)**2 block), so detail finer than a texel averages out instead of aliasing."""
+    from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS
+    for name in ("wood", "text"):
+        fine = HEIGHTFIELDS[name](64)
+        for t in (16, 32):
+            k = 64 // t
+            want = np.array([[fine[i * k:(i + 1) * k, j * k:(j + 1) * k].mean() for j in range(t)]
+                             for i in range(t)])
+            assert np.allclose(HEIGHTFIELDS[name](t), want, rtol=0, atol=1e-12), (name, t)

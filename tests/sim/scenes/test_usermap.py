@@ -371,3 +371,14 @@ def test_written_pngs_pass_a_decoders_check(tmp_path):
         path = tmp_path / f"{name}.png"
         write_png(path, pixels, bit_depth=depth)
         Image.open(path).verify()
+
+
+def test_map_size_of_a_bad_npy_names_the_file(tmp_path):
+    """map_size reads a .npy's shape only, but a file that is no array, or an array of
+    booleans, is still one line naming the file."""
+    (tmp_path / "junk.npy").write_bytes(b"not an array")
+    np.save(tmp_path / "bits.npy", np.zeros((32, 32), bool))
+    for name, words in (("junk.npy", "not a readable .npy"), ("bits.npy", "real numbers")):
+        with pytest.raises(BumpError) as e:
+            map_size(tmp_path / name)
+        assert str(e.value).startswith(str(tmp_path / name) + ": ") and words in str(e.value)

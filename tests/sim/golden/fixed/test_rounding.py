@@ -318,3 +318,19 @@ def test_input_cartesian_components():
     """Cartesian components -> B fractional bits, rounded to nearest (Q.quantize)."""
     x = np.random.default_rng(34).uniform(-1, 1, N)
     assert_rounds_to_nearest(Q(1, CFG.frac_bits).quantize(x), x * CFG.one, "Q.quantize")
+
+
+def test_shade_without_specular_is_zero_in_every_pixel():
+    """Without the specular term the specular outputs are 0 in every pixel (the shape of
+    the dots given) and the colour is the Phong sum of ambient and diffuse alone."""
+    cfg = CFG.replace(specular=False)
+    rng = np.random.default_rng(26)
+    ndotl, ndoth = rng.integers(0, cfg.one + 1, (2, 40, 50))
+    out = shade_fixed(ndotl, ndoth, cfg)
+    for key in ("specular", "specular_fine"):
+        assert out[key].shape == ndotl.shape and np.issubdtype(out[key].dtype, np.integer)
+        assert not out[key].any(), key
+    ka, kd, ks = phong_coefficients(cfg)
+    exact = phong_exact(ka, kd, ks, out["diffuse_fine"], 0, cfg)
+    assert out["color"].shape == ndotl.shape
+    assert_rounds_to_nearest(out["color"], exact, "phong sum without specular")
