@@ -311,10 +311,10 @@ KNOWN = [
      "(checked with the mutant switched on)"),
     ("bumprtl.sim.golden.fixed.exact.x_rotation_fixed", "c = lambda a: None", "killed outside the selection",
      "the TABLE_READ hook's cosine reads: only the coverage frame's table-sensitivity search "
-     "(sim/tb/bulk_frame.py) sets the hook, and with the mutant switched on building the frame "
-     "raises TypeError, so make test's tests/sim/tb tests that build a coverage frame "
-     "(test_bulk_scene_frames.py, test_bulk.py::test_bulk_pipeline_frame_equals_golden, "
-     "test_tb_pipeline.py) fail; the fast tiers have no simulator"),
+     "(sim/tb/bulk_frame.py) sets the hook, so only make test's tests/sim/tb tests that build "
+     "a coverage frame reach it, and with the mutant switched on building the frame raises "
+     "TypeError: tests/sim/tb/test_bulk_scene_frames.py::test_scene_coverage_frame_equals_golden[diffuse] "
+     "fails (checked); the hook has no use outside that search for a fast test to check"),
     ("bumprtl.sim.golden.fixed.lee.x_rotate_fixed", "k + 2 * b - 2 <= 63", "equivalent",
      "the two guards differ only at k + 2B = 62 (angle_bits 16, frac_bits 24, the largest "
      "Config allowed), where |y2| <= 2**25 and the reciprocal ROM's words have 38 bits: the "
@@ -333,7 +333,10 @@ KNOWN = [
     ("bumprtl.sim.scenes.heightfields.x__band_limited", "k = None", "killed since",
      "no test drew wood or text below 64 texels; "
      "tests/sim/scenes/test_heightfields.py::test_small_wood_and_text_are_the_64_texel_fields_averaged_over_blocks "
-     "(checked with the mutant switched on)"),
+     "does, but the decorator runs when heightfields is imported, so mutmut credits it to no "
+     "test (seed 9 at ecee408 kept it); "
+     "tests/sim/scenes/test_heightfields.py::test_band_limiting_averages_detail_finer_than_a_texel "
+     "calls _band_limited itself (checked with the mutant switched on)"),
     ("bumprtl.sim.scenes.heightfields.x__skimage", "img.resize((t, t), )", "missed by mutmut's record",
      "the closure is made when heightfields is imported, so mutmut credits _skimage to the "
      "test that ran then; and the mutant is Pillow's default filter (bicubic, also "

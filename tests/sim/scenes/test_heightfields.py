@@ -62,3 +62,20 @@ def test_small_wood_and_text_are_the_64_texel_fields_averaged_over_blocks():
             want = np.array([[fine[i * k:(i + 1) * k, j * k:(j + 1) * k].mean() for j in range(t)]
                              for i in range(t)])
             assert np.allclose(HEIGHTFIELDS[name](t), want, rtol=0, atol=1e-12), (name, t)
+
+
+def test_band_limiting_averages_detail_finer_than_a_texel():
+    """A field drawn through _band_limited below 64 texels is the mean of each block of the
+    64-texel drawing: a one-texel checkerboard (detail no smaller map can hold) becomes a
+    flat 0.5 instead of aliasing, and a linear ramp stays the ramp at the blocks' centres."""
+    from bumprtl.sim.scenes.heightfields import _band_limited
+
+    def checker_and_ramp(t):
+        i, j = np.mgrid[0:t, 0:t]
+        return (i + j) % 2 + (j + 0.5) / t
+
+    field = _band_limited(checker_and_ramp)
+    assert np.array_equal(field(64), checker_and_ramp(64)) and field.__name__ == "checker_and_ramp"
+    for t in (16, 32):
+        ramp = (np.arange(t) + 0.5) / t
+        assert np.allclose(field(t), 0.5 + ramp[None, :], rtol=0, atol=1e-12), t
