@@ -181,12 +181,21 @@ def test_arithmetic_pixels_grid_then_shifted_with_l_equal_to_h():
     assert _cos(grid, "h").min() > np.cos(4 * reach * STEP)
 
 
+def _central_slope(keys, name, field):
+    """float64 ``field`` (ndotl or ndoth) of the pixels ``keys`` with angle ``name`` moved
+    1e-7 up, minus with it moved 1e-7 down (the sign of its partial derivative)."""
+    from bumprtl.sim.golden.common import PixelInputs
+    from bumprtl.sim.golden.float.conventional import conventional
+    x = keys[name]
+    up = getattr(conventional(PixelInputs(**{**keys, name: x + 1e-7}), CFG), field)
+    dn = getattr(conventional(PixelInputs(**{**keys, name: x - 1e-7}), CFG), field)
+    return up - dn
+
+
 def test_adversarial_pixels_sit_on_the_side_that_moves_the_channel_most():
     """Step 2's 'worse side': each angle sits 0.4999 step off its grid point in the direction
     its partial derivative points (d(255 N'.L')/d angle by central differences here), so the
     rounding to the grid moves every angle against the output."""
-    from bumprtl.sim.golden.common import PixelInputs
-    from bumprtl.sim.golden.float.conventional import conventional
 
     keep = 40
     px = adversarial_pixels(CFG, candidates=3000, keep=keep, seed=11, channel="diffuse").subset(slice(0, keep))
@@ -194,11 +203,10 @@ def test_adversarial_pixels_sit_on_the_side_that_moves_the_channel_most():
     agree = total = 0
     for name in ANGLES_OF["diffuse"]:
         x = keys[name]
-        up = conventional(PixelInputs(**{**keys, name: x + 1e-7}), CFG).ndotl
-        dn = conventional(PixelInputs(**{**keys, name: x - 1e-7}), CFG).ndotl
-        grad = np.sign(up - dn)
+        slope = _central_slope(keys, name, "ndotl")
+        grad = np.sign(slope)
         side = np.sign(x / STEP - np.rint(x / STEP))
-        ok = _interior(name, x) & (np.abs(up - dn) > 1e-9)
+        ok = _interior(name, x) & (np.abs(slope) > 1e-9)
         agree += int(np.sum(side[ok] == grad[ok]))
         total += int(ok.sum())
     assert total > 150 and agree >= 0.95 * total, (agree, total)
@@ -223,7 +231,6 @@ def test_arithmetic_pixels_shift_each_angle_the_way_the_arithmetic_error_goes():
     is below the grid's when the model's N'.H' is above the float64 one (and above when
     below), so that rounding to the grid adds to the arithmetic error: the sign of the side
     is -sign(error) x sign(d N'.H' / d angle) (central differences here)."""
-    from bumprtl.sim.golden.common import PixelInputs
     from bumprtl.sim.golden.float.conventional import conventional
     from bumprtl.sim.golden.methods import encode_pixels
 
@@ -237,10 +244,9 @@ def test_arithmetic_pixels_shift_each_angle_the_way_the_arithmetic_error_goes():
     agree = total = 0
     for name in ANGLES_OF["specular"]:
         x = keys[name]
-        up = conventional(PixelInputs(**{**keys, name: x + 1e-7}), CFG).ndoth
-        dn = conventional(PixelInputs(**{**keys, name: x - 1e-7}), CFG).ndoth
+        slope = _central_slope(keys, name, "ndoth")
         side = np.sign(getattr(shifted, name) - x)
-        ok = _interior(name, x) & (np.abs(up - dn) > 1e-14) & (error != 0)
-        agree += int(np.sum(side[ok] == -error[ok] * np.sign(up - dn)[ok]))
+        ok = _interior(name, x) & (np.abs(slope) > 1e-14) & (error != 0)
+        agree += int(np.sum(side[ok] == -error[ok] * np.sign(slope)[ok]))
         total += int(ok.sum())
     assert total > 200 and agree >= 0.95 * total, (agree, total)
