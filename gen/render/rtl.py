@@ -201,9 +201,19 @@ def run_pipeline(scene, inputs, words, polygon, table, simulator, build_dir, pat
     ``load = "port"``: the memories start at zero and the host writes them before the pixels."""
     build_dir = Path(build_dir).resolve()      # the simulator runs in its own directory
     v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
+    return run_pipeline_emitted(v, j, inputs, polygon, table, simulator, build_dir, patterns,
+                                progress, writes)
+
+
+def run_pipeline_emitted(v, j, inputs, polygon, table, simulator, build_dir,
+                         patterns=("no_stall",), progress=True, setup=()):
+    """:func:`run_pipeline` on a pipeline already emitted (``v``, ``j``): ``setup`` the host
+    cycles (``{port: value}`` per clock) played before the pixels, e.g. map words written
+    through the host port."""
+    build_dir = Path(build_dir).resolve()
     build_dir.mkdir(parents=True, exist_ok=True)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
-    write_stimulus(stim, inputs, polygon, table, writes)
+    write_stimulus(stim, inputs, polygon, table, setup)
     from bumprtl.sim.tb.runner import run_cocotb  # optional dependency: the [sim] extra
     run = run_cocotb(simulator, v, "bumprtl.sim.tb.tb_pipeline", build_dir / simulator,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_STIMULUS": stim, "BUMPRTL_RESULT": result,
