@@ -298,6 +298,21 @@ EQUIV_SEQ = 4   # time steps of equiv_simple / equiv_induct and of the base-case
 STREAM_DONT_CARE = "payload don't-care while valid is low"
 
 
+def _proved(how, stream):
+    """The verdict of a proof ``how``: equivalent, or under the stream contract when its
+    payloads were masked by valid (``stream``)."""
+    if stream:
+        return f"equivalent under the stream contract ({how}, {STREAM_DONT_CARE})"
+    return f"equivalent ({how})"
+
+
+def _yosys_error(step, e):
+    """What a failed Yosys run (CalledProcessError ``e``) of step ``step`` said: its first
+    ERROR line."""
+    err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
+    return f"{step}: " + (err[:1] or ["yosys error"])[0][:100]
+
+
 def _wrappers(ports, unit):
     """Verilog of the modules ``gold_s`` and ``gate_s``: ``gold`` / ``gate`` with each stream
     payload output masked by its valid (the stream contract's don't-care, made explicit)."""
@@ -428,35 +443,35 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
                        + (", the bits of K at their initial value" if kept else "")
                        + f"' inductive on the cut at the registers, R = {held}"
                        + (f", K = {kept}" if kept else ""))
-                if stream:
-                    return f"equivalent under the stream contract ({how}, {STREAM_DONT_CARE})", None
-                return f"equivalent ({how})", None
+                return _proved(how, stream), None
             why.append(R)
             if "__payload" not in R:
                 break
-    if {"never", "rel"} & set(steps):
-        proved, said = _rel_steps(meta, line, work, timeout, has_stream, steps)
+    if {"never", "rel", "pdr"} & set(steps):
+        # steps 6 to 8 read the netlist with its memories' read registers kept apart
+        try:
+            net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
+        except (subprocess.CalledProcessError, KeyError) as e:
+            return None, "; ".join(why + [f"never/rel/pdr: the -ctrl netlist was not built "
+                                          f"({type(e).__name__})"])
+        proved, said = _rel_steps(net, line, work, timeout, has_stream, steps)
         if proved:
             return proved, None
         why += said
-    if "pdr" in steps:
-        proved, said = _pdr_step(meta, line, work, timeout, has_stream)
-        if proved:
-            return proved, None
-        why.append(said)
+        if "pdr" in steps:
+            proved, said = _pdr_step(net, work, timeout, has_stream)
+            if proved:
+                return proved, None
+            why.append(said)
     return None, "; ".join(why)
 
 
-def _rel_steps(meta, line, work, timeout, has_stream, steps):
+def _rel_steps(net, line, work, timeout, has_stream, steps):
     """Steps 6 and 7 (tests/mutants/netlist_rel.py): ``never`` (a cnot mutation's control
     bit inactive in every reachable state of the design alone, by inductive upper bounds on
     its registers and memories) and ``rel`` (Houdini on the product machine with the clauses
-    "register equal in design and mutant or valid bit 0"), each within ``timeout`` seconds:
-    ``(verdict, [why])``."""
-    try:
-        net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
-    except (subprocess.CalledProcessError, KeyError) as e:
-        return None, [f"never/rel: the -ctrl netlist was not built ({type(e).__name__})"]
+    "register equal in design and mutant or valid bit 0"), each within ``timeout`` seconds,
+    on ``net`` (the -ctrl netlist, memories' read registers apart): ``(verdict, [why])``."""
     why = []
     for step in ("never", "rel"):
         if step not in steps:
@@ -469,8 +484,7 @@ def _rel_steps(meta, line, work, timeout, has_stream, steps):
         except nc.Undecided as e:
             verdict, how = "undecided", f"{step}: {e}"
         except subprocess.CalledProcessError as e:
-            err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
-            verdict, how = "undecided", f"{step}: " + (err[:1] or ["yosys error"])[0][:100]
+            verdict, how = "undecided", _yosys_error(step, e)
         if verdict is None:
             continue                        # never: not a cnot mutation
         if verdict == "equivalent":
@@ -478,37 +492,27 @@ def _rel_steps(meta, line, work, timeout, has_stream, steps):
                 return (f"equivalent (never: z3 proves on the design alone, memories cut to "
                         f"free read data, {how}; the mutant computes what the design does "
                         f"in every such state)"), why
-            said = (f"rel: z3 proves on the product machine of design and mutant, memories "
-                    f"cut to free read data, {how}")
-            if has_stream:
-                return f"equivalent under the stream contract ({said}, {STREAM_DONT_CARE})", why
-            return f"equivalent ({said})", why
+            return _proved(f"rel: z3 proves on the product machine of design and mutant, "
+                           f"memories cut to free read data, {how}", has_stream), why
         why.append(how)
     return None, why
 
 
-def _pdr_step(meta, line, work, timeout, has_stream):
-    """Step 8 (tests/mutants/netlist_pdr.py): the product machine of design and mutant, the
-    memories cut, proved safe by z3's Spacer (IC3/PDR) within ``timeout`` seconds, payloads
-    masked by valid when the unit has streams: ``(verdict, why)``."""
-    try:
-        net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
-    except (subprocess.CalledProcessError, KeyError) as e:
-        return None, f"pdr: the -ctrl netlist was not built ({type(e).__name__})"
+def _pdr_step(net, work, timeout, has_stream):
+    """Step 8 (tests/mutants/netlist_pdr.py): the product machine of design and mutant
+    (``net``, as for :func:`_rel_steps`), the memories cut, proved safe by z3's Spacer
+    (IC3/PDR) within ``timeout`` seconds, payloads masked by valid when the unit has
+    streams: ``(verdict, why)``."""
     try:
         verdict, how = npdr.pdr(net, work, nc.yosys_log, timeout, has_stream, log=print)
     except nc.Undecided as e:
         return None, f"pdr: {e}"
     except subprocess.CalledProcessError as e:
-        err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
-        return None, "pdr: " + (err[:1] or ["yosys error"])[0][:100]
+        return None, _yosys_error("pdr", e)
     if verdict != "equivalent":
         return None, how
-    said = (f"pdr: z3 Spacer (IC3/PDR) proves the product machine of design and mutant safe, "
-            f"memories cut to free read data, {how}")
-    if has_stream:
-        return f"equivalent under the stream contract ({said}, {STREAM_DONT_CARE})", None
-    return f"equivalent ({said})", None
+    return _proved(f"pdr: z3 Spacer (IC3/PDR) proves the product machine of design and "
+                   f"mutant safe, memories cut to free read data, {how}", has_stream), None
 
 
 def equivalence(v, meta, line, work, timeout, steps=STEPS):
@@ -549,12 +553,10 @@ def equivalence(v, meta, line, work, timeout, steps=STEPS):
     if "structural" in steps and _structural(unit, line, work, timeout, False):
         return "equivalent (equiv_simple/equiv_induct, every output every cycle)"
     if "stream" in steps and has_stream and _structural(unit, line, work, timeout, True):
-        return f"equivalent under the stream contract (equiv_simple/equiv_induct, {STREAM_DONT_CARE})"
+        return _proved("equiv_simple/equiv_induct", True)
     verdict = _miter(unit, line, work, timeout, has_stream) if "miter" in steps else None
-    if verdict == "equivalent" and has_stream:
-        return f"equivalent under the stream contract (miter + sat -tempinduct, {STREAM_DONT_CARE})"
     if verdict == "equivalent":
-        return "equivalent (miter + sat -tempinduct)"
+        return _proved("miter + sat -tempinduct", has_stream)
     if verdict == "not equivalent":
         return "not equivalent (counterexample from the miter)"
     proved, why = _cone_steps(meta, line, work, timeout, has_stream, steps)
