@@ -262,73 +262,143 @@ def product(net, stream, depth):
     return json.dumps({"modules": {"product": mod}}), free, n
 
 
-def _aiger(text, work, yosys_run, timeout):
-    """Bit-blast the product JSON to ASCII AIGER (``pdr_product.aag``); None on the time
-    limit."""
-    (work / "pdr_product.json").write_text(text)
-    out = yosys_run(["read_json pdr_product.json", "hierarchy -top product", "async2sync",
-                     "dffunmap", "techmap", "opt -fast", "dffunmap",
+def blast(text, work, yosys_run, timeout, name, opt=True):
+    """The Yosys JSON ``text`` (module ``product``) as ASCII AIGER and its map (``<name>.aag``
+    and ``<name>.aim`` in ``work``; None on the time limit). Without ``opt`` for the bounds
+    of netlist_rel's never: it merges registers of the same next state (the operand
+    registers of three products of one value), and a register whose latches the map no
+    longer names gets no bound (only a weaker invariant, never a wrong one)."""
+    (work / f"{name}.json").write_text(text)
+    out = yosys_run([f"read_json {name}.json", "hierarchy -top product", "async2sync",
+                     "dffunmap", "techmap", *(["opt -fast"] if opt else []), "dffunmap",
                      "setundef -undriven -anyseq", "aigmap", "opt_clean",
-                     "write_aiger -ascii -zinit -map pdr_product.aim pdr_product.aag"],
+                     f"write_aiger -ascii -zinit -map {name}.aim {name}.aag"],
                     work, timeout=timeout)
-    return None if out is None else work / "pdr_product.aag"
+    return None if out is None else (work / f"{name}.aag", work / f"{name}.aim")
+
+
+class Aig:
+    """An ASCII AIGER file and Yosys's map of it, as z3 expressions over one frame: a latch
+    is a Bool variable (its current value), an input another; ``next`` is a latch's
+    next-state function of the current frame."""
+
+    def __init__(self, aag, aim=None):
+        import z3
+        self.z3 = z3
+        lines = Path(aag).read_text().splitlines()
+        _, M, I, L, O, A = lines[0].split()[:6]
+        I, L, O, A = int(I), int(L), int(O), int(A)
+        ins = [int(l.split()[0]) for l in lines[1:1 + I]]
+        lat = [l.split() for l in lines[1 + I:1 + I + L]]
+        self.outs = [int(l.split()[0]) for l in lines[1 + I + L:1 + I + L + O]]
+        self.defs = {}
+        for l in lines[1 + I + L + O:1 + I + L + O + A]:
+            x, a, b = map(int, l.split()[:3])
+            self.defs[x >> 1] = (a, b)
+        self.var = {}
+        for k, v in enumerate(ins):
+            self.var[v >> 1] = z3.Bool(f"i{k}")
+        self.ins = ins
+        self.latch = [int(l[0]) for l in lat]
+        self.next_lit = [int(l[1]) for l in lat]
+        self.init = [int(l[2]) if len(l) > 2 else 0 for l in lat]
+        for k, l in enumerate(self.latch):
+            self.var[l >> 1] = z3.Bool(f"l{k}")
+        # the map (``aim``, Yosys's write_aiger -map): (kind, name) -> {bit: literal}
+        self.sig = {}
+        for line in (Path(aim).read_text().splitlines() if aim else ()):
+            kind, idx, bit, name = line.split(" ", 3)
+            idx, bit = int(idx), int(bit)
+            inv = kind.startswith("inv")
+            kind = kind[3:] if inv else kind
+            base = {"input": lambda i: ins[i], "latch": lambda i: self.latch[i],
+                    "output": lambda i: self.outs[i]}.get(kind)
+            if base is None:
+                continue
+            self.sig.setdefault((kind, name), {})[bit] = base(idx) ^ int(inv)
+            if kind == "latch":
+                self.sig.setdefault(("latchidx", name), {})[bit] = (idx, int(inv))
+
+    def lit(self, x):
+        """The z3 expression of literal ``x`` in the current frame (built once)."""
+        z3 = self.z3
+        v = x >> 1
+        if v == 0:
+            e = z3.BoolVal(False)
+        else:
+            stack = [v]
+            while stack:
+                u = stack[-1]
+                if u in self.var:
+                    stack.pop()
+                    continue
+                a, b = self.defs[u]
+                pend = [w >> 1 for w in (a, b) if (w >> 1) and (w >> 1) not in self.var]
+                if pend:
+                    stack += pend
+                    continue
+                ops = []
+                for w in (a, b):
+                    ew = z3.BoolVal(False) if not (w >> 1) else self.var[w >> 1]
+                    ops.append(z3.Not(ew) if w & 1 else ew)
+                self.var[u] = z3.And(*ops)
+                stack.pop()
+            e = self.var[v]
+        return z3.Not(e) if x & 1 else e
+
+    def latch_bits(self, name, width):
+        """[(latch index, inverted)] of the register word ``name`` (None: a bit not kept)."""
+        m = self.sig.get(("latchidx", name), {})
+        return [m.get(i) for i in range(width)]
+
+    def cur(self, li):
+        idx, inv = li
+        e = self.var[self.latch[idx] >> 1]
+        return self.z3.Not(e) if inv else e
+
+    def nxt(self, li):
+        idx, inv = li
+        e = self.lit(self.next_lit[idx])
+        return self.z3.Not(e) if inv else e
+
+    def init_of(self, li):
+        idx, inv = li
+        return bool(self.init[idx]) ^ bool(inv)
+
+    def support(self, lits):
+        """The latch indices the literals ``lits`` read (through the and gates) and the input
+        variables."""
+        seen, stack, latches, inputs = set(), [x >> 1 for x in lits], set(), set()
+        lvars = {l >> 1: k for k, l in enumerate(self.latch)}
+        ivars = {v >> 1 for v in self.ins}
+        while stack:
+            v = stack.pop()
+            if v in seen or not v:
+                continue
+            seen.add(v)
+            if v in lvars:
+                latches.add(lvars[v])
+            elif v in ivars:
+                inputs.add(v)
+            elif v in self.defs:
+                stack += [w >> 1 for w in self.defs[v]]
+        return latches, inputs
 
 
 def solve(aag):
     """Spacer on the AIGER file: prints ``proved``, ``cex`` or ``unknown`` (run in a child
     process, so that a time limit can stop it)."""
-    import z3
-    lines = Path(aag).read_text().splitlines()
-    _, M, I, L, O, A = lines[0].split()[:6]
-    I, L, O, A = int(I), int(L), int(O), int(A)
-    ins = [int(l.split()[0]) for l in lines[1:1 + I]]
-    lat = [l.split() for l in lines[1 + I:1 + I + L]]
-    outs = [int(l.split()[0]) for l in lines[1 + I + L:1 + I + L + O]]
-    ands = [tuple(map(int, l.split()[:3])) for l in lines[1 + I + L + O:1 + I + L + O + A]]
-    var = {}
-    for k, v in enumerate(ins):
-        var[v >> 1] = z3.Bool(f"i{k}")
-    cur = [z3.Bool(f"l{k}") for k in range(L)]
-    for k, l in enumerate(lat):
-        var[int(l[0]) >> 1] = cur[k]
-    defs = {lhs >> 1: (a, b) for lhs, a, b in ands}
-
-    def lit(x):
-        v = x >> 1
-        if v == 0:
-            e = z3.BoolVal(False)
-        elif v in var:
-            e = var[v]
-        else:
-            stack = [v]
-            while stack:
-                u = stack[-1]
-                if u in var:
-                    stack.pop()
-                    continue
-                a, b = defs[u]
-                pend = [w >> 1 for w in (a, b) if (w >> 1) and (w >> 1) not in var]
-                if pend:
-                    stack += pend
-                    continue
-                ea = z3.BoolVal(False) if not (a >> 1) else var[a >> 1]
-                eb = z3.BoolVal(False) if not (b >> 1) else var[b >> 1]
-                var[u] = z3.And(z3.Not(ea) if a & 1 else ea, z3.Not(eb) if b & 1 else eb)
-                stack.pop()
-            e = var[v]
-        return z3.Not(e) if x & 1 else e
-
-    nxt = [lit(int(l[1])) for l in lat]
-    init = []
-    for k, l in enumerate(lat):
-        r = int(l[2]) if len(l) > 2 else 0
-        init.append(z3.BoolVal(bool(r)) if r in (0, 1) else cur[k])
-    bad = z3.Or(*[lit(o) for o in outs]) if outs else z3.BoolVal(False)
+    aig = Aig(aag)
+    z3 = aig.z3
+    cur = [aig.var[l >> 1] for l in aig.latch]
+    nxt = [aig.lit(x) for x in aig.next_lit]
+    init = [z3.BoolVal(bool(r)) if r in (0, 1) else cur[k] for k, r in enumerate(aig.init)]
+    bad = z3.Or(*[aig.lit(o) for o in aig.outs]) if aig.outs else z3.BoolVal(False)
     fp = z3.Fixedpoint()
     fp.set(engine="spacer")
-    inv = z3.Function("inv", *([z3.BoolSort()] * L), z3.BoolSort())
+    inv = z3.Function("inv", *([z3.BoolSort()] * len(cur)), z3.BoolSort())
     fp.register_relation(inv)
-    fp.declare_var(*cur, *[var[v >> 1] for v in ins])
+    fp.declare_var(*cur, *[aig.var[v >> 1] for v in aig.ins])
     fp.rule(inv(*init))
     fp.rule(inv(*nxt), inv(*cur))
     r = fp.query(z3.And(inv(*cur), bad))
@@ -348,9 +418,10 @@ def pdr(net, rtl, yosys_run, timeout, stream, log=None):
         text, free, n = product(net, stream, depth)
         if text is None:
             return "equivalent", "no output or memory input can differ"
-        aag = _aiger(text, work, yosys_run, int(left) + 1)
-        if aag is None:
+        got = blast(text, work, yosys_run, int(left) + 1, "pdr_product")
+        if got is None:
             return "undecided", f"pdr: no proof within {timeout} s (bit-blasting)"
+        aag = got[0]
         head = aag.read_text().split("\n", 1)[0].split()
         size = f"{head[3]} latches, {head[5]} and gates, {n} compared bits"
         left = timeout - (time.monotonic() - t0)

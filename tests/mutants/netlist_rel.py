@@ -55,133 +55,11 @@ WIDEN_AFTER = 3          # a bound that grew this many times becomes all ones
 MAX_QUERY_MS = 20000     # sat's time for one query of the bound search (then: all ones)
 
 
-class Aig:
-    """An ASCII AIGER file and Yosys's map of it, as z3 expressions over one frame: a latch
-    is a Bool variable (its current value), an input another; ``next`` is a latch's
-    next-state function of the current frame."""
-
-    def __init__(self, aag, aim):
-        import z3
-        self.z3 = z3
-        lines = Path(aag).read_text().splitlines()
-        _, M, I, L, O, A = lines[0].split()[:6]
-        I, L, O, A = int(I), int(L), int(O), int(A)
-        ins = [int(l.split()[0]) for l in lines[1:1 + I]]
-        lat = [l.split() for l in lines[1 + I:1 + I + L]]
-        self.outs = [int(l.split()[0]) for l in lines[1 + I + L:1 + I + L + O]]
-        self.defs = {}
-        for l in lines[1 + I + L + O:1 + I + L + O + A]:
-            x, a, b = map(int, l.split()[:3])
-            self.defs[x >> 1] = (a, b)
-        self.var = {}
-        for k, v in enumerate(ins):
-            self.var[v >> 1] = z3.Bool(f"i{k}")
-        self.ins = ins
-        self.latch = [int(l[0]) for l in lat]
-        self.next_lit = [int(l[1]) for l in lat]
-        self.init = [int(l[2]) if len(l) > 2 else 0 for l in lat]
-        for k, l in enumerate(self.latch):
-            self.var[l >> 1] = z3.Bool(f"l{k}")
-        # the map: (kind, name) -> {bit: literal of that signal bit}
-        self.sig = {}
-        for line in Path(aim).read_text().splitlines():
-            kind, idx, bit, name = line.split(" ", 3)
-            idx, bit = int(idx), int(bit)
-            inv = kind.startswith("inv")
-            kind = kind[3:] if inv else kind
-            base = {"input": lambda i: ins[i], "latch": lambda i: self.latch[i],
-                    "output": lambda i: self.outs[i]}.get(kind)
-            if base is None:
-                continue
-            self.sig.setdefault((kind, name), {})[bit] = base(idx) ^ int(inv)
-            if kind == "latch":
-                self.sig.setdefault(("latchidx", name), {})[bit] = (idx, int(inv))
-
-    def lit(self, x):
-        """The z3 expression of literal ``x`` in the current frame (built once)."""
-        z3 = self.z3
-        v = x >> 1
-        if v == 0:
-            e = z3.BoolVal(False)
-        else:
-            stack = [v]
-            while stack:
-                u = stack[-1]
-                if u in self.var:
-                    stack.pop()
-                    continue
-                a, b = self.defs[u]
-                pend = [w >> 1 for w in (a, b) if (w >> 1) and (w >> 1) not in self.var]
-                if pend:
-                    stack += pend
-                    continue
-                ops = []
-                for w in (a, b):
-                    ew = z3.BoolVal(False) if not (w >> 1) else self.var[w >> 1]
-                    ops.append(z3.Not(ew) if w & 1 else ew)
-                self.var[u] = z3.And(*ops)
-                stack.pop()
-            e = self.var[v]
-        return z3.Not(e) if x & 1 else e
-
-    def latch_bits(self, name, width):
-        """[(latch index, inverted)] of the register word ``name`` (None: a bit not kept)."""
-        m = self.sig.get(("latchidx", name), {})
-        return [m.get(i) for i in range(width)]
-
-    def cur(self, li):
-        idx, inv = li
-        e = self.var[self.latch[idx] >> 1]
-        return self.z3.Not(e) if inv else e
-
-    def nxt(self, li):
-        idx, inv = li
-        e = self.lit(self.next_lit[idx])
-        return self.z3.Not(e) if inv else e
-
-    def init_of(self, li):
-        idx, inv = li
-        return bool(self.init[idx]) ^ bool(inv)
-
-    def support(self, lits):
-        """The latch indices the literals ``lits`` read (through the and gates) and the input
-        variables."""
-        seen, stack, latches, inputs = set(), [x >> 1 for x in lits], set(), set()
-        lvars = {l >> 1: k for k, l in enumerate(self.latch)}
-        ivars = {v >> 1 for v in self.ins}
-        while stack:
-            v = stack.pop()
-            if v in seen or not v:
-                continue
-            seen.add(v)
-            if v in lvars:
-                latches.add(lvars[v])
-            elif v in ivars:
-                inputs.add(v)
-            elif v in self.defs:
-                stack += [w >> 1 for w in self.defs[v]]
-        return latches, inputs
-
-
 def _bv(z3, bits):
     """An unsigned bit-vector of Bool expressions, bit 0 first."""
     one, zero = z3.BitVecVal(1, 1), z3.BitVecVal(0, 1)
     parts = [z3.If(b, one, zero) for b in reversed(bits)]
     return parts[0] if len(parts) == 1 else z3.Concat(*parts)
-
-
-def _blast(text, work, yosys_run, timeout, name, opt=True):
-    """The Yosys JSON ``text`` (module ``product``) as ASCII AIGER and its map. Without
-    ``opt`` for the bounds: it merges registers of the same next state (the operand
-    registers of three products of one value), and a register whose latches the map no
-    longer names gets no bound (only a weaker invariant, never a wrong one)."""
-    (work / f"{name}.json").write_text(text)
-    out = yosys_run([f"read_json {name}.json", "hierarchy -top product", "async2sync",
-                     "dffunmap", "techmap", *(["opt -fast"] if opt else []), "dffunmap",
-                     "setundef -undriven -anyseq", "aigmap", "opt_clean",
-                     f"write_aiger -ascii -zinit -map {name}.aim {name}.aag"],
-                    work, timeout=timeout)
-    return None if out is None else (work / f"{name}.aag", work / f"{name}.aim")
 
 
 # --- never: the control bit of a cnot mutation inactive in every reachable state -----------
@@ -284,10 +162,10 @@ def never(net, line, rtl, yosys_run, timeout, log=None, detail=None, depths=NEVE
     active = mode == "cnot1"
     text, mems = single(net, target)
     work = Path(rtl)
-    got = _blast(text, work, yosys_run, int(timeout) + 1, "never_design", opt=False)
+    got = npdr.blast(text, work, yosys_run, int(timeout) + 1, "never_design", opt=False)
     if got is None:
         return "undecided", f"never: no proof within {timeout} s (bit-blasting)"
-    aig = Aig(*got)
+    aig = npdr.Aig(*got)
     head = got[0].read_text().split("\n", 1)[0].split()
     size = f"{head[3]} latches, {head[5]} and gates"
     tgt = aig.lit(aig.sig[("output", "target")][0])
@@ -459,10 +337,10 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
                 m["netnames"][nm] = {"bits": c["connections"]["Q"],
                                      "attributes": {"init": "0" * len(c["connections"]["Q"])}}
     work = Path(rtl)
-    got = _blast(json.dumps(mod), work, yosys_run, int(timeout) + 1, "rel_product")
+    got = npdr.blast(json.dumps(mod), work, yosys_run, int(timeout) + 1, "rel_product")
     if got is None:
         return "undecided", f"rel: no proof within {timeout} s (bit-blasting)"
-    aig = Aig(*got)
+    aig = npdr.Aig(*got)
     head = got[0].read_text().split("\n", 1)[0].split()
     size = f"{head[3]} latches, {head[5]} and gates, {n} compared bits"
     bad = z3.Or(*[aig.lit(x) for x in aig.sig[("output", "bad")].values()])
