@@ -146,3 +146,134 @@ def test_made_at_records_both_widths_and_a_note_only_when_given():
     cfg = Config(angle_bits=12, frac_bits=13)
     assert cfg.made_at() == "Made at: angle_bits=12, frac_bits=13"
     assert cfg.made_at("palette scene") == "Made at: angle_bits=12, frac_bits=13 (palette scene)"
+
+
+# ---- every documented formula, range end and refusal, from Config's docstring and the
+# ---- BumpError rule (one line naming the parameter, the value and its allowed range)
+
+from bumprtl.rtl.config import FRAC_BITS_MAX, frac_bits_floor          # noqa: E402
+from bumprtl.rtl.methods import METHODS                                 # noqa: E402
+
+INT_FIELDS = [r for r in RANGES if isinstance(r[1], int)]
+
+
+@pytest.mark.parametrize("angle_bits", range(4, 17))
+def test_derived_properties_follow_the_number_formats(angle_bits):
+    """k = angle_bits - 2, a full circle of 2**angle_bits steps, a quarter-wave ROM of
+    2**k + 1 entries, sin/cos B + 2 bits wide and 1.0 == 2**B (module docstring)."""
+    for frac_bits in (frac_bits_floor(angle_bits), FRAC_BITS_MAX):
+        cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
+        k = angle_bits - 2
+        assert cfg.k == k
+        assert cfg.full_circle == 2 ** angle_bits
+        assert cfg.sincos_depth == 2 ** k + 1
+        assert cfg.sincos_width == frac_bits + 2
+        assert cfg.one == 2 ** frac_bits
+
+
+@pytest.mark.parametrize("angle_bits", range(4, 17))
+def test_frac_bits_floor_is_k_minus_1_and_at_least_4(angle_bits):
+    """frac_bits_floor: B >= k - 1 (and 4); Config accepts the floor and 24 and refuses one
+    step past either, naming frac_bits and the range."""
+    floor = max(4, (angle_bits - 2) - 1)
+    assert frac_bits_floor(angle_bits) == floor
+    for ok in (floor, FRAC_BITS_MAX):
+        assert Config(angle_bits=angle_bits, frac_bits=ok).frac_bits == ok
+    for bad in (floor - 1, FRAC_BITS_MAX + 1):
+        with pytest.raises(ConfigError) as e:
+            Config(angle_bits=angle_bits, frac_bits=bad)
+        assert e.value.field == "frac_bits"
+        assert f"[{floor}, {FRAC_BITS_MAX}]" in str(e.value)
+
+
+def test_documented_defaults():
+    """Config's docstring and docs/architecture.md: 14-bit angles, B = 15, n = 16, a
+    10-bit specular index, the exact method, one light, 8-bit outputs and colours, the H
+    path built and no palette blend (``--palette-blend`` turns it on, docs/palette.md)."""
+    cfg = Config()
+    assert (cfg.angle_bits, cfg.frac_bits, cfg.spec_exponent, cfg.spec_index_bits) == (14, 15, 16, 10)
+    assert (cfg.method, cfg.lights, cfg.out_bits, cfg.color_bits) == ("exact", 1, 8, 8)
+    assert cfg.specular is True and cfg.palette_blend is False
+    for name in ("ka", "kd", "ks"):
+        assert 0.0 <= getattr(cfg, name) <= 1.0
+
+
+@pytest.mark.parametrize("field, lo, hi, base", INT_FIELDS,
+                         ids=[f"{r[0]}-{r[1]}-{r[2]}" for r in INT_FIELDS])
+def test_an_integer_out_of_range_is_one_line_naming_field_value_and_range(field, lo, hi, base):
+    """BumpError's rule: one line that names the parameter, the refused value and its
+    allowed range, and ``field`` is the parameter."""
+    for value in (lo - 1, hi + 1):
+        with pytest.raises(ConfigError) as e:
+            Config(**base, **{field: value})
+        msg = str(e.value)
+        assert e.value.field == field and "\n" not in msg
+        assert msg.startswith(f"{field} = {value} ") and f"[{lo}, {hi}]" in msg, msg
+
+
+@pytest.mark.parametrize("field, lo, hi, base", INT_FIELDS,
+                         ids=[f"{r[0]}-{r[1]}-{r[2]}" for r in INT_FIELDS])
+def test_an_integer_field_refuses_a_bool_float_or_string_naming_the_range(field, lo, hi, base):
+    """An integer field takes an int only (True == 1 and 8.0 == 8 are no widths); the
+    refusal names the field, the value and the range."""
+    for value in (True, float(lo), str(lo)):
+        with pytest.raises(ConfigError) as e:
+            Config(**base, **{field: value})
+        msg = str(e.value)
+        assert e.value.field == field
+        assert msg.startswith(field) and repr(value) in msg and f"[{lo}, {hi}]" in msg, msg
+
+
+@pytest.mark.parametrize("field", ["ka", "kd", "ks"])
+def test_a_coefficient_is_any_number_in_0_1_and_a_refusal_names_it(field):
+    """ka, kd, ks: each a number in [0, 1] (ints 0 and 1 too); outside, the message names the
+    field, the range and the value."""
+    for value in (0, 1, 0.0, 0.5, 1.0):
+        assert getattr(Config(**{field: value}), field) == value
+    for value in (-0.25, 1.25, None):
+        with pytest.raises(ConfigError) as e:
+            Config(**{field: value})
+        msg = str(e.value)
+        assert e.value.field == field
+        assert msg.startswith(field) and "[0, 1]" in msg and repr(value) in msg, msg
+
+
+def test_an_unknown_method_lists_every_method_of_the_registry():
+    """method must be a name of rtl/methods.py's METHODS; the refusal names the field, the
+    value and the allowed names, comma-separated in registry order; each name is accepted."""
+    for name in METHODS:
+        assert Config(method=name).method == name
+    with pytest.raises(ConfigError) as e:
+        Config(method="cordic")
+    msg = str(e.value)
+    assert e.value.field == "method" and msg.startswith("method")
+    assert ", ".join(METHODS) in msg and "'cordic'" in msg, msg
+
+
+@pytest.mark.parametrize("field", ["specular", "palette_blend"])
+def test_a_switch_takes_true_or_false_only_and_its_refusal_names_it(field):
+    """specular and palette_blend are bools: both accepted, 0/1/"true" refused with a
+    message that names the field, the value and what is allowed (true or false)."""
+    for value in (True, False):
+        assert getattr(Config(**{field: value}), field) is value
+    for value in (0, 1, "true", None):
+        with pytest.raises(ConfigError) as e:
+            Config(**{field: value})
+        msg = str(e.value)
+        assert e.value.field == field
+        assert msg.startswith(field) and repr(value) in msg and "true or false" in msg, msg
+
+
+def test_replace_lists_every_unknown_field_sorted_and_changes_only_what_it_is_given():
+    """replace refuses unknown fields, naming all of them sorted (the first is ``field``);
+    otherwise it is the Config with those fields changed, validated again."""
+    with pytest.raises(ConfigError) as e:
+        Config().replace(zeta=1, alpha=2, angle_bits=12)
+    assert e.value.field == "alpha"
+    assert str(e.value).endswith(": alpha, zeta"), str(e.value)
+    base = Config(angle_bits=12, frac_bits=13, ks=0.25)
+    assert base.replace(lights=3) == Config(angle_bits=12, frac_bits=13, ks=0.25, lights=3)
+    assert base.replace() == base
+    with pytest.raises(ConfigError) as e:              # B = 9 is below k - 1 = 13 at 16 bits
+        Config(angle_bits=12, frac_bits=9).replace(angle_bits=16)
+    assert e.value.field == "frac_bits"
