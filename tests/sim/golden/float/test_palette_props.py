@@ -1,0 +1,299 @@
+"""The palette method's preprocessing (sim/golden/float/palette.py, palette_quantize.py)
+against closed forms and the properties Tarini et al. Sec. 4-5 state: the least-squares
+normal of a paraboloid (exact: the central difference of a quadratic is its derivative),
+the validators refusing exactly what their docstrings say, every quantized texel a unit
+table normal nearest to its own (to its dithered copy with dithering), Lloyd's iterations
+never raising the weighted error, the material component kept apart and unnormalized."""
+
+import numpy as np
+import pytest
+
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.float.palette import (MATERIAL_SCALE, Material, check_normal_map, color_table,
+                                              displacement_to_normals, frame_directions, lookup,
+                                              mipmap_indices, nearest_spacing, quantize_normal_map)
+from bumprtl.sim.golden.float.palette_quantize import (bayer_offsets, distinct, kmeans, median_cut,
+                                                       nearest)
+
+
+def _normals(t, seed=0, spread=0.6):
+    rng = np.random.default_rng(seed)
+    n = np.concatenate([rng.normal(0, spread, (t, t, 2)), np.ones((t, t, 1))], -1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def _unit(v):
+    v = np.asarray(v, dtype=np.float64)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+# --- Sec. 4.1: displacement -> normals --------------------------------------------------------
+
+@pytest.mark.parametrize("scale", [1.0, 0.25, 3.0])
+def test_paraboloid_normals_are_its_gradient_in_the_interior(scale):
+    """h = c ((r - r0)**2 + (col - c0)**2): the cross's least-squares plane has slopes
+    (dh/dr, dh/dcol) = 2 c (r - r0, col - c0) exactly (a quadratic's central difference), so
+    N = normalize(-s dh/dr, -s dh/dcol, 1) with s = scale; at the apex N = +z."""
+    t, c = 16, 0.05
+    r, col = np.indices((t, t), dtype=np.float64)
+    h = c * ((r - 7) ** 2 + (col - 9) ** 2)
+    n = displacement_to_normals(h, scale)
+    want = _unit(np.stack([-scale * 2 * c * (r - 7), -scale * 2 * c * (col - 9), np.ones_like(h)], -1))
+    assert np.allclose(n[1:-1, 1:-1], want[1:-1, 1:-1], atol=1e-12)
+    assert np.allclose(n[7, 9], [0, 0, 1], atol=1e-15)
+    assert np.allclose(np.linalg.norm(n, axis=-1), 1, atol=1e-15)
+
+
+def test_a_constant_height_and_a_periodic_ramp_along_columns():
+    """A flat map: +z everywhere (any scale). h = sin(2 pi col / T) wraps: N tilts only in
+    y, by the central difference s (sin(w (c + 1)) - sin(w (c - 1))) / 2 = s sin(w) cos(w c)."""
+    assert np.allclose(displacement_to_normals(np.full((8, 8), 5.0), 4.0), [0, 0, 1], atol=1e-13)
+    t = 16
+    w = 2 * np.pi / t
+    col = np.arange(t)[None, :].repeat(t, 0)
+    n = displacement_to_normals(np.sin(w * col), 2.0)
+    slope = 2.0 * np.sin(w) * np.cos(w * col)
+    assert np.allclose(n, _unit(np.stack([np.zeros_like(slope), -slope, np.ones_like(slope)], -1)), atol=1e-12)
+
+
+@pytest.mark.parametrize("height, words", [
+    (np.zeros((4, 4, 1)), "got shape (4, 4, 1)"),
+    (np.zeros(4), "got shape (4,)"),
+    (np.zeros((3, 4)), "got shape (3, 4)"),
+])
+def test_height_maps_that_are_not_square_2d_are_refused_by_shape(height, words):
+    with pytest.raises(BumpError) as e:
+        displacement_to_normals(height)
+    assert str(e.value) == f"height must be a non-empty square 2-D map, {words}"
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_height_map_with_a_non_finite_value_is_refused(bad):
+    h = np.zeros((4, 4))
+    h[2, 1] = bad
+    with pytest.raises(BumpError, match="^height contains NaN or infinity$"):
+        displacement_to_normals(h)
+
+
+# --- check_normal_map --------------------------------------------------------------------------
+
+def test_check_normal_map_returns_the_unit_vectors_of_any_non_zero_lengths():
+    rng = np.random.default_rng(1)
+    n = rng.normal(size=(5, 5, 3)) * rng.uniform(1e-9, 1e3, (5, 5, 1))
+    got = check_normal_map(n)
+    assert np.allclose(np.linalg.norm(got, axis=-1), 1, atol=1e-15)
+    assert np.allclose(got * np.linalg.norm(n, axis=-1, keepdims=True), n, rtol=1e-12)
+    one = check_normal_map(np.array([[[0.0, 0.0, 2.0]]]))           # 1 x 1 is square
+    assert one.tolist() == [[[0.0, 0.0, 1.0]]]
+
+
+@pytest.mark.parametrize("shape", [(4, 4, 4), (4, 4, 2), (4, 4), (4, 4, 3, 1), (4, 3, 3), (0, 0, 3)])
+def test_check_normal_map_refuses_every_other_shape_naming_it(shape):
+    with pytest.raises(BumpError) as e:
+        check_normal_map(np.ones(shape), name="tbl")
+    assert str(e.value) == f"tbl must be a non-empty square (T, T, 3) map, got shape {shape}"
+
+
+def test_check_normal_map_names_the_first_zero_texel_row_then_column():
+    n = _normals(6)
+    n[3, 1] = 0.0
+    n[4, 0] = 0.0
+    with pytest.raises(BumpError) as e:
+        check_normal_map(n, name="m")
+    assert str(e.value) == "m has a zero-length normal at texel (3, 1)"
+    n = _normals(6)
+    n[2, 4, 0] = np.inf
+    with pytest.raises(BumpError, match="^m contains NaN or infinity$"):
+        check_normal_map(n, name="m")
+
+
+# --- Sec. 4: quantization ----------------------------------------------------------------------
+
+def _check_nearest(vectors, table, idx):
+    d = np.linalg.norm(vectors[:, None, :] - table[None], axis=-1)
+    assert np.allclose(d[np.arange(len(vectors)), idx], d.min(-1), rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("quantizer", ["median-cut", "kmeans"])
+@pytest.mark.parametrize("size", [16, 37])
+def test_every_texel_gets_a_unit_table_normal_nearest_to_it(quantizer, size):
+    """Sec. 4: the table has sN unit normals (not the exact case), each index is in it and
+    names the entry nearest to the texel's (normalized) normal; the map keeps its shape."""
+    n = 2.5 * _normals(12, seed=3)                       # not unit: check_normal_map's job
+    q = quantize_normal_map(n, size, quantizer)
+    assert not q.exact and q.size == size == len(q.table) and q.distinct == 144
+    assert q.indices.shape == (12, 12) and q.indices.min() >= 0 and q.indices.max() < size
+    assert np.allclose(np.linalg.norm(q.table, axis=1), 1, atol=1e-15)
+    _check_nearest(_unit(n).reshape(-1, 3), q.table, q.indices.ravel())
+    assert q.materials is None
+
+
+def test_dithering_picks_the_entry_nearest_to_the_bayer_moved_normal():
+    """Sec. 4, Fig. 4: each normal moved by its Bayer offset times the spacing of the table
+    around its nearest entry (the distance to that entry's nearest other entry), then
+    renormalized, gets the entry nearest to the moved normal."""
+    n = _normals(8, seed=4, spread=0.3)
+    q = quantize_normal_map(n, 16, "median-cut", dither=True)
+    flat = n.reshape(-1, 3)
+    d = np.linalg.norm(q.table[:, None] - q.table[None], axis=-1)
+    spacing = np.sort(d, axis=1)[:, 1]
+    own = np.argmin(np.linalg.norm(flat[:, None] - q.table[None], axis=-1), axis=1)
+    moved = _unit(flat + spacing[own][:, None] * bayer_offsets((8, 8)).reshape(-1, 3))
+    _check_nearest(moved, q.table, q.indices.ravel())
+    assert np.array_equal(nearest_spacing(q.table), spacing)
+    plain = quantize_normal_map(n, 16, "median-cut")
+    assert np.array_equal(plain.table, q.table) and not np.array_equal(plain.indices, q.indices)
+
+
+@pytest.mark.parametrize("materials, words", [
+    (np.zeros((8, 7), np.int64), "shape (8, 7) dtype int64"),
+    (np.zeros((8, 8)), "shape (8, 8) dtype float64"),
+    (np.full((8, 8), -1), "shape (8, 8) dtype int64"),
+])
+def test_materials_must_be_a_non_negative_integer_map_like_the_normals(materials, words):
+    with pytest.raises(BumpError) as e:
+        quantize_normal_map(_normals(8), 16, materials=materials)
+    assert str(e.value) == ("materials must be a (T, T) map of non-negative integers like the "
+                            f"normals, got {words}")
+
+
+def test_materials_are_kept_apart_sorted_and_read_back_as_integers():
+    """Sec. 6: the material a fourth component MATERIAL_SCALE apart, so no entry mixes two;
+    the table sorted by material (intervals); materials 0 and 2 (none of 1) read back."""
+    n = _normals(8, seed=5)
+    mats = np.where(np.arange(8)[:, None] < 3, 2, 0) + np.zeros(8, np.int64)
+    for quantizer in ("median-cut", "kmeans"):
+        q = quantize_normal_map(n, 16, quantizer, materials=mats.astype(np.uint8))
+        assert q.materials.dtype == np.int64 and set(q.materials.tolist()) == {0, 2}
+        assert np.all(np.diff(q.materials) >= 0)
+        assert np.array_equal(q.materials[q.indices], mats)
+        assert np.allclose(np.linalg.norm(q.table, axis=1), 1, atol=1e-15)
+
+
+def test_renormalizing_keeps_the_material_component():
+    """Representatives are renormalized on the sphere in their first three components only:
+    a box of one material keeps MATERIAL_SCALE x that material as its fourth."""
+    pts = np.array([[1.0, 0, 0, 0], [0.8, 0.6, 0, 0], [0, 0.6, 0.8, 8.0], [0, 0, 1.0, 8.0]])
+    w = np.array([1.0, 1.0, 1.0, 3.0])
+    for table in (median_cut(pts, w, 2), kmeans(pts, w, 2)):
+        table = table[np.argsort(table[:, 3])]
+        assert table[:, 3].tolist() == [0.0, 8.0]
+        assert np.allclose(np.linalg.norm(table[:, :3], axis=1), 1)
+        assert np.allclose(table[0, :3], _unit([1.8, 0.6, 0])) and np.allclose(table[1, :3], _unit([0, 0.6, 3.8]))
+
+
+def test_lloyd_iterations_never_raise_the_weighted_error():
+    """Lloyd's algorithm: assigning each point its nearest centre and moving each centre to
+    its members' mean never raises the weighted squared error (renormalizing onto the
+    sphere neither, for unit points: the nearest unit vector to a mean is its direction);
+    zero iterations are the median cut."""
+    rng = np.random.default_rng(6)
+    pts, w = distinct(_unit(rng.normal(size=(600, 3)) * [1, 1, 0.3] + [0, 0, 0.8]), rng.uniform(0.5, 3, 600))
+
+    def sse(t):
+        return float(np.sum(w * np.sum((pts - t[nearest(pts, t)]) ** 2, axis=1)))
+    errs = [sse(kmeans(pts, w, 16, iterations=i)) for i in range(6)]
+    assert errs[0] == sse(median_cut(pts, w, 16))
+    assert all(b <= a * (1 + 1e-12) for a, b in zip(errs, errs[1:])), errs
+    assert errs[-1] < 0.98 * errs[0]
+
+
+def test_median_cut_of_as_many_entries_as_points_is_every_point():
+    rng = np.random.default_rng(7)
+    pts = _unit(rng.normal(size=(20, 3)))
+    table = median_cut(pts, rng.uniform(0.1, 5, 20), 20)
+    assert np.allclose(np.sort(table, axis=0), np.sort(pts, axis=0), atol=1e-15)
+
+
+def test_distinct_with_all_weights_zero_is_empty_and_weights_are_summed():
+    v = np.array([[0, 0, 1.0], [0, 0, 1.0], [1.0, 0, 0]])
+    uniq, counts = distinct(v, np.zeros(3))
+    assert uniq.shape == (0, 3) and counts.shape == (0,)
+    uniq, counts = distinct(v, np.array([0.25, 0.5, 2]))
+    assert dict(zip(map(tuple, uniq), counts.tolist())) == {(0, 0, 1): 0.75, (1, 0, 0): 2.0}
+
+
+# --- Sec. 5: mipmaps, lookup, colour tables -----------------------------------------------------
+
+def test_mipmaps_stop_at_the_first_odd_size_and_pick_nearest_to_each_blocks_mean():
+    n = _normals(12, seed=8)
+    q = quantize_normal_map(n, 16, "median-cut")
+    levels = mipmap_indices(q)
+    assert [lv.shape for lv in levels] == [(12, 12), (6, 6), (3, 3)]
+    for k in (1, 2):
+        up = q.table[levels[k - 1]]
+        t = levels[k].shape[0]
+        mean = _unit(up.reshape(t, 2, t, 2, 3).mean(axis=(1, 3))).reshape(-1, 3)
+        _check_nearest(mean, q.table, levels[k].ravel())
+
+
+def test_lookup_accepts_exactly_the_table_indices():
+    """Indices in [0, len(table) - 1]: both ends read their rows; -1 and len(table) are
+    refused naming the index and the range; non-integer indices are refused."""
+    table = np.arange(12).reshape(3, 4)
+    assert lookup(np.array([[0, 2], [1, 0]]), table).tolist() == [[table[0].tolist(), table[2].tolist()],
+                                                                  [table[1].tolist(), table[0].tolist()]]
+    assert lookup(np.array([], np.int64), table).shape == (0, 4)
+    for bad in (3, -1):
+        with pytest.raises(BumpError) as e:
+            lookup(np.array([0, bad, 1]), table)
+        assert str(e.value) == f"index {bad} is outside the table: allowed [0, 2]"
+    with pytest.raises(BumpError, match="^indices must be integers, got dtype float64$"):
+        lookup(np.array([0.0, 1.0]), table)
+
+
+def test_colour_table_needs_parameters_for_every_material_it_names():
+    table = _normals(2).reshape(-1, 3)
+    params = [Material(), Material(kd=0.2)]
+    ok = color_table(table, "lambert", [0, 0, 1.0], [0, 0, 1.0], materials=np.array([0, 1, 1, 0]),
+                     material_params=params)
+    assert ok.shape == (4, 4)
+    with pytest.raises(BumpError) as e:
+        color_table(table, "lambert", [0, 0, 1.0], [0, 0, 1.0], materials=np.array([0, 2, 1, 0]),
+                    material_params=params)
+    assert str(e.value) == "material 2 has no parameters: allowed [0, 1]"
+    with pytest.raises(BumpError) as e:
+        color_table(table, "Lambert", [0, 0, 1.0], [0, 0, 1.0])
+    assert str(e.value) == "lighting must be one of lambert, phong, chrome, toon, got 'Lambert'"
+
+
+def test_lambert_and_phong_tables_of_unnormalized_inputs_are_eq_2():
+    """Sec. 5.1 items 1-2: RGB = (ka + kd sum clamp(N.L)) x colour (+ ks sum clamp(N.H)**n
+    with H = normalize(L + V) for phong), alpha the Lambert intensity, all clamped to
+    [0, 1]; table, lights and view normalized first."""
+    mat = Material(ka=0.05, kd=0.6, ks=0.3, spec_exponent=8, color=(1.0, 0.5, 0.25))
+    table = _normals(3, seed=9).reshape(-1, 3)
+    lights = np.array([[0, 0, 3.0], [0.6, 0, 0.8]])
+    view = np.array([0, 1.2, 1.6])
+    lu, vu = _unit(lights), _unit(view)
+    lam = mat.ka + mat.kd * np.clip(table @ lu.T, 0, 1).sum(-1)
+    spec = mat.ks * (np.clip(table @ _unit(lu + vu).T, 0, 1) ** 8).sum(-1)
+    col = np.array(mat.color)
+    got = color_table(5 * table, "lambert", lights, view, material_params=[mat])
+    assert np.allclose(got[:, :3], np.clip(lam[:, None] * col, 0, 1)) and np.allclose(got[:, 3], np.clip(lam, 0, 1))
+    got = color_table(table, "phong", lights, view, material_params=[mat])
+    assert np.allclose(got[:, :3], np.clip(lam[:, None] * col + spec[:, None], 0, 1))
+
+
+def test_chrome_is_the_environment_of_the_view_reflected_about_the_normal():
+    """Sec. 5.1 item 6: R = 2 (N.V) N - V; a normal along V reflects V onto itself, a
+    normal at 45 degrees between V = +x and +z reflects V to +z (the sky) or -z (ground)."""
+    view = np.array([1.0, 0, 0])
+    table = np.array([[1.0, 0, 0], _unit([1.0, 0, 1.0]), _unit([1.0, 0, -1.0])])
+    c = color_table(table, "chrome", [0, 0, 1.0], view)
+    sky = lambda z: np.array([0.35, 0.55, 0.95]) + (1 - z) * np.array([0.4, 0.3, 0.05])
+    assert np.allclose(c[0, :3], np.clip(sky(0.0), 0, 1))        # R = V, horizon: z = 0
+    assert np.allclose(c[1, :3], sky(1.0))                       # R = +z
+    assert np.allclose(c[2, :3], 0.0)                            # R = -z: ground x (1 + z) = 0
+
+
+def test_frame_view_is_the_reflection_of_the_light_about_the_half_vector():
+    """V = 2 (L.H) H - L: then H is the half vector normalize(L + V) and |V| = 1."""
+    from bumprtl.sim.scenes import load_scene
+    scene = load_scene("bumps", size=16)
+    l, v = frame_directions(scene)
+    assert np.allclose(np.linalg.norm(l), 1) and np.allclose(np.linalg.norm(v), 1)
+    px, m = scene.px, scene.mask
+    h = _unit(np.stack([np.sin(px.h_theta) * np.cos(px.h_phi), np.sin(px.h_theta) * np.sin(px.h_phi),
+                        np.cos(px.h_theta)], -1)[m].mean(0))
+    assert np.allclose(_unit(l[0] + v[0]), h)
