@@ -177,3 +177,101 @@ def test_crater_scene_is_the_bumps_plane_with_its_own_heights_normals():
     # a bowl and a rim each: the field goes below and above its zero level
     assert sc.height.min() < 0 < sc.height.max()
     assert not np.array_equal(crater_scene(size=size, seed=1).height, sc.height)
+
+
+def _sensitivity(px, field, angles):
+    """sum over ``angles`` of |d(255 x float64 ``field``)/d angle| (central differences)."""
+    keys = {f: getattr(px, f) for f in FIELDS}
+    total = 0.0
+    for name in angles:
+        hi = np.pi if name.endswith("theta") else 2 * np.pi
+        up = PixelInputs(**{**keys, name: np.clip(keys[name] + 1e-6, 0, hi)})
+        dn = PixelInputs(**{**keys, name: np.clip(keys[name] - 1e-6, 0, hi)})
+        total = total + np.abs(getattr(conventional(up, CFG), field) - getattr(conventional(dn, CFG), field)) * 255 / 2e-6
+    return total
+
+
+def test_adversarial_pixels_keep_the_most_sensitive_unclamped_candidates():
+    """Step 1: the kept pixels are where 255 N'.L' is not clamped (N'.L' in (0.02, 0.98),
+    up to the half step they moved) and most sensitive to its six angles: their summed
+    |slope| beats 95 % of random valid unclamped pixels."""
+    from bumprtl.sim.golden.accuracy import ANGLES_OF, adversarial_pixels
+    keep = 20
+    px = adversarial_pixels(CFG, candidates=4000, keep=keep, seed=12, channel="diffuse").subset(slice(0, keep))
+    d = conventional(px, CFG).ndotl
+    assert d.min() > 0.02 - 0.01 and d.max() < 0.98 + 0.01
+    ref = PixelInputs.random(4000, np.random.default_rng(13))
+    r = conventional(ref, CFG).ndotl
+    ref = ref.subset((r > 0.02) & (r < 0.98))
+    angles = ANGLES_OF["diffuse"]
+    assert np.median(_sensitivity(px, "ndotl", angles)) > np.quantile(_sensitivity(ref, "ndotl", angles), 0.95)
+
+
+def test_adversarial_specular_pixels_sit_inside_the_highlight_slope():
+    """For specular the kept pixels have 255 cos^n strictly inside (0.5, 254.5) (up to the
+    half step they moved) and N'.H' close to 1 (cos^n has a slope only there)."""
+    from bumprtl.sim.golden.accuracy import adversarial_pixels
+    keep = 20
+    px = adversarial_pixels(CFG, candidates=4000, keep=keep, seed=14, channel="specular").subset(slice(0, keep))
+    s = 255 * conventional(px, CFG).specular
+    assert s.min() > 0.3 and s.max() < 254.7
+    assert conventional(px, CFG).ndoth.min() > 1 - 4 / CFG.spec_exponent
+
+
+def test_arithmetic_pixels_put_h_on_the_grid_point_nearest_n_prime_and_its_neighbours():
+    """Step 1-2: in the middle block H is the grid point nearest world N' (each of its
+    angles within half a step of N''s); block (dt, dp) has H dt steps off in theta and dp in
+    phi (theta clipped to [0, pi], phi wrapping); N and N' on the grid with N' in the upper
+    tangent hemisphere."""
+    from bumprtl.sim.golden.accuracy import arithmetic_pixels
+    from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
+    keep, reach = 10, 2
+    px = arithmetic_pixels(datapath_fixed, CFG, candidates=1000, keep=keep, seed=8, reach=reach)
+    side = 2 * reach + 1
+    blocks = [px.subset(slice(i * keep, (i + 1) * keep)) for i in range(side * side)]
+    mid = blocks[reach * side + reach]
+    w_phi, w_theta = cartesian_to_polar(world_bump_normal(mid.n_phi, mid.n_theta, mid.b_phi, mid.b_theta))
+    assert np.abs(mid.h_theta - w_theta).max() <= STEP / 2 + 1e-9
+    dphi = np.abs(mid.h_phi - w_phi)
+    assert np.minimum(dphi, 2 * np.pi - dphi).max() <= STEP / 2 + 1e-9
+    for i, blk in enumerate(blocks):
+        dt, dp = i // side - reach, i % side - reach
+        want_t = np.clip(np.rint(mid.h_theta / STEP) + dt, 0, CFG.full_circle // 2)
+        want_p = (np.rint(mid.h_phi / STEP) + dp) % CFG.full_circle
+        assert np.array_equal(np.rint(blk.h_theta / STEP), want_t), (dt, dp)
+        assert np.array_equal(np.rint(blk.h_phi / STEP), want_p), (dt, dp)
+        for f in ("n_phi", "n_theta", "b_phi", "b_theta"):
+            assert np.array_equal(getattr(blk, f), getattr(mid, f)), f
+    assert px.b_theta.max() <= np.pi / 2
+
+
+def test_arithmetic_pixels_keep_the_n_prime_whose_error_stays_whatever_h():
+    """Step 1: the kept N' have the largest mean model error of N'.H' over H at the grid
+    point nearest N' and its four neighbours: larger than that of most random N' so
+    placed."""
+    from bumprtl.sim.golden.accuracy import arithmetic_pixels
+    keep, reach = 10, 1
+    px = arithmetic_pixels(datapath_fixed, CFG, candidates=3000, keep=keep, seed=9, reach=reach)
+    side = 2 * reach + 1
+    m = keep * side * side
+    grid = px.subset(slice(0, m))
+
+    def dot_error(p):
+        return datapath_fixed(encode_pixels(p, CFG), CFG)["ndoth"] / CFG.one - conventional(p, CFG).ndoth
+    err = dot_error(grid).reshape(side, side, keep)
+    persistent = np.abs(err[reach, reach] + err[reach - 1, reach] + err[reach + 1, reach]
+                        + err[reach, reach - 1] + err[reach, reach + 1])
+    # random N, N' on the grid with H the grid point nearest N' and its 4 neighbours
+    from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
+    rng = np.random.default_rng(10)
+    n, full = 3000, CFG.full_circle
+    c = {"n_phi": rng.integers(0, full, n), "n_theta": rng.integers(0, full // 2 + 1, n),
+         "b_phi": rng.integers(0, full, n), "b_theta": rng.integers(0, full // 4 + 1, n)}
+    ang = {k: v * STEP for k, v in c.items()}
+    hp, ht = cartesian_to_polar(world_bump_normal(ang["n_phi"], ang["n_theta"], ang["b_phi"], ang["b_theta"]))
+    total = 0
+    for dt, dp in ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)):
+        t = np.clip(np.rint(ht / STEP) + dt, 0, full // 2) * STEP
+        p = ((np.rint(hp / STEP) + dp) % full) * STEP
+        total = total + dot_error(PixelInputs(**ang, h_phi=p, h_theta=t, l_phi=p, l_theta=t))
+    assert np.median(persistent) > np.quantile(np.abs(total), 0.99)
