@@ -297,3 +297,70 @@ def test_frame_view_is_the_reflection_of_the_light_about_the_half_vector():
     h = _unit(np.stack([np.sin(px.h_theta) * np.cos(px.h_phi), np.sin(px.h_theta) * np.sin(px.h_phi),
                         np.cos(px.h_theta)], -1)[m].mean(0))
     assert np.allclose(_unit(l[0] + v[0]), h)
+
+
+# --- Sec. 5 on a scene: the object-space normal map -------------------------------------------
+
+def _tangent(n_phi, n_theta):
+    """M = R_y(-th_N) R_z(-ph_N) (Lee Sec. 3.1.1), built here."""
+    cp, sp, ct, st = np.cos(n_phi), np.sin(n_phi), np.cos(n_theta), np.sin(n_theta)
+    rz = np.array([[cp, sp, 0], [-sp, cp, 0], [0, 0, 1.0]])
+    ry = np.array([[ct, 0, -st], [0, 1.0, 0], [st, 0, ct]])
+    return ry @ rz
+
+
+def _polar(phi, theta):
+    return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1)
+
+
+def test_world_normal_map_sums_each_texels_pixels_and_turns_unused_ones_by_the_mean_frame():
+    """Per used texel the sum over its covered pixels of M^T N' (counts = those pixels);
+    an unused texel (count 0) holds its map N' turned by the frame of the covered pixels'
+    mean N (normalized); distinct_normals counts the distinct directions of the used texels."""
+    from bumprtl.sim.golden.float.palette import distinct_normals, world_normal_map
+    from bumprtl.sim.scenes import load_scene
+    scene = load_scene("bumps", size=64, texture_size=16, geometry="sphere")
+    t = scene.texture_size
+    normals, counts = world_normal_map(scene)
+    assert normals.shape == (t, t, 3) and counts.shape == (t, t)
+    px, m = scene.px, scene.mask
+    want = np.zeros((t, t, 3))
+    want_counts = np.zeros((t, t), np.int64)
+    for i in zip(*np.nonzero(m)):
+        world = _tangent(px.n_phi[i], px.n_theta[i]).T @ _polar(px.b_phi[i], px.b_theta[i])
+        want[scene.v[i], scene.u[i]] += world
+        want_counts[scene.v[i], scene.u[i]] += 1
+    used = want_counts > 0
+    assert np.array_equal(counts, want_counts) and 0 < used.sum() < t * t
+    assert np.allclose(normals[used], want[used], atol=1e-12)
+    mean = _polar(px.n_phi[m], px.n_theta[m]).mean(0)
+    mean /= np.linalg.norm(mean)
+    frame = _tangent(np.arctan2(mean[1], mean[0]) % (2 * np.pi), np.arccos(mean[2]))
+    fallback = _polar(scene.b_phi_map, scene.b_theta_map) @ frame
+    assert np.allclose(normals[~used], fallback[~used], atol=1e-12)
+    unit = want[used] / np.linalg.norm(want[used], axis=-1, keepdims=True)
+    assert distinct_normals(scene) == len(np.unique(unit, axis=0))
+
+
+def test_a_palette_holding_every_normal_renders_the_exact_dots():
+    """With sN at least the distinct normals, render_palette's N'.L and N'.H are the
+    per-texel normal's dot with the frame's L and H = normalize(L + V); the colour is the
+    mean of the 8-bit table's RGB of each pixel's entry."""
+    from bumprtl.rtl.config import Config
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.float.palette import distinct_normals, render_palette, world_normal_map
+    from bumprtl.sim.scenes import load_scene
+    scene = load_scene("bumps", size=32)
+    cfg = Config()
+    normals, _ = world_normal_map(scene)
+    n = normals / np.linalg.norm(normals, axis=-1, keepdims=True)
+    size = max(16, distinct_normals(scene))
+    r = render_palette(scene, cfg, size, "median-cut")
+    l, v = frame_directions(scene)
+    h = _unit(l[0] + v[0])
+    texel = n[scene.v, scene.u]
+    assert np.allclose(r.ndotl, texel @ l[0], atol=1e-12) and np.allclose(r.ndoth, texel @ h, atol=1e-12)
+    assert np.allclose(r.diffuse, np.clip(texel @ l[0], 0, 1), atol=1e-12)
+    table = color_table(texel.reshape(-1, 3), "phong", l, v, cfg)
+    rgb = to_8bit(table)[:, :3].reshape(texel.shape) / 255.0
+    assert np.allclose(r.color, rgb.mean(-1), atol=1e-12)
