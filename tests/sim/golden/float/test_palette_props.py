@@ -276,15 +276,23 @@ def test_lambert_and_phong_tables_of_unnormalized_inputs_are_eq_2():
 
 
 def test_chrome_is_the_environment_of_the_view_reflected_about_the_normal():
-    """Sec. 5.1 item 6: R = 2 (N.V) N - V; a normal along V reflects V onto itself, a
-    normal at 45 degrees between V = +x and +z reflects V to +z (the sky) or -z (ground)."""
-    view = np.array([1.0, 0, 0])
-    table = np.array([[1.0, 0, 0], _unit([1.0, 0, 1.0]), _unit([1.0, 0, -1.0])])
-    c = color_table(table, "chrome", [0, 0, 1.0], view)
-    sky = lambda z: np.array([0.35, 0.55, 0.95]) + (1 - z) * np.array([0.4, 0.3, 0.05])
-    assert np.allclose(c[0, :3], np.clip(sky(0.0), 0, 1))        # R = V, horizon: z = 0
-    assert np.allclose(c[1, :3], sky(1.0))                       # R = +z
-    assert np.allclose(c[2, :3], 0.0)                            # R = -z: ground x (1 + z) = 0
+    """Sec. 5.1 item 6: the colour is the landscape's in the direction R = 2 (N.V) N - V,
+    which depends on R's height z alone (world z up): normals reflecting V to directions
+    of one z but other azimuths get one colour; blue dominates above the horizon, brown
+    (red over blue) below; the lights play no part."""
+    rng = np.random.default_rng(10)
+    view = _unit([0.3, -0.4, 0.5])
+    z = rng.uniform(-0.95, 0.95, 40)
+    az = rng.uniform(0, 2 * np.pi, (2, 40))
+    reflected = [np.stack([np.sqrt(1 - z * z) * np.cos(a), np.sqrt(1 - z * z) * np.sin(a), z], -1) for a in az]
+    normals = [_unit(r + view) for r in reflected]            # the normal halving V and R
+    c0 = color_table(normals[0], "chrome", [0, 0, 1.0], view)
+    c1 = color_table(normals[1], "chrome", [1.0, 0, 0], view)
+    assert np.allclose(c0[:, :3], c1[:, :3], atol=1e-12)
+    up, down = z > 0.05, z < -0.05
+    assert np.all(c0[up, 2] > c0[up, 0]) and np.all(c0[down, 0] > c0[down, 2])
+    order = np.argsort(z[up])
+    assert not np.allclose(c0[up][order[0], :3], c0[up][order[-1], :3])  # it does vary with z
 
 
 def test_frame_view_is_the_reflection_of_the_light_about_the_half_vector():
@@ -364,3 +372,25 @@ def test_a_palette_holding_every_normal_renders_the_exact_dots():
     table = color_table(texel.reshape(-1, 3), "phong", l, v, cfg)
     rgb = to_8bit(table)[:, :3].reshape(texel.shape) / 255.0
     assert np.allclose(r.color, rgb.mean(-1), atol=1e-12)
+
+
+def test_toon_shades_three_bands_rising_with_lambert_and_a_white_highlight():
+    """Sec. 5.1 item 4: three intensity bands, non-decreasing with the Lambert intensity,
+    times the material colour; a hard highlight is white (1, 1, 1), and only normals near H
+    get it."""
+    light = np.array([0, 0, 1.0])
+    view = _unit([0.6, 0, 0.8])
+    h = _unit(light + view)
+    angle = np.linspace(0, np.pi / 2, 400)
+    table = np.stack([np.sin(angle), np.zeros_like(angle), np.cos(angle)], -1)   # N.L = cos
+    plain = color_table(table, "toon", light, view, material_params=[Material(ks=0.0, color=(1.0, 0.5, 0.25))])
+    levels = np.unique(np.round(plain[:, 0], 12))
+    assert len(levels) == 3
+    order = np.argsort(plain[:, 3])
+    assert np.all(np.diff(plain[order, 0]) >= 0)
+    assert np.allclose(plain[:, 1], plain[:, 0] * 0.5) and np.allclose(plain[:, 2], plain[:, 0] * 0.25)
+    shiny = color_table(np.concatenate([table, h[None]]), "toon", light, view,
+                        material_params=[Material(ks=0.5, spec_exponent=64)])
+    assert np.allclose(shiny[-1, :3], 1.0)
+    far = table @ h < 0.9
+    assert np.all(shiny[:-1][far, 0] < 1.0) and len(np.unique(np.round(shiny[:-1][far, 0], 12))) <= 3
