@@ -198,6 +198,40 @@ def test_lloyd_iterations_never_raise_the_weighted_error():
     assert errs[-1] < 0.98 * errs[0]
 
 
+def test_an_empty_centre_is_reseeded_at_the_point_worst_served():
+    """Four unit normals on an arc (angles 0, 0.1, 0.5, 0.55 rad, weights 3, 1, 0.5, 2):
+    median cut's box {0.1, 0.5} has its mean (0.23 rad) nearer to no point than the other
+    entries are, so Lloyd's first step empties it; it is re-seeded at the point then worst
+    served (0.1 rad, 0.075 rad from the nearest moved centre), and the table ends as the
+    point at 0 rad, that point, and the weighted mean of the last two."""
+    a = np.array([0.0, 0.1, 0.5, 0.55])
+    pts = np.stack([np.cos(a), np.sin(a), np.zeros(4)], -1)
+    w = np.array([3.0, 1.0, 0.5, 2.0])
+    mc = median_cut(pts, w, 3)
+    d = np.linalg.norm(pts[:, None] - mc[None], axis=-1)
+    assert len(set(np.argmin(d, axis=1).tolist())) == 2                  # one entry serves no point
+    one = kmeans(pts, w, 3, iterations=1)
+    assert any(np.array_equal(row, pts[1]) for row in one)
+    final = kmeans(pts, w, 3)
+    mean = _unit(w[2] * pts[2] + w[3] * pts[3])
+    want = sorted(map(tuple, np.round([pts[0], pts[1], mean], 12)))
+    assert sorted(map(tuple, np.round(final, 12))) == want
+
+    def sse(t):
+        return float(np.sum(w * np.min(np.sum((pts[:, None] - t[None]) ** 2, axis=-1), axis=1)))
+    assert sse(final) < sse(mc)
+
+
+def test_median_cut_never_cuts_between_equal_coordinates():
+    """The cut lies between distinct values of the longest axis: three points at x = 0 and
+    two at x = 1 split 3 | 2 even where the weighted median falls among the three."""
+    pts = np.array([[0, 0, 1.0], [0, 0.05, 1.0], [0, 0.1, 1.0], [1.0, 0, 1.0], [1.0, 0.1, 1.0]])
+    for w in (np.ones(5), np.array([1.0, 1.0, 1.0, 0.5, 0.5]), np.array([0.2, 0.2, 0.2, 5.0, 5.0])):
+        table = median_cut(pts, w, 2)
+        want = [_unit(np.average(pts[:3], axis=0, weights=w[:3])), _unit(np.average(pts[3:], axis=0, weights=w[3:]))]
+        assert sorted(map(tuple, np.round(table, 12))) == sorted(map(tuple, np.round(want, 12)))
+
+
 def test_median_cut_of_as_many_entries_as_points_is_every_point():
     rng = np.random.default_rng(7)
     pts = _unit(rng.normal(size=(20, 3)))
