@@ -226,3 +226,34 @@ def test_isqrt_at_the_top_of_its_range_and_every_small_value():
     assert isqrt(x).tolist() == [math.isqrt(int(v)) for v in x]
     small = np.arange(1 << 16)
     assert isqrt(small).tolist() == [math.isqrt(int(v)) for v in small]
+
+
+# --- every refusal's whole message ---------------------------------------------------------------
+
+def test_refusals_name_the_parameter_the_value_and_what_is_allowed():
+    """The searches' channel, the quantizer, the palette size and the memory image's level
+    count: each message whole (a regex match would let text be added around it)."""
+    from bumprtl.sim.golden.accuracy import adversarial_pixels, worst_case_pixels
+    from bumprtl.sim.golden.fixed.pipeline import map_words
+    from bumprtl.sim.golden.float.palette import quantize_normal_map
+    from bumprtl.sim.golden.float.palette_quantize import check_palette_size
+    from bumprtl.sim.golden.methods import datapath_fixed
+    from bumprtl.sim.scenes.config import load_scene_config
+    cfg = Config()
+    for call in (lambda: adversarial_pixels(cfg, candidates=10, keep=2, channel="blend"),
+                 lambda: worst_case_pixels(datapath_fixed, cfg, "blend", candidates=10, keep=2)):
+        with pytest.raises(BumpError) as e:
+            call()
+        assert str(e.value) == "channel must be one of diffuse, specular, color, got 'blend'"
+    normals = np.tile([0.0, 0.0, 1.0], (4, 4, 1))
+    with pytest.raises(BumpError) as e:
+        quantize_normal_map(normals, 16, "octree")
+    assert str(e.value) == "quantizer must be one of median-cut, kmeans, got 'octree'"
+    for size in (15, 16385, 16.0, False):
+        with pytest.raises(BumpError) as e:
+            check_palette_size(size)
+        assert str(e.value) == f"palette_size must be an integer in [16, 16384], got {size!r}"
+    scene = load_scene_config("default", {"texture_size": 16, "mip_levels": 2})
+    with pytest.raises(ValueError) as e:
+        map_words([np.zeros((16, 16))], scene)
+    assert str(e.value) == "1 levels given, the scene has 2"
