@@ -275,3 +275,16 @@ def test_arithmetic_pixels_keep_the_n_prime_whose_error_stays_whatever_h():
         p = ((np.rint(hp / STEP) + dp) % full) * STEP
         total = total + dot_error(PixelInputs(**ang, h_phi=p, h_theta=t, l_phi=p, l_theta=t))
     assert np.median(persistent) > np.quantile(np.abs(total), 0.99)
+
+
+def test_steep_pixels_of_a_small_exponent_keep_h_above_the_bump():
+    """n < 4: 1 - 4 / n is below 0, so N'.H is drawn uniformly in [0, 1] (H never below
+    N'), L unmoved for the specular channel."""
+    from bumprtl.sim.golden.accuracy import steep_pixels
+    from bumprtl.sim.golden.common import world_bump_normal
+    cfg = Config(spec_exponent=2)
+    px = steep_pixels(4000, np.random.default_rng(6), cfg, "specular")
+    nw = world_bump_normal(px.n_phi, px.n_theta, px.b_phi, px.b_theta)
+    c = np.einsum("ni,ni->n", nw, polar_to_cartesian(px.h_phi, px.h_theta))
+    assert c.min() >= -1e-12 and c.max() <= 1 + 1e-12
+    assert abs(c.mean() - 0.5) < 0.02 and np.quantile(c, 0.02) < 0.05
