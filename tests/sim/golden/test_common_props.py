@@ -136,6 +136,14 @@ def test_polar_and_cartesian_are_inverse_for_any_length():
     assert np.allclose(p[:3], [0, np.pi / 2, 3 * np.pi / 2]) and np.allclose(t, [np.pi / 2] * 3 + [0, np.pi])
 
 
+def test_a_zero_vector_has_finite_angles_in_range():
+    """A zero vector (no direction; cartesian_to_polar divides by the length only where
+    it is not 0) gets finite angles in their ranges, which PixelInputs accepts."""
+    p, t = cartesian_to_polar(np.zeros((2, 3)))
+    assert np.all(np.isfinite(p)) and np.all(np.isfinite(t))
+    assert p.min() >= 0 and p.max() < 2 * np.pi and t.min() >= 0 and t.max() <= np.pi
+
+
 def test_the_tangent_rotation_is_a_rotation_taking_n_to_z_and_world_bump_normal_undoes_it():
     """M is orthonormal with det +1 and M N = +z; world_bump_normal = M^T N' so that
     M (world N') = N'."""

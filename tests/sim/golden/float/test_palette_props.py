@@ -85,6 +85,8 @@ def test_check_normal_map_returns_the_unit_vectors_of_any_non_zero_lengths():
     assert np.allclose(got * np.linalg.norm(n, axis=-1, keepdims=True), n, rtol=1e-12)
     one = check_normal_map(np.array([[[0.0, 0.0, 2.0]]]))           # 1 x 1 is square
     assert one.tolist() == [[[0.0, 0.0, 1.0]]]
+    tiny = check_normal_map(np.array([[[1e-12, 0.0, 0.0]]]))        # short but not zero
+    assert tiny.tolist() == [[[1.0, 0.0, 0.0]]]
 
 
 @pytest.mark.parametrize("shape", [(4, 4, 4), (4, 4, 2), (4, 4), (4, 4, 3, 1), (4, 3, 3), (0, 0, 3)])
@@ -220,6 +222,44 @@ def test_an_empty_centre_is_reseeded_at_the_point_worst_served():
     def sse(t):
         return float(np.sum(w * np.min(np.sum((pts[:, None] - t[None]) ** 2, axis=-1), axis=1)))
     assert sse(final) < sse(mc)
+
+
+def _lloyd_step(pts, w, table):
+    """One step of the documented k-means: each point to its nearest centre, each centre
+    to the renormalized weighted mean of its members, each emptied centre to one of the
+    points worst served by the moved centres (worst first)."""
+    idx = np.argmin(np.sum((pts[:, None] - table[None]) ** 2, axis=-1), axis=1)
+    moved = table.copy()
+    empty = []
+    for j in range(len(table)):
+        if np.any(idx == j):
+            m = np.sum(w[idx == j, None] * pts[idx == j], axis=0)
+            moved[j] = m / np.linalg.norm(m)
+        else:
+            empty.append(j)
+    err = np.sum((pts - moved[idx]) ** 2, axis=1)
+    order = np.argsort(err)[::-1]
+    assert len(set(np.round(err[order[:len(empty) + 1]], 12))) == len(empty) + 1   # no ties
+    moved[empty] = pts[order[:len(empty)]]
+    return moved, empty
+
+
+@pytest.mark.parametrize("angles, weights, size", [
+    ([0.0, 0.1, 0.5, 0.55], [3.0, 1.0, 0.5, 2.0], 3),                   # the first entry empties
+    ([0.0, -0.1, -0.5, -0.55], [3.0, 1.0, 0.5, 2.0], 3),                # mirrored
+    ([0.06, 0.08, 0.1, 0.39, 0.44, 0.48, 0.7], [1.0, 2.9, 0.5, 0.7, 1.6, 2.6, 0.3], 3),   # the last
+    ([0.05, 0.07, 0.38, 0.41, 0.46, 0.68, 0.78], [1.9, 0.5, 0.8, 3.3, 2.5, 1.4, 3.5], 5),  # two
+])
+def test_one_kmeans_step_is_lloyds_with_emptied_centres_reseeded(angles, weights, size):
+    """kmeans(iterations=1) from median cut's table is one Lloyd step with each emptied
+    centre re-seeded at a point worst served (a step worked here; median cut of these
+    arcs empties the entries named)."""
+    a, w = np.array(angles), np.array(weights)
+    pts = np.stack([np.cos(a), np.sin(a), np.zeros(len(a))], -1)
+    want, empty = _lloyd_step(pts, w, median_cut(pts, w, size))
+    assert empty
+    got = kmeans(pts, w, size, iterations=1)
+    assert sorted(map(tuple, np.round(got, 12))) == sorted(map(tuple, np.round(want, 12)))
 
 
 def test_median_cut_never_cuts_between_equal_coordinates():
