@@ -288,3 +288,16 @@ def test_steep_pixels_of_a_small_exponent_keep_h_above_the_bump():
     c = np.einsum("ni,ni->n", nw, polar_to_cartesian(px.h_phi, px.h_theta))
     assert c.min() >= -1e-12 and c.max() <= 1 + 1e-12
     assert abs(c.mean() - 0.5) < 0.02 and np.quantile(c, 0.02) < 0.05
+
+
+def test_a_crater_is_a_continuous_bowl_with_a_raised_rim():
+    """One crater (count = 1, the same centre and radius at any size): its height field is
+    continuous, so doubling the resolution halves the largest step between neighbouring
+    texels; it goes below the plain (the bowl) and above it by a tenth of that depth or
+    more (a raised rim)."""
+    steps = []
+    for size in (64, 128, 256):
+        h = crater_scene(size=size, seed=5, count=1).height
+        steps.append(max(np.abs(h - np.roll(h, 1, a)).max() for a in (0, 1)))
+        assert h.min() < 0 and h.max() > 0.1 * -h.min()
+    assert steps[0] / steps[1] > 1.6 and steps[1] / steps[2] > 1.6, steps
