@@ -172,6 +172,17 @@ def test_materials_are_kept_apart_sorted_and_read_back_as_integers():
         assert np.allclose(np.linalg.norm(q.table, axis=1), 1, atol=1e-15)
 
 
+def test_dithering_keeps_each_texels_material():
+    """Sec. 6 with Sec. 4's dithering: the Bayer offset moves the normal only (then
+    renormalized), never the material component, so every texel still gets an entry of
+    its own material, even between neighbouring material ids (40 and 41)."""
+    n = _normals(16, seed=6, spread=0.4)
+    mats = 40 + (np.arange(16)[:, None] + np.arange(16)[None, :]) % 2
+    q = quantize_normal_map(n, 16, "median-cut", dither=True, materials=mats)
+    assert not q.exact and set(q.materials.tolist()) == {40, 41}
+    assert np.array_equal(q.materials[q.indices], mats)
+
+
 def test_renormalizing_keeps_the_material_component():
     """Representatives are renormalized on the sphere in their first three components only:
     a box of one material keeps MATERIAL_SCALE x that material as its fourth."""
