@@ -479,3 +479,16 @@ def test_toon_shades_three_bands_rising_with_lambert_and_a_white_highlight():
     assert np.allclose(shiny[-1, :3], 1.0)
     far = table @ h < 0.9
     assert np.all(shiny[:-1][far, 0] < 1.0) and len(np.unique(np.round(shiny[:-1][far, 0], 12))) <= 3
+
+
+def test_the_blend_layout_clamps_a_highlight_summed_over_lights_to_1():
+    """Sec. 7.1/7.2 layout: RGB the specular sum ks sum clamp(N.H)**n clamped to [0, 1]
+    (two full highlights sum to 2), alpha the Lambert intensity clamped likewise."""
+    light = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+    view = np.array([0, 0, 1.0])
+    table = np.array([[0, 0, 1.0], _unit([1.0, 0, 1.0])])
+    c = color_table(table, "phong", light, view, blend=True,
+                    material_params=[Material(ka=0.5, kd=1.0, ks=1.0, spec_exponent=4)])
+    assert np.allclose(c[0], [1.0, 1.0, 1.0, 1.0])
+    h = 1 / np.sqrt(2)
+    assert np.allclose(c[1, :3], min(1.0, 2 * h ** 4)) and np.allclose(c[1, 3], min(1.0, 0.5 + 2 * h))
