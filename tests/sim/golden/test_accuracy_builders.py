@@ -301,3 +301,18 @@ def test_a_crater_is_a_continuous_bowl_with_a_raised_rim():
         steps.append(max(np.abs(h - np.roll(h, 1, a)).max() for a in (0, 1)))
         assert h.min() < 0 and h.max() > 0.1 * -h.min()
     assert steps[0] / steps[1] > 1.6 and steps[1] / steps[2] > 1.6, steps
+
+
+def test_a_craters_bowl_is_round_on_the_torus():
+    """One crater's bowl (where the height is below the plain) is a disc around its lowest
+    point, the map wrapping at its edges: as many rows as columns across (within a texel),
+    and the area of a disc of that diameter (within 15 %)."""
+    size = 256
+    for seed in (5, 6, 7):
+        h = crater_scene(size=size, seed=seed, count=1).height
+        i, j = np.unravel_index(np.argmin(h), h.shape)
+        bowl = np.roll(h, (size // 2 - i, size // 2 - j), axis=(0, 1)) < 0
+        rows, cols = np.nonzero(bowl.any(1))[0], np.nonzero(bowl.any(0))[0]
+        across_v, across_u = np.ptp(rows) + 1, np.ptp(cols) + 1
+        assert abs(across_v - across_u) <= 1, (seed, across_v, across_u)
+        assert abs(bowl.sum() / (np.pi * across_u ** 2 / 4) - 1) < 0.15, seed

@@ -348,7 +348,7 @@ def test_lambert_and_phong_tables_of_unnormalized_inputs_are_eq_2():
     [0, 1]; table, lights and view normalized first."""
     mat = Material(ka=0.05, kd=0.6, ks=0.3, spec_exponent=8, color=(1.0, 0.5, 0.25))
     table = _normals(3, seed=9).reshape(-1, 3)
-    lights = np.array([[0, 0, 3.0], [0.6, 0, 0.8]])
+    lights = np.array([[0, 0, 3.0], [0.6, 0, 0.8], [-1.0, 0.2, -0.1]])      # the last mostly behind
     view = np.array([0, 1.2, 1.6])
     lu, vu = _unit(lights), _unit(view)
     lam = mat.ka + mat.kd * np.clip(table @ lu.T, 0, 1).sum(-1)
@@ -367,7 +367,7 @@ def test_chrome_is_the_environment_of_the_view_reflected_about_the_normal():
     (red over blue) below; the lights play no part."""
     rng = np.random.default_rng(10)
     view = _unit([0.3, -0.4, 0.5])
-    z = rng.uniform(-0.95, 0.95, 40)
+    z = np.concatenate([rng.uniform(-0.95, 0.95, 38), [-0.99, 0.99]])      # and near both poles
     az = rng.uniform(0, 2 * np.pi, (2, 40))
     reflected = [np.stack([np.sqrt(1 - z * z) * np.cos(a), np.sqrt(1 - z * z) * np.sin(a), z], -1) for a in az]
     normals = [_unit(r + view) for r in reflected]            # the normal halving V and R
