@@ -257,3 +257,21 @@ def test_refusals_name_the_parameter_the_value_and_what_is_allowed():
     with pytest.raises(ValueError) as e:
         map_words([np.zeros((16, 16))], scene)
     assert str(e.value) == "1 levels given, the scene has 2"
+
+
+def test_stress_directions_are_uniform_in_azimuth_and_drawn_apart():
+    """The hemisphere cases' uniform directions: N' (drawn in the tangent frame) has its
+    azimuth uniform over the circle; the azimuth-wrap case draws ph_L, ph_H and ph_N' each
+    on its own (different offsets from the seam)."""
+    from bumprtl.sim.golden.stress import stress_case
+    for name in ("theta_n_zero", "grazing", "below_horizon", "l_equals_n"):
+        px = stress_case(name, 4000, seed=3)
+        b = px.b_phi
+        assert abs(np.mean(np.cos(b))) < 0.05 and abs(np.mean(np.sin(b))) < 0.05, name
+        assert abs(np.mean(b < np.pi / 2) - 0.25) < 0.03, name
+    w = stress_case("azimuth_wrap", 2000, seed=4)
+    seam = lambda phi: np.minimum(phi, 2 * np.pi - phi)
+    offsets = [seam(getattr(w, f)) for f in ("l_phi", "h_phi", "b_phi")]
+    for i in range(3):
+        for j in range(i + 1, 3):
+            assert abs(np.corrcoef(offsets[i], offsets[j])[0, 1]) < 0.1, (i, j)
