@@ -80,3 +80,30 @@ def test_a_blended_lookup_is_eq_2_of_the_entry_and_the_base_colour():
     assert want != {c: entry[c] for c in want}
     plain = lut.lookup(5, base)
     assert {c: plain[f"color.{c}"] for c in "rgba"} == entry
+
+
+def test_palette_colours_are_each_pixels_entry_and_with_a_texture_eq_2_of_the_texel():
+    """palette_colors: pixel i shows table entry index[i] (r, g, b, a from the packed
+    word); with a colour texture the entry is blended by eq. 2 with the pixel's texel as
+    the base colour (opaque: alpha 255; its r in the low byte)."""
+    from bumprtl.rtl.palette import blend_eq2
+    from bumprtl.sim.golden.fixed.palette_lut import palette_colors
+    from bumprtl.sim.scenes.config import load_scene_config
+    rng = np.random.default_rng(5)
+    rgba = rng.integers(0, 256, (256, 4))
+    table = pack_rgba(rgba, Config())
+    index = rng.integers(0, 256, 50)
+    plain = load_scene_config("palette", {"texture_size": 16})
+    got = palette_colors({"index": index}, table, plain)
+    assert sorted(got) == ["color.a", "color.b", "color.g", "color.r"]
+    for n, c in enumerate("rgba"):
+        assert np.array_equal(got[f"color.{c}"], rgba[index, n]), c
+    textured = load_scene_config("palette", {"texture_size": 16, "texture": True})
+    texel = rng.integers(0, 1 << 24, 50)
+    got = palette_colors({"index": index, "texel": texel}, table, textured)
+    base = {"r": texel & 255, "g": (texel >> 8) & 255, "b": texel >> 16, "a": np.full(50, 255)}
+    entry = {c: rgba[index, n] for n, c in enumerate("rgba")}
+    want = blend_eq2(entry, base, textured.config)
+    for c in "rgba":
+        assert np.array_equal(got[f"color.{c}"], np.asarray(want[c])), c
+    assert got["color.a"].tolist() == [255] * 50
