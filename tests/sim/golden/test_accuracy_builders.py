@@ -31,7 +31,8 @@ def test_tilted_puts_the_vector_at_the_angle_asked_and_turns_it_about_the_axis()
     gives two vectors whose parts perpendicular to nw are t2 - t1 apart; nw = +-z (where
     the helper axis changes) too."""
     rng = np.random.default_rng(1)
-    nw = np.concatenate([_units(300, rng), [[0, 0, 1.0], [0, 0, -1.0], [0, 0.3, np.sqrt(0.91)]]])
+    h = np.sqrt(0.5)
+    nw = np.concatenate([_units(300, rng), [[0, 0, 1.0], [0, 0, -1.0], [0, 0.3, np.sqrt(0.91)], [h, 0, h], [-h, 0, -h]]])
     n = len(nw)
     a = rng.uniform(0, np.pi, n)
     t1, t2 = rng.uniform(0, 2 * np.pi, (2, n))

@@ -312,6 +312,35 @@ def test_mipmaps_stop_at_the_first_odd_size_and_pick_nearest_to_each_blocks_mean
         _check_nearest(mean, q.table, levels[k].ravel())
 
 
+def test_mipmaps_of_a_map_with_materials_keep_each_blocks_material():
+    """Sec. 5.2 with Sec. 6: where each 2x2 block holds one material, the next level's
+    entry is of that material and, among its entries, the one nearest to the block's
+    renormalized mean normal."""
+    n = _normals(8, seed=9)
+    mats = (np.arange(8)[:, None] // 2 + np.arange(8)[None, :] // 2) % 2 * 3        # per 2x2 block
+    q = quantize_normal_map(n, 16, "median-cut", materials=mats)
+    levels = mipmap_indices(q)
+    assert [lv.shape for lv in levels] == [(8, 8), (4, 4), (2, 2), (1, 1)]
+    block_mats = mats[::2, ::2]
+    assert np.array_equal(q.materials[levels[1]], block_mats)
+    mean = _unit(q.table[levels[0]].reshape(4, 2, 4, 2, 3).mean(axis=(1, 3)))
+    for (r, c), m in np.ndenumerate(block_mats):
+        own = np.flatnonzero(q.materials == m)
+        d = np.linalg.norm(q.table[own] - mean[r, c], axis=1)
+        assert levels[1][r, c] == own[np.argmin(d)], (r, c)
+    # mixed blocks: the mean (normal renormalized, material averaged) picks the entry
+    # nearest to it, the material being MATERIAL_SCALE apart per id
+    wide = _normals(16, seed=10, spread=3.0)                 # blocks whose means are short
+    mixed = np.random.default_rng(3).integers(0, 2, (16, 16))
+    q = quantize_normal_map(wide, 64, "median-cut", materials=mixed)
+    levels = mipmap_indices(q)
+    table4 = np.concatenate([q.table, MATERIAL_SCALE * q.materials[:, None]], -1)
+    mean = table4[levels[0]].reshape(8, 2, 8, 2, 4).mean(axis=(1, 3))
+    mean[..., :3] = _unit(mean[..., :3])
+    want = np.argmin(np.linalg.norm(mean[:, :, None] - table4[None, None], axis=-1), axis=-1)
+    assert np.array_equal(levels[1], want)
+
+
 def test_lookup_accepts_exactly_the_table_indices():
     """Indices in [0, len(table) - 1]: both ends read their rows; -1 and len(table) are
     refused naming the index and the range; non-integer indices are refused."""
