@@ -120,6 +120,16 @@ def test_lights_below_one_are_refused_naming_the_range(value):
     assert e.field == "lights" and "[1, 8]" in str(e) and str(value) in str(e)
 
 
+def test_no_light_is_refused_by_the_scene_itself():
+    """lights = 0: the scene's own refusal (a scene needs at least one light)."""
+    assert "needs at least one light" in str(_refused("lights", lights=0))
+
+
+@pytest.mark.parametrize("value", ["2", 2.0, None])
+def test_lights_must_be_an_integer(value):
+    assert _refused("lights", lights=value).field == "lights"
+
+
 def test_one_light_is_allowed_with_either_method():
     """Several lights need a method that rotates N'; one light does not."""
     for method in ("exact", "lee"):
@@ -153,7 +163,41 @@ def test_a_map_must_be_a_non_empty_path_string(key, value):
 def test_image_must_be_a_procedural_scene(value):
     """Without a map, image must name one of SCENES; the message lists them and the maps."""
     msg = str(_refused("image", image=value))
-    assert all(name in msg for name in SCENES) and "height_map" in msg and repr(value) in msg
+    assert msg.startswith("image must be one of " + ", ".join(SCENES) + " (or give height_map")
+    assert repr(value) in msg
+
+
+def test_two_maps_are_refused_before_either_is_read():
+    """height_map and normal_map together: one line saying to give one, from a dict of keys
+    as from SceneConfig (the files are not opened: they need not exist)."""
+    for make in (lambda: SceneConfig(height_map="a.png", normal_map="b.png"),
+                 lambda: load_scene_config({"name": "t", "height_map": "a.png", "normal_map": "b.png"})):
+        with pytest.raises(BumpError) as e:
+            make()
+        assert str(e.value).startswith("give height_map or normal_map, not both")
+
+
+def test_a_map_that_is_no_path_is_refused_before_it_is_read():
+    with pytest.raises(BumpError, match="height_map must be a file path"):
+        load_scene_config({"name": "t", "height_map": 3})
+
+
+def test_an_impossible_rotation_says_why():
+    """The refusal names the rotation, the reason (palette shading's colour table, or the
+    bump map) and the one allowed rotation."""
+    msg = str(_refused("rotation", shading="palette", rotation="per-pixel"))
+    assert msg == ("rotation = 'per-pixel' is impossible with shading = 'palette' looks normals "
+                   "up in a colour table: allowed rotation = 'none'")
+    msg = str(_refused("rotation", bump_map="flat", rotation="none"))
+    assert msg == "rotation = 'none' is impossible with bump_map = 'flat': allowed rotation = 'per-polygon'"
+
+
+def test_replace_validates_a_given_rotation():
+    """replace derives the rotation again unless one is given; a given one is checked."""
+    scene = load_scene_config("default")
+    with pytest.raises(BumpError, match="rotation = 'per-polygon' is impossible"):
+        scene.replace(rotation="per-polygon")
+    assert scene.replace(bump_map="flat", rotation="per-polygon").rotation == "per-polygon"
 
 
 def test_every_procedural_image_and_geometry_is_accepted():

@@ -98,14 +98,27 @@ def test_a_wide_maps_bevel_is_0_12_sixteenths_of_the_map():
     rows, joints = brick_lines(t)
     d = np.arange(6) + 0.5                               # texel centres beside a line
     want = np.clip(d / width, 0, 1)
-    # across course line 2 (row 127.5), in a column at a brick's middle
-    line, col = rows[2], int(joints[2][1] + t / 8)
-    below = h[(line + d).astype(int), col]
-    assert np.allclose(below / below[-1], want, rtol=0, atol=0.05), below / below[-1]
-    # across joint 1 of course 3, in a row at the course's middle
+    # on both sides of course line 2 (row 127.5), in a column a quarter brick from the
+    # joints of the courses above and below (running bond: theirs are half a brick apart)
+    line, col = rows[2], int(joints[2][1] + t / 16)
+    for side in (1, -1):
+        ramp = h[(line + side * d).astype(int), col]
+        assert np.allclose(ramp / ramp[-1], want, rtol=0, atol=0.05), (side, ramp / ramp[-1])
+    # on both sides of joint 1 of course 3, in a row at the course's middle
     mid = int(rows[3] + t / 16)
-    right = h[mid, (joints[3][1] + d).astype(int)]
-    assert np.allclose(right / right[-1], want, rtol=0, atol=0.05), right / right[-1]
+    for side in (1, -1):
+        ramp = h[mid, (joints[3][1] + side * d).astype(int)]
+        assert np.allclose(ramp / ramp[-1], want, rtol=0, atol=0.05), (side, ramp / ramp[-1])
+
+
+@pytest.mark.parametrize("t", [32, 512])
+def test_brick_faces_are_slightly_rough(t):
+    """The faces are 'slightly rough' (many distinct normals): off the grooves the height
+    varies a little around a level below 1, never flat and never more than a few percent."""
+    h = bricks(t)
+    face = h[h > 0.6 * h.max()]
+    assert 0.5 < np.median(face) < 1 and len(np.unique(face)) > face.size // 2
+    assert 0.002 < face.std() < 0.1
 
 
 @pytest.mark.parametrize("t", [16, 64])
@@ -139,7 +152,7 @@ def test_a_photographs_heights_keep_its_mean_grey():
     for name in ("brick", "gravel", "moon"):
         whole = getattr(skimage.data, name)() / 255.0
         h = HEIGHTFIELDS[name](64)
-        assert h.shape == (64, 64) and abs(h.mean() - whole.mean()) < 0.01, name
+        assert h.shape == (64, 64) and abs(h.mean() - whole.mean()) < 5e-4, name
         coarse = whole.reshape(64, 8, 64, 8).mean(axis=(1, 3))
         assert np.corrcoef(h.ravel(), coarse.ravel())[0, 1] > 0.8, name
 
@@ -185,12 +198,12 @@ def test_height_to_normals_is_a_wrapping_central_difference():
     (np.zeros((4, 4)), 0.0, "strength must be a positive finite number, got 0.0"),
     (np.zeros((4, 4)), float("inf"), "got inf"),
     (np.zeros((4, 4)), "1", "got '1'"),
-    (np.array([[0.0, np.inf], [0.0, 0.0]]), 1.0, "NaN or infinity"),
+    (np.array([[0.0, np.inf], [0.0, 0.0]]), 1.0, "height map contains NaN or infinity"),
 ])
 def test_height_to_normals_refusals(height, strength, words):
     with pytest.raises(BumpError) as e:
         height_to_normals(height, strength)
-    assert words in str(e.value)
+    assert str(e.value).startswith(words) or str(e.value).endswith(words), str(e.value)
 
 
 # --- the scene ---------------------------------------------------------------------------------
@@ -202,6 +215,15 @@ def test_light_direction_closed_form():
         want = [np.cos(e) * np.cos(a), -np.sin(e), np.cos(e) * np.sin(a)]
         assert np.allclose(light_direction(el, az), want, atol=1e-15), (el, az)
     assert np.allclose(light_direction(0, 0), [1, 0, 0])
+
+
+def test_load_scene_defaults():
+    """Defaults: 512 x 512 pixels, a directional light from elevation 45, azimuth 30."""
+    s = load_scene("bumps")
+    assert s.size == 512 and s.texture_size == 512
+    small = load_scene("bumps", size=16)
+    want = light_direction(45.0, 30.0)
+    assert np.allclose(polar_to_cartesian(small.px.l_phi, small.px.l_theta), want, atol=1e-12)
 
 
 def _bump(t):
@@ -327,8 +349,13 @@ def test_panel_of_greyscale_images_and_its_gain():
 
 
 def test_save_png_returns_the_path_it_wrote(tmp_path):
+    """save_png makes the missing directories (or reuses them) and writes 8-bit pixels,
+    also from an integer array of 8-bit values."""
     from PIL import Image
     grey = np.arange(12, dtype=np.uint8).reshape(3, 4)
     path = save_png(str(tmp_path / "a" / "b" / "g.png"), grey)
     assert path == tmp_path / "a" / "b" / "g.png"
     assert np.array_equal(np.asarray(Image.open(path)), grey)
+    again = save_png(tmp_path / "a" / "b" / "h.png", np.arange(12).reshape(3, 4) * 20)
+    back = np.asarray(Image.open(again))
+    assert back.dtype == np.uint8 and np.array_equal(back, np.arange(12).reshape(3, 4) * 20)

@@ -421,3 +421,129 @@ def test_write_png_writes_rgb_16_bit_and_the_header(tmp_path):
     grey = write_png(tmp_path / "g.png", np.arange(35, dtype=np.uint8).reshape(5, 7)).read_bytes()
     assert struct.unpack(">IIBB", grey[16:26]) == (7, 5, 8, 0)
     assert np.array_equal(np.asarray(Image.open(tmp_path / "g.png")), np.arange(35).reshape(5, 7))
+
+
+# --- resampling, sizes given, and what counts as flat -----------------------------------------
+
+def _lanczos_matrix(n_in, n_out):
+    """Lanczos-3 weights (sinc(x) sinc(x / 3), |x| < 3, widened by the ratio when shrinking)
+    from n_in texel centres to n_out, each row normalized, the window cut at the edges."""
+    scale = n_in / n_out
+    widen = max(scale, 1.0)
+    w = np.zeros((n_out, n_in))
+    for i in range(n_out):
+        centre = (i + 0.5) * scale
+        lo, hi = max(int(centre - 3 * widen + 0.5), 0), min(int(centre + 3 * widen + 0.5), n_in)
+        x = (np.arange(lo, hi) + 0.5 - centre) / widen
+        k = np.where(np.abs(x) < 3, np.sinc(x) * np.sinc(x / 3), 0.0)
+        w[i, lo:hi] = k / k.sum()
+    return w
+
+
+@pytest.mark.parametrize("side, size", [(16, 32), (64, 16)])
+def test_resampling_is_lanczos(tmp_path, side, size):
+    """The module resamples with Lanczos (a = 3), rows and columns separately: a random map
+    resampled is the separable Lanczos-3 filter of it (float32 precision)."""
+    rng = np.random.default_rng(15)
+    h = rng.uniform(size=(side, side))
+    np.save(tmp_path / "h.npy", h)
+    got = read_height(tmp_path / "h.npy", size=size, resample=True)
+    w = _lanczos_matrix(side, size)
+    assert np.abs(got - w @ h @ w.T).max() < 1e-5
+
+
+def test_a_tall_map_is_resampled_to_the_size_of_its_longer_side(tmp_path):
+    """Not square: the nearest allowed size to the larger side (40 rows -> 32, not 16)."""
+    np.save(tmp_path / "tall.npy", _ramp(40, 16))
+    assert read_height(tmp_path / "tall.npy", resample=True).shape == (32, 32)
+    v = np.dstack([np.zeros((40, 16)), _ramp(40, 16) / 4, np.ones((40, 16))])
+    np.save(tmp_path / "tall_n.npy", v)
+    assert read_normals(tmp_path / "tall_n.npy", resample=True).shape == (32, 32, 3)
+
+
+def test_a_normal_map_at_an_odd_size_is_resampled_to_the_nearest(tmp_path):
+    v = np.dstack([np.zeros((24, 24)), _ramp(24) / 4, np.ones((24, 24))])
+    np.save(tmp_path / "n.npy", v)
+    assert "nearest allowed size is 32x32" in _refusal(read_normals, tmp_path / "n.npy")
+    got = read_normals(tmp_path / "n.npy", resample=True)
+    assert got.shape == (32, 32, 3) and np.allclose(np.linalg.norm(got, axis=-1), 1, atol=1e-12)
+
+
+def test_a_normal_map_at_the_size_asked_for_is_kept_and_another_refused(tmp_path):
+    v = np.dstack([np.zeros((16, 16)), _ramp(16) / 4, np.ones((16, 16))])
+    np.save(tmp_path / "n.npy", v)
+    assert np.array_equal(read_normals(tmp_path / "n.npy", size=16), read_normals(tmp_path / "n.npy"))
+    assert _refusal(read_normals, tmp_path / "n.npy", size=32).startswith(
+        f"{tmp_path / 'n.npy'}: 16x16 texels but texture_size = 32 (pass --resample")
+
+
+def test_vectors_of_one_direction_are_flat_whatever_their_lengths(tmp_path):
+    """Every vector is re-normalized, so (0, 0, 1) and (0, 0, 2) are the same normal: a map
+    of them has no bumps."""
+    v = np.zeros((16, 16, 3))
+    v[..., 2] = 1.0
+    v[::2, :, 2] = 2.0
+    np.save(tmp_path / "n.npy", v)
+    assert "every texel has the same normal" in _refusal(read_normals, tmp_path / "n.npy")
+
+
+def test_a_single_texel_map_is_flat(tmp_path):
+    np.save(tmp_path / "one.npy", np.full((1, 1), 0.75))
+    assert "every texel has the same height (0.75)" in _refusal(read_height, tmp_path / "one.npy")
+
+
+@pytest.mark.parametrize("kind, ctype, ending", [
+    ("height", 2, "a height map is a 1-channel greyscale PNG (an RGB normal map goes to --normal-map)"),
+    ("height", 3, "a height map is a 1-channel greyscale PNG"),
+    ("normal", 0, "a normal map is an RGB PNG (3 channels) (a greyscale height map goes to --height-map)"),
+    ("normal", 3, "a normal map is an RGB PNG (3 channels)"),
+])
+def test_a_wrong_kind_of_png_ends_with_the_hint_or_nothing(tmp_path, kind, ctype, ending):
+    path = _file(tmp_path, "m.png", _header(16, 16, 8, ctype))
+    assert _refusal(map_size, path, kind=kind).endswith(ending)
+
+
+def test_an_unreadable_file_is_named_with_the_reason(tmp_path):
+    """A file that exists but cannot be read: the OS's reason, in one line."""
+    link = tmp_path / "mem.png"
+    link.symlink_to("/proc/self/mem")                   # a file whose read fails (EIO)
+    try:
+        link.read_bytes()
+    except OSError as e:
+        reason = e.strerror
+    else:
+        pytest.skip("reading /proc/self/mem did not fail here")
+    assert _refusal(map_size, link) == f"{link}: cannot read ({reason})"
+
+
+def _chunks(raw):
+    """(tag, data) of every chunk of a PNG, each chunk's CRC checked (PNG spec: CRC-32 of the
+    tag and the data)."""
+    out, pos = [], 8
+    while pos < len(raw):
+        (length,) = struct.unpack(">I", raw[pos:pos + 4])
+        tag, data = raw[pos + 4:pos + 8], raw[pos + 8:pos + 8 + length]
+        (crc,) = struct.unpack(">I", raw[pos + 8 + length:pos + 12 + length])
+        assert crc == zlib.crc32(tag + data), tag
+        out.append((tag, data))
+        pos += 12 + length
+    return out
+
+
+@pytest.mark.parametrize("shape, depth, ctype", [((5, 7), 8, 0), ((5, 7, 3), 16, 2), ((3, 9, 3), 8, 2)])
+def test_write_png_is_ihdr_idat_iend(tmp_path, shape, depth, ctype):
+    """PNG structure: the signature, then IHDR (width, height, depth, colour type, and 0 for
+    compression, filter and interlace), one IDAT of filter-0 rows, an empty IEND."""
+    rng = np.random.default_rng(16)
+    pixels = rng.integers(0, 2 ** depth, shape)
+    raw = write_png(tmp_path / "p.png", pixels, bit_depth=depth).read_bytes()
+    assert raw[:8] == SIG
+    chunks = _chunks(raw)
+    assert [t for t, _ in chunks] == [b"IHDR", b"IDAT", b"IEND"] and chunks[2][1] == b""
+    assert struct.unpack(">IIBBBBB", chunks[0][1]) == (shape[1], shape[0], depth, ctype, 0, 0, 0)
+    rows = zlib.decompress(chunks[1][1])
+    stride = 1 + shape[1] * (3 if ctype == 2 else 1) * depth // 8
+    assert len(rows) == shape[0] * stride and all(rows[i * stride] == 0 for i in range(shape[0]))
+    body = b"".join(rows[i * stride + 1:(i + 1) * stride] for i in range(shape[0]))
+    back = np.frombuffer(body, ">u2" if depth == 16 else np.uint8).reshape(shape)
+    assert np.array_equal(back, pixels)
