@@ -118,31 +118,24 @@ def test_an_unknown_colour_type_is_a_corrupt_png(tmp_path, ctype):
     assert _refusal(map_size, path) == f"{path}: corrupt PNG (colour type {ctype})"
 
 
-@pytest.mark.parametrize("depth, ctype, words, absent", [
-    (8, 3, ["indexed-colour PNG with 1 channel(s)", "1-channel greyscale"], "--normal-map"),
-    (8, 4, ["greyscale + alpha PNG with 2 channel(s)"], "--normal-map"),
-    (8, 2, ["RGB PNG with 3 channel(s)", "(an RGB normal map goes to --normal-map)"], None),
-    (8, 6, ["RGBA PNG with 4 channel(s)", "--normal-map"], None),
-    (1, 0, ["1-bit greyscale PNG; a height map is 8- or 16-bit"], None),
-    (4, 0, ["4-bit greyscale PNG"], None),
+# a height map is 8- or 16-bit greyscale, a normal map 8-bit RGB: every other header is
+# refused with what it is and, where it would fit, the flag of the other kind
+@pytest.mark.parametrize("kind, depth, ctype, words, absent", [
+    ("height", 8, 3, ["indexed-colour PNG with 1 channel(s)", "1-channel greyscale"], "--normal-map"),
+    ("height", 8, 4, ["greyscale + alpha PNG with 2 channel(s)"], "--normal-map"),
+    ("height", 8, 2, ["RGB PNG with 3 channel(s)", "(an RGB normal map goes to --normal-map)"], None),
+    ("height", 8, 6, ["RGBA PNG with 4 channel(s)", "--normal-map"], None),
+    ("height", 1, 0, ["1-bit greyscale PNG; a height map is 8- or 16-bit"], None),
+    ("height", 4, 0, ["4-bit greyscale PNG"], None),
+    ("normal", 8, 0, ["greyscale PNG with 1 channel(s)", "an RGB PNG (3 channels)", "--height-map"], None),
+    ("normal", 8, 4, ["greyscale + alpha PNG with 2 channel(s)", "--height-map"], None),
+    ("normal", 8, 3, ["indexed-colour PNG with 1 channel(s)"], "--height-map"),
+    ("normal", 16, 2, ["16-bit RGB PNG; a normal map must be 8 bits per channel"], None),
+    ("normal", 16, 6, ["16-bit RGB PNG"], None),
 ])
-def test_a_height_map_png_must_be_8_or_16_bit_greyscale(tmp_path, depth, ctype, words, absent):
-    path = _file(tmp_path, "h.png", _header(16, 16, depth, ctype))
-    msg = _refusal(map_size, path, kind="height")
-    assert msg.startswith(f"{path}: ") and all(w in msg for w in words), msg
-    assert absent is None or absent not in msg
-
-
-@pytest.mark.parametrize("depth, ctype, words, absent", [
-    (8, 0, ["greyscale PNG with 1 channel(s)", "an RGB PNG (3 channels)", "--height-map"], None),
-    (8, 4, ["greyscale + alpha PNG with 2 channel(s)", "--height-map"], None),
-    (8, 3, ["indexed-colour PNG with 1 channel(s)"], "--height-map"),
-    (16, 2, ["16-bit RGB PNG; a normal map must be 8 bits per channel"], None),
-    (16, 6, ["16-bit RGB PNG"], None),
-])
-def test_a_normal_map_png_must_be_8_bit_rgb(tmp_path, depth, ctype, words, absent):
-    path = _file(tmp_path, "n.png", _header(16, 16, depth, ctype))
-    msg = _refusal(map_size, path, kind="normal")
+def test_a_png_of_the_wrong_kind_is_refused_with_what_it_is(tmp_path, kind, depth, ctype, words, absent):
+    path = _file(tmp_path, f"{kind[0]}.png", _header(16, 16, depth, ctype))
+    msg = _refusal(map_size, path, kind=kind)
     assert msg.startswith(f"{path}: ") and all(w in msg for w in words), msg
     assert absent is None or absent not in msg
 
