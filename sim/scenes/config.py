@@ -115,7 +115,7 @@ class SceneConfig:
 
     def __post_init__(self):
         if not isinstance(self.name, str):
-            raise SceneError(f"name must be a string, got {self.name!r}")
+            raise SceneError(f"name must be a string, got {self.name!r}", "name")
         self._check_picture()
         for key, allowed in (("bump_map", BUMP_MAPS), ("shading", SHADINGS),
                              ("addressing", ADDRESSING)):
@@ -141,7 +141,7 @@ class SceneConfig:
             raise SceneError(f"scene {self.name!r}: {e}", e.field) from None
         if self.method not in PER_PIXEL:
             raise SceneError(f"method must be one of {', '.join(PER_PIXEL)} in a scene (the "
-                             f"baselines are built for the cost comparison only), got {self.method!r}")
+                             f"baselines are built for the cost comparison only), got {self.method!r}", "method")
         self._check_rotation()
         rotates_normal = get(self.method).rotates_normal
         allowed = " or ".join(repr(n) for n in PER_PIXEL if get(n).rotates_normal)
@@ -159,7 +159,7 @@ class SceneConfig:
         maps = [k for k in MAP_KEYS if getattr(self, k) is not None]
         for key in maps:
             if not isinstance(getattr(self, key), str) or not getattr(self, key):
-                raise SceneError(f"{key} must be a file path (a string), got {getattr(self, key)!r}")
+                raise SceneError(f"{key} must be a file path (a string), got {getattr(self, key)!r}", key)
         if len(maps) > 1:
             raise SceneError("give height_map or normal_map, not both: a height map becomes "
                              "normals by the plane fit, a normal map already is one")
@@ -167,7 +167,7 @@ class SceneConfig:
             object.__setattr__(self, "image", None)
         elif not isinstance(self.image, str) or self.image not in SCENES:
             raise SceneError(f"image must be one of {', '.join(SCENES)} (or give height_map "
-                             f"or normal_map for your own map), got {self.image!r}")
+                             f"or normal_map for your own map), got {self.image!r}", "image")
         _choice("normal_convention", self.normal_convention, CONVENTIONS)
         if self.geometry is not None:
             _choice("geometry", self.geometry, GEOMETRIES)
@@ -202,7 +202,7 @@ class SceneConfig:
             why = {"palette": "shading = 'palette' looks normals up in a colour table"}.get(
                 self.shading, f"bump_map = {self.bump_map!r}")
             raise SceneError(f"rotation = {self.rotation!r} is impossible with {why}: "
-                             f"allowed rotation = {derived!r}")
+                             f"allowed rotation = {derived!r}", "rotation")
 
     @property
     def derived_rotation(self):

@@ -444,3 +444,16 @@ def test_resample_sizes_a_map_to_the_nearest_allowed_side(tmp_path):
     assert load_scene_config({"name": "t", "height_map": path, "resample": True}).texture_size == 32
     assert load_scene_config({"name": "t", "height_map": path, "resample": True,
                               "texture_size": 16}).texture_size == 16
+
+
+@pytest.mark.parametrize("key, keys", [
+    ("name", {"name": 3}),
+    ("method", {"method": "peercy"}),
+    ("height_map", {"height_map": 5}),
+    ("normal_map", {"normal_map": ""}),
+    ("image", {"image": "no-such-picture"}),
+    ("rotation", {"shading": "palette", "rotation": "per-pixel"}),
+])
+def test_a_refusal_about_one_key_names_it_as_its_field(key, keys):
+    """BumpError.field names the refused parameter (rtl/errors.py), not only the wording."""
+    assert _refused(key, **keys).field == key
