@@ -522,3 +522,20 @@ def test_the_blend_layout_clamps_a_highlight_summed_over_lights_to_1():
     assert np.allclose(c[0], [1.0, 1.0, 1.0, 1.0])
     h = 1 / np.sqrt(2)
     assert np.allclose(c[1, :3], min(1.0, 2 * h ** 4)) and np.allclose(c[1, 3], min(1.0, 0.5 + 2 * h))
+
+
+def test_render_palette_dithers_when_asked():
+    """render_palette(dither=True) shades the dithered index map (Sec. 4, Fig. 4): its
+    colours are palette_rgb's of the map quantized with dithering, not of the plain one."""
+    from bumprtl.rtl.config import Config
+    from bumprtl.sim.golden.float.palette import palette_rgb, render_palette, world_normal_map
+    from bumprtl.sim.scenes import load_scene
+    scene = load_scene("bumps", size=32)
+    cfg = Config()
+    normals, counts = world_normal_map(scene)
+    dithered = quantize_normal_map(normals, 16, "median-cut", True, weights=counts)
+    plain = quantize_normal_map(normals, 16, "median-cut", False, weights=counts)
+    assert not np.array_equal(dithered.indices, plain.indices)
+    got = render_palette(scene, cfg, 16, "median-cut", dither=True).color
+    assert np.array_equal(got, palette_rgb(scene, cfg, qmap=dithered)[0].mean(-1))
+    assert not np.array_equal(got, render_palette(scene, cfg, 16, "median-cut").color)
