@@ -346,6 +346,28 @@ KNOWN = [
      "a bad .npy's message from map_size named 'None' instead of the file; "
      "tests/sim/scenes/test_usermap.py::test_map_size_of_a_bad_npy_names_the_file "
      "(checked with the mutant switched on)"),
+    ("bumprtl.sim.scenes.heightfields.x__narrow", "BRICK_BEVEL * t / 17 <= 0.5", "equivalent",
+     "the narrow/wide switch moves from t = 66.7 to 70.8 texels and map sides are powers of two: "
+     "no side lies between"),
+    ("bumprtl.sim.scenes.heightfields.x_brick_lines", "(j + 1.5 * (k % 2))", "equivalent",
+     "modulo the map side the same four joint columns, in another order, which nothing specifies"),
+    ("bumprtl.sim.scenes.usermap.x_nearest_allowed_size", "np.log2(side) - 1e-9", "equivalent",
+     "no integer side has a log2 within 1e-9 of a half (both forms give the same size for every "
+     "side from 1 to 200,000)"),
+    ("bumprtl.sim.golden.common.x_cartesian_to_polar", "==v = np.asarray(v, )", "equivalent",
+     "float64 input is unchanged and integer input gives the same angles: the norm, the division "
+     "and arctan2 return float64"),
+    ("bumprtl.sim.golden.float.palette_quantize.x_distinct", "np.asarray(vectors, dtype=None)",
+     "equivalent", "every caller passes float64 vectors (the normal maps' unit vectors)"),
+    ("bumprtl.sim.golden.float.palette_quantize.x_kmeans", "iterations=13", "not specified",
+     "k-means stops when its table stops changing; one more allowed iteration changes nothing on "
+     "a table that settles within 12, and the docstring names no count"),
+    ("bumprtl.sim.golden.measure.x_worst_pixel", "seed=2", "not specified",
+     "the default seed of the sample: any seed draws a valid sample, and every caller passes its own"),
+    ("bumprtl.sim.golden.float.palette.x_render_palette", "lighting, None)", "killed since",
+     "no test rendered with dithering, so dropping `dither` went unseen; "
+     "tests/sim/golden/float/test_palette_props.py::test_render_palette_dithers_when_asked "
+     "(checked with the mutant switched on)"),
 ]
 
 
