@@ -392,8 +392,8 @@ def lay_out(dest, src, files):
         top = name.split("/", 1)[0]
         if top in PACKAGES:
             target = dest / "bumprtl" / PACKAGES[top] / name.split("/", 1)[1]
-        elif top in ("tests", "pyproject.toml", "CHANGELOG.md"):     # test_version reads the changelog
-            target = dest / name
+        elif top in ("tests", "pyproject.toml", "CHANGELOG.md") or name == "docs/scenes.md":
+            target = dest / name      # test_version reads the changelog, the map flags' help test the doc
         else:
             continue
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -431,8 +431,9 @@ def configure(dest, deselect, only=None, tests=None):
             "    -m", "    not regress and not fpga and not formal",
             *[x for d in deselect for x in ("    --deselect", f"    {d}")],
             # mutmut runs the tests in mutants/, which holds the package and tests/ only:
-            # tests/gen/cli/test_packaging.py::test_version reads the changelog beside them
-            "also_copy =", "    CHANGELOG.md",
+            # tests/gen/cli/test_packaging.py::test_version reads the changelog beside them,
+            # tests/gen/cli/test_flags_roundtrip.py docs/scenes.md
+            "also_copy =", "    CHANGELOG.md", "    docs",
             "use_git_change_detection = false", "timeout_multiplier = 5.0",
             # each mutant's tests run in a process forked from a server that imported the
             # third-party modules only: forked from mutmut's own process (its default), a

@@ -190,8 +190,6 @@ def test_map_flag_help_says_what_docs_scenes_md_says():
             assert fragment in _words(acts[dest].help), (dest, fragment)
 
 
-@pytest.mark.skipif(not (ROOT / "docs/scenes.md").exists(),
-                    reason="no docs/ here (the mutation runner's copy holds the package and tests)")
 def test_the_documented_fragments_are_in_docs_scenes_md():
     """DOCUMENTED quotes docs/scenes.md's section "Your own bump map", not the help."""
     docs = _docs_section()
