@@ -368,6 +368,20 @@ KNOWN = [
      "no test rendered with dithering, so dropping `dither` went unseen; "
      "tests/sim/golden/float/test_palette_props.py::test_render_palette_dithers_when_asked "
      "(checked with the mutant switched on)"),
+    ("bumprtl.gen.cli.flags.x_add_config_flags", "parser.add_argument(flag, action=argparse.BooleanOptionalAction,",
+     "equivalent", "argparse derives the same dest from `--flag-name` (the flag is the field's "
+                   "name with `_` as `-`)"),
+    ("bumprtl.sim.scenes.usermap.x__resize", "np.asarray(channels, None)", "equivalent",
+     "each plane is cast to float32 for Pillow's resize whatever the array's dtype, and the "
+     "result is read back as float64"),
+    ("bumprtl.sim.scenes.x__brick_albedo", "np.clip(height, None, 1)", "equivalent",
+     "the brick field is clipped to [0, 1] where it is made (sim/scenes/heightfields.bricks), so "
+     "no height is below 0"),
+    ("bumprtl.sim.golden.accuracy.x_arithmetic_pixels", "/ cfg.one + conventional(p, cfg).ndoth",
+     "killed since", "step 1 then kept only the N' whose model overshoots N'.H' (the sum is "
+     "dominated by the positive errors); "
+     "tests/sim/golden/test_accuracy_builders.py::test_arithmetic_pixels_keep_errors_of_both_polarities "
+     "(checked with the mutant switched on)"),
 ]
 
 

@@ -317,3 +317,15 @@ def test_a_craters_bowl_is_round_on_the_torus():
         across_v, across_u = np.ptp(rows) + 1, np.ptp(cols) + 1
         assert abs(across_v - across_u) <= 1, (seed, across_v, across_u)
         assert abs(bowl.sum() / (np.pi * across_u ** 2 / 4) - 1) < 0.15, seed
+
+
+def test_arithmetic_pixels_keep_errors_of_both_polarities():
+    """Step 1 keeps the largest errors by magnitude, so N' whose model overshoots N'.H' and
+    N' whose model falls short are both kept (the search aims at the arithmetic error in
+    either direction): each polarity is at least a quarter of the kept N'."""
+    from bumprtl.sim.golden.accuracy import arithmetic_pixels
+    keep = 40
+    mid = arithmetic_pixels(datapath_fixed, CFG, candidates=2000, keep=keep, seed=3, reach=0)
+    mid = mid.subset(slice(0, keep))
+    err = datapath_fixed(encode_pixels(mid, CFG), CFG)["ndoth"] / CFG.one - conventional(mid, CFG).ndoth
+    assert np.mean(err < 0) >= 0.25 and np.mean(err > 0) >= 0.25, err
