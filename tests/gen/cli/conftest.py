@@ -1,8 +1,19 @@
-"""Fixtures of the command-line tests."""
+"""Fixtures and helpers of the command-line tests."""
 
+import argparse
 import importlib
 
 import pytest
+
+from bumprtl.gen.cli.flags import add_config_flags
+
+
+def config_parser(**kw):
+    """A parser holding only the Config flags (``add_config_flags(parser, **kw)``) that raises
+    argparse errors instead of exiting."""
+    p = argparse.ArgumentParser(prog="t", exit_on_error=False)
+    add_config_flags(p, **kw)
+    return p
 
 
 @pytest.fixture

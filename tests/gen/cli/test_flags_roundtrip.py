@@ -12,10 +12,11 @@ from pathlib import Path
 import pytest
 
 from bumprtl.gen.cli import main as cli_main
-from bumprtl.gen.cli.flags import (MAP_FLAGS, add_config_flags, add_map_flags, config_from_args,
+from bumprtl.gen.cli.flags import (MAP_FLAGS, add_map_flags, config_from_args,
                                    map_overrides, scene_from_args)
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
+from tests.gen.cli.conftest import config_parser
 
 ROOT = Path(__file__).resolve().parents[3]
 FIELDS = [f.name for f in dataclasses.fields(Config)]
@@ -40,11 +41,6 @@ def _argv(values):
     return argv
 
 
-def _config_parser(**kw):
-    p = argparse.ArgumentParser(prog="t", exit_on_error=False)
-    add_config_flags(p, **kw)
-    return p
-
 
 def test_other_values_cover_every_field():
     assert set(OTHER) == set(FIELDS)
@@ -54,7 +50,7 @@ def test_other_values_cover_every_field():
 def test_each_config_flag_round_trips_into_the_config(name):
     """``--field VALUE`` (``--field`` / ``--no-field`` for a switch) gives the Config with
     that field, of the field's type, and every other field at its default."""
-    got = config_from_args(_config_parser().parse_args(_argv({name: OTHER[name]})))
+    got = config_from_args(config_parser().parse_args(_argv({name: OTHER[name]})))
     assert got == Config(**{name: OTHER[name]})
     assert type(getattr(got, name)) is type(getattr(Config(), name))
 
@@ -62,13 +58,13 @@ def test_each_config_flag_round_trips_into_the_config(name):
 def test_all_config_flags_at_once_round_trip():
     """A Config written as flags and read back is the same Config, also over a base."""
     cfg = Config(**OTHER)
-    assert config_from_args(_config_parser().parse_args(_argv(OTHER))) == cfg
-    assert config_from_args(_config_parser().parse_args(_argv(OTHER)), Config(angle_bits=16)) == cfg
+    assert config_from_args(config_parser().parse_args(_argv(OTHER))) == cfg
+    assert config_from_args(config_parser().parse_args(_argv(OTHER)), Config(angle_bits=16)) == cfg
 
 
 def test_both_spellings_of_a_switch_override_the_base():
     """``--specular`` sets True and ``--no-specular`` False whatever the base says."""
-    p = _config_parser()
+    p = config_parser()
     assert config_from_args(p.parse_args(["--specular"]), Config(specular=False)).specular is True
     assert config_from_args(p.parse_args(["--no-specular"]), Config()).specular is False
     assert config_from_args(p.parse_args(["--palette-blend"])).palette_blend is True
@@ -81,7 +77,7 @@ def test_both_spellings_of_a_switch_override_the_base():
     (["--out-bits", "9"], "out_bits"), (["--angle-bits", "12", "--frac-bits", "8"], "frac_bits")])
 def test_a_config_flag_out_of_range_is_refused_naming_its_field(argv, field):
     """A value the Config refuses is a BumpError naming the field (not an argparse error)."""
-    args = _config_parser().parse_args(argv)
+    args = config_parser().parse_args(argv)
     with pytest.raises(BumpError) as e:
         config_from_args(args)
     assert e.value.field == field and field in str(e.value)
@@ -90,7 +86,7 @@ def test_a_config_flag_out_of_range_is_refused_naming_its_field(argv, field):
 def test_config_from_args_reads_only_the_flags_the_parser_has():
     """With ``fields`` the parser has some flags only; the rest of the Config keeps the base
     (a Namespace without the attribute is a flag not given)."""
-    p = _config_parser(fields=["angle_bits"])
+    p = config_parser(fields=["angle_bits"])
     assert config_from_args(p.parse_args(["--angle-bits", "12"])) == Config(angle_bits=12)
     assert config_from_args(argparse.Namespace()) == Config()
     base = Config(ks=0.5)
@@ -100,7 +96,7 @@ def test_config_from_args_reads_only_the_flags_the_parser_has():
 def test_a_config_flag_with_a_wrong_type_is_an_argparse_error():
     """Each non-switch flag converts its value to the field's type: a word for an integer
     or a number is refused by the parser."""
-    p = _config_parser()
+    p = config_parser()
     for flag in ("--angle-bits", "--ka", "--palette-size"):
         with pytest.raises(argparse.ArgumentError):
             p.parse_args([flag, "twelve"])
@@ -114,7 +110,7 @@ def test_map_overrides_of_a_namespace_without_map_flags_is_empty():
 
 def test_scene_from_args_without_any_flags_is_the_source():
     """No flag given, or a Namespace without the flags, gives the scene as the source has it."""
-    p = _config_parser()
+    p = config_parser()
     add_map_flags(p)
     assert scene_from_args(p.parse_args([]), "default") == load_scene_config("default")
     assert scene_from_args(argparse.Namespace(), "default") == load_scene_config("default")
@@ -146,7 +142,7 @@ def test_an_extra_key_that_contradicts_the_source_names_the_flag_that_set_it():
 def test_a_config_flag_the_scene_decides_is_one_line_naming_flag_and_source(name):
     """A Config field that is not a scene key is refused for a scene: the message names the
     flag and the source and says where the scene keys are."""
-    p = _config_parser()
+    p = config_parser()
     with pytest.raises(BumpError) as e:
         scene_from_args(p.parse_args(_argv({name: OTHER[name]})), "default")
     msg = str(e.value)
@@ -246,7 +242,7 @@ def test_help_texts_are_lower_case_but_acronyms():
     argparse's own (acronyms such as PNG and RGB aside), never in capitals."""
     p, acts = _map_parser()
     texts = [a.help for a in acts.values()] + [g.title for g in p._action_groups]
-    texts += [a.help for a in _config_parser()._actions if a.dest in FIELDS]
+    texts += [a.help for a in config_parser()._actions if a.dest in FIELDS]
     texts.append(cli_main.build_parser().description)
     for text in texts:
         assert not _shouting(text), text

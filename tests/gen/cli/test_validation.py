@@ -10,11 +10,12 @@ import re
 import pytest
 
 from bumprtl.gen.cli import main as cli_main
-from bumprtl.gen.cli.flags import (MAP_FLAGS, add_config_flags, add_map_flags, config_from_args,
+from bumprtl.gen.cli.flags import (MAP_FLAGS, add_map_flags, config_from_args,
                                    map_overrides, scene_from_args)
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes import GEOMETRIES
 from bumprtl.sim.scenes.usermap import CONVENTIONS
+from tests.gen.cli.conftest import config_parser
 
 FIELDS = [f.name for f in dataclasses.fields(Config)]
 # a value other than the default, as typed, and what the field must hold then
@@ -24,11 +25,6 @@ OTHER = {"angle_bits": ("12", 12), "frac_bits": ("13", 13), "method": ("lee", "l
          "lights": ("2", 2), "palette_size": ("64", 64), "color_bits": ("8", 8)}
 
 
-def _parser(**kw):
-    p = argparse.ArgumentParser(prog="t", exit_on_error=False)
-    add_config_flags(p, **kw)
-    return p
-
 
 def _action(parser, dest):
     [a] = [a for a in parser._actions if a.dest == dest]
@@ -37,7 +33,7 @@ def _action(parser, dest):
 
 @pytest.mark.parametrize("name", FIELDS)
 def test_every_config_field_has_a_flag_that_shows_its_default(name):
-    p = _parser()
+    p = config_parser()
     a = _action(p, name)
     flag = "--" + name.replace("_", "-")
     assert flag in a.option_strings and a.default is None
@@ -57,13 +53,13 @@ def test_every_config_field_has_a_flag_that_shows_its_default(name):
 
 
 def test_fields_limits_the_flags_to_those_named():
-    p = _parser(fields=["angle_bits", "specular"])
+    p = config_parser(fields=["angle_bits", "specular"])
     dests = {a.dest for a in p._actions} - {"help"}
     assert dests == {"angle_bits", "specular"}
 
 
 def test_config_from_args_keeps_the_base_where_no_flag_was_given():
-    p = _parser()
+    p = config_parser()
     base = Config(angle_bits=12, ks=0.3)
     got = config_from_args(p.parse_args(["--frac-bits", "13", "--no-specular"]), base)
     assert got == dataclasses.replace(base, frac_bits=13, specular=False)
@@ -72,7 +68,7 @@ def test_config_from_args_keeps_the_base_where_no_flag_was_given():
 
 
 def test_a_config_flag_out_of_range_names_the_field():
-    p = _parser()
+    p = config_parser()
     with pytest.raises(BumpError) as e:
         config_from_args(p.parse_args(["--spec-index-bits", "3"]))
     assert e.value.field == "spec_index_bits" and "[4, 16]" in str(e.value)
@@ -103,7 +99,7 @@ def test_map_flags_leave_a_texture_size_flag_that_exists():
 
 
 def test_a_config_flag_a_scene_decides_is_refused_naming_the_flag():
-    p = _parser()
+    p = config_parser()
     add_map_flags(p)
     with pytest.raises(BumpError) as e:
         scene_from_args(p.parse_args(["--out-bits", "8"]), "default")

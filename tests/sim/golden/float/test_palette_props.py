@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.golden.float.palette import (MATERIAL_SCALE, Material, check_normal_map, color_table,
                                               displacement_to_normals, frame_directions, lookup,
                                               mipmap_indices, nearest_spacing, quantize_normal_map)
@@ -432,10 +433,6 @@ def _tangent(n_phi, n_theta):
     return ry @ rz
 
 
-def _polar(phi, theta):
-    return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1)
-
-
 def test_world_normal_map_sums_each_texels_pixels_and_turns_unused_ones_by_the_mean_frame():
     """Per used texel the sum over its covered pixels of M^T N' (counts = those pixels);
     an unused texel (count 0) holds its map N' turned by the frame of the covered pixels'
@@ -450,16 +447,16 @@ def test_world_normal_map_sums_each_texels_pixels_and_turns_unused_ones_by_the_m
     want = np.zeros((t, t, 3))
     want_counts = np.zeros((t, t), np.int64)
     for i in zip(*np.nonzero(m)):
-        world = _tangent(px.n_phi[i], px.n_theta[i]).T @ _polar(px.b_phi[i], px.b_theta[i])
+        world = _tangent(px.n_phi[i], px.n_theta[i]).T @ polar_to_cartesian(px.b_phi[i], px.b_theta[i])
         want[scene.v[i], scene.u[i]] += world
         want_counts[scene.v[i], scene.u[i]] += 1
     used = want_counts > 0
     assert np.array_equal(counts, want_counts) and 0 < used.sum() < t * t
     assert np.allclose(normals[used], want[used], atol=1e-12)
-    mean = _polar(px.n_phi[m], px.n_theta[m]).mean(0)
+    mean = polar_to_cartesian(px.n_phi[m], px.n_theta[m]).mean(0)
     mean /= np.linalg.norm(mean)
     frame = _tangent(np.arctan2(mean[1], mean[0]) % (2 * np.pi), np.arccos(mean[2]))
-    fallback = _polar(scene.b_phi_map, scene.b_theta_map) @ frame
+    fallback = polar_to_cartesian(scene.b_phi_map, scene.b_theta_map) @ frame
     assert np.allclose(normals[~used], fallback[~used], atol=1e-12)
     unit = want[used] / np.linalg.norm(want[used], axis=-1, keepdims=True)
     assert distinct_normals(scene) == len(np.unique(unit, axis=0))
