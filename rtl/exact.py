@@ -14,8 +14,8 @@ from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit, fits_dsp
 from bumprtl.rtl.shade import IlluminationDatapath
-from bumprtl.rtl.sincos import (registered_quarter_wave_rom, registered_sine_latency, sine_read,
-                                spread_sine)
+from bumprtl.rtl.sincos import (registered_quarter_wave_rom, registered_sine_latency, sine_line,
+                                near_sine, sine_read)
 
 __all__ = ["ExactRotation", "ExactIllumination", "SineBank", "rotated_layout", "rotation_latency",
            "vector_terms", "vectors"]
@@ -40,12 +40,13 @@ def rotated_layout(cfg: Config):
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
     a value read appears ``latency`` ``adv`` stages after its angle (angle register,
-    address register, [its near copy for a spread ROM,] read, block-RAM output register,
+    address register, [its near copy for a wide ROM,] read, block-RAM output register,
     data register, sign: sincos.registered_sine_latency)."""
 
     def __init__(self, m, pipe, cfg):
         self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], []
-        self.near, self.latency = spread_sine(cfg), registered_sine_latency(cfg)
+        self.near, self.latency = near_sine(cfg), registered_sine_latency(cfg)
+        self.line = sine_line(cfg)
 
     def _port(self):
         if not self.pending:
@@ -56,7 +57,7 @@ class SineBank:
 
     def sin(self, angle, name):
         return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True,
-                         near=self.near)
+                         near=self.near, line=self.line)
 
     def cos(self, angle, name):
         return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)

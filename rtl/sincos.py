@@ -1,34 +1,68 @@
 """Quarter-wave sine/cosine unit: the toolchain vertical slice (docs/architecture.md, Number formats)."""
 
-from amaranth.hdl import Module, Mux, signed, unsigned
+from amaranth.hdl import Cat, Const, Module, Mux, signed, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe, pipe_observer
-from bumprtl.rtl.tables import quarter_sine
-from bumprtl.rtl.targets import is_spread
+from bumprtl.rtl.tables import quarter_sine, quarter_sine_above_line
+from bumprtl.rtl.targets import NEAR_BLOCKS, is_spread, rom_blocks
 
 __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
-           "REGISTERED_SINE_LATENCY", "spread_sine", "registered_sine_latency"]
+           "REGISTERED_SINE_LATENCY", "spread_sine", "near_sine", "registered_sine_latency", "sine_line",
+           "sine_rom_table"]
 
 # sine_read(registered=True): angle register, address register, ROM read, block-RAM
 # output register, data register, sign.
 REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 2
 
 
+def _width(words):
+    return max(1, int(max(words)).bit_length())
+
+
+def sine_line(cfg: Config):
+    """The registered quarter-wave ROM stores the sine minus the line under it
+    (tables.quarter_sine_above_line, B - 2 bits) where that takes fewer DP16KD side by side
+    (targets.rom_blocks) than the sine itself (B + 1 bits): 15-bit angles at B = 16, seven
+    8192 x 2 blocks instead of nine. :func:`sine_read` (``line``) adds the line back, a shift
+    of the ROM address, in the sign's stage: the values read are the same."""
+    words = 1 << cfg.k
+    return (rom_blocks(words, _width(quarter_sine_above_line(cfg)))
+            < rom_blocks(words, cfg.frac_bits + 1))
+
+
+def sine_rom_table(cfg: Config):
+    """(words, width) of the registered quarter-wave ROM of ``cfg``: tables.quarter_sine, or
+    where :func:`sine_line` holds tables.quarter_sine_above_line."""
+    if sine_line(cfg):
+        table = quarter_sine_above_line(cfg)
+        return table, _width(table)
+    return quarter_sine(cfg), cfg.frac_bits + 1
+
+
 def spread_sine(cfg: Config):
-    """The quarter-wave ROM (2**k words and the spill word, B + 1 bits) is spread over more
-    than targets.SPREAD_BLOCKS block RAMs (15-bit angles at B = 16: nine 8192 x 2 blocks),
-    so :func:`sine_read` gives its reads a second address register (``near``)."""
-    return is_spread(1 << cfg.k, cfg.frac_bits + 1)
+    """The registered quarter-wave ROM (2**k words and the spill word, :func:`sine_rom_table`)
+    is spread over more than targets.SPREAD_BLOCKS block RAMs (16-bit angles at B = 16:
+    fourteen 16384 x 1 blocks of the sine above its line): its clock enable is a flip-flop of
+    its own (pipe.StallPipe.rom)."""
+    return is_spread(1 << cfg.k, sine_rom_table(cfg)[1])
+
+
+def near_sine(cfg: Config):
+    """The registered quarter-wave ROM spans more than targets.NEAR_BLOCKS block RAMs side by
+    side (15-bit angles at B = 16: seven 8192 x 2 blocks), so :func:`sine_read` gives its
+    reads a second address register beside the blocks (``near``)."""
+    return rom_blocks(1 << cfg.k, sine_rom_table(cfg)[1]) > NEAR_BLOCKS
 
 
 def registered_sine_latency(cfg: Config):
     """Stages of :func:`sine_read` (registered) through the quarter-wave ROM of ``cfg``:
-    REGISTERED_SINE_LATENCY, one more where the ROM is spread (:func:`spread_sine`)."""
-    return REGISTERED_SINE_LATENCY + spread_sine(cfg)
+    REGISTERED_SINE_LATENCY, one more where its reads take a near address register
+    (:func:`near_sine`)."""
+    return REGISTERED_SINE_LATENCY + near_sine(cfg)
 
 
 def quarter_wave_rom(cfg: Config):
@@ -38,13 +72,15 @@ def quarter_wave_rom(cfg: Config):
 
 
 def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
-    """The quarter-wave sine ROM as a :class:`pipe.RegisteredROM` (read, output register;
-    one DP16KD with both ports on ECP5)."""
-    return pipe.rom(quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
+    """The quarter-wave sine ROM (:func:`sine_rom_table`) as a :class:`pipe.RegisteredROM`
+    (read, output register; DP16KD with both ports on ECP5), read by :func:`sine_read`
+    with ``registered`` and ``line=sine_line(cfg)``."""
+    table, width = sine_rom_table(cfg)
+    return pipe.rom(table.tolist(), unsigned(width), name, ports)
 
 
 def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True,
-              near=False):
+              near=False, line=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
@@ -54,7 +90,10 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     is long where a table spans two blocks side by side, each get a cycle of their own;
     ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
     stage; ``near``: one more address register, a plain copy the placer puts beside the
-    ROM's blocks, for a spread ROM: :func:`spread_sine`). ``cos(a)`` is ``sin(a + 2**k)``.
+    ROM's blocks, for a wide ROM: :func:`near_sine`; ``line``: the ROM holds the sine minus
+    the line under it, :func:`sine_line`, and the line ``(address << B) >> k``, delayed beside
+    the read and signed a stage ahead, is added in the sign's stage, one carry chain as the
+    sign alone is: :func:`_sine_above_line`). ``cos(a)`` is ``sin(a + 2**k)``.
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
@@ -70,6 +109,8 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
         if near:
             address = pipe.register(address, f"{name}_address_near")
         m.d.comb += port.addr.eq(address)
+        if line:
+            return _sine_above_line(pipe, port, address, quadrant[1], cfg, name, near)
         negative = pipe.delay(quadrant[1], 2 + near + ROM_LATENCY, f"{name}_negative")
         value = pipe.register(port.data, f"{name}_data")
     else:
@@ -77,6 +118,27 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
         negative = pipe.register(quadrant[1], f"{name}_negative")
         value = port.data
     return pipe.register(Mux(negative, -value, value), name)
+
+
+def _sine_above_line(pipe, port, address, negative, cfg: Config, name, near):
+    """The end of :func:`sine_read` with ``line``: ``+-(line + above)`` from the word read (the
+    sine above its line) and the line of its ``address``, in one carry chain: with the
+    quadrant's sign ``s`` (0 or -1 in every bit), ``-(a + b) = ~a + ~b + 2``, so the line is
+    taken as ``(line ^ s) - 2s`` and the word as ``above ^ s`` in the data register, a stage
+    ahead, and the sum is theirs."""
+    stages = 2 + near + ROM_LATENCY                    # the quadrant's bit to the sign stage
+    at_data = pipe.delay(negative, stages - 1, f"{name}_negative")
+    negative = pipe.register(at_data, f"{name}_negative_d{stages}")
+    above = pipe.register(port.data ^ at_data.replicate(len(port.data)), f"{name}_data")
+    width = cfg.sincos_width + 1
+    line = ((address << cfg.frac_bits) >> cfg.k)[:cfg.frac_bits + 1]     # 0 .. 2**B
+    under = pipe.delay(line, ROM_LATENCY, f"{name}_line")
+    under = Cat(under, Const(0, width - len(under)))
+    under = pipe.register(Mux(at_data, (~under).as_signed() + 2, under.as_signed())[:width]
+                          .as_signed(), f"{name}_signed_line")
+    above = Cat(above, negative.replicate(width - len(above)))         # above ^ s
+    value = under + above.as_signed()                               # |value| <= 2**B
+    return pipe.register(value[:cfg.sincos_width].as_signed(), name)
 
 
 class SinCos(wiring.Component):
@@ -127,7 +189,8 @@ class SinCos(wiring.Component):
         self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
-                                   registered=True, angle_stage=False, near=spread_sine(cfg))
+                                   registered=True, angle_stage=False, near=near_sine(cfg),
+                                   line=sine_line(cfg))
                    for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)))}
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),

@@ -10,7 +10,7 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 
-__all__ = ["quarter_sine", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits",
+__all__ = ["quarter_sine", "quarter_line", "quarter_sine_above_line", "sine_circle", "sin_lookup", "cos_lookup", "specular_index_bits",
            "specular_step_bits", "specular_base", "specular_table", "specular_table_error_lsb",
            "SPEC_FRAC_BITS", "COLOR_FRAC_BITS", "KD_FRAC_BITS", "KS_FRAC_BITS", "LIT_FRAC_BITS",
            "phong_coefficients", "blend_coefficients", "coefficient_error_lsb", "lee_asin_index_bits", "lee_asin_table", "lee_reciprocal_bits",
@@ -29,6 +29,22 @@ def quarter_sine(cfg: Config) -> np.ndarray:
     """
     i = np.arange(cfg.sincos_depth, dtype=np.float64)
     return np.rint(np.sin(i * (np.pi / 2) / (1 << cfg.k)) * cfg.one).astype(np.int64)
+
+
+def quarter_line(cfg: Config, index):
+    """The straight line under the quarter wave: ``floor(i * 2**B / 2**k)``, 0 at ``i = 0`` and
+    exactly 1.0 at ``i = 2**k`` (the RTL computes it as ``(i << B) >> k``: a shift, no
+    multiplier). ``sin x >= 2x/pi`` on [0, pi/2], so :func:`quarter_sine` never falls below it."""
+    return (np.asarray(index, dtype=np.int64) << cfg.frac_bits) >> cfg.k
+
+
+def quarter_sine_above_line(cfg: Config) -> np.ndarray:
+    """:func:`quarter_sine` minus :func:`quarter_line`: what a quarter-wave ROM stores where
+    storing the sine itself would take more block RAMs (rtl/sincos.sine_line). Every entry
+    is at least 0 and below ``0.2106 * 2**B + 1`` (``max(sin x - 2x/pi)`` is 0.2105, at
+    ``cos x = 2/pi``), so it needs ``B - 2`` bits instead of the sine's ``B + 1``; entries 0
+    and ``2**k`` are 0."""
+    return quarter_sine(cfg) - quarter_line(cfg, np.arange(cfg.sincos_depth))
 
 
 @functools.lru_cache(maxsize=32)

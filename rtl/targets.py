@@ -15,7 +15,7 @@ from amaranth.lib.memory import Memory, ReadPort
 __all__ = ["Generic", "ECP5", "GENERIC", "form", "RegisteredProduct", "WideProduct",
            "RegisteredROM", "RegisteredRAM", "read_port", "dp16kd_rom_block", "dp16kd_initvals",
            "fits_dsp", "product_latency", "limb_products", "DP16KD_MODES", "ROM_MAX_BLOCKS",
-           "SPREAD_BLOCKS", "rom_blocks", "is_spread",
+           "SPREAD_BLOCKS", "NEAR_BLOCKS", "rom_blocks", "is_spread",
            "DSP_WIDTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY"]
 
 # Width of one signed DSP input (ECP5's MULT18X18D): fits_dsp's default.
@@ -253,17 +253,23 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
 
 
 # Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5:
-# the 8193 x 17 quarter-wave table of 15-bit angles is nine x2 blocks (no output multiplexer;
-# the generic form, which Yosys maps with one, ran at 72 MHz).
+# an 8193 x 17 table (the quarter-wave sine of 15-bit angles at B = 16, before it was stored
+# above its line: sincos.sine_line) is nine x2 blocks (no output multiplexer; the generic
+# form, which Yosys maps with one, ran at 72 MHz).
 ROM_MAX_BLOCKS = 9
 # A memory of more DP16KD than this side by side is "spread" over the die: it gets an enable
 # flip-flop of its own in lock step (pipe.StallPipe.rom / ram) and its reads a second address
-# register (sincos.sine_read ``near``, bumpfetch.BumpMapFetch), so neither the clock enable
-# nor the address crosses the spread in the cycle that computes it. Measured (bumprtl report
-# fpga, docs/report.md): every row whose memories are at most eight blocks wide met 150 MHz
-# on seeds 1-3; scene_full's nine-block sine ROMs (15-bit angles) and its 15-block map held
-# it at 121.1 MHz.
+# register (sincos.near_sine, bumpfetch.BumpMapFetch), so neither the clock enable nor the
+# address crosses the spread in the cycle that computes it. Measured (bumprtl report fpga,
+# docs/report.md): every row whose memories are at most eight blocks wide met 150 MHz on
+# seeds 1-3; scene_full's nine-block sine ROMs (15-bit angles, before they were stored above
+# their line) and its 15-block map held it at 121.1 MHz.
 SPREAD_BLOCKS = 8
+# A quarter-wave sine ROM of more DP16KD than this side by side has its reads take a second
+# address register beside its blocks (sincos.near_sine): scene_full's sine ROMs of the sine
+# above its line (seven 8192 x 2 blocks) without it had the angle -> mirrored address route,
+# 4.7 ns, as the worst path (149.7 MHz, seed 1).
+NEAR_BLOCKS = 6
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.
 DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 16384, 0))

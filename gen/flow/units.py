@@ -15,7 +15,7 @@ from bumprtl.sim.golden.methods import METHODS, get
 from bumprtl.rtl.palette import PaletteLUT, index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.sincos import SinCos
+from bumprtl.rtl.sincos import SinCos, sine_rom_table
 
 __all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "unit_memories",
            "canonical_command", "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]
@@ -42,9 +42,10 @@ class Unit:
 
 
 def _sincos_sidecar(cfg, dut):
+    width = sine_rom_table(cfg)[1]
     return {"latency": dut.latency, "throughput": 1,
-            "roms": {"quarter_sine": {"depth": cfg.sincos_depth, "width": cfg.frac_bits + 1,
-                                      "bits": cfg.sincos_depth * (cfg.frac_bits + 1)}},
+            "roms": {"quarter_sine": {"depth": cfg.sincos_depth, "width": width,
+                                      "bits": cfg.sincos_depth * width}},
             "error_bound_ulp": 0.5}
 
 

@@ -24,11 +24,12 @@ from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
                               RegisteredProduct, RegisteredROM, WideProduct, fits_dsp,
                               product_latency)
-from bumprtl.rtl.targets import ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
+from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY, SinCos, spread_sine
+from bumprtl.rtl.sincos import (REGISTERED_SINE_LATENCY, SinCos, near_sine, sine_rom_table,
+                                spread_sine)
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.texture import TextureBlend
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
@@ -369,11 +370,13 @@ def test_cycles_within_the_stall_bound(unit):
 @pytest.mark.parametrize("angle_bits,frac_bits", [(a, b) for a in (10, 12, 13, 14, 15, 16)
                                                   for b in (12, 14, 15, 16, 17) if b >= a - 3])
 def test_spread_rule_follows_the_roms_block_count(angle_bits, frac_bits):
-    """sincos.spread_sine (what sets the sine reads' latency, before any ROM is built) says
-    the same as RegisteredROM.spread of the quarter-wave table, and rom_blocks counts the
+    """sincos.spread_sine (what gives the ROM an enable of its own, before any ROM is built)
+    says the same as RegisteredROM.spread of the quarter-wave table, sincos.near_sine (what
+    sets the sine reads' latency) holds for every spread ROM, and rom_blocks counts the
     blocks of the ECP5 form's mode (RegisteredROM.mode): columns of ``width / bits``."""
     cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
-    rom = RegisteredROM(quarter_sine(cfg).tolist(), unsigned(frac_bits + 1), 2, "r")
+    table, width = sine_rom_table(cfg)
+    rom = RegisteredROM(table.tolist(), unsigned(width), 2, "r")
     assert spread_sine(cfg) == rom.spread
     blocks = rom_blocks(rom.depth - 1, rom.width)
     mode = rom.mode(ECP5)
@@ -382,7 +385,9 @@ def test_spread_rule_follows_the_roms_block_count(angle_bits, frac_bits):
     else:
         assert blocks == -(-rom.width // mode[0])
         assert rom.spread == (blocks > SPREAD_BLOCKS)
-    assert SinCos(cfg).latency == REGISTERED_SINE_LATENCY + rom.spread
+    near = blocks > NEAR_BLOCKS
+    assert near_sine(cfg) == near and (near or not rom.spread)
+    assert SinCos(cfg).latency == REGISTERED_SINE_LATENCY + near
 
 
 def _enable_copies(dut):
@@ -394,17 +399,18 @@ def _enable_copies(dut):
 
 
 def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
-    """The full scene's memories are spread (nine-block sine ROMs at 15-bit angles and
-    B = 16, a 15-block map, a 12-block texture): in its BumpPipeline each gets a flip-flop
-    enable of its own (rtl/pipe.StallPipe.rom / ram), which must equal its unit's enable in
-    every cycle under traffic on both sides, and its reads take the extra address register
-    (one more stage in the rotation, the light terms and the fetch). The default scene's
-    memories (at most seven blocks) get none."""
+    """The full scene's map (15 blocks) and texture (12 blocks) are spread: in its
+    BumpPipeline each gets a flip-flop enable of its own (rtl/pipe.StallPipe.rom / ram), which
+    must equal its unit's enable in every cycle under traffic on both sides, and their reads
+    take the extra address register (one more stage in the fetch). Its sine ROMs at 15-bit
+    angles and B = 16 hold the sine above its line, seven blocks: not spread, but wider than
+    NEAR_BLOCKS, so their reads take the extra address register too (one more stage in the
+    rotation). The default scene's memories (at most seven blocks) get no enable copy."""
     dut = BumpPipeline(load_scene_config("full"))
     sim, units = _enable_copies(dut)
     copies = [(name, run, c) for name, (run, cs) in units.items() for c in cs]
     per_unit = {name: len(cs) for name, (_, cs) in units.items() if cs}
-    assert per_unit == {"fetch": 2, "rotation": 12, "terms": 5}, per_unit
+    assert per_unit == {"fetch": 2}, per_unit
     for name, _, copy in copies:           # each copy is named after its memory: "<memory>_run"
         mem = dut.units[name].memories[copy.name.removesuffix("_run")]
         words = mem["depth"] - (mem["depth"] % 2 == 1 and mem["depth"] > 1)   # the spill word

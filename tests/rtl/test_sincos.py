@@ -3,7 +3,8 @@
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.sincos import SinCos
+from bumprtl.rtl.sincos import SinCos, near_sine, sine_line, sine_rom_table, spread_sine
+from bumprtl.rtl.targets import rom_blocks
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
 from bumprtl.sim.amaranth_stream import simulate_stream
 from bumprtl.sim.traffic import PATTERNS
@@ -37,3 +38,31 @@ def test_one_angle_per_clock_without_stalls():
     dut = SinCos(cfg)
     _, cycles = simulate_stream(dut, [{"angle": a, "tag": 0} for a in range(200)], "no_stall")
     assert cycles == 200 + dut.latency
+
+
+def test_exhaustive_sine_above_line():
+    """13-bit angles at B = 11: the ROM holds the sine above its line (one 2048 x 9 block
+    instead of two), and every angle still reads the table's sine and cosine."""
+    cfg = Config(angle_bits=13, frac_bits=11, tag_bits=8)
+    assert sine_line(cfg) and sine_rom_table(cfg)[1] == 9
+    _check_exhaustive(cfg, "both")
+
+
+@pytest.mark.parametrize("angle_bits, frac_bits, line, width, blocks", [
+    (14, 15, False, 16, 4),     # 4096 x 4 blocks: 13 bits above the line are still four
+    (15, 16, True, 14, 7),      # 8192 x 2 blocks: 17 bits are nine, 14 bits seven
+    (13, 11, True, 9, 1),       # 2048 x 9: 12 bits are two blocks, 9 bits one
+    (12, 13, False, 14, 1),     # 1025 words: one x18 block either way (the spill word aside)
+    (16, 16, True, 14, 14)])    # 16384 x 1: seventeen blocks or fourteen
+def test_sine_line_where_it_saves_block_rams(angle_bits, frac_bits, line, width, blocks):
+    """DP16KD holds 1024 x 18 ... 16384 x 1 (18 Kbit): the ROM stores the sine above its line
+    (B - 2 bits) only where that takes fewer blocks side by side than the sine (B + 1); more
+    than six blocks take a near address register (one more stage), more than eight an enable
+    of their own."""
+    cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
+    assert sine_line(cfg) is line
+    assert sine_rom_table(cfg)[1] == width
+    assert rom_blocks(1 << cfg.k, width) == blocks
+    assert spread_sine(cfg) == (blocks > 8)
+    assert near_sine(cfg) == (blocks > 6)
+    assert SinCos(cfg).latency == 6 + near_sine(cfg)

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.tables import (blend_coefficients, cos_lookup, phong_coefficients, quarter_sine,
-                                sin_lookup, specular_step_bits, specular_table)
+from bumprtl.rtl.tables import (blend_coefficients, cos_lookup, phong_coefficients, quarter_line,
+                                quarter_sine, quarter_sine_above_line, sin_lookup,
+                                specular_step_bits, specular_table)
 
 
 @pytest.mark.parametrize("angle_bits, frac_bits", [(8, 8), (12, 13), (14, 16)])
@@ -88,3 +89,22 @@ def test_quarter_sine_entries_from_math_sin(angle_bits, frac_bits):
     want = [math.floor(math.sin(i * (math.pi / 2) / (1 << k)) * (1 << frac_bits) + 0.5)
             for i in range((1 << k) + 1)]
     assert quarter_sine(cfg).tolist() == want
+
+
+@pytest.mark.parametrize("angle_bits, frac_bits", [(6, 4), (13, 11), (14, 15), (15, 16), (16, 13),
+                                                   (16, 24)])
+def test_sine_above_line_is_the_sine_minus_a_shift(angle_bits, frac_bits):
+    """quarter_line(i) = floor(i 2**B / 2**k) in Python integers; the ROM's sine above it adds
+    back to quarter_sine, is never negative (sin x >= 2x/pi on [0, pi/2]) and stays below
+    0.2106 2**B + 1, B - 2 bits (max(sin x - 2x/pi) = sqrt(1 - 4/pi**2) - 2 acos(2/pi)/pi)."""
+    cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
+    k, depth = angle_bits - 2, cfg.sincos_depth
+    line = quarter_line(cfg, np.arange(depth))
+    assert line.tolist() == [(i * (1 << frac_bits)) // (1 << k) for i in range(depth)]
+    above = quarter_sine_above_line(cfg)
+    assert (above + line).tolist() == quarter_sine(cfg).tolist()
+    peak = math.sqrt(1 - 4 / math.pi ** 2) - 2 * math.acos(2 / math.pi) / math.pi
+    assert 0.2105 < peak < 0.2106
+    assert above.min() == 0 and above[0] == 0 and above[-1] == 0
+    assert above.max() <= peak * (1 << frac_bits) + 1
+    assert int(above.max()).bit_length() <= frac_bits - 2
