@@ -243,8 +243,9 @@ FPGA_NOTES = """
   own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
   about 1 ns clock-to-out instead of 5.8 ns; the last word of a 2^n + 1-word table is kept
   in a flip-flop, so the specular table is one 1024 x 18 block and each quarter-wave
-  table of the default 14-bit angles four 4096 x 4 blocks side by side (15-bit angles: nine
-  8192 x 2 blocks, no output multiplexer), whose word gets a data register of its own
+  table of the default 14-bit angles four 4096 x 4 blocks side by side (15-bit angles at
+  B = 16: seven 8192 x 2 blocks of the sine above its line, next bullet but one), whose word
+  gets a data register of its own
   before the sign: the route from two blocks side by side ended the exact pipeline's cycle
   at 146.7 MHz at 13-bit angles); every product uses the DSP's input and output registers
   (`rtl/pipe.RegisteredProduct`: MULT18X18D with REG_INPUTA/B and REG_OUTPUT, about 3.9 ns
@@ -290,15 +291,25 @@ FPGA_NOTES = """
   held scene_full at 97.8 MHz (mostly routing delay). The blend registers `lit` before its
   albedo products, the light sum registers the Phong terms' sum before the rounding and
   clamp, and the palette table's read is registered (each one more stage).
-- A memory more than eight DP16KD wide (`rtl/targets.SPREAD_BLOCKS`: the quarter-wave
-  ROMs at 15-bit angles and B = 16, nine 8192 x 2 blocks in their natural layout; the full
-  scene's 15-block map and 12-block texture) is spread over the die. In lock step it runs on
-  an enable flip-flop of its own (`rtl/pipe.StallPipe`: each copy has the unit copy's next
+- A memory more than eight DP16KD wide (`rtl/targets.SPREAD_BLOCKS`: the full scene's
+  15-block map and 12-block texture) is spread over the die. In lock step it runs on an
+  enable flip-flop of its own (`rtl/pipe.StallPipe`: each copy has the unit copy's next
   state), and its reads take a second address register, a plain copy the placer puts
-  beside the blocks (`rtl/sincos.sine_read` `near`, `rtl/bumpfetch.BumpMapFetch`): one more
-  stage in the rotation, the light terms and the fetch of those scenes. Without both,
-  the rotation's enable fanned out to 108 block RAMs and held scene_full at 121.1 MHz.
-  Rows whose memories are at most eight blocks wide are unchanged.
+  beside the blocks (`rtl/bumpfetch.BumpMapFetch`): one more stage in the fetch. Without
+  both, the rotation's enable fanned out to 108 block RAMs (the quarter-wave ROMs of 15-bit
+  angles at B = 16, then nine 8192 x 2 blocks each) and held scene_full at 121.1 MHz.
+- At 15-bit angles and B = 16 (scene_full, scene_two_lights) each quarter-wave ROM stores
+  the sine minus the line under it, `floor(i * 2**B / 2**k)`, in 14 bits instead of 17
+  (`rtl/sincos.sine_line`, `rtl/tables.quarter_sine_above_line`): seven 8192 x 2 blocks
+  instead of nine, 148 and 129 DP16KD instead of 182 and 163. The read adds the line, a
+  shift of the address, back in one carry chain: the quadrant's sign is folded into the
+  word's data register and into the line a stage ahead (`-(a + b) = ~a + ~b + 2`). Its
+  reads keep the second address register beside the blocks (`rtl/targets.NEAR_BLOCKS`:
+  more than six blocks; one more stage in the rotation and the light terms); without it
+  the angle -> mirrored address route held scene_full at 149.7 MHz, and with the sign
+  still in the sum's stage the data register -> sum route held scene_two_lights at
+  144.3 MHz (seed 2; docs/fixed_point.md has the table). Rows whose memories are at most
+  six blocks wide are unchanged.
 - The `<method>_pipeline` rows chain the method's two units the same way, in lock step
   behind a 2-entry output buffer (`gen/flow/fpga.pipeline_component`); with
   `wiring.connect` each unit's `adv = ~o.valid | o.ready` chained through both, and where
