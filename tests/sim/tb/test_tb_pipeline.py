@@ -17,23 +17,26 @@ from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
 from bumprtl.sim.traffic import PATTERNS
 
 
-# make test: the full scene on Icarus (a build costs little there); the default scene's
-# per-cycle run is in make regress, since make test streams that scene's pipeline on Icarus
-# under the same traffic patterns through the bulk path (tests/sim/tb/test_bulk.py: the
-# coverage frame, then this render frame); make regress: the full scene's build on Verilator
-# too (a minute of C++ compilation).
-@pytest.mark.parametrize("sim, name", [("icarus", "full"),
-                                       pytest.param("icarus", "default", marks=pytest.mark.regress),
-                                       pytest.param("verilator", "full", marks=pytest.mark.regress)])
-def test_pipeline_stream_cocotb(sim, name, build_dir):
+# make test: the full scene's coverage frame on Icarus (a build costs little there); the
+# default scene's per-cycle run is in make regress, since make test streams that scene's
+# pipeline on Icarus under the same traffic patterns through the bulk path
+# (tests/sim/tb/test_bulk.py: the coverage frame, then the render frame); make regress: the
+# render frame behind the coverage frame, and the full scene's build on Verilator too (a
+# minute of C++ compilation).
+@pytest.mark.parametrize("sim, name, render", [
+    ("icarus", "full", False),
+    pytest.param("icarus", "full", True, marks=pytest.mark.regress),
+    pytest.param("icarus", "default", True, marks=pytest.mark.regress),
+    pytest.param("verilator", "full", True, marks=pytest.mark.regress)])
+def test_pipeline_stream_cocotb(sim, name, render, build_dir):
     """``full``: two lights, mip levels and the colour texture (RGB out). One build and one
     run of sim/tb/tb_pipeline.py: under each traffic pattern the host writes the coverage
     frame's map and texture words (sim/tb/bulk_frame.py, the frame the netlist mutants of
     pipeline:full and pipeline:two-lights stream: two-lights is this datapath without the
     texture and the mip levels), then the frame's pixels stream, then the rendered 16 x 16
-    frame's; every output field equals the golden model's on the memories as the host left
-    them (2 of the render's 256 pixels read a word the host wrote; the others' outputs are
-    the golden render's)."""
+    frame's (``render``); every output field equals the golden model's on the memories as
+    the host left them (2 of the render's 256 pixels read a word the host wrote; the others'
+    outputs are the golden render's)."""
     scene = load_scene_config(name)
     inputs, words, polygon, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
@@ -42,7 +45,8 @@ def test_pipeline_stream_cocotb(sim, name, build_dir):
     frame = coverage_frame(scene, words, texels)
     assert sorted(frame.inputs) == sorted(inputs)
     assert len(frame.inputs["tag"]) > PIXELS                  # the table-sensitivity pixels
-    stream = {k: np.concatenate([frame.inputs[k], inputs[k]]) for k in inputs}
+    stream = {k: np.concatenate([frame.inputs[k], inputs[k]]) if render else frame.inputs[k]
+              for k in inputs}
     outs, cycles, _ = run_pipeline_emitted(v, j, stream, polygon, table, sim, build_dir,
                                            list(PATTERNS), progress=False,
                                            setup=frame.setup(meta))
