@@ -28,8 +28,8 @@ out. A config whose fields do not fit ``tdata_width`` raises :class:`AxisError` 
 the widths.
 """
 
-from amaranth.hdl import Cat, ClockDomain, ClockSignal, Module, ResetSignal, Shape, unsigned
-from amaranth.lib import data, wiring
+from amaranth.hdl import Cat, ClockDomain, ClockSignal, Module, ResetSignal
+from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import BumpError

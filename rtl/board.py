@@ -32,8 +32,7 @@ pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's
 k) and ``tmds_clk_p``.
 """
 
-from amaranth.hdl import (Cat, ClockDomain, ClockSignal, Const, Elaboratable, Instance,
-                          Module, Mux, ResetSignal, Signal)
+from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.cdc import ResetSynchronizer
 from amaranth.lib.fifo import SyncFIFOBuffered
@@ -113,7 +112,7 @@ class PixelSource(Elaboratable):
         m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
         m.d.comb += [payload_field(pay, k).eq(c) for k, c in self.constants.items()]
         at = 0
-        for k, w in zip(self.keys, self.widths):
+        for k, w in zip(self.keys, self.widths, strict=True):
             m.d.comb += payload_field(pay, k).eq(rd.data[at:at + w])
             at += w
         return m

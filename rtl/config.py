@@ -10,7 +10,7 @@ The RTL, the golden models, the testbenches, the emitter and the reports all rea
 * outputs are ``out_bits``-bit unsigned intensities after clamping.
 """
 
-from dataclasses import dataclass, fields, asdict
+from dataclasses import asdict, dataclass, fields
 
 from bumprtl.rtl.errors import BumpError, ConfigError
 from bumprtl.rtl.methods import METHODS

@@ -10,12 +10,16 @@ from amaranth.hdl import signed
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import pixel_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, PipeUnit, fits_dsp
 from bumprtl.rtl.shade import IlluminationDatapath
-from bumprtl.rtl.sincos import (registered_quarter_wave_rom, registered_sine_latency, sine_line,
-                                near_sine, sine_read)
+from bumprtl.rtl.sincos import (
+    near_sine,
+    registered_quarter_wave_rom,
+    registered_sine_latency,
+    sine_line,
+    sine_read,
+)
 
 __all__ = ["ExactRotation", "ExactIllumination", "SineBank", "rotated_layout", "rotation_latency",
            "vector_terms", "vectors"]

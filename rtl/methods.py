@@ -23,7 +23,6 @@ under the other's name (:data:`HARDWARE`).
 
 import importlib
 from dataclasses import dataclass
-from typing import Optional
 
 from bumprtl.rtl.errors import ConfigError
 
@@ -85,8 +84,8 @@ class Method:
     layout_path: str
     cartesian: bool
     rotates_normal: bool
-    not_placed: Optional[str] = None
-    hardware_of: Optional[str] = None
+    not_placed: str | None = None
+    hardware_of: str | None = None
 
     @property
     def per_pixel(self):

@@ -15,10 +15,24 @@ from amaranth.lib.wiring import In, Out
 
 # The registered elements a StallPipe builds, and the targets that build them (rtl/targets.py);
 # the names are also read from here by the units.
-from bumprtl.rtl.targets import (DP16KD_MODES, ECP5, PRODUCT_LATENCY, RAM_LATENCY, ROM_LATENCY,
-                                 WIDE_PRODUCT_LATENCY, RegisteredProduct, RegisteredRAM,
-                                 RegisteredROM, WideProduct, dp16kd_initvals, dp16kd_rom_block,
-                                 fits_dsp, limb_products, product_latency, read_port)
+from bumprtl.rtl.targets import (
+    DP16KD_MODES,
+    ECP5,
+    PRODUCT_LATENCY,
+    RAM_LATENCY,
+    ROM_LATENCY,
+    WIDE_PRODUCT_LATENCY,
+    RegisteredProduct,
+    RegisteredRAM,
+    RegisteredROM,
+    WideProduct,
+    dp16kd_initvals,
+    dp16kd_rom_block,
+    fits_dsp,
+    limb_products,
+    product_latency,
+    read_port,
+)
 
 __all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",

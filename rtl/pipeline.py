@@ -37,17 +37,32 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
-from bumprtl.rtl.exact import ExactRotation, SineBank, rotated_layout, rotation_latency, vector_terms
+from bumprtl.rtl.exact import (
+    SineBank,
+    rotated_layout,
+    rotation_latency,
+    vector_terms,
+)
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.layouts import (angle_shape, light_fields, light_layout, pixel_layout,
-                                 shade_layout)
+from bumprtl.rtl.layouts import angle_shape, light_fields, light_layout, pixel_layout, shade_layout
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import (BUFFER_DEPTH, PRODUCT_LATENCY, StallPipe, lockstep_buffer,
-                              lockstep_enables, pipe_observer)
+from bumprtl.rtl.pipe import (
+    BUFFER_DEPTH,
+    PRODUCT_LATENCY,
+    StallPipe,
+    lockstep_buffer,
+    lockstep_enables,
+    pipe_observer,
+)
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
-                                phong_coefficients)
+from bumprtl.rtl.tables import (
+    COLOR_FRAC_BITS,
+    KD_FRAC_BITS,
+    KS_FRAC_BITS,
+    SPEC_FRAC_BITS,
+    phong_coefficients,
+)
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
 
 __all__ = ["BumpPipeline", "VectorTerms", "LightSum", "BUFFER_DEPTH"]

@@ -17,9 +17,17 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import shade_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
-from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
-                                phong_coefficients, specular_base, specular_index_bits,
-                                specular_step_bits, specular_table)
+from bumprtl.rtl.tables import (
+    COLOR_FRAC_BITS,
+    KD_FRAC_BITS,
+    KS_FRAC_BITS,
+    SPEC_FRAC_BITS,
+    phong_coefficients,
+    specular_base,
+    specular_index_bits,
+    specular_step_bits,
+    specular_table,
+)
 
 __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 

@@ -7,8 +7,18 @@ the ECP5 flow). An element asks its target (:func:`form`) to build it; no elemen
 target names.
 """
 
-from amaranth.hdl import (ClockSignal, Const, Elaboratable, Instance, Module, Mux, Shape, Signal,
-                          Value, signed)
+from amaranth.hdl import (
+    ClockSignal,
+    Const,
+    Elaboratable,
+    Instance,
+    Module,
+    Mux,
+    Shape,
+    Signal,
+    Value,
+    signed,
+)
 from amaranth.lib import wiring
 from amaranth.lib.memory import Memory, ReadPort
 
@@ -202,7 +212,7 @@ class RegisteredROM(Elaboratable):
 
     def dp16kd(self, m, bits, words, shift):
         """The ECP5 form in mode (``bits``, ``words``, ``shift``) (:meth:`ECP5.rom`)."""
-        sides = list(zip("AB", self.ports + self.ports[:1]))[:max(2, len(self.ports))]
+        sides = list(zip("AB", self.ports + self.ports[:1], strict=True))[:max(2, len(self.ports))]
         douts = {side: Signal(self.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
         for col in range(-(-self.width // bits)):
             lo, hi = col * bits, min(self.width, (col + 1) * bits)

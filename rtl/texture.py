@@ -32,8 +32,13 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.pipe import ECP5, StallPipe, pipe_observer
-from bumprtl.rtl.tables import (KS_FRAC_BITS, LIT_FRAC_BITS, SPEC_FRAC_BITS, blend_coefficients,
-                                coefficient_error_lsb)
+from bumprtl.rtl.tables import (
+    KS_FRAC_BITS,
+    LIT_FRAC_BITS,
+    SPEC_FRAC_BITS,
+    blend_coefficients,
+    coefficient_error_lsb,
+)
 
 __all__ = ["RGB", "rgb_layout", "texture_blend", "sum_product", "blend_error_bound_lsb",
            "TextureBlend", "TexelDelay", "BLEND_LATENCY", "SUMS8_STAGE"]

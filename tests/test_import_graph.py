@@ -78,7 +78,7 @@ def _where(path, node, root):
 def function_level_imports(mods, root=ROOT):
     """Lines ``file:line in func(): statement`` of imports inside a function body."""
     bad = []
-    for name, (path, tree, lines) in mods.items():
+    for _name, (path, tree, lines) in mods.items():
         for node, func in imports(tree):
             text = lines[node.lineno - 1:node.end_lineno]
             if func is None or any(OPTIONAL in ln for ln in text):
@@ -152,7 +152,7 @@ def cycles(graph):
 
 
 def describe_cycle(cycle, graph, mods, root=ROOT):
-    steps = [f"{a} ({mods[a][0].relative_to(root)}:{graph[a][b]})" for a, b in zip(cycle, cycle[1:])]
+    steps = [f"{a} ({mods[a][0].relative_to(root)}:{graph[a][b]})" for a, b in zip(cycle, cycle[1:], strict=False)]
     return " -> ".join(steps + [cycle[-1]])
 
 

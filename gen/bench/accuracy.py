@@ -18,19 +18,28 @@ from dataclasses import fields, replace
 
 import numpy as np
 
+from bumprtl.gen.flow.units import build_unit, error_bounds
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config, ConfigError
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
-from bumprtl.sim.golden.methods import METHODS, datapath_fixed, encode_pixels, get
 from bumprtl.rtl.texture import RGB, texture_blend
-from bumprtl.sim.golden.accuracy import (CHANNELS, adversarial_pixels, arithmetic_pixels,
-                                         crater_scene, grid_errors_lsb, on_grid, reference_blend,
-                                         scene_error, term_errors_lsb, worst_case_pixels)
+from bumprtl.sim.golden.accuracy import (
+    CHANNELS,
+    adversarial_pixels,
+    arithmetic_pixels,
+    crater_scene,
+    grid_errors_lsb,
+    on_grid,
+    reference_blend,
+    scene_error,
+    term_errors_lsb,
+    worst_case_pixels,
+)
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import input_angle_error, phong_sum_fixed, term_bounds_lsb
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed, encode_pixels, get
 from bumprtl.sim.scenes import SCENES, load_scene
-from bumprtl.gen.flow.units import build_unit, error_bounds
 
 __all__ = ["measure", "light_sums", "run", "add_parser"]
 
@@ -319,7 +328,7 @@ def _light_row(cfg, m, output, row):
 def _scene_config(args):
     """The Config of the light-sum, blend and scene tables: ``--scene-widths`` (angle bits,
     frac bits) when given, else Config's default widths."""
-    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or ()))
+    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or (), strict=True))
     return Config(method=args.method, spec_index_bits=args.spec_index_bits, **widths)
 
 

@@ -6,8 +6,14 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
-from bumprtl.sim.golden.measure import (compare, error_at_theta_n, error_by_theta_n,
-                                        proportion_worst_case_deg, random_pixels, worst_pixel)
+from bumprtl.sim.golden.measure import (
+    compare,
+    error_at_theta_n,
+    error_by_theta_n,
+    proportion_worst_case_deg,
+    random_pixels,
+    worst_pixel,
+)
 
 
 def _cols(s):

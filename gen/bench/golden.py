@@ -4,13 +4,11 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
+from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
-from bumprtl.sim.tb.runner import run_cocotb, SIMULATORS
-from bumprtl.gen.flow.units import emit_unit
+from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
 
 def _golden_rate(cfg, n, repeats=3):

@@ -10,9 +10,9 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import quantize_pixels
-from bumprtl.sim.golden.methods import datapath_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.lee import lee_corrected
+from bumprtl.sim.golden.methods import datapath_fixed
 
 WIDTHS = ((8, 7), (10, 9), (10, 13), (12, 13), (12, 16), (14, 18), (16, 24))
 

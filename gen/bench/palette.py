@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
@@ -17,7 +18,12 @@ import numpy as np
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.palette import color_table, distinct_normals, palette_rgb, render_palette
+from bumprtl.sim.golden.float.palette import (
+    color_table,
+    distinct_normals,
+    palette_rgb,
+    render_palette,
+)
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 
@@ -48,10 +54,10 @@ def speed(cfg, sizes, palettes):
             table /= np.linalg.norm(table, axis=1, keepdims=True)
             idx = rng.integers(0, sn, (size, size))
             per_pixel_normals = table[idx]
-            t_table = _best(lambda: shade8(table))
+            t_table = _best(lambda table=table: shade8(table))
             colors = shade8(table)
-            t_lookup = _best(lambda: colors[idx])
-            t_direct = _best(lambda: shade8(per_pixel_normals.reshape(-1, 3)))
+            t_lookup = _best(lambda colors=colors, idx=idx: colors[idx])
+            t_direct = _best(lambda normals=per_pixel_normals: shade8(normals.reshape(-1, 3)))
             frame = t_table + t_lookup
             print(f"| {size}² | {sn} | {t_table * 1e3:.2f} | {t_lookup * 1e3:.2f} | {frame * 1e3:.2f} "
                   f"| {t_direct * 1e3:.1f} | {t_direct / frame:.1f}x |", flush=True)
@@ -82,9 +88,9 @@ def accuracy(cfg, scenes, palettes, size, plot=None):
 
 def _plot(curves, path, size):
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=80)
-    for n, ((name, quantizer), curve) in enumerate(sorted(curves.items())):
+    for _n, ((name, quantizer), curve) in enumerate(sorted(curves.items())):
         if curve:
-            xs, ys = zip(*curve)
+            xs, ys = zip(*curve, strict=False)
             ax.semilogx(xs, ys, "-o" if quantizer == "kmeans" else "--x", base=2,
                         color=f"C{sorted({k[0] for k in curves}).index(name)}", label=f"{name} {quantizer}")
     ax.set_xlabel("palette size sN")

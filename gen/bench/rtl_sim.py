@@ -17,7 +17,6 @@ docs/bench.md.
 
 import json
 import os
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,8 +24,8 @@ import numpy as np
 from bumprtl.gen.bench.sweep import write_section
 from bumprtl.gen.render.rtl import run_pipeline, run_pipeline_bulk, scene_stimulus, scene_texels
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 
 __all__ = ["BULK_BUILDS", "rtl_sim_rows", "markdown", "add_parser"]

@@ -21,14 +21,14 @@ from pathlib import Path
 import numpy as np
 from amaranth.back import verilog
 
-from bumprtl.rtl.bumpfetch import pack_texels
-from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
-from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed
 from bumprtl.gen.bench.sweep import _cached, _digest, write_section
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
+from bumprtl.rtl.bumpfetch import pack_texels
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["unskipped", "skip_rows", "markdown", "add_parser"]
 
@@ -135,7 +135,7 @@ def markdown(rows, command, size):
             lines.append(f"| {r['scene']} | **{r['status']}**: {r['reason']} | | | | | | | | |")
             continue
         on, off = r["on"], r["off"]
-        pair = lambda k: f"{on[k]} / {off[k]}"
+        pair = lambda k, on=on, off=off: f"{on[k]} / {off[k]}"
         lines.append(f"| {r['scene']} | {'; '.join(r['skipped']) or '—'} "
                      f"| {on['golden_s'] * 1e3:.2f} / {off['golden_s'] * 1e3:.2f} "
                      f"| {_ratio(off['golden_s'], on['golden_s'])} | {pair('multipliers')} "

@@ -23,12 +23,12 @@ import numpy as np
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_index_bits, specular_step_bits
 from bumprtl.sim.golden.accuracy import adversarial_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import specular_fine_fixed
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 
 __all__ = ["CANDIDATES", "candidate_fine", "run", "add_parser"]
 
@@ -111,7 +111,7 @@ def run(args):
             print(f"| {n} | {name} | {words} | {blocks} | {mults} | {term:.3f} | "
                   f"{errs['random'].max()} / {errs['random'].mean():.4f} | "
                   f"{errs['adversarial'].max()} / {errs['adversarial'].mean():.4f} |", flush=True)
-    print(f"\nstep of the kept table (2^-t) per n: "
+    print("\nstep of the kept table (2^-t) per n: "
           + ", ".join(f"n={n}: t={specular_step_bits(Config(spec_exponent=n))}" for n in args.spec_exponent))
     counts = count_unit("illumination", Config(), args.work).summary()
     print("\nIllumination at the default widths, Yosys coarse netlist (gen/flow/resources.py): "

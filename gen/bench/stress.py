@@ -10,10 +10,10 @@ model that raises is recorded with its exception, never hidden.
 
 from pathlib import Path
 
-from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
-from bumprtl.sim.golden.stress import CASES, check_fixed, float_stats, stress_case, STRESS_CONFIGS
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed
+from bumprtl.sim.golden.stress import CASES, STRESS_CONFIGS, check_fixed, float_stats, stress_case
 
 __all__ = ["stress_rows", "markdown", "add_parser"]
 

@@ -33,29 +33,41 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from tqdm import tqdm
 
-from bumprtl.rtl.config import BumpError, Config, ConfigError
-from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
-from bumprtl.rtl.pipe import ECP5
+from bumprtl.gen.bench.golden import _sim_rate
+from bumprtl.gen.flow.fpga import (
+    NOT_PLACED,
+    FpgaError,
+    Placement,
+    check_device,
+    pipeline_component,
+    place_component,
+    place_text,
+)
+from bumprtl.gen.flow.resources import SynthesisError, count_verilog
+from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.gen.report import write_section
+from bumprtl.rtl.config import BumpError, Config, ConfigError
+from bumprtl.rtl.pipe import ECP5
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.palette import (distinct_normals, palette_rgb, quantize_normal_map,
-                                               world_normal_map)
-from bumprtl.sim.scenes import SCENES, load_scene
-from bumprtl.sim.scenes.imaging import max_diff, psnr
-from bumprtl.gen.bench.golden import _sim_rate
+from bumprtl.sim.golden.float.palette import (
+    distinct_normals,
+    palette_rgb,
+    quantize_normal_map,
+    world_normal_map,
+)
+from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
 from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.sim.jobs import add_arguments as add_job_arguments
-from bumprtl.gen.flow.fpga import (check_device, FpgaError, NOT_PLACED, Placement,
-                                   pipeline_component, place_component, place_text)
-from bumprtl.gen.flow.resources import count_verilog, SynthesisError
-from bumprtl.gen.flow.units import build_unit, emit_unit
+from bumprtl.sim.scenes import SCENES, load_scene
+from bumprtl.sim.scenes.imaging import max_diff, psnr
 
 __all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot",
            "parse_maps", "map_key", "MAP_SIZES"]
@@ -390,7 +402,7 @@ def palette_point(ctx, size, opts):
         rgb, _ = palette_rgb(scene, cfg, qmap=qmap)
         scenes[name] = {**_scene_stats(ctx, name, to_8bit(rgb.mean(-1))), "quantized": not qmap.exact,
                         "distinct_normals": qmap.distinct}
-        speeds.append(scene.mask.size / _best_time(lambda: palette_rgb(scene, cfg, qmap=qmap)))
+        speeds.append(scene.mask.size / _best_time(lambda scene=scene, qmap=qmap: palette_rgb(scene, cfg, qmap=qmap)))
     exact = [name for name, s in scenes.items() if not s["quantized"]]
     point = {"method": "palette", "palette_size": size, "status": "ok", "config": cfg.to_dict(),
              "quantizes": len(exact) < len(scenes), "stores_every_normal_of": exact,
@@ -585,7 +597,7 @@ def plot(data, path):
                        color=f"C{n}")
         front = sorted((x(pts[i]), max(error_lsb(pts[i]), 0.5)) for i in pareto_front(pts, x, error_lsb))
         if front:
-            ax.step(*zip(*front), where="post", color="k", lw=0.8, label="Pareto front")
+            ax.step(*zip(*front, strict=False), where="post", color="k", lw=0.8, label="Pareto front")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel(xlabel)

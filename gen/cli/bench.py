@@ -3,8 +3,18 @@
 Each kind lives in its own module with ``add_parser(subparsers)``; register it in BENCHES.
 """
 
-from bumprtl.gen.bench import (accuracy, float64, golden, lee_widths, palette, rtl_sim, skip,
-                                specular, stress, sweep)
+from bumprtl.gen.bench import (
+    accuracy,
+    float64,
+    golden,
+    lee_widths,
+    palette,
+    rtl_sim,
+    skip,
+    specular,
+    stress,
+    sweep,
+)
 from bumprtl.gen.flow.quiet import quiet_commands
 
 # kind -> module of gen/bench/ providing add_parser(subparsers); each benchmark module adds

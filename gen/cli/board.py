@@ -10,14 +10,19 @@ beside the video logic) prints one line and exits 2 before anything is written.
 """
 
 import json
-import time
 from pathlib import Path
 
+from bumprtl.gen.cli.flags import add_map_flags, scene_from_args
+from bumprtl.gen.flow.board import (
+    BOARDS,
+    board_data,
+    build_bitstream,
+    check_board,
+    check_frames,
+    part_costs,
+)
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.video import MODES
-from bumprtl.gen.cli.flags import add_map_flags, scene_from_args
-from bumprtl.gen.flow.board import (BOARDS, board_data, build_bitstream, check_board,
-                                    check_frames, part_costs)
 from bumprtl.sim.scenes.imaging import save_png
 
 __all__ = ["add_parser", "run"]

@@ -6,18 +6,28 @@ import re
 import sys
 from pathlib import Path
 
-from bumprtl.rtl.config import BumpError
-from bumprtl.gen.cli.flags import (add_config_flags, add_map_flags, config_from_args, map_overrides,
-                                   scene_from_args)
+from bumprtl.gen.cli.flags import (
+    add_config_flags,
+    add_map_flags,
+    config_from_args,
+    map_overrides,
+    scene_from_args,
+)
 from bumprtl.gen.flow.axis import emit_axis
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.fusesoc import write_core
+from bumprtl.gen.flow.memories import (
+    DEFAULT_DEVICE,
+    DEVICE_BRAM,
+    LOADS,
+    emit_scene_unit,
+    memory_images,
+    scene_command,
+)
 from bumprtl.gen.flow.named import named_module, named_ports, write_named
-from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, DEVICE_BRAM, LOADS, emit_scene_unit,
-                                       memory_images, scene_command)
-from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, default_module, emit_unit, faithful_note
-
+from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.rtl.config import BumpError
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 

@@ -5,8 +5,8 @@ import argparse
 import dataclasses
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.scenes.config import SceneConfig, flag_name, load_scene_config
 from bumprtl.sim.scenes import GEOMETRIES
+from bumprtl.sim.scenes.config import SceneConfig, flag_name, load_scene_config
 from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE
 
 __all__ = ["add_config_flags", "config_from_args", "add_map_flags", "map_overrides", "MAP_FLAGS",

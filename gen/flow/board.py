@@ -19,27 +19,25 @@
 import hashlib
 import json
 import os
-import re
 import subprocess
 import time
 from pathlib import Path
 
 import amaranth_boards.ulx3s as ulx3s
-from cocotb_tools.runner import Verilator, get_results
 import numpy as np
 from amaranth.back import rtlil, verilog
+from cocotb_tools.runner import Verilator, get_results
 
+from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
+from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
+from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
 from bumprtl.sim.scenes import SCENES
-from bumprtl.sim.toolchain import require, tool_env
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS
-from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
-from bumprtl.gen.render.rtl import scene_memories
-from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames"]
@@ -265,7 +263,7 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
     captured = [res[f"frame{k}"] for k in range(frames)]
     words, texels, _, table = data
     golden = [golden_frame(scene, mode, k, table, words, texels) for k in range(frames)]
-    same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden)]
+    same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden, strict=True)]
     return {"captured": captured, "golden": golden, "same": same,
             "timing_errors": [str(e) for e in res["timing_errors"]],
             "underflow": int(res["underflow"]), "order_error": int(res["order_error"]),

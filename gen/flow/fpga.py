@@ -23,13 +23,13 @@ from amaranth.hdl import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.illumination import Illumination
-from bumprtl.sim.golden.methods import METHODS
-from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
-from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
+from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.toolchain import require, tool_env
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",

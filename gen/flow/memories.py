@@ -18,15 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
+from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.fpga import DEVICES
+from bumprtl.gen.flow.units import UNITS, name_flag, unit_memories
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import DP16KD_MODES
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.gen.flow.emit import emit
-from bumprtl.gen.flow.fpga import DEVICES
-from bumprtl.gen.flow.units import UNITS, name_flag, unit_memories
 
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
            "table_blocks", "memory_blocks",
@@ -124,10 +124,10 @@ def _layout(name, scene):
                 f"[{a - 1}:0], theta in bits [{2 * a - 1}:{a}] (full circle = 2^{a}); {where}")
     if name == "texture":
         return f"RGB colour texel, r in bits [7:0], g [15:8], b [23:16]; {where}"
-    return (f"colour-table entry i (palette normal i shaded for one frame): r [7:0], g [15:8], "
-            f"b [23:16], a [31:24] (Lambert intensity, Tarini Sec. 5.1); written through lut_w_* "
-            f"(a write is taken when lut_w_ready is high), then lut_swap (double-buffered), "
-            f"never initial contents")
+    return ("colour-table entry i (palette normal i shaded for one frame): r [7:0], g [15:8], "
+            "b [23:16], a [31:24] (Lambert intensity, Tarini Sec. 5.1); written through lut_w_* "
+            "(a write is taken when lut_w_ready is high), then lut_swap (double-buffered), "
+            "never initial contents")
 
 
 def memory_images(unit, scene, words, texels=None, table=None, load="initial"):

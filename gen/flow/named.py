@@ -40,7 +40,7 @@ def named_ports(meta):
     out = {n: {"dir": ports[n]["dir"], "width": ports[n]["width"], "signed": False, "from": n,
                "bits": None} for n in ("clk", "rst") if n in ports}
     stream_ports = set(out)
-    for side, (prefix, payload, valid, ready) in _STREAMS.items():
+    for _side, (prefix, payload, valid, ready) in _STREAMS.items():
         stream_ports |= {payload, valid, ready}
         pdir = ports[payload]["dir"]
         out[f"{prefix}_valid"] = {"dir": pdir, "width": 1, "signed": False, "from": valid, "bits": None}

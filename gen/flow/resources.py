@@ -42,9 +42,9 @@ from pathlib import Path
 
 from amaranth.back import verilog
 
+from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
-from bumprtl.gen.flow.units import emit_unit
 
 __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
            "count_component", "count_unit", "multiplier_pairs", "yosys_input"]
@@ -156,7 +156,7 @@ def _count_macc(counts, cell):
     a = _split(conn.get("A", []), _widths(p["A_WIDTHS"], n_products))
     b = _split(conn.get("B", []), _widths(p["B_WIDTHS"], n_products))
     c = _split(conn.get("C", []), _widths(p["C_WIDTHS"], n_addends))
-    terms = sum(_count_product(counts, x, y) for x, y in zip(a, b))
+    terms = sum(_count_product(counts, x, y) for x, y in zip(a, b, strict=True))
     terms += sum(_constant(x) is None for x in c)
     width = _int(p["Y_WIDTH"])
     counts.adders += [width] * max(terms - 1, 0)

@@ -4,18 +4,18 @@
 and the reports elaborate exactly the same hardware from the same Config.
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from bumprtl.gen.flow.emit import elaborated, emit
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.sim.golden.methods import METHODS, get
 from bumprtl.rtl.palette import PaletteLUT, index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos, sine_rom_table
+from bumprtl.sim.golden.methods import METHODS, get
 
 __all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "unit_memories",
            "canonical_command", "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]

@@ -22,16 +22,22 @@ from pathlib import Path
 
 import numpy as np
 
-from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.sim.scenes import load_scene
-from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, check_scene_fits
 from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_verilog
-from bumprtl.gen.render.images import (FIXED_METHODS, PALETTE, fixed_image, float_image,
-                                       render_methods, shade_scene)
+from bumprtl.gen.render.images import (
+    FIXED_METHODS,
+    PALETTE,
+    fixed_image,
+    float_image,
+    render_methods,
+    shade_scene,
+)
 from bumprtl.gen.render.rtl import render_rtl, require_sim
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.scenes import load_scene
+from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 
 DEMO_SCENES = ("bricks", "globe")
 REFERENCE = "conventional"
@@ -156,7 +162,7 @@ def _rtl_section(args, out):
              f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {args.simulator}, "
              f"streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:.0f} pixels/s "
              f"(build {r.build_seconds:.1f} s{', cached' if r.cached else ''})",
-             f"  rtl.png vs golden.png: " + ("identical bytes, max |difference| 0" if error is None
+             "  rtl.png vs golden.png: " + ("identical bytes, max |difference| 0" if error is None
                                              else error) +
              f"; diff.png = |rtl - golden| x {DIFF_GAIN}",
              f"  rtl.png vs float64 conventional (same scene and map): PSNR "

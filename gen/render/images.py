@@ -11,17 +11,17 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from bumprtl.rtl.config import BumpError
-from bumprtl.sim.golden.methods import METHODS, PER_PIXEL, datapath_fixed, encode_pixels
-from bumprtl.sim.scenes.config import SceneConfig
-from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
-from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
-from bumprtl.sim.golden.float.models import FLOAT_MODELS
-from bumprtl.sim.scenes import SCENES
-from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 from bumprtl.gen.cli.flags import add_config_flags, add_map_flags, scene_from_args
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, DEVICE_BRAM, LOADS
 from bumprtl.gen.render.rtl import cli_render, golden_render, scene_stimulus, sim_scene
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
+from bumprtl.sim.golden.methods import METHODS, PER_PIXEL, datapath_fixed, encode_pixels
+from bumprtl.sim.scenes import SCENES
+from bumprtl.sim.scenes.config import SceneConfig
+from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 
 __all__ = ["PALETTE", "MODELS", "FIXED_METHODS", "render_methods", "shade_scene", "fixed_image",
            "float_image", "render_scene", "add_parser"]

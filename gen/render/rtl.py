@@ -18,26 +18,35 @@ from pathlib import Path
 
 import numpy as np
 
+from bumprtl.gen.flow.memories import (
+    DEFAULT_DEVICE,
+    check_scene_fits,
+    emit_scene_unit,
+    host_writes,
+    memory_images,
+)
+from bumprtl.gen.flow.quiet import tool_log
+from bumprtl.gen.flow.resources import count_unit
+from bumprtl.gen.report import write_section
 from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.scenes.config import SceneConfig, load_scene_config, BUILTIN
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
 from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, polygon_fixed
-from bumprtl.sim.golden.float.palette import (color_table, frame_directions, mipmap_indices,
-                                              quantize_normal_map, world_normal_map)
-from bumprtl.sim.scenes import load_scene, SCENES
-from bumprtl.sim.scenes.usermap import load_bump_map
+from bumprtl.sim.golden.float.palette import (
+    color_table,
+    frame_directions,
+    mipmap_indices,
+    quantize_normal_map,
+    world_normal_map,
+)
+from bumprtl.sim.scenes import SCENES, load_scene
+from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 from bumprtl.sim.scenes.imaging import compose, save_png
-from bumprtl.gen.flow.memories import (DEFAULT_DEVICE, check_scene_fits, emit_scene_unit,
-                                       host_writes, memory_images)
-from bumprtl.gen.flow.quiet import tool_log
-from bumprtl.gen.report import write_section
-from bumprtl.gen.flow.resources import count_unit
-from bumprtl.gen.flow.units import build_unit
+from bumprtl.sim.scenes.usermap import load_bump_map
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
            "render_rtl", "sim_scene"]
@@ -291,7 +300,6 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
 def require_sim():
     """Import the simulator path (cocotb, the [sim] extra) before any work: without it the
     ImportError reaches gen/cli/main.py, which names the extra in one line."""
-    import bumprtl.sim.tb.bulk  # optional dependency: the [sim] extra
 
 
 def cli_render(args, scene=None):

@@ -13,21 +13,31 @@ import os
 from pathlib import Path
 
 import matplotlib
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from bumprtl.rtl.config import BumpError
-from bumprtl.sim.golden.methods import METHODS
-from bumprtl.rtl.pipe import ECP5
-from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
-from bumprtl.gen.flow.fpga import (DEVICES, NOT_PLACED, PACKAGE, FpgaError, Placement,
-                                   check_device, lpf_mhz, pipeline_component, place_text)
+from bumprtl.gen.flow.fpga import (
+    DEVICES,
+    NOT_PLACED,
+    PACKAGE,
+    FpgaError,
+    Placement,
+    check_device,
+    lpf_mhz,
+    pipeline_component,
+    place_text,
+)
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipe import ECP5
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.golden.methods import METHODS
+from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["fpga_units", "fpga_report", "write_report", "add_parser"]
 

@@ -227,7 +227,7 @@ def write_doc(doc, generated):
                              rf"{re.escape(name)} -->)", re.S)
         if not pattern.search(text):
             raise BumpError(f"doc {doc} has no '<!-- generated: {name} -->' block")
-        text = pattern.sub(lambda m: m.group(1) + body + "\n" + m.group(2), text)
+        text = pattern.sub(lambda m, body=body: m.group(1) + body + "\n" + m.group(2), text)
     doc.write_text(text)
     return doc
 

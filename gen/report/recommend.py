@@ -16,9 +16,17 @@ point that held every normal of some maps is counted on the others, and says whi
 import json
 from pathlib import Path
 
+from bumprtl.gen.bench.sweep import (
+    cost_key,
+    describe_map,
+    error_lsb,
+    maps_of,
+    measured_maps,
+    ok_points,
+    point_label,
+    unquantized_maps,
+)
 from bumprtl.rtl.config import BumpError
-from bumprtl.gen.bench.sweep import (cost_key, describe_map, error_lsb, maps_of, measured_maps,
-                                     ok_points, point_label, unquantized_maps)
 
 __all__ = ["recommend", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
            "evidence_line"]

@@ -20,8 +20,8 @@ from yowasp_wavedrom import render
 
 from bumprtl.gen.report import write_section
 from bumprtl.rtl.config import Config
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.scenes.config import load_scene_config
 
 __all__ = ["simulate", "wavedrom", "scenarios", "write_timing", "add_parser"]
 
@@ -66,7 +66,7 @@ def _bit(values):
 
 def _bus(values, valid):
     wave, data, last = "", [], None
-    for v, ok in zip(values, valid):
+    for v, ok in zip(values, valid, strict=True):
         key = v if ok else None
         if key == last and wave:
             wave += "."

@@ -87,7 +87,7 @@ def enabled_delay(values, en, latency):
     """The reference of an en-gated pipe: after clock k, the value taken ``latency`` enabled
     clocks before the last enabled clock up to k (None until the pipe has filled)."""
     taken, out = [], []
-    for v, e in zip(values, en):
+    for v, e in zip(values, en, strict=True):
         if e:
             taken.append(v)
         out.append(taken[-1 - latency] if len(taken) > latency else None)
@@ -110,7 +110,7 @@ def run_vectors(sources, top, inputs, outputs, build_dir, includes=(), cycles=No
     build_dir.mkdir(parents=True, exist_ok=True)
     n = len(next(iter(inputs.values()))[1]) if cycles is None else cycles
     in_w = sum(w for w, _ in inputs.values())
-    out_w = sum(outputs.values())
+    sum(outputs.values())
     with open(build_dir / "stim.hex", "w") as f:
         for k in range(n):
             word = 0

@@ -49,10 +49,20 @@ units of :mod:`bumprtl.sim.formal.mutants`, whose failure must be the property i
 
 import re
 
-from amaranth.hdl import (Assert, Assume, Const, Cover, Elaboratable, Fragment, Module, Mux,
-                          Signal, Value, ValueCastable)
+from amaranth.hdl import (
+    Assert,
+    Assume,
+    Const,
+    Cover,
+    Elaboratable,
+    Fragment,
+    Module,
+    Mux,
+    Signal,
+    Value,
+    ValueCastable,
+)
 from amaranth.lib import wiring
-
 
 __all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers"]
 
@@ -195,7 +205,7 @@ class StreamContract(Elaboratable):
             self._layer_takes.append((unit.i.valid & unit.i.ready, unit.o.valid & unit.o.ready))
             for rec in recs[1:]:
                 if rec is not None:
-                    lockstep += list(zip(lead["valid"][1:], rec["valid"][1:]))
+                    lockstep += list(zip(lead["valid"][1:], rec["valid"][1:], strict=False))
         if self.buffer is not None:
             count, entries = self.buffer["count"], self.buffer["entries"]
             for n in reversed(range(len(entries))):
@@ -334,7 +344,7 @@ class StreamContract(Elaboratable):
             return [(f"layer{n}", took, gave, first, count,
                      "valid stages of a layer = its pixels in flight")
                     for n, ((took, gave), first, count)
-                    in enumerate(zip(self._layer_takes, starts, self._layer_stages))]
+                    in enumerate(zip(self._layer_takes, starts, self._layer_stages, strict=True))]
         if len(stages) > CHUNK and len(self._lead_pipes) == 1:
             valid, adv = self._lead_pipes[0]["valid"], self._lead_pipes[0]["adv"]
             runs = []
@@ -511,11 +521,11 @@ class StreamContract(Elaboratable):
         valid = fetch["valid"][1:]
         banks = [fetch["banks"][n] for n in range(1, len(valid) + 1)]
         for b, pending in enumerate(dut.lut_pending):
-            self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks)),
+            self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks, strict=True)),
                         "the per-bank counters count the fetch stages' bank bits")
         self._lemma(m, occ_f == sum(valid), "pixels before the LUT = valid fetch stages")
         found, downstream = Const(0), Const(0, 4)
-        for v, bank in reversed(list(zip(valid, banks))):
+        for v, bank in reversed(list(zip(valid, banks, strict=True))):
             found = found | (v & (downstream == ahead_f) & (bank == wbank))
             downstream = downstream + v
         waiting_f = watching & before

@@ -28,8 +28,8 @@ def write_doc(path, rows, args=""):
                f"re-checked by `python -m bumprtl.sim.formal.run {args}`, the others kept "
                f"from the previous run's `results.json`")
     else:
-        how = (f"Produced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
-               f"--doc docs/formal.md`; `bumprtl formal` is the same command)")
+        how = ("Produced by `make formal` (`python -m bumprtl.sim.formal.run -j 2 "
+               "--doc docs/formal.md`; `bumprtl formal` is the same command)")
     record = Config().made_at("the default; each proof runs at the small widths of "
                               "sim/formal/targets.py")
     block = f"{BEGIN}\n{how}.\n{record}:\n\n{table(rows)}\n{END}"

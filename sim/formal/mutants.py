@@ -15,8 +15,8 @@ from amaranth.lib import wiring
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import StallPipe
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.rtl.sincos import SinCos
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["MUTANTS", "EagerStallSinCos", "Dropper", "Duplicator", "Glitcher", "ExtraStage",
            "Spontaneous", "SwapAheadPalette", "UncarriedBankPipeline"]

@@ -16,13 +16,13 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.formal.contract import StreamContract
 from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
 from bumprtl.sim.formal.sby import run_sby
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
+from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
+from bumprtl.sim.jobs import add_arguments as add_job_arguments
 
 __all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
 
@@ -173,7 +173,7 @@ def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=p
 
     with Runner(scheduler, jobs) as runner:
         runner.run((Job(name, formal_job, args, timeout) for name, (_u, _p, args)
-                    in zip(order, jobs_list)), desc="formal", on_done=finished)
+                    in zip(order, jobs_list, strict=True)), desc="formal", on_done=finished)
     return [done[k] for k in sorted(done)]
 
 

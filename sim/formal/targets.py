@@ -6,19 +6,19 @@ enough that the tags in flight never alias (``2**tag_bits > latency + 1``), so a
 or duplicated pixel always shows in the order check.
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.sim.golden.methods import BASELINES, HARDWARE, PER_PIXEL
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.texture import TextureBlend
+from bumprtl.sim.golden.methods import BASELINES, HARDWARE, PER_PIXEL
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "target"]
 

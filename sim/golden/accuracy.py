@@ -9,8 +9,7 @@ import numpy as np
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import texture_blend
-from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, to_8bit,
-                                       world_bump_normal)
+from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, to_8bit, world_bump_normal
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.methods import encode_pixels, get

@@ -12,8 +12,8 @@ one :class:`Models` entry in :data:`MODELS` under the name of its hardware recor
 (docs/contributing.md, "Adding a method").
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Optional
 
 from bumprtl.rtl import methods as hardware
 from bumprtl.rtl.config import Config, ConfigError
@@ -79,9 +79,9 @@ class Models:
     from_angle_codes: Callable
     predicted_error_bound_lsb: Callable
     error_note: str
-    reference: Optional[Callable] = None
+    reference: Callable | None = None
     other_references: tuple = ()
-    faithful_widths: Optional[Callable] = None
+    faithful_widths: Callable | None = None
 
     def __getattr__(self, attr):
         if attr.startswith("__"):

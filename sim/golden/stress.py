@@ -14,11 +14,17 @@ import numpy as np
 from bumprtl.rtl.bumpfetch import pack_texels
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.layouts import layout_fields, shade_layout
-from bumprtl.sim.golden.methods import encode_pixels, get
-from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, tangent_rotation, to_8bit
+from bumprtl.sim.golden.common import (
+    PixelInputs,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    tangent_rotation,
+    to_8bit,
+)
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.pipeline import map_words
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.methods import encode_pixels, get
 
 __all__ = ["CASES", "STRESS_CONFIGS", "stress_case", "rotate_azimuth", "check_fixed",
            "float_stats", "payload_fields"]

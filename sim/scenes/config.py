@@ -9,7 +9,7 @@ widths follows from the scene (:meth:`SceneConfig.config`).
 
 import math
 import tomllib
-from dataclasses import dataclass, fields, asdict
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config
@@ -136,7 +136,7 @@ class SceneConfig:
             raise SceneError(f"mip_levels must be an integer in [1, {top}] for texture_size "
                              f"{t}, got {self.mip_levels!r}", "mip_levels")
         try:
-            self.config
+            _ = self.config       # derive it now: a bad width is the scene's error
         except BumpError as e:
             raise SceneError(f"scene {self.name!r}: {e}", e.field) from None
         if self.method not in PER_PIXEL:
@@ -249,7 +249,7 @@ def flag_name(key):
 _KEYS = tuple(f.name for f in fields(SceneConfig))
 
 # The two-light scenes take the widths that prove 1 LSB on every channel with two lights.
-_TWO_LIGHTS = dict(zip(("angle_bits", "frac_bits"), TWO_LIGHT_WIDTHS))
+_TWO_LIGHTS = dict(zip(("angle_bits", "frac_bits"), TWO_LIGHT_WIDTHS, strict=True))
 
 # The scene classes of docs/scenes.md.
 BUILTIN = {

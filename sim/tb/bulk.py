@@ -28,12 +28,29 @@ import numpy as np
 from cocotb_tools.runner import get_results
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.tb.bulk_build import (CLOCKS, DEFAULTS, IOS, RUNNERS, SIMULATORS, TIMESCALE,
-                                       build, build_args, build_options, cache_root, locked,
-                                       tool_environ)
+from bumprtl.sim.tb.bulk_build import (
+    CLOCKS,
+    DEFAULTS,
+    IOS,
+    RUNNERS,
+    SIMULATORS,
+    TIMESCALE,
+    build,
+    build_args,
+    build_options,
+    cache_root,
+    locked,
+    tool_environ,
+)
 from bumprtl.sim.tb.bulk_codec import check_stimulus, decode_words, encode_words
-from bumprtl.sim.tb.bulk_wrapper import (DENSITY_BITS, PERIOD, host_fields, setup_arrays,
-                                         setup_writes, wrapper_verilog)
+from bumprtl.sim.tb.bulk_wrapper import (
+    DENSITY_BITS,
+    PERIOD,
+    host_fields,
+    setup_arrays,
+    setup_writes,
+    wrapper_verilog,
+)
 from bumprtl.sim.traffic import PATTERNS as TRAFFIC
 
 __all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "IOS", "PERIOD",

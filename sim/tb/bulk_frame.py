@@ -51,16 +51,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bumprtl.rtl.bumpfetch import (coord_bits, has_map, level_bases, level_bits,
-                                   memory_depth, pack_texels)
+from bumprtl.rtl.bumpfetch import (
+    coord_bits,
+    has_map,
+    level_bases,
+    level_bits,
+    memory_depth,
+    pack_texels,
+)
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
 from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
+from bumprtl.sim.golden.fixed import exact
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
-from bumprtl.sim.golden.fixed import exact
-from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, pipeline_fixed, polygon_fixed,
-                                               random_inputs, unpack_texels)
+from bumprtl.sim.golden.fixed.pipeline import (
+    fetch_fixed,
+    pipeline_fixed,
+    polygon_fixed,
+    random_inputs,
+    unpack_texels,
+)
 from bumprtl.sim.tb.bulk_sources import rounding_codes
 from bumprtl.sim.tb.bulk_wrapper import setup_writes
 
@@ -189,7 +200,7 @@ def _texel_writes(scene, rng, words, texels):
         new_texels = np.asarray(texels, np.int64).copy()
         new_texels[addr] = np.concatenate([[(1 << 24) - 1], rng.integers(0, 1 << 24, m - 1)])
     writes = []
-    for k, a in enumerate(addr.tolist()):
+    for _k, a in enumerate(addr.tolist()):
         cycle = {}
         if new_words is not None:
             cycle.update({"map_w_en": 1, "map_w_addr": a, "map_w_data": int(new_words[a])})

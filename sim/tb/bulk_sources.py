@@ -14,13 +14,13 @@ import numpy as np
 from bumprtl.rtl.bumpfetch import pack_texels
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import CHANNELS, blend_eq2, index_bits
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, random_inputs
+from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.stress import stress_codes
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
+from bumprtl.sim.scenes.config import load_scene_config
 
 __all__ = ["make_source", "pipeline_map", "palette_table", "SOURCES"]
 

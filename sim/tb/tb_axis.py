@@ -22,10 +22,10 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
+from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.stream import load_sidecar, pack, samples, unpack
 
 LINE = 7                     # pixels per line (tlast every LINE transfers)

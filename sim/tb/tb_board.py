@@ -34,7 +34,7 @@ def runs(seq):
     edges = np.flatnonzero(np.diff(seq)) + 1
     starts = np.concatenate([[0], edges])
     ends = np.concatenate([edges, [len(seq)]])
-    return [(int(seq[s]), int(s), int(e - s)) for s, e in zip(starts, ends)]
+    return [(int(seq[s]), int(s), int(e - s)) for s, e in zip(starts, ends, strict=True)]
 
 
 def timing_errors(de, hs, vs, t):
@@ -64,8 +64,8 @@ def timing_errors(de, hs, vs, t):
     if any(n != hsw for _, n in hs_runs):
         errors.append(f"hsync pulse lengths {sorted({n for _, n in hs_runs})}, expected {hsw}")
     starts = [s for s, _ in hs_runs]
-    if any(b - a != htot for a, b in zip(starts, starts[1:])):
-        errors.append(f"hsync periods {sorted({b - a for a, b in zip(starts, starts[1:])})}, "
+    if any(b - a != htot for a, b in zip(starts, starts[1:], strict=False)):
+        errors.append(f"hsync periods {sorted({b - a for a, b in zip(starts, starts[1:], strict=False)})}, "
                       f"expected {htot}")
     # porches: front = active end -> hsync start, back = hsync end -> active start
     for s, n in de_runs:

@@ -23,8 +23,15 @@ import numpy as np
 from cocotb.triggers import Timer
 
 from bumprtl.sim.tb.bulk_codec import decode_words, encode_words
-from bumprtl.sim.tb.bulk_wrapper import (DENSITY_BITS, IN_FILE, OUT_FILE, PERIOD, SETUP_FILE,
-                                         host_fields, setup_arrays)
+from bumprtl.sim.tb.bulk_wrapper import (
+    DENSITY_BITS,
+    IN_FILE,
+    OUT_FILE,
+    PERIOD,
+    SETUP_FILE,
+    host_fields,
+    setup_arrays,
+)
 
 DENSITY_ONE = 1 << DENSITY_BITS
 

@@ -74,7 +74,7 @@ async def palette_matches_model(dut, pattern):
     pending, offered = _pixels(cfg, samples(500), rng), None
     total = len(pending)
     expected, received = [], []
-    for cycle in range(30 * total):
+    for _cycle in range(30 * total):
         if len(received) == total:
             break
         if offered is None and pending and rng.random() >= gap_p:
@@ -96,7 +96,7 @@ async def palette_matches_model(dut, pattern):
         model.clock(write, swap)
         await RisingEdge(dut.clk)
     assert len(received) == total, f"timeout: {len(received)} of {total} outputs"
-    for n, (exp, got) in enumerate(zip(expected, received)):
+    for n, (exp, got) in enumerate(zip(expected, received, strict=True)):
         assert got == exp, f"pixel {n} ({pattern}): RTL {got} != model {exp}"
     log.info("%s: %d pixels bit-exact, %d out of range, host writes and swaps racing",
              pattern, total, sum(e["oor"] for e in expected))

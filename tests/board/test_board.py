@@ -16,11 +16,11 @@ import pytest
 from amaranth.sim import Simulator
 from cocotbext.dvi.tmds import TMDS
 
-from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.gen.flow.board import board_data, check_board, check_frames
 from bumprtl.rtl.tmds import CONTROL, TMDSEncoder
 from bumprtl.rtl.video import MODES
-from bumprtl.gen.flow.board import board_data, check_board, check_frames
 from bumprtl.sim.golden.board import golden_frame, light_table
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.tb_board import timing_errors
 
 SMALL = {"angle_bits": 10, "texture_size": 16}
@@ -55,7 +55,7 @@ def test_tmds_words_decode_with_cocotbext_tables_and_stay_dc_balanced():
     words = _encode(values, 1)
     dec = TMDS()
     disparity, worst = 0, 0
-    for (v, d, c0, c1), w in zip(values, words):
+    for (v, d, c0, c1), w in zip(values, words, strict=True):
         out, de, vs, hs = dec.decode(w)
         if d:
             assert de == 1 and out == v, f"{v:#04x} -> {w:#05x} decoded {out:#04x}"
@@ -74,7 +74,7 @@ def test_timing_checker_catches_a_wrong_porch():
 
     def raster(hb):
         de, hs, vs = [], [], []
-        for frame in range(3):
+        for _frame in range(3):
             for y in range(t.v_total):
                 for x in range(t.h_total):
                     de.append(int(x < t.h_active and y < t.v_active))
@@ -94,7 +94,7 @@ def test_reduced_mode_frames_match_the_golden_frames_through_the_dvi_sink(build_
     r = check_frames(scene, mode, build_dir / "board", frames=3, opt_fast="-O0")   # a cocotb-paced run
     assert r["timing_errors"] == []
     assert r["underflow"] == 0 and r["order_error"] == 0
-    for k, (c, g) in enumerate(zip(r["captured"], r["golden"])):
+    for k, (c, g) in enumerate(zip(r["captured"], r["golden"], strict=True)):
         assert c.shape == g.shape == (mode.v_active, mode.h_active, 3), k
         assert np.array_equal(c, g), f"frame {k}: {np.count_nonzero(np.any(c != g, -1))} pixels differ"
     # the light turns: consecutive frames differ, so the comparison sees the light step

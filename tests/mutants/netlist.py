@@ -439,7 +439,7 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
             if verdict == "equivalent":
                 held = ", ".join(nc.names(net, R["R"])) or "none"
                 kept = ", ".join(nc.names(net, R["K"]))
-                how = (f"cut: sat proves the invariant 'every register bit equal but R"
+                how = ("cut: sat proves the invariant 'every register bit equal but R"
                        + (", the bits of K at their initial value" if kept else "")
                        + f"' inductive on the cut at the registers, R = {held}"
                        + (f", K = {kept}" if kept else ""))
@@ -651,7 +651,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
             survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
     killed = sum(r.startswith("killed") for r in results.values())
     equivalent = sum(s["verdict"].startswith("equivalent") for s in survivors)
-    for i, r in sorted(results.items()):
+    for i in sorted(results):
         shutil.rmtree(work / f"run{i}", ignore_errors=True)
     return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
             "equivalent": equivalent, "counted": len(lines) - equivalent,
@@ -688,7 +688,7 @@ def _stimulus_words(target, n, sim="verilator"):
             f"x 4 traffic patterns{on}, {where}")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _table_pixels(scene):
     """The table-sensitivity pixels the coverage frame of ``scene`` adds to its PIXELS."""
     from bumprtl.gen.render.rtl import scene_stimulus, scene_texels

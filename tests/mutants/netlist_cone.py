@@ -242,7 +242,7 @@ def cone(net):
 
 
 def _acyclic(net, comb):
-    order, state = [], {}
+    _order, state = [], {}
     succ = {c: set() for c in comb}
     for c in comb:
         cell = net.cells[c]
@@ -473,7 +473,7 @@ def cut(net, rtl, yosys_run, timeout, stream, log=None):
         if bits is None:
             return "undecided", "cut: no counterexample read"
         grow, drop = set(), set()
-        for on, pt in zip(bits, plist):
+        for on, pt in zip(bits, plist, strict=True):
             if not on:
                 continue
             if pt[0] == "const":

@@ -77,7 +77,7 @@ def single(net, target):
     the output ``target`` the net ``target``. Also {memory: (width, [read data bit lists],
     [(enable bits, data bits)], init words)}."""
     bits = nc.CopyBits(net, ())                  # the design's copy alone: nothing moves
-    new, fin = bits.new, bits.gold_in
+    _new, fin = bits.new, bits.gold_in
 
     cells, names, ports, mems = {}, {}, {}, {}
     for name, c in net.cells.items():
@@ -96,7 +96,7 @@ def single(net, target):
             if c["type"] != "$mem_v2":
                 raise nc.Undecided(f"memory cell {name} of type {c['type']}")
             p, con = c["parameters"], c["connections"]
-            w, ab = npdr._w(p, "WIDTH"), npdr._w(p, "ABITS")
+            w, _ab = npdr._w(p, "WIDTH"), npdr._w(p, "ABITS")
             if any(ch == "1" for ch in str(p.get("RD_CLK_ENABLE", "0"))):
                 raise nc.Undecided(f"memory {name}: a synchronous read port")
             rd = []
@@ -175,11 +175,11 @@ def never(net, line, rtl, yosys_run, timeout, log=None, detail=None, depths=NEVE
         if kind == "latchidx" and name.startswith("ff:"):
             w = 1 + max(m)
             words[name] = [m.get(i) for i in range(w)]
-    lit_of_word = {n: [aig.latch[li[0]] for li in bits if li] for n, bits in words.items()}
+    {n: [aig.latch[li[0]] for li in bits if li] for n, bits in words.items()}
     # the support of each word's next state, and of the target, as words
     word_of_latch = {li[0]: n for n, bits in words.items() for li in bits if li}
     in_word = {}
-    for m, (w, rd, wr, _) in mems.items():
+    for m, (_w, rd, _wr, _) in mems.items():
         for r in rd:
             for x in aig.sig.get(("input", r), {}).values():
                 in_word[x >> 1] = m
@@ -190,7 +190,7 @@ def never(net, line, rtl, yosys_run, timeout, log=None, detail=None, depths=NEVE
                 | {in_word[v] for v in ins if v in in_word})
 
     next_lits = {n: [aig.next_lit[li[0]] for li in bits if li] for n, bits in words.items()}
-    for m, (w, rd, wr, _) in mems.items():
+    for m, (_w, _rd, wr, _) in mems.items():
         next_lits[m] = [x for en, da in wr for s in (en, da)
                         for x in aig.sig.get(("output", s), {}).values()]
     dep_cache = {}
@@ -366,7 +366,7 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
     one = sorted(cell for cell, copies in regs.items() if set(copies) == {"shared"}
                  and list(copies["shared"]) == [0] and cell in net.cells)
     valid = [(cell, nm, regs[cell]["shared"][0])
-             for cell, nm in zip(one, nc.names(net, [(cell, 0) for cell in one]))
+             for cell, nm in zip(one, nc.names(net, [(cell, 0) for cell in one]), strict=True)
              if "valid" in nm]
     for cell, copies in sorted(regs.items()):
         if "shared" in copies:
@@ -377,7 +377,7 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
     # name, "terms" of terms.h_cx_data), or all of them for a register of the top module
     unit = lambda nm: nm.split(".", 1)[0] if "." in nm else None
     cells_w = sorted(c for c in eqw if c in net.cells)
-    own = dict(zip(cells_w, (unit(nm) for nm in nc.names(net, [(c, 0) for c in cells_w]))))
+    own = dict(zip(cells_w, (unit(nm) for nm in nc.names(net, [(c, 0) for c in cells_w])), strict=True))
     for cell, (ec, en) in eqw.items():
         for vc, vn, li in valid:
             if own.get(cell) and unit(vn) and own[cell] != unit(vn):

@@ -34,7 +34,6 @@ import argparse
 import json
 import os
 import random
-import re
 import shutil
 import subprocess
 import sys
@@ -520,7 +519,10 @@ def command_line(argv):
     return "python tests/mutants/pymut.py " + " ".join(argv if argv is not None else sys.argv[1:])
 
 
-def mutant_diff(tree, name, _modules={}):
+_MODULES = {}     # module path -> its functions' lines, parsed once a run
+
+
+def mutant_diff(tree, name, _modules=_MODULES):
     """The lines a mutant changes (``-`` original, ``+`` mutant), from mutmut's mutated copy
     of its module: the ``..._mutmut_orig`` and ``..._mutmut_N`` functions found with ast
     (one parse a module, milliseconds), diffed with difflib."""
@@ -645,10 +647,10 @@ def write_doc(doc, runs):
         if len(runs) > 1:
             block += [f"**Draw {i + 1} of {len(runs)}** (seed {run['seed']}, commit {run['commit']}).", ""]
         block += doc_section(run) + [""]
-    block += [f"The section between the markers is written by `pymut.py --doc` (or `--doc-from` "
-              f"with saved runs); a survivor's reason comes from `KNOWN` in tests/mutants/pymut.py, "
-              f"matched on its function and the changed line, so a reason written once holds for "
-              f"any later draw of the same mutant.", "", END]
+    block += ["The section between the markers is written by `pymut.py --doc` (or `--doc-from` "
+              "with saved runs); a survivor's reason comes from `KNOWN` in tests/mutants/pymut.py, "
+              "matched on its function and the changed line, so a reason written once holds for "
+              "any later draw of the same mutant.", "", END]
     text = doc.read_text() if doc.exists() else ""
     if BEGIN in text and END in text:
         head, rest = text.split(BEGIN, 1)

@@ -9,8 +9,17 @@ import re
 import pytest
 
 from tests.mutants import curated as mutate
-from tests.mutants.curated import (Edit, Mutant, MutantError, RestoreError, applied,
-                                     check_applies, load_mutants, markdown, run_mutants)
+from tests.mutants.curated import (
+    Edit,
+    Mutant,
+    MutantError,
+    RestoreError,
+    applied,
+    check_applies,
+    load_mutants,
+    markdown,
+    run_mutants,
+)
 
 ROOT = mutate.ROOT
 # Every unit and every shared helper has at least one mutant (the file it edits).
@@ -79,7 +88,7 @@ def test_apply_and_restore_byte_for_byte(tmp_path):
     assert _sha(f) == before
     with pytest.raises(ZeroDivisionError):
         with applied(m, tmp_path):
-            1 / 0
+            _ = 1 / 0
     assert _sha(f) == before
 
 

@@ -4,8 +4,8 @@ resolves to the copy, not to the working tree."""
 
 import io
 import subprocess
-import tarfile
 import sys
+import tarfile
 from pathlib import Path
 
 from tests.mutants import curated

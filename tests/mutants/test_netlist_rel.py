@@ -9,8 +9,15 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist  # noqa: E402
-from test_netlist_pdr import (PIPE, RANGE, _cell_driving, _net_name, _prepare,  # noqa: E402
-                              payload_mutant, reset_value_mutant)
+from test_netlist_pdr import (  # noqa: E402
+    PIPE,
+    RANGE,
+    _cell_driving,
+    _net_name,
+    _prepare,
+    payload_mutant,
+    reset_value_mutant,
+)
 
 # the pipe of test_netlist_pdr with its stage's valid bit named as the step looks for it
 PIPE = PIPE.replace("reg v = 0;", "reg stage1_valid = 0;").replace(

@@ -47,7 +47,7 @@ def test_tdata_width_lower_end_and_byte_multiples():
     assert AxisWrapper(Toy, Config(tag_bits=4)).tdata_width == 8           # the default
     assert AxisWrapper(Toy, Config(tag_bits=4), tdata_width=16).tdata_width == 16
     for bad in (0, -8, 7, 9, 12, 8.0, True, "8"):
-        _refused(lambda: AxisWrapper(Toy, Config(tag_bits=4), tdata_width=bad), "tdata_width")
+        _refused(lambda bad=bad: AxisWrapper(Toy, Config(tag_bits=4), tdata_width=bad), "tdata_width")
 
 
 @pytest.mark.parametrize("bits", [8, 9, 16, 17])

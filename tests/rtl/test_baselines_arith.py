@@ -9,8 +9,13 @@ import random
 import pytest
 from amaranth.sim import Simulator
 
-from bumprtl.rtl.baselines.peercy import (PeercyDivider, PeercySqrt, quotient_bits,
-                                          sqrt_stages, square_bits)
+from bumprtl.rtl.baselines.peercy import (
+    PeercyDivider,
+    PeercySqrt,
+    quotient_bits,
+    sqrt_stages,
+    square_bits,
+)
 from bumprtl.rtl.config import Config
 
 
@@ -28,7 +33,7 @@ def stream(dut, inputs, outputs, values, stall=0.0, seed=0):
         while len(got) < len(values):
             en = rng.random() >= stall
             if pending:
-                for sig, v in zip(inputs, pending[0]):
+                for sig, v in zip(inputs, pending[0], strict=True):
                     ctx.set(sig, v)
             ctx.set(dut.en, en)
             await ctx.tick()

@@ -15,12 +15,12 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.resources import count_component, count_verilog, multiplier_pairs
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden import methods
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
 from bumprtl.rtl.shade import SHADE_LATENCY, BackEnd
 from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
-from bumprtl.sim.golden.fixed import peercy as fixed_peercy
+from bumprtl.sim.golden import methods
 from bumprtl.sim.golden.common import PixelInputs
+from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.vectors import concat_codes, edge_codes
 from bumprtl.sim.traffic import PATTERNS
 

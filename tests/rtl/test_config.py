@@ -151,8 +151,8 @@ def test_made_at_records_both_widths_and_a_note_only_when_given():
 # ---- every documented formula, range end and refusal, from Config's docstring and the
 # ---- BumpError rule (one line naming the parameter, the value and its allowed range)
 
-from bumprtl.rtl.config import FRAC_BITS_MAX, frac_bits_floor          # noqa: E402
-from bumprtl.rtl.methods import METHODS                                 # noqa: E402
+from bumprtl.rtl.config import FRAC_BITS_MAX, frac_bits_floor  # noqa: E402
+from bumprtl.rtl.methods import METHODS  # noqa: E402
 
 INT_FIELDS = [r for r in RANGES if isinstance(r[1], int)]
 

@@ -3,7 +3,8 @@
 import numpy as np
 from amaranth.hdl import Module, Signal, signed
 from amaranth.sim import Simulator
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from bumprtl.rtl.fixed import Q, mul_round, round_shift, saturate
 

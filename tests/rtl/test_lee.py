@@ -15,8 +15,14 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl import tables
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.lee import (ROM_STAGES, SINE_STAGES, BlockROM, LeeIllumination, LeeRotation,
-                             ratio_index)
+from bumprtl.rtl.lee import (
+    ROM_STAGES,
+    SINE_STAGES,
+    BlockROM,
+    LeeIllumination,
+    LeeRotation,
+    ratio_index,
+)
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY
 from bumprtl.rtl.shade import SHADE_LATENCY
 from bumprtl.rtl.sincos import REGISTERED_SINE_LATENCY
@@ -24,7 +30,6 @@ from bumprtl.sim.amaranth_stream import assert_bit_exact, check_datapath, simula
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.golden.fixed import lee as fixed_lee
 from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
-
 
 # --- ROM contents (tables.py, Lee section) ----------------------------------------------------
 

@@ -11,10 +11,10 @@ from amaranth.lib import wiring
 
 from bumprtl.rtl import methods as hardware
 from bumprtl.rtl.config import Config, ConfigError
-from bumprtl.sim.golden import methods
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import shade_layout
 from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.sim.golden import methods
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.vectors import TINY
 

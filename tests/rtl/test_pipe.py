@@ -16,23 +16,36 @@ from amaranth.hdl import Const, Fragment, Instance, Module, Signal, signed, unsi
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
-from bumprtl.sim.toolchain import require, tool_env
-from bumprtl.rtl.config import Config
 from bumprtl.rtl.bumpfetch import BumpMapFetch
+from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import (ECP5, PRODUCT_LATENCY, ROM_LATENCY, WIDE_PRODUCT_LATENCY,
-                              RegisteredProduct, RegisteredROM, WideProduct, fits_dsp,
-                              product_latency)
-from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
+from bumprtl.rtl.pipe import (
+    ECP5,
+    PRODUCT_LATENCY,
+    ROM_LATENCY,
+    WIDE_PRODUCT_LATENCY,
+    RegisteredProduct,
+    RegisteredROM,
+    WideProduct,
+    fits_dsp,
+    product_latency,
+)
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.rtl.sincos import (REGISTERED_SINE_LATENCY, SinCos, near_sine, sine_rom_table,
-                                spread_sine)
+from bumprtl.rtl.sincos import (
+    REGISTERED_SINE_LATENCY,
+    SinCos,
+    near_sine,
+    sine_rom_table,
+    spread_sine,
+)
 from bumprtl.rtl.tables import quarter_sine, specular_table
+from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.texture import TextureBlend
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
+from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.sim.toolchain import require, tool_env
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -104,7 +117,7 @@ def test_registered_rom_reads_two_enables_later(ports):
 
     def drive(ctx, rng):
         addrs = [int(rng.integers(0, len(table))) for _ in dut.ports]
-        for port, addr in zip(dut.ports, addrs):
+        for port, addr in zip(dut.ports, addrs, strict=True):
             ctx.set(port.addr, addr)
         return addrs
 
@@ -234,7 +247,7 @@ def test_wide_products_are_the_product_in_both_forms(unit, latency, a_shape, b_s
                            "prod_b": (b_shape.width, [mask(x, b_shape.width) for x in b]),
                            "prod_en": (1, en)},
                           {"prod": width}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
-    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b)], en, latency - 1)
+    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b, strict=True)], en, latency - 1)
     filled = [c for c in range(n) if want[c] is not None]
     assert len(filled) > n // 2
     for form in forms:

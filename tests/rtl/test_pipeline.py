@@ -17,16 +17,22 @@ from amaranth.sim import Simulator
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
+from bumprtl.rtl.methods import PER_PIXEL
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline
-from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
-from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, pipeline_fixed, polygon_fixed,
-                                               random_inputs, random_map, random_texture,
-                                               unpack_rgb)
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel
+from bumprtl.sim.golden.fixed.pipeline import (
+    as_payload_list,
+    pipeline_fixed,
+    polygon_fixed,
+    random_inputs,
+    random_map,
+    random_texture,
+    unpack_rgb,
+)
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.traffic import PATTERNS
-from bumprtl.rtl.methods import PER_PIXEL
 
 SWITCHES = {"lights": (1, 2), "specular": (True, False), "bump_map": ("varying", "flat"),
             "shading": ("per-pixel", "palette"), "addressing": ("wrap", "clamp"),
@@ -39,7 +45,7 @@ def combinations():
     collapse; with a texture they address the colour texture)."""
     seen = {}
     for values in itertools.product(*SWITCHES.values()):
-        keys = dict(zip(SWITCHES, values))
+        keys = dict(zip(SWITCHES, values, strict=True))
         scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
         if scene.shading == "palette":
             keys.update(lights=1, specular=True, bump_map="varying")
@@ -105,7 +111,7 @@ def run(scene, n, pattern, seed=0):
         if scene.texture:                 # Tarini eq. 2 with the texel as the base colour
             bases = [{**{c: int(v) for c, v in unpack_rgb(t).items()}, "a": 255}
                      for t in golden["texel"]]
-            looked = [model.lookup(i, b, blend=True) for i, b in zip(golden["index"], bases)]
+            looked = [model.lookup(i, b, blend=True) for i, b in zip(golden["index"], bases, strict=True)]
         else:
             looked = [model.lookup(i) for i in golden["index"]]
         golden = {k: [d[k] for d in looked] for k in looked[0]}

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import PER_PIXEL
 from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
+from bumprtl.sim.golden.methods import PER_PIXEL
 from bumprtl.sim.golden.vectors import TINY, concat_codes, edge_codes, random_codes
 from bumprtl.sim.traffic import PATTERNS
 

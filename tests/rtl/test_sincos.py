@@ -4,8 +4,8 @@ import pytest
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.sincos import SinCos, near_sine, sine_line, sine_rom_table, spread_sine
-from bumprtl.rtl.targets import rom_blocks
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
+from bumprtl.rtl.targets import rom_blocks
 from bumprtl.sim.amaranth_stream import simulate_stream
 from bumprtl.sim.traffic import PATTERNS
 
@@ -14,7 +14,7 @@ def _check_exhaustive(cfg, pattern):
     dut = SinCos(cfg)
     angles = list(range(cfg.full_circle))
     tags = [(a * 7) % (1 << cfg.tag_bits) for a in angles]
-    out, cycles = simulate_stream(dut, [{"angle": a, "tag": t} for a, t in zip(angles, tags)], pattern,
+    out, cycles = simulate_stream(dut, [{"angle": a, "tag": t} for a, t in zip(angles, tags, strict=True)], pattern,
                                   pipe_handshake=True)
     s, c = sin_lookup(cfg, angles), cos_lookup(cfg, angles)
     assert [o["sin"] for o in out] == s.tolist()

@@ -5,9 +5,17 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.tables import (blend_coefficients, cos_lookup, phong_coefficients, quarter_line,
-                                quarter_sine, quarter_sine_above_line, sin_lookup,
-                                specular_step_bits, specular_table)
+from bumprtl.rtl.tables import (
+    blend_coefficients,
+    cos_lookup,
+    phong_coefficients,
+    quarter_line,
+    quarter_sine,
+    quarter_sine_above_line,
+    sin_lookup,
+    specular_step_bits,
+    specular_table,
+)
 
 
 @pytest.mark.parametrize("angle_bits, frac_bits", [(8, 8), (12, 13), (14, 16)])
@@ -75,7 +83,7 @@ def test_phong_coefficients_round_to_nearest(ka, kd, ks, specular):
     got = phong_coefficients(cfg) + blend_coefficients(cfg)[:2]
     exact = (255 * 512 * Fraction(ka), 255 * 512 * Fraction(kd),
              65536 * Fraction(ks) if specular else 0, 65536 * Fraction(ka), 65536 * Fraction(kd))
-    for g, e in zip(got, exact):
+    for g, e in zip(got, exact, strict=True):
         assert isinstance(g, int) and abs(g - e) <= Fraction(1, 2), (got, exact)
 
 

@@ -94,6 +94,7 @@ def parse_coverage(path):
 def verilator_run(out):
     """Build the default pipeline's bulk wrapper with coverage and run make test's frame."""
     import numpy as np
+
     from bumprtl.gen.render.rtl import run_pipeline_bulk, scene_stimulus, scene_texels
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.traffic import PATTERNS as TRAFFIC

@@ -39,6 +39,7 @@ def _cli(argv):
 
 def _ecp5_text(name, cfg_or_scene):
     from amaranth.back import rtlil
+
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.rtl.pipe import ECP5
     dut = build_unit(name, cfg_or_scene, ECP5())[0]

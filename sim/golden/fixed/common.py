@@ -9,10 +9,19 @@ import numpy as np
 from bumprtl.rtl.config import Config, ConfigError
 from bumprtl.rtl.exact import vectors
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.tables import (COLOR_FRAC_BITS, KD_FRAC_BITS, KS_FRAC_BITS, SPEC_FRAC_BITS,
-                                coefficient_error_lsb, phong_coefficients, specular_base,
-                                specular_index_bits, specular_step_bits, specular_table,
-                                specular_table_error_lsb)
+from bumprtl.rtl.tables import (
+    COLOR_FRAC_BITS,
+    KD_FRAC_BITS,
+    KS_FRAC_BITS,
+    SPEC_FRAC_BITS,
+    coefficient_error_lsb,
+    phong_coefficients,
+    specular_base,
+    specular_index_bits,
+    specular_step_bits,
+    specular_table,
+    specular_table_error_lsb,
+)
 from bumprtl.sim.golden.common import PixelInputs
 
 __all__ = ["angle_codes", "quantize_pixels", "shade_fixed", "specular_fine_fixed",
@@ -115,7 +124,7 @@ def _term_bounds(exponent, angle, additive, grid=1 << 16):
     hi_c = np.cos(np.maximum(a[:-1] - angle, 0.0)) + additive
     out = []
     for n in (1, exponent):
-        f = lambda x: 255.0 * np.clip(x, 0.0, 1.0) ** n
+        f = lambda x, n=n: 255.0 * np.clip(x, 0.0, 1.0) ** n
         out.append(float(np.maximum(f(hi_c) - f(lo), f(hi) - f(lo_c)).max()))
     return tuple(out)
 

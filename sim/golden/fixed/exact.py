@@ -12,10 +12,15 @@ import itertools
 import numpy as np
 
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, Config, frac_bits_floor
-from bumprtl.rtl.exact import vectors          # L, and H with specular: the RTL's own list
+from bumprtl.rtl.exact import vectors  # L, and H with specular: the RTL's own list
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.golden.fixed.common import BOUND_CHANNELS, channel_bound, input_angle_error, shade_fixed
+from bumprtl.sim.golden.fixed.common import (
+    BOUND_CHANNELS,
+    channel_bound,
+    input_angle_error,
+    shade_fixed,
+)
 
 __all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors", "dot_error_bound",
            "predicted_error_bound_lsb"]

@@ -16,17 +16,40 @@ Illumination: N'.A' = cos th_A' cos th_N' + sin th_A' sin th_N' cos(ph_A' - ph_N
 
 import numpy as np
 
-from bumprtl.rtl.baselines.kim import (asin_address, cartesian, dot_sum, dot_terms, matrix_entries,
-                                  normalize, octant, phi_from_octant, ratio_of,
-                                  reciprocal_address, rho_of, theta_from_octant, theta_select,
-                                  transform)
+from bumprtl.rtl.baselines.kim import (
+    asin_address,
+    cartesian,
+    dot_sum,
+    dot_terms,
+    matrix_entries,
+    normalize,
+    octant,
+    phi_from_octant,
+    ratio_of,
+    reciprocal_address,
+    rho_of,
+    theta_from_octant,
+    theta_select,
+    transform,
+)
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.lee import ratio_index
-from bumprtl.rtl.tables import (cos_lookup, kim_reciprocal_bits, kim_reciprocal_table,
-                           lee_asin_index_bits, lee_asin_table, lee_atan_mantissa_bits,
-                           lee_atan_table, sin_lookup)
-from bumprtl.sim.golden.fixed.common import (channel_bound, input_angle_error,
-                                             polar_illumination_fixed, polar_rotation_fixed)
+from bumprtl.rtl.tables import (
+    cos_lookup,
+    kim_reciprocal_bits,
+    kim_reciprocal_table,
+    lee_asin_index_bits,
+    lee_asin_table,
+    lee_atan_mantissa_bits,
+    lee_atan_table,
+    sin_lookup,
+)
+from bumprtl.sim.golden.fixed.common import (
+    channel_bound,
+    input_angle_error,
+    polar_illumination_fixed,
+    polar_rotation_fixed,
+)
 
 __all__ = ["rotate_fixed", "to_polar_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
            "predicted_error_bound_lsb", "direction_error_bound"]

@@ -22,12 +22,29 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.lee import (asin_address, below_horizon, magnitude, phi_quadrant, prop_address,
-                        quarter_address, ratio_index, theta_from_prop)
-from bumprtl.rtl.tables import (cos_lookup, lee_asin_table, lee_atan_table,
-                           lee_prop_table, lee_reciprocal_table, sin_lookup)
-from bumprtl.sim.golden.fixed.common import (check_channel, polar_illumination_fixed,
-                                             polar_rotation_fixed)
+from bumprtl.rtl.lee import (
+    asin_address,
+    below_horizon,
+    magnitude,
+    phi_quadrant,
+    prop_address,
+    quarter_address,
+    ratio_index,
+    theta_from_prop,
+)
+from bumprtl.rtl.tables import (
+    cos_lookup,
+    lee_asin_table,
+    lee_atan_table,
+    lee_prop_table,
+    lee_reciprocal_table,
+    sin_lookup,
+)
+from bumprtl.sim.golden.fixed.common import (
+    check_channel,
+    polar_illumination_fixed,
+    polar_rotation_fixed,
+)
 
 __all__ = ["rotate_fixed", "illuminate_fixed", "rotation_fixed", "illumination_fixed",
            "predicted_error_bound_lsb"]

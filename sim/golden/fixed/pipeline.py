@@ -22,18 +22,25 @@ palette shading returns the texel word beside the index (PaletteLUT's eq. 2 base
 
 import numpy as np
 
-from bumprtl.rtl.bumpfetch import (has_map, level_bases, pack_texels, texel_address, coord_bits,
-                                   level_bits, memory_depth)
+from bumprtl.rtl.bumpfetch import (
+    coord_bits,
+    has_map,
+    level_bases,
+    level_bits,
+    memory_depth,
+    pack_texels,
+    texel_address,
+)
 from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
-from bumprtl.sim.scenes.config import SceneConfig
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
-from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.fixed import exact
 from bumprtl.sim.golden.fixed.common import phong_sum_fixed
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import random_codes
+from bumprtl.sim.scenes.config import SceneConfig
 
 # The outputs of one Illumination unit (rtl/layouts.shade_layout) a single-light pipeline has.
 SHADE_OUTPUTS = ("diffuse", "specular", "color", "diffuse_fine", "specular_fine")

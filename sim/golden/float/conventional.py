@@ -3,7 +3,13 @@
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, shade, tangent_rotation
+from bumprtl.sim.golden.common import (
+    PixelInputs,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    shade,
+    tangent_rotation,
+)
 
 __all__ = ["conventional"]
 

@@ -11,7 +11,13 @@ N'.L = cos th_l cos th_N' + sin th_l sin th_N' cos(ph_l - ph_N')
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, shade, tangent_rotation
+from bumprtl.sim.golden.common import (
+    PixelInputs,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    shade,
+    tangent_rotation,
+)
 
 __all__ = ["kim", "polar_dot"]
 

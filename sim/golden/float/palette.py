@@ -19,10 +19,22 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.golden.common import (Result, cartesian_to_polar, polar_to_cartesian, shade, tangent_rotation,
-                     to_8bit)
-from bumprtl.sim.golden.float.palette_quantize import (QUANTIZERS, bayer_offsets, check_palette_size, distinct, nearest,
-                                                       stores_every_normal)
+from bumprtl.sim.golden.common import (
+    Result,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    shade,
+    tangent_rotation,
+    to_8bit,
+)
+from bumprtl.sim.golden.float.palette_quantize import (
+    QUANTIZERS,
+    bayer_offsets,
+    check_palette_size,
+    distinct,
+    nearest,
+    stores_every_normal,
+)
 
 __all__ = ["LIGHTING_MODELS", "Material", "QuantizedNormalMap", "displacement_to_normals",
            "check_normal_map", "quantize_normal_map", "mipmap_indices", "lookup",

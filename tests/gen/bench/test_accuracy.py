@@ -9,10 +9,10 @@ import pytest
 from bumprtl.gen.bench import accuracy
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, Config
-from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.exact import faithful_widths
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 
 DEFAULT = Config()
 ARGS = ["bench", "accuracy", "--samples", "3000", "--angle-bits", str(DEFAULT.angle_bits),

@@ -9,10 +9,17 @@ import pytest
 
 from bumprtl.gen.bench import skip as bench_skip
 from bumprtl.gen.bench import sweep as bench_sweep
-from bumprtl.gen.bench.sweep import Grid, error_lsb, map_key, pareto_front, parse_maps, sweep, write_section
+from bumprtl.gen.bench.sweep import (
+    Grid,
+    error_lsb,
+    map_key,
+    pareto_front,
+    parse_maps,
+    sweep,
+    write_section,
+)
 from bumprtl.gen.cli.main import main
-from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb, term_errors_lsb
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.methods import BASELINES, datapath_fixed
@@ -219,7 +226,7 @@ def test_fpga_points_diagonal_and_all():
     diag = SimpleNamespace(fpga_points="diagonal")
     chosen = [(a, b) for a in grid.angle_bits for b in grid.frac_bits
               if bench_sweep.fpga_selected(grid, a, b, diag)]
-    assert chosen == list(zip(grid.angle_bits, grid.frac_bits))
+    assert chosen == list(zip(grid.angle_bits, grid.frac_bits, strict=True))
     assert [(a, b) for a in grid.angle_bits for b in grid.frac_bits
             if bench_sweep.fpga_selected(grid, a, b, diag, "peercy")] == [DEFAULT_WIDTHS]
     default = SimpleNamespace(fpga_points="default")
@@ -238,7 +245,7 @@ def test_cost_cache_follows_the_verilog(tmp_path, monkeypatch):
     cfg = Config(angle_bits=6, frac_bits=5)
     first = bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert bench_sweep.unit_cost(("sincos",), cfg, tmp_path) == first and len(calls) == 1
-    from bumprtl.gen.flow import units          # same Config, different Verilog text: counted anew
+    from bumprtl.gen.flow import units  # same Config, different Verilog text: counted anew
     monkeypatch.setattr(units, "canonical_command", lambda unit, c, module=None: "changed datapath")
     bench_sweep.unit_cost(("sincos",), cfg, tmp_path)
     assert len(calls) == 2
@@ -248,6 +255,7 @@ def test_sim_rate_with_a_relative_work_dir(tmp_path, monkeypatch):
     """--sim measures cocotb pixels/s; a relative --work (the CLI default) must work although
     cocotb runs in its own build directory."""
     from pathlib import Path
+
     from bumprtl.gen.bench.golden import _sim_rate
     monkeypatch.chdir(tmp_path)
     rate, build_s = _sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))

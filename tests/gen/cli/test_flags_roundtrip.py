@@ -12,8 +12,13 @@ from pathlib import Path
 import pytest
 
 from bumprtl.gen.cli import main as cli_main
-from bumprtl.gen.cli.flags import (MAP_FLAGS, add_map_flags, config_from_args,
-                                   map_overrides, scene_from_args)
+from bumprtl.gen.cli.flags import (
+    MAP_FLAGS,
+    add_map_flags,
+    config_from_args,
+    map_overrides,
+    scene_from_args,
+)
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
 from tests.gen.cli.conftest import config_parser

@@ -29,7 +29,10 @@ sys.exit(main(sys.argv[2:]))
 """
 
 
-def _core(*argv, block=",".join(sorted(OPTIONAL))):
+_ALL_OPTIONAL = ",".join(sorted(OPTIONAL))
+
+
+def _core(*argv, block=_ALL_OPTIONAL):
     return subprocess.run([sys.executable, "-c", _BLOCKED, block, *argv], capture_output=True,
                           text=True, cwd=ROOT)
 

@@ -10,8 +10,13 @@ import re
 import pytest
 
 from bumprtl.gen.cli import main as cli_main
-from bumprtl.gen.cli.flags import (MAP_FLAGS, add_map_flags, config_from_args,
-                                   map_overrides, scene_from_args)
+from bumprtl.gen.cli.flags import (
+    MAP_FLAGS,
+    add_map_flags,
+    config_from_args,
+    map_overrides,
+    scene_from_args,
+)
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes import GEOMETRIES
 from bumprtl.sim.scenes.usermap import CONVENTIONS
@@ -185,7 +190,7 @@ def test_no_command_is_an_error_naming_command(capsys):
 def test_a_command_returning_nothing_exits_0_and_its_status_otherwise(monkeypatch):
     for value, status in ((None, 0), (0, 0), (3, 3)):
         class Parser:
-            def parse_args(self, argv):
+            def parse_args(self, argv, value=value):
                 return argparse.Namespace(func=lambda args: value)
         monkeypatch.setattr(cli_main, "build_parser", Parser)
         assert cli_main.main(["x"]) == status

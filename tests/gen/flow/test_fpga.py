@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from amaranth.sim import Simulator
 
-from bumprtl.gen.flow import fpga
 from bumprtl.gen.cli.main import main
+from bumprtl.gen.flow import fpga
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.rtl.pipe import BUFFER_DEPTH, ECP5
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
 
 
@@ -63,6 +63,7 @@ def test_placements_are_cached_by_verilog(tmp_path, monkeypatch):
     """report fpga and bench sweep share placements: the same Verilog is placed once, a
     different one (another config) again."""
     import json
+
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.rtl.config import Config
     calls = []
@@ -158,7 +159,7 @@ def test_placed_pipeline_runs_in_lock_step_bit_exact(method):
 
     async def bench(ctx):
         nonlocal taken
-        for cycle in range(dut.latency + 10):
+        for _cycle in range(dut.latency + 10):
             ctx.set(dut.i.valid, 1)
             ctx.set(dut.o.ready, 0)
             ready0 = ctx.get(dut.i.ready)
@@ -181,10 +182,11 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
     """Two rows with the same hardware under two labels (Peercy's and Ernst's pipelines) in
     one run are one placement job; each row gets its own label; a second run reads the cache
     and starts no job."""
+    from types import SimpleNamespace
+
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.gen.report import fpga as report
     from bumprtl.sim import jobs
-    from types import SimpleNamespace
 
     calls = []
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)

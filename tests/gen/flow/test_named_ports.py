@@ -11,8 +11,8 @@ import pytest
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.emit import lint
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.runner import run_cocotb
 
 # Two pipelines of the default scene class at different widths; a's map is written through

@@ -10,8 +10,13 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.gen.flow import resources
-from bumprtl.gen.flow.resources import (SynthesisError, count_component, count_netlist,
-                                        count_verilog, multiplier_pairs)
+from bumprtl.gen.flow.resources import (
+    SynthesisError,
+    count_component,
+    count_netlist,
+    count_verilog,
+    multiplier_pairs,
+)
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.toolchain import roms_as_readmemh

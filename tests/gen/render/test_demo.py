@@ -8,9 +8,9 @@ from bumprtl.gen.flow.memories import bram_blocks
 from bumprtl.gen.render.demo import DEMO_SCENES, demo_map_size, demo_methods, rtl_mismatch
 from bumprtl.gen.render.images import FIXED_METHODS, float_image
 from bumprtl.rtl.config import Config
+from bumprtl.sim.golden.float.models import FLOAT_MODELS
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.heightfields import brick_lines
-from bumprtl.sim.golden.float.models import FLOAT_MODELS
 
 
 def _report_rows(text):
@@ -117,6 +117,7 @@ def test_rtl_mismatch_names_the_difference():
 
 def test_demo_flags():
     import argparse
+
     from bumprtl.gen.render import demo
     sub = argparse.ArgumentParser().add_subparsers()
     demo.add_parser(sub)

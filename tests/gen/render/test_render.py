@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from bumprtl.gen.render import images as render
 from bumprtl.gen.cli.main import main
+from bumprtl.gen.render import images as render
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.models import FLOAT_MODELS

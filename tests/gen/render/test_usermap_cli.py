@@ -15,14 +15,14 @@ from PIL import Image
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, check_scene_fits, map_blocks
-from bumprtl.gen.render import images, rtl
+from bumprtl.gen.render import rtl
 from bumprtl.gen.render.images import fixed_image
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.report import recommend as rec
 from bumprtl.rtl.config import Config
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.scenes import heightfields
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.usermap import load_bump_map, normals_to_rgb, write_png
 
 CLI = [sys.executable, "-m", "bumprtl.gen.cli.main"]

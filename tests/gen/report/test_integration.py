@@ -78,6 +78,7 @@ def test_the_latency_the_page_states_is_the_simulated_one():
     """A pixel taken at edge t leaves at edge t + latency with out_ready high (Amaranth
     simulator on a small pipeline of the default scene class)."""
     from amaranth.sim import Simulator
+
     from bumprtl.rtl.pipeline import BumpPipeline
     scene = load_scene_config("default", {"texture_size": 16, "angle_bits": 10, "frac_bits": 11})
     dut, seen = BumpPipeline(scene), {}

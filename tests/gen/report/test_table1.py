@@ -5,16 +5,14 @@ import re
 
 import pytest
 
-from bumprtl.gen.report import table1 as report
-
-from bumprtl.gen.flow import resources
 from bumprtl.gen.cli.main import main
+from bumprtl.gen.flow import resources
+from bumprtl.gen.report import table1 as report
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import BASELINES
 from bumprtl.sim import jobs
 from bumprtl.sim.golden.fixed import exact as fixed_exact
+from bumprtl.sim.golden.methods import BASELINES
 from bumprtl.sim.toolchain import ToolMissing
-
 
 # Table 1's counts do not depend on the widths (the same units, narrower), so the module counts
 # them at 10-bit angles, B = 11: the default widths' tables (2049 words) would double the time.
@@ -41,7 +39,7 @@ def _row(text, design, row):
     cells = [c.strip() for c in line.strip("|").split("|")]
     names = ["design", "row", "multipliers", "const_multipliers", "dividers", "sqrts", "tables",
              "table_bits", "adders", "const_adders", "comparators", "register_bits"]
-    return {n: int(re.match(r"\d+", c).group()) for n, c in zip(names, cells) if n not in ("design", "row")}
+    return {n: int(re.match(r"\d+", c).group()) for n, c in zip(names, cells, strict=True) if n not in ("design", "row")}
 
 
 def test_lee_counts_agree_with_the_paper_where_they_should(table1):

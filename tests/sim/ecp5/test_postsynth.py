@@ -22,14 +22,19 @@ from bumprtl.gen.flow.emit import port_table
 from bumprtl.gen.flow.fpga import pipeline_component
 from bumprtl.gen.render.rtl import scene_stimulus, write_stimulus
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.rtl.pipe import ECP5, RAM_LATENCY, RegisteredRAM
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.sim.ecp5 import (ecp5_lockstep, enabled_delay, postsynth_sources, run_vectors,
-                               synth_netlist)
+from bumprtl.sim.ecp5 import (
+    ecp5_lockstep,
+    enabled_delay,
+    postsynth_sources,
+    run_vectors,
+    synth_netlist,
+)
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import random_codes
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.runner import run_cocotb
 
 

@@ -9,9 +9,17 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.accuracy import (_around, _tilted, crater_scene, diffuse_error_lsb,
-                                         grid_errors_lsb, on_grid, reference_blend, scene_error,
-                                         term_errors_lsb)
+from bumprtl.sim.golden.accuracy import (
+    _around,
+    _tilted,
+    crater_scene,
+    diffuse_error_lsb,
+    grid_errors_lsb,
+    on_grid,
+    reference_blend,
+    scene_error,
+    term_errors_lsb,
+)
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, shade, to_8bit
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels

@@ -8,9 +8,15 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.golden.accuracy import (ANGLES_OF, adversarial_pixels, arithmetic_pixels,
-                                         highlight_pixels, steep_pixels, unrounded_lsb,
-                                         worst_case_pixels)
+from bumprtl.sim.golden.accuracy import (
+    ANGLES_OF,
+    adversarial_pixels,
+    arithmetic_pixels,
+    highlight_pixels,
+    steep_pixels,
+    unrounded_lsb,
+    worst_case_pixels,
+)
 from bumprtl.sim.golden.methods import datapath_fixed
 
 CFG = Config()
@@ -155,7 +161,7 @@ def test_worst_case_pixels_are_the_largest_errors_then_their_neighbours():
         moved = [np.max(np.abs(getattr(blk, a) - getattr(top, a))) / STEP for a in angles]
         assert sum(m > 0.5 for m in moved) <= 2 and max(moved) <= 2 + 1e-6, b
         assert all(abs(m - round(m)) < 1e-6 for m in moved), b
-        seen |= {(a, round(m)) for a, m in zip(angles, moved) if m > 0.5}
+        seen |= {(a, round(m)) for a, m in zip(angles, moved, strict=True) if m > 0.5}
     assert seen == {(a, k) for a in angles for k in (1, 2)}
     with pytest.raises(BumpError):
         worst_case_pixels(datapath_fixed, CFG, "alpha", candidates=10, keep=2)
@@ -217,6 +223,7 @@ def test_the_search_targets_only_channel_values_inside_the_clamps():
     for diffuse, 255 x the channel strictly inside (0.5, 254.5) for the others (0 and 255,
     where the channel is clamped, are left out)."""
     from types import SimpleNamespace
+
     from bumprtl.sim.golden.accuracy import _target
     v = np.array([0.0, 0.001, 0.3, 0.999, 1.0])
     ref = SimpleNamespace(ndotl=v, specular=v, color=v)

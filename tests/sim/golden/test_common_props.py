@@ -8,8 +8,15 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.golden.common import (PixelInputs, cartesian_to_polar, polar_to_cartesian, shade,
-                                       tangent_rotation, to_8bit, world_bump_normal)
+from bumprtl.sim.golden.common import (
+    PixelInputs,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    shade,
+    tangent_rotation,
+    to_8bit,
+    world_bump_normal,
+)
 
 FIELDS = ("n_phi", "n_theta", "l_phi", "l_theta", "h_phi", "h_theta", "b_phi", "b_theta")
 
@@ -39,7 +46,7 @@ def test_a_value_out_of_range_at_both_ends_names_the_negative_one():
 
 @pytest.mark.parametrize("bad, word", [(np.inf, "infinity"), (-np.inf, "infinity"), (np.nan, "NaN")])
 def test_non_finite_angles_are_refused_by_name(bad, word):
-    with pytest.raises(BumpError, match=f"h_phi contains NaN or infinity"):
+    with pytest.raises(BumpError, match="h_phi contains NaN or infinity"):
         _pixels(h_phi=np.array([0.0, bad, 0.0]))
 
 

@@ -8,12 +8,12 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.sim.golden.common import PixelInputs, shade
 from bumprtl.sim.golden.float.conventional import conventional
-
 
 # --- measure.py --------------------------------------------------------------------------------
 

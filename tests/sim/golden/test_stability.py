@@ -4,18 +4,25 @@ scene turned in azimuth shades the same."""
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import to_8bit
-from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.exact import exact
-from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.exact import predicted_error_bound_lsb
+from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.float.exact import exact
 from bumprtl.sim.golden.float.lee import lee_corrected, lee_printed
-from bumprtl.sim.golden.stress import (CASES, check_fixed, float_stats, payload_fields,
-                                       rotate_azimuth, stress_case)
+from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
+from bumprtl.sim.golden.stress import (
+    CASES,
+    check_fixed,
+    float_stats,
+    payload_fields,
+    rotate_azimuth,
+    stress_case,
+)
 from bumprtl.sim.traffic import PATTERNS
 
 N = 400
@@ -145,9 +152,9 @@ def test_printed_lee_nan_is_counted():
 def test_pipeline_stimulus_reaches_the_datapath():
     """The pipeline golden model on the stress stimulus equals the datapath model on the
     same codes: every N' went through the map to its pixel."""
-    from bumprtl.sim.scenes.config import load_scene_config
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus, stress_codes
+    from bumprtl.sim.scenes.config import load_scene_config
     scene = load_scene_config("default")
     n = scene.texture_size ** 2 + 100
     inputs, words = pipeline_stimulus(scene, n, seed=2)
@@ -165,9 +172,9 @@ def test_pipeline_1e6_stress_vectors_verilator(build_dir):
     """10^6 stress vectors (all cases) through the emitted pipeline on Verilator, 250k per
     traffic pattern, bit-exact against the pipeline golden model, in order (bulk path)."""
     from bumprtl.gen.render.rtl import run_pipeline_bulk
-    from bumprtl.sim.scenes.config import load_scene_config
     from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
     from bumprtl.sim.golden.stress import pipeline_stimulus
+    from bumprtl.sim.scenes.config import load_scene_config
     scene = load_scene_config("default")
     inputs, words = pipeline_stimulus(scene, 250_000, seed=9)
     patterns = list(PATTERNS)

@@ -1,6 +1,5 @@
 """The datapath units' test vectors (sim/golden/vectors.py): payloads as the RTL takes them."""
 
-import numpy as np
 
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.vectors import TINY, as_payloads, concat_codes, edge_codes, random_codes

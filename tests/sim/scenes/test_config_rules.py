@@ -2,14 +2,13 @@
 properties, each key's type errors, the picture keys, where a scene's keys come from (a
 dict, a built-in name, a TOML file) and how overrides, flags and defaults merge."""
 
-import math
 
 import numpy as np
 import pytest
 
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes import SCENES
-from bumprtl.sim.scenes.config import (BUILTIN, SceneConfig, flag_name, load_scene_config)
+from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, flag_name, load_scene_config
 from bumprtl.sim.scenes.usermap import DEFAULT_HEIGHT_SCALE, write_png
 
 
@@ -258,7 +257,7 @@ def test_an_unknown_key_in_a_file_names_the_file_and_the_first_key(tmp_path):
 def test_a_file_that_is_not_utf8_is_not_valid_toml(tmp_path):
     f = tmp_path / "latin.toml"
     f.write_bytes(b'name = "caf\xe9"\n')
-    with pytest.raises(BumpError, match=rf"scene file .*latin\.toml: not valid TOML"):
+    with pytest.raises(BumpError, match=r"scene file .*latin\.toml: not valid TOML"):
         load_scene_config(f)
 
 

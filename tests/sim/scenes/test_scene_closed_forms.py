@@ -9,8 +9,15 @@ import pytest
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.scenes import GEOMETRIES, SCENES, light_direction, load_scene
-from bumprtl.sim.scenes.heightfields import (BRICK_BEVEL, HEIGHTFIELDS, bricks, brick_lines,
-                                             height_to_normals, normals_from_gradient, smooth_noise)
+from bumprtl.sim.scenes.heightfields import (
+    BRICK_BEVEL,
+    HEIGHTFIELDS,
+    brick_lines,
+    bricks,
+    height_to_normals,
+    normals_from_gradient,
+    smooth_noise,
+)
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
 from bumprtl.sim.scenes.usermap import BumpMap
 

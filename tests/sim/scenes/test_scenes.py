@@ -7,10 +7,20 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.exact import exact
-from bumprtl.sim.scenes import (REFERENCE_TEXTURE_SIZE, SCENES, bump_strength, light_direction,
-                                load_scene)
-from bumprtl.sim.scenes.heightfields import (BRICK_BEVEL, HEIGHTFIELDS, brick_lines,
-                                             height_to_normals, smooth_noise)
+from bumprtl.sim.scenes import (
+    REFERENCE_TEXTURE_SIZE,
+    SCENES,
+    bump_strength,
+    light_direction,
+    load_scene,
+)
+from bumprtl.sim.scenes.heightfields import (
+    BRICK_BEVEL,
+    HEIGHTFIELDS,
+    brick_lines,
+    height_to_normals,
+    smooth_noise,
+)
 from bumprtl.sim.scenes.imaging import compose, psnr
 
 
@@ -178,8 +188,9 @@ def test_bump_maps_are_central_differences_of_the_height():
 
 def test_image_scenes_ship_inside_the_wheel():
     """brick, gravel, moon load from scikit-image's package directory (no download)."""
-    import skimage.data
     from pathlib import Path
+
+    import skimage.data
     here = Path(skimage.data.__file__).parent
     for name in ("brick", "gravel", "moon"):
         assert (here / f"{name}.png").is_file()

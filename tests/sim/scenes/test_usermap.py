@@ -14,8 +14,15 @@ from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.palette import displacement_to_normals
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose
-from bumprtl.sim.scenes.usermap import (load_bump_map, map_size, nearest_allowed_size,
-                                        normals_to_rgb, read_height, read_normals, write_png)
+from bumprtl.sim.scenes.usermap import (
+    load_bump_map,
+    map_size,
+    nearest_allowed_size,
+    normals_to_rgb,
+    read_height,
+    read_normals,
+    write_png,
+)
 
 
 def hex_tiles(t, seed=3, tiles=6):
@@ -317,6 +324,7 @@ def test_load_bump_map_resamples_to_the_size_asked_for(tmp_path):
 
 def test_an_rgba_normal_map_is_read_only_when_opaque(tmp_path):
     from PIL import Image
+
     from bumprtl.sim.scenes.usermap import MapError, read_normals
 
     rgba = np.zeros((16, 16, 4), np.uint8)

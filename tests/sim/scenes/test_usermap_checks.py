@@ -9,13 +9,22 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.golden.float.palette import displacement_to_normals
-from bumprtl.sim.scenes.usermap import (DEFAULT_HEIGHT_SCALE, MAX_SIZE, MIN_SIZE, MapError,
-                                        check_height_scale, load_bump_map, map_size,
-                                        nearest_allowed_size, normals_to_rgb, read_height,
-                                        read_normals, write_png)
+from bumprtl.sim.scenes.usermap import (
+    DEFAULT_HEIGHT_SCALE,
+    MAX_SIZE,
+    MIN_SIZE,
+    MapError,
+    check_height_scale,
+    load_bump_map,
+    map_size,
+    nearest_allowed_size,
+    normals_to_rgb,
+    read_height,
+    read_normals,
+    write_png,
+)
 
 SIG = b"\x89PNG\r\n\x1a\n"
 

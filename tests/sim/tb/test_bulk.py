@@ -18,18 +18,25 @@ import numpy as np
 import pytest
 
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.gen.render.rtl import scene_stimulus, scene_texels, emit_pipeline
+from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.rtl.tables import cos_lookup, sin_lookup
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb import bulk
-from bumprtl.sim.tb.bulk import (SIMULATORS, TRAFFIC, SimulationTimeout, check_stimulus,
-                                 decode_words, encode_words, run_bulk)
+from bumprtl.sim.tb.bulk import (
+    SIMULATORS,
+    TRAFFIC,
+    SimulationTimeout,
+    check_stimulus,
+    decode_words,
+    encode_words,
+    run_bulk,
+)
 from bumprtl.sim.tb.bulk_frame import coverage_frame
-from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
-from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.sim.tb.bulk_sources import pipeline_map
 from bumprtl.sim.tb.bulk_shards import run_bulk_shards
-from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.sim.tb.bulk_sources import pipeline_map
 
 # Icarus is ~1000x slower than Verilator on the pipeline: a smaller frame, the same patterns.
 FRAME = {"icarus": 16, "verilator": 64}

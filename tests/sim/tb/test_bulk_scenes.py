@@ -12,8 +12,8 @@ import pytest
 
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.methods import encode_pixels, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.accuracy import crater_scene, scene_error
+from bumprtl.sim.golden.methods import encode_pixels, illumination_fixed, rotation_fixed
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.tb.bulk import run_bulk
 

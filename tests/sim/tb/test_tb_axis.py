@@ -85,7 +85,7 @@ def test_axis_ports_and_byte_aligned_packing(tmp_path):
     assert axis["tdata_width"] % 8 == 0 and axis["tdata_width"] >= axis["m_axis_tdata_bits"]
     assert ports["s_axis_tdata"]["width"] == axis["tdata_width"] and ports["m_axis_tuser"]["width"] == 6
     fields = sorted(axis["s_axis_tdata_fields"].values())          # packed from bit 0, no gaps
-    assert fields[0][0] == 0 and all(a[0] + a[1] == b[0] for a, b in zip(fields, fields[1:]))
+    assert fields[0][0] == 0 and all(a[0] + a[1] == b[0] for a, b in zip(fields, fields[1:], strict=False))
     assert meta["config"]["tag_bits"] == 6 and meta["command"].endswith("--interface axis")
     assert "tag" not in axis["s_axis_tdata_fields"]
 

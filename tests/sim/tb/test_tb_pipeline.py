@@ -9,10 +9,16 @@ import json
 import numpy as np
 import pytest
 
-from bumprtl.gen.render.rtl import (emit_pipeline, golden_render, render_rtl,
-                                    run_pipeline_emitted, scene_stimulus, scene_texels)
-from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.gen.render.rtl import (
+    emit_pipeline,
+    golden_render,
+    render_rtl,
+    run_pipeline_emitted,
+    scene_stimulus,
+    scene_texels,
+)
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
 from bumprtl.sim.traffic import PATTERNS
 

@@ -11,8 +11,8 @@ from PIL import Image
 
 from bumprtl.gen.render.images import FIXED_METHODS, fixed_image, float_image, render_methods
 from bumprtl.gen.render.rtl import render_rtl
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes import heightfields
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 
 SIZE = 32                           # map and image: small, so make test stays fast

@@ -9,8 +9,12 @@ import pytest
 
 from bumprtl.rtl.config import Config, ConfigError
 from bumprtl.rtl.tables import coefficient_error_lsb, specular_table_error_lsb
-from bumprtl.sim.golden.fixed.common import (channel_bound, channel_bounds_lsb, input_angle_error,
-                                             term_bounds_lsb)
+from bumprtl.sim.golden.fixed.common import (
+    channel_bound,
+    channel_bounds_lsb,
+    input_angle_error,
+    term_bounds_lsb,
+)
 
 GRID = np.pi / (1 << 16)
 

@@ -7,12 +7,13 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from bumprtl.rtl.baselines.peercy import component_width, square_bits
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
+from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels, get
 

@@ -18,19 +18,27 @@ import pytest
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.units import build_unit, error_bounds
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, TWO_LIGHT_WIDTHS, Config
-from bumprtl.sim.golden.methods import METHODS
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_table_error_lsb
 from bumprtl.rtl.texture import RGB, texture_blend
-from bumprtl.sim.golden.accuracy import (adversarial_pixels, arithmetic_pixels, crater_scene,
-                                         grid_errors_lsb, on_grid, reference_blend, scene_error,
-                                         term_errors_lsb, worst_case_pixels)
+from bumprtl.sim.golden.accuracy import (
+    adversarial_pixels,
+    arithmetic_pixels,
+    crater_scene,
+    grid_errors_lsb,
+    on_grid,
+    reference_blend,
+    scene_error,
+    term_errors_lsb,
+    worst_case_pixels,
+)
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, to_8bit
 from bumprtl.sim.golden.fixed.common import specular_fine_fixed
 from bumprtl.sim.golden.fixed.exact import faithful_widths
 from bumprtl.sim.golden.fixed.pipeline import combine_lights_fixed
 from bumprtl.sim.golden.float.conventional import conventional
+from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.scenes import SCENES, load_scene
+from bumprtl.sim.scenes.config import load_scene_config
 
 exact_fixed = METHODS["exact"].datapath_fixed
 CHANNELS = ("diffuse", "specular", "color")
@@ -230,7 +238,7 @@ def test_colour_and_blend_adversarial_held_tight_and_arithmetic_within_1_lsb():
             want = to_8bit(np.clip(cfg.ka + lights * (cfg.kd * np.clip(ref.ndotl, 0, 1) +
                                                       cfg.ks * ref.specular), 0, 1))
             blend = max(int(np.abs(got[c] - want_c[c].astype(int)).max())
-                        for got, tex in zip(blends, texels)
+                        for got, tex in zip(blends, texels, strict=True)
                         for want_c in [reference_blend([ref] * lights, tex, cfg)] for c in RGB)
             measured[name] = {"color": int(np.abs(color - want.astype(int)).max()), "blend": blend}
         bounds = {"color": error_bounds(cfg, lights)["color"],

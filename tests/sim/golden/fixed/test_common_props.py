@@ -6,14 +6,22 @@ bounds growing with both errors."""
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bumprtl.rtl.config import Config, ConfigError
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.sim.golden.common import PixelInputs
-from bumprtl.sim.golden.fixed.common import (BOUND_CHANNELS, angle_codes, check_channel,
-                                             polar_illumination_fixed, polar_rotation_fixed,
-                                             quantize_pixels, shade_fixed, term_bounds_lsb)
+from bumprtl.sim.golden.fixed.common import (
+    BOUND_CHANNELS,
+    angle_codes,
+    check_channel,
+    polar_illumination_fixed,
+    polar_rotation_fixed,
+    quantize_pixels,
+    shade_fixed,
+    term_bounds_lsb,
+)
 
 
 @pytest.mark.parametrize("angle_bits", [4, 9, 14])

@@ -11,10 +11,14 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.accuracy import adversarial_pixels, diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import quantize_pixels
-from bumprtl.sim.golden.methods import METHODS
-from bumprtl.sim.golden.fixed.kim import (direction_error_bound, predicted_error_bound_lsb,
-                                          rotate_fixed, to_polar_fixed)
+from bumprtl.sim.golden.fixed.kim import (
+    direction_error_bound,
+    predicted_error_bound_lsb,
+    rotate_fixed,
+    to_polar_fixed,
+)
 from bumprtl.sim.golden.float.kim import kim
+from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.golden.stress import CASES, stress_case
 
 CFG = Config(method="kim")

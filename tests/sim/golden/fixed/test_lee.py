@@ -17,11 +17,11 @@ import pytest
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.tables import lee_asin_index_bits, lee_prop_index_bits
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
-from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 from bumprtl.sim.golden.fixed.lee import illuminate_fixed, rotate_fixed
+from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.lee import lee_corrected
+from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.sim.golden.vectors import TINY
 
 CFG = Config(method="lee", angle_bits=12, frac_bits=13)   # k = 10, B = 13: the pins below
@@ -146,7 +146,7 @@ def test_rotation_depends_on_the_azimuth_difference_only():
     a_phi, a_theta, n_phi, n_theta = ((idx >> (4 * j)) & 15 for j in range(4))
     full = rotate_fixed(a_phi, a_theta, n_phi, n_theta, cfg)
     moved = rotate_fixed((a_phi - n_phi) & 15, a_theta, 0, n_theta, cfg)
-    assert all(np.array_equal(f, g) for f, g in zip(full, moved))
+    assert all(np.array_equal(f, g) for f, g in zip(full, moved, strict=True))
 
 
 def test_light_equal_to_normal():

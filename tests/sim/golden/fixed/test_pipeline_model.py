@@ -8,8 +8,15 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.bumpfetch import memory_depth
-from bumprtl.sim.golden.fixed.pipeline import (fetch_fixed, map_words, pipeline_fixed, polygon_fixed,
-                                               random_inputs, random_map, unpack_texels)
+from bumprtl.sim.golden.fixed.pipeline import (
+    fetch_fixed,
+    map_words,
+    pipeline_fixed,
+    polygon_fixed,
+    random_inputs,
+    random_map,
+    unpack_texels,
+)
 from bumprtl.sim.scenes.config import load_scene_config
 
 

@@ -10,8 +10,13 @@ import pytest
 from bumprtl.rtl.bumpfetch import coord_bits, level_bits, memory_depth
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
-from bumprtl.sim.golden.fixed.pipeline import (as_payload_list, combine_lights_fixed, random_inputs,
-                                               random_map, unpack_texels)
+from bumprtl.sim.golden.fixed.pipeline import (
+    as_payload_list,
+    combine_lights_fixed,
+    random_inputs,
+    random_map,
+    unpack_texels,
+)
 from bumprtl.sim.scenes.config import load_scene_config
 
 

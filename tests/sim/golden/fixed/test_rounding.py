@@ -26,16 +26,22 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q
 from bumprtl.rtl.lee import asin_address, prop_address, theta_from_prop
 from bumprtl.rtl.palette import mul8
-from bumprtl.rtl.tables import (SPEC_FRAC_BITS, blend_coefficients, cos_lookup,
-                                lee_asin_index_bits, lee_prop_index_bits, phong_coefficients)
+from bumprtl.rtl.tables import (
+    SPEC_FRAC_BITS,
+    blend_coefficients,
+    cos_lookup,
+    lee_asin_index_bits,
+    lee_prop_index_bits,
+    phong_coefficients,
+)
 from bumprtl.rtl.texture import texture_blend
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.golden.fixed import lee as fixed_lee
 from bumprtl.sim.golden.fixed import peercy as fixed_peercy
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels, shade_fixed
 from bumprtl.sim.golden.fixed.pipeline import combine_lights_fixed
+from bumprtl.sim.scenes.config import load_scene_config
 
 N = 200_000
 DELTA = 1e-9
@@ -237,9 +243,9 @@ def test_kim_products():
     f = lambda *xs: [x.astype(np.float64) for x in xs]
     fst, fct, fsp, fcp = f(st, ct, sp, cp)
     entries = kim_rtl.matrix_entries(st, ct, sp, cp, cfg)
-    for got, (x, y) in zip(entries, ((fct, fcp), (fct, fsp), (fst, fcp), (fst, fsp))):
+    for got, (x, y) in zip(entries, ((fct, fcp), (fct, fsp), (fst, fcp), (fst, fsp)), strict=True):
         assert_rounds_to_nearest(got, x * y / cfg.one, "kim matrix entries")
-    for got, x in zip(kim_rtl.cartesian(st, sp, cp, cfg), (fst * fcp, fst * fsp)):
+    for got, x in zip(kim_rtl.cartesian(st, sp, cp, cfg), (fst * fcp, fst * fsp), strict=True):
         assert_rounds_to_nearest(got, x / cfg.one, "kim cartesian")
     half = lambda: rng.integers(-cfg.one // 2, cfg.one // 2 + 1, N)   # |sums| < 1: no clamp
     mat, x, y, z = (half(), half(), half(), half()), half(), half(), half()
@@ -247,7 +253,7 @@ def test_kim_products():
     fm, (fx, fy, fz) = f(*mat), f(x, y, z)
     fs, fc, fp, fq = f(st // 2, ct // 2, sp // 2, cp // 2)
     exact = ((fm[0] * fx + fm[1] * fy - fs * fz), (fq * fy - fp * fx), (fm[2] * fx + fm[3] * fy + fc * fz))
-    for g, e in zip(got, exact):
+    for g, e in zip(got, exact, strict=True):
         assert_rounds_to_nearest(g, e / cfg.one, "kim transform")
     p, q, ca, sa = pos(), pos(), pos(), pos()
     assert_rounds_to_nearest(kim_rtl.rho_of(p, q, ca, sa, cfg),
@@ -272,10 +278,10 @@ def test_peercy_normalization_quotient():
     rng = np.random.default_rng(31)
     at = [rng.integers(-cfg.one, cfg.one + 1, N // 4) for _ in range(3)]
     got = fixed_peercy.normalize_fixed(at, cfg)
-    s = sum(int(0) + a.astype(object) * a for a in at)
+    s = sum(0 + a.astype(object) * a for a in at)
     r = np.array([math.isqrt(4 * int(x)) for x in s], dtype=np.float64)
     keep = r > 0
-    for a, g in zip(at, got):
+    for a, g in zip(at, got, strict=True):
         exact = np.abs(a[keep]).astype(np.float64) * 2 ** (cfg.frac_bits + 1) / r[keep]
         assert np.array_equal(np.sign(g[keep]), np.sign(a[keep]))
         assert_rounds_to_nearest(np.abs(g[keep]), exact, "peercy quotient")

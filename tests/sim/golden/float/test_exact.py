@@ -3,7 +3,8 @@ matrices, agreement with the Cartesian reference on 10^5 random inputs and on th
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, tangent_rotation
 from bumprtl.sim.golden.float.conventional import conventional

@@ -8,10 +8,15 @@ Inputs are chosen where the method's own approximations are exact (y = 0, i.e. D
 import numpy as np
 import pytest
 
-from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar, polar_to_cartesian, tangent_rotation
+from bumprtl.sim.golden import measure
+from bumprtl.sim.golden.common import (
+    PixelInputs,
+    cartesian_to_polar,
+    polar_to_cartesian,
+    tangent_rotation,
+)
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.lee import ALL_ERRATA, illuminate, lee_corrected, lee_printed, rotate
-from bumprtl.sim.golden import measure
 from bumprtl.sim.golden.measure import angle_error_deg, error_stats
 
 d = np.radians

@@ -6,9 +6,16 @@ import pytest
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.common import shade
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.float.palette import (Material, color_table, displacement_to_normals, lookup,
-                                        mipmap_indices, quantize_normal_map, render_palette,
-                                        world_normal_map)
+from bumprtl.sim.golden.float.palette import (
+    Material,
+    color_table,
+    displacement_to_normals,
+    lookup,
+    mipmap_indices,
+    quantize_normal_map,
+    render_palette,
+    world_normal_map,
+)
 from bumprtl.sim.golden.float.palette_quantize import QUANTIZERS
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.imaging import compose, max_diff, psnr
@@ -277,7 +284,7 @@ def test_palette_psnr_grows_with_size_on_a_small_scene():
     ref = compose(scene, conventional(scene.px, cfg).color)
     scores = [psnr(ref, compose(scene, render_palette(scene, cfg, s, "kmeans").color))
               for s in (16, 64, 256, 1024)]
-    assert all(a < b for a, b in zip(scores, scores[1:])), scores
+    assert all(a < b for a, b in zip(scores, scores[1:], strict=False)), scores
 
 
 def test_plane_is_exact_up_to_quantization():

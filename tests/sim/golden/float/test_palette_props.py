@@ -10,11 +10,25 @@ import pytest
 
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.common import polar_to_cartesian
-from bumprtl.sim.golden.float.palette import (MATERIAL_SCALE, Material, check_normal_map, color_table,
-                                              displacement_to_normals, frame_directions, lookup,
-                                              mipmap_indices, nearest_spacing, quantize_normal_map)
-from bumprtl.sim.golden.float.palette_quantize import (bayer_offsets, distinct, kmeans, median_cut,
-                                                       nearest)
+from bumprtl.sim.golden.float.palette import (
+    MATERIAL_SCALE,
+    Material,
+    check_normal_map,
+    color_table,
+    displacement_to_normals,
+    frame_directions,
+    lookup,
+    mipmap_indices,
+    nearest_spacing,
+    quantize_normal_map,
+)
+from bumprtl.sim.golden.float.palette_quantize import (
+    bayer_offsets,
+    distinct,
+    kmeans,
+    median_cut,
+    nearest,
+)
 
 
 def _normals(t, seed=0, spread=0.6):
@@ -208,7 +222,7 @@ def test_lloyd_iterations_never_raise_the_weighted_error():
         return float(np.sum(w * np.sum((pts - t[nearest(pts, t)]) ** 2, axis=1)))
     errs = [sse(kmeans(pts, w, 16, iterations=i)) for i in range(6)]
     assert errs[0] == sse(median_cut(pts, w, 16))
-    assert all(b <= a * (1 + 1e-12) for a, b in zip(errs, errs[1:])), errs
+    assert all(b <= a * (1 + 1e-12) for a, b in zip(errs, errs[1:], strict=False)), errs
     assert errs[-1] < 0.98 * errs[0]
 
 
@@ -296,7 +310,7 @@ def test_distinct_with_all_weights_zero_is_empty_and_weights_are_summed():
     uniq, counts = distinct(v, np.zeros(3))
     assert uniq.shape == (0, 3) and counts.shape == (0,)
     uniq, counts = distinct(v, np.array([0.25, 0.5, 2]))
-    assert dict(zip(map(tuple, uniq), counts.tolist())) == {(0, 0, 1): 0.75, (1, 0, 0): 2.0}
+    assert dict(zip(map(tuple, uniq), counts.tolist(), strict=True)) == {(0, 0, 1): 0.75, (1, 0, 0): 2.0}
 
 
 # --- Sec. 5: mipmaps, lookup, colour tables -----------------------------------------------------
@@ -446,7 +460,7 @@ def test_world_normal_map_sums_each_texels_pixels_and_turns_unused_ones_by_the_m
     px, m = scene.px, scene.mask
     want = np.zeros((t, t, 3))
     want_counts = np.zeros((t, t), np.int64)
-    for i in zip(*np.nonzero(m)):
+    for i in zip(*np.nonzero(m), strict=False):
         world = _tangent(px.n_phi[i], px.n_theta[i]).T @ polar_to_cartesian(px.b_phi[i], px.b_theta[i])
         want[scene.v[i], scene.u[i]] += world
         want_counts[scene.v[i], scene.u[i]] += 1
@@ -466,7 +480,6 @@ def test_a_palette_holding_every_normal_renders_the_exact_dots():
     """With sN at least the distinct normals, render_palette's N'.L and N'.H are the
     per-texel normal's dot with the frame's L and H = normalize(L + V); the colour is the
     mean of the 8-bit table's RGB of each pixel's entry."""
-    from bumprtl.rtl.config import Config
     from bumprtl.sim.golden.common import to_8bit
     from bumprtl.sim.golden.float.palette import distinct_normals, render_palette, world_normal_map
     from bumprtl.sim.scenes import load_scene
@@ -524,7 +537,6 @@ def test_the_blend_layout_clamps_a_highlight_summed_over_lights_to_1():
 def test_render_palette_dithers_when_asked():
     """render_palette(dither=True) shades the dithered index map (Sec. 4, Fig. 4): its
     colours are palette_rgb's of the map quantized with dithering, not of the plain one."""
-    from bumprtl.rtl.config import Config
     from bumprtl.sim.golden.float.palette import palette_rgb, render_palette, world_normal_map
     from bumprtl.sim.scenes import load_scene
     scene = load_scene("bumps", size=32)

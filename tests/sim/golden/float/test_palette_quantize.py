@@ -7,9 +7,17 @@ import numpy as np
 import pytest
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.golden.float.palette_quantize import (PALETTE_MAX, PALETTE_MIN, bayer_offsets,
-                                                       check_palette_size, distinct, kmeans,
-                                                       median_cut, nearest, stores_every_normal)
+from bumprtl.sim.golden.float.palette_quantize import (
+    PALETTE_MAX,
+    PALETTE_MIN,
+    bayer_offsets,
+    check_palette_size,
+    distinct,
+    kmeans,
+    median_cut,
+    nearest,
+    stores_every_normal,
+)
 
 # two pairs of unit normals; by x: (0,0,1) w2, (0,.6,.8) w2 | (.8,.6,0) w3, (1,0,0) w1
 POINTS = np.array([[1.0, 0, 0], [0.8, 0.6, 0], [0, 0, 1.0], [0, 0.6, 0.8]])
@@ -72,9 +80,9 @@ def test_distinct_sums_the_weights_of_equal_rows_and_drops_weight_zero():
     v = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])
     uniq, counts = distinct(v)
     assert _as_set(uniq) == _as_set([[0, 0, 1], [1, 0, 0], [0, 1, 0]])
-    assert dict(zip(map(tuple, uniq), counts)) == {(0, 0, 1): 2, (1, 0, 0): 1, (0, 1, 0): 1}
+    assert dict(zip(map(tuple, uniq), counts, strict=True)) == {(0, 0, 1): 2, (1, 0, 0): 1, (0, 1, 0): 1}
     uniq, counts = distinct(v, [0.5, 0, 2.0, 1.0])
-    assert dict(zip(map(tuple, uniq), counts)) == {(0, 0, 1): 2.5, (0, 1, 0): 1.0}
+    assert dict(zip(map(tuple, uniq), counts, strict=True)) == {(0, 0, 1): 2.5, (0, 1, 0): 1.0}
 
 
 def test_palette_size_range_and_lossless_case():

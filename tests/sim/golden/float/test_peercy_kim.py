@@ -7,8 +7,8 @@ import pytest
 from bumprtl.sim.golden.common import PixelInputs, polar_to_cartesian, tangent_rotation
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.kim import kim, polar_dot
-from bumprtl.sim.golden.measure import angle_error_deg
 from bumprtl.sim.golden.float.peercy import peercy, tbn_frame
+from bumprtl.sim.golden.measure import angle_error_deg
 
 
 @pytest.fixture(scope="module")
