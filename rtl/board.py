@@ -112,7 +112,7 @@ class PixelSource(Elaboratable):
         m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
         m.d.comb += [payload_field(pay, k).eq(c) for k, c in self.constants.items()]
         at = 0
-        for k, w in zip(self.keys, self.widths, strict=True):
+        for k, w in zip(self.keys, self.widths, strict=False):
             m.d.comb += payload_field(pay, k).eq(rd.data[at:at + w])
             at += w
         return m

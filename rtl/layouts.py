@@ -48,7 +48,7 @@ def light_keys(cfg: Config):
     own = list(layout_fields(light_layout(cfg)))
     names = list(layout_fields(data.StructLayout(light_fields(cfg))))
     k = len(own)
-    return [dict(zip(own, names[j * k:(j + 1) * k], strict=True)) for j in range(cfg.lights)]
+    return [dict(zip(own, names[j * k:(j + 1) * k], strict=False)) for j in range(cfg.lights)]
 
 
 def pixel_layout(cfg: Config):

@@ -218,10 +218,10 @@ class BlockROM(RegisteredROM):
                                         [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
                                         bits, shift, self.en,
                                         [(side, port.addr, f"{port.addr.name}_{side}{col}")
-                                         for side, port in zip("AB", ports, strict=True)])
-                for out, dout in zip(columns, outs.values(), strict=True):
+                                         for side, port in zip("AB", ports, strict=False)])
+                for out, dout in zip(columns, outs.values(), strict=False):
                     out.append(dout[:hi - lo])
-            for port, out in zip(ports, columns, strict=True):
+            for port, out in zip(ports, columns, strict=False):
                 data = Cat(*out)
                 if self.depth > words:          # the last word: the address wrapped to word 0
                     last = Signal(name=f"{port.addr.name}_last")
@@ -349,7 +349,7 @@ class LeeRotation(PipeUnit):
         sx, sy, cx, cy = (sine_value(m, pipe, port, angle, cfg, f"{v}_{nm}")
                           for port, (nm, angle) in zip(sincos.ports, (
                               ("sin_x", x), ("sin_y", y),
-                              ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k))), strict=True))  # S
+                              ("cos_x", x + (1 << k)), ("cos_y", y + (1 << k))), strict=False))  # S
         s2 = reg(sx + sy, f"{v}_s2")                                       # adder 4: 2 s (eq. 7)
         y2 = reg(cy - cx, f"{v}_y2")                                       # adder 5: 2 sin th sin D
         abs_s2 = reg(abs(s2), f"{v}_abs_s2")                               # S + 2
@@ -373,7 +373,7 @@ class LeeRotation(PipeUnit):
         prop = rom_read(pipe, f"{v}_prop_rom", lee_prop_table(cfg), b + 1,
                     prop_address(product, cfg, stage))                    # S + 6 + 3R + W
         z_negative, abs_z = (delay(reg(x, f"{v}_{nm}"), 2 * R + W, f"{v}_{nm}")
-                             for x, nm in zip(magnitude(z, cfg), ("z_negative", "abs_z"), strict=True))
+                             for x, nm in zip(magnitude(z, cfg), ("z_negative", "abs_z"), strict=False))
         y_negative = delay(y2[-1], 5 + 3 * R + W, f"{v}_y_negative")      # S + 6 + 3R + W
         phi = reg(phi_quadrant(atan, z_negative, y_negative, cfg, stage), f"{v}_phi")
         term = reg(prop_term(abs_z, prop, cfg, lambda x, w: mul(x, w, f"{v}_theta_prop")),

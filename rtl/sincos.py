@@ -191,7 +191,7 @@ class SinCos(wiring.Component):
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
                                    registered=True, angle_stage=False, near=near_sine(cfg),
                                    line=sine_line(cfg))
-                   for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)), strict=True)}
+                   for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)), strict=False)}
         m.d.comb += [
             self.o.payload.sin.eq(outputs["sin"]),
             self.o.payload.cos.eq(outputs["cos"]),

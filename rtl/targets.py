@@ -212,7 +212,7 @@ class RegisteredROM(Elaboratable):
 
     def dp16kd(self, m, bits, words, shift):
         """The ECP5 form in mode (``bits``, ``words``, ``shift``) (:meth:`ECP5.rom`)."""
-        sides = list(zip("AB", self.ports + self.ports[:1], strict=True))[:max(2, len(self.ports))]
+        sides = list(zip("AB", self.ports + self.ports[:1], strict=False))[:max(2, len(self.ports))]
         douts = {side: Signal(self.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
         for col in range(-(-self.width // bits)):
             lo, hi = col * bits, min(self.width, (col + 1) * bits)
@@ -263,22 +263,19 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
 
 
 # Most DP16KD blocks side by side that one ROM of more than 1024 words is given on ECP5:
-# an 8193 x 17 table (the quarter-wave sine of 15-bit angles at B = 16, before it was stored
-# above its line: sincos.sine_line) is nine x2 blocks (no output multiplexer; the generic
-# form, which Yosys maps with one, ran at 72 MHz).
+# an 8193 x 17 table (the quarter-wave sine of 15-bit angles at B = 16 stored whole) is nine
+# x2 blocks, read without an output multiplexer (the generic form, which Yosys maps with
+# one, is slower: docs/report.md).
 ROM_MAX_BLOCKS = 9
 # A memory of more DP16KD than this side by side is "spread" over the die: it gets an enable
 # flip-flop of its own in lock step (pipe.StallPipe.rom / ram) and its reads a second address
 # register (sincos.near_sine, bumpfetch.BumpMapFetch), so neither the clock enable nor the
-# address crosses the spread in the cycle that computes it. Measured (bumprtl report fpga,
-# docs/report.md): every row whose memories are at most eight blocks wide met 150 MHz on
-# seeds 1-3; scene_full's nine-block sine ROMs (15-bit angles, before they were stored above
-# their line) and its 15-block map held it at 121.1 MHz.
+# address crosses the spread in the cycle that computes it. The threshold is the widest
+# memory whose rows place without it (bumprtl report fpga, docs/report.md).
 SPREAD_BLOCKS = 8
 # A quarter-wave sine ROM of more DP16KD than this side by side has its reads take a second
-# address register beside its blocks (sincos.near_sine): scene_full's sine ROMs of the sine
-# above its line (seven 8192 x 2 blocks) without it had the angle -> mirrored address route,
-# 4.7 ns, as the worst path (149.7 MHz, seed 1).
+# address register beside its blocks (sincos.near_sine): without it the angle -> mirrored
+# address route across the blocks is the worst path of the widest sine ROMs (docs/report.md).
 NEAR_BLOCKS = 6
 
 # DP16KD data widths (one port) and their depths: 18 Kbit as 1024 x 18 ... 16384 x 1.

@@ -1,7 +1,7 @@
 """A compile cache for the Verilator run-time library, run by make as ``$(OBJCACHE)``.
 
 Every Verilator build of a testbench compiles the same run-time sources (verilated.cpp,
-verilated_vpi.cpp, verilated_dpi.cpp, verilated_threads.cpp: about 19 s of CPU of a build)
+verilated_vpi.cpp, verilated_dpi.cpp, verilated_threads.cpp: most of a small build's CPU)
 with the same flags. Verilator's makefiles put ``$(OBJCACHE)`` in front of every compile
 command; sim/toolchain.py's :func:`tool_env` sets it to ``python -m bumprtl.sim.objcache``.
 A compile of a source under ``$VERILATOR_ROOT/include`` is served from the cache directory

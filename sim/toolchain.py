@@ -60,7 +60,7 @@ def tool_env(base=None):
     # in MAKEFLAGS is a command-line override for the make that cocotb runs.
     if "CFG_CXXFLAGS_PCH_I" not in env.get("MAKEFLAGS", ""):
         env["MAKEFLAGS"] = (env.get("MAKEFLAGS", "") + " CFG_CXXFLAGS_PCH_I=-include").strip()
-    # Every Verilator build compiles the same run-time library (about 19 s of CPU):
+    # Every Verilator build compiles the same run-time library:
     # verilated.mk runs each compile through $(OBJCACHE), here sim/objcache.py, which keeps
     # those objects in build/objcache (a user's own OBJCACHE, e.g. ccache, is kept).
     if "OBJCACHE" not in env:

@@ -328,7 +328,7 @@ def _light_row(cfg, m, output, row):
 def _scene_config(args):
     """The Config of the light-sum, blend and scene tables: ``--scene-widths`` (angle bits,
     frac bits) when given, else Config's default widths."""
-    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or (), strict=True))
+    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or (), strict=False))
     return Config(method=args.method, spec_index_bits=args.spec_index_bits, **widths)
 
 

@@ -263,7 +263,7 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
     captured = [res[f"frame{k}"] for k in range(frames)]
     words, texels, _, table = data
     golden = [golden_frame(scene, mode, k, table, words, texels) for k in range(frames)]
-    same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden, strict=True)]
+    same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden, strict=False)]
     return {"captured": captured, "golden": golden, "same": same,
             "timing_errors": [str(e) for e in res["timing_errors"]],
             "underflow": int(res["underflow"]), "order_error": int(res["order_error"]),

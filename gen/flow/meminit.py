@@ -2,8 +2,8 @@
 
 Amaranth 0.5's ``rtlil`` back end writes a memory's initial contents (the ``DATA`` of its
 ``$meminit_v2`` cell) by making one netlist constant per bit and joining them again into one
-binary constant: for the ``full`` scene's pipeline (seventeen 8193-word sine ROMs) that is
-2.7 million Python objects, and its emission took 9.9 s instead of 3.8 s with this writer.
+binary constant: one Python object per bit of every table, which dominates the emission of
+the scenes with large sine ROMs (the ``full`` scene's).
 :func:`install` replaces that one method of the back end (``ModuleEmitter.emit_memory``) by
 one that formats the words straight into the same constant, so every emitted file keeps its
 bytes (tests/gen/flow/test_meminit.py compares the two writers' output). It is installed

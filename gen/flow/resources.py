@@ -156,7 +156,7 @@ def _count_macc(counts, cell):
     a = _split(conn.get("A", []), _widths(p["A_WIDTHS"], n_products))
     b = _split(conn.get("B", []), _widths(p["B_WIDTHS"], n_products))
     c = _split(conn.get("C", []), _widths(p["C_WIDTHS"], n_addends))
-    terms = sum(_count_product(counts, x, y) for x, y in zip(a, b, strict=True))
+    terms = sum(_count_product(counts, x, y) for x, y in zip(a, b, strict=False))
     terms += sum(_constant(x) is None for x in c)
     width = _int(p["Y_WIDTH"])
     counts.adders += [width] * max(terms - 1, 0)

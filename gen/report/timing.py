@@ -66,7 +66,7 @@ def _bit(values):
 
 def _bus(values, valid):
     wave, data, last = "", [], None
-    for v, ok in zip(values, valid, strict=True):
+    for v, ok in zip(values, valid, strict=False):
         key = v if ok else None
         if key == last and wave:
             wave += "."

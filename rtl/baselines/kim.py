@@ -167,10 +167,10 @@ def transform(mat, n, a, cfg: Config, mul=_times, stage=_same):
     terms = ((mul(m00, x) + mul(m01, y), mul(st, z)), (mul(cp, y), mul(sp, x)),
              (mul(m20, x) + mul(m21, y), mul(ct, z)))
     (u0, w0), (u1, w1), (u2, w2) = ((stage(u, f"{c}_u"), stage(w, f"{c}_w"))
-                                    for (u, w), c in zip(terms, "xyz", strict=True))
+                                    for (u, w), c in zip(terms, "xyz", strict=False))
     sums = (u0 - w0, u1 - w1, u2 + w2)
     return tuple(_clamp_unit(stage(round_shift(t, b), f"{c}_rounded"), cfg)
-                 for t, c in zip(sums, "xyz", strict=True))
+                 for t, c in zip(sums, "xyz", strict=False))
 
 
 def octant(x, y, stage=_same):
@@ -191,7 +191,7 @@ def normalize(p, q, cfg: Config, stage=_same):
     cuts = [min(b, (b + 1) * j // 3 + 1) for j in (1, 2)]
     for e in range(1, b + 1):                      # the last (largest) true e wins
         for n in range(cuts.count(e)):
-            p, q, pn, qn = (stage(x, f"{nm}{e}_{n}") for x, nm in zip((p, q, pn, qn), ("p", "q", "pn", "qn"), strict=True))
+            p, q, pn, qn = (stage(x, f"{nm}{e}_{n}") for x, nm in zip((p, q, pn, qn), ("p", "q", "pn", "qn"), strict=False))
         small = p < (1 << (b + 1 - e))
         pn, qn = _select(small, p << e, pn), _select(small, q << e, qn)
     return _fit(pn, b + 1, signed=False), _fit(qn, b + 1, signed=False)
@@ -330,10 +330,10 @@ class KimRotation(PipeUnit):
         n = tuple(sine_value(m, pipe, port, angle, cfg, name)
                   for port, (angle, name) in zip(rom.ports, (
                       (px.n.theta, "n_sin_theta"), (px.n.theta + (1 << k), "n_cos_theta"),
-                      (px.n.phi, "n_sin_phi"), (px.n.phi + (1 << k), "n_cos_phi")), strict=True))   # S
+                      (px.n.phi, "n_sin_phi"), (px.n.phi + (1 << k), "n_cos_phi")), strict=False))   # S
         mat = tuple(pipe.register(e, f"m{nm}") for e, nm in
-                    zip(matrix_entries(*n, cfg, _multiplier(pipe, "m")), ("00", "01", "20", "21"), strict=True))
-        n = tuple(pipe.delay(e, P + 1, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp"), strict=True))
+                    zip(matrix_entries(*n, cfg, _multiplier(pipe, "m")), ("00", "01", "20", "21"), strict=False))
+        n = tuple(pipe.delay(e, P + 1, f"n_{nm}") for e, nm in zip(n, ("st", "ct", "sp", "cp"), strict=False))
         for v in vectors(cfg):                                                      # S + P + 1
             phi, theta = self._vector(m, pipe, v, px[v], mat, n)
             m.d.comb += [o[v].phi.eq(phi), o[v].theta.eq(theta)]
@@ -349,12 +349,12 @@ class KimRotation(PipeUnit):
         read = lambda angle, name: sine_value(m, pipe, next(ports), angle, cfg, f"{v}_{name}")
         st, ct = read(a.theta, "sin_theta"), read(a.theta + (1 << k), "cos_theta")
         sp, cp = read(a.phi, "sin_phi"), read(a.phi + (1 << k), "cos_phi")          # S
-        x, y = (reg(c, f"{v}_{nm}") for c, nm in zip(cartesian(st, sp, cp, cfg, mul), "xy", strict=True))
+        x, y = (reg(c, f"{v}_{nm}") for c, nm in zip(cartesian(st, sp, cp, cfg, mul), "xy", strict=False))
         z = delay(ct, P + 1, f"{v}_z")                                              # S + P + 1
         xp, yp, zp = (reg(c, f"{v}_{nm}_rot") for c, nm in
-                      zip(transform(mat, n, (x, y, z), cfg, mul, stage), "xyz", strict=True))    # S + 2P + 4
+                      zip(transform(mat, n, (x, y, z), cfg, mul, stage), "xyz", strict=False))    # S + 2P + 4
         swap, p, q = (reg(c, f"{v}_{nm}") for c, nm in
-                      zip(octant(xp, yp, stage), ("swap", "p", "q"), strict=True))              # S + 2P + 6
+                      zip(octant(xp, yp, stage), ("swap", "p", "q"), strict=False))              # S + 2P + 6
         x_neg, y_neg = reg(xp < 0, f"{v}_x_negative"), reg(yp < 0, f"{v}_y_negative")
         pn, qn = normalize(p, q, cfg, stage)                                        # S + 2P + 8
         recip = rom_read(pipe, f"{v}_recip_rom", kim_reciprocal_table(cfg), cfg.frac_bits + 1,
@@ -372,7 +372,7 @@ class KimRotation(PipeUnit):
                          ca0, sa0, cfg, mul), f"{v}_rho")                           # 2S + 4P + 10 + 2R
         use_rho, z_neg, val = (reg(c, f"{v}_{nm}") for c, nm in zip(
             theta_select(rho, delay(zp, S + 2 * P + 6 + 2 * R, f"{v}_z_rot"), cfg, stage),
-            ("use_rho", "z_negative", "asin_arg"), strict=True))                                 # 2S + 4P + 12 + 2R
+            ("use_rho", "z_negative", "asin_arg"), strict=False))                                 # 2S + 4P + 12 + 2R
         asin = rom_read(pipe, f"{v}_asin_rom", lee_asin_table(cfg), k + 1,
                         asin_address(val, cfg))                                     # 2S + 4P + 12 + 3R
         theta = reg(theta_from_octant(asin, delay(use_rho, R, f"{v}_use_rho"),
@@ -411,7 +411,7 @@ class KimIllumination(IlluminationDatapath):
             st, ct, cphi = (sine_read(m, pipe, port, angle, cfg, f"{v}_{name}", registered=True)
                             for port, (angle, name) in zip(rom.ports, (
                                 (a.theta, "sin_theta"), (a.theta + (1 << k), "cos_theta"),
-                                (a.phi - b.phi + (1 << k), "cos_dphi")), strict=True))          # sin/cos
+                                (a.phi - b.phi + (1 << k), "cos_dphi")), strict=False))          # sin/cos
             cc, ss = dot_terms(st, ct, st_n, ct_n, cfg, mul)                         # + P
             ss = pipe.register(ss, f"{v}_ss")                                       # + P + 1
             cc = pipe.delay(cc, P + 1, f"{v}_cc")                                   # + 2P + 1

@@ -275,7 +275,7 @@ class PeercyRotation(PipeUnit):
         for v in vectors(cfg):
             a = px[v]
             comps = {}
-            for row, axis in zip(FRAME, AXES, strict=True):             # A_t = (T.A, B.A, N.A)
+            for row, axis in zip(FRAME, AXES, strict=False):             # A_t = (T.A, B.A, N.A)
                 p = [mul(px[row][c], a[c], f"{v}_{row}{c}") for c in AXES]          # + P
                 comps[axis] = sum3_rounded(reg, p, b, f"{v}t_{axis}")[:cw].as_signed()  # + 2
             sq = [square(comps[c], comps[c], f"{v}t_{c}_sq") for c in AXES]         # + P

@@ -87,7 +87,7 @@ def enabled_delay(values, en, latency):
     """The reference of an en-gated pipe: after clock k, the value taken ``latency`` enabled
     clocks before the last enabled clock up to k (None until the pipe has filled)."""
     taken, out = [], []
-    for v, e in zip(values, en, strict=True):
+    for v, e in zip(values, en, strict=False):
         if e:
             taken.append(v)
         out.append(taken[-1 - latency] if len(taken) > latency else None)

@@ -344,7 +344,7 @@ class StreamContract(Elaboratable):
             return [(f"layer{n}", took, gave, first, count,
                      "valid stages of a layer = its pixels in flight")
                     for n, ((took, gave), first, count)
-                    in enumerate(zip(self._layer_takes, starts, self._layer_stages, strict=True))]
+                    in enumerate(zip(self._layer_takes, starts, self._layer_stages, strict=False))]
         if len(stages) > CHUNK and len(self._lead_pipes) == 1:
             valid, adv = self._lead_pipes[0]["valid"], self._lead_pipes[0]["adv"]
             runs = []
@@ -521,11 +521,11 @@ class StreamContract(Elaboratable):
         valid = fetch["valid"][1:]
         banks = [fetch["banks"][n] for n in range(1, len(valid) + 1)]
         for b, pending in enumerate(dut.lut_pending):
-            self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks, strict=True)),
+            self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks, strict=False)),
                         "the per-bank counters count the fetch stages' bank bits")
         self._lemma(m, occ_f == sum(valid), "pixels before the LUT = valid fetch stages")
         found, downstream = Const(0), Const(0, 4)
-        for v, bank in reversed(list(zip(valid, banks, strict=True))):
+        for v, bank in reversed(list(zip(valid, banks, strict=False))):
             found = found | (v & (downstream == ahead_f) & (bank == wbank))
             downstream = downstream + v
         waiting_f = watching & before

@@ -173,7 +173,7 @@ def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=p
 
     with Runner(scheduler, jobs) as runner:
         runner.run((Job(name, formal_job, args, timeout) for name, (_u, _p, args)
-                    in zip(order, jobs_list, strict=True)), desc="formal", on_done=finished)
+                    in zip(order, jobs_list, strict=False)), desc="formal", on_done=finished)
     return [done[k] for k in sorted(done)]
 
 

@@ -249,7 +249,7 @@ def flag_name(key):
 _KEYS = tuple(f.name for f in fields(SceneConfig))
 
 # The two-light scenes take the widths that prove 1 LSB on every channel with two lights.
-_TWO_LIGHTS = dict(zip(("angle_bits", "frac_bits"), TWO_LIGHT_WIDTHS, strict=True))
+_TWO_LIGHTS = dict(zip(("angle_bits", "frac_bits"), TWO_LIGHT_WIDTHS, strict=False))
 
 # The scene classes of docs/scenes.md.
 BUILTIN = {

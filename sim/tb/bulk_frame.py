@@ -34,8 +34,8 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   as the host left them; of the pixels on which the flip changes some output, the frame
   keeps TABLE_QUOTA = 3 for each read, bit and value of that bit (fewer where the pool has
   fewer), chosen greedily so that one pixel serves every read it moves: about 60 pixels for
-  the 34 reads of two lights, 14 for the default scene's 24 (whose unrounded outputs show
-  most flips), about 1.5 s of CPU;
+  the reads of two lights, fewer for the default scene's (whose unrounded outputs show
+  most flips);
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
@@ -272,8 +272,8 @@ def _near_carry(scene, seed):
 
 
 # The table-sensitivity pixels: random pixels searched (a flipped bit 0 of one read's word
-# changes an output on 0.01 to 0.4 % of random pixels of two-lights, so 2**15 find a few for
-# nearly every read; 34 reads x 4 bits = 136 golden runs of the pool, about 1.5 s of CPU), the
+# changes an output on a small fraction of random pixels, so the pool must be large enough to
+# find a few for nearly every read; one golden run of the pool per read and bit), the
 # low bits of a word flipped (errors of 1 to 8 LSBs) and the pixels kept for each read, bit and
 # value of that bit.
 TABLE_POOL = 1 << 15

@@ -20,8 +20,7 @@ SIMULATORS = ("icarus", "verilator")
 _BINARY = {"icarus": "iverilog", "verilator": "verilator"}
 # g++'s optimisation of a Verilator model's per-cycle code (verilated.mk's OPT_FAST, -Os by
 # default). A cocotb testbench drives every cycle from Python, so the model's evaluation is a
-# small part of a run: at -O0 the exact illumination unit builds in 5 s of CPU instead of 8 and
-# runs its 4 x 4 000 vectors as fast. None keeps Verilator's own (gen/bench/golden.py measures
+# small part of a run: -O0 builds faster and runs such a bench as fast. None keeps Verilator's own (gen/bench/golden.py measures
 # pixels/s with it).
 OPT_FAST = "-O0"
 

@@ -34,7 +34,7 @@ def runs(seq):
     edges = np.flatnonzero(np.diff(seq)) + 1
     starts = np.concatenate([[0], edges])
     ends = np.concatenate([edges, [len(seq)]])
-    return [(int(seq[s]), int(s), int(e - s)) for s, e in zip(starts, ends, strict=True)]
+    return [(int(seq[s]), int(s), int(e - s)) for s, e in zip(starts, ends, strict=False)]
 
 
 def timing_errors(de, hs, vs, t):

@@ -473,7 +473,7 @@ def cut(net, rtl, yosys_run, timeout, stream, log=None):
         if bits is None:
             return "undecided", "cut: no counterexample read"
         grow, drop = set(), set()
-        for on, pt in zip(bits, plist, strict=True):
+        for on, pt in zip(bits, plist, strict=False):
             if not on:
                 continue
             if pt[0] == "const":

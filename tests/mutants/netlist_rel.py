@@ -366,7 +366,7 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
     one = sorted(cell for cell, copies in regs.items() if set(copies) == {"shared"}
                  and list(copies["shared"]) == [0] and cell in net.cells)
     valid = [(cell, nm, regs[cell]["shared"][0])
-             for cell, nm in zip(one, nc.names(net, [(cell, 0) for cell in one]), strict=True)
+             for cell, nm in zip(one, nc.names(net, [(cell, 0) for cell in one]), strict=False)
              if "valid" in nm]
     for cell, copies in sorted(regs.items()):
         if "shared" in copies:
@@ -377,7 +377,7 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
     # name, "terms" of terms.h_cx_data), or all of them for a register of the top module
     unit = lambda nm: nm.split(".", 1)[0] if "." in nm else None
     cells_w = sorted(c for c in eqw if c in net.cells)
-    own = dict(zip(cells_w, (unit(nm) for nm in nc.names(net, [(c, 0) for c in cells_w])), strict=True))
+    own = dict(zip(cells_w, (unit(nm) for nm in nc.names(net, [(c, 0) for c in cells_w])), strict=False))
     for cell, (ec, en) in eqw.items():
         for vc, vn, li in valid:
             if own.get(cell) and unit(vn) and own[cell] != unit(vn):

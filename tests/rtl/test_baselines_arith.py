@@ -33,7 +33,7 @@ def stream(dut, inputs, outputs, values, stall=0.0, seed=0):
         while len(got) < len(values):
             en = rng.random() >= stall
             if pending:
-                for sig, v in zip(inputs, pending[0], strict=True):
+                for sig, v in zip(inputs, pending[0], strict=False):
                     ctx.set(sig, v)
             ctx.set(dut.en, en)
             await ctx.tick()

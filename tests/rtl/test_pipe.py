@@ -117,7 +117,7 @@ def test_registered_rom_reads_two_enables_later(ports):
 
     def drive(ctx, rng):
         addrs = [int(rng.integers(0, len(table))) for _ in dut.ports]
-        for port, addr in zip(dut.ports, addrs, strict=True):
+        for port, addr in zip(dut.ports, addrs, strict=False):
             ctx.set(port.addr, addr)
         return addrs
 
@@ -247,7 +247,7 @@ def test_wide_products_are_the_product_in_both_forms(unit, latency, a_shape, b_s
                            "prod_b": (b_shape.width, [mask(x, b_shape.width) for x in b]),
                            "prod_en": (1, en)},
                           {"prod": width}, build_dir, ports=lambda u: [u.a, u.b, u.en, u.p])
-    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b, strict=True)], en, latency - 1)
+    want = enabled_delay([mask(int(x) * int(y), width) for x, y in zip(a, b, strict=False)], en, latency - 1)
     filled = [c for c in range(n) if want[c] is not None]
     assert len(filled) > n // 2
     for form in forms:

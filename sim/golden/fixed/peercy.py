@@ -105,9 +105,9 @@ def rotation_fixed(codes, cfg: Config):
     for v in vectors(cfg):
         a = _vec(codes, v)
         at = [round_shift(r[0] * a[0] + r[1] * a[1] + r[2] * a[2], b) for r in frame]
-        for axis, value in zip(AXES, normalize_fixed(at, cfg), strict=True):
+        for axis, value in zip(AXES, normalize_fixed(at, cfg), strict=False):
             out[f"{v}.{axis}"] = value
-    for axis, value in zip(AXES, _vec(codes, "np"), strict=True):
+    for axis, value in zip(AXES, _vec(codes, "np"), strict=False):
         out[f"np.{axis}"] = value
     return out
 

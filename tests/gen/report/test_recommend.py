@@ -25,7 +25,7 @@ def _point(name, err, rom, mult=6, adders=30, fpga=None):
 
 def _fpga(lut, dsp, bram, device="LFE5U-25F", avail=(24000, 28, 56)):
     return {"device": device, "LUT4": lut, "DSP": dsp, "BRAM": bram, "fmax_mhz": 100.0,
-            "available": dict(zip(("LUT4", "DSP", "BRAM"), avail, strict=True))}
+            "available": dict(zip(("LUT4", "DSP", "BRAM"), avail, strict=False))}
 
 
 TOY = {"command": "bumprtl bench sweep --toy", "points": [

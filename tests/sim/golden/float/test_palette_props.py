@@ -310,7 +310,7 @@ def test_distinct_with_all_weights_zero_is_empty_and_weights_are_summed():
     uniq, counts = distinct(v, np.zeros(3))
     assert uniq.shape == (0, 3) and counts.shape == (0,)
     uniq, counts = distinct(v, np.array([0.25, 0.5, 2]))
-    assert dict(zip(map(tuple, uniq), counts.tolist(), strict=True)) == {(0, 0, 1): 0.75, (1, 0, 0): 2.0}
+    assert dict(zip(map(tuple, uniq), counts.tolist(), strict=False)) == {(0, 0, 1): 0.75, (1, 0, 0): 2.0}
 
 
 # --- Sec. 5: mipmaps, lookup, colour tables -----------------------------------------------------
