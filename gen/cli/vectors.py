@@ -1,0 +1,122 @@
+"""``bumprtl vectors``: stimulus and expected outputs for an emitted pipeline, with the
+design and a self-checking Verilog testbench (gen/flow/vectors.py, gen/flow/vectors_tb.py)."""
+
+import argparse
+import re
+import shlex
+from pathlib import Path
+
+from bumprtl.gen.cli.flags import add_config_flags, add_map_flags, scene_from_args
+from bumprtl.gen.flow.memories import DEFAULT_DEVICE, DEVICE_BRAM, LOADS, scene_command
+from bumprtl.gen.flow.units import default_module
+from bumprtl.gen.flow.vectors import (
+    DEFAULT_COUNT,
+    MAX_COUNT,
+    SOURCES,
+    check_count,
+    pipeline_vectors,
+    run_commands,
+    write_vectors,
+)
+from bumprtl.rtl.config import BumpError
+
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+EXAMPLES = """examples:
+  bumprtl vectors --pipeline default --count 1000 --out build/vec
+      the default scene's pipeline, 1000 random pixels; then in build/vec:
+      iverilog -g2005 -s bumprtl_pipeline_tb -o tb.vvp bumprtl_pipeline_tb.v \\
+          bumprtl_pipeline_named.v bumprtl_pipeline.v && vvp -n tb.vvp      -> PASS 1000
+  bumprtl vectors --pipeline palette --source frame --load port --out build/vec_pal
+  bumprtl vectors --height-map my_map.png --source my_pixels.csv --name my_bump --out build/mine
+      your map and your own pixels: a CSV with a header row u,v,n_phi,n_theta,l_phi,
+      l_theta,h_phi,h_theta[,tag] (texel coordinates; angles in radians, phi in [0, 2*pi],
+      theta in [0, pi]; the columns of another scene: a wrong header lists them)
+  bumprtl vectors --pipeline default --load port --top my_top --out build/top
+      a bench for your own top module my_top (the named ports' clk, rst, in_*, out_*),
+      which loads the map through the host write port itself
+"""
+
+
+def _identifier(flag, value):
+    if value is not None and (not _IDENT.fullmatch(value) or len(value) > 200):
+        raise BumpError(f"{flag} must be a Verilog identifier (letters, digits, _; not starting "
+                        f"with a digit), got {value!r}")
+    return value
+
+
+def _command(scene, args, module, top, count):
+    """The ``bumprtl vectors`` line that reproduces the files (no output directory): the
+    scene and its flags as emit's reproducing line gives them."""
+    emit = scene_command("pipeline", scene, args.load or "initial", module)
+    scene_part = emit[len("bumprtl emit pipeline --scene "):]
+    parts = [f"--source {shlex.quote(str(args.source))}", f"--count {count}",
+             f"--seed {args.seed}"] + ([f"--top {top}"] if top else [])
+    return f"bumprtl vectors --pipeline {scene_part} " + " ".join(parts)
+
+
+def run(args):
+    module = _identifier("--name", args.name) or default_module("pipeline")
+    top = _identifier("--top", args.top)
+    if args.count is not None:
+        check_count(args.count)
+    scene = scene_from_args(args, args.pipeline)
+    vectors = pipeline_vectors(scene, args.source, args.count, args.seed)
+    command = _command(scene, args, module, top, len(vectors))
+    paths = write_vectors(vectors, args.out, module, args.load or "initial", top,
+                          args.device or DEFAULT_DEVICE, command)
+    print(f"wrote {len(paths)} files to {args.out}: {module}_tb.v, the design "
+          f"({module}.v, {module}_named.v) and {len(vectors)} pixels' stimulus and expected "
+          f"words ({module}_in_*.hex, {module}_out_*.hex)")
+    print(f"run it in {args.out}:")
+    for sim, line in run_commands(module, top).items():
+        print(f"  {sim:<9} {line}")
+    return 0
+
+
+def add_parser(sub):
+    sources = ", ".join(SOURCES)
+    p = sub.add_parser("vectors", help="test vectors and a self-checking Verilog bench for an "
+                                       "emitted pipeline",
+                       description="Write the pipeline of a scene (as `bumprtl emit pipeline "
+                                   "--ports named`), stimulus and the bit-exact golden model's "
+                                   "expected outputs as $readmemh files (one per field), and "
+                                   "NAME_tb.v, a self-checking plain Verilog-2005 bench for "
+                                   "Icarus and Verilator: input gaps and output backpressure "
+                                   "from a seeded LFSR, every output field of every pixel "
+                                   "compared in order, one last line PASS n or FAIL (the "
+                                   "first mismatch: pixel, field, got, expected), a timeout if "
+                                   "the pipeline hangs.\n\n" + EXAMPLES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--pipeline", default="default", metavar="FILE|NAME",
+                   help="the scene class: a built-in scene (sim/scenes/config.py) or a TOML "
+                        "file, as emit --scene and render --pipeline (default: default)")
+    p.add_argument("--source", default="random", metavar="frame|random|FILE",
+                   help=f"the pixels: one of {sources} (the scene's own frame, the stimulus "
+                        f"render streams; seeded random valid pixels), or a .csv (header row) "
+                        f"or .npy file of your pixels as physical values: texel coordinates u, "
+                        f"v, angles in radians (default: random)")
+    p.add_argument("--count", type=int, default=None, metavar="N",
+                   help=f"pixels, in [1, {MAX_COUNT}] (default: {DEFAULT_COUNT}; with a file "
+                        f"every row)")
+    p.add_argument("--seed", type=int, default=1, metavar="S",
+                   help="seed of --source random and the bench's default LFSR seed (the gaps "
+                        "and stalls; +seed=N at run time changes it) (default: 1)")
+    p.add_argument("--out", type=Path, default=Path("build/vectors"),
+                   help="output directory (default: build/vectors)")
+    p.add_argument("--name", default=None, metavar="PREFIX",
+                   help="module and file prefix, as emit's --name (default: bumprtl_pipeline)")
+    p.add_argument("--load", default=None, choices=LOADS,
+                   help="initial: the map is the design's own initial contents; port: the "
+                        "bench writes NAME_map.hex through the host write port first "
+                        "(default: initial)")
+    p.add_argument("--top", default=None, metavar="MODULE",
+                   help="the bench instantiates your top module MODULE (the named ports' clk, "
+                        "rst, in_*, out_*; it loads its memories itself) instead of "
+                        "NAME_named")
+    p.add_argument("--device", default=None, choices=sorted(DEVICE_BRAM),
+                   help=f"refuse memories that do not fit this ECP5's block RAM (default: "
+                        f"{DEFAULT_DEVICE})")
+    add_map_flags(p)
+    add_config_flags(p)
+    p.set_defaults(func=run)
