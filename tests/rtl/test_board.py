@@ -112,8 +112,8 @@ def test_buffer_at_its_least_depth_keeps_long_lines_fed_and_starves_one_below(sc
 def test_board_buffer_depth_keeps_long_lines_fed(scene_data):
     scene, data = scene_data
     latency = unelaborated_pipeline(scene).latency
-    assert buffer_depth(latency) >= 1 + latency + FIFO_DELAY
     assert run_core(scene, data, long_line_mode(buffer_depth(latency), latency)) == (0, 0)
+    assert buffer_depth(latency) >= 1 + latency + FIFO_DELAY
 
 
 def source_payloads(scene, mode, table, frames, seed):
