@@ -6,9 +6,9 @@ that line.
 
 The reduced mode ``test`` (32 x 24) is no monitor mode and has no standard line: it is
 held to the numbers docs/board.md gives it, and its waveform is checked over two whole
-frames. 640 x 480 is checked over its vertical blanking into its first active lines (every
-horizontal region, the vertical porches and sync) in ``make test``, and over a whole frame
-in ``make regress``.
+frames. Each monitor mode (640 x 480 today) is checked from reset through its vertical
+blanking into its first active lines (every horizontal region, the vertical porches and
+sync) in ``make test``, and over a whole frame in ``make regress``.
 """
 
 import pytest
@@ -30,6 +30,8 @@ STANDARD = {
 # syncs negative as the VESA mode's, run at the 640 x 480 board's pixel clock
 REDUCED = {"test": ("docs/board.md reduced mode", 25.0, (32, 4, 8, 4, 48), (24, 2, 2, 2, 30),
                     True, True)}
+LINES = {**STANDARD, **REDUCED}
+MONITOR_MODES = [name for name in MODES if name in STANDARD]
 
 
 def _numbers(mode):
@@ -40,10 +42,9 @@ def _numbers(mode):
 
 
 def test_every_mode_offered_has_its_standards_numbers():
-    lines = {**STANDARD, **REDUCED}
-    assert set(MODES) <= set(lines), f"modes without a standard line here: {set(MODES) - set(lines)}"
+    assert set(MODES) <= set(LINES), f"modes without a standard line here: {set(MODES) - set(LINES)}"
     for name, mode in MODES.items():
-        standard, *want = lines[name]
+        standard, *want = LINES[name]
         assert _numbers(mode) == tuple(want), f"{name} is not {standard}"
     # the board's clock is a PLL's (25 MHz reference), near the standard's, not equal to it
     for name, mode in MODES.items():
@@ -139,13 +140,14 @@ def test_reduced_mode_waveform_over_two_frames():
     assert active_frames == 2 and syncs == 2 and lines == 2 * numbers[2][0]
 
 
-def test_640x480_waveform_through_the_vertical_blanking():
+@pytest.mark.parametrize("name", MONITOR_MODES)
+def test_monitor_mode_waveform_through_the_vertical_blanking(name):
     """From reset (the first front-porch line) through the vertical sync and back porch into
-    the first active lines: every horizontal region, v sync and v back porch, both
-    polarities."""
-    numbers = STANDARD["640x480"][1:]
+    the first active lines: every horizontal region, v front porch, sync and back porch,
+    both polarities."""
+    numbers = STANDARD[name][1:]
     (_, vf, vsw, vb, _), htot = numbers[2], numbers[1][4]
-    samples = _waveform(MODES["640x480"], (vf + vsw + vb + 2) * htot)
+    samples = _waveform(MODES[name], (vf + vsw + vb + 2) * htot)
     _, syncs, lines = check_waveform(samples, numbers)
     assert syncs == 1 and lines == 2
     # the first vf lines are front porch: the sync starts at line vf exactly
@@ -154,9 +156,10 @@ def test_640x480_waveform_through_the_vertical_blanking():
 
 
 @pytest.mark.regress
-def test_640x480_waveform_over_a_whole_frame():
-    numbers = STANDARD["640x480"][1:]
+@pytest.mark.parametrize("name", MONITOR_MODES)
+def test_monitor_mode_waveform_over_a_whole_frame(name):
+    numbers = STANDARD[name][1:]
     htot, vtot = numbers[1][4], numbers[2][4]
-    samples = _waveform(MODES["640x480"], vtot * htot + (numbers[2][1] + numbers[2][2] + 1) * htot)
+    samples = _waveform(MODES[name], vtot * htot + (numbers[2][1] + numbers[2][2] + 1) * htot)
     active_frames, syncs, lines = check_waveform(samples, numbers)
     assert active_frames == 1 and syncs == 2 and lines == numbers[2][0]
