@@ -139,6 +139,9 @@ class BumpMapFetch(wiring.Component):
     texture : sequence of int, optional
         Initial colour-texture words (:func:`pack_rgb`, same level layout); only with
         ``scene.texture``.
+    write_port : bool
+        True (default): the host write ports below; False: none, the memories hold their
+        ``init`` and ``texture`` words for good (``bumprtl emit --load initial``).
     target : None or pipe.ECP5
         Elaboration target (None: the generic form every simulator runs).
 
@@ -151,9 +154,10 @@ class BumpMapFetch(wiring.Component):
         ``texel`` (rgb, with a texture) is filled like the map's field.
     w_en, w_addr, w_data : In
         Host write port (a scene's map loaded at run time). A read in the cycle of a write to
-        the same word returns the old word. Absent with a flat bump map.
+        the same word returns the old word. Absent with a flat bump map or without
+        ``write_port``.
     tex_w_en, tex_w_addr, tex_w_data : In
-        The colour texture's host write port (``texture = true``).
+        The colour texture's host write port (``texture = true`` and ``write_port``).
 
     Latency :func:`fetch_latency`: 2 + RAM_LATENCY (address register, block-RAM read, the
     block RAM's output register: rtl/pipe.RegisteredRAM, a DP16KD with REGMODE OUTREG on
@@ -164,8 +168,9 @@ class BumpMapFetch(wiring.Component):
     """
 
     def __init__(self, scene, out_layout=None, init=None, texture=None, target=None,
-                 lockstep=None):
+                 lockstep=None, write_port=True):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
+        self.write_port = write_port
         self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         self.fetched = fetched_fields(scene)
         if not self.fetched:
@@ -196,10 +201,10 @@ class BumpMapFetch(wiring.Component):
             raise ValueError("texture words given but the scene has texture = false")
         ports = {"i": In(stream.Signature(data.StructLayout(fields))),
                  "o": Out(stream.Signature(out_layout))}
-        if has_map(scene):
+        if has_map(scene) and write_port:
             ports.update({"w_en": In(1), "w_addr": In(range(self.depth)),
                           "w_data": In(self.word_bits)})
-        if scene.texture:
+        if scene.texture and write_port:
             ports.update({"tex_w_en": In(1), "tex_w_addr": In(range(self.depth)),
                           "tex_w_data": In(TEXEL_BITS)})
         super().__init__(ports)
@@ -216,12 +221,14 @@ class BumpMapFetch(wiring.Component):
         self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):
-            mem = pipe.ram("map", self.depth, unsigned(self.word_bits), self.init)
+            mem = pipe.ram("map", self.depth, unsigned(self.word_bits), self.init,
+                           self.write_port)
             mems[fetched_field(scene)] = mem, ""
         if scene.texture:
-            mem = pipe.ram("texture", self.depth, unsigned(TEXEL_BITS), self.texture)
+            mem = pipe.ram("texture", self.depth, unsigned(TEXEL_BITS), self.texture,
+                           self.write_port)
             mems["texel"] = mem, "tex_"
-        for mem, prefix in mems.values():
+        for mem, prefix in mems.values() if self.write_port else ():
             m.d.comb += [mem.w_en.eq(getattr(self, f"{prefix}w_en")),
                          mem.w_addr.eq(getattr(self, f"{prefix}w_addr")),
                          mem.w_data.eq(getattr(self, f"{prefix}w_data"))]

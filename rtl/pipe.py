@@ -138,10 +138,11 @@ class StallPipe:
         self._record(name, unit.depth, unit.width)
         return unit
 
-    def ram(self, name, depth, shape, init=None):
+    def ram(self, name, depth, shape, init=None, writable=True):
         """A :class:`RegisteredRAM` whose read is enabled by ``adv``; the caller drives its
-        ``r_addr`` and write port and reads ``r_data`` RAM_LATENCY stages later."""
-        unit = RegisteredRAM(depth, shape, name, init, target=self.target)
+        ``r_addr`` and write port (none when not ``writable``) and reads ``r_data``
+        RAM_LATENCY stages later."""
+        unit = RegisteredRAM(depth, shape, name, init, target=self.target, writable=writable)
         self.m.submodules[name] = unit
         self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
         self._record(name, depth, unit.width)

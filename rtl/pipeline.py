@@ -193,6 +193,9 @@ class BumpPipeline(wiring.Component):
         Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
     texture : sequence of int, optional
         Colour-texture words (``bumpfetch.pack_rgb``, same level layout as the map).
+    write_port : bool
+        True (default): the map's and texture's host write ports; False: none, the memories
+        hold ``init`` and ``texture`` for good (``bumprtl emit --load initial``).
     target : None or pipe.ECP5
         Elaboration target of every unit (None: the generic form every simulator runs).
 
@@ -210,9 +213,9 @@ class BumpPipeline(wiring.Component):
         {diffuse, specular, color: rgb, tag}; or PaletteLUT's {color: rgba, oor, tag} with
         palette shading.
     map_w_en, map_w_addr, map_w_data : In
-        Host write port of the bump map (varying map and palette).
+        Host write port of the bump map (varying map and palette; only with ``write_port``).
     tex_w_en, tex_w_addr, tex_w_data : In
-        Host write port of the colour texture (``texture = true``).
+        Host write port of the colour texture (``texture = true``; only with ``write_port``).
     poly_en, poly : In
         Flat map: the polygon registers {n_phi, x4, y2, z4} (n'' rotated once per polygon).
     lut_w_en, lut_w_addr, lut_w_data, lut_swap, lut_bank, lut_w_ready :
@@ -240,8 +243,9 @@ class BumpPipeline(wiring.Component):
     sim/formal's lemmas.
     """
 
-    def __init__(self, scene, init=None, texture=None, target=None):
+    def __init__(self, scene, init=None, texture=None, target=None, write_port=True):
         self.scene = scene
+        self.write_port = write_port
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
@@ -261,11 +265,11 @@ class BumpPipeline(wiring.Component):
             in_layout = data.StructLayout({**light_fields(cfg), "tag": unsigned(cfg.tag_bits)})
         ports["i"] = In(stream.Signature(in_layout))
         ports["o"] = Out(stream.Signature(self.units[self._last].o.payload.shape()))
-        if "fetch" in self.units and has_map(scene):
+        if "fetch" in self.units and has_map(scene) and write_port:
             f = self.units["fetch"]
             ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
                           "map_w_data": In(f.w_data.shape())})
-        if scene.texture:
+        if scene.texture and write_port:
             f = self.units["fetch"]
             ports.update({"tex_w_en": In(1), "tex_w_addr": In(f.tex_w_addr.shape()),
                           "tex_w_data": In(f.tex_w_data.shape())})
@@ -297,7 +301,8 @@ class BumpPipeline(wiring.Component):
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
             (["texture = true: the RGB colour texel"] if s.texture else [])
         self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target,
-                                        lockstep=self._run("fetch")),
+                                        lockstep=self._run("fetch"),
+                                        write_port=self.write_port),
                   f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 

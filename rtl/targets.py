@@ -330,10 +330,12 @@ class RegisteredRAM(Elaboratable):
     same word returns the old word. On ECP5 (``target`` :class:`ECP5`, depth <= 16384) it is
     DP16KD blocks in the widest mode (:data:`DP16KD_MODES`) that holds ``depth`` words, side
     by side for the width: port A writes, port B reads with its output register (REGMODE_B
-    OUTREG); elsewhere an Amaranth Memory and a register."""
+    OUTREG); elsewhere an Amaranth Memory and a register. ``writable = False``: no write
+    port at all (a memory whose contents are its ``init``), ``w_*`` unused."""
 
-    def __init__(self, depth, shape, name, init=None, target=None):
+    def __init__(self, depth, shape, name, init=None, target=None, writable=True):
         self.depth, self.shape, self.name, self.target = depth, shape, name, target
+        self.writable = writable
         self.width = Shape.cast(shape).width
         self.init = [int(x) for x in init] if init is not None else []
         self.en = Signal(name=f"{name}_en")
@@ -365,8 +367,9 @@ class RegisteredRAM(Elaboratable):
         """The generic form: an Amaranth Memory, a synchronous read and an output register;
         returns the Memory."""
         m.submodules.mem = mem = Memory(shape=self.shape, depth=self.depth, init=self.init)
-        wp = mem.write_port()
-        m.d.comb += [wp.en.eq(self.w_en), wp.addr.eq(self.w_addr), wp.data.eq(self.w_data)]
+        if self.writable:
+            wp = mem.write_port()
+            m.d.comb += [wp.en.eq(self.w_en), wp.addr.eq(self.w_addr), wp.data.eq(self.w_data)]
         rp = mem.read_port(domain="sync")
         m.d.comb += [rp.en.eq(self.en), rp.addr.eq(self.r_addr)]
         with m.If(self.en):

@@ -25,7 +25,15 @@ from bumprtl.gen.flow.memories import (
     scene_command,
 )
 from bumprtl.gen.flow.named import named_module, named_ports, write_named
-from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, default_module, emit_unit, faithful_note
+from bumprtl.gen.flow.units import (
+    SCENE_UNITS,
+    UNITS,
+    canonical_command,
+    default_module,
+    emit_unit,
+    faithful_note,
+    name_flag,
+)
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import BumpError
 
@@ -67,7 +75,8 @@ def run(args):
         extra.append(write_named(v_path, meta, command))
         meta["named_ports"] = {"module": named_module(v_path.stem), "command": command,
                                "ports": named_ports(meta)}
-        j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    meta["command"] = full_command(args, cfg, module)
+    j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     for path in (v_path, *extra, j_path, *hexes):
         print(f"wrote {path}")
     note = _faithful_note(args.unit, cfg)
@@ -84,6 +93,32 @@ def run(args):
         print(f"lint: {'clean' if not problems else f'{len(problems)} problem(s)'}")
         return 1 if problems else 0
     return 0
+
+
+def full_command(args, cfg, module):
+    """The ``bumprtl emit`` line that reproduces every file this emission wrote, byte for
+    byte (the sidecar's ``command``): the unit and its Config or scene flags (with the map
+    flags even under ``--load port``, whose Verilog does not depend on them but whose
+    memory images do), then ``--load``, ``--interface``, ``--tdata-width``, ``--name``,
+    ``--ports``, ``--device`` and ``--fusesoc`` as given (a default left out); never
+    ``--out`` (the files do not depend on where they go) or ``--lint`` (it writes nothing).
+    The Verilog's first line keeps the shorter command that reproduces that file alone."""
+    if args.unit in SCENE_UNITS:
+        parts = [scene_command(args.unit, cfg, args.load or "initial", picture=True)]
+    else:
+        parts = [canonical_command(UNITS[args.unit], cfg)]
+    if args.interface != "stream":
+        parts.append(f"--interface {args.interface}")
+    if args.tdata_width is not None:
+        parts.append(f"--tdata-width {args.tdata_width}")
+    parts.append(name_flag(args.unit, module).strip())
+    if args.ports != "payload":
+        parts.append(f"--ports {args.ports}")
+    if args.device not in (None, DEFAULT_DEVICE):
+        parts.append(f"--device {args.device}")
+    if args.fusesoc:
+        parts.append("--fusesoc")
+    return " ".join(p for p in parts if p)
 
 
 def _faithful_note(unit, cfg):

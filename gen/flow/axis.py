@@ -7,15 +7,16 @@ both buses, the tuser/tlast conventions and the reset.
 
 A scene unit (``pipeline``, ``fetch``) is built with its memory images
 (gen/flow/memories.py ``memory_images``): the ``load = "initial"`` ones as the Verilog's
-initial contents, each written beside it as ``<unit>_axis_<memory>.hex`` and described in
-the sidecar's ``memory_images``, as ``bumprtl emit`` does without ``--interface axis``.
+initial contents (and then without the map's and texture's host write ports), each written
+beside it as ``<unit>_axis_<memory>.hex`` and described in the sidecar's ``memory_images``,
+as ``bumprtl emit`` does without ``--interface axis``.
 """
 
 import json
 from pathlib import Path
 
 from bumprtl.gen.flow.emit import emit
-from bumprtl.gen.flow.memories import hex_text, scene_command
+from bumprtl.gen.flow.memories import has_write_port, hex_text, image_records, scene_command
 from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, canonical_command, name_flag
 from bumprtl.rtl.axis import AxisWrapper
 from bumprtl.rtl.bumpfetch import BumpMapFetch
@@ -35,7 +36,8 @@ def _builder(name, images):
         return lambda c: UNITS[name].build(c, target=None)
     init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
     cls = BumpPipeline if name == "pipeline" else BumpMapFetch
-    return lambda scene: cls(scene, init=init("map"), texture=init("texture"))
+    return lambda scene: cls(scene, init=init("map"), texture=init("texture"),
+                             write_port=has_write_port(images))
 
 
 def build_axis(name, cfg, tdata_width=None, images=None, module=None):
@@ -53,8 +55,8 @@ def build_axis(name, cfg, tdata_width=None, images=None, module=None):
         sidecar["scene"] = cfg.to_dict()
     if images:
         sidecar["memory_images"] = {
-            n: {**{k: v for k, v in img.items() if k != "words"},
-                "file": f"{axis_name(module or name)}_{n}.hex"} for n, img in images.items()}
+            n: {**img, "file": f"{axis_name(module or name)}_{n}.hex"}
+            for n, img in image_records(images, has_write_port(images)).items()}
     command = (canonical_command(unit, cfg) if name not in SCENE_UNITS or not images
                else scene_command(name, cfg, _load(images))) + " --interface axis"
     if tdata_width is not None:

@@ -7,10 +7,12 @@ texture ``<unit>_texture.hex``, with palette shading ``<unit>_lut.hex`` (the col
 one frame). Each file holds one word per line in hexadecimal, without address markers or
 comments, word 0 first: what Verilog's ``$readmemh`` (and every FPGA flow's memory
 initialisation) reads. The sidecar's ``memory_images`` gives each file's depth, width,
-word layout and host write port. The Verilog takes the contents either as its built-in
-initial contents (``load = "initial"``, the same words as the file) or through the host
-write port (``load = "port"``: the memory starts at zero and the host writes word ``a`` of
-the file at address ``a``, one per clock, before the first pixel).
+word layout and, with ``load = "port"``, host write port. The Verilog takes the contents
+either as its built-in initial contents (``load = "initial"``, the same words as the file;
+the map and texture then have no write port at all: not in the module, the named wrapper or
+the sidecar) or through the host write port (``load = "port"``: the memory starts at zero
+and the host writes word ``a`` of the file at address ``a``, one per clock, before the first
+pixel). The palette colour table is always written through its port.
 """
 
 import math
@@ -31,6 +33,7 @@ from bumprtl.sim.scenes.config import load_scene_config
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
            "table_blocks", "memory_blocks",
            "check_fits", "check_scene_fits", "hex_text", "memory_images", "emit_scene_unit", "host_writes",
+           "has_write_port", "image_records",
            "scene_command"]
 
 LOADS = ("initial", "port")
@@ -159,6 +162,13 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
     return images
 
 
+def image_records(images, write_port):
+    """The sidecar's ``memory_images``: each image without its words; the map's and the
+    texture's ``port`` only where the unit has it (``write_port``)."""
+    return {n: {k: v for k, v in img.items() if k != "words" and
+                (k != "port" or write_port or n == "lut")} for n, img in images.items()}
+
+
 def host_writes(images, meta):
     """Host set-up cycles (``{port: value}`` per clock) that write the map and texture
     images with ``load = "port"`` through their write ports, word ``a`` at address ``a``.
@@ -185,18 +195,19 @@ _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "
                   "resample")
 
 
-def scene_command(unit, scene, load="initial", module=None):
+def scene_command(unit, scene, load="initial", module=None, picture=False):
     """The ``bumprtl emit`` line that reproduces ``unit``'s Verilog for ``scene``: ``--scene
     NAME`` plus a flag for every key with a flag that differs from the named scene's. With
     ``load = "port"`` the Verilog holds no map, so the keys that only shape the map's
-    contents are left out: every map of one size gives the same Verilog."""
+    contents are left out: every map of one size gives the same Verilog; ``picture`` keeps
+    them (the memory images do depend on them: the sidecar's full command)."""
     parts = ["bumprtl", "emit", unit, "--scene", scene.name]
     try:
         base = load_scene_config(scene.name)
     except BumpError:                                  # a scene built in code: no source
         base = None
     for key in _FLAG_KEYS if base is not None else ():
-        if load == "port" and key in _PICTURE_FLAGS:
+        if load == "port" and key in _PICTURE_FLAGS and not picture:
             continue
         value = getattr(scene, key)
         if value == getattr(base, key) or value is None:
@@ -211,21 +222,31 @@ def scene_command(unit, scene, load="initial", module=None):
     return " ".join(parts) + name_flag(unit, module)
 
 
+def has_write_port(images):
+    """The map or texture of ``images`` (:func:`memory_images`) is loaded through the host
+    write port (``load = "port"``); with ``load = "initial"`` the unit has no such port."""
+    return any(img["load"] == "port" for n, img in images.items() if n != "lut")
+
+
 def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command=None,
-                    module=None):
+                    module=None, write_port=None):
     """Build ``unit`` (``pipeline`` or ``fetch``) of ``scene`` with the ``images`` of
     :func:`memory_images` (built-in initial contents where ``load = "initial"``), check its
     memories fit ``device`` (``None``: no check), then write ``<unit>.v``, ``<unit>.json``
     (with ``memory_images``) and one ``$readmemh`` file per image. Returns the paths
     ``(v, json, [hex...])``; nothing is written when a check fails. ``module`` (default
-    ``unit``) names the top module and every file, the images ``<module>_<memory>.hex``."""
+    ``unit``) names the top module and every file, the images ``<module>_<memory>.hex``.
+    ``write_port`` (default :func:`has_write_port`): the map's and texture's host write
+    ports; True with initial contents is the testbenches' unit whose built-in map the host
+    overwrites in part (no ``bumprtl emit`` flag gives it)."""
     init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
     spec = UNITS[unit]
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
+    write_port = has_write_port(images) if write_port is None else write_port
     fit = None
     if device is not None:                      # before building a large map's contents
         fit = check_scene_fits(scene, device, unit)
-    dut = build(scene, init=init("map"), texture=init("texture"))
+    dut = build(scene, init=init("map"), texture=init("texture"), write_port=write_port)
     sidecar = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
     if fit is not None:
         sidecar["block_ram"] = {"device": device, "dp16kd_needed": fit[0],
@@ -233,8 +254,7 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
                                 "note": "maps tiled into DP16KD shapes, one block per other table"}
     if module is not None:
         images = {n: {**img, "file": f"{module}_{n}.hex"} for n, img in images.items()}
-    sidecar["memory_images"] = {n: {k: v for k, v in img.items() if k != "words"}
-                                for n, img in images.items()}
+    sidecar["memory_images"] = image_records(images, write_port)
     texts = {img["file"]: hex_text(img["words"], img["width"]) for img in images.values()}
     load = images["map"]["load"] if "map" in images else "initial"
     v, j = emit(dut, unit, command or scene_command(unit, scene, load, module), out_dir, sidecar,

@@ -233,13 +233,17 @@ def run_pipeline_emitted(v, j, inputs, polygon, table, simulator, build_dir,
     return outs, {p: int(res[f"{p}.cycles"]) for p in patterns}, run
 
 
-def emit_pipeline(scene, words, texels, build_dir, rtl_dir, table=None, load="initial"):
+def emit_pipeline(scene, words, texels, build_dir, rtl_dir, table=None, load="initial",
+                  write_port=None):
     """Write pipeline.v, pipeline.json and the $readmemh files of its memories
     (gen/flow/memories.py); ``load``: the contents built in (``initial``) or left to the
-    host write port (``port``). Returns the .v and .json paths."""
+    host write port (``port``). ``write_port = True`` with ``initial``: the contents built
+    in and the host write port too (a bench that overwrites part of the map; default: the
+    port only with ``port``). Returns the .v and .json paths."""
     images = memory_images("pipeline", scene, words, texels, table, load)
     rtl_dir = Path(build_dir) / "rtl" if rtl_dir is None else Path(rtl_dir).resolve()
-    v, j, _ = emit_scene_unit("pipeline", scene, rtl_dir, images, device=None)
+    v, j, _ = emit_scene_unit("pipeline", scene, rtl_dir, images, device=None,
+                              write_port=write_port)
     return v, j
 
 

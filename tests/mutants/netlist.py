@@ -177,7 +177,7 @@ def emit_target(target, out, n, seed):
     # table built in), and the coverage frame it streams (tests/sim/tb/test_bulk.py)
     _, words, _, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
-    v, j = emit_pipeline(scene, words, texels, out, out, table, "initial")
+    v, j = emit_pipeline(scene, words, texels, out, out, table, "initial", write_port=True)
     frame = coverage_frame(scene, words, texels)
     meta = json.loads(Path(j).read_text())
     expected = frame.expected(meta)

@@ -216,3 +216,34 @@ def test_pipeline_host_ports_address_every_mip_level(keys):
     for port in ("map_w_addr", "tex_w_addr"):
         if port in dut.signature.members:
             assert len(getattr(dut, port)) == 9, port
+
+
+@pytest.mark.parametrize("keys", [{"mip_levels": 3, "texture": True},
+                                  {"shading": "palette", "mip_levels": 2}])
+def test_without_write_port_the_built_in_words_are_read_and_no_host_port_exists(keys):
+    """``write_port=False`` (``bumprtl emit --load initial``): neither the fetch nor the
+    pipeline has a map or texture host port, and the fetch still reads its built-in words
+    bit for bit (against the independent reference)."""
+    from bumprtl.rtl.pipeline import BumpPipeline
+    from bumprtl.sim.golden.fixed.pipeline import random_texture
+    scene = load_scene_config({"texture_size": 16, **keys})
+    rng = np.random.default_rng(5)
+    words = random_map(scene, rng)
+    texels = random_texture(scene, rng) if scene.texture else None
+    dut = BumpMapFetch(scene, init=words, texture=texels, write_port=False)
+    host = {"w_en", "w_addr", "w_data", "tex_w_en", "tex_w_addr", "tex_w_data"}
+    assert not host & set(dut.signature.members)
+    pipe = BumpPipeline(scene, init=words, texture=texels, write_port=False)
+    pipe._MustUse__silence = True                  # only its ports are read
+    assert not {f"map_{p}" for p in host if not p.startswith("tex")} & set(pipe.signature.members)
+    assert not {p for p in host if p.startswith("tex")} & set(pipe.signature.members)
+    assert "map_w_en" in BumpPipeline(scene, init=words, texture=texels).signature.members
+    inputs = random_inputs(scene, 200, rng)
+    payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
+                for n in range(200)]
+    out, _ = simulate_stream(dut, payloads, "backpressure", pipe_handshake=True)
+    field = "index" if scene.shading == "palette" else "b"
+    flat = {"b": lambda o: o["b.phi"] | (o["b.theta"] << scene.angle_bits),
+            "index": lambda o: o["index"]}[field]
+    assert [flat(o) for o in out] == [reference_word(words, p["u"], p["v"], p.get("level", 0), scene)
+                                      for p in payloads]

@@ -105,7 +105,7 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     img = meta["memory_images"]["map"]
     assert img["file"] == "bumprtl_pipeline_map.hex" and img["load"] == "initial" and img["width"] == 20
     assert "phi in bits [9:0], theta in bits [19:10]" in img["layout"]      # 10-bit angles
-    assert img["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
+    assert "port" not in img and "map_w_en" not in meta["ports"]   # built in: no write port
     assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
     assert meta["block_ram"]["device"] == "LFE5U-85F"
     assert lint(out / "bumprtl_pipeline.v") == []
@@ -115,6 +115,9 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     assert not any(_initial_contents(pv).values())          # no map in the Verilog
     assert pv.splitlines()[0].endswith(f"--scene {toml} --load port")
     assert (port / "bumprtl_pipeline_map.hex").read_text() == (out / "bumprtl_pipeline_map.hex").read_text()
+    pmeta = json.loads((port / "bumprtl_pipeline.json").read_text())
+    assert pmeta["memory_images"]["map"]["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
+    assert {"map_w_en", "map_w_addr", "map_w_data"} <= set(pmeta["ports"])
     again = tmp_path / "c"
     assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(again)]) == 0
     for name in ("bumprtl_pipeline.v", "bumprtl_pipeline_map.hex"):
@@ -127,7 +130,7 @@ def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsy
     assert main(["emit", "fetch", "--normal-map", str(tmp_path / "n.png"), "--out",
                  str(tmp_path / "f")]) == 0
     meta = json.loads((tmp_path / "f" / "bumprtl_fetch.json").read_text())
-    assert meta["memory_images"]["map"]["port"] == ["w_en", "w_addr", "w_data"]
+    assert "port" not in meta["memory_images"]["map"] and "w_en" not in meta["ports"]
     assert len((tmp_path / "f" / "bumprtl_fetch_map.hex").read_text().split()) == 32 * 32
     _one_line_exit_2(capsys, ["emit", "fetch", "--scene", "flat", "--out", str(tmp_path / "g")],
                      "flat", "nothing to fetch")

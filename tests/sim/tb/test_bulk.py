@@ -68,7 +68,7 @@ def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
     frame (tests/mutants/netlist.py)."""
     size = FRAME[sim]
     scene, render, words, _, _, texels = _frame(size)
-    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    v, j = emit_pipeline(scene, words, texels, build_dir, None, write_port=True)
     meta = json.loads(j.read_text())
     frame = coverage_frame(scene, words, texels, n=size * size)
     n = len(frame.inputs["tag"])

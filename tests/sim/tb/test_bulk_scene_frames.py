@@ -27,7 +27,7 @@ def _scene_frame(scene, build_dir):
     outputs of the frame: (verilog, sidecar, frame, golden)."""
     _, words, _, _, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
-    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    v, j = emit_pipeline(scene, words, texels, build_dir, None, write_port=True)
     meta = json.loads(j.read_text())
     frame = coverage_frame(scene, words, texels)
     return v, j, meta, frame, frame.expected(meta)

@@ -46,7 +46,7 @@ def test_pipeline_stream_cocotb(sim, name, render, build_dir):
     scene = load_scene_config(name)
     inputs, words, polygon, table, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
-    v, j = emit_pipeline(scene, words, texels, build_dir, None)
+    v, j = emit_pipeline(scene, words, texels, build_dir, None, write_port=True)
     meta = json.loads(j.read_text())
     frame = coverage_frame(scene, words, texels)
     assert sorted(frame.inputs) == sorted(inputs)
