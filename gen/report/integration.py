@@ -1,10 +1,11 @@
 """``bumprtl report integration``: the generated parts of docs/integration.md, the page an HDL
 user reads, from the sidecar of the pipeline ``bumprtl emit`` writes.
 
-The scene's pipeline is emitted as ``bumprtl emit pipeline --load port --ports named`` does
-(into ``--out``), and from its sidecar (``built`` units, ``roms``, ``ports`` with their
-payload fields, ``named_ports``, ``memory_images``, ``latency``) this writes, between the
-``<!-- generated: NAME -->`` and ``<!-- end: NAME -->`` markers of the page:
+The scene's pipeline is emitted by ``bumprtl emit pipeline --load port --name my_bump --ports
+named`` itself (in process, into ``--out``), and from its sidecar (``built`` units, ``roms``,
+``ports`` with their payload fields, ``named_ports``, ``memory_images``, ``latency``,
+``command``) and the golden model this writes, between the ``<!-- generated: NAME -->`` and
+``<!-- end: NAME -->`` markers of the page:
 
 ``made-at``   the configuration and the command (``Made at: angle_bits=..., frac_bits=...``);
 ``diagram``   a Mermaid block diagram: the built units in order with their latencies and
@@ -12,6 +13,9 @@ payload fields, ``named_ports``, ``memory_images``, ``latency``) this writes, be
 ``ports``     the port table: every port of the named wrapper with its bits in the packed
               payload, its format and meaning;
 ``timing``    latency, throughput and the memory images;
+``example``   one pixel worked through: physical angles -> codes -> the outputs, as Python
+              that runs the golden model and asserts the numbers (the doc test runs it), and
+              the packed payload words;
 ``verilog``   an instantiation template of the named wrapper;
 ``load``      a testbench fragment that ``$readmemh``-reads each memory image and writes it
               through the host port.
@@ -19,21 +23,29 @@ payload fields, ``named_ports``, ``memory_images``, ``latency``) this writes, be
 The prose between the blocks is hand-written; a run rewrites only the blocks.
 """
 
+import contextlib
+import io
 import json
 import re
 from pathlib import Path
 
-from bumprtl.gen.flow.memories import DEFAULT_DEVICE, emit_scene_unit, memory_images, scene_command
-from bumprtl.gen.flow.named import named_module, named_ports, write_named
-from bumprtl.gen.flow.units import default_module
+import numpy as np
+
+from bumprtl.gen.flow.memories import DEFAULT_DEVICE
+from bumprtl.gen.flow.named import named_ports
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian
+from bumprtl.sim.golden.fixed.common import angle_codes
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 
-__all__ = ["emit_for_integration", "blocks", "write_doc", "made_at", "add_parser"]
+__all__ = ["emit_for_integration", "blocks", "write_doc", "made_at", "add_parser", "NAME",
+           "example_pixel", "pack_payload"]
 
 DOC = Path("docs/integration.md")
 COMMAND = "bumprtl report integration"
+NAME = "my_bump"              # the --name the page's examples use
 
 # field path (regular expression) -> meaning; the first match wins.
 _MEANINGS = (
@@ -47,13 +59,15 @@ _MEANINGS = (
                                               "angles (specular only)"),
     (r"b\.(phi|theta)", "tangent-space bump normal N' as binary angles"),
     (r"tag", "side-band tag: passed through unchanged, in order (e.g. the pixel address)"),
-    (r"diffuse", "diffuse intensity, 0..255 (ka + kd * max(N'.L', 0))"),
-    (r"specular", "specular intensity, 0..255 (ks * (N'.H')^n)"),
-    (r"color(\.\w)?", "Phong sum diffuse + specular, 0..255 (with a texture: the blended "
-                      "channel)"),
+    (r"diffuse", "round(255 clamp(N'.L', 0, 1)), 0..255"),
+    (r"specular", "round(255 (N'.H')^n), 0..255 (n = spec_exponent)"),
+    (r"color(\.\w)?", "Phong sum (eq. 2) min(255, round(255 ka + kd 255 clamp(N'.L', 0, 1) + "
+                      "ks 255 (N'.H')^n)) of the unrounded terms, 0..255 (with a texture: the "
+                      "blended channel)"),
     (r"diffuse_fine", "unrounded clamp(N'.L', 0, 1), frac_bits fractional bits (for the "
                       "light sum and texture blend)"),
-    (r"specular_fine", "unrounded 255 (N'.H')^n with fractional bits"),
+    (r"specular_fine", "unrounded 255 (N'.H')^n with 9 fractional bits (rtl/tables.py "
+                       "SPEC_FRAC_BITS)"),
     (r"index", "palette index"),
     (r"oor", "palette index out of range (the colour reads as 0)"),
 )
@@ -91,29 +105,24 @@ def _meaning(port, p):
     return "see rtl/layouts.py"
 
 
-def emit_for_integration(scene, out_dir, device=DEFAULT_DEVICE):
-    """Emit ``scene``'s pipeline as ``bumprtl emit pipeline --load port --ports named`` does
-    (top module ``bumprtl_pipeline``); returns its sidecar with ``named_ports``."""
-    scene = load_scene_config(scene)
-    module = default_module("pipeline")
-    words, texels, table = scene_memories(scene)
-    images = memory_images("pipeline", scene, words, texels, table, "port")
-    v, j, _ = emit_scene_unit("pipeline", scene, out_dir, images, device,
-                              scene_command("pipeline", scene, "port", module), module=module)
-    meta = json.loads(j.read_text())
-    command = meta["command"] + " --ports named"
-    write_named(v, meta, command)
-    meta["named_ports"] = {"module": named_module(module), "command": command,
-                           "ports": named_ports(meta)}
-    j.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
-    return meta
+def emit_for_integration(scene, out_dir, name=NAME, flags=()):
+    """Emit ``scene``'s pipeline with ``bumprtl emit pipeline --scene SCENE [FLAGS] --load port
+    --name NAME --ports named --out OUT_DIR`` (the command itself, in process; ``scene`` a
+    name or a TOML path, ``flags`` further ``bumprtl emit`` flags); returns its sidecar."""
+    from bumprtl.gen.cli.main import main
+    argv = ["emit", "pipeline", "--scene", str(scene), *flags, "--load", "port", "--name", name,
+            "--ports", "named", "--out", str(out_dir)]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        if main(argv) != 0:
+            raise BumpError(f"bumprtl {' '.join(argv)} failed")
+    return json.loads((Path(out_dir) / f"{name}.json").read_text())
 
 
 def made_at(meta):
     """The page's record (rtl.config.Config.made_at) of the sidecar's Config."""
     cfg = Config(**meta["config"])
     return cfg.made_at(f"scene `{meta['scene']['name']}`, method {cfg.method}; `{COMMAND}`, "
-                       f"from `{meta['named_ports']['command']}`")
+                       f"from `{meta['command']}`")
 
 
 def _unit_memories(meta, unit):
@@ -155,8 +164,13 @@ def diagram(meta):
     return "\n".join(lines)
 
 
+def _ordered_ports(meta):
+    """The named wrapper's ports in its port order (the sidecar's JSON keeps them sorted)."""
+    return {n: meta["named_ports"]["ports"][n] for n in named_ports(meta)}
+
+
 def port_table(meta):
-    ports = meta["named_ports"]["ports"]
+    ports = _ordered_ports(meta)
     rows = ["| Port | Dir | Width | Packed bits | Format | Meaning |", "|---|---|---|---|---|---|"]
     for name, p in ports.items():
         bits = (f"`{p['from']}[{p['bits'][1]}:{p['bits'][0]}]`" if p["bits"] is not None
@@ -182,8 +196,86 @@ def timing(meta):
     return "\n".join(out)
 
 
+# The worked example: one pixel of the scene, physical angles in degrees (phi, theta).
+EXAMPLE = {"u": 5, "v": 3, "n": (-30, 20), "l": (60, 45), "view": (0, 0)}
+
+
+def example_pixel(scene):
+    """``(codes, outputs)`` of :data:`EXAMPLE` through ``scene``'s golden pipeline: the input
+    payload fields as the encoder rounds them (H = normalize(L + V)), the tag the texel's
+    word address, and the output fields (:func:`~bumprtl.sim.golden.fixed.pipeline.pipeline_fixed`
+    with the scene's own map)."""
+    scene = load_scene_config(scene)
+    cfg, e, deg = scene.config, EXAMPLE, np.pi / 180
+    angles = {"n": [a * deg for a in e["n"]], "l": [a * deg for a in e["l"]]}
+    view = polar_to_cartesian(*[a * deg for a in e["view"]])
+    angles["h"] = cartesian_to_polar(polar_to_cartesian(*angles["l"]) + view)
+    codes = {"u": e["u"], "v": e["v"], "tag": e["v"] * scene.texture_size + e["u"]}
+    for vec, (phi, theta) in angles.items():
+        codes[f"{vec}.phi"] = int(angle_codes(phi, cfg))
+        codes[f"{vec}.theta"] = int(angle_codes(theta, cfg))
+    words = scene_memories(scene)[0]
+    out = pipeline_fixed({k: np.array([c]) for k, c in codes.items()}, scene, words)
+    return codes, {k: int(v[0]) for k, v in out.items()} | {"tag": codes["tag"]}
+
+
+def pack_payload(fields, values):
+    """A packed payload word from ``{field: value}`` and the sidecar's ``{field: [offset,
+    width, signed]}`` (two's complement within its width)."""
+    word = 0
+    for name, (off, width, _) in fields.items():
+        word |= (int(values[name]) & ((1 << width) - 1)) << off
+    return word
+
+
+def example(meta):
+    """The worked example as Python that recomputes it with the golden model and asserts
+    every number, then the packed payload words of the same pixel."""
+    e, module = EXAMPLE, meta.get("module", meta["unit"])
+    scene = load_scene_config(meta["scene"])
+    named = load_scene_config(scene.name).to_dict()
+    over = {k: v for k, v in scene.to_dict().items() if named.get(k) != v}
+    source = f'"{scene.name}"' + (f", {over!r}" if over else "")
+    codes, out = example_pixel(scene)
+    fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
+    missing = (set(fin) - set(codes)) | (set(fout) - set(out))
+    if missing:
+        raise BumpError(f"the worked example has no value for {', '.join(sorted(missing))}")
+    wi, wo = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
+    code = f'''```python
+import numpy as np
+
+from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian
+from bumprtl.sim.golden.fixed.common import angle_codes
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+from bumprtl.sim.scenes.config import load_scene_config
+
+scene = load_scene_config({source})        # the scene {module} was emitted from
+cfg = scene.config
+deg = np.pi / 180
+n = ({e["n"][0]} * deg, {e["n"][1]} * deg)   # world normal N: (phi, theta)
+l = ({e["l"][0]} * deg, {e["l"][1]} * deg)   # light L
+view = polar_to_cartesian({e["view"][0]} * deg, {e["view"][1]} * deg)   # viewer V
+h = cartesian_to_polar(polar_to_cartesian(*l) + view)   # H = normalize(L + V)
+codes = {{"u": {e["u"]}, "v": {e["v"]}, "tag": {codes["tag"]}}}   # tag: the texel's word address
+for vec, (phi, theta) in {{"n": n, "l": l, "h": h}}.items():
+    codes[f"{{vec}}.phi"] = int(angle_codes(phi, cfg))       # round, wrap mod 2^angle_bits
+    codes[f"{{vec}}.theta"] = int(angle_codes(theta, cfg))
+assert codes == {codes!r}
+
+words = scene_memories(scene)[0]                  # the words of {module}_map.hex
+out = pipeline_fixed({{k: np.array([c]) for k, c in codes.items()}}, scene, words)
+out = {{k: int(x[0]) for k, x in out.items()}} | {{"tag": codes["tag"]}}
+assert out == {out!r}
+```'''
+    return (f"{code}\n\nPacked: `i__payload` = {wi}'h{pack_payload(fin, codes):x}, "
+            f"`o__payload` = {wo}'h{pack_payload(fout, out):x} (the fields at the bit positions "
+            f"of the port table).")
+
+
 def verilog_template(meta):
-    ports = meta["named_ports"]["ports"]
+    ports = _ordered_ports(meta)
     wrapper = meta["named_ports"]["module"]
     conns = ",\n".join(f"    .{n:<14}({'' if n in ('clk', 'rst') else 'my_'}{n})" for n in ports)
     return f"```verilog\n{wrapper} u_bump (\n{conns}\n);\n```"
@@ -191,7 +283,7 @@ def verilog_template(meta):
 
 def load_template(meta):
     """A Verilog testbench fragment that loads each ``load = port`` image through its port."""
-    ports = meta["named_ports"]["ports"]
+    ports = _ordered_ports(meta)
     out = ["```verilog"]
     for name, img in meta.get("memory_images", {}).items():
         if img["load"] != "port" or name == "lut":
@@ -213,7 +305,7 @@ def load_template(meta):
 
 def blocks(meta):
     return {"made-at": made_at(meta), "diagram": diagram(meta), "ports": port_table(meta),
-            "timing": timing(meta), "verilog": verilog_template(meta),
+            "timing": timing(meta), "example": example(meta), "verilog": verilog_template(meta),
             "load": load_template(meta)}
 
 
@@ -233,7 +325,7 @@ def write_doc(doc, generated):
 
 
 def run(args):
-    meta = emit_for_integration(args.scene, args.out)
+    meta = emit_for_integration(args.scene, args.out, args.name)
     path = write_doc(args.doc, blocks(meta))
     print(f"wrote {path} ({made_at(meta)})")
     return 0
@@ -241,7 +333,8 @@ def run(args):
 
 def add_parser(sub):
     p = sub.add_parser("integration", help="the generated parts of docs/integration.md",
-                       description="Emit the scene's pipeline with named ports (--load port) and "
+                       description="Emit the scene's pipeline with named ports (--load port --name "
+                                   f"{NAME} --ports named) and "
                                    "write docs/integration.md's generated blocks from its "
                                    "sidecar: block diagram, port table, latency, memory images, "
                                    "instantiation template.")
@@ -250,4 +343,6 @@ def add_parser(sub):
     p.add_argument("--out", type=Path, default=Path("build/integration"),
                    help="where the pipeline is emitted (default: build/integration)")
     p.add_argument("--doc", type=Path, default=DOC, help=f"the page (default: {DOC})")
+    p.add_argument("--name", default=NAME, metavar="PREFIX",
+                   help=f"the --name the page's pipeline is emitted under (default: {NAME})")
     p.set_defaults(func=run)

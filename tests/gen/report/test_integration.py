@@ -17,8 +17,9 @@ DOC = ROOT / "docs" / "integration.md"
 
 @pytest.fixture(scope="module")
 def small(tmp_path_factory):
-    scene = load_scene_config("default", {"texture_size": 16, "angle_bits": 10, "frac_bits": 11})
-    return emit_for_integration(scene, tmp_path_factory.mktemp("integration"))
+    return emit_for_integration("default", tmp_path_factory.mktemp("integration"),
+                                flags=["--texture-size", "16", "--angle-bits", "10",
+                                       "--frac-bits", "11"])
 
 
 def test_blocks_cover_every_port_field_and_unit(small):
@@ -38,17 +39,18 @@ def test_blocks_cover_every_port_field_and_unit(small):
         assert f'{b["unit"]}: {b["class"]}<br/>latency {b["latency"]}' in out["diagram"]
     assert f"**{small['latency']} cycles**" in out["timing"]
     assert all(f".{p}" in out["verilog"] for p in named)
-    assert "$readmemh(\"bumprtl_pipeline_map.hex\"" in out["load"]
+    assert "$readmemh(\"my_bump_map.hex\"" in out["load"]
+    assert "--texture-size 16" in out["made-at"] and "--name my_bump" in out["made-at"]
 
 
 def test_write_doc_rewrites_only_the_blocks(small, tmp_path):
     doc = tmp_path / "page.md"
-    text = "intro\n" + "".join(f"<!-- generated: {n} -->\nold\n<!-- end: {n} -->\nprose {n}\n"
+    text = "intro\n" + "".join(f"<!-- generated: {n} -->\nOLD-BODY\n<!-- end: {n} -->\nprose {n}\n"
                                for n in blocks(small))
     doc.write_text(text)
     write_doc(doc, blocks(small))
     once = doc.read_text()
-    assert "old" not in once and all(f"prose {n}" in once for n in blocks(small))
+    assert "OLD-BODY" not in once and all(f"prose {n}" in once for n in blocks(small))
     write_doc(doc, blocks(small))
     assert doc.read_text() == once                        # idempotent
     doc.write_text("no blocks here\n")
@@ -58,7 +60,7 @@ def test_write_doc_rewrites_only_the_blocks(small, tmp_path):
 
 def test_the_page_has_every_block_filled():
     text = DOC.read_text()
-    for name in ("made-at", "diagram", "ports", "timing", "load", "verilog"):
+    for name in ("made-at", "diagram", "ports", "timing", "example", "load", "verilog"):
         body = re.search(rf"<!-- generated: {name} -->\n(.*?)<!-- end: {name} -->", text, re.S)
         assert body and body.group(1).strip(), name
     assert "bumprtl report integration" in text
