@@ -20,7 +20,9 @@ of the run: the report writes the failed rows with the reason. A worker that die
 worker (up to ``distributed.scheduler.allowed-failures`` times).
 
 This module lives in ``sim/`` because ``sim/formal/run.py`` uses it and ``sim/`` does not
-import ``gen/`` (docs/scale.md).
+import ``gen/`` (docs/scale.md). Dask ``distributed`` and ``psutil`` (the extras that run jobs:
+[fpga], [formal], [bench]) are imported by the functions that use them, never at import
+time: every command's parser, ``--help`` included, imports this module in a core install.
 """
 
 import logging
@@ -34,10 +36,6 @@ import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import psutil
-from distributed import Client, LocalCluster, as_completed, get_worker
-from distributed.client import FutureCancelledError
-from distributed.scheduler import KilledWorker
 from tqdm import tqdm
 
 from bumprtl.rtl.config import BumpError
@@ -113,6 +111,8 @@ class _Timeout(Exception):
 
 
 def _worker_address():
+    from distributed import get_worker  # optional dependency
+
     try:
         return get_worker().address
     except ValueError:
@@ -138,6 +138,8 @@ def _call(fn, args, timeout):
     t.start()
     t.join(timeout)
     if t.is_alive():
+        import psutil  # optional dependency
+
         for child in psutil.Process().children(recursive=True):
             try:
                 child.kill()
@@ -193,6 +195,8 @@ class Runner:
 
     def __enter__(self):
         if self.address:
+            from distributed import Client  # optional dependency
+
             try:
                 self.client = Client(self.address, timeout=CONNECT_TIMEOUT)
             except (OSError, TimeoutError) as e:
@@ -205,6 +209,8 @@ class Runner:
         """The LocalCluster, started at the first job (a run whose results are all cached
         starts none)."""
         if self.client is None:
+            from distributed import Client, LocalCluster  # optional dependency
+
             self.cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
                                         processes=LOCAL_PROCESSES, dashboard_address=None,
                                         silence_logs=logging.ERROR,
@@ -234,6 +240,10 @@ class Runner:
         """Run ``jobs`` (an iterable of :class:`Job`; each is submitted as soon as it is
         produced, so the client's own preparation overlaps the workers'), with a progress
         bar; returns ``{name: Outcome}``. ``on_done(outcome)`` is called as each ends."""
+        from distributed import as_completed  # optional dependency
+        from distributed.client import FutureCancelledError  # optional dependency
+        from distributed.scheduler import KilledWorker  # optional dependency
+
         futures, outcomes, names = {}, {}, set()
         for job in jobs:
             if job.name in names:

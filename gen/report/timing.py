@@ -16,7 +16,6 @@ import json
 from pathlib import Path
 
 from amaranth.sim import Simulator
-from yowasp_wavedrom import render
 
 from bumprtl.gen.report import write_section
 from bumprtl.rtl.config import Config
@@ -141,6 +140,8 @@ def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default"))):
 def write_timing(out_dir=Path("docs/timing")):
     """Write ``<name>.json`` (WaveDrom source) and ``<name>.svg`` per diagram; returns
     ``{name: facts}``."""
+    from yowasp_wavedrom import render  # optional dependency: [docs]
+
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     facts = {}

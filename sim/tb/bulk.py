@@ -25,14 +25,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from cocotb_tools.runner import get_results
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.tb.bulk_build import (
     CLOCKS,
     DEFAULTS,
     IOS,
-    RUNNERS,
     SIMULATORS,
     TIMESCALE,
     build,
@@ -40,6 +38,7 @@ from bumprtl.sim.tb.bulk_build import (
     build_options,
     cache_root,
     locked,
+    runners,
     tool_environ,
 )
 from bumprtl.sim.tb.bulk_codec import check_stimulus, decode_words, encode_words
@@ -110,7 +109,7 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
     t0 = time.perf_counter()
     try:
         with tool_environ():
-            results = RUNNERS[sim]().test(
+            results = runners()[sim]().test(
                 hdl_toplevel=top, hdl_toplevel_lang="verilog", test_module=module,
                 build_dir=bdir, test_dir=work, results_xml=str(work / "results.xml"),
                 extra_env={"BUMPRTL_BULK_JOB": str(work / "bulk_job.json")}, timescale=TIMESCALE)
@@ -121,6 +120,8 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
     if summary.get("error"):
         exc = SimulationTimeout if summary.get("timeout") else AssertionError
         raise exc(f"bulk run on {sim}: {summary['error']}")
+    from cocotb_tools.runner import get_results  # optional dependency: [sim]
+
     tests, failures = get_results(results) if results is not None else (0, 1)
     if tests == 0 or failures or not summary.get("finished"):
         raise AssertionError(f"bulk cocotb run on {sim} failed (no summary); see {work}")

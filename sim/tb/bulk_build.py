@@ -40,6 +40,7 @@ second run of the same unit starts at once.
 """
 
 import fcntl
+import functools
 import hashlib
 import json
 import os
@@ -47,13 +48,11 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from cocotb_tools.runner import Icarus, Verilator
-
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.tb.bulk_wrapper import PERIOD, wrapper_verilog
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env, version
 
-__all__ = ["SIMULATORS", "CLOCKS", "IOS", "DEFAULTS", "TIMESCALE", "RUNNERS", "build_options",
+__all__ = ["SIMULATORS", "CLOCKS", "IOS", "DEFAULTS", "TIMESCALE", "runners", "build_options",
            "build_args", "build", "cache_root", "locked", "tool_environ"]
 
 SIMULATORS = ("icarus", "verilator")
@@ -85,25 +84,30 @@ DEFAULTS = {"icarus": {"clock": "verilog", "io": "file", "opt_fast": None, "extr
             "verilator": {"clock": "cxx", "io": "dpi", "opt_fast": "-Os", "extra": ()}}
 
 
-class _BulkVerilator(Verilator):
-    """cocotb's Verilator runner without ``--public-flat-rw``: only the wrapper's control
-    ports are public (metacomments), so Verilator optimises the unit as a whole. With
-    ``main`` set, that C++ file replaces cocotb's main (verilator.cpp)."""
+@functools.cache
+def runners():
+    """``{simulator: cocotb runner class}``. cocotb is the [sim] extra: imported at the first
+    build or run, not with this module (the command parsers import it in a core install)."""
+    from cocotb_tools.runner import Icarus, Verilator  # optional dependency: [sim]
 
-    main = None
+    class _BulkVerilator(Verilator):
+        """cocotb's Verilator runner without ``--public-flat-rw``: only the wrapper's control
+        ports are public (metacomments), so Verilator optimises the unit as a whole. With
+        ``main`` set, that C++ file replaces cocotb's main (verilator.cpp)."""
 
-    def _build_command(self):
-        cmds = super()._build_command()
-        cmds[0] = [a for a in cmds[0] if a != "--public-flat-rw"]
-        if self.main is not None:
-            cocotb_main = [a for a in cmds[0] if Path(a).name == "verilator.cpp"]
-            if len(cocotb_main) != 1:
-                raise AssertionError(f"cocotb's Verilator main not found in {cmds[0]}")
-            cmds[0] = [str(self.main) if a == cocotb_main[0] else a for a in cmds[0]]
-        return cmds
+        main = None
 
+        def _build_command(self):
+            cmds = super()._build_command()
+            cmds[0] = [a for a in cmds[0] if a != "--public-flat-rw"]
+            if self.main is not None:
+                cocotb_main = [a for a in cmds[0] if Path(a).name == "verilator.cpp"]
+                if len(cocotb_main) != 1:
+                    raise AssertionError(f"cocotb's Verilator main not found in {cmds[0]}")
+                cmds[0] = [str(self.main) if a == cocotb_main[0] else a for a in cmds[0]]
+            return cmds
 
-RUNNERS = {"icarus": Icarus, "verilator": _BulkVerilator}
+    return {"icarus": Icarus, "verilator": _BulkVerilator}
 
 
 def _digest(*parts):
@@ -216,7 +220,7 @@ def build(sim, v_path, meta, chunk, clock=None, cache=None, io=None, opt_fast=No
         (bdir / f"{meta['unit']}.v").write_bytes(v_bytes)
         (bdir / f"{top}.v").write_text(text)
         t0 = time.perf_counter()
-        runner = RUNNERS[sim]()
+        runner = runners()[sim]()
         if opts["clock"] == "cxx":
             runner.main = MAIN_CPP
         with tool_environ(make_vars):

@@ -10,8 +10,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from cocotb_tools.runner import get_results, get_runner
-
 from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["SIMULATORS", "CocotbRun", "run_cocotb"]
@@ -66,6 +64,8 @@ def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None, 
     if sim not in SIMULATORS:
         raise ValueError(f"simulator must be one of {', '.join(SIMULATORS)}, got {sim!r}")
     require(_BINARY[sim])
+    from cocotb_tools.runner import get_results, get_runner  # optional dependency: [sim]
+
     v_path = Path(v_path).resolve()
     build_dir = Path(build_dir).resolve()
     waves = bool(int(os.environ.get("WAVES", "0"))) if waves is None else waves

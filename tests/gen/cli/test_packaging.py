@@ -1,41 +1,17 @@
-"""Dependencies by use: the core (``pip install bumprtl``) emits and renders the golden
-model with every optional package absent; a command whose extra is missing says which one
-in one line and exits 2; every pin is exact and [dev] holds every extra's pins;
-``bumprtl --version`` is the package's version."""
+"""Dependencies by use: a command whose extra is missing says which one in one line and
+exits 2; every pin is exact and [dev] holds every extra's pins; ``bumprtl --version`` is the
+package's version. The core install itself (every optional distribution absent, computed
+from pyproject.toml, not a hand-kept list) is tests/gen/cli/test_core_install.py."""
 
 import re
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
 from bumprtl.gen import __version__
-from bumprtl.gen.cli.main import OPTIONAL, build_parser, main
+from bumprtl.gen.cli.main import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[3]
 PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-
-# Runs the command line with the optional packages made unimportable (as in a core install).
-_BLOCKED = """
-import sys
-BLOCK = set(sys.argv[1].split(","))
-class Blocker:
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in BLOCK:
-            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
-sys.meta_path.insert(0, Blocker())
-from bumprtl.gen.cli.main import main
-sys.exit(main(sys.argv[2:]))
-"""
-
-
-_ALL_OPTIONAL = ",".join(sorted(OPTIONAL))
-
-
-def _core(*argv, block=_ALL_OPTIONAL):
-    return subprocess.run([sys.executable, "-c", _BLOCKED, block, *argv], capture_output=True,
-                          text=True, cwd=ROOT)
-
 
 def _name(pin):
     return re.split(r"[\[=;<> ]", pin, maxsplit=1)[0].lower()
@@ -66,28 +42,6 @@ def test_version(capsys):
     assert capsys.readouterr().out.strip() == f"bumprtl {__version__}"
     changelog = (ROOT / "CHANGELOG.md").read_text()
     assert f"## [{__version__}]" in changelog
-
-
-def test_core_emits_and_renders_without_any_extra(tmp_path):
-    r = _core("emit", "sincos", "--angle-bits", "8", "--frac-bits", "8", "--out", str(tmp_path))
-    assert r.returncode == 0, r.stderr
-    assert (tmp_path / "bumprtl_sincos.v").exists()
-    r = _core("render", "--scene", "bricks", "--size", "16", "--out", str(tmp_path / "b.png"))
-    assert r.returncode == 0, r.stderr
-    assert (tmp_path / "b.png").stat().st_size > 0
-
-
-def test_a_missing_extra_is_one_line_exit_2(tmp_path):
-    for argv, extra in ((["bench", "golden", "--samples", "10"], "bench"),
-                        (["render", "--rtl", "--size", "16", "--out", str(tmp_path / "r.png")], "sim"),
-                        (["report", "fpga"], "fpga")):
-        r = _core(*argv)
-        err = r.stderr.strip().splitlines()
-        assert r.returncode == 2 and len(err) == 1, (argv, r.stderr)
-        assert f"needs the [{extra}] extra" in err[0] and f"pip install 'bumprtl[{extra}]'" in err[0]
-    # the same commands with nothing blocked do not say so (the check can fail)
-    r = _core("bench", "golden", "--help", block="none")
-    assert r.returncode == 0 and "extra" not in r.stderr
 
 
 def test_a_command_whose_extra_is_missing_keeps_its_arguments(monkeypatch, capsys, import_fails):
