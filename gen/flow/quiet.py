@@ -44,7 +44,9 @@ def tool_log(path, label, verbose=False, python=False):
     exception the log is copied to stderr in full, then the exception propagates.
     ``verbose``: no redirection, the tools print as they run. ``python``: this process's
     ``print`` and progress bars (``sys.stdout``/``sys.stderr``) still reach the terminal
-    (a bench's table); only the child processes' output goes to the log, and no ticker."""
+    (a bench's table); only the child processes' output goes to the log, no ticker, and the
+    log's path is named after the block, on success (a command's refusal inside the block,
+    bad input, stays its one line on stderr)."""
     if verbose:
         yield None
         return
@@ -54,7 +56,8 @@ def tool_log(path, label, verbose=False, python=False):
     sys.stderr.flush()
     saved = os.dup(1), os.dup(2)
     term = os.fdopen(os.dup(saved[1]), "w", buffering=1)
-    term.write(f"{label} (tool output: {path})\n")
+    if not python:
+        term.write(f"{label} (tool output: {path})\n")
     stop = threading.Event()
     ticker = threading.Thread(target=_ticker, args=(term, label, stop), daemon=True)
     failed = False
@@ -87,6 +90,8 @@ def tool_log(path, label, verbose=False, python=False):
                 sys.stdout.close()
             if python:
                 sys.stdout, sys.stderr = streams
+                if not failed:
+                    term.write(f"{label}: tool output in {path}\n")
             else:
                 stop.set()
                 ticker.join()
