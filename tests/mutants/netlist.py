@@ -61,6 +61,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import netlist_board as nb  # noqa: E402  (the board's units and their bench)
 import netlist_cone as nc  # noqa: E402  (steps 4 and 5, beside this file)
 import netlist_pdr as npdr  # noqa: E402  (step 8)
 import netlist_rel as nrel  # noqa: E402  (steps 6 and 7)
@@ -130,7 +131,7 @@ def _scenes():
 
 def targets():
     BUILTIN = _scenes().BUILTIN
-    return [*UNITS, *(f"pipeline:{name}" for name in BUILTIN)]
+    return [*UNITS, *(f"pipeline:{name}" for name in BUILTIN), *nb.TARGETS]
 
 
 def yosys(script, cwd, timeout=None):
@@ -209,7 +210,7 @@ def mutation_list(v, unit, n, seed, work):
 MUTATED_STAMP = "mutated.json"   # the script and shim the kept mutated.v was built from
 
 
-def mutated_netlist(v, meta, lines, work, reuse=False):
+def mutated_netlist(v, meta, lines, work, reuse=False, passes=()):
     """``mutated.v``: the flattened unit renamed ``<unit>__mutated`` with a ``mutsel`` input
     selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``. With ``reuse``
     a ``mutated.v`` in ``work`` is kept when MUTATED_STAMP says it was built by this same
@@ -219,13 +220,15 @@ def mutated_netlist(v, meta, lines, work, reuse=False):
     prepared netlist (a memory write's address and data are ``en ? addr : 'x``), which
     Icarus simulates as X (a write to an X address is dropped) and Verilator as 0 (the word
     at address 0 is written); with every x a 0 both simulate the same defined netlist. The
-    mutation list (``mutate -list`` on the prepared netlist) is unchanged."""
+    mutation list (``mutate -list`` on the prepared netlist) is unchanged. ``passes``: Yosys
+    commands run after those (the board's units: ``pmuxtree``, since Icarus reads the
+    function write_verilog makes of a $pmux named ``\\$procmux$N`` as a system function)."""
     unit = meta["unit"]
     width = max(1, len(lines).bit_length())
     script = ["read_rtlil prepped.il"]
     script += [f"mutate -ctrl mutsel {width} {i} " + l[len("mutate "):]
                for i, l in enumerate(lines, 1)]
-    script += ["setundef -zero", "opt_clean", f"rename {unit} {unit}__mutated",
+    script += ["setundef -zero", *passes, "opt_clean", f"rename {unit} {unit}__mutated",
                "write_verilog -noattr -norename mutated_core.v"]
     ports = meta["ports"]
     decl = []
@@ -283,6 +286,8 @@ def run_one(v, j, job, work, idx, sim="verilator"):
         return "killed: timeout " + str(e).splitlines()[0][:120]
     except AssertionError as e:
         return "killed: " + (str(e).splitlines() or ["mismatch"])[0][:160]
+    except Exception as e:      # noqa: BLE001  (a build or run failure decides nothing)
+        return "undecided: " + tool_error("simulation", e)
     return "passed"
 
 
@@ -298,19 +303,25 @@ EQUIV_SEQ = 4   # time steps of equiv_simple / equiv_induct and of the base-case
 STREAM_DONT_CARE = "payload don't-care while valid is low"
 
 
+def tool_error(step, e):
+    """What step ``step`` says when its tool or our code around it fails with ``e``: one
+    line naming the step and the error (a Yosys run's first ERROR line, else the exception's
+    type and first line), never a traceback. The survivor is then undecided, counted."""
+    if isinstance(e, subprocess.CalledProcessError):
+        err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
+        said = err[0] if err else (f"exit status {e.returncode}" if e.returncode >= 0
+                                   else f"killed by signal {-e.returncode}")
+        return f"{step}: tool error: {' '.join(said.split())[:120]}"
+    first = (str(e).strip().splitlines() or [""])[0]
+    return f"{step}: tool error: {type(e).__name__}" + (f": {first[:120]}" if first else "")
+
+
 def _proved(how, stream):
     """The verdict of a proof ``how``: equivalent, or under the stream contract when its
     payloads were masked by valid (``stream``)."""
     if stream:
         return f"equivalent under the stream contract ({how}, {STREAM_DONT_CARE})"
     return f"equivalent ({how})"
-
-
-def _yosys_error(step, e):
-    """What a failed Yosys run (CalledProcessError ``e``) of step ``step`` said: its first
-    ERROR line."""
-    err = [l for l in ((e.stdout or "") + (e.stderr or "")).splitlines() if "ERROR" in l]
-    return f"{step}: " + (err[:1] or ["yosys error"])[0][:100]
 
 
 def _wrappers(ports, unit):
@@ -418,14 +429,16 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
     ``(verdict, why)``, the verdict None when neither proves the mutant equivalent."""
     try:
         net = nc.Netlist(nc.load(work, meta["unit"], line))
-    except (subprocess.CalledProcessError, KeyError) as e:
-        return None, f"cone: the -ctrl netlist was not built ({type(e).__name__})"
+    except Exception as e:      # noqa: BLE001  (any failure is the step's undecided)
+        return None, tool_error("cone: the -ctrl netlist was not built", e)
     why = []
     if "cone" in steps:
         try:
             reached = nc.cone(net)
         except nc.Undecided as e:
             reached = [str(e)]
+        except Exception as e:  # noqa: BLE001
+            reached = [tool_error("cone", e)]
         if reached is None:
             return ("equivalent (cone: no output port bit in the mutated bit's fan-out cone, "
                     "followed through every register and memory)"), None
@@ -436,6 +449,8 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
                 verdict, R = nc.cut(net, work, nc.yosys_log, timeout, stream)
             except nc.Undecided as e:
                 verdict, R = "undecided", f"cut: {e}"
+            except Exception as e:  # noqa: BLE001
+                verdict, R = "undecided", tool_error("cut", e)
             if verdict == "equivalent":
                 held = ", ".join(nc.names(net, R["R"])) or "none"
                 kept = ", ".join(nc.names(net, R["K"]))
@@ -451,9 +466,9 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
         # steps 6 to 8 read the netlist with its memories' read registers kept apart
         try:
             net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
-        except (subprocess.CalledProcessError, KeyError) as e:
-            return None, "; ".join(why + [f"never/rel/pdr: the -ctrl netlist was not built "
-                                          f"({type(e).__name__})"])
+        except Exception as e:  # noqa: BLE001
+            return None, "; ".join(why + [tool_error("never/rel/pdr: the -ctrl netlist was "
+                                                     "not built", e)])
         proved, said = _rel_steps(net, line, work, timeout, has_stream, steps)
         if proved:
             return proved, None
@@ -483,8 +498,8 @@ def _rel_steps(net, line, work, timeout, has_stream, steps):
                 verdict, how = nrel.rel(net, work, nc.yosys_log, timeout, has_stream, log=print)
         except nc.Undecided as e:
             verdict, how = "undecided", f"{step}: {e}"
-        except subprocess.CalledProcessError as e:
-            verdict, how = "undecided", _yosys_error(step, e)
+        except Exception as e:  # noqa: BLE001  (a tool's or a parser's failure)
+            verdict, how = "undecided", tool_error(step, e)
         if verdict is None:
             continue                        # never: not a cnot mutation
         if verdict == "equivalent":
@@ -507,8 +522,8 @@ def _pdr_step(net, work, timeout, has_stream):
         verdict, how = npdr.pdr(net, work, nc.yosys_log, timeout, has_stream, log=print)
     except nc.Undecided as e:
         return None, f"pdr: {e}"
-    except subprocess.CalledProcessError as e:
-        return None, _yosys_error("pdr", e)
+    except Exception as e:  # noqa: BLE001
+        return None, tool_error("pdr", e)
     if verdict != "equivalent":
         return None, how
     return _proved(f"pdr: z3 Spacer (IC3/PDR) proves the product machine of design and "
@@ -546,7 +561,15 @@ def equivalence(v, meta, line, work, timeout, steps=STEPS):
     among STEPS (``--steps``; ``--recheck --steps cone,cut``, ``--steps never,rel`` or
     ``--steps pdr`` runs only
     those on a finished run's survivors, whose earlier steps were run then). The verdict names the step
-    that proved it."""
+    that proved it. Never raises: a step whose tool or parser fails leaves the survivor
+    ``"undecided: <step>: tool error: ..."`` (:func:`tool_error`), counted as a survivor."""
+    try:
+        return _equivalence(meta, line, work, timeout, steps)
+    except Exception as e:      # noqa: BLE001  (whatever failed, the verdict says so)
+        return "undecided: " + tool_error("equivalence", e)
+
+
+def _equivalence(meta, line, work, timeout, steps):
     unit = meta["unit"]
     wrappers, has_stream = _wrappers(meta["ports"], unit)
     (Path(work) / "equiv_wrappers.v").write_text(wrappers)
@@ -607,8 +630,51 @@ def _kept_netlist(target, work, n, seed, stim_n, log):
     return rtl / Path(v).name, rtl / Path(j).name, job, rtl
 
 
+def run_board_target(target, n, seed, out, jobs, eq_timeout, log=print, steps=STEPS):
+    """A board unit (tests/mutants/netlist_board.py): emitted, sampled and built into one
+    mutated netlist as every other target, simulated on Icarus by its own bench against its
+    oracle; survivors checked for equivalence as every other target's."""
+    t0 = time.perf_counter()
+    work = out / target.replace(":", "_")
+    if work.exists():
+        shutil.rmtree(work)
+    rtl = work / "rtl"
+    v, meta, bench = nb.bench(target, rtl, seed)
+    lines = mutation_list(v, meta["unit"], n, seed, rtl)
+    mv, _ = mutated_netlist(v, meta, lines, rtl, passes=("pmuxtree",))
+    bench.build(mv, rtl)
+    base = bench.run(work / "run0", 0)
+    if base != "passed":
+        raise NetlistError(f"{target}: the mutated netlist with mutsel = 0 fails its oracle "
+                           f"({base}); see {work}")
+    log(f"  {target}: {len(lines)} mutants, netlist built and unmutated run passed "
+        f"({time.perf_counter() - t0:.0f} s)")
+    with ThreadPoolExecutor(max(1, jobs)) as pool:
+        results = dict(pool.map(lambda i: (i, bench.run(work / f"run{i}", i)),
+                                range(1, len(lines) + 1)))
+    survivors = []
+    for i, r in sorted(results.items()):
+        if r == "passed":
+            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout, steps)
+        elif r.startswith("undecided"):
+            verdict = r
+        else:
+            continue
+        survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
+    for i in results:
+        shutil.rmtree(work / f"run{i}", ignore_errors=True)
+    killed = sum(r.startswith("killed") for r in results.values())
+    equivalent = sum(s["verdict"].startswith("equivalent") for s in survivors)
+    return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
+            "equivalent": equivalent, "counted": len(lines) - equivalent,
+            "survivors": survivors, "seconds": time.perf_counter() - t0,
+            "stimulus": bench.words}
+
+
 def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeline_sim="icarus",
                reuse=False, steps=STEPS):
+    if target in nb.TARGETS:
+        return run_board_target(target, n, seed, out, jobs, eq_timeout, log, steps)
     t0 = time.perf_counter()
     sim = simulator(target, pipeline_sim)
     work = out / target.replace(":", "_")
@@ -649,6 +715,9 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
         if r == "passed":
             verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout, steps)
             survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
+        elif r.startswith("undecided"):
+            # the simulation itself failed: neither killed nor checked, counted
+            survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": r})
     killed = sum(r.startswith("killed") for r in results.values())
     equivalent = sum(s["verdict"].startswith("equivalent") for s in survivors)
     for i in sorted(results):
@@ -718,7 +787,7 @@ def report(results, runs):
              "|---|---|---|---|---|---|---|"]
     for r in results:
         if "error" in r:
-            lines.append(f"| `{r['target']}` | — | — | — | error: {r['error']} | — | — |")
+            lines.append(f"| `{r['target']}` | — | — | — | undecided: {r['error']} | — | — |")
             continue
         ratio = r["killed"] / r["counted"] if r["counted"] else 1.0
         surv = "; ".join(f"#{s['index']} {s['verdict']}"
@@ -785,10 +854,14 @@ def recheck(path, out, timeout, steps=STEPS):
         if not r.get("survivors"):
             continue
         rtl = out / r["target"].replace(":", "_") / "rtl"
-        meta = next(m for m in (json.loads(p.read_text()) for p in sorted(rtl.glob("*.json")))
-                    if isinstance(m, dict) and "ports" in m and "unit" in m)
-        lines = [l for l in (rtl / "mutations.ys").read_text().splitlines()
-                 if l.startswith("mutate ")]
+        try:
+            meta = next(m for m in (json.loads(p.read_text()) for p in sorted(rtl.glob("*.json")))
+                        if isinstance(m, dict) and "ports" in m and "unit" in m)
+            lines = _listed(rtl)
+        except (OSError, StopIteration, ValueError) as e:
+            print(f"  {r['target']}: not rechecked: {tool_error('recheck', e)} (in {rtl})",
+                  flush=True)
+            continue
         for s in r["survivors"]:
             if s["verdict"].startswith(("equivalent", "not equivalent")) and tuple(steps) != STEPS:
                 continue            # decided by an earlier step: the new steps come after it
@@ -885,10 +958,9 @@ def main(argv=None):
         try:
             r = run_target(target, a.sample, a.seed, a.out, a.jobs, a.stimulus, a.equiv_timeout,
                            pipeline_sim=a.pipeline_sim, reuse=a.reuse, steps=steps)
-        except (NetlistError, subprocess.CalledProcessError) as e:
-            msg = str(e) if isinstance(e, NetlistError) else \
-                f"{target}: {e.cmd} failed: {((e.stderr or '') + (e.stdout or '')).strip().splitlines()[-1:]}"
-            print(f"  {msg}")
+        except Exception as e:  # noqa: BLE001  (the target is undecided, the run goes on)
+            msg = str(e) if isinstance(e, NetlistError) else tool_error(target, e)
+            print(f"  {target}: undecided: {msg}")
             results.append({"target": target, "error": msg[:200]})
             continue
         ratio = r["killed"] / r["counted"] if r["counted"] else 1.0

@@ -277,45 +277,159 @@ def blast(text, work, yosys_run, timeout, name, opt=True):
     return None if out is None else (work / f"{name}.aag", work / f"{name}.aim")
 
 
+class AigerError(ValueError):
+    """An AIGER file or Yosys map this module cannot read: the message names the line."""
+
+
+# The sections of an AIGER 1.9 file after its header "aag M I L O A [B C J F]", in order,
+# and the letter of each in the symbol table ("i0 name", "l3 name", "b0 name", ...)
+SECTIONS = ("i", "l", "o", "b", "c", "j", "f")
+
+
+def parse_aag(text):
+    """An ASCII AIGER file (format 1.9, "aag M I L O A [B C J F]") as a dict: ``header``
+    (the ten counts, absent ones 0), ``i`` (input literals), ``l`` ([literal, next,
+    reset], reset 0, 1 or None for uninitialized: the latch's own literal in the file),
+    ``o``, ``b`` (bad states), ``c`` (invariant constraints), ``j`` (each justice property:
+    its literals), ``f`` (fairness), ``and`` ([lhs, rhs0, rhs1]), ``symbols`` ({(letter,
+    index): name}: a name is the rest of its line and may hold spaces and brackets) and
+    ``comment`` (the lines after a line ``c``). Raises AigerError naming the line on
+    anything else."""
+    lines = text.splitlines()
+    pos = [0]
+
+    def take(what):
+        if pos[0] >= len(lines):
+            raise AigerError(f"aag: the file ends before {what} (line {pos[0] + 1})")
+        pos[0] += 1
+        return lines[pos[0] - 1]
+
+    def ints(line, n_min, n_max, what):
+        try:
+            vals = [int(x) for x in line.split()]
+        except ValueError:
+            raise AigerError(f"aag line {pos[0]}: {what} is not numbers: {line[:60]!r}") from None
+        if not n_min <= len(vals) <= n_max or any(v < 0 for v in vals):
+            raise AigerError(f"aag line {pos[0]}: {what} takes {n_min}"
+                             f"{'' if n_min == n_max else f' to {n_max}'} numbers: {line[:60]!r}")
+        return vals
+
+    head = take("the header").split()
+    if not head or head[0] != "aag" or len(head) not in (6, 7, 8, 9, 10):
+        raise AigerError(f"aag line 1: not an ASCII AIGER header: {' '.join(head)[:60]!r}")
+    counts = ints(" ".join(head[1:]), 5, 9, "the header")
+    counts += [0] * (9 - len(counts))
+    M, I, L, O, A, B, C, J, F = counts
+    g = {"header": dict(zip("MILOABCJF", counts, strict=True))}
+    g["i"] = [ints(take("an input"), 1, 1, "an input")[0] for _ in range(I)]
+    g["l"] = []
+    for _ in range(L):
+        lat = ints(take("a latch"), 2, 3, "a latch")
+        reset = lat[2] if len(lat) == 3 else 0
+        if reset not in (0, 1, lat[0]):
+            raise AigerError(f"aag line {pos[0]}: a latch's reset is 0, 1 or its own literal, "
+                             f"got {reset}")
+        g["l"].append([lat[0], lat[1], None if reset == lat[0] and reset > 1 else reset])
+    for key, n, what in (("o", O, "an output"), ("b", B, "a bad state"),
+                         ("c", C, "an invariant constraint")):
+        g[key] = [ints(take(what), 1, 1, what)[0] for _ in range(n)]
+    sizes = [ints(take("a justice size"), 1, 1, "a justice size")[0] for _ in range(J)]
+    g["j"] = [[ints(take("a justice literal"), 1, 1, "a justice literal")[0] for _ in range(k)]
+              for k in sizes]
+    g["f"] = [ints(take("a fairness literal"), 1, 1, "a fairness literal")[0] for _ in range(F)]
+    g["and"] = [ints(take("an and gate"), 3, 3, "an and gate") for _ in range(A)]
+    defined = [x for x in g["i"]] + [l[0] for l in g["l"]] + [a[0] for a in g["and"]]
+    if any(x & 1 or not 2 <= x <= 2 * M for x in defined) or len(set(defined)) != len(defined):
+        raise AigerError("aag: an input, latch or and gate literal is odd, 0, past M or "
+                         "defined twice")
+    g["symbols"], g["comment"] = {}, []
+    limit = {"i": I, "l": L, "o": O, "b": B, "c": C, "j": J, "f": F}
+    while pos[0] < len(lines):
+        line = take("a symbol")
+        if line == "c" or line.startswith("c ") and not line[1:].strip():
+            g["comment"] = lines[pos[0]:]
+            break
+        if not line.strip():
+            continue
+        letter, _, rest = line.partition(" ")
+        kind, idx = letter[:1], letter[1:]
+        if kind not in SECTIONS or not idx.isdigit() or not rest:
+            raise AigerError(f"aag line {pos[0]}: not a symbol (i/l/o/b/c/j/f, an index, a "
+                             f"name) nor the comment's 'c': {line[:60]!r}")
+        if int(idx) >= limit[kind]:
+            raise AigerError(f"aag line {pos[0]}: symbol {letter} past the {limit[kind]} "
+                             f"of its section")
+        g["symbols"][(kind, int(idx))] = rest
+    return g
+
+
+MAP_KINDS = ("input", "init", "output", "latch", "invlatch", "wire")
+
+
+def parse_map(text):
+    """Yosys's ``write_aiger -map`` file as [(kind, index, bit, name)]: kind one of
+    MAP_KINDS (``wire`` from ``-vmap``: its index is the literal), the name the rest of the
+    line; a ``ninitff N`` line (the latch Yosys adds for the registers without an initial
+    value under ``-zinit``) as ("ninitff", N, 0, ""). Raises AigerError naming the line."""
+    out = []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        parts = line.split(" ", 3)
+        try:
+            if parts[0] == "ninitff" and len(parts) == 2:
+                out.append(("ninitff", int(parts[1]), 0, ""))
+                continue
+            if parts[0] in MAP_KINDS and len(parts) == 4 and parts[3]:
+                out.append((parts[0], int(parts[1]), int(parts[2]), parts[3]))
+                continue
+        except ValueError:
+            pass
+        raise AigerError(f"map line {n}: not '<{'|'.join(MAP_KINDS)}> <index> <bit> <name>' "
+                         f"nor 'ninitff <latch>': {line[:60]!r}")
+    return out
+
+
 class Aig:
     """An ASCII AIGER file and Yosys's map of it, as z3 expressions over one frame: a latch
     is a Bool variable (its current value), an input another; ``next`` is a latch's
-    next-state function of the current frame."""
+    next-state function of the current frame. ``outs`` are the outputs and the bad-state
+    properties (each a failure when true: the product's ``bad`` is one output), ``constraints``
+    the invariant constraints (a state outside them is not reachable); a justice or fairness
+    property (liveness) is refused with AigerError, which the steps report as undecided."""
 
     def __init__(self, aag, aim=None):
         import z3
         self.z3 = z3
-        lines = Path(aag).read_text().splitlines()
-        _, M, I, L, O, A = lines[0].split()[:6]
-        I, L, O, A = int(I), int(L), int(O), int(A)
-        ins = [int(l.split()[0]) for l in lines[1:1 + I]]
-        lat = [l.split() for l in lines[1 + I:1 + I + L]]
-        self.outs = [int(l.split()[0]) for l in lines[1 + I + L:1 + I + L + O]]
-        self.defs = {}
-        for l in lines[1 + I + L + O:1 + I + L + O + A]:
-            x, a, b = map(int, l.split()[:3])
-            self.defs[x >> 1] = (a, b)
+        g = parse_aag(Path(aag).read_text())
+        if g["j"] or g["f"]:
+            raise AigerError("aag: justice or fairness properties (liveness): no safety "
+                             "engine here proves them")
+        self.symbols = g["symbols"]
+        ins = g["i"]
+        self.outs = g["o"] + g["b"]
+        self.constraints = g["c"]
+        self.defs = {x >> 1: (a, b) for x, a, b in g["and"]}
         self.var = {}
         for k, v in enumerate(ins):
             self.var[v >> 1] = z3.Bool(f"i{k}")
         self.ins = ins
-        self.latch = [int(l[0]) for l in lat]
-        self.next_lit = [int(l[1]) for l in lat]
-        self.init = [int(l[2]) if len(l) > 2 else 0 for l in lat]
+        self.latch = [l[0] for l in g["l"]]
+        self.next_lit = [l[1] for l in g["l"]]
+        self.init = [l[2] for l in g["l"]]          # 0, 1 or None (uninitialized)
         for k, l in enumerate(self.latch):
             self.var[l >> 1] = z3.Bool(f"l{k}")
         # the map (``aim``, Yosys's write_aiger -map): (kind, name) -> {bit: literal}
         self.sig = {}
-        for line in (Path(aim).read_text().splitlines() if aim else ()):
-            kind, idx, bit, name = line.split(" ", 3)
-            idx, bit = int(idx), int(bit)
-            inv = kind.startswith("inv")
-            kind = kind[3:] if inv else kind
-            base = {"input": lambda i: ins[i], "latch": lambda i: self.latch[i],
-                    "output": lambda i: self.outs[i]}.get(kind)
-            if base is None:
-                continue
-            self.sig.setdefault((kind, name), {})[bit] = base(idx) ^ int(inv)
+        for kind, idx, bit, name in (parse_map(Path(aim).read_text()) if aim else ()):
+            inv = kind == "invlatch"
+            kind = "latch" if inv else kind
+            table = {"input": ins, "latch": self.latch, "output": self.outs}.get(kind)
+            if table is None:
+                continue                  # init inputs, the initstate latch, wires: not named
+            if not 0 <= idx < len(table):
+                raise AigerError(f"map: {kind} {idx} ({name}) past the {len(table)} of the aag")
+            self.sig.setdefault((kind, name), {})[bit] = table[idx] ^ int(inv)
             if kind == "latch":
                 self.sig.setdefault(("latchidx", name), {})[bit] = (idx, int(inv))
 
@@ -362,8 +476,9 @@ class Aig:
         return self.z3.Not(e) if inv else e
 
     def init_of(self, li):
+        """The initial value of a latch bit, None when it has none (any value)."""
         idx, inv = li
-        return bool(self.init[idx]) ^ bool(inv)
+        return None if self.init[idx] is None else bool(self.init[idx]) ^ bool(inv)
 
     def support(self, lits):
         """The latch indices the literals ``lits`` read (through the and gates) and the input
@@ -394,14 +509,17 @@ def solve(aag):
     nxt = [aig.lit(x) for x in aig.next_lit]
     init = [z3.BoolVal(bool(r)) if r in (0, 1) else cur[k] for k, r in enumerate(aig.init)]
     bad = z3.Or(*[aig.lit(o) for o in aig.outs]) if aig.outs else z3.BoolVal(False)
+    # invariant constraints: a state (with its inputs) outside them has no successor and
+    # is never a failure
+    ok = z3.And(*[aig.lit(c) for c in aig.constraints]) if aig.constraints else z3.BoolVal(True)
     fp = z3.Fixedpoint()
     fp.set(engine="spacer")
     inv = z3.Function("inv", *([z3.BoolSort()] * len(cur)), z3.BoolSort())
     fp.register_relation(inv)
     fp.declare_var(*cur, *[aig.var[v >> 1] for v in aig.ins])
     fp.rule(inv(*init))
-    fp.rule(inv(*nxt), inv(*cur))
-    r = fp.query(z3.And(inv(*cur), bad))
+    fp.rule(inv(*nxt), z3.And(inv(*cur), ok))
+    r = fp.query(z3.And(inv(*cur), ok, bad))
     print("proved" if r == z3.unsat else "cex" if r == z3.sat else "unknown", flush=True)
 
 

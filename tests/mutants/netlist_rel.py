@@ -372,6 +372,8 @@ def rel(net, rtl, yosys_run, timeout, stream, log=None):
         if "shared" in copies:
             for i, li in copies["shared"].items():
                 v = aig.init_of(li)
+                if v is None:
+                    continue                # no initial value: no candidate
                 cands[("const", cell, i)] = (aig.cur(li) == v, aig.nxt(li) == v)
     # a register's valid-bit candidates: those of its own unit (the first part of the wire
     # name, "terms" of terms.h_cx_data), or all of them for a register of the top module
