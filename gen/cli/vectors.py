@@ -19,6 +19,7 @@ from bumprtl.gen.flow.vectors import (
     write_vectors,
 )
 from bumprtl.rtl.config import BumpError
+from bumprtl.sim.scenes.config import BUILTIN
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -60,6 +61,9 @@ def run(args):
     top = _identifier("--top", args.top)
     if args.count is not None:
         check_count(args.count)
+    if args.pipeline not in BUILTIN and not Path(args.pipeline).is_file():
+        raise BumpError(f"--pipeline must be a scene TOML file or one of {', '.join(BUILTIN)}, "
+                        f"got {args.pipeline!r}")
     scene = scene_from_args(args, args.pipeline)
     vectors = pipeline_vectors(scene, args.source, args.count, args.seed)
     command = _command(scene, args, module, top, len(vectors))

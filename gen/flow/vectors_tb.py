@@ -87,7 +87,8 @@ def bench_verilog(meta, module, count, seed, command, top=None):
     hosts = [] if top else host_ports(ports)
     tb = f"{module}_tb"
     latency = int(meta["latency"])
-    setup_words = 0 if top else sum(img["depth"] + (1 if "lut_w_ready" in img["port"] else 0)
+    # the host set-up's clocks (a top loads the same words itself, in about as many)
+    setup_words = sum(img["depth"] + (1 if "lut_w_ready" in img["port"] else 0)
                                     for img in meta.get("memory_images", {}).values()
                                     if img["load"] == "port")
     timeout = 8 * count + setup_words + 4 * latency + 1000
