@@ -7,9 +7,11 @@ and its allowed range and exits with status 2; there is no traceback.
 
 import argparse
 import importlib
+import importlib.metadata
 import sys
 
 from bumprtl.gen import __version__
+from bumprtl.gen.cli.doctor import requirements
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.toolchain import ToolMissing
 
@@ -47,6 +49,21 @@ def _optional(error):
     return OPTIONAL.get(name), name
 
 
+def _extra(command_extra, need, name):
+    """The extra a missing package ``name`` names: the only extra that pins its
+    distribution when just one does (report timing's yowasp_wavedrom: [docs], not report's
+    [fpga]), else the command's own, else ``need`` (OPTIONAL's). Read from bumprtl's
+    installed metadata; [dev], which holds every extra, does not count."""
+    dist = name.replace("_", "-").lower()
+    try:
+        groups = requirements()
+    except importlib.metadata.PackageNotFoundError:
+        groups = {}
+    extras = [x for x, reqs in groups.items() if x not in (None, "dev")
+              and any(n.replace("_", "-").lower() == dist for n, _ in reqs)]
+    return extras[0] if len(extras) == 1 else command_extra or need
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
         self.print_usage(sys.stderr)
@@ -69,11 +86,12 @@ def build_parser():
             need, name = _optional(e)
             if need is None:
                 raise
-            p = sub.add_parser(command, help=f"(needs the [{extra or need}] extra: "
-                                             f"pip install 'bumprtl[{extra or need}]')",
+            need = _extra(extra, need, name)
+            p = sub.add_parser(command, help=f"(needs the [{need}] extra: "
+                                             f"pip install 'bumprtl[{need}]')",
                                add_help=False, prefix_chars="\0")
             p.add_argument("rest", nargs="*")
-            p.set_defaults(missing=MissingExtra(command, extra or need, name))
+            p.set_defaults(missing=MissingExtra(command, need, name))
             continue
         module.add_parser(sub)
     return parser
@@ -93,7 +111,7 @@ def main(argv=None):
         if need is None:
             raise
         command = (argv if argv is not None else sys.argv[1:] or ["?"])[0]
-        extra = dict((c, x) for c, _, x in COMMANDS).get(command) or need
+        extra = _extra(dict((c, x) for c, _, x in COMMANDS).get(command), need, name)
         print(f"bumprtl: error: {MissingExtra(command, extra, name)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -41,6 +41,7 @@ NEEDS_EXTRA = [(["render", "--rtl", "--size", "16", "--out", "rtl.png"], "sim"),
                (["demo", "--size", "16", "--out", "demo"], "sim"),
                (["report", "fpga", "--out", "fpga.md"], "fpga"),
                (["report", "table1", "--out", "table1.md"], "fpga"),
+               (["report", "timing", "--out", "timing"], "docs"),  # the only extra with WaveDrom
                (["formal", "--out", "formal"], "formal"),
                (["board", "ulx3s", "--out", "board"], "board")]
 
