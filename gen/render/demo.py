@@ -177,7 +177,7 @@ def _rtl_section(args, out):
 def run(args):
     load_scene(DEMO_SCENES[0], size=args.size)         # bad --size fails before any work
     if args.rtl:
-        require_sim()                                   # no [sim] extra: one line, before any work
+        require_sim(args.simulator)                     # no [sim] extra: one line, before any work
     cfg, out, methods = Config(), Path(args.out), demo_methods()
     start = time.perf_counter()
     lines = [f"bumprtl demo: {args.size}x{args.size} pixels, directional light at elevation "

@@ -47,6 +47,7 @@ from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.sim.scenes.usermap import load_bump_map
+from bumprtl.sim.toolchain import require
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
            "render_rtl", "sim_scene"]
@@ -301,10 +302,15 @@ def render_rtl(scene, size, simulator="verilator", build_dir="build/render_rtl",
                      cycles["no_stall"], *times)
 
 
-def require_sim():
+def require_sim(simulator=None):
     """Import the simulator path (cocotb, the [sim] extra) before any work: without it the
-    ImportError reaches gen/cli/main.py, which names the extra in one line."""
+    ImportError reaches gen/cli/main.py, which names the extra in one line. ``simulator``
+    (``icarus`` / ``verilator``): its binary too (ToolMissing, one line), before the tool
+    log's banner and the emit."""
     import cocotb_tools.runner  # noqa: F401  # optional dependency: [sim]
+
+    if simulator is not None:
+        require({"icarus": "iverilog", "verilator": "verilator"}[simulator])
 
 
 def cli_render(args, scene=None):
@@ -316,7 +322,7 @@ def cli_render(args, scene=None):
     check_scene_fits(scene, getattr(args, "device", None) or DEFAULT_DEVICE)
     light = {"azimuth": args.light_azimuth, "light_elevation": args.light_elevation,
              "light": args.light}
-    require_sim()
+    require_sim(args.simulator)
     t0 = time.perf_counter()
     per_cycle = getattr(args, "per_cycle", False)
     load = getattr(args, "load", None) or "initial"

@@ -70,3 +70,17 @@ def test_a_quiet_command_names_its_log_after_it_succeeds(capfd, tmp_path):
         pass
     _, err = capfd.readouterr()
     assert err == f"report k: tool output in {tmp_path / 'k.log'}\n"
+
+
+@pytest.mark.parametrize("argv", [["render", "--rtl", "--size", "16", "--out", "r.png"],
+                                  ["demo", "--size", "16", "--out", "demo"]])
+def test_a_missing_simulator_is_one_line_before_any_work(argv, capfd, monkeypatch, tmp_path):
+    """Icarus not on PATH: render --rtl and demo refuse before the tool log's banner, the
+    emit and the golden renders (nothing written)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bin").mkdir()
+    monkeypatch.setenv("PATH", str(tmp_path / "bin"))
+    assert main([*argv, "--simulator", "icarus"]) == 2
+    line = _one_line(capfd)
+    assert line.startswith("bumprtl: error: iverilog not found; install it with:"), line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bin"]
