@@ -63,15 +63,19 @@ mutate: $(STAMP)
 	$(RUN) $(PY) -m tests.mutants.curated $(MUTATE_ARGS)
 
 # Netlist mutation (the mcy method, tests/mutants/netlist.py): yosys mutate -list on every
-# unit's and built-in scene pipeline's emitted Verilog, all mutants in one Verilator build of
-# the bulk path behind a mutsel input, each run against the golden model; survivors checked
-# for equivalence (miter + sat -tempinduct). MUTATE_RTL_ARGS="--sample 20 --seed 1 -k sincos --doc docs/mutation.md".
+# unit's, built-in scene pipeline's and board unit's (board:timing, board:tmds, board:buffer,
+# board:source) emitted Verilog, all mutants in one build behind a mutsel input, each run
+# against the golden model or the board unit's oracle; survivors checked for equivalence
+# (Yosys equiv_* and sat first, then our cone/cut/never/rel steps and z3 Spacer). Every
+# target and mutant ends killed, equivalent, survived or "undecided: <reason>", never a
+# traceback. MUTATE_RTL_ARGS="--sample 20 --seed 1 -k sincos --doc docs/mutation.md".
 mutate-rtl: $(STAMP)
 	$(RUN) $(PY) tests/mutants/netlist.py -j $(JOBS) $(MUTATE_RTL_ARGS)
 
 # Python mutation with mutmut 3.8.1 (tests/mutants/pymut.py): a seeded sample of the mutants of
-# the golden models, config, scenes and CLI validation, each run against the tests that reach
-# its function. MUTATE_PY_ARGS="--sample 100 --seed 1 --commit HEAD --doc docs/mutation.md".
+# every Python file of rtl/, gen/ and sim/, at least --min-area from each area (pymut.AREAS,
+# listed in docs/mutation.md), each run against the tests that reach its function.
+# MUTATE_PY_ARGS="--sample 100 --seed 1 --commit HEAD --doc docs/mutation.md".
 mutate-py: $(STAMP)
 	$(RUN) $(PY) tests/mutants/pymut.py -j $(JOBS) $(MUTATE_PY_ARGS)
 

@@ -1,8 +1,9 @@
 """Python mutation with mutmut 3.8.1 on a random sample (``make mutate-py``).
 
-Mutated: the golden models (sim/golden/), the configuration (rtl/config.py, sim/scenes/config.py),
-the scenes and user maps (sim/scenes/) and the command line's validation (gen/cli/flags.py,
-gen/cli/main.py). mutmut, not cosmic-ray: it generates every mutant of a file in one
+Mutated: every Python file of rtl/, gen/ and sim/, drawn by area (:data:`AREAS`: the
+configuration, the rest of the hardware, the golden models, the scenes, the testbenches, the
+job runner, the rest of sim/, and each of gen/'s command line, flow, reports, benches and
+renders) with at least ``--min-area`` mutants from each. mutmut, not cosmic-ray: it generates every mutant of a file in one
 copy (trampolines switched by an environment variable, no re-import per mutant), records
 which tests reach each function (its own coverage: a first run of the selected tests with
 the trampolines counting calls) and runs each mutant only against those tests.
@@ -43,15 +44,24 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = {"rtl": "rtl", "sim": "sim", "gen": "gen", "constraints": "constraints"}
-MUTATE = ["bumprtl/sim/golden/*", "bumprtl/rtl/config.py", "bumprtl/sim/scenes/config.py",
-          "bumprtl/sim/scenes/*", "bumprtl/gen/cli/flags.py", "bumprtl/gen/cli/main.py"]
-AREAS = {"sim/golden": "bumprtl.sim.golden.", "rtl/config.py": "bumprtl.rtl.config.",
+# every Python file of the three packages (the globs match subdirectories too)
+MUTATE = ["bumprtl/rtl/*", "bumprtl/gen/*", "bumprtl/sim/*"]
+# the areas of the stratified draw, each a prefix of mutmut's mutant names; the first that
+# matches names a mutant's area, so a file's own area comes before its package's rest.
+# docs/mutation.md lists them (tests/mutants/test_pymut_areas.py holds the two together)
+AREAS = {"rtl/config.py": "bumprtl.rtl.config.", "rtl": "bumprtl.rtl.",
+         "sim/golden": "bumprtl.sim.golden.",
          "sim/scenes/config.py": "bumprtl.sim.scenes.config.", "sim/scenes": "bumprtl.sim.scenes.",
-         "gen/cli": "bumprtl.gen.cli."}
-TESTS = ["tests/rtl/test_config.py", "tests/sim/scenes/test_config.py", "tests/rtl/test_fixed.py",
-         "tests/rtl/test_tables.py", "tests/rtl/test_methods.py", "tests/rtl/test_palette.py",
-         "tests/sim/golden",
-         "tests/sim/scenes", "tests/gen/cli"]
+         "sim/tb": "bumprtl.sim.tb.", "sim/jobs.py": "bumprtl.sim.jobs.",
+         "sim/other": "bumprtl.sim.",
+         "gen/cli": "bumprtl.gen.cli.", "gen/flow": "bumprtl.gen.flow.",
+         "gen/report": "bumprtl.gen.report.", "gen/bench": "bumprtl.gen.bench.",
+         "gen/render": "bumprtl.gen.render."}
+# the fast tiers of make test that reach those files (mutmut runs each mutant against the
+# ones that call its function); tests/mutants is this tooling, tests/board the slow board run
+TESTS = ["tests/rtl", "tests/sim/golden", "tests/sim/scenes", "tests/sim/tb",
+         "tests/sim/test_jobs.py", "tests/sim/test_objcache.py", "tests/sim/formal", "tests/gen",
+         "tests/test_add_a_method.py", "tests/test_import_graph.py"]
 # imported once by the fork server (never the project's own modules: each worker imports
 # those afresh, with the mutant switched on)
 PRELOAD = ["numpy", "pytest", "hypothesis", "amaranth", "amaranth.hdl", "amaranth.sim", "PIL.Image",
