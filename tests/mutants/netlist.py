@@ -1,5 +1,6 @@
 """Netlist mutation (the mcy method): mutants the curated list has never seen, drawn by Yosys
-from the emitted Verilog of every unit and built-in scene pipeline (``make mutate-rtl``).
+from the emitted Verilog of every unit and built-in scene pipeline (``make mutate-rtl``), and
+of the board's units (``board:*``: netlist_board.py has their emission, bench and oracles).
 
 For each target (a unit at the default Config, or a built-in scene's pipeline):
 

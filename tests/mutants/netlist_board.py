@@ -31,6 +31,7 @@ does not finish in its time is undecided (reason given).
 """
 
 import functools
+import json
 import shutil
 import subprocess
 import sys
@@ -139,6 +140,8 @@ def emit(target, out):
     meta = {"unit": unit, "ports": {"clk": {"dir": "in", "width": 1},
                                     "rst": {"dir": "in", "width": 1},
                                     **{s.name: {"dir": d, "width": len(s)} for s, d in ports}}}
+    # beside the Verilog as a unit's sidecar is: netlist.py --recheck reads it there
+    (out / f"{unit}.json").write_text(json.dumps(meta, indent=1))
     return path, meta, ctx
 
 
