@@ -1,5 +1,9 @@
-"""Test vectors for the datapath units: random valid pixels and the edge cases, as the
-flattened input payloads the RTL takes (binary-angle codes)."""
+"""Test vectors for the datapath units: random valid pixels, the edge cases and the extreme
+corners, as the flattened input payloads the RTL takes (binary-angle codes).
+
+:func:`corner_codes` is the one corner generator of every bit-exact streaming test: the
+datapath benches take it through :func:`edge_codes`, the pipeline's through
+``sim/golden/fixed/pipeline.random_inputs`` (which gives every light the same corner row)."""
 
 import numpy as np
 
@@ -7,7 +11,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 
-__all__ = ["TINY", "edge_codes", "random_codes", "as_payloads", "concat_codes"]
+__all__ = ["TINY", "corner_codes", "edge_codes", "random_codes", "as_payloads", "concat_codes"]
 
 KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
 
@@ -20,10 +24,30 @@ def random_codes(n, cfg: Config, seed=0):
     return quantize_pixels(PixelInputs.random(n, np.random.default_rng(seed)), cfg)
 
 
+def corner_codes(cfg: Config):
+    """The extreme corners of the angle inputs, every term at its maximum or its minimum at
+    once (so a carry only saturating inputs reach is reached): head-on (L = H = N and
+    N' = N: theta_A = 0, so N'.L = N'.H = 1 exactly) and behind (L = H = -N), for N at
+    both ends of its fields (phi 0 and ``full_circle - 1``, theta 0 and 180 degrees, the
+    last theta on the grid) and at 90 degrees, N' at both ends of phi; and every field at
+    code 0, and at its last code, at once. Widths from ``cfg``."""
+    full, q = cfg.full_circle, cfg.full_circle // 4
+    ends = {k: (0, 2 * q if k.endswith("theta") else full - 1) for k in KEYS}
+    rows = [tuple(ends[k][0] for k in KEYS), tuple(ends[k][1] for k in KEYS)]
+    for n_phi in ends["n.phi"]:
+        for n_theta in (*ends["n.theta"], q):
+            for b_phi in ends["b.phi"]:
+                rows.append((n_phi, n_theta, n_phi, n_theta, n_phi, n_theta, b_phi, 0))
+                back = ((n_phi + 2 * q) % full, 2 * q - n_theta)            # L = H = -N
+                rows.append((n_phi, n_theta, *back, *back, b_phi, 0))
+    arr = np.array(rows, dtype=np.int32)
+    return {k: arr[:, i] for i, k in enumerate(KEYS)}
+
+
 def edge_codes(cfg: Config):
-    """theta 0, 90, 180 degrees; azimuth wrap (ph_A just below 0 and ph_N just above, and the
-    reverse); L = N; grazing light; light below the horizon; in all combinations with a few
-    N and N' directions."""
+    """The corners (:func:`corner_codes`), then theta 0, 90, 180 degrees; azimuth wrap (ph_A
+    just below 0 and ph_N just above, and the reverse); L = N; grazing light; light below
+    the horizon; in all combinations with a few N and N' directions."""
     full, q = cfg.full_circle, cfg.full_circle // 4
     thetas = [0, 1, q - 1, q, q + 1, 2 * q - 1, 2 * q]            # 0, 90, 180 degrees
     phis = [0, 1, full - 1, q, 2 * q, 3 * q]
@@ -41,7 +65,7 @@ def edge_codes(cfg: Config):
                     rows.append((n_phi, n_theta, l_phi, l_theta, (l_phi + n_phi) // 2 % full,
                                  (l_theta + n_theta) // 2, b_phi, b_theta))
     arr = np.array(rows, dtype=np.int32)
-    return {k: arr[:, i] for i, k in enumerate(KEYS)}
+    return concat_codes(corner_codes(cfg), {k: arr[:, i] for i, k in enumerate(KEYS)})
 
 
 def as_payloads(codes, cfg: Config, keys=None):

@@ -16,7 +16,13 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import CHANNELS, blend_eq2, index_bits
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, unpack_rgba
-from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed, random_inputs
+from bumprtl.sim.golden.fixed.pipeline import (
+    corner_inputs,
+    corner_texels,
+    map_words,
+    pipeline_fixed,
+    random_inputs,
+)
 from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.stress import stress_codes
 from bumprtl.sim.golden.vectors import edge_codes, random_codes
@@ -166,17 +172,22 @@ def _palette(meta, spec, chunk):
 
 def pipeline_map(scene, seed):
     """The bump-map words of the pipeline regression: the N' of T^2 stress pixels (every
-    stress case) at level 0, the other levels from the same texels. Emit the pipeline with
-    these words as its map (``BumpPipeline(scene, init=...)``)."""
+    stress case) at level 0, the other levels from the same texels; the first and the last
+    texel of every level N' = N (theta_A = 0), where the corners of the first chunk
+    (sim/golden/fixed/pipeline.corner_inputs) read. Emit the pipeline with these words as
+    its map (``BumpPipeline(scene, init=...)``)."""
     t = scene.texture_size
     codes = stress_codes(t * t, scene.config, seed)
     level0 = pack_texels(scene, codes["b.phi"].reshape(t, t), codes["b.theta"].reshape(t, t))
-    return map_words([level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)], scene)
+    words = map_words([level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)], scene)
+    words[corner_texels(scene)] &= (1 << scene.angle_bits) - 1          # theta_A = 0
+    return words
 
 
 def _pipeline(meta, spec, chunk):
     """BumpPipeline of a varying-map, per-pixel scene with :func:`pipeline_map` in its map:
-    chunks alternate stress vectors (every case of sim/golden/stress.py; texels in order)
+    the corners first (sim/golden/fixed/pipeline.corner_inputs: every light head-on or
+    behind at once, coordinates and levels at both ends), then chunks alternate stress vectors (every case of sim/golden/stress.py; texels in order)
     and random payloads over the whole port ranges (wrap/clamp, levels past the last);
     golden = sim/golden/fixed/pipeline.py."""
     scene = load_scene_config(meta["scene"])
@@ -197,6 +208,10 @@ def _pipeline(meta, spec, chunk):
                 inputs = random_inputs(scene, n, rng)
             inputs["tag"] = _tags(n, start, scene.tag_bits)
             inputs = {c: np.asarray(inputs[c], np.int64) for c in keys}
+            if k == 0:
+                corners = corner_inputs(scene)
+                m = min(n, len(corners["u"]))
+                inputs.update({c: np.concatenate([v[:m], inputs[c][m:]]) for c, v in corners.items()})
             want = pipeline_fixed(inputs, scene, words)
             yield inputs, {**{c: np.asarray(v, np.int64) for c, v in want.items()},
                            "tag": inputs["tag"]}

@@ -39,7 +39,7 @@ from bumprtl.rtl.texture import RGB, texture_blend
 from bumprtl.sim.golden.fixed import exact
 from bumprtl.sim.golden.fixed.common import phong_sum_fixed
 from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
-from bumprtl.sim.golden.vectors import random_codes
+from bumprtl.sim.golden.vectors import corner_codes, random_codes
 from bumprtl.sim.scenes.config import SceneConfig
 
 # The outputs of one Illumination unit (rtl/layouts.shade_layout) a single-light pipeline has.
@@ -47,7 +47,7 @@ SHADE_OUTPUTS = ("diffuse", "specular", "color", "diffuse_fine", "specular_fine"
 
 __all__ = ["SHADE_OUTPUTS", "fetch_fixed", "unpack_texels", "map_words", "pipeline_fixed",
            "polygon_fixed", "combine_lights_fixed", "random_map", "random_texture",
-           "random_inputs", "as_payload_list", "unpack_rgb"]
+           "corner_inputs", "corner_texels", "random_inputs", "as_payload_list", "unpack_rgb"]
 
 
 def unpack_rgb(words):
@@ -155,22 +155,67 @@ def pipeline_fixed(inputs, scene: SceneConfig, words=None, polygon=None, texels=
     return combine_lights_fixed(shades, scene)
 
 
+def corner_texels(scene):
+    """Word addresses of the first and the last texel of every level: where the corners of
+    :func:`corner_inputs` read (their coordinates wrap or clamp to one of the two)."""
+    ends = []
+    for base, n in zip(level_bases(scene), range(scene.mip_levels), strict=True):
+        ends += [base, base + (scene.texture_size >> n) ** 2 - 1]
+    return np.array(ends, np.int64)
+
+
 def random_map(scene: SceneConfig, rng):
-    """A random memory image: N' in the upper tangent hemisphere, or palette indices."""
+    """A random memory image: N' in the upper tangent hemisphere, or palette indices. The
+    first and the last texel of every level hold N' = N (theta_A = 0, phi_A 0 and the last
+    code), so the corners of :func:`corner_inputs` see every light head-on."""
     n, full = memory_depth(scene), 1 << scene.angle_bits
     if scene.shading == "palette":
         return pack_texels(scene, index=rng.integers(0, 1 << index_bits(scene.config), n))
-    return pack_texels(scene, phi=rng.integers(0, full, n), theta=rng.integers(0, full // 4 + 1, n))
+    phi, theta = rng.integers(0, full, n), rng.integers(0, full // 4 + 1, n)
+    ends = corner_texels(scene)
+    phi[ends], theta[ends] = np.resize([0, full - 1], len(ends)), 0
+    return pack_texels(scene, phi=phi, theta=theta)
 
 
 def random_texture(scene: SceneConfig, rng):
-    """A random colour-texture memory image (24-bit RGB words), or None without a texture."""
-    return rng.integers(0, 1 << 24, memory_depth(scene)) if scene.texture else None
+    """A random colour-texture memory image (24-bit RGB words), or None without a texture;
+    the first and the last texel of every level are white (every channel's last code)."""
+    if not scene.texture:
+        return None
+    words = rng.integers(0, 1 << 24, memory_depth(scene))
+    words[corner_texels(scene)] = (1 << 24) - 1
+    return words
+
+
+def corner_inputs(scene: SceneConfig):
+    """The extreme corners of the pipeline's inputs (dict of arrays, no tag), the rows of
+    :func:`~bumprtl.sim.golden.vectors.corner_codes` with every light given the same row
+    (so m lights are head-on, or behind, at once: the light sum at its maximum), each row
+    at one of the texel coordinates 0, the map's last texel (T - 1) and both ends of the
+    signed port range, in turn, and at level 0 or the last level code, in turn. Palette
+    shading: the coordinate corners alone. Widths from ``scene``."""
+    cfg = scene.config
+    codes = corner_codes(cfg) if scene.shading == "per-pixel" else {}
+    rows = len(next(iter(codes.values()))) if codes else 8
+    out = {}
+    if has_map(scene) or scene.texture:
+        half, last = 1 << (coord_bits(scene) - 1), scene.texture_size - 1
+        coords = np.resize([0, last, -half, half - 1], rows)
+        out["u"], out["v"] = coords, coords
+        if scene.mip_levels > 1:
+            out["level"] = np.resize([0, 0, 0, 0, (1 << level_bits(scene)) - 1], rows)
+    if codes:
+        for j, keys in enumerate(light_keys(cfg)):
+            if j == 0 and scene.bump_map == "varying":
+                out["n.phi"], out["n.theta"] = codes["n.phi"], codes["n.theta"]
+            out.update({key: codes[own] for own, key in keys.items()})
+    return {k: np.asarray(v, np.int64) for k, v in out.items()}
 
 
 def random_inputs(scene: SceneConfig, n, rng):
-    """``n`` random input payloads (dict of arrays): texel coordinates over the whole signed
-    port range (so wrap/clamp are exercised), levels past the last, random angles."""
+    """``n`` input payloads (dict of arrays): the corners first (:func:`corner_inputs`, as
+    many as fit in ``n``), then random ones: texel coordinates over the whole signed port
+    range (so wrap/clamp are exercised), levels past the last, random angles."""
     out = {}
     if has_map(scene) or scene.texture:
         half = 1 << (coord_bits(scene) - 1)
@@ -183,6 +228,10 @@ def random_inputs(scene: SceneConfig, n, rng):
             if j == 0 and scene.bump_map == "varying":
                 out["n.phi"], out["n.theta"] = codes["n.phi"], codes["n.theta"]
             out.update({key: codes[own] for own, key in keys.items()})
+    corners = corner_inputs(scene)
+    for k, c in corners.items():
+        m = min(n, len(c))
+        out[k] = np.concatenate([c[:m], np.asarray(out[k])[:n - m]])
     # consecutive tags centred on the middle of the tag range, so the top tag bit (and every
     # bit below it) changes within any run of two or more pixels
     mask = (1 << scene.tag_bits) - 1

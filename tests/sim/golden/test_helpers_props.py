@@ -165,10 +165,14 @@ def test_turning_the_scene_in_azimuth_moves_n_l_h_and_keeps_n_prime():
 
 def test_edge_rows_hold_l_equal_to_n_grazing_and_h_half_way():
     """Each (N, N') combination gets L = N, L at 90 degrees azimuth on the equator
-    (grazing), and H the code half way between L and N; N' azimuth 7 ph_N + th_N' mod full."""
-    from bumprtl.sim.golden.vectors import edge_codes
+    (grazing), and H the code half way between L and N; N' azimuth 7 ph_N + th_N' mod full
+    (after the corners, which lead)."""
+    from bumprtl.sim.golden.vectors import corner_codes, edge_codes
     cfg = Config(angle_bits=10)
-    c = edge_codes(cfg)
+    c, corners = edge_codes(cfg), corner_codes(cfg)
+    m = len(corners["n.phi"])
+    assert all(np.array_equal(c[k][:m], v) for k, v in corners.items())
+    c = {k: v[m:] for k, v in c.items()}
     full, q = cfg.full_circle, cfg.full_circle // 4
     n = len(c["n.phi"])
     assert n == 6 * 7 * 3 * 5 and all(len(v) == n and v.dtype == np.int32 for v in c.values())

@@ -1,8 +1,18 @@
 """The datapath units' test vectors (sim/golden/vectors.py): payloads as the RTL takes them."""
 
+import numpy as np
+import pytest
 
 from bumprtl.rtl.config import Config
-from bumprtl.sim.golden.vectors import TINY, as_payloads, concat_codes, edge_codes, random_codes
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
+from bumprtl.sim.golden.vectors import (
+    TINY,
+    as_payloads,
+    concat_codes,
+    corner_codes,
+    edge_codes,
+    random_codes,
+)
 
 
 def test_payloads_number_the_pixels_with_a_tag_that_wraps_at_tag_bits():
@@ -31,3 +41,24 @@ def test_edge_codes_reach_the_poles_the_equator_and_the_azimuth_wrap():
     for k, c in codes.items():
         hi = 2 * q if k.endswith("theta") else full - 1
         assert c.min() >= 0 and c.max() <= hi, k
+
+
+@pytest.mark.parametrize("cfg", [TINY, Config(angle_bits=9, frac_bits=10)], ids=["tiny", "9-bit"])
+def test_corners_reach_both_ends_of_every_field_and_both_extremes_of_the_dots(cfg):
+    """corner_codes (the corners every bit-exact streaming test starts with, widths from the
+    Config): every field at code 0 and at its last code (phi full_circle - 1, theta 180
+    degrees), in one row each; some row with N'.L = N'.H = 1 exactly (head-on: the diffuse
+    and specular terms at their maximum) and some with the light straight behind (0); the
+    edge cases start with them."""
+    codes = corner_codes(cfg)
+    full, q = cfg.full_circle, cfg.full_circle // 4
+    rows = np.stack([codes[k] for k in codes], axis=1)
+    assert (rows == 0).all(axis=1).any()
+    assert (rows == [2 * q if k.endswith("theta") else full - 1 for k in codes]).all(axis=1).any()
+    out = illumination_fixed(rotation_fixed({k: v.astype(np.int64) for k, v in codes.items()}, cfg), cfg)
+    one = 1 << cfg.frac_bits
+    assert out["ndotl"].max() == one and out["ndoth"].max() == one
+    assert out["diffuse_fine"].max() == one and out["diffuse"].max() == 255
+    assert out["diffuse_fine"].min() == 0 and out["ndotl"].min() < 0
+    edges = edge_codes(cfg)
+    assert all((edges[k][:len(c)] == c).all() for k, c in codes.items())

@@ -13,10 +13,13 @@ from bumprtl.rtl.palette import index_bits
 from bumprtl.sim.golden.fixed.pipeline import (
     as_payload_list,
     combine_lights_fixed,
+    corner_inputs,
+    fetch_fixed,
     random_inputs,
     random_map,
     unpack_texels,
 )
+from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 
 
@@ -95,3 +98,26 @@ def test_light_sums_saturate_and_round_once():
     assert out["diffuse"].tolist() == [255, 255, 0, 0]
     assert out["specular"].tolist() == [0, 255, 0, 1]
     assert out["color"][1] == 255 and out["color"][2] == round(255 * scene.config.ka)
+
+
+
+@pytest.mark.parametrize("name", ["two-lights", "full"])
+def test_corners_lead_and_light_every_light_head_on_at_once(name):
+    """random_inputs starts with corner_inputs, whose coordinates (0, the last texel, both
+    ends of the port) all read a corner texel of random_map (N' = N); there some row has
+    every light head-on at once, so the light sum reaches its maximum (m lights x 2**F:
+    the carry into the sum's top bit)."""
+    scene = load_scene_config(name, {"texture_size": 16})
+    rng = np.random.default_rng(2)
+    words, corners = random_map(scene, rng), corner_inputs(scene)
+    n = len(corners["u"])
+    got = random_inputs(scene, n + 5, rng)
+    assert all((got[k][:n] == c).all() for k, c in corners.items())
+    b = unpack_texels(fetch_fixed(corners["u"], corners["v"], corners.get("level"), words, scene), scene)
+    assert (b["b.theta"] == 0).all()
+    total = 0
+    for keys in light_keys(scene.config):
+        light = {**b, **{k: corners[k] for k in ("n.phi", "n.theta")},
+                 **{own: corners[key] for own, key in keys.items()}}
+        total = total + illumination_fixed(rotation_fixed(light, scene.config), scene.config)["diffuse_fine"]
+    assert total.max() == scene.lights << scene.frac_bits and total.min() == 0
