@@ -6,16 +6,24 @@ import re
 import shlex
 from pathlib import Path
 
-from bumprtl.gen.cli.flags import add_config_flags, add_map_flags, scene_from_args
+from bumprtl.gen.cli.flags import (
+    add_config_flags,
+    add_map_flags,
+    config_from_args,
+    map_overrides,
+    scene_from_args,
+)
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE, DEVICE_BRAM, LOADS, scene_command
-from bumprtl.gen.flow.units import default_module
+from bumprtl.gen.flow.units import UNITS, canonical_command, default_module
 from bumprtl.gen.flow.vectors import (
     DEFAULT_COUNT,
     MAX_COUNT,
     SOURCES,
+    UNIT_SOURCES,
     check_count,
     pipeline_vectors,
     run_commands,
+    unit_vectors,
     write_vectors,
 )
 from bumprtl.rtl.config import BumpError
@@ -33,6 +41,8 @@ EXAMPLES = """examples:
       your map and your own pixels: a CSV with a header row u,v,n_phi,n_theta,l_phi,
       l_theta,h_phi,h_theta[,tag] (texel coordinates; angles in radians, phi in [0, 2*pi],
       theta in [0, pi]; the columns of another scene: a wrong header lists them)
+  bumprtl vectors --unit rotation --method lee --source frame --count 500 --out build/rot
+      the rotation unit alone (module bumprtl_rotation_named), the default scene's pixels
   bumprtl vectors --pipeline default --load port --top my_top --out build/top
       a bench for your own top module my_top (the named ports' clk, rst, in_*, out_*),
       which loads the map through the host write port itself
@@ -56,17 +66,38 @@ def _command(scene, args, module, top, count):
     return f"bumprtl vectors --pipeline {scene_part} " + " ".join(parts)
 
 
+def _unit_vectors(args, module):
+    """``--unit``: the vectors of a datapath unit and the line that reproduces them."""
+    if args.pipeline is not None:
+        raise BumpError(f"--unit {args.unit} and --pipeline {args.pipeline}: give one of them")
+    given = [*map_overrides(args), *(k for k in ("load", "top", "device")
+                                     if getattr(args, k) is not None)]
+    if given:
+        raise BumpError(f"--{given[0].replace('_', '-')} applies to --pipeline (a scene's "
+                        f"memories and host ports), not to --unit {args.unit}")
+    cfg = config_from_args(args)
+    vectors = unit_vectors(args.unit, cfg, args.source, args.count, args.seed)
+    emit = canonical_command(UNITS[args.unit], cfg, module)
+    flags = emit[len(f"bumprtl emit {args.unit}"):]
+    return vectors, (f"bumprtl vectors --unit {args.unit}{flags} --source "
+                     f"{shlex.quote(str(args.source))} --count {len(vectors)} --seed {args.seed}")
+
+
 def run(args):
-    module = _identifier("--name", args.name) or default_module("pipeline")
+    module = _identifier("--name", args.name) or default_module(args.unit or "pipeline")
     top = _identifier("--top", args.top)
     if args.count is not None:
         check_count(args.count)
-    if args.pipeline not in BUILTIN and not Path(args.pipeline).is_file():
-        raise BumpError(f"--pipeline must be a scene TOML file or one of {', '.join(BUILTIN)}, "
-                        f"got {args.pipeline!r}")
-    scene = scene_from_args(args, args.pipeline)
-    vectors = pipeline_vectors(scene, args.source, args.count, args.seed)
-    command = _command(scene, args, module, top, len(vectors))
+    if args.unit is not None:
+        vectors, command = _unit_vectors(args, module)
+    else:
+        pipeline = args.pipeline or "default"
+        if pipeline not in BUILTIN and not Path(pipeline).is_file():
+            raise BumpError(f"--pipeline must be a scene TOML file or one of "
+                            f"{', '.join(BUILTIN)}, got {pipeline!r}")
+        scene = scene_from_args(args, pipeline)
+        vectors = pipeline_vectors(scene, args.source, args.count, args.seed)
+        command = _command(scene, args, module, top, len(vectors))
     paths = write_vectors(vectors, args.out, module, args.load or "initial", top,
                           args.device or DEFAULT_DEVICE, command)
     print(f"wrote {len(paths)} files to {args.out}: {module}_tb.v, the design "
@@ -92,9 +123,14 @@ def add_parser(sub):
                                    "first mismatch: pixel, field, got, expected), a timeout if "
                                    "the pipeline hangs.\n\n" + EXAMPLES,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--pipeline", default="default", metavar="FILE|NAME",
+    p.add_argument("--pipeline", default=None, metavar="FILE|NAME",
                    help="the scene class: a built-in scene (sim/scenes/config.py) or a TOML "
                         "file, as emit --scene and render --pipeline (default: default)")
+    p.add_argument("--unit", default=None, choices=sorted(UNIT_SOURCES),
+                   help="a datapath unit instead of a pipeline, as bumprtl emit UNIT names it, "
+                        "with the Config flags (--method, --angle-bits, ...); rotation takes "
+                        "every source, illumination frame or random (its inputs are the "
+                        "rotation's outputs of those pixels)")
     p.add_argument("--source", default="random", metavar="frame|random|FILE",
                    help=f"the pixels: one of {sources} (the scene's own frame, the stimulus "
                         f"render streams; seeded random valid pixels), or a .csv (header row) "

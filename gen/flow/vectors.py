@@ -44,21 +44,25 @@ from bumprtl.gen.flow.memories import (
     scene_command,
 )
 from bumprtl.gen.flow.named import named_module, named_ports, write_named
+from bumprtl.gen.flow.units import UNITS, emit_unit
 from bumprtl.gen.flow.vectors_tb import bench_verilog, run_commands
-from bumprtl.gen.render.rtl import scene_memories, scene_stimulus
+from bumprtl.gen.render.rtl import scene_memories, scene_stimulus, sim_scene
 from bumprtl.rtl.bumpfetch import coord_bits, level_bits
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed.palette_lut import palette_colors
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
 from bumprtl.sim.golden.methods import encode_pixels
-from bumprtl.sim.scenes.config import SceneConfig
+from bumprtl.sim.golden.methods import get as get_models
+from bumprtl.sim.golden.vectors import random_codes
+from bumprtl.sim.scenes.config import SceneConfig, load_scene_config
 
 __all__ = ["SOURCES", "MAX_COUNT", "DEFAULT_COUNT", "Vectors", "pipeline_fields",
            "pixel_columns", "read_user_pixels", "encode_user_pixels", "pipeline_vectors",
-           "write_vectors", "run_commands"]
+           "write_vectors", "run_commands", "UNIT_SOURCES", "unit_fields", "rotation_columns",
+           "unit_vectors", "check_count"]
 
 SOURCES = ("frame", "random")          # or a .csv / .npy file of the user's pixels
 MAX_COUNT = 1 << 20                    # pixels (a 1024 x 1024 frame)
@@ -71,11 +75,12 @@ _TWO_PI = 2 * math.pi
 class Vectors:
     """Pixels for one scene pipeline and what it must output.
 
+    ``unit``: ``pipeline`` (of ``scene``) or a unit of :data:`UNIT_SOURCES` (of ``config``).
     ``inputs``/``expected``: ``{payload field: int64 array}`` keyed like the flattened
     payloads (``"n.phi"``, ``"color"``, ``"tag"``); ``words``, ``texels``, ``table``: the
     memories (None where the scene has none); ``polygon``: a flat map's polygon registers.
     """
-    scene: SceneConfig
+    scene: SceneConfig | None          # None for a unit
     source: str
     seed: int
     inputs: dict
@@ -84,6 +89,8 @@ class Vectors:
     texels: object = None
     table: object = None
     polygon: dict = None
+    unit: str = "pipeline"
+    config: Config | None = None       # a unit's Config (a pipeline's is its scene's)
 
     def __len__(self):
         return len(self.inputs["tag"])
@@ -128,15 +135,18 @@ def pixel_columns(scene: SceneConfig):
     return out
 
 
-def _ranges(scene: SceneConfig):
-    """Allowed range of each kind of column: (low, high, text)."""
-    half = 1 << (coord_bits(scene) - 1)
-    return {"coord": (-half, half - 1, f"integers in [{-half}, {half - 1}]"),
-            "level": (0, (1 << level_bits(scene)) - 1,
-                      f"integers in [0, {(1 << level_bits(scene)) - 1}]"),
-            "phi": (0.0, _TWO_PI, "radians in [0, 2*pi]"),
-            "theta": (0.0, math.pi, "radians in [0, pi]"),
-            "tag": (0, (1 << scene.tag_bits) - 1, f"integers in [0, {(1 << scene.tag_bits) - 1}]")}
+def _ranges(scene: SceneConfig | None, cfg: Config):
+    """Allowed range of each kind of column: (low, high, text); coordinates and levels only
+    with a scene."""
+    tag = (1 << cfg.tag_bits) - 1
+    out = {"phi": (0.0, _TWO_PI, "radians in [0, 2*pi]"),
+           "theta": (0.0, math.pi, "radians in [0, pi]"),
+           "tag": (0, tag, f"integers in [0, {tag}]")}
+    if scene is not None:
+        half, top = 1 << (coord_bits(scene) - 1), (1 << level_bits(scene)) - 1
+        out.update({"coord": (-half, half - 1, f"integers in [{-half}, {half - 1}]"),
+                    "level": (0, top, f"integers in [0, {top}]")})
+    return out
 
 
 def _read_table(path: Path):
@@ -180,27 +190,32 @@ def read_user_pixels(path, scene: SceneConfig):
     coordinates and levels integers in the port's range, ``*_phi`` in [0, 2 pi], ``*_theta``
     in [0, pi] radians, ``tag`` (optional) an integer of ``tag_bits``. A
     :class:`BumpError` names the parameter, the column and the allowed range."""
+    return _user_table(path, pixel_columns(scene), _ranges(scene, scene.config),
+                       f"the {scene.name} pipeline")
+
+
+def _user_table(path, columns, ranges, what):
+    """:func:`read_user_pixels` for the ``columns`` (``{column: (field, kind)}``, ``tag``
+    last and optional) of ``what``."""
     path = Path(path)
     if path.suffix.lower() not in (".csv", ".npy"):
         raise BumpError(f"--source must be one of {', '.join(SOURCES)} or a .csv or .npy file, "
                         f"got {str(path)!r}")
     if not path.is_file():
         raise BumpError(f"--source {path}: no such file")
-    columns = pixel_columns(scene)
     need = [c for c in columns if c != "tag"]
     table, rows = _read_table(path)
     if isinstance(table, list):                          # a 2-D .npy: columns by position
         if len(table) not in (len(need), len(need) + 1):
-            raise BumpError(f"--source {path}: {len(table)} columns; the {scene.name} pipeline "
-                            f"takes {len(need)} ({', '.join(need)}) and an optional tag")
+            raise BumpError(f"--source {path}: {len(table)} columns; {what} takes "
+                            f"{len(need)} ({', '.join(need)}) and an optional tag")
         table = dict(zip([*need, "tag"], table, strict=False))
     names = set(table)
     if names - set(columns) or set(need) - names:
         raise BumpError(f"--source {path}: columns must be {', '.join(need)} (and optionally "
-                        f"tag) for the {scene.name} pipeline, got {', '.join(table)}")
+                        f"tag) for {what}, got {', '.join(table)}")
     if rows == 0:
         raise BumpError(f"--source {path}: no pixels (a header only)")
-    ranges = _ranges(scene)
     for col, values in table.items():
         lo, hi, text = ranges[columns[col][1]]
         integral = columns[col][1] in ("coord", "level", "tag")
@@ -255,12 +270,8 @@ def check_count(count):
         raise BumpError(f"--count must be an integer in [1, {MAX_COUNT}], got {count!r}")
 
 
-def pipeline_vectors(scene: SceneConfig, source="random", count=None, seed=1) -> Vectors:
-    """:class:`Vectors` of ``count`` pixels (None: DEFAULT_COUNT, or every row of a file) from
-    ``source`` (``frame``, ``random`` or a .csv/.npy path; module docstring) for the
-    pipeline of ``scene``; ``seed`` seeds the random pixels. Bad input raises a
-    :class:`BumpError` naming the parameter; nothing is written."""
-    source = str(source)
+def _check_source(source, count, seed):
+    """The checks every source shares; returns the pixel count of a frame or random source."""
     if source not in SOURCES and Path(source).suffix.lower() not in (".csv", ".npy"):
         raise BumpError(f"--source must be one of {', '.join(SOURCES)} or a .csv or .npy file, "
                         f"got {source!r}")
@@ -268,19 +279,32 @@ def pipeline_vectors(scene: SceneConfig, source="random", count=None, seed=1) ->
         check_count(count)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 1 << 31:
         raise BumpError(f"--seed must be an integer in [0, {(1 << 31) - 1}], got {seed!r}")
-    n = DEFAULT_COUNT if count is None else count
+    return DEFAULT_COUNT if count is None else count
+
+
+def _file_count(table, source, count):
+    """The pixels taken from a file: every row, or the first ``count``."""
+    rows = len(next(iter(table.values())))
+    if count is not None and count > rows:
+        raise BumpError(f"--count must be at most the {rows} pixels of {source}, got {count}")
+    return rows if count is None else count
+
+
+def pipeline_vectors(scene: SceneConfig, source="random", count=None, seed=1) -> Vectors:
+    """:class:`Vectors` of ``count`` pixels (None: DEFAULT_COUNT, or every row of a file) from
+    ``source`` (``frame``, ``random`` or a .csv/.npy path; module docstring) for the
+    pipeline of ``scene``; ``seed`` seeds the random pixels. Bad input raises a
+    :class:`BumpError` naming the parameter; nothing is written."""
+    source = str(source)
+    n = _check_source(source, count, seed)
     fields, outs, _ = pipeline_fields(scene)
     user = None
     if source not in SOURCES:                  # checked before any map or frame is built
         user = read_user_pixels(source, scene)
-        rows = len(next(iter(user.values())))
-        if count is not None and count > rows:
-            raise BumpError(f"--count must be at most the {rows} pixels of {source}, got {count}")
-        n = rows if count is None else count
+        n = _file_count(user, source, count)
         user = {k: v[:n] for k, v in user.items()}
     words, texels, table = scene_memories(scene)
-    side = _frame_side(n)
-    frame, _, polygon, _, _ = scene_stimulus(scene, side)
+    frame, _, polygon, _, _ = scene_stimulus(scene, _frame_side(n))
     if source == "frame":
         inputs = {k: v[:n] for k, v in frame.items()}
     elif source == "random":
@@ -306,6 +330,93 @@ def pipeline_vectors(scene: SceneConfig, source="random", count=None, seed=1) ->
     return Vectors(scene, source, seed, inputs, expected, words, texels, table, polygon)
 
 
+# unit -> the sources it takes (its inputs are the datapath's: no map, no memories)
+UNIT_SOURCES = {"rotation": ("frame", "random", "file"), "illumination": ("frame", "random")}
+_PIXEL_KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
+
+
+def unit_fields(unit, cfg: Config):
+    """``(input fields, output fields)`` of unit ``unit`` (gen/flow/units.py) at ``cfg``."""
+    dut = UNITS[unit].build(cfg)
+    dut._MustUse__silence = True
+    ports = port_table(dut)
+    return ports["i__payload"]["fields"], ports["o__payload"]["fields"]
+
+
+def rotation_columns(cfg: Config):
+    """The columns of a pixel file for the rotation unit: N, L, (H with specular) and the
+    bump normal N' (``b``) as polar angles in radians, ``tag`` optional; as
+    :func:`pixel_columns`."""
+    keys = [k for k in _PIXEL_KEYS if cfg.specular or not k.startswith("h.")]
+    return {**{_column(k): (k, k.rsplit(".", 1)[1]) for k in keys}, "tag": ("tag", "tag")}
+
+
+def unit_vectors(unit, cfg: Config, source="random", count=None, seed=1) -> Vectors:
+    """:class:`Vectors` of ``count`` pixels for the rotation or illumination unit of ``cfg``:
+    ``frame`` (the default scene's frame, encoded by the method's encoder,
+    sim/golden/methods.encode_pixels), ``random`` (sim/golden/vectors.random_codes: valid
+    pixels, as the method's input codes) or, for rotation, a .csv/.npy of physical angles
+    (:func:`rotation_columns`). Illumination's inputs are the rotation's outputs of those
+    pixels. Expected outputs: the method's bit-exact models."""
+    if unit not in UNIT_SOURCES:
+        raise BumpError(f"--unit must be one of {', '.join(UNIT_SOURCES)}, got {unit!r}")
+    source = str(source)
+    is_file = source not in SOURCES
+    if is_file and "file" not in UNIT_SOURCES[unit]:
+        raise BumpError(f"--source FILE applies to --pipeline and --unit rotation (the "
+                        f"{unit} unit's inputs are rotated terms, not angles); use "
+                        f"{' or '.join(UNIT_SOURCES[unit])}")
+    n = _check_source(source, count, seed)
+    fields, outs = unit_fields(unit, cfg)
+    mask = (1 << cfg.tag_bits) - 1
+    models = get_models(cfg.method)
+    if is_file:
+        table = _user_table(source, rotation_columns(cfg), _ranges(None, cfg), "the rotation unit")
+        n = _file_count(table, source, count)
+        zero = np.zeros(n)
+        px = PixelInputs(**{f.replace(".", "_"): table.get(_column(f), zero)[:n]
+                            for f in _PIXEL_KEYS})
+        codes = encode_pixels(px, cfg)
+        tag = table.get("tag")
+        tag = np.arange(n) & mask if tag is None else np.rint(tag[:n])
+    elif source == "frame":
+        side = _frame_side(n)
+        px = sim_scene(load_scene_config("default"), side).px
+        codes = {k: np.asarray(v).ravel()[:n] for k, v in encode_pixels(px, cfg).items()}
+        tag = np.arange(n) & mask
+    else:
+        codes = models.from_angle_codes(random_codes(n, cfg, seed), cfg)
+        tag = np.arange(n) & mask
+    codes = {k: np.asarray(v, np.int64) for k, v in codes.items()}
+    rot = models.rotation_fixed(codes, cfg)
+    inputs, golden = (codes, rot) if unit == "rotation" else (rot, models.illumination_fixed(rot, cfg))
+    inputs = {**{k: np.asarray(inputs[k], np.int64) for k in fields if k != "tag"},
+              "tag": np.asarray(tag, np.int64)}
+    missing = set(outs) - set(golden) - {"tag"}
+    if missing:
+        raise AssertionError(f"the golden model gives no {', '.join(sorted(missing))}")
+    expected = {**{k: np.asarray(golden[k], np.int64) for k in outs if k != "tag"},
+                "tag": inputs["tag"]}
+    return Vectors(None, source, seed, inputs, expected, unit=unit, config=cfg)
+
+
+def _emit_unit_named(v: Vectors, out, module):
+    """A rotation or illumination unit emitted as ``bumprtl emit UNIT --ports named``."""
+    vpath, jpath = emit_unit(v.unit, v.config, out, module=module)
+    return _add_named(vpath, jpath), [vpath, vpath.with_name(f"{named_module(module)}.v"), jpath]
+
+
+def _add_named(vpath, jpath):
+    """Write the named-ports wrapper and record it in the sidecar; returns the sidecar."""
+    meta = json.loads(jpath.read_text())
+    command = meta["command"] + " --ports named"
+    write_named(vpath, meta, command)
+    meta["named_ports"] = {"module": named_module(vpath.stem), "command": command,
+                           "ports": named_ports(meta)}
+    jpath.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    return meta
+
+
 def _emit_named(v: Vectors, out, module, load, device):
     """The pipeline emitted as ``bumprtl emit pipeline --ports named`` does it: ``(sidecar,
     paths)``."""
@@ -313,13 +424,8 @@ def _emit_named(v: Vectors, out, module, load, device):
     vpath, jpath, hexes = emit_scene_unit("pipeline", v.scene, out, images, device,
                                           scene_command("pipeline", v.scene, load, module),
                                           module=module)
-    meta = json.loads(jpath.read_text())
-    command = meta["command"] + " --ports named"
-    wrapper = write_named(vpath, meta, command)
-    meta["named_ports"] = {"module": named_module(vpath.stem), "command": command,
-                           "ports": named_ports(meta)}
-    jpath.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
-    return meta, [vpath, wrapper, jpath, *hexes]
+    meta = _add_named(vpath, jpath)
+    return meta, [vpath, vpath.with_name(f"{named_module(module)}.v"), jpath, *hexes]
 
 
 def _field_hex(values, width):
@@ -344,10 +450,13 @@ def write_vectors(v: Vectors, out, module="bumprtl_pipeline", load="initial", to
     maps itself) instead of ``<module>_named``. Returns the paths written."""
     if load not in LOADS:
         raise BumpError(f"--load must be one of {', '.join(LOADS)}, got {load!r}")
-    if device is not None:
-        check_scene_fits(v.scene, device)      # refused before anything is written
     out = Path(out)
-    meta, paths = _emit_named(v, out, module, load, device)
+    if v.scene is None:                        # a unit: no memories to load or fit
+        meta, paths = _emit_unit_named(v, out, module)
+    else:
+        if device is not None:
+            check_scene_fits(v.scene, device)  # refused before anything is written
+        meta, paths = _emit_named(v, out, module, load, device)
     ports = meta["named_ports"]["ports"]
     for direction, values in (("in", v.inputs), ("out", v.expected)):
         for field, arr in values.items():
@@ -360,7 +469,8 @@ def write_vectors(v: Vectors, out, module="bumprtl_pipeline", load="initial", to
         poly = out / f"{module}_poly.hex"
         poly.write_text(hex_text([_poly_word(meta, v.polygon)], meta["ports"]["poly"]["width"]))
         paths.append(poly)
-    command = command or f"bumprtl vectors --pipeline {v.scene.name} --count {len(v)}"
+    command = command or (f"bumprtl vectors --unit {v.unit}" if v.scene is None else
+                          f"bumprtl vectors --pipeline {v.scene.name}") + f" --count {len(v)}"
     tb = out / f"{module}_tb.v"
     tb.write_text(bench_verilog(meta, module, len(v), v.seed, command, top=top))
     paths.append(tb)

@@ -187,6 +187,28 @@ def test_users_physical_values_encode_to_the_documented_binary_angles(tmp_path):
             assert got["tag"].tolist() == list(range(n))
 
 
+def test_rotation_unit_bench_with_the_users_angles(tmp_path):
+    """``--unit rotation``: the unit alone behind its named ports, the user's N, L, H and N'
+    (``b_*``) in radians encoded as the documented binary angles, PASS on Icarus."""
+    from bumprtl.gen.cli.main import main
+    rng = np.random.default_rng(11)
+    n, k = 60, 10
+    cols = {f"{v}_{a}": _angles(rng, n, 2 * math.pi if a == "phi" else math.pi)
+            for v in "nlhb" for a in ("phi", "theta")}
+    _write_csv(tmp_path / "px.csv", {c: [repr(float(x)) for x in v] for c, v in cols.items()})
+    out = tmp_path / "rot"
+    assert main(["vectors", "--unit", "rotation", "--angle-bits", str(k), "--frac-bits", "11",
+                 "--source", str(tmp_path / "px.csv"), "--out", str(out)]) == 0
+    for c, v in cols.items():
+        words = (out / f"bumprtl_rotation_in_{c}.hex").read_text().split()
+        assert [int(w, 16) for w in words] == \
+            [int(math.floor(x / (2 * math.pi) * 2 ** k + 0.5)) % 2 ** k for x in v], c
+    tb = "bumprtl_rotation_tb"
+    subprocess.run(["iverilog", "-g2005", "-s", tb, "-o", "tb.vvp", f"{tb}.v",
+                    "bumprtl_rotation_named.v", "bumprtl_rotation.v"], cwd=out, check=True)
+    assert _vvp(out, out / "tb.vvp")[-1] == f"PASS {n}"
+
+
 def test_frame_source_is_the_renders_stimulus_and_random_is_seeded():
     from bumprtl.gen.render.rtl import scene_stimulus
     scene = load_scene_config("default")
@@ -215,6 +237,13 @@ BAD = [
     (["--name", "9bad"], "--name must be a Verilog identifier"),
     (["--top", "a-b"], "--top must be a Verilog identifier"),
     (["--seed", "-1"], "--seed must be an integer in [0, 2147483647], got -1"),
+    (["--unit", "illumination", "--source", "{dir}/good.csv"],
+     "--source FILE applies to --pipeline and --unit rotation"),
+    (["--unit", "rotation", "--pipeline", "default"], "--unit rotation and --pipeline default"),
+    (["--unit", "rotation", "--load", "port"], "--load applies to --pipeline"),
+    (["--unit", "rotation", "--source", "{dir}/good.csv"],
+     "columns must be n_phi, n_theta, l_phi, l_theta, h_phi, h_theta, b_phi, b_theta"),
+    (["--unit", "rotation", "--angle-bits", "99"], "angle_bits"),
 ]
 
 
