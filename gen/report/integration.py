@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE
 from bumprtl.gen.flow.named import named_ports
 from bumprtl.gen.render.rtl import scene_memories
@@ -109,7 +110,6 @@ def emit_for_integration(scene, out_dir, name=NAME, flags=()):
     """Emit ``scene``'s pipeline with ``bumprtl emit pipeline --scene SCENE [FLAGS] --load port
     --name NAME --ports named --out OUT_DIR`` (the command itself, in process; ``scene`` a
     name or a TOML path, ``flags`` further ``bumprtl emit`` flags); returns its sidecar."""
-    from bumprtl.gen.cli.main import main
     argv = ["emit", "pipeline", "--scene", str(scene), *flags, "--load", "port", "--name", name,
             "--ports", "named", "--out", str(out_dir)]
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
