@@ -59,10 +59,13 @@ def _identifier(flag, value):
 def _command(scene, args, module, top, count):
     """The ``bumprtl vectors`` line that reproduces the files (no output directory): the
     scene and its flags as emit's reproducing line gives them."""
-    emit = scene_command("pipeline", scene, args.load or "initial", module)
+    # the map's own flags too (emit's line leaves them out under --load port: the Verilog
+    # is the same for every map; the expected outputs are not)
+    emit = scene_command("pipeline", scene, "initial", module)
     scene_part = emit[len("bumprtl emit pipeline --scene "):]
     parts = [f"--source {shlex.quote(str(args.source))}", f"--count {count}",
-             f"--seed {args.seed}"] + ([f"--top {top}"] if top else [])
+             f"--seed {args.seed}"] + ([f"--load {args.load}"] if args.load == "port" else []) \
+        + ([f"--top {top}"] if top else [])
     return f"bumprtl vectors --pipeline {scene_part} " + " ".join(parts)
 
 
@@ -114,7 +117,7 @@ def add_parser(sub):
     p = sub.add_parser("vectors", help="test vectors and a self-checking Verilog bench for an "
                                        "emitted pipeline",
                        description="Write the pipeline of a scene (as `bumprtl emit pipeline "
-                                   "--ports named`), stimulus and the bit-exact golden model's "
+                                   "--ports named`; or a datapath unit, --unit), stimulus and the bit-exact golden model's "
                                    "expected outputs as $readmemh files (one per field), and "
                                    "NAME_tb.v, a self-checking plain Verilog-2005 bench for "
                                    "Icarus and Verilator: input gaps and output backpressure "

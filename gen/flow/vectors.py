@@ -1,5 +1,6 @@
-"""Test vectors for an emitted scene pipeline (``bumprtl vectors``): stimulus, the expected
-outputs of the bit-exact golden model, and a self-checking Verilog bench for them.
+"""Test vectors for an emitted scene pipeline, or a rotation or illumination unit alone
+(``bumprtl vectors``): stimulus, the expected outputs of the bit-exact golden model, and a
+self-checking Verilog bench for them.
 
 Three sources of pixels:
 
@@ -13,6 +14,9 @@ Three sources of pixels:
   encoded to the port codes by the golden model's one encoder,
   sim/golden/methods.encode_pixels (binary angles: ``round(angle / 2 pi * 2**angle_bits)``
   modulo the full circle).
+
+A unit (:func:`unit_vectors`) takes the datapath's inputs: the default scene's frame, random
+pixels, or for rotation a file of N, L, H and N' angles (:func:`rotation_columns`).
 
 The memories (bump map, colour texture, palette colour table) are the ones ``bumprtl emit``
 builds into or writes beside the design (gen/render/rtl.scene_memories), and a flat map's
