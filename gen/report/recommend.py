@@ -28,7 +28,7 @@ from bumprtl.gen.bench.sweep import (
 )
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["recommend", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
+__all__ = ["recommend", "rank_key", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
            "evidence_line"]
 
 LOCAL_SWEEP = Path("build/bench/sweep.json")          # what `bumprtl bench sweep` writes
@@ -88,9 +88,22 @@ def evidence_line(data):
     return "evidence: maps " + ", ".join(describe_map(m) for m in maps)
 
 
+def rank_key(point, device=None):
+    """The order of :func:`recommend`'s candidates: cheapest first by :func:`cost_key`; equal
+    cost, the smaller worst colour error (:func:`error_lsb`); equal again, the narrower
+    configuration (angle_bits, then frac_bits, then palette_size), then the method name.
+    A total order on distinct configurations, so the answer never depends on the order of
+    the sweep's points."""
+    c = point.get("config", {})
+    width = lambda k: point.get(k, c.get(k, 0)) or 0
+    return (cost_key(point, device), error_lsb(point), width("angle_bits"), width("frac_bits"),
+            width("palette_size"), point["method"])
+
+
 def recommend(data, max_error_lsb, device=None):
-    """``(best, candidates)``: the points meeting the bound (and fitting ``device``), cheapest
-    first by :func:`cost_key`; raises BumpError when none does. A palette point in
+    """``(best, candidates)``: the points meeting the bound (and fitting ``device``) in
+    :func:`rank_key`'s order (cheapest first; ties by error, then the narrower widths, then
+    the method name); raises BumpError when none does. A palette point in
     :func:`not_evidence` is never a candidate."""
     if isinstance(max_error_lsb, bool) or not isinstance(max_error_lsb, (int, float)) or max_error_lsb < 0:
         raise BumpError(f"max_error_lsb must be a number >= 0, got {max_error_lsb!r}")
@@ -103,7 +116,7 @@ def recommend(data, max_error_lsb, device=None):
                             f"`bumprtl bench sweep --fpga --device {device}` first")
         points = [p for p in placed if _fits(p, device)]
     meeting = sorted((p for p in points if error_lsb(p) <= max_error_lsb),
-                     key=lambda p: (cost_key(p, device), error_lsb(p)))
+                     key=lambda p: rank_key(p, device))
     if not meeting:
         best = min((error_lsb(p) for p in points), default=None)
         raise BumpError(f"no configuration in the sweep meets max_error_lsb = {max_error_lsb}"
