@@ -9,8 +9,6 @@ commands run in it one after the other through ``main(argv)``.
 
 import argparse
 
-import pytest
-
 from bumprtl.gen import __version__
 from bumprtl.gen.cli.main import COMMANDS, OPTIONAL, build_parser
 from tests.gen.cli.core_install import core_distributions, hidden, run_cli
@@ -70,48 +68,54 @@ def test_every_optional_module_names_an_extra():
     assert imported <= set(OPTIONAL)
 
 
-@pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    """Every command's --help, --version, the core commands and the refusals, run once in
-    one core-install subprocess."""
-    work = tmp_path_factory.mktemp("core")
+def _help_problem(argv, r):
+    if r["code"] != 0 or r["err"]:
+        return f"exit {r['code']}, stderr {r['err']!r}"
+    if not r["out"].startswith(f"usage: bumprtl {' '.join(argv[:-1])}".rstrip()):
+        return "no usage on stdout"
+    if "needs the [" in r["out"]:                      # a command listed as missing its extra
+        return "a command is listed as needing an extra"
+    return None
+
+
+def _core_problem(writes, r, work):
+    if r["code"] != 0 or "Traceback" in r["err"]:
+        return f"exit {r['code']}, stderr {r['err'][-300:]!r}"
+    if writes is not None and not (work / writes).is_file():
+        return f"{writes} not written"
+    if writes is None and not ("core:" in r["out"] and "[sim]: not installed" in r["out"]):
+        return "doctor does not list the core and the [sim] extra as not installed"
+    return None
+
+
+def _refusal_problem(argv, extra, r, work):
+    err = r["err"].splitlines()
+    if r["code"] != 2 or len(err) != 1:
+        return f"exit {r['code']}, {len(err)} stderr lines {r['err'][-300:]!r}"
+    if not (err[0].startswith("bumprtl: error: ") and f"pip install 'bumprtl[{extra}]'" in err[0]):
+        return f"does not name [{extra}]: {err[0]!r}"
+    if (work / argv[argv.index("--out") + 1]).exists():
+        return "wrote its --out"
+    return None
+
+
+def test_a_core_install_runs_the_core_and_names_each_missing_extra(tmp_path):
+    """One subprocess (one test, so xdist never runs it twice): --version; --help and every
+    command's and kind's --help; the core commands, each writing its file; each command
+    needing an extra: one stderr line naming it, exit 2, nothing written."""
     paths = command_paths()
-    argvs = ([["--version"], ["--help"]] + [[*p, "--help"] for p in paths]
-             + [argv for argv, _ in CORE] + [argv for argv, _ in NEEDS_EXTRA])
-    runs = run_cli(argvs, work)
-    return work, paths, {" ".join(r["argv"]): r for r in runs}
-
-
-def test_version_and_every_help_run_without_any_extra(results):
-    _, paths, runs = results
-    assert runs["--version"]["code"] == 0
-    assert runs["--version"]["out"] == f"bumprtl {__version__}\n"
     assert {p[0] for p in paths} == {c for c, _, _ in COMMANDS}
     assert len(paths) > len(COMMANDS)                 # the kinds of bench, report, emit... too
-    for argv in [["--help"]] + [[*p, "--help"] for p in paths]:
-        r = runs[" ".join(argv)]
-        assert r["code"] == 0 and r["err"] == "", (argv, r["code"], r["err"])
-        assert r["out"].startswith(f"usage: bumprtl {' '.join(argv[:-1])}".rstrip()), argv
-        assert "needs the [" not in r["out"], argv      # no command listed as missing
-
-
-@pytest.mark.parametrize("argv, writes", CORE, ids=[" ".join(a[:2]) for a, _ in CORE])
-def test_the_core_commands_run_without_any_extra(results, argv, writes):
-    work, _, runs = results
-    r = runs[" ".join(argv)]
-    assert r["code"] == 0, (r["out"], r["err"])
-    assert "Traceback" not in r["err"]
-    if writes is not None:
-        assert (work / writes).stat().st_size > 0
-    else:                                              # doctor: the extras not installed
-        assert "core:" in r["out"] and "[sim]: not installed" in r["out"], r["out"]
-
-
-@pytest.mark.parametrize("argv, extra", NEEDS_EXTRA, ids=[" ".join(a[:2]) for a, _ in NEEDS_EXTRA])
-def test_a_command_needing_an_extra_says_which_in_one_line(results, argv, extra):
-    work, _, runs = results
-    r = runs[" ".join(argv)]
-    err = r["err"].splitlines()
-    assert r["code"] == 2 and len(err) == 1, (argv, r["code"], r["err"])
-    assert err[0].startswith("bumprtl: error: ") and f"pip install 'bumprtl[{extra}]'" in err[0]
-    assert not (work / argv[argv.index("--out") + 1]).exists()       # nothing written
+    helps = [["--help"]] + [[*p, "--help"] for p in paths]
+    runs = run_cli([["--version"], *helps, *[a for a, _ in CORE], *[a for a, _ in NEEDS_EXTRA]],
+                   tmp_path)
+    runs = {" ".join(r["argv"]): r for r in runs}
+    assert runs["--version"]["code"] == 0
+    assert runs["--version"]["out"] == f"bumprtl {__version__}\n"
+    problems = [(argv, _help_problem(argv, runs[" ".join(argv)])) for argv in helps]
+    problems += [(argv, _core_problem(writes, runs[" ".join(argv)], tmp_path))
+                 for argv, writes in CORE]
+    problems += [(argv, _refusal_problem(argv, extra, runs[" ".join(argv)], tmp_path))
+                 for argv, extra in NEEDS_EXTRA]
+    problems = [f"bumprtl {' '.join(argv)}: {why}" for argv, why in problems if why]
+    assert not problems, "\n".join(problems)
