@@ -77,7 +77,7 @@ _TWO_PI = 2 * math.pi
 
 @dataclass
 class Vectors:
-    """Pixels for one scene pipeline and what it must output.
+    """Pixels for one scene pipeline (or one unit) and what it must output.
 
     ``unit``: ``pipeline`` (of ``scene``) or a unit of :data:`UNIT_SOURCES` (of ``config``).
     ``inputs``/``expected``: ``{payload field: int64 array}`` keyed like the flattened
@@ -266,10 +266,12 @@ def encode_user_pixels(table, scene: SceneConfig):
 
 
 def _frame_side(count):
+    """The side of the smallest frame of at least ``count`` pixels: a power of two >= 16."""
     return max(FRAME_MIN, 1 << max(0, math.ceil(math.sqrt(count)) - 1).bit_length())
 
 
 def check_count(count):
+    """A :class:`BumpError` naming ``--count`` unless 1 <= count <= MAX_COUNT."""
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_COUNT:
         raise BumpError(f"--count must be an integer in [1, {MAX_COUNT}], got {count!r}")
 
@@ -308,7 +310,9 @@ def pipeline_vectors(scene: SceneConfig, source="random", count=None, seed=1) ->
         n = _file_count(user, source, count)
         user = {k: v[:n] for k, v in user.items()}
     words, texels, table = scene_memories(scene)
-    frame, _, polygon, _, _ = scene_stimulus(scene, _frame_side(n))
+    # the frame gives the pixels (frame) and a flat map's polygon registers (every source)
+    frame, _, polygon, _, _ = scene_stimulus(scene, _frame_side(n) if source == "frame"
+                                             else FRAME_MIN)
     if source == "frame":
         inputs = {k: v[:n] for k, v in frame.items()}
     elif source == "random":
