@@ -87,9 +87,9 @@ def _stub(meta, valid):
     ports = meta["named_ports"]["ports"]
     decl = ",\n".join(f"  {'input' if p['dir'] == 'in' else 'output'} wire "
                       f"{f'[{w - 1}:0] ' if (w := p['width']) > 1 else ''}{n}" for n, p in ports.items())
-    outs = [n for n, p in ports.items() if p["dir"] == "out"]
-    body = "\n".join(f"  assign {n} = {1 if n in ('in_ready', 'out_valid') and (n == 'in_ready' or valid) else 0};"
-                     for n in outs)
+    value = {"in_ready": 1, "out_valid": int(valid)}          # every other output 0
+    body = "\n".join(f"  assign {n} = {value.get(n, 0)};" for n, p in ports.items()
+                     if p["dir"] == "out")
     return f"module {meta['named_ports']['module']} (\n{decl}\n);\n{body}\nendmodule\n"
 
 
