@@ -252,6 +252,7 @@ BAD = [
     (["--unit", "rotation", "--source", "{dir}/good.csv"],
      "columns must be n_phi, n_theta, l_phi, l_theta, h_phi, h_theta, b_phi, b_theta"),
     (["--unit", "rotation", "--angle-bits", "99"], "angle_bits"),
+    (["--unit", "rotation", "--ka", "0.5"], "--ka does not apply to --unit rotation"),
 ]
 
 
