@@ -69,8 +69,6 @@ def test_amaranth_top_matches_the_golden_model(capsys):
     example = _amaranth_example()
     assert example.main(["--pixels", "8"]) == 0
     assert capsys.readouterr().out.splitlines()[-1] == "PASS 8"
-    got, expected = example.simulate(8, seed=2)
-    assert len(got) == 8 and got == expected
 
 
 @pytest.mark.parametrize("bad", ["bump.map_w_en.eq(0)"])
