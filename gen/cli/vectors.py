@@ -66,7 +66,8 @@ def _command(scene, args, module, top, count):
     scene_part = emit[len("bumprtl emit pipeline --scene "):]
     parts = [f"--source {shlex.quote(str(args.source))}", f"--count {count}",
              f"--seed {args.seed}"] + ([f"--load {args.load}"] if args.load == "port" else []) \
-        + ([f"--top {top}"] if top else [])
+        + ([f"--top {top}"] if top else []) \
+        + ([f"--device {args.device}"] if args.device not in (None, DEFAULT_DEVICE) else [])
     return f"bumprtl vectors --pipeline {scene_part} " + " ".join(parts)
 
 
