@@ -78,7 +78,7 @@ MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py, before its 16 x 16 re
                     "full": "tests/sim/tb/test_tb_pipeline.py, before its 16 x 16 render frame",
                     **{name: "tests/sim/tb/test_bulk_scene_frames.py"
                        for name in ("diffuse", "flat", "textured", "two-lights", "palette")}}
-SECTIONS = ("netlist", "netlist-board")     # --doc-section: the markers a table goes between
+SECTIONS = ("netlist", "netlist-board", "netlist-seeds")   # --doc-section: a table's markers
 
 
 def markers(section="netlist"):
@@ -916,7 +916,8 @@ def main(argv=None):
     p.add_argument("--doc", type=Path, default=None, help="write the table into this file")
     p.add_argument("--doc-section", choices=SECTIONS, default="netlist",
                    help="the generated section --doc writes (default netlist; the board's "
-                        "units have their own, netlist-board)")
+                        "units have their own, netlist-board; netlist-seeds: runs at seeds the main table "
+                        "has not drawn)")
     p.add_argument("--doc-from", type=Path, action="append", default=[], metavar="JSON",
                    help="only write --doc from runs' netlist_results.json (repeatable: the "
                         "runs' tables merged; the targets each finished)")

@@ -415,8 +415,10 @@ def lay_out(dest, src, files):
         top = name.split("/", 1)[0]
         if top in PACKAGES:
             target = dest / "bumprtl" / PACKAGES[top] / name.split("/", 1)[1]
-        elif top in ("tests", "pyproject.toml", "CHANGELOG.md") or name == "docs/scenes.md":
-            target = dest / name      # test_version reads the changelog, the map flags' help test the doc
+        elif top in ("tests", "pyproject.toml", "CHANGELOG.md", "docs"):
+            # test_version reads the changelog; the map flags' help, the integration page's
+            # and the reports' tests read pages of docs/
+            target = dest / name
         else:
             continue
         target.parent.mkdir(parents=True, exist_ok=True)
