@@ -216,3 +216,10 @@ def test_a_target_that_fails_is_an_undecided_row_of_the_table():
                              "killed by signal 9"}], [("cmd", 11, 10, 1, 60.0)])
     row = next(l for l in block.splitlines() if l.startswith("| `pipeline:default`"))
     assert "undecided: prep: tool error: killed by signal 9" in row
+
+
+def test_a_step_out_of_time_leaves_the_survivor_undecided_with_its_limit(tmp_path):
+    from test_netlist_pdr import PIPE, reset_value_mutant
+    meta, line = reset_value_mutant(tmp_path, PIPE)     # pdr proves it in its time (60 s)
+    verdict = netlist.equivalence(None, meta, line, tmp_path, 1, steps=("pdr",))
+    assert verdict == "undecided: pdr: no proof within 1 s (no depth run)", verdict
