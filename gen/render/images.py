@@ -172,9 +172,20 @@ def run(args):
     if args.rtl:                                   # through the emitted pipeline (gen/render/rtl.py)
         if args.model != "float64":
             raise BumpError("--rtl renders through the hardware; --model applies without --rtl")
+        args.simulator = args.simulator or "verilator"
         return cli_render(args, render_scene(args, rtl=True))
-    if args.load is not None or args.device is not None or args.per_cycle:
-        raise BumpError("--load, --device and --per-cycle apply to --rtl only")
+    rtl_only = {"--load": args.load is not None, "--device": args.device is not None,
+                "--per-cycle": args.per_cycle, "--simulator": args.simulator is not None,
+                "--verbose": args.verbose}
+    if any(rtl_only.values()):
+        raise BumpError(f"{next(k for k, v in rtl_only.items() if v)} applies to --rtl only "
+                        f"(as --load, --device, --per-cycle, --simulator and --verbose)")
+    if args.pipeline is not None and args.model != "fixed":
+        raise BumpError("--pipeline applies to --rtl and --model fixed (the scene class the "
+                        "hardware builds); the float64 models draw --scene")
+    if args.palette_size is not None and (args.render_method or "exact") != PALETTE:
+        raise BumpError(f"--palette-size applies to --method palette, not "
+                        f"{args.render_method or 'exact'}")
     palette_opts = _palette_opts(args)
     scene = render_scene(args)
     t0 = time.perf_counter()
@@ -243,7 +254,8 @@ def add_parser(sub):
                         "(Tarini Sec. 5.1; a bad name lists them)")
     p.add_argument("--rtl", action="store_true",
                    help="render through the emitted BumpPipeline with cocotb; checks it equals the golden render")
-    p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"], help="with --rtl")
+    p.add_argument("--simulator", default=None, choices=["verilator", "icarus"],
+                   help="with --rtl (default: verilator)")
     p.add_argument("--verbose", action="store_true",
                    help="with --rtl: print the simulator's build and run output (by default it "
                         "goes to build/render_rtl/<scene>/tools.log, shown in full on a failure)")

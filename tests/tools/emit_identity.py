@@ -66,7 +66,7 @@ def emit_all(out):
                  for u in ("pipeline", "fetch") for s in BUILTIN]
         for label, argv in jobs:
             d = out / f"a{a}f{f}" / label
-            rc, err = _cli(["emit", *argv, *([] if "--scene" in argv else widths),
+            rc, err = _cli(["emit", *argv, *([] if "--scene" in argv or argv[0] == "palette" else widths),
                             "--out", str(d)])
             notes.append(f"{label} a{a}f{f}: rc {rc} {err}")
             print(f"{label} a{a}f{f}: rc {rc}", flush=True)
