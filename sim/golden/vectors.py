@@ -11,7 +11,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed.common import quantize_pixels
 
-__all__ = ["TINY", "corner_codes", "edge_codes", "random_codes", "as_payloads", "concat_codes"]
+__all__ = ["TINY", "corner_codes", "range_corners", "edge_codes", "random_codes", "as_payloads", "concat_codes"]
 
 KEYS = ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta", "b.phi", "b.theta")
 
@@ -42,6 +42,21 @@ def corner_codes(cfg: Config):
                 rows.append((n_phi, n_theta, *back, *back, b_phi, 0))
     arr = np.array(rows, dtype=np.int32)
     return {k: arr[:, i] for i, k in enumerate(KEYS)}
+
+
+def range_corners(ranges):
+    """The corners of independent integer fields, ``{field: (lo, hi)}`` (their ranges from
+    the Config or the sidecar): every field at ``lo`` at once, every field at ``hi`` at once,
+    then each field alone at ``hi`` (the rest at ``lo``) and alone at ``lo`` (the rest at
+    ``hi``). Dict of int64 arrays."""
+    keys = list(ranges)
+    lo = np.array([ranges[k][0] for k in keys], np.int64)
+    hi = np.array([ranges[k][1] for k in keys], np.int64)
+    rows = [lo, hi]
+    for i in range(len(keys)):
+        rows += [np.where(np.arange(len(keys)) == i, hi, lo), np.where(np.arange(len(keys)) == i, lo, hi)]
+    arr = np.stack(rows)
+    return {k: arr[:, i] for i, k in enumerate(keys)}
 
 
 def edge_codes(cfg: Config):

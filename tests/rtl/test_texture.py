@@ -11,6 +11,7 @@ from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 from bumprtl.rtl.texture import RGB, TextureBlend, blend_error_bound_lsb, texture_blend
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden.vectors import range_corners
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -65,10 +66,18 @@ def test_white_texel_gives_the_grey_shade_black_gives_the_highlight():
 
 
 def _unit_bit_exact(cfg, lights, pattern, n):
+    """The corners of every term (range_corners: every light's d at 2**B and s at 255 2**F
+    with white texels, all at 0, each alone), then ``n`` random pixels."""
     rng = np.random.default_rng(9)
-    inputs = [{**{f"d.{j}": int(rng.integers(cfg.one + 1)) for j in range(lights)},
-               **{f"s.{j}": int(rng.integers(255 << SPEC_FRAC_BITS)) for j in range(lights)},
-               **{f"texel.{c}": int(rng.integers(256)) for c in RGB}, "tag": t} for t in range(n)]
+    ranges = {**{f"d.{j}": (0, cfg.one) for j in range(lights)},
+              **{f"s.{j}": (0, 255 << SPEC_FRAC_BITS) for j in range(lights)},
+              **{f"texel.{c}": (0, 255) for c in RGB}}
+    corners = range_corners(ranges)
+    inputs = [{k: int(v[i]) for k, v in corners.items()} for i in range(len(corners["texel.r"]))]
+    inputs += [{**{f"d.{j}": int(rng.integers(cfg.one + 1)) for j in range(lights)},
+                **{f"s.{j}": int(rng.integers(255 << SPEC_FRAC_BITS)) for j in range(lights)},
+                **{f"texel.{c}": int(rng.integers(256)) for c in RGB}} for _ in range(n)]
+    inputs = [{**p, "tag": t % (1 << cfg.tag_bits)} for t, p in enumerate(inputs)]
     col = lambda k: np.array([p[k] for p in inputs])
     color, d, s = texture_blend([col(f"d.{j}") for j in range(lights)],
                                 [col(f"s.{j}") for j in range(lights)],
@@ -77,13 +86,12 @@ def _unit_bit_exact(cfg, lights, pattern, n):
     dut = TextureBlend(cfg, lights)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=2, pipe_handshake=True)
     assert_bit_exact(out, golden, inputs)
-    return dut, cycles
+    return dut, cycles, len(inputs)
 
 
 @pytest.mark.parametrize("pattern", list(PATTERNS))
 def test_unit_bit_exact(pattern):
-    n = 300
-    dut, cycles = _unit_bit_exact(Config(lights=2), 2, pattern, n)
+    dut, cycles, n = _unit_bit_exact(Config(lights=2), 2, pattern, 300)
     if pattern == "no_stall":
         assert cycles <= n + dut.latency + 1
 

@@ -12,6 +12,7 @@ from bumprtl.sim.golden.vectors import (
     corner_codes,
     edge_codes,
     random_codes,
+    range_corners,
 )
 
 
@@ -62,3 +63,12 @@ def test_corners_reach_both_ends_of_every_field_and_both_extremes_of_the_dots(cf
     assert out["diffuse_fine"].min() == 0 and out["ndotl"].min() < 0
     edges = edge_codes(cfg)
     assert all((edges[k][:len(c)] == c).all() for k, c in codes.items())
+
+
+def test_range_corners_put_every_field_at_both_ends_together_and_alone():
+    """All low, all high, then each field alone high and alone low."""
+    got = range_corners({"a": (0, 7), "b": (-4, 3), "c": (1, 1)})
+    rows = list(zip(*(got[k].tolist() for k in ("a", "b", "c")), strict=True))
+    assert rows[:2] == [(0, -4, 1), (7, 3, 1)]
+    assert rows[2:4] == [(7, -4, 1), (0, 3, 1)] and rows[4:6] == [(0, 3, 1), (7, -4, 1)]
+    assert len(rows) == 8 and all(v.dtype == np.int64 for v in got.values())
