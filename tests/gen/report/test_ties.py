@@ -1,7 +1,9 @@
 """Every ranking breaks its ties by the rule its docstring states, whatever the order of its
 input: ``bumprtl recommend`` (gen/report/recommend.rank_key: cost, then error, then the
 narrower widths, then the method name) and the sweep's Pareto front (gen/bench/sweep.
-pareto_front: of points tied in both coordinates the first is kept)."""
+pareto_front: of points tied in both coordinates the first is kept) and the seed a
+``report fpga`` row reports (gen/report/fpga.worst_run: the lowest Fmax, then the lowest
+seed)."""
 
 import json
 
@@ -9,6 +11,7 @@ import pytest
 
 from bumprtl.gen.bench.sweep import pareto_front
 from bumprtl.gen.cli.main import main
+from bumprtl.gen.report.fpga import worst_run
 from bumprtl.gen.report.recommend import recommend
 
 DEVICE = "LFE5U-25F"
@@ -80,3 +83,13 @@ def test_pareto_front_keeps_the_first_of_an_exact_tie_in_either_order():
     assert sorted(back) == [1, 3]          # reversed: the tie at indices 1, 2 -> the first, 1
     values = lambda ps, idx: sorted((ps[i]["x"], ps[i]["y"]) for i in idx)
     assert values(pts, front) == values(pts[::-1], back)
+
+
+def test_fpga_row_reports_the_worst_seed_and_the_lowest_seed_of_a_tie():
+    """report fpga's row is the seed with the lowest Fmax (a failed timing lowest of all);
+    of seeds tied on it, the lowest seed, whatever the order of --seeds."""
+    runs = [{"seed": 3, "fmax_mhz": 90.0, "LUT4": 1}, {"seed": 1, "fmax_mhz": 90.0, "LUT4": 2},
+            {"seed": 2, "fmax_mhz": 120.0, "LUT4": 3}]
+    for order in (runs, runs[::-1], runs[1:] + runs[:1]):
+        assert worst_run(order)["seed"] == 1
+    assert worst_run([*runs, {"seed": 9, "fmax_mhz": None}])["seed"] == 9
