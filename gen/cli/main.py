@@ -13,7 +13,7 @@ import sys
 from bumprtl.gen import __version__
 from bumprtl.gen.cli.doctor import requirements
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.toolchain import ToolMissing
+from bumprtl.gen.tools.toolchain import ToolMissing
 
 # Subcommand modules (each with add_parser), in the order `bumprtl --help` lists them: the
 # command, its module and the pip extra that holds the packages it needs beyond the core

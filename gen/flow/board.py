@@ -35,7 +35,7 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
 from bumprtl.sim.scenes import SCENES
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames"]

@@ -19,7 +19,7 @@ from amaranth.hdl import Elaboratable, Fragment, Shape
 from amaranth.lib import data, wiring
 
 from bumprtl.rtl.layouts import layout_fields
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["emit", "elaborated", "port_table", "lint"]
 

@@ -30,7 +30,7 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
-from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.gen.tools.toolchain import require, tool_env
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",
            "Placement", "place_text", "place_component", "placement_key"]
@@ -176,7 +176,7 @@ def elaborate(component, label):
 
 
 def place_text(text, label, device, lpf_text, seed=1):
-    """A placement job (sim/jobs.py): place Verilog ``text`` (top ``label``) with the
+    """A placement job (gen/tools/jobs.py): place Verilog ``text`` (top ``label``) with the
     constraints ``lpf_text`` in a temporary directory of the machine it runs on; returns
     ``{"row": the report row with the device's available resources, "files": the Yosys and
     nextpnr logs and report by name, "log": both logs}``. Needs no file of the client."""
@@ -233,7 +233,7 @@ def place_component(component, label, device, cache=CACHE, lpf=LPF, seed=1):
     (:func:`placement_key`), so ``report fpga`` and ``bench sweep --fpga`` share every
     placement and a changed datapath is placed anew. ``component`` must be built with
     ``target=ECP5()``, e.g. ``build_unit(name, cfg, ECP5())[0]``. ``report fpga`` runs the
-    same steps as jobs (:class:`Placement`, :func:`place_text` on sim/jobs.py's workers)."""
+    same steps as jobs (:class:`Placement`, :func:`place_text` on gen/tools/jobs.py's workers)."""
     p = Placement(component, label, device, cache, lpf, seed)
     if p.cached is not None:
         return p.cached

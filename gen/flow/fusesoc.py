@@ -8,7 +8,7 @@ the build directory, so a target runs from the core alone. Three targets:
 
 ``default``  the files and the top level, for a parent core to depend on;
 ``lint``     ``verilator --lint-only -Wall`` minus the project's waivers
-             (``sim.toolchain.VERILATOR_WAIVERS``), the check ``bumprtl emit --lint`` runs;
+             (``gen.tools.toolchain.VERILATOR_WAIVERS``), the check ``bumprtl emit --lint`` runs;
 ``sim``      Icarus Verilog: compiles and elaborates the unit (the cocotb benches of
              sim/tb/ drive it with stimulus; this target is the bare build).
 
@@ -20,7 +20,7 @@ import re
 from pathlib import Path
 
 from bumprtl.gen import __version__
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS
 
 __all__ = ["core_text", "write_core", "vlnv", "memory_files"]
 

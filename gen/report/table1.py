@@ -23,8 +23,8 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.methods import METHODS, datapath_fixed
-from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 
 __all__ = ["PAPER", "TABLE1_ORDER", "paper_multiplier_savings", "netlist_multiplier_savings",
            "count_design", "accuracy", "check_samples",
@@ -248,7 +248,7 @@ UNITS = (("setup", "rotation"), ("illumination", "illumination"))
 
 
 def count_text(text, top):
-    """A count job (sim/jobs.py): Yosys-count Verilog ``text`` (top ``top``) in a
+    """A count job (gen/tools/jobs.py): Yosys-count Verilog ``text`` (top ``top``) in a
     temporary directory of the worker; ``{"counts": Counts, "log": Yosys' log}``."""
     with tempfile.TemporaryDirectory(prefix=f"bumprtl-count-{top}-") as tmp:
         v_path = Path(tmp) / f"{top}.v"

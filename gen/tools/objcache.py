@@ -3,7 +3,7 @@
 Every Verilator build of a testbench compiles the same run-time sources (verilated.cpp,
 verilated_vpi.cpp, verilated_dpi.cpp, verilated_threads.cpp: most of a small build's CPU)
 with the same flags. Verilator's makefiles put ``$(OBJCACHE)`` in front of every compile
-command; sim/toolchain.py's :func:`tool_env` sets it to ``python -m bumprtl.sim.objcache``.
+command; gen/tools/toolchain.py's :func:`tool_env` sets it to ``python -m bumprtl.gen.tools.objcache``.
 A compile of a source under ``$VERILATOR_ROOT/include`` is served from the cache directory
 ``$BUMPRTL_OBJCACHE`` when the compile command, the source and every header it read (the
 ``-MMD`` dependency file, by content) are the ones cached; any other compile (the design's

@@ -65,10 +65,10 @@ def tool_env(base=None):
     if "CFG_CXXFLAGS_PCH_I" not in env.get("MAKEFLAGS", ""):
         env["MAKEFLAGS"] = (env.get("MAKEFLAGS", "") + " CFG_CXXFLAGS_PCH_I=-include").strip()
     # Every Verilator build compiles the same run-time library:
-    # verilated.mk runs each compile through $(OBJCACHE), here sim/objcache.py, which keeps
+    # verilated.mk runs each compile through $(OBJCACHE), here gen/tools/objcache.py, which keeps
     # those objects in build/objcache (a user's own OBJCACHE, e.g. ccache, is kept).
     if "OBJCACHE" not in env:
-        env["OBJCACHE"] = f"{shlex.quote(sys.executable)} -m bumprtl.sim.objcache"
+        env["OBJCACHE"] = f"{shlex.quote(sys.executable)} -m bumprtl.gen.tools.objcache"
         env.setdefault("BUMPRTL_OBJCACHE", str(Path("build", "objcache").resolve()))
     return env
 

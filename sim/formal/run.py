@@ -21,8 +21,8 @@ from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
 from bumprtl.sim.formal.sby import run_sby
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
-from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
-from bumprtl.sim.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 
 __all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
 
@@ -115,7 +115,7 @@ def check_mutant(name, root, cfg=None):
 
 
 def formal_job(kind, name, prop):
-    """One check as a job (sim/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`) or
+    """One check as a job (gen/tools/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`) or
     "mutant" (of :data:`MUTANTS`), checked in a temporary directory of the worker. Returns
     ``{"row": Row as a dict, "files": {path under the work root: text} (each sby run's
     log and the counterexample trace), "log": the sby logs}``; the client writes the files
@@ -135,7 +135,7 @@ def formal_job(kind, name, prop):
 def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=print, save=None,
         scheduler=None, timeout=None):
     """Every requested check; returns the rows (in order). Each check is a job of
-    sim/jobs.py: a local cluster of ``jobs`` worker processes, or ``scheduler``'s workers.
+    gen/tools/jobs.py: a local cluster of ``jobs`` worker processes, or ``scheduler``'s workers.
     ``save(rows_so_far)`` is called after each check (results.json is written as the run
     goes). A check that raises (a unit that does not elaborate), a tool missing on a worker
     or a ``timeout`` is an ERROR row, not the end of the run."""

@@ -1,4 +1,4 @@
-"""A bulk regression split into shards, each a job of sim/jobs.py (Dask).
+"""A bulk regression split into shards, each a job of gen/tools/jobs.py (Dask).
 
 ``run_bulk_shards`` streams ``source["n"]`` vectors per traffic pattern like
 :func:`bumprtl.sim.tb.bulk.run_bulk`, split into ``shards`` runs of about ``n / shards``
@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.sim.tb.bulk import run_bulk
 
 __all__ = ["bulk_shard", "run_bulk_shards", "shard_sources"]

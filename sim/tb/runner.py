@@ -1,7 +1,7 @@
 """Build and run a cocotb testbench on emitted Verilog with ``cocotb_tools.runner``.
 
 One build directory per (unit, configuration, simulator). A missing simulator raises
-:class:`bumprtl.sim.toolchain.ToolMissing`: the suite fails, it never skips.
+:class:`bumprtl.gen.tools.toolchain.ToolMissing`: the suite fails, it never skips.
 """
 
 import os
@@ -10,7 +10,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["SIMULATORS", "CocotbRun", "run_cocotb"]
 

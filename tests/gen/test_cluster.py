@@ -20,7 +20,7 @@ import pytest
 from distributed import Client
 
 from bumprtl.gen.cli.main import main
-from bumprtl.sim import jobs
+from bumprtl.gen.tools import jobs
 from bumprtl.sim.formal.run import check
 from bumprtl.sim.formal.targets import TARGETS
 

@@ -21,7 +21,7 @@ For each mutant: apply it (every file's content hash recorded first), run its gu
 (``pytest -x -q -n 0``, bytecode writing off so no stale ``.pyc`` outlives it), restore in
 a ``finally`` and verify each file's content hash against the one recorded. ``--check``
 reads the working tree and copies nothing. ``--jobs N`` or ``--scheduler tcp://HOST:PORT``
-runs the baseline and each mutant as a job of bumprtl's job layer (sim/jobs.py, Dask): the
+runs the baseline and each mutant as a job of bumprtl's job layer (gen/tools/jobs.py, Dask): the
 tree travels with the job as a tar archive and each job mutates its own unpacked copy in a
 temporary directory of its worker, so mutants run side by side, on this machine or a cluster.
 
@@ -48,7 +48,7 @@ from pathlib import Path
 import cloudpickle
 
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 
 __all__ = ["Edit", "Mutant", "MutantError", "RestoreError", "Outcome", "ROOT", "DEFAULT_LIST",
            "load_mutants", "check_applies", "applied", "run_guards", "run_mutants", "markdown",
@@ -419,7 +419,7 @@ def unpack_tree(archive, dest):
 
 
 def mutant_job(archive, mutant, timeout, guards=()):
-    """One mutant as a job of bumprtl's job layer (sim/jobs.py): the tree unpacked in a
+    """One mutant as a job of bumprtl's job layer (gen/tools/jobs.py): the tree unpacked in a
     temporary directory of the worker, the mutant applied there and its guards run; with
     ``mutant`` None, ``guards`` run on the unmutated tree (the baseline). Returns
     ``{"outcome": Outcome or (status, seconds, output), "log": pytest's output}``."""

@@ -45,7 +45,7 @@ from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_
 from bumprtl.rtl.texture import TextureBlend
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.sim.toolchain import require, tool_env
+from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.sim.traffic import PATTERNS
 
 

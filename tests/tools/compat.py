@@ -15,7 +15,7 @@ descriptors 1 and 2 captured):
   exactly one line on stderr naming the extra, exit 2.
 
 Why it missed the psutil crash of a core install (every command, ``--version`` included,
-on 3.11 to 3.13): make compat is opt-in and had last run before sim/jobs.py (module-level
+on 3.11 to 3.13): make compat is opt-in and had last run before gen/tools/jobs.py (module-level
 ``import psutil``) landed, and it tried four commands only. make test now holds the same
 check without network (tests/gen/cli/test_core_install.py: the optional distributions
 hidden in this venv); this script is the real wheel on each real interpreter.

@@ -1,4 +1,4 @@
-"""bench sweep --fpga places as jobs of sim/jobs.py after the points (make fpga; in-process local
+"""bench sweep --fpga places as jobs of gen/tools/jobs.py after the points (make fpga; in-process local
 cluster here, the tools faked): the point gets its row and hardware speed, a failed
 placement its fpga_error, and a second run reads the cache without a job."""
 
@@ -10,7 +10,7 @@ import pytest
 from bumprtl.gen.bench import sweep as bench_sweep
 from bumprtl.gen.flow import fpga
 from bumprtl.rtl.config import Config
-from bumprtl.sim import jobs
+from bumprtl.gen.tools import jobs
 
 
 @pytest.mark.fpga

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from bumprtl.gen.cli import main as cli_main
-from bumprtl.sim.toolchain import ToolMissing
+from bumprtl.gen.tools.toolchain import ToolMissing
 
 ROOT = Path(__file__).resolve().parents[3]
 EXTRAS = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]

@@ -12,7 +12,7 @@ import pytest
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.quiet import tool_log
-from bumprtl.sim import jobs
+from bumprtl.gen.tools import jobs
 
 
 def _one_line(capfd):

@@ -119,7 +119,7 @@ def test_report_fpga_seeds_minimum_and_failed_placement(tmp_path, monkeypatch):
     written on its row with the reason, the other rows still placed (the job layer's local
     cluster in threads of this process, so the patched tools are the ones it runs)."""
     from bumprtl.gen.report import fpga as report
-    from bumprtl.sim import jobs
+    from bumprtl.gen.tools import jobs
 
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
     monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
@@ -186,7 +186,7 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
 
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.gen.report import fpga as report
-    from bumprtl.sim import jobs
+    from bumprtl.gen.tools import jobs
 
     calls = []
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
@@ -210,7 +210,7 @@ def test_a_run_stopped_early_keeps_the_placements_it_finished(tmp_path, monkeypa
 
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.gen.report import fpga as report
-    from bumprtl.sim import jobs
+    from bumprtl.gen.tools import jobs
 
     calls = []
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.fusesoc import memory_files, vlnv
-from bumprtl.sim.toolchain import VERILATOR_WAIVERS, tool_env
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, tool_env
 
 FUSESOC = str(Path(sys.executable).parent / "fusesoc")
 

@@ -19,7 +19,7 @@ from bumprtl.gen.flow.resources import (
 )
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.toolchain import roms_as_readmemh
+from bumprtl.gen.tools.toolchain import roms_as_readmemh
 
 
 class Known(wiring.Component):

@@ -9,10 +9,10 @@ from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow import resources
 from bumprtl.gen.report import table1 as report
 from bumprtl.rtl.config import Config
-from bumprtl.sim import jobs
+from bumprtl.gen.tools import jobs
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.golden.methods import BASELINES
-from bumprtl.sim.toolchain import ToolMissing
+from bumprtl.gen.tools.toolchain import ToolMissing
 
 # Table 1's counts do not depend on the widths (the same units, narrower), so the module counts
 # them at 10-bit angles, B = 11: the default widths' tables (2049 words) would double the time.
@@ -22,7 +22,7 @@ WIDTHS = {"angle_bits": 10, "frac_bits": 11}
 @pytest.fixture(scope="module")
 def table1(tmp_path_factory):
     # The count jobs on the job layer's local cluster in threads of this process (Yosys runs
-    # as a child process either way), as tests/sim/test_jobs.py runs it: two worker processes
+    # as a child process either way), as tests/gen/tools/test_jobs.py runs it: two worker processes
     # would each import the package again (~6 s of CPU); the real scheduler and worker
     # processes are tests/gen/test_cluster.py's.
     out = tmp_path_factory.mktemp("table1")

@@ -1,4 +1,4 @@
-"""The job layer (sim/jobs.py) without a scheduler process: its local cluster in threads of
+"""The job layer (gen/tools/jobs.py) without a scheduler process: its local cluster in threads of
 this process (LOCAL_PROCESSES = False), so each test runs in a second or two. The real
 scheduler and worker processes are tests/gen/test_cluster.py's."""
 
@@ -9,7 +9,7 @@ import time
 import pytest
 
 from bumprtl.gen.cli.main import main
-from bumprtl.sim import jobs
+from bumprtl.gen.tools import jobs
 
 
 def _sleeper(seconds):

@@ -1,4 +1,4 @@
-"""sim/objcache.py: a Verilator run-time source compiles once, then comes from the cache
+"""gen/tools/objcache.py: a Verilator run-time source compiles once, then comes from the cache
 until the command, the source or a header it read changes; every other compile runs the
 compiler unchanged."""
 
@@ -25,7 +25,7 @@ def _setup(tmp_path):
 
 
 def _compile(cc, src, obj, build, env):
-    cmd = [sys.executable, "-m", "bumprtl.sim.objcache", str(cc), "-Os", "-MMD", "-c", "-o", obj, str(src)]
+    cmd = [sys.executable, "-m", "bumprtl.gen.tools.objcache", str(cc), "-Os", "-MMD", "-c", "-o", obj, str(src)]
     subprocess.run(cmd, cwd=build, env=env, check=True)
     return (build / obj).read_bytes()
 

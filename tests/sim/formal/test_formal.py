@@ -88,7 +88,7 @@ def test_a_vacuous_order_assumption_fails_its_cover(build_dir):
 # make formal (marker formal): its sby run paid for make test's order cover and dropping unit
 @pytest.mark.formal
 def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir, capsys):
-    from bumprtl.sim import jobs
+    from bumprtl.gen.tools import jobs
     broken = Target("broken", lambda bits: Glitcher(Config(**SMALL)), ("hold",))
     monkeypatch.setitem(formal_run.TARGETS, "broken", broken)
     monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)    # the job sees the patched TARGETS

@@ -207,7 +207,7 @@ REGRESS_VECTORS = 10_000_000
 PER_PATTERN = REGRESS_VECTORS // len(TRAFFIC)          # x 4 patterns = 10^7 through the unit
 
 
-# BUMPRTL_BULK_SHARDS=N splits each run into N jobs of sim/jobs.py (sim/tb/bulk_shards.py),
+# BUMPRTL_BULK_SHARDS=N splits each run into N jobs of gen/tools/jobs.py (sim/tb/bulk_shards.py),
 # on a local cluster or on $BUMPRTL_SCHEDULER's workers (docs/scale.md); 1 (the default):
 # one run here, as before.
 SHARDS = int(os.environ.get("BUMPRTL_BULK_SHARDS", "1"))

@@ -21,7 +21,7 @@ def test_sincos_cocotb(sim, angle_bits, frac_bits, build_dir):
 
 def test_missing_simulator_fails_with_install_hint(monkeypatch, tmp_path):
     """A simulator that is not on PATH is an error naming the install command, never a skip."""
-    from bumprtl.sim import toolchain
+    from bumprtl.gen.tools import toolchain
     monkeypatch.setattr(toolchain.shutil, "which", lambda *a, **k: None)
     v, _ = emit_unit("sincos", Config(angle_bits=8, frac_bits=8), tmp_path)
     with pytest.raises(toolchain.ToolMissing, match="apt-get install -y iverilog"):
