@@ -48,6 +48,8 @@ from bumprtl.gen.flow.fpga import (
 from bumprtl.gen.flow.resources import SynthesisError, count_verilog
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.gen.report import write_section
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb
@@ -60,8 +62,6 @@ from bumprtl.sim.golden.float.palette import (
     world_normal_map,
 )
 from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, encode_pixels, get
-from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 

@@ -36,9 +36,9 @@ from bumprtl.gen.flow.units import (
     name_flag,
 )
 from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.tools.toolchain import require
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.scenes.config import flag_name
-from bumprtl.gen.tools.toolchain import require
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 

@@ -12,8 +12,8 @@ import sys
 
 from bumprtl.gen import __version__
 from bumprtl.gen.cli.doctor import requirements
-from bumprtl.rtl.config import BumpError
 from bumprtl.gen.tools.toolchain import ToolMissing
+from bumprtl.rtl.config import BumpError
 
 # Subcommand modules (each with add_parser), in the order `bumprtl --help` lists them: the
 # command, its module and the pip extra that holds the packages it needs beyond the core

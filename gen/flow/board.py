@@ -28,6 +28,7 @@ from amaranth.back import rtlil, verilog
 
 from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
 from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
@@ -35,7 +36,6 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
 from bumprtl.sim.scenes import SCENES
-from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames"]

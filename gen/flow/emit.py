@@ -18,8 +18,8 @@ from amaranth.back import rtlil, verilog
 from amaranth.hdl import Elaboratable, Fragment, Shape
 from amaranth.lib import data, wiring
 
-from bumprtl.rtl.layouts import layout_fields
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.rtl.layouts import layout_fields
 
 __all__ = ["emit", "elaborated", "port_table", "lint"]
 

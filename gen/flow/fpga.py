@@ -25,12 +25,12 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.gen.flow.resources import run_yosys, yosys_input
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
-from bumprtl.gen.tools.toolchain import require, tool_env
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",
            "Placement", "place_text", "place_component", "placement_key"]

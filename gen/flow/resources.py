@@ -43,8 +43,8 @@ from pathlib import Path
 from amaranth.back import verilog
 
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.rtl.config import BumpError
 from bumprtl.gen.tools.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.rtl.config import BumpError
 
 __all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
            "count_component", "count_unit", "multiplier_pairs", "yosys_input"]

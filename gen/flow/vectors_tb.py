@@ -29,8 +29,8 @@ its payload until taken. All of the bench's own signals change by non-blocking a
 at the rising edge, as the design's registers do.
 """
 
-from bumprtl.sim.tb.bulk_build import TIMING_ARGS
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS
+from bumprtl.sim.tb.bulk_build import TIMING_ARGS
 
 __all__ = ["bench_verilog", "stream_ports", "host_ports", "run_commands"]
 

@@ -28,6 +28,7 @@ from bumprtl.gen.flow.memories import (
 from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_unit
 from bumprtl.gen.report import write_section
+from bumprtl.gen.tools.toolchain import require
 from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
@@ -47,7 +48,6 @@ from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 from bumprtl.sim.scenes.imaging import compose, save_png
 from bumprtl.sim.scenes.usermap import load_bump_map
-from bumprtl.gen.tools.toolchain import require
 
 __all__ = ["RtlRender", "scene_stimulus", "scene_texels", "scene_memories", "golden_render",
            "render_rtl", "sim_scene"]

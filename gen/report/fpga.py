@@ -26,12 +26,12 @@ from bumprtl.gen.flow.fpga import (
 )
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.methods import METHODS
-from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["fpga_units", "fpga_report", "write_report", "worst_run", "add_parser"]

@@ -19,12 +19,12 @@ from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow import resources
 from bumprtl.gen.flow.resources import count_unit, count_verilog
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.methods import METHODS, datapath_fixed
-from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 
 __all__ = ["PAPER", "TABLE1_ORDER", "paper_multiplier_savings", "netlist_multiplier_savings",
            "count_design", "accuracy", "check_samples",

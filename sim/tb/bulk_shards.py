@@ -12,8 +12,8 @@ temporary directory of its worker (the build cached there by the Verilog's diges
 import tempfile
 from pathlib import Path
 
-from bumprtl.rtl.config import BumpError
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.rtl.config import BumpError
 from bumprtl.sim.tb.bulk import run_bulk
 
 __all__ = ["bulk_shard", "run_bulk_shards", "shard_sources"]

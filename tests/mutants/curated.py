@@ -47,8 +47,8 @@ from pathlib import Path
 
 import cloudpickle
 
-from bumprtl.rtl.config import BumpError, Config
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
+from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["Edit", "Mutant", "MutantError", "RestoreError", "Outcome", "ROOT", "DEFAULT_LIST",
            "load_mutants", "check_applies", "applied", "run_guards", "run_mutants", "markdown",

@@ -16,6 +16,7 @@ from amaranth.hdl import Const, Fragment, Instance, Module, Signal, signed, unsi
 from amaranth.lib.memory import Memory
 from amaranth.sim import Simulator
 
+from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.illumination import Illumination
@@ -45,7 +46,6 @@ from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_
 from bumprtl.rtl.texture import TextureBlend
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.scenes.config import load_scene_config
-from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.sim.traffic import PATTERNS
 
 

@@ -9,8 +9,8 @@ import pytest
 
 from bumprtl.gen.bench import sweep as bench_sweep
 from bumprtl.gen.flow import fpga
-from bumprtl.rtl.config import Config
 from bumprtl.gen.tools import jobs
+from bumprtl.rtl.config import Config
 
 
 @pytest.mark.fpga

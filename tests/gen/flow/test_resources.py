@@ -18,8 +18,8 @@ from bumprtl.gen.flow.resources import (
     multiplier_pairs,
 )
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.rtl.config import BumpError, Config
 from bumprtl.gen.tools.toolchain import roms_as_readmemh
+from bumprtl.rtl.config import BumpError, Config
 
 
 class Known(wiring.Component):

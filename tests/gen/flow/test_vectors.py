@@ -17,8 +17,8 @@ import pytest
 
 from bumprtl.gen.flow.vectors import MAX_COUNT, pipeline_vectors, pixel_columns
 from bumprtl.gen.flow.vectors_tb import run_commands
-from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.gen.tools.toolchain import tool_env
+from bumprtl.sim.scenes.config import load_scene_config
 
 PIXELS = 120
 TB = "bumprtl_pipeline_tb"

@@ -8,11 +8,11 @@ import pytest
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow import resources
 from bumprtl.gen.report import table1 as report
-from bumprtl.rtl.config import Config
 from bumprtl.gen.tools import jobs
+from bumprtl.gen.tools.toolchain import ToolMissing
+from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.golden.methods import BASELINES
-from bumprtl.gen.tools.toolchain import ToolMissing
 
 # Table 1's counts do not depend on the widths (the same units, narrower), so the module counts
 # them at 10-bit angles, B = 11: the default widths' tables (2049 words) would double the time.

@@ -9,9 +9,9 @@ import subprocess
 import pytest
 
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.config import Config
 from bumprtl.sim.tb.bulk_wrapper import HOOK, TEMPLATE, TOP, host_fields, wrapper_verilog
-from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 
 BUILDS = {"own clock": ["-DBULK_OWN_CLOCK"], "cxx clock, file": [],
           "cxx clock, dpi": ["-DBUMPRTL_BULK_DPI"]}
