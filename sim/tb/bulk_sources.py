@@ -25,7 +25,7 @@ from bumprtl.sim.golden.fixed.pipeline import (
 )
 from bumprtl.sim.golden.methods import get, illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.stress import stress_codes
-from bumprtl.sim.golden.vectors import edge_codes, random_codes
+from bumprtl.sim.golden.vectors import edge_codes, random_codes, range_corners
 from bumprtl.sim.scenes.config import load_scene_config
 
 __all__ = ["make_source", "pipeline_map", "palette_table", "SOURCES"]
@@ -136,7 +136,8 @@ def palette_table(cfg, seed):
 def _palette(meta, spec, chunk):
     """PaletteLUT: a decoy table written to the back bank and swapped in, then the random
     table written to the other bank and swapped in (set-up: two swaps, so a swap that does
-    not alternate the banks reads the decoy), then random indices over the whole index
+    not alternate the banks reads the decoy), then the corners (the index and every base
+    channel at both ends, together and alone) and random indices over the whole index
     range (out-of-range ones read as zero, oor = 1) with random base colours; golden = the
     table lookup and Tarini eq. 2."""
     cfg = Config(**meta["config"])
@@ -153,12 +154,16 @@ def _palette(meta, spec, chunk):
         for k, n in enumerate(_counts(int(spec["n"]), chunk)):
             rng = np.random.default_rng(seed * 1000 + k + 1)
             index = rng.integers(0, top, n)
+            base = {c: rng.integers(0, 256, n) for c in CHANNELS}
+            if k == 0:          # the corners first: index and base channels at both ends
+                corners = range_corners({"index": (0, top - 1), **{c: (0, 255) for c in CHANNELS}})
+                m = min(n, len(corners["index"]))
+                for c, col in (("index", index), *base.items()):
+                    col[:m] = corners[c][:m]
             oor = index >= cfg.palette_size
             entry = unpack_rgba(np.where(oor, 0, table[np.minimum(index, cfg.palette_size - 1)]), cfg)
             inputs = {"index": index}
             if cfg.palette_blend:
-                base = {c: rng.integers(0, 256, n) for c in CHANNELS}
-                base["r"][:3] = (0, 255, 128)[:min(3, n)]
                 entry = blend_eq2(entry, base, cfg)
                 inputs.update({f"base.{c}": base[c] for c in CHANNELS})
             tag = _tags(n, start, cfg.tag_bits)

@@ -12,20 +12,27 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import CHANNELS, index_bits
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op
+from bumprtl.sim.golden.vectors import range_corners
 from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, samples, unpack
 
 log = logging.getLogger("bumprtl.tb")
 
 
 def _pixels(cfg, n, rng):
+    """The corners (sim/golden/vectors.range_corners: the index and every base channel at
+    both ends, together and alone; the table's last entry), then ``n`` random pixels."""
     top = 1 << index_bits(cfg)
-    out = []
-    for k, index in enumerate([0, cfg.palette_size - 1, top - 1] + [rng.randrange(top) for _ in range(n)]):
-        px = {"index": index, "tag": k & ((1 << cfg.tag_bits) - 1)}
+    ranges = {"index": (0, top - 1),
+              **({f"base.{c}": (0, 255) for c in CHANNELS} if cfg.palette_blend else {})}
+    corners = range_corners(ranges)
+    out = [{k: int(v[i]) for k, v in corners.items()} for i in range(len(corners["index"]))]
+    out.append({**out[0], "index": cfg.palette_size - 1})
+    for _ in range(n):
+        px = {"index": rng.randrange(top)}
         if cfg.palette_blend:
             px.update({f"base.{c}": rng.choice([0, 255, rng.randrange(256)]) for c in CHANNELS})
         out.append(px)
-    return out
+    return [{**px, "tag": k & ((1 << cfg.tag_bits) - 1)} for k, px in enumerate(out)]
 
 
 async def _reset(dut):
