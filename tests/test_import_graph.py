@@ -5,9 +5,9 @@
 (b) no import cycle among the bumprtl modules (module-level imports; ``from bumprtl.x
     import y`` counts as importing ``bumprtl.x.y`` when that is a module, and importing a
     module also runs its packages' ``__init__``);
-(c) the layers point one way: nothing in rtl/ imports bumprtl.sim or bumprtl.gen, nothing
-    in sim/ imports bumprtl.gen (function-level imports and
-    ``importlib.import_module("bumprtl.gen...")`` included).
+(c) the layers point one way, lowest first: rtl/, gen/tools/ (running the external tools),
+    sim/, the rest of gen/; a module imports its own layer and those below it only
+    (function-level imports and ``importlib.import_module("bumprtl.gen...")`` included).
 
 Each check names the offending module, file and line. The ``*_is_caught`` tests run the
 same checks on a small package with one planted offence each, so every check is shown to
@@ -170,21 +170,27 @@ def _dynamic_imports(tree):
                 yield node, arg.value
 
 
-# The layers point one way: rtl/ (the hardware) imports neither the models that check it
-# nor the tools above; sim/ (models, testbenches, formal) does not import gen/.
-FORBIDDEN = {"bumprtl.rtl": ("bumprtl.sim", "bumprtl.gen"), "bumprtl.sim": ("bumprtl.gen",)}
+# The layers point one way, lowest first: rtl/ (the hardware) imports nothing above it;
+# gen/tools/ (the toolchain lookup, job layer, Yosys runner, page sections) imports only
+# rtl/; sim/ (models, testbenches, formal) imports rtl/ and gen/tools/ but no other gen/;
+# the rest of gen/ imports all of them. A module's layer is the longest prefix it has.
+ORDER = ("bumprtl.rtl", "bumprtl.gen.tools", "bumprtl.sim", "bumprtl.gen")
+
+
+def _layer(name):
+    found = [n for n, layer in enumerate(ORDER) if name == layer or name.startswith(layer + ".")]
+    return max(found, key=lambda n: len(ORDER[n])) if found else None
 
 
 def _forbidden(name, target):
-    for layer, above in FORBIDDEN.items():
-        if name == layer or name.startswith(layer + "."):
-            return any(target == a or target.startswith(a + ".") for a in above)
-    return False
+    mine, theirs = _layer(name), _layer(target)
+    return mine is not None and theirs is not None and theirs > mine
 
 
 def wrong_way_imports(mods, root=ROOT):
-    """Lines where a module imports a layer above its own (:data:`FORBIDDEN`): rtl imports
-    bumprtl.sim or bumprtl.gen, sim imports bumprtl.gen."""
+    """Lines where a module imports a layer above its own (:data:`ORDER`): rtl imports
+    bumprtl.sim or bumprtl.gen, gen/tools imports bumprtl.sim or the rest of bumprtl.gen,
+    sim imports bumprtl.gen outside gen/tools."""
     bad = []
     for name, (path, tree, _) in mods.items():
         for node, _ in imports(tree):
@@ -220,7 +226,8 @@ def test_no_import_cycle():
 
 def test_layers_point_one_way():
     bad = wrong_way_imports(MODULES)
-    assert not bad, ("rtl/ must not depend on sim/ or gen/, sim/ not on gen/:\n  "
+    assert not bad, ("rtl/ must not depend on sim/ or gen/, gen/tools/ not on sim/ or the rest of "
+                     "gen/, sim/ not on gen/ outside gen/tools/:\n  "
                      + "\n  ".join(bad))
 
 
@@ -275,6 +282,22 @@ def test_a_wrong_way_import_is_caught(tmp_path):
         "bumprtl.sim.stress (sim/stress.py:5) imports bumprtl.gen.flow.emit",
         "bumprtl.sim.stress (sim/stress.py:6) imports bumprtl.gen.flow. dynamically",
         "bumprtl.sim.tb.runner (sim/tb/runner.py:1) imports bumprtl.gen.flow.emit"]
+
+
+def test_the_tool_layer_importing_above_it_is_caught(tmp_path):
+    """gen/tools sits below sim: sim may import it, it may import rtl, but it importing sim
+    or the rest of gen (or rtl importing it) is an offence."""
+    mods = _tree(tmp_path, {
+        "gen/tools/__init__.py": "", "gen/tools/yosys.py": "from bumprtl.rtl import a\n",
+        "gen/tools/jobs.py": "from bumprtl.sim.golden import b\nfrom bumprtl.gen.flow import emit\n",
+        "gen/flow/__init__.py": "", "gen/flow/emit.py": "from bumprtl.gen.tools import yosys\n",
+        "rtl/a.py": "from bumprtl.gen.tools import jobs\n",
+        "sim/golden.py": "from bumprtl.gen.tools import yosys\nfrom bumprtl.gen import flow\n"})
+    assert sorted(wrong_way_imports(mods, tmp_path)) == [
+        "bumprtl.gen.tools.jobs (gen/tools/jobs.py:1) imports bumprtl.sim.golden",
+        "bumprtl.gen.tools.jobs (gen/tools/jobs.py:2) imports bumprtl.gen.flow.emit",
+        "bumprtl.rtl.a (rtl/a.py:1) imports bumprtl.gen.tools.jobs",
+        "bumprtl.sim.golden (sim/golden.py:2) imports bumprtl.gen.flow"]
 
 
 def test_rtl_importing_sim_is_caught(tmp_path):
