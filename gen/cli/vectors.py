@@ -94,6 +94,18 @@ def _unit_vectors(args, module):
                      f"{shlex.quote(str(args.source))} --count {len(vectors)} --seed {args.seed}")
 
 
+def _scene_flags_used(args, scene):
+    """Refuse a scene flag that changes neither the design nor the pixels: the surface a map
+    is wrapped on shapes only the scene's own frame, and a per-pixel scene has no colour
+    table."""
+    if args.geometry is not None and args.source != "frame":
+        raise BumpError(f"--geometry shapes the scene's frame (--source frame), not --source "
+                        f"{args.source}")
+    if args.palette_size is not None and scene.shading == "per-pixel":
+        raise BumpError("--palette-size does not apply to a scene with per-pixel shading "
+                        "(no colour table)")
+
+
 def run(args):
     module = _identifier("--name", args.name) or default_module(args.unit or "pipeline")
     top = _identifier("--top", args.top)
@@ -107,6 +119,7 @@ def run(args):
             raise BumpError(f"--pipeline must be a scene TOML file or one of "
                             f"{', '.join(BUILTIN)}, got {pipeline!r}")
         scene = scene_from_args(args, pipeline)
+        _scene_flags_used(args, scene)
         vectors = pipeline_vectors(scene, args.source, args.count, args.seed)
         command = _command(scene, args, module, top, len(vectors))
     paths = write_vectors(vectors, args.out, module, args.load or "initial", top,

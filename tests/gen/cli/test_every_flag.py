@@ -267,14 +267,8 @@ def test_render_model_changes_the_output(tmp_path):
     _check(("render",), "--model", "fixed", RENDER_BASE, tmp_path, {}, out_file="r.png")
 
 
-# vectors emits a pipeline and its golden outputs every run: make regress. Two flags it
-# accepts with no effect on this base (a per-pixel scene, random pixels) are open in
-# gen/cli/vectors.py, which the vectors change owns: strict xfails, so their fix shows.
-VECTORS_OPEN = {"--geometry": "the surface changes the frame source's pixels only",
-                "--palette-size": "a per-pixel scene has no colour table"}
-VECTORS_CASES = [pytest.param(f, id=f, marks=[pytest.mark.regress] + (
-    [pytest.mark.xfail(strict=True, reason=f"accepted without effect: {VECTORS_OPEN[f]}")]
-    if f in VECTORS_OPEN else [])) for f in VALUES[("vectors",)]]
+# vectors emits a pipeline and its golden outputs every run: make regress.
+VECTORS_CASES = [pytest.param(f, id=f, marks=pytest.mark.regress) for f in VALUES[("vectors",)]]
 
 
 @pytest.mark.parametrize("flag", VECTORS_CASES)
