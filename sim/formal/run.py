@@ -18,10 +18,10 @@ from pathlib import Path
 
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
+from bumprtl.gen.tools.sby import run_sby
 from bumprtl.sim.formal.contract import StreamContract
 from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
-from bumprtl.sim.formal.sby import run_sby
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
 
 __all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]

