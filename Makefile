@@ -89,10 +89,10 @@ coverage: $(STAMP)
 	  --cov-report=term:skip-covered $(PYTEST_ARGS)
 	$(RUN) $(PY) tests/tools/coverage_map.py --python build/coverage/python.json --verilator --doc docs/coverage.md
 
-# Every unit and scene pipeline, every property, the broken units (sim/formal/run.py), then
+# Every unit and scene pipeline, every property, the broken units (gen/formal/run.py), then
 # the formal tests left out of make test (pytest marker formal).
 formal: $(STAMP)
-	$(RUN) $(PY) -m bumprtl.sim.formal.run -j $(JOBS) --doc docs/formal.md $(FORMAL_ARGS)
+	$(RUN) $(PY) -m bumprtl.gen.formal.run -j $(JOBS) --doc docs/formal.md $(FORMAL_ARGS)
 	$(RUN) $(PY) -m pytest -n $(JOBS) -m formal tests/sim/formal
 
 # The ULX3S top (docs/board.md): bitstream and .svf, nextpnr seeds BOARD_SEEDS (the minimum

@@ -156,12 +156,6 @@ class Config:
         """The integer that represents 1.0 in a value with ``frac_bits`` fractional bits."""
         return 1 << self.frac_bits
 
-    def made_at(self, note=""):
-        """The one-line record of the configuration a generated page was made at
-        (tests/test_docs_made_at.py holds every such line to today's default)."""
-        return (f"Made at: angle_bits={self.angle_bits}, frac_bits={self.frac_bits}"
-                + (f" ({note})" if note else ""))
-
     def replace(self, **changes):
         """A copy with some fields changed (validated again)."""
         unknown = set(changes) - {f.name for f in fields(self)}

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bumprtl.gen.bench.sweep import write_section
 from bumprtl.gen.render.rtl import run_pipeline, run_pipeline_bulk, scene_stimulus, scene_texels
+from bumprtl.gen.tools.docs import write_section
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config

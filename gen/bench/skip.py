@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 from amaranth.back import verilog
 
-from bumprtl.gen.bench.sweep import _cached, _digest, write_section
+from bumprtl.gen.bench.sweep import _cached, _digest
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
+from bumprtl.gen.tools.docs import write_section
 from bumprtl.rtl.bumpfetch import pack_texels
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipeline import BumpPipeline

@@ -47,7 +47,7 @@ from bumprtl.gen.flow.fpga import (
 )
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.flow.units import build_unit, emit_unit
-from bumprtl.gen.report import write_section
+from bumprtl.gen.tools.docs import write_section
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.tools.yosys import SynthesisError

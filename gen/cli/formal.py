@@ -1,6 +1,6 @@
 """``bumprtl formal``: SymbiYosys proofs of the stream contract (sim/formal/, docs/formal.md)."""
 
-from bumprtl.sim.formal.run import add_arguments, execute
+from bumprtl.gen.formal.run import add_arguments, execute
 
 
 def add_parser(sub):

@@ -27,7 +27,7 @@ from bumprtl.gen.flow.memories import (
 )
 from bumprtl.gen.flow.quiet import tool_log
 from bumprtl.gen.flow.resources import count_unit
-from bumprtl.gen.report import write_section
+from bumprtl.gen.tools.docs import made_at, write_section
 from bumprtl.gen.tools.toolchain import require
 from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError, Config
@@ -385,7 +385,7 @@ def scenes_table(work_dir="build/scenes"):
 def write_scenes_doc(path="docs/scenes.md", work_dir="build/scenes"):
     """Write :func:`scenes_table` into ``path`` between its markers, with its record."""
     text = (f"Produced by `.venv/bin/python -m bumprtl.gen.render.rtl --doc {path}` in one run. "
-            + Config().made_at("the default; each scene at its own widths, "
+            + made_at(Config(), "the default; each scene at its own widths, "
                                 "sim/scenes/config.BUILTIN") + ".\n\n" + scenes_table(work_dir))
     write_section(path, "scenes table", text)
 

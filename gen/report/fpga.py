@@ -26,6 +26,7 @@ from bumprtl.gen.flow.fpga import (
 )
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
+from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
@@ -175,7 +176,7 @@ def write_report(args, rows, acc, cfg):
              "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
              "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
              f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
-             cfg.made_at(_scene_widths(rows)), "",
+             made_at(cfg, _scene_widths(rows)), "",
              "| unit | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | target met | max LSB | mean LSB | Fmax by seed |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -35,6 +35,7 @@ from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.memories import DEFAULT_DEVICE
 from bumprtl.gen.flow.named import named_ports
 from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.tools import docs
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import angle_codes
@@ -119,9 +120,9 @@ def emit_for_integration(scene, out_dir, name=NAME, flags=()):
 
 
 def made_at(meta):
-    """The page's record (rtl.config.Config.made_at) of the sidecar's Config."""
+    """The page's record (gen/tools/docs.made_at) of the sidecar's Config."""
     cfg = Config(**meta["config"])
-    return cfg.made_at(f"scene `{meta['scene']['name']}`, method {cfg.method}; `{COMMAND}`, "
+    return docs.made_at(cfg, f"scene `{meta['scene']['name']}`, method {cfg.method}; `{COMMAND}`, "
                        f"from `{meta['command']}`")
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from amaranth.sim import Simulator
 
-from bumprtl.gen.report import write_section
+from bumprtl.gen.tools.docs import made_at, write_section
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
@@ -157,7 +157,7 @@ def run_timing(args):
     for name in facts:
         print(f"wrote {args.out / name}.json and .svg")
     if args.doc is not None and args.doc.is_file():
-        write_section(args.doc, "made-at", Config().made_at(f"`bumprtl report timing`: the "
+        write_section(args.doc, "made-at", made_at(Config(), f"`bumprtl report timing`: the "
                       f"default pipeline's latency is {facts['latency']['latency']} cycles"))
         print(f"wrote the record of {args.doc}")
     print(f"default pipeline latency: {facts['latency']['latency']} cycles "

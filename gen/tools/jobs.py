@@ -19,8 +19,8 @@ of the run: the report writes the failed rows with the reason. A worker that die
 (killed, out of memory) is the scheduler's business: it reschedules the job on another
 worker (up to ``distributed.scheduler.allowed-failures`` times).
 
-This module lives in ``sim/`` because ``sim/formal/run.py`` uses it and ``sim/`` does not
-import ``gen/`` (docs/scale.md). Dask ``distributed`` and ``psutil`` (the extras that run jobs:
+This module is in the tool layer (gen/tools/, below sim/: sim/tb/bulk_shards.py runs its
+shards here; docs/scale.md). Dask ``distributed`` and ``psutil`` (the extras that run jobs:
 [fpga], [formal], [bench]) are imported by the functions that use them, never at import
 time: every command's parser, ``--help`` included, imports this module in a core install.
 """

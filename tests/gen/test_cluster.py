@@ -20,8 +20,8 @@ import pytest
 from distributed import Client
 
 from bumprtl.gen.cli.main import main
+from bumprtl.gen.formal.run import check
 from bumprtl.gen.tools import jobs
-from bumprtl.sim.formal.run import check
 from bumprtl.sim.formal.targets import TARGETS
 
 BIN = Path(sys.executable).parent
@@ -100,7 +100,7 @@ def _comparable(row):
 
 
 def test_a_formal_check_through_the_scheduler_equals_the_local_check(cluster, tmp_path, monkeypatch):
-    from bumprtl.sim.formal import run as formal_run
+    from bumprtl.gen.formal import run as formal_run
     monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
     remote = formal_run.run(["sincos"], ["order"], mutants=False, root=tmp_path / "remote",
                             scheduler=cluster.address, log=lambda line: None)

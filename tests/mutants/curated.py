@@ -47,6 +47,7 @@ from pathlib import Path
 
 import cloudpickle
 
+from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 from bumprtl.rtl.config import BumpError, Config
 
@@ -332,7 +333,7 @@ def markdown(outcomes, command, wall_s):
              f"({100 * killed / max(counted, 1):.0f} %), "
              f"{sum(o.status == 'equivalent' for o in outcomes)} listed as equivalent; "
              f"wall time {wall_s / 60:.1f} min.", "",
-             Config().made_at("the default Config of the tree the mutants were applied to") + ".", "",
+             made_at(Config(), "the default Config of the tree the mutants were applied to") + ".", "",
              "| mutant | models | guarding tests | result | seconds |", "|---|---|---|---|---|"]
     for o in outcomes:
         m = o.mutant

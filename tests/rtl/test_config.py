@@ -140,14 +140,6 @@ def test_replace_names_the_unknown_field():
     assert e.value.field == "nosuch"
 
 
-def test_made_at_records_both_widths_and_a_note_only_when_given():
-    """made_at is the one line a generated page names its configuration with: both widths,
-    then the note in parentheses, and nothing after the widths without a note."""
-    cfg = Config(angle_bits=12, frac_bits=13)
-    assert cfg.made_at() == "Made at: angle_bits=12, frac_bits=13"
-    assert cfg.made_at("palette scene") == "Made at: angle_bits=12, frac_bits=13 (palette scene)"
-
-
 # ---- every documented formula, range end and refusal, from Config's docstring and the
 # ---- BumpError rule (one line naming the parameter, the value and its allowed range)
 

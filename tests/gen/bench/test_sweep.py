@@ -16,7 +16,6 @@ from bumprtl.gen.bench.sweep import (
     pareto_front,
     parse_maps,
     sweep,
-    write_section,
 )
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl.config import BumpError, Config
@@ -64,16 +63,6 @@ def test_error_lsb_is_worst_of_sets():
                                                                 "adversarial": {"max": 3}}},
                    "scenes": {"a": {"max_lsb": 2}}}}
     assert error_lsb(p) == 3
-
-
-def test_write_section_keeps_other_sections(tmp_path):
-    doc = tmp_path / "bench.md"
-    write_section(doc, "sweep", "one")
-    write_section(doc, "skip", "two")
-    write_section(doc, "sweep", "three")
-    text = doc.read_text()
-    assert "three" in text and "two" in text and "one" not in text
-    assert text.index("three") < text.index("two")
 
 
 @pytest.fixture(scope="module")

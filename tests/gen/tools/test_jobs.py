@@ -49,8 +49,8 @@ def test_values_errors_timeouts_and_logs(threads):
 def test_a_tool_missing_on_a_worker_names_the_worker_and_the_tool(threads, monkeypatch, capsys):
     """bumprtl formal with the solver missing where the job runs: the row says which tool
     and which worker, the table is still printed, exit 1."""
+    from bumprtl.gen.formal import run as formal_run
     from bumprtl.gen.tools import sby
-    from bumprtl.sim.formal import run as formal_run
 
     monkeypatch.setattr(sby, "_bin_dirs", lambda: [str(threads / "nothing")])
     monkeypatch.setenv("PATH", str(threads / "nothing"))

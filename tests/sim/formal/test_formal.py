@@ -10,11 +10,11 @@ from pathlib import Path
 import pytest
 from amaranth.back import rtlil
 
+from bumprtl.gen.formal import run as formal_run
+from bumprtl.gen.formal.run import check, check_mutant
 from bumprtl.rtl.pipe import StallPipe
-from bumprtl.sim.formal import run as formal_run
 from bumprtl.sim.formal.contract import CHUNK, StreamContract, observe_pipes
 from bumprtl.sim.formal.mutants import MUTANTS, Glitcher
-from bumprtl.sim.formal.run import check, check_mutant
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
 
 _REGISTER = StallPipe.register

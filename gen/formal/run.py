@@ -1,6 +1,6 @@
 """Run the formal checks of :mod:`bumprtl.sim.formal.targets` and print the proof table.
 
-``python -m bumprtl.sim.formal.run`` or ``bumprtl formal`` (``make formal`` runs all of it
+``python -m bumprtl.gen.formal.run`` or ``bumprtl formal`` (``make formal`` runs all of it
 and writes docs/formal.md). Each (unit, property) is one sby job under ``build/formal/``:
 k-induction (``mode prove``) first; a property whose induction does not close at the
 induction depth is checked by BMC to ``latency + BMC_MARGIN`` instead and reported as
@@ -16,11 +16,11 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from bumprtl.gen.formal.doc import table, write_doc
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.tools.sby import run_sby
 from bumprtl.sim.formal.contract import StreamContract
-from bumprtl.sim.formal.doc import table, write_doc
 from bumprtl.sim.formal.mutants import MUTANTS
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
 
@@ -272,7 +272,7 @@ def execute(args):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m bumprtl.sim.formal.run", description=__doc__,
+    p = argparse.ArgumentParser(prog="python -m bumprtl.gen.formal.run", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(p)
     return execute(p.parse_args(argv))
