@@ -6,9 +6,8 @@ import re
 import pytest
 
 from bumprtl.gen.cli.main import main
-from bumprtl.gen.flow import resources
 from bumprtl.gen.report import table1 as report
-from bumprtl.gen.tools import jobs
+from bumprtl.gen.tools import jobs, yosys
 from bumprtl.gen.tools.toolchain import ToolMissing
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.fixed import exact as fixed_exact
@@ -156,7 +155,7 @@ def test_bad_input_is_one_line(argv, message, capsys):
 def test_missing_yosys_is_reported(monkeypatch, tmp_path, capsys):
     def missing(tool):
         raise ToolMissing(tool)
-    monkeypatch.setattr(resources, "require", missing)
+    monkeypatch.setattr(yosys, "require", missing)
     assert main(["report", "table1", "--samples", "10", "--out", str(tmp_path / "t.md"),
                  "--work", str(tmp_path)]) == 2
     err = capsys.readouterr().err
