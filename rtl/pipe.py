@@ -80,8 +80,9 @@ class StallPipe:
         None (the default) builds the same hardware and tells no one.
 
     ``memories`` records every memory built through the pipe (:meth:`rom`, :meth:`memory`):
-    name -> {depth, width, bits}. A unit keeps it as its own ``memories`` when it elaborates
-    (the ROM sizes of gen/flow/units.py's sidecar).
+    name -> {kind ("rom", or "ram" when written through a port), depth, width, bits}. A
+    unit keeps it as its own ``memories`` when it elaborates (the memories of
+    gen/flow/units.py's sidecar).
     """
 
     def __init__(self, m, i, o, depth, target=None, enable=None, observer=None, enable_next=None):
@@ -128,7 +129,7 @@ class StallPipe:
         return copy
 
     def _record(self, name, depth, width):
-        self.memories[name] = {"depth": depth, "width": width, "bits": depth * width}
+        self.memories[name] = {"kind": "rom", "depth": depth, "width": width, "bits": depth * width}
 
     def rom(self, init, shape, name, ports=2):
         """A :class:`RegisteredROM` with ``ports`` read ports enabled by ``adv``."""
@@ -146,6 +147,7 @@ class StallPipe:
         self.m.submodules[name] = unit
         self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
         self._record(name, depth, unit.width)
+        self.memories[name]["kind"] = "ram" if writable else "rom"     # written through a port
         if self.observer is not None:
             self.observer.ram(self, name, unit)
         return unit

@@ -1,6 +1,6 @@
 """``bumprtl bench accuracy``: the fixed-point golden model against float64, per output
 channel (diffuse, specular, colour), on random inputs and on the adversarial searches aimed
-at each channel, beside the proven bound of each channel (the sidecar's ``error_bounds_lsb``).
+at each channel, beside the proven bound of each channel (the sidecar's ``error_bounds.lsb_per_channel``).
 
 Two measures per channel, on the same pixels:
 
@@ -62,7 +62,7 @@ def measure(cfg: Config, px: PixelInputs):
     for channel in CHANNELS:
         sets[f"adversarial {channel}"] = adversarial_pixels(cfg, channel=channel)
         sets[f"worst {channel}"] = worst_case_pixels(datapath_fixed, cfg, channel)
-    bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
+    bounds = build_unit("illumination", cfg)[1].error_bounds.lsb_per_channel
     errors = {name: term_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
     grid = {name: grid_errors_lsb(datapath_fixed, p, cfg) for name, p in sets.items()}
     out = {}
@@ -151,7 +151,7 @@ def run(args):
           f"against float64 on the unquantized inputs (input rounding + arithmetic); "
           f"arithmetic = against float64 on the angles the hardware receives (the inputs "
           f"rounded to the angle grid; — for Cartesian inputs). bound = the sidecar's "
-          f"error_bounds_lsb (end-to-end; proof: predicted_error_bound_lsb)\n")
+          f"error_bounds.lsb_per_channel (end-to-end; proof: predicted_error_bound_lsb)\n")
     print("| angle bits | frac bits | n | channel | end-to-end random max / mean "
           "| end-to-end adversarial max / mean | end-to-end search max | end-to-end worst-case max "
           "| arithmetic max (random / adversarial / search / worst-case) | bound | worst / bound |")
@@ -281,7 +281,7 @@ def _lights(args, px):
           f"(a further light: random L, H on the same N, N', seed 12); adversarial = the search "
           f"aimed at the colour, worst-case = the searches aimed at the proof's worst case of "
           f"the specular term and the colour, every light the same; bound = the pipeline "
-          f"sidecar's error_bounds_lsb of an m-light (textured) scene\n")
+          f"sidecar's error_bounds.lsb_per_channel of an m-light (textured) scene\n")
     print("| angle bits | frac bits | lights | output | end-to-end random max / mean "
           "| end-to-end adversarial max / mean | end-to-end worst-case max "
           "| arithmetic max (random / adversarial / worst-case) | bound | worst / bound |")

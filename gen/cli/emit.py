@@ -2,7 +2,6 @@
 ``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
 import dataclasses
-import json
 import re
 import sys
 from pathlib import Path
@@ -25,7 +24,7 @@ from bumprtl.gen.flow.memories import (
     memory_images,
     scene_command,
 )
-from bumprtl.gen.flow.named import named_module, named_ports, write_named
+from bumprtl.gen.flow.named import named_module, with_named, write_named
 from bumprtl.gen.flow.units import (
     SCENE_UNITS,
     UNITS,
@@ -38,6 +37,7 @@ from bumprtl.gen.flow.units import (
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools.toolchain import require
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.sidecar import load
 from bumprtl.sim.scenes.config import flag_name
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -76,22 +76,21 @@ def run(args):
         v_path, j_path, hexes = _emit_scene(args.unit, cfg, args, module)
     else:
         v_path, j_path = emit_unit(args.unit, cfg, args.out, module=module)
-    meta = json.loads(j_path.read_text())
+    meta = load(j_path)
     extra = []
     if args.ports == "named":
-        command = meta["command"] + " --ports named"
+        command = meta.command + " --ports named"
         extra.append(write_named(v_path, meta, command))
-        meta["named_ports"] = {"module": named_module(v_path.stem), "command": command,
-                               "ports": named_ports(meta)}
-    meta["command"] = full_command(args, cfg, module)
-    j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+        meta = with_named(meta, named_module(v_path.stem), command)
+    meta = meta.replace(command=full_command(args, cfg, module))
+    meta.dump(j_path)
     for path in (v_path, *extra, j_path, *hexes):
         print(f"wrote {path}")
     note = _faithful_note(args.unit, cfg)
     if note:
         print(note, file=sys.stderr)
     if args.fusesoc:
-        print(f"wrote {write_core(v_path, meta['command'], extra=extra, data=[j_path, *hexes])}")
+        print(f"wrote {write_core(v_path, meta.command, extra=extra, data=[j_path, *hexes])}")
     if args.lint:
         problems = lint(v_path)
         for wrapper in extra:

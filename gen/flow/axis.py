@@ -12,16 +12,16 @@ beside it as ``<unit>_axis_<memory>.hex`` and described in the sidecar's ``memor
 as ``bumprtl emit`` does without ``--interface axis``.
 """
 
-import json
 from pathlib import Path
 
-from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.emit import emit, port_table
 from bumprtl.gen.flow.memories import has_write_port, hex_text, image_records, scene_command
 from bumprtl.gen.flow.units import SCENE_UNITS, UNITS, canonical_command, name_flag
 from bumprtl.rtl.axis import AxisWrapper
 from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sidecar import from_facts
 
 __all__ = ["build_axis", "emit_axis", "axis_name"]
 
@@ -41,7 +41,8 @@ def _builder(name, images):
 
 
 def build_axis(name, cfg, tdata_width=None, images=None, module=None):
-    """``(wrapper, sidecar, command)`` for unit ``name`` in AXI4-Stream ports; ``images``:
+    """``(wrapper, sidecar, command)`` for unit ``name`` in AXI4-Stream ports (``sidecar``
+    a :class:`~bumprtl.rtl.sidecar.Sidecar`); ``images``:
     a scene unit's memory images (``memory_images``), None for empty memories; ``module``:
     the name the wrapper is emitted under is ``<module>_axis`` (default ``name``)."""
     if name not in UNITS:
@@ -49,19 +50,22 @@ def build_axis(name, cfg, tdata_width=None, images=None, module=None):
     unit = UNITS[name]
     wrapper = AxisWrapper(_builder(name, images), cfg, tdata_width)
     inner = unit.sidecar(cfg.replace(tag_bits=cfg.tag_bits + 1), wrapper.unit)
-    sidecar = {**inner, "config": cfg.config.to_dict() if name in SCENE_UNITS else cfg.to_dict(),
+    facts = {**inner, "config": cfg.config.to_dict() if name in SCENE_UNITS else cfg.to_dict(),
                "interface": "axis", "axis": wrapper.sidecar()}
     if "scene" in inner:
-        sidecar["scene"] = cfg.to_dict()
+        facts["scene"] = cfg.to_dict()
     if images:
-        sidecar["memory_images"] = {
+        facts["memory_images"] = {
             n: {**img, "file": f"{axis_name(module or name)}_{n}.hex"}
             for n, img in image_records(images, has_write_port(images)).items()}
     command = (canonical_command(unit, cfg) if name not in SCENE_UNITS or not images
                else scene_command(name, cfg, _load(images))) + " --interface axis"
     if tdata_width is not None:
         command += f" --tdata-width {tdata_width}"
-    return wrapper, sidecar, command + name_flag(name, module)
+    command += name_flag(name, module)
+    ports = {n: p for n, p in port_table(wrapper).items()     # aclk/aresetn, not clk/rst
+             if n not in ("clk", "rst")}
+    return wrapper, from_facts(axis_name(name), command, ports, facts), command
 
 
 def _load(images):
@@ -75,13 +79,9 @@ def emit_axis(name, cfg, out_dir, tdata_width=None, images=None, module=None):
     wrapper, sidecar, command = build_axis(name, cfg, tdata_width, images, module)
     v_path, j_path = emit(wrapper, axis_name(name), command, out_dir, sidecar, flatten=True,
                           module=axis_name(module) if module else None)
-    meta = json.loads(j_path.read_text())
-    for port in ("clk", "rst"):                 # aclk/aresetn instead (port_table adds these)
-        meta["ports"].pop(port, None)
-    j_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     hexes = []
     for n, img in (images or {}).items():
-        path = Path(out_dir) / sidecar["memory_images"][n]["file"]
+        path = Path(out_dir) / sidecar.memory_images[n]["file"]
         path.write_text(hex_text(img["words"], img["width"]))
         hexes.append(path)
     return v_path, j_path, hexes

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bumprtl.gen.flow.emit import emit
+from bumprtl.gen.flow.emit import emit, port_table
 from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag, unit_memories
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
@@ -28,6 +28,7 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import DP16KD_MODES
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sidecar import from_facts
 from bumprtl.sim.scenes.config import load_scene_config
 
 __all__ = ["LOADS", "DEFAULT_DEVICE", "DEVICE_BRAM", "BRAM_BITS", "BRAM_SHAPES", "bram_blocks", "map_blocks",
@@ -178,7 +179,7 @@ def host_writes(images, meta):
         if img["load"] != "port" or name == "lut":
             continue
         en, addr, data = img["port"][:3]
-        if en not in meta["ports"]:
+        if en not in meta.ports:
             raise BumpError(f"the emitted unit has no {en} port for the {name} image")
         cycles += [{en: 1, addr: a, data: int(w)} for a, w in enumerate(img["words"].tolist())]
     return cycles
@@ -247,17 +248,18 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
     if device is not None:                      # before building a large map's contents
         fit = check_scene_fits(scene, device, unit)
     dut = build(scene, init=init("map"), texture=init("texture"), write_port=write_port)
-    sidecar = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
+    facts = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
     if fit is not None:
-        sidecar["block_ram"] = {"device": device, "dp16kd_needed": fit[0],
+        facts["block_ram"] = {"device": device, "dp16kd_needed": fit[0],
                                 "dp16kd_available": fit[1],
                                 "note": "maps tiled into DP16KD shapes, one block per other table"}
     if module is not None:
         images = {n: {**img, "file": f"{module}_{n}.hex"} for n, img in images.items()}
-    sidecar["memory_images"] = image_records(images, write_port)
+    facts["memory_images"] = image_records(images, write_port)
     texts = {img["file"]: hex_text(img["words"], img["width"]) for img in images.values()}
     load = images["map"]["load"] if "map" in images else "initial"
-    v, j = emit(dut, unit, command or scene_command(unit, scene, load, module), out_dir, sidecar,
+    command = command or scene_command(unit, scene, load, module)
+    v, j = emit(dut, unit, command, out_dir, from_facts(unit, command, port_table(dut), facts),
                 flatten=True, module=module)
     paths = []
     for name, text in texts.items():

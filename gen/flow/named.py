@@ -1,5 +1,5 @@
 """``bumprtl emit UNIT --ports named``: a thin Verilog wrapper with one named port per payload
-field, generated from the sidecar's field table.
+field, generated from the sidecar's field table (a :class:`~bumprtl.rtl.sidecar.Sidecar`).
 
 The emitted unit carries each stream's fields packed into one vector (``i__payload``,
 ``o__payload``; their bit positions are in the sidecar's ``ports``). The wrapper
@@ -15,8 +15,9 @@ import re
 from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.sidecar import Field, NamedPort, NamedPorts
 
-__all__ = ["named_ports", "named_wrapper", "write_named", "named_module"]
+__all__ = ["named_ports", "named_wrapper", "write_named", "named_module", "with_named"]
 
 _STREAMS = {"i": ("in", "i__payload", "i__valid", "i__ready"),
             "o": ("out", "o__payload", "o__valid", "o__ready")}
@@ -31,35 +32,40 @@ def _ident(path):
 
 
 def named_ports(meta):
-    """``{port: {"dir", "width", "signed", "from", "bits"}}`` of the wrapper, in port order:
-    ``from`` is the unit's port, ``bits`` ``[lsb, msb]`` within it (None: the whole port)."""
-    ports = meta["ports"]
+    """``{port: NamedPort}`` of the wrapper of the unit with sidecar ``meta`` (a
+    :class:`~bumprtl.rtl.sidecar.Sidecar`), in port order: ``source`` is the unit's port,
+    ``bits`` ``(lsb, msb)`` within it (None: the whole port)."""
+    ports = meta.ports
     if "i__payload" not in ports or "o__payload" not in ports:
         raise BumpError("ports = named needs a unit with i__payload and o__payload (the stream "
                         "interface), not --interface axis")
-    out = {n: {"dir": ports[n]["dir"], "width": ports[n]["width"], "signed": False, "from": n,
-               "bits": None} for n in ("clk", "rst") if n in ports}
+    out = {n: NamedPort(ports[n].dir, ports[n].width, False, n) for n in ("clk", "rst")
+           if n in ports}
     stream_ports = set(out)
     for _side, (prefix, payload, valid, ready) in _STREAMS.items():
         stream_ports |= {payload, valid, ready}
-        pdir = ports[payload]["dir"]
-        out[f"{prefix}_valid"] = {"dir": pdir, "width": 1, "signed": False, "from": valid, "bits": None}
-        out[f"{prefix}_ready"] = {"dir": "out" if pdir == "in" else "in", "width": 1,
-                                  "signed": False, "from": ready, "bits": None}
-        fields = ports[payload].get("fields") or {"data": [0, ports[payload]["width"], False]}
-        for path, (off, width, signed) in sorted(fields.items(), key=lambda kv: kv[1][0]):
+        pdir = ports[payload].dir
+        out[f"{prefix}_valid"] = NamedPort(pdir, 1, False, valid)
+        out[f"{prefix}_ready"] = NamedPort("out" if pdir == "in" else "in", 1, False, ready)
+        fields = meta.fields_of(payload) or {"data": Field(0, ports[payload].width, False)}
+        for path, (off, width, signed) in sorted(fields.items(), key=lambda kv: kv[1].offset):
             name = f"{prefix}_{_ident(path)}"
             if name in out:
                 raise BumpError(f"ports = named: two fields of {payload} map to port {name}")
-            out[name] = {"dir": pdir, "width": width, "signed": bool(signed), "from": payload,
-                         "bits": [off, off + width - 1], "field": path}
+            out[name] = NamedPort(pdir, width, bool(signed), payload, (off, off + width - 1), path)
     for name, p in sorted(ports.items()):
         if name in stream_ports:
             continue
         if name in out:
             raise BumpError(f"ports = named: the unit's port {name} clashes with a field port")
-        out[name] = {"dir": p["dir"], "width": p["width"], "signed": False, "from": name, "bits": None}
+        out[name] = NamedPort(p.dir, p.width, False, name)
     return out
+
+
+def with_named(meta, module, command):
+    """``meta`` with its ``named_ports`` record: the wrapper ``module`` written by
+    ``command``."""
+    return meta.replace(named_ports=NamedPorts(module, command, named_ports(meta)))
 
 
 def _vec(width, signed=False):
@@ -70,13 +76,13 @@ def named_wrapper(meta, module, command):
     """Verilog text of ``<module>_named`` around ``module`` (sidecar ``meta``)."""
     ports = named_ports(meta)
     wrapper = named_module(module)
-    decl = ",\n".join(f"  {'input' if p['dir'] == 'in' else 'output'} wire "
-                      f"{_vec(p['width'], p['signed'])}{n}" for n, p in ports.items())
+    decl = ",\n".join(f"  {'input' if p.dir == 'in' else 'output'} wire "
+                      f"{_vec(p.width, p.signed)}{n}" for n, p in ports.items())
     body, conns = [], []
     for payload in ("i__payload", "o__payload"):
-        width = meta["ports"][payload]["width"]
-        fields = sorted((p["bits"][0], p["bits"][1], n) for n, p in ports.items()
-                        if p["from"] == payload and p["bits"] is not None)
+        width = meta.port(payload).width
+        fields = sorted((p.bits[0], p.bits[1], n) for n, p in ports.items()
+                        if p.source == payload and p.bits is not None)
         covered = sum(hi - lo + 1 for lo, hi, _ in fields)
         unused = payload == "o__payload" and covered < width
         if unused:
@@ -98,8 +104,8 @@ def named_wrapper(meta, module, command):
             body += [f"  assign {n} = o__payload[{hi}:{lo}];" for lo, hi, n in fields]
         conns.append(f"    .{payload}({payload})")
     for n, p in ports.items():
-        if p["bits"] is None:
-            conns.append(f"    .{p['from']}({n})")
+        if p.bits is None:
+            conns.append(f"    .{p.source}({n})")
     return (f"// Generated by: {command}\n"
             f"// Do not edit: regenerate with the command above.\n"
             f"// Named ports around `{module}`: one port per payload field of {module}.json,\n"

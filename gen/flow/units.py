@@ -7,17 +7,18 @@ and the reports elaborate exactly the same hardware from the same Config.
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bumprtl.gen.flow.emit import elaborated, emit
+from bumprtl.gen.flow.emit import elaborated, emit, port_table
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT, index_bits
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.sidecar import from_facts
 from bumprtl.rtl.sincos import SinCos, sine_rom_table
 from bumprtl.sim.golden.methods import METHODS, get
 
-__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "unit_memories",
+__all__ = ["UNITS", "SCENE_UNITS", "Unit", "build_unit", "emit_unit", "unit_sidecar", "unit_memories",
            "canonical_command", "default_module", "name_flag", "bound_fields", "error_bounds", "faithful_widths", "faithful_note"]
 
 
@@ -37,7 +38,7 @@ class Unit:
     name: str
     help: str
     build: Callable        # (Config or SceneConfig, target) -> Component
-    sidecar: Callable      # (Config, Component) -> dict of derived facts
+    sidecar: Callable      # (Config, Component) -> dict of derived facts (rtl/sidecar.py from_facts)
     flags: tuple = ("angle_bits", "frac_bits", "tag_bits")   # Config fields on the CLI
 
 
@@ -106,7 +107,7 @@ def faithful_note(cfg, lights=1, texture=False):
            f"no widths up to the Config's angle_bits {ANGLE_BITS_RANGE[1]}, frac_bits "
            f"{FRAC_BITS_MAX} prove 1 LSB at spec_exponent {cfg.spec_exponent}")
     return (f"note: proven error bounds at angle_bits {cfg.angle_bits}, frac_bits "
-            f"{cfg.frac_bits}: {bounds} (sidecar error_bounds_lsb; measured errors: "
+            f"{cfg.frac_bits}: {bounds} (sidecar error_bounds.lsb_per_channel; measured errors: "
             f"bumprtl bench accuracy); {fix}")
 
 
@@ -185,14 +186,25 @@ def canonical_command(unit, cfg, module=None):
 
 
 def build_unit(name, cfg: Config, target=None):
-    """Elaborate unit ``name``: returns ``(component, sidecar_dict, command)``. ``target``:
-    None (the generic form ``bumprtl emit`` writes) or ``rtl.pipe.ECP5()`` (gen/flow/fpga.py)."""
+    """Elaborate unit ``name``: returns ``(component, sidecar, command)``, ``sidecar`` the
+    :class:`~bumprtl.rtl.sidecar.Sidecar` ``bumprtl emit`` writes (the unit's bare name as
+    its module). ``target``: None (the generic form ``bumprtl emit`` writes) or
+    ``rtl.pipe.ECP5()`` (gen/flow/fpga.py)."""
     if name not in UNITS:
         raise BumpError(f"unit must be one of {', '.join(UNITS)}, got {name!r}")
     unit = UNITS[name]
     dut = unit.build(cfg, target=target)
-    sidecar = {"config": cfg.to_dict(), **unit.sidecar(cfg, dut)}
-    return dut, sidecar, canonical_command(unit, cfg)
+    facts = {"config": cfg.to_dict(), **unit.sidecar(cfg, dut)}
+    command = canonical_command(unit, cfg)
+    return dut, from_facts(name, command, port_table(dut), facts), command
+
+
+def unit_sidecar(name, cfg, module=None):
+    """The :class:`~bumprtl.rtl.sidecar.Sidecar` ``emit_unit`` writes, without the Verilog
+    (the unit is elaborated for its memory records, not converted)."""
+    sidecar = build_unit(name, cfg)[1]
+    return sidecar.replace(command=canonical_command(UNITS[name], cfg, module),
+                           module=module or name)
 
 
 def emit_unit(name, cfg, out_dir, module=None):

@@ -30,7 +30,6 @@ directory, one ``$readmemh`` file per input and per output field, and the testbe
 """
 
 import csv
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,7 +46,7 @@ from bumprtl.gen.flow.memories import (
     memory_images,
     scene_command,
 )
-from bumprtl.gen.flow.named import named_module, named_ports, write_named
+from bumprtl.gen.flow.named import named_module, with_named, write_named
 from bumprtl.gen.flow.units import UNITS, emit_unit
 from bumprtl.gen.flow.vectors_tb import bench_verilog, run_commands
 from bumprtl.gen.render.rtl import scene_memories, scene_stimulus, sim_scene
@@ -55,6 +54,7 @@ from bumprtl.rtl.bumpfetch import coord_bits, level_bits
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sidecar import load, ports_from_table
 from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.fixed.palette_lut import palette_colors
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
@@ -109,10 +109,10 @@ def _silenced(dut):
 
 def pipeline_fields(scene: SceneConfig):
     """``(input fields, output fields, ports)`` of ``BumpPipeline(scene)``: the payload
-    field tables ``{path: [offset, width, signed]}`` and the port table
-    (gen/flow/emit.port_table), read off its signature without elaborating it."""
-    ports = port_table(_silenced(BumpPipeline(scene)))
-    return ports["i__payload"]["fields"], ports["o__payload"]["fields"], ports
+    field tables ``{path: Field}`` and ``{name: Port}`` (rtl/sidecar.py, from
+    gen/flow/emit.port_table), read off its signature without elaborating it."""
+    ports = ports_from_table(port_table(_silenced(BumpPipeline(scene))))
+    return ports["i__payload"].fields, ports["o__payload"].fields, ports
 
 
 def _column(path):
@@ -347,8 +347,8 @@ def unit_fields(unit, cfg: Config):
     """``(input fields, output fields)`` of unit ``unit`` (gen/flow/units.py) at ``cfg``."""
     dut = UNITS[unit].build(cfg)
     dut._MustUse__silence = True
-    ports = port_table(dut)
-    return ports["i__payload"]["fields"], ports["o__payload"]["fields"]
+    ports = ports_from_table(port_table(dut))
+    return ports["i__payload"].fields, ports["o__payload"].fields
 
 
 def rotation_columns(cfg: Config):
@@ -416,12 +416,11 @@ def _emit_unit_named(v: Vectors, out, module):
 
 def _add_named(vpath, jpath):
     """Write the named-ports wrapper and record it in the sidecar; returns the sidecar."""
-    meta = json.loads(jpath.read_text())
-    command = meta["command"] + " --ports named"
+    meta = load(jpath)
+    command = meta.command + " --ports named"
     write_named(vpath, meta, command)
-    meta["named_ports"] = {"module": named_module(vpath.stem), "command": command,
-                           "ports": named_ports(meta)}
-    jpath.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    meta = with_named(meta, named_module(vpath.stem), command)
+    meta.dump(jpath)
     return meta
 
 
@@ -442,7 +441,7 @@ def _field_hex(values, width):
 
 def _poly_word(meta, polygon):
     word = 0
-    for name, (off, w, _s) in meta["ports"]["poly"]["fields"].items():
+    for name, (off, w, _s) in meta.fields_of("poly").items():
         word |= (int(polygon[name]) & ((1 << w) - 1)) << off
     return word
 
@@ -465,17 +464,17 @@ def write_vectors(v: Vectors, out, module="bumprtl_pipeline", load="initial", to
         if device is not None:
             check_scene_fits(v.scene, device)  # refused before anything is written
         meta, paths = _emit_named(v, out, module, load, device)
-    ports = meta["named_ports"]["ports"]
+    ports = meta.named_ports.ports
     for direction, values in (("in", v.inputs), ("out", v.expected)):
         for field, arr in values.items():
             name = f"{direction}_{_column(field)}"
             path = out / f"{module}_{name}.hex"
-            path.write_text(_field_hex(arr, ports[name]["width"]))
+            path.write_text(_field_hex(arr, ports[name].width))
             paths.append(path)
     poly = None
-    if "poly" in meta["ports"] and v.polygon is not None:
+    if "poly" in meta.ports and v.polygon is not None:
         poly = out / f"{module}_poly.hex"
-        poly.write_text(hex_text([_poly_word(meta, v.polygon)], meta["ports"]["poly"]["width"]))
+        poly.write_text(hex_text([_poly_word(meta, v.polygon)], meta.port("poly").width))
         paths.append(poly)
     command = command or (f"bumprtl vectors --unit {v.unit}" if v.scene is None else
                           f"bumprtl vectors --pipeline {v.scene.name}") + f" --count {len(v)}"

@@ -45,15 +45,15 @@ def _vec(width):
 
 def stream_ports(ports):
     """``(inputs, outputs)``: the named ports of the stream payload fields, in port order."""
-    fields = {n: p for n, p in ports.items() if p["bits"] is not None}
-    return ([n for n, p in fields.items() if p["dir"] == "in"],
-            [n for n, p in fields.items() if p["dir"] == "out"])
+    fields = {n: p for n, p in ports.items() if p.bits is not None}
+    return ([n for n, p in fields.items() if p.dir == "in"],
+            [n for n, p in fields.items() if p.dir == "out"])
 
 
 def host_ports(ports):
     """The named ports that are neither clock, reset nor stream: the host ports."""
     return [n for n, p in ports.items()
-            if p["bits"] is None and n not in ("clk", "rst", *_HANDSHAKE)]
+            if p.bits is None and n not in ("clk", "rst", *_HANDSHAKE)]
 
 
 def _load_image(image, ports, lines):
@@ -64,7 +64,7 @@ def _load_image(image, ports, lines):
     lines.append(f"    // {image['file']}: {depth} words of {image['width']} bits, word a at "
                  f"address a" + (" (a write is taken when lut_w_ready is high)" if handshake else ""))
     lines.append(f"    for (a = 0; a < {depth}; a = a + 1) begin")
-    lines.append(f"      {en} <= 1'b1; {addr} <= a[{ports[addr]['width'] - 1}:0]; "
+    lines.append(f"      {en} <= 1'b1; {addr} <= a[{ports[addr].width - 1}:0]; "
                  f"{data} <= {words}[a];")
     lines.append("      @(posedge clk);" if not handshake else
                  "      @(posedge clk); while (!lut_w_ready) @(posedge clk);")
@@ -81,39 +81,39 @@ def bench_verilog(meta, module, count, seed, command, top=None):
     """The text of ``<module>_tb.v`` for the named-ports pipeline of sidecar ``meta``
     (``named_ports``, ``memory_images``, ``latency``) and ``count`` pixels (module
     docstring). ``command``: the line that wrote it, the first comment."""
-    ports = meta["named_ports"]["ports"]
-    dut = top or meta["named_ports"]["module"]
+    ports = meta.named_ports.ports
+    dut = top or meta.named_ports.module
     ins, outs = stream_ports(ports)
     hosts = [] if top else host_ports(ports)
     tb = f"{module}_tb"
-    latency = int(meta["latency"])
+    latency = meta.latency
     # the host set-up's clocks (a top loads the same words itself, in about as many)
     setup_words = sum(img["depth"] + (1 if "lut_w_ready" in img["port"] else 0)
-                                    for img in meta.get("memory_images", {}).values()
+                                    for img in (meta.memory_images or {}).values()
                                     if img["load"] == "port")
     timeout = 8 * count + setup_words + 4 * latency + 1000
     drain = latency + 8
     decl, mems, setup, conns = [], [], [], []
     for n in hosts:                               # host inputs idle at zero, outputs read
         p = ports[n]
-        decl.append(f"  {'reg' if p['dir'] == 'in' else 'wire'} {_vec(p['width'])}{n}"
-                    f"{' = 0' if p['dir'] == 'in' else ''};")
-    for img in (meta.get("memory_images", {}).values() if not top else ()):
+        decl.append(f"  {'reg' if p.dir == 'in' else 'wire'} {_vec(p.width)}{n}"
+                    f"{' = 0' if p.dir == 'in' else ''};")
+    for img in ((meta.memory_images or {}).values() if not top else ()):
         if img["load"] == "port":
             mems.append(_load_image(img, ports, setup))
     if "poly" in hosts:
-        mems.append(f"  reg {_vec(ports['poly']['width'])}poly_word [0:0];\n"
+        mems.append(f"  reg {_vec(ports['poly'].width)}poly_word [0:0];\n"
                     f"  initial $readmemh(\"{module}_poly.hex\", poly_word);\n")
         setup.append("    // the polygon registers of the flat map (n'' rotated once per polygon)")
         setup.append("    poly <= poly_word[0]; poly_en <= 1'b1; @(posedge clk); poly_en <= 1'b0;")
     for n in ins:
-        mems.append(f"  reg {_vec(ports[n]['width'])}{n}_words [0:N-1];\n"
+        mems.append(f"  reg {_vec(ports[n].width)}{n}_words [0:N-1];\n"
                     f"  initial $readmemh(\"{module}_{n}.hex\", {n}_words);\n")
-        decl.append(f"  reg {_vec(ports[n]['width'])}{n} = 0;")
+        decl.append(f"  reg {_vec(ports[n].width)}{n} = 0;")
     for n in outs:
-        mems.append(f"  reg {_vec(ports[n]['width'])}{n}_words [0:N-1];   // expected\n"
+        mems.append(f"  reg {_vec(ports[n].width)}{n}_words [0:N-1];   // expected\n"
                     f"  initial $readmemh(\"{module}_{n}.hex\", {n}_words);\n")
-        decl.append(f"  wire {_vec(ports[n]['width'])}{n};")
+        decl.append(f"  wire {_vec(ports[n].width)}{n};")
     names = ["clk", "rst", "in_valid", "in_ready", *ins, "out_valid", "out_ready", *outs, *hosts]
     pad = max(len(n) for n in names)
     conns = ",\n".join(f"    .{n:<{pad}} ({n})" for n in names)

@@ -15,7 +15,6 @@
 """
 
 import importlib.util
-import json
 import sys
 import time
 from pathlib import Path
@@ -35,6 +34,7 @@ from bumprtl.gen.render.images import (
 )
 from bumprtl.gen.render.rtl import render_rtl, require_sim
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.scenes import load_scene
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.imaging import compose, max_diff, panel, psnr, save_png
@@ -139,10 +139,10 @@ def _rtl_section(args, out):
     diff = np.abs(r.image.astype(int) - r.golden.astype(int))
     save_png(out / "diff.png", np.clip(diff * DIFF_GAIN, 0, 255))
     error = rtl_mismatch(r.image, r.golden)
-    meta = json.loads((out / "pipeline" / "pipeline.json").read_text())
+    meta = load_sidecar(out / "pipeline" / "pipeline.json")
     counts = count_verilog(out / "pipeline" / "pipeline.v", "pipeline", out / "pipeline" / "yosys")
     c = counts.summary()
-    lines = ["", f"RTL render: scene class {scene.name!r} (`{meta['command']}`, the "
+    lines = ["", f"RTL render: scene class {scene.name!r} (`{meta.command}`, the "
                  f"{scene.image} bump map at {t}x{t} texels written through the host write port "
                  f"from pipeline_map.hex) -> {out / 'pipeline' / 'pipeline.v'} + pipeline.json",
              f"  map {t}x{t} x {2 * scene.angle_bits} bits: {blocks} of {have} DP16KD on "
@@ -151,13 +151,13 @@ def _rtl_section(args, out):
              f"  image {scene.image} {args.size}x{args.size}, simulator {args.simulator} (cocotb, bulk path), "
              f"same stimulus as the fixed-point golden render (sim/golden/fixed/pipeline.py)",
              "  units built: " + "; ".join(f"{b['unit']} ({b['class']}, latency {b['latency']})"
-                                          for b in meta["built"]),
-             "  units skipped: " + ("; ".join(f"{k['unit']} ({k['why']})" for k in meta["skipped"])
+                                          for b in meta.built),
+             "  units skipped: " + ("; ".join(f"{k['unit']} ({k['why']})" for k in meta.skipped)
                                     or "none"),
              f"  resources (Yosys coarse netlist, gen/flow/resources.py): multipliers {c['multipliers']}, "
              f"adders {c['adders']}, ROM bits {c['table_bits']}, "
              f"RAM bits {sum(x['bits'] for x in counts.rams)}, register bits {c['register_bits']}",
-             f"  latency {meta['latency']} cycles; {n} pixels in {r.cycles} cycles without stalls "
+             f"  latency {meta.latency} cycles; {n} pixels in {r.cycles} cycles without stalls "
              f"= {r.cycles / n:.4f} cycles per pixel (the pipe fills once, then 1 pixel per clock)",
              f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {args.simulator}, "
              f"streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:.0f} pixels/s "

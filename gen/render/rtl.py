@@ -11,7 +11,6 @@ colour texture's; the pipeline then outputs RGB itself. The bump map is the scen
 procedural image or the user's map file (``height_map``/``normal_map``, sim/scenes/usermap.py).
 """
 
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +32,7 @@ from bumprtl.rtl.bumpfetch import pack_rgb, pack_texels
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.common import to_8bit
 from bumprtl.sim.golden.fixed.common import angle_codes, quantize_pixels
 from bumprtl.sim.golden.fixed.palette_lut import pack_rgba, palette_colors
@@ -252,7 +252,7 @@ def _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load):
     """emit_pipeline, plus the host cycles that load the memories when ``load = "port"``."""
     v, j = emit_pipeline(scene, words, texels, build_dir, rtl_dir, table, load)
     images = memory_images("pipeline", scene, words, texels, None, load)
-    return v, j, host_writes(images, json.loads(Path(j).read_text()))
+    return v, j, host_writes(images, load_sidecar(j))
 
 
 def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir,
@@ -268,7 +268,7 @@ def run_pipeline_bulk(scene, inputs, words, polygon, table, simulator, build_dir
     Returns ({pattern: {field: array}}, {pattern: cycles}, :class:`BulkResult`)."""
     build_dir = Path(build_dir).resolve()
     v, j, writes = _emit_and_writes(scene, words, texels, table, build_dir, rtl_dir, load)
-    meta = json.loads(Path(j).read_text())
+    meta = load_sidecar(j)
     from bumprtl.sim.tb.bulk import run_bulk, setup_writes  # optional dependency: [sim]
     r = run_bulk(simulator, v, j, build_dir / f"bulk_{simulator}", patterns, inputs=inputs,
                  expected=expected, setup=writes + setup_writes(meta, polygon, table), **build)

@@ -2,7 +2,7 @@
 user reads, from the sidecar of the pipeline ``bumprtl emit`` writes.
 
 The scene's pipeline is emitted by ``bumprtl emit pipeline --load port --name my_bump --ports
-named`` itself (in process, into ``--out``), and from its sidecar (``built`` units, ``roms``,
+named`` itself (in process, into ``--out``), and from its sidecar (``built`` units, ``memories``,
 ``ports`` with their payload fields, ``named_ports``, ``memory_images``, ``latency``,
 ``command``) and the golden model this writes, between the ``<!-- generated: NAME -->`` and
 ``<!-- end: NAME -->`` markers of the page:
@@ -19,13 +19,14 @@ named`` itself (in process, into ``--out``), and from its sidecar (``built`` uni
 ``verilog``   an instantiation template of the named wrapper;
 ``load``      a testbench fragment that ``$readmemh``-reads each memory image and writes it
               through the host port.
+``sidecar``   the sidecar's schema (rtl/sidecar.py ``SCHEMA``), its version, what changed
+              from version 1, and this design's facts from it.
 
 The prose between the blocks is hand-written; a run rewrites only the blocks.
 """
 
 import contextlib
 import io
-import json
 import re
 from pathlib import Path
 
@@ -37,6 +38,8 @@ from bumprtl.gen.flow.named import named_ports
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import docs
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.sidecar import CHANGES_FROM_1, SCHEMA, SCHEMA_VERSION
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
@@ -100,7 +103,7 @@ _PORTS = {
 def _meaning(port, p):
     if port in _PORTS:
         return _PORTS[port]
-    field = p.get("field", "")
+    field = p.field or ""
     for pattern, text in _MEANINGS:
         if re.fullmatch(pattern, field):
             return text
@@ -116,23 +119,23 @@ def emit_for_integration(scene, out_dir, name=NAME, flags=()):
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         if main(argv) != 0:
             raise BumpError(f"bumprtl {' '.join(argv)} failed")
-    return json.loads((Path(out_dir) / f"{name}.json").read_text())
+    return load_sidecar(Path(out_dir) / f"{name}.json")
 
 
 def made_at(meta):
     """The page's record (gen/tools/docs.made_at) of the sidecar's Config."""
-    cfg = Config(**meta["config"])
-    return docs.made_at(cfg, f"scene `{meta['scene']['name']}`, method {cfg.method}; `{COMMAND}`, "
-                       f"from `{meta['command']}`")
+    cfg = Config(**meta.config)
+    return docs.made_at(cfg, f"scene `{meta.scene['name']}`, method {cfg.method}; `{COMMAND}`, "
+                       f"from `{meta.command}`")
 
 
 def _unit_memories(meta, unit):
-    roms = {k.split(".", 1)[1]: v for k, v in meta["roms"].items() if k.split(".")[0] == unit}
+    roms = {k.split(".", 1)[1]: v for k, v in meta.memories.items() if k.split(".")[0] == unit}
     if not roms:
         return ""
     groups = {}
     for name, r in roms.items():
-        key = (re.sub(r"\d+$", "", name), r["depth"], r["width"])
+        key = (re.sub(r"\d+$", "", name), r.depth, r.width)
         groups[key] = groups.get(key, 0) + 1
     return "<br/>" + "<br/>".join(f"{n} x {base} {d} x {w}" if n > 1 else f"{base} {d} x {w}"
                                   for (base, d, w), n in sorted(groups.items()))
@@ -140,13 +143,12 @@ def _unit_memories(meta, unit):
 
 def diagram(meta):
     """Mermaid flowchart: input stream -> built units -> output buffer -> output stream."""
-    ports = meta["ports"]
-    fin = ", ".join(sorted({f.split(".")[0] for f in ports["i__payload"]["fields"]}))
-    fout = ", ".join(sorted({f.split(".")[0] for f in ports["o__payload"]["fields"]}))
+    fin = ", ".join(sorted({f.split(".")[0] for f in meta.input_fields}))
+    fout = ", ".join(sorted({f.split(".")[0] for f in meta.output_fields}))
     lines = ["```mermaid", "flowchart LR",
              f'  IN(["in: {fin}<br/>valid / ready"])']
     prev = "IN"
-    for i, b in enumerate(meta["built"]):
+    for i, b in enumerate(meta.built):
         node = f"U{i}"
         lines.append(f'  {node}["{b["unit"]}: {b["class"]}<br/>latency {b["latency"]}'
                      f'{_unit_memories(meta, b["unit"])}"]')
@@ -154,9 +156,9 @@ def diagram(meta):
         prev = node
     lines += ['  BUF["output buffer<br/>2 entries"]', f"  {prev} --> BUF",
               f'  OUT(["out: {fout}<br/>valid / ready"])', "  BUF --> OUT"]
-    for img in meta.get("memory_images", {}).values():
+    for img in (meta.memory_images or {}).values():
         host = img["port"][0].rsplit("_w_en", 1)[0]
-        target = next((f"U{i}" for i, b in enumerate(meta["built"])
+        target = next((f"U{i}" for i, b in enumerate(meta.built)
                        if b["unit"] == ("fetch" if host in ("map", "tex") else "palette")), None)
         if target:
             lines += [f'  H_{host}[/"host: {", ".join(img["port"])}"/]',
@@ -167,31 +169,32 @@ def diagram(meta):
 
 def _ordered_ports(meta):
     """The named wrapper's ports in its port order (the sidecar's JSON keeps them sorted)."""
-    return {n: meta["named_ports"]["ports"][n] for n in named_ports(meta)}
+    return {n: meta.named_ports.ports[n] for n in named_ports(meta)}
 
 
 def port_table(meta):
     ports = _ordered_ports(meta)
     rows = ["| Port | Dir | Width | Packed bits | Format | Meaning |", "|---|---|---|---|---|---|"]
     for name, p in ports.items():
-        bits = (f"`{p['from']}[{p['bits'][1]}:{p['bits'][0]}]`" if p["bits"] is not None
-                else f"`{p['from']}`")
-        fmt = ("signed" if p["signed"] else "unsigned") if p["width"] > 1 else "bit"
-        rows.append(f"| `{name}` | {p['dir']} | {p['width']} | {bits} | {fmt} | "
+        bits = (f"`{p.source}[{p.bits[1]}:{p.bits[0]}]`" if p.bits is not None
+                else f"`{p.source}`")
+        fmt = ("signed" if p.signed else "unsigned") if p.width > 1 else "bit"
+        rows.append(f"| `{name}` | {p.dir} | {p.width} | {bits} | {fmt} | "
                     f"{_meaning(name, p)} |")
     return "\n".join(rows)
 
 
 def timing(meta):
-    lat = " + ".join(f"{b['unit']} {b['latency']}" for b in meta["built"])
-    out = [f"* Latency: **{meta['latency']} cycles**: a pixel taken at rising edge t (in_valid "
-           f"and in_ready high) leaves at edge t + {meta['latency']} (out_valid is high in the "
+    lat = " + ".join(f"{b['unit']} {b['latency']}" for b in meta.built)
+    block_ram = meta.block_ram or {}
+    out = [f"* Latency: **{meta.latency} cycles**: a pixel taken at rising edge t (in_valid "
+           f"and in_ready high) leaves at edge t + {meta.latency} (out_valid is high in the "
            f"cycle before it) when out_ready is held high; {lat}.",
-           f"* Throughput: {meta['throughput']} pixel per clock while out_ready is high.",
-           f"* Block RAM ({meta.get('block_ram', {}).get('device', DEFAULT_DEVICE)}): "
-           f"{meta.get('block_ram', {}).get('dp16kd_needed', '?')} DP16KD of "
-           f"{meta.get('block_ram', {}).get('dp16kd_available', '?')}."]
-    for name, img in meta.get("memory_images", {}).items():
+           f"* Throughput: {meta.throughput} pixel per clock while out_ready is high.",
+           f"* Block RAM ({block_ram.get('device', DEFAULT_DEVICE)}): "
+           f"{block_ram.get('dp16kd_needed', '?')} DP16KD of "
+           f"{block_ram.get('dp16kd_available', '?')}."]
+    for name, img in (meta.memory_images or {}).items():
         out.append(f"* Memory image `{img['file']}` ({name}): {img['depth']} words of "
                    f"{img['width']} bits, through `{'`, `'.join(img['port'])}`; {img['layout']}.")
     return "\n".join(out)
@@ -232,17 +235,17 @@ def pack_payload(fields, values):
 def example(meta):
     """The worked example as Python that recomputes it with the golden model and asserts
     every number, then the packed payload words of the same pixel."""
-    e, module = EXAMPLE, meta.get("module", meta["unit"])
-    scene = load_scene_config(meta["scene"])
+    e, module = EXAMPLE, meta.module
+    scene = load_scene_config(meta.scene)
     named = load_scene_config(scene.name).to_dict()
     over = {k: v for k, v in scene.to_dict().items() if named.get(k) != v}
     source = f'"{scene.name}"' + (f", {over!r}" if over else "")
     codes, out = example_pixel(scene)
-    fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
+    fin, fout = meta.input_fields, meta.output_fields
     missing = (set(fin) - set(codes)) | (set(fout) - set(out))
     if missing:
         raise BumpError(f"the worked example has no value for {', '.join(sorted(missing))}")
-    wi, wo = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
+    wi, wo = meta.port("i__payload").width, meta.port("o__payload").width
     code = f'''```python
 import numpy as np
 
@@ -277,7 +280,7 @@ assert out == {out!r}
 
 def verilog_template(meta):
     ports = _ordered_ports(meta)
-    wrapper = meta["named_ports"]["module"]
+    wrapper = meta.named_ports.module
     conns = ",\n".join(f"    .{n:<14}({'' if n in ('clk', 'rst') else 'my_'}{n})" for n in ports)
     return f"```verilog\n{wrapper} u_bump (\n{conns}\n);\n```"
 
@@ -286,11 +289,11 @@ def load_template(meta):
     """A Verilog testbench fragment that loads each ``load = port`` image through its port."""
     ports = _ordered_ports(meta)
     out = ["```verilog"]
-    for name, img in meta.get("memory_images", {}).items():
+    for name, img in (meta.memory_images or {}).items():
         if img["load"] != "port" or name == "lut":
             continue
         en, addr, data = img["port"][:3]
-        out += [f"reg [{ports[data]['width'] - 1}:0] {name}_words [0:{img['depth'] - 1}];",
+        out += [f"reg [{ports[data].width - 1}:0] {name}_words [0:{img['depth'] - 1}];",
                 f'initial $readmemh("{img["file"]}", {name}_words);', "integer a;",
                 "initial begin",
                 f"  {en} = 1'b0;",
@@ -304,10 +307,30 @@ def load_template(meta):
     return "\n".join(out)
 
 
+def sidecar_schema(meta):
+    """The sidecar's schema table (rtl/sidecar.py ``SCHEMA``), its version, what changed from
+    the untyped version 1, and the facts of this design's sidecar."""
+    rows = ["| Key | JSON type | Meaning |", "|---|---|---|"]
+    rows += [f"| `{k}` | {t} | {m} |" for k, (t, m) in SCHEMA.items()]
+    fin, fout = meta.input_fields, meta.output_fields
+    return "\n".join([
+        f"`{meta.module}.json` has `schema_version` **{meta.schema_version}** "
+        f"(`bumprtl.rtl.sidecar.SCHEMA_VERSION` = {SCHEMA_VERSION}). Every key is written in "
+        f"every sidecar (`null` where it does not apply); `bumprtl.rtl.sidecar.load` refuses a "
+        f"file of another version, with a missing or an unknown key, in one line naming the key "
+        f"and the version it reads.", "", *rows, "",
+        f"Changed from version 1 (the untyped sidecar of bumprtl 0.2 and before): "
+        f"{CHANGES_FROM_1}.", "",
+        f"This design's sidecar: latency {meta.latency}, ROMs {len(meta.roms)}, RAMs "
+        f"{len(meta.rams)}, `i__payload` {meta.port('i__payload').width} bits in "
+        f"{len(fin)} fields, `o__payload` {meta.port('o__payload').width} bits in {len(fout)} "
+        f"fields, {len(meta.named_ports.ports)} named ports."])
+
+
 def blocks(meta):
     return {"made-at": made_at(meta), "diagram": diagram(meta), "ports": port_table(meta),
             "timing": timing(meta), "example": example(meta), "verilog": verilog_template(meta),
-            "load": load_template(meta)}
+            "load": load_template(meta), "sidecar": sidecar_schema(meta)}
 
 
 def write_doc(doc, generated):

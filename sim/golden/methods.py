@@ -100,7 +100,7 @@ def _same_codes(codes, cfg: Config):
     return codes
 
 
-_UNQUANTIZED = "the largest over the channels (error_bound_lsb; each channel in error_bounds_lsb) vs float64 on unquantized inputs"
+_UNQUANTIZED = "the largest over the channels (error_bounds.lsb; each channel in error_bounds.lsb_per_channel) vs float64 on unquantized inputs"
 _CARTESIAN_NOTE = (f"{_UNQUANTIZED}, Cartesian input codes from "
                    "sim/golden/fixed/peercy.encode "
                    "(proof: sim/golden/fixed/peercy.predicted_error_bound_lsb)")

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.tb.bulk_build import (
     CLOCKS,
     DEFAULTS,
@@ -153,7 +154,7 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
     outputs and AssertionError on a mismatch.
     """
     opts = build_options(sim, clock, io, opt_fast, extra)
-    meta = json.loads(Path(j_path).read_text())
+    meta = load_sidecar(j_path)
     traffic = {**TRAFFIC, **(traffic or {})}
     for p in patterns:
         if p not in traffic:
@@ -162,11 +163,11 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
         raise BumpError("run_bulk takes stimulus inputs or a source, not both")
     if inputs is not None:
         check_stimulus(meta, inputs, widths)          # before the build
-        outs = meta["ports"]["o__payload"]["fields"]
+        outs = meta.output_fields
         for name in expected or {}:
             if name not in outs:
                 raise BumpError(f"expected field {name!r} is not an output field of "
-                                f"{meta['unit']}.json (o__payload fields: {', '.join(outs)})")
+                                f"{meta.unit}.json (o__payload fields: {', '.join(outs)})")
     work = Path(work_dir).resolve()
     work.mkdir(parents=True, exist_ok=True)
     bdir, top, build_s, cached = build(sim, v_path, meta, chunk, cache=cache, **opts)

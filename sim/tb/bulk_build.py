@@ -211,20 +211,20 @@ def build(sim, v_path, meta, chunk, clock=None, cache=None, io=None, opt_fast=No
                      _tool_version(sim))
     root = Path(cache or cache_root())
     root.mkdir(parents=True, exist_ok=True)
-    bdir = root / f"{sim}-{meta['unit']}-{digest}"
+    bdir = root / f"{sim}-{meta.unit}-{digest}"
     marker = bdir / "bulk_build.json"
-    with locked(root / f"{sim}-{meta['unit']}-{digest}.lock"):   # one build per digest
+    with locked(root / f"{sim}-{meta.unit}-{digest}.lock"):   # one build per digest
         if marker.exists():
             return bdir, top, json.loads(marker.read_text())["build_s"], True
         bdir.mkdir(parents=True, exist_ok=True)
-        (bdir / f"{meta['unit']}.v").write_bytes(v_bytes)
+        (bdir / f"{meta.unit}.v").write_bytes(v_bytes)
         (bdir / f"{top}.v").write_text(text)
         t0 = time.perf_counter()
         runner = runners()[sim]()
         if opts["clock"] == "cxx":
             runner.main = MAIN_CPP
         with tool_environ(make_vars):
-            runner.build(sources=[bdir / f"{meta['unit']}.v", bdir / f"{top}.v"],
+            runner.build(sources=[bdir / f"{meta.unit}.v", bdir / f"{top}.v"],
                          hdl_toplevel=top, build_dir=bdir, timescale=TIMESCALE,
                          parameters=parameters, defines=defines,
                          build_args=args, waves=False, always=True)

@@ -15,7 +15,7 @@ __all__ = ["check_stimulus", "encode_words", "decode_words"]
 
 
 def _fields(meta, port):
-    return {k: tuple(v) for k, v in meta["ports"][port]["fields"].items()}
+    return {k: tuple(v) for k, v in meta.fields_of(port).items()}
 
 
 def check_stimulus(meta, inputs, widths=None):
@@ -25,7 +25,7 @@ def check_stimulus(meta, inputs, widths=None):
     included) and no other, all of one length; ``widths`` (optional): ``{field: bits}``
     the arrays were made for. Raises :class:`BumpError` naming the field and both widths.
     """
-    unit = f"{meta['unit']}.json"
+    unit = f"{meta.unit}.json"
     fields = _fields(meta, "i__payload")
     for name in inputs:
         if name not in fields:

@@ -112,7 +112,7 @@ class CoverageFrame:
 
     def expected(self, meta):
         """The golden outputs of the pipeline's output fields, the tag included."""
-        outs = meta["ports"]["o__payload"]["fields"]
+        outs = meta.output_fields
         return {k: np.asarray(v, np.int64) for k, v in self.golden.items() if k in outs}
 
 

@@ -41,16 +41,16 @@ def _tags(n, start, bits):
 
 
 def _out_fields(meta):
-    return [k for k in meta["ports"]["o__payload"]["fields"] if k != "tag"]
+    return [k for k in meta.output_fields if k != "tag"]
 
 
 def _datapath(meta, spec, chunk):
     """Rotation or illumination: the edge cases and (exact method) the pixels whose dot
     products sit next to a rounding carry (:func:`rounding_codes`), then random pixels
     (seed + chunk number); golden = the unit's bit-exact model (rtl/methods.py)."""
-    cfg = Config(**meta["config"])
-    unit, outs = meta["unit"], _out_fields(meta)
-    keys = [k for k in meta["ports"]["i__payload"]["fields"] if k != "tag"]
+    cfg = Config(**meta.config)
+    unit, outs = meta.unit, _out_fields(meta)
+    keys = [k for k in meta.input_fields if k != "tag"]
 
     def chunks():
         start = 0
@@ -110,7 +110,7 @@ def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS, lit=F
 
 def _sincos(meta, spec, chunk):
     """Every quadrant boundary and its neighbours, then random angles; golden = the tables."""
-    cfg = Config(**meta["config"])
+    cfg = Config(**meta.config)
 
     def chunks():
         start = 0
@@ -140,7 +140,7 @@ def _palette(meta, spec, chunk):
     channel at both ends, together and alone) and random indices over the whole index
     range (out-of-range ones read as zero, oor = 1) with random base colours; golden = the
     table lookup and Tarini eq. 2."""
-    cfg = Config(**meta["config"])
+    cfg = Config(**meta.config)
     seed = int(spec.get("seed", 0))
     table = palette_table(cfg, seed)
     setup = []
@@ -195,10 +195,10 @@ def _pipeline(meta, spec, chunk):
     behind at once, coordinates and levels at both ends), then chunks alternate stress vectors (every case of sim/golden/stress.py; texels in order)
     and random payloads over the whole port ranges (wrap/clamp, levels past the last);
     golden = sim/golden/fixed/pipeline.py."""
-    scene = load_scene_config(meta["scene"])
+    scene = load_scene_config(meta.scene)
     seed = int(spec.get("seed", 0))
     words = pipeline_map(scene, int(spec.get("map_seed", 0)))
-    keys = list(meta["ports"]["i__payload"]["fields"])
+    keys = list(meta.input_fields)
     t = scene.texture_size
 
     def chunks():

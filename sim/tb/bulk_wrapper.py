@@ -37,13 +37,13 @@ STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", 
 def _host_ports(meta):
     """The unit's inputs besides the two streams, clk and rst (map/LUT/polygon host ports),
     in name order: the wrapper registers the set-up word on its way into them."""
-    return {name: p["width"] for name, p in sorted(meta["ports"].items())
-            if p["dir"] == "in" and name not in STREAM_PORTS}
+    return {name: p.width for name, p in sorted(meta.ports.items())
+            if p.dir == "in" and name not in STREAM_PORTS}
 
 
 def _other_outputs(meta):
-    return {name: p["width"] for name, p in sorted(meta["ports"].items())
-            if p["dir"] == "out" and name not in STREAM_PORTS}
+    return {name: p.width for name, p in sorted(meta.ports.items())
+            if p.dir == "out" and name not in STREAM_PORTS}
 
 
 def host_fields(meta):
@@ -75,9 +75,9 @@ def setup_writes(meta, polygon=None, table=None):
     """Host set-up cycles of a pipeline (cocotb drives them after reset, before the stream):
     the polygon registers of a flat map and the palette colour table (written, then
     swapped in). A list of ``{port: int}``, one per clock."""
-    ports, cycles = meta["ports"], []
+    ports, cycles = meta.ports, []
     if polygon is not None and "poly" in ports:
-        fields = ports["poly"]["fields"]
+        fields = meta.fields_of("poly")
         word = 0
         for name, (off, w, _s) in fields.items():
             word |= (int(polygon[name]) & ((1 << w) - 1)) << off
@@ -116,10 +116,10 @@ def wrapper_verilog(meta, own_clock, chunk):
     template = TEMPLATE.read_text()
     if template.count(HOOK) != 1:
         raise AssertionError(f"{TEMPLATE}: expected one {HOOK} hook")
-    unit = meta["unit"]
+    unit = meta.unit
     _, hw = host_fields(meta)
-    parameters = {"IW": meta["ports"]["i__payload"]["width"],
-                  "OW": meta["ports"]["o__payload"]["width"], "DEPTH": chunk, "HW": hw,
+    parameters = {"IW": meta.port("i__payload").width,
+                  "OW": meta.port("o__payload").width, "DEPTH": chunk, "HW": hw,
                   "XW": sum(_other_outputs(meta).values()), "PERIOD": PERIOD}
     defines = {"BULK_UNIT": unit, **({OWN_CLOCK_DEFINE: 1} if own_clock else {})}
     head = f"// bulk wrapper around `{unit}` (widths from {unit}.json): {parameters}\n"

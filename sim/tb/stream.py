@@ -1,12 +1,11 @@
 """cocotb stream verification components: driver, monitors, in-order scoreboard.
 
 Payloads are packed and unpacked from the bit-field table of the sidecar
-(``ports[...]["fields"]``), so no testbench hard-codes a bit position. Traffic patterns
+(``Sidecar.input_fields``/``output_fields``), so no testbench hard-codes a bit position. Traffic patterns
 are sim/traffic.py's (after verilog-axis: no stall, random input gaps, random output
 backpressure, both).
 """
 
-import json
 import logging
 import os
 import random
@@ -15,6 +14,7 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
+from bumprtl.rtl.sidecar import load
 from bumprtl.sim.traffic import PATTERNS
 
 __all__ = ["PATTERNS", "load_sidecar", "pack", "unpack", "run_stream", "samples"]
@@ -23,8 +23,8 @@ log = logging.getLogger("bumprtl.tb")
 
 
 def load_sidecar():
-    with open(os.environ["BUMPRTL_SIDECAR"]) as f:
-        return json.load(f)
+    """The :class:`~bumprtl.rtl.sidecar.Sidecar` named by ``BUMPRTL_SIDECAR``."""
+    return load(os.environ["BUMPRTL_SIDECAR"])
 
 
 def samples(default):
@@ -73,8 +73,7 @@ async def run_stream(dut, meta, inputs, model, pattern, seed=1, timeout_factor=2
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
-    fin = meta["ports"]["i__payload"]["fields"]
-    fout = meta["ports"]["o__payload"]["fields"]
+    fin, fout = meta.input_fields, meta.output_fields
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
     await _reset(dut)
 

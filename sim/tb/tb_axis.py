@@ -34,8 +34,8 @@ LINE = 7                     # pixels per line (tlast every LINE transfers)
 def _scene_inputs(meta, n, seed):
     """A scene pipeline's random pixels and its golden outputs, the memories read from the
     ``$readmemh`` files beside the sidecar."""
-    scene = load_scene_config(meta["scene"])
-    images = meta.get("memory_images", {})
+    scene = load_scene_config(meta.scene)
+    images = meta.memory_images or {}
     if scene.shading != "per-pixel" or scene.bump_map != "varying" or \
             any(img["load"] != "initial" for img in images.values()):
         raise ValueError(f"scene {scene.name!r}: this bench drives no host port (needs a varying "
@@ -70,14 +70,14 @@ def _pauses(rng, p):
 @cocotb.test()
 async def axis_matches_golden_with_pauses(dut):
     meta = load_sidecar()
-    cfg = Config(**meta["config"])
-    axis = meta["axis"]
+    cfg = Config(**meta.config)
+    axis = meta.axis
     s_fields, m_fields = axis["s_axis_tdata_fields"], axis["m_axis_tdata_fields"]
     rng = random.Random(5)
-    if "scene" in meta:
+    if meta.scene is not None:
         inputs, golden = _scene_inputs(meta, samples(300), seed=3)
     else:
-        inputs, golden = _inputs(meta["unit"], cfg, samples(300), seed=3)
+        inputs, golden = _inputs(meta.unit, cfg, samples(300), seed=3)
     n = len(next(iter(inputs.values())))
     n -= n % LINE
     mask = (1 << axis["tuser_width"]) - 1

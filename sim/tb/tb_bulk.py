@@ -22,6 +22,7 @@ import cocotb
 import numpy as np
 from cocotb.triggers import Timer
 
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.tb.bulk_codec import decode_words, encode_words
 from bumprtl.sim.tb.bulk_wrapper import (
     DENSITY_BITS,
@@ -113,8 +114,8 @@ def _compare(pattern, k, got, want, inputs):
 
 
 async def _run(dut, job, meta, summary, make_source):
-    fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
-    iw, ow = meta["ports"]["i__payload"]["width"], meta["ports"]["o__payload"]["width"]
+    fin, fout = meta.input_fields, meta.output_fields
+    iw, ow = meta.port("i__payload").width, meta.port("o__payload").width
     patterns = job["patterns"]
     setup, chunks = make_source(meta, job["source"], job["chunk"])
     await _reset_and_setup(dut, meta, job["setup"] + setup, job["chunk"])
@@ -194,7 +195,7 @@ async def run_job(dut, make_source):
     ``make_source(meta, spec, chunk)`` -> ``(setup cycles, iterator of (inputs, expected))``.
     The summary JSON is written whatever happens."""
     job = json.loads(Path(os.environ["BUMPRTL_BULK_JOB"]).read_text())
-    meta = json.loads(Path(job["sidecar"]).read_text())
+    meta = load_sidecar(job["sidecar"])
     summary = {"patterns": {p: {"pixels": 0, "cycles": 0, "sim_s": 0.0, "sim_cpu_s": 0.0}
                             for p in job["patterns"]},
                "finished": False, "checked": False, "timeout": False, "error": None}

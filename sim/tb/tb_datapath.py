@@ -41,7 +41,7 @@ def _golden(accepted, cfg, model, fields):
 @cocotb.parametrize(pattern=list(PATTERNS))
 async def datapath_matches_golden(dut, pattern):
     meta = load_sidecar()
-    cfg = Config(**meta["config"])
-    fields = {k for k in meta["ports"]["o__payload"]["fields"] if k != "tag"}
-    inputs, model = _stimulus(meta["unit"], cfg, samples(1000), len(pattern), fields)
+    cfg = Config(**meta.config)
+    fields = {k for k in meta.output_fields if k != "tag"}
+    inputs, model = _stimulus(meta.unit, cfg, samples(1000), len(pattern), fields)
     await run_stream(dut, meta, inputs, model, pattern)

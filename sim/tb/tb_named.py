@@ -20,6 +20,8 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
+from bumprtl.rtl.sidecar import load
+
 
 def _port(dut, prefix, name):
     return getattr(dut, f"{prefix}{name}")
@@ -47,8 +49,8 @@ async def _stream(dut, prefix, ports, stim, seed):
     """Offer every input (gaps of 1 in 4), take outputs (stalls of 1 in 4); returns the
     output arrays and the cycles from the first offer to the last output."""
     rng = random.Random(seed)
-    ins = {n: p for n, p in ports.items() if p["dir"] == "in" and p["bits"] is not None}
-    outs = {n: p for n, p in ports.items() if p["dir"] == "out" and p["bits"] is not None}
+    ins = {n: p for n, p in ports.items() if p.dir == "in" and p.bits is not None}
+    outs = {n: p for n, p in ports.items() if p.dir == "out" and p.bits is not None}
     cols = {n: stim[n].tolist() for n in ins}
     n = len(next(iter(cols.values())))
     got, nxt, offered, cycles = {k: [] for k in outs}, 0, False, 0
@@ -56,7 +58,7 @@ async def _stream(dut, prefix, ports, stim, seed):
     while len(got[next(iter(outs))]) < n:
         if not offered and nxt < n and rng.random() >= 0.25:
             for k, p in ins.items():
-                _port(dut, prefix, k).value = _mask(cols[k][nxt], p["width"])
+                _port(dut, prefix, k).value = _mask(cols[k][nxt], p.width)
             offered, nxt = True, nxt + 1
         valid.value = int(offered)
         ready.value = int(rng.random() >= 0.25)
@@ -66,7 +68,7 @@ async def _stream(dut, prefix, ports, stim, seed):
         if int(_port(dut, prefix, "out_valid").value) and int(ready.value):
             for k, p in outs.items():
                 v = int(_port(dut, prefix, k).value)
-                got[k].append(_signed(v, p["width"]) if p["signed"] else v)
+                got[k].append(_signed(v, p.width) if p.signed else v)
         await RisingEdge(dut.clk)
         cycles += 1
         assert cycles < 40 * (n + 100), f"{prefix}: timeout after {cycles} cycles"
@@ -78,12 +80,12 @@ async def _stream(dut, prefix, ports, stim, seed):
 async def named_side_by_side(dut):
     units = json.loads(os.environ["BUMPRTL_NAMED"])
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
-    metas = {p: json.load(open(u["sidecar"])) for p, u in units.items()}
+    metas = {p: load(u["sidecar"]) for p, u in units.items()}
     stims = {p: dict(np.load(u["stimulus"])) for p, u in units.items()}
     dut.rst.value = 1
     for prefix, meta in metas.items():
-        for name, p in meta["named_ports"]["ports"].items():
-            if p["dir"] == "in" and name not in ("clk", "rst"):
+        for name, p in meta.named_ports.ports.items():
+            if p.dir == "in" and name not in ("clk", "rst"):
                 _port(dut, prefix, name).value = 0
     for _ in range(3):
         await RisingEdge(dut.clk)
@@ -91,7 +93,7 @@ async def named_side_by_side(dut):
     await RisingEdge(dut.clk)
     for prefix in units:
         await _setup(dut, prefix, stims[prefix])
-    tasks = {p: cocotb.start_soon(_stream(dut, p, metas[p]["named_ports"]["ports"], stims[p],
+    tasks = {p: cocotb.start_soon(_stream(dut, p, metas[p].named_ports.ports, stims[p],
                                           seed=i + 1))
              for i, p in enumerate(units)}
     for prefix, task in tasks.items():

@@ -70,8 +70,8 @@ def _set_host(dut, write, swap):
 @cocotb.parametrize(pattern=list(PATTERNS))
 async def palette_matches_model(dut, pattern):
     meta = load_sidecar()
-    cfg = Config(**meta["config"])
-    fin, fout = meta["ports"]["i__payload"]["fields"], meta["ports"]["o__payload"]["fields"]
+    cfg = Config(**meta.config)
+    fin, fout = meta.input_fields, meta.output_fields
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(11)
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())

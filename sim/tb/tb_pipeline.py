@@ -25,7 +25,7 @@ async def _host_setup(dut, meta, stim):
     """Host cycles of the stimulus (``setup.<port>`` arrays: e.g. the map written through
     its port), the polygon registers (flat map) and the palette colour table, before the
     first pixel."""
-    ports = meta["ports"]
+    ports = meta.ports
     setup = {k[len("setup."):]: v.tolist() for k, v in stim.items() if k.startswith("setup.")}
     for i in range(len(next(iter(setup.values()), []))):
         for port, values in setup.items():
@@ -34,7 +34,7 @@ async def _host_setup(dut, meta, stim):
     for port in setup:
         getattr(dut, port).value = 0
     if "poly" in ports:
-        dut.poly.value = pack(ports["poly"]["fields"],
+        dut.poly.value = pack(meta.fields_of("poly"),
                               {k[len("polygon."):]: int(v) for k, v in stim.items()
                                if k.startswith("polygon.")})
         dut.poly_en.value = 1
@@ -58,7 +58,7 @@ async def _reset(dut, meta):
     dut.i__valid.value = 0
     dut.o__ready.value = 0
     for port in ("poly_en", "lut_w_en", "lut_swap", "map_w_en", "tex_w_en"):
-        if port in meta["ports"]:
+        if port in meta.ports:
             getattr(dut, port).value = 0
     for _ in range(3):
         await RisingEdge(dut.clk)
@@ -103,8 +103,7 @@ async def _stream(dut, meta, words, pattern, seed=1):
 async def pipeline_stream(dut):
     meta = load_sidecar()
     stim = dict(np.load(os.environ["BUMPRTL_STIMULUS"]))
-    fin = meta["ports"]["i__payload"]["fields"]
-    fout = meta["ports"]["o__payload"]["fields"]
+    fin, fout = meta.input_fields, meta.output_fields
     inputs = {k[3:]: v.tolist() for k, v in stim.items() if k.startswith("in.")}
     n = len(next(iter(inputs.values())))
     words = [pack(fin, {k: col[i] for k, col in inputs.items()}) for i in range(n)]

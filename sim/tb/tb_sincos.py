@@ -21,7 +21,7 @@ def model(cfg):
 @cocotb.parametrize(pattern=list(PATTERNS))
 async def sincos_matches_table(dut, pattern):
     meta = load_sidecar()
-    cfg = Config(**meta["config"])
+    cfg = Config(**meta.config)
     rng = np.random.default_rng(7)
     n = samples(500)
     angles = rng.integers(0, cfg.full_circle, n)

@@ -178,6 +178,7 @@ def emit_target(target, out, n, seed):
         inputs, expected, setup = _fetch_stimulus(scene, n, seed)
         return v, j, {"inputs": inputs, "expected": expected, "setup": setup}
     from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
+    from bumprtl.rtl.sidecar import load as load_sidecar
     from bumprtl.sim.tb.bulk_frame import coverage_frame
     scene = load_scene_config(target.split(":", 1)[1])
     # the memories as make test's bulk pipeline test emits them (the scene's map, texture and
@@ -186,12 +187,12 @@ def emit_target(target, out, n, seed):
     texels = scene_texels(scene, base)
     v, j = emit_pipeline(scene, words, texels, out, out, table, "initial", write_port=True)
     frame = coverage_frame(scene, words, texels)
-    meta = json.loads(Path(j).read_text())
-    expected = frame.expected(meta)
+    side = load_sidecar(j)
+    expected = frame.expected(side)
     if set(expected) == {"tag"}:
         raise NetlistError(f"{target}: no golden field matches the outputs "
-                           f"{list(meta['ports']['o__payload']['fields'])}")
-    return v, j, {"inputs": frame.inputs, "expected": expected, "setup": frame.setup(meta)}
+                           f"{list(side.output_fields)}")
+    return v, j, {"inputs": frame.inputs, "expected": expected, "setup": frame.setup(side)}
 
 
 # --- Yosys: the sample of mutations and the one netlist holding them all ---------------------

@@ -131,7 +131,7 @@ def test_fetch_sidecar_lists_every_output(name, outputs):
     from bumprtl.sim.scenes.config import load_scene_config
     dut, sidecar, _ = build_unit("fetch", load_scene_config(name))
     dut._MustUse__silence = True                   # only its ports are read
-    assert sidecar["outputs"] == outputs
+    assert sidecar.fetch["outputs"] == outputs
     assert set(outputs) <= set(dut.o.payload.shape().members)
 
 

@@ -75,7 +75,7 @@ def test_atan_address_and_table(cfg):
 
 def _memories(unit, cfg):
     _, sidecar, _ = build_unit(unit, cfg)
-    return sidecar["roms"]
+    return sidecar.roms
 
 
 def test_rom_count_matches_table_1():

@@ -189,9 +189,9 @@ def test_emit_lint_and_sidecar(cfg, build_dir):
     v, _ = emit_unit("palette", cfg, build_dir)
     assert lint(v) == []
     dut, side, command = build_unit("palette", cfg)
-    assert side["latency"] == dut.latency == READ_LATENCY + cfg.palette_blend
-    assert side["memory_bits"] == 2 * cfg.palette_size * 32
-    assert side["roms"]["table"]["depth"] == 2 * cfg.palette_size
+    assert side.latency == dut.latency == READ_LATENCY + cfg.palette_blend
+    assert side.memory_bits == 2 * cfg.palette_size * 32
+    assert side.rams["table"].depth == 2 * cfg.palette_size and not side.roms
     assert f"--palette-size {cfg.palette_size}" in command
 
 

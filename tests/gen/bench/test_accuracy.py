@@ -1,6 +1,7 @@
 """bumprtl bench accuracy: one row per channel beside its bound; an error above a bound is a
 failure (exit 1) that prints the offending input, which reproduces the error."""
 
+import dataclasses
 import re
 
 import numpy as np
@@ -74,7 +75,9 @@ def _tighten(monkeypatch, channel):
 
     def tight(unit, cfg):
         dut, sidecar, command = real(unit, cfg)
-        return dut, {**sidecar, "error_bounds_lsb": {**sidecar["error_bounds_lsb"], channel: 0}}, command
+        bounds = sidecar.error_bounds
+        tight = dataclasses.replace(bounds, lsb_per_channel={**bounds.lsb_per_channel, channel: 0})
+        return dut, sidecar.replace(error_bounds=tight), command
     monkeypatch.setattr(accuracy, "build_unit", tight)
 
 

@@ -10,7 +10,6 @@ sidecar; with ``--load port`` it is in all three.
 
 import contextlib
 import io
-import json
 import shlex
 
 import numpy as np
@@ -18,6 +17,8 @@ import pytest
 from PIL import Image
 
 from bumprtl.gen.cli.main import main
+from bumprtl.rtl.sidecar import load as load_sidecar
+from bumprtl.rtl.sidecar import loads
 
 SMALL = ["--angle-bits", "6", "--frac-bits", "8", "--texture-size", "16"]
 
@@ -62,7 +63,7 @@ def test_the_recorded_command_writes_the_same_files(case, emitted):
     tmp_path = emitted / case
     first = _files(tmp_path / "a")
     sidecar = next(n for n in first if n.endswith(".json"))
-    command = json.loads(first[sidecar])["command"]
+    command = loads(first[sidecar]).command
     words = shlex.split(command)
     assert words[:3] == ["bumprtl", "emit", CASES[case][0]] and "--out" not in words, command
     _emit(words[2:], tmp_path / "b")
@@ -72,13 +73,13 @@ def test_the_recorded_command_writes_the_same_files(case, emitted):
 
 
 def _host_ports(folder, name):
-    meta = json.loads((folder / f"{name}.json").read_text())
+    meta = load_sidecar(folder / f"{name}.json")
     found = {"module": "map_w_en" in (folder / f"{name}.v").read_text(),
-             "ports": "map_w_en" in meta["ports"],
-             "named": "map_w_en" in meta["named_ports"]["ports"],
+             "ports": "map_w_en" in meta.ports,
+             "named": "map_w_en" in meta.named_ports.ports,
              "wrapper": "map_w_en" in (folder / f"{name}_named.v").read_text(),
-             "image": "port" in meta["memory_images"]["map"]}
-    return found, meta["memory_images"]["map"]["load"]
+             "image": "port" in meta.memory_images["map"]}
+    return found, meta.memory_images["map"]["load"]
 
 
 def test_load_initial_emits_no_host_write_port_and_load_port_does(tmp_path, emitted):

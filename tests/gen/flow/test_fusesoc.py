@@ -10,6 +10,7 @@ from pathlib import Path
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.fusesoc import memory_files, vlnv
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, tool_env
+from bumprtl.rtl.sidecar import load
 
 FUSESOC = str(Path(sys.executable).parent / "fusesoc")
 
@@ -25,6 +26,8 @@ def test_emitted_core_lints_and_builds_under_fusesoc(tmp_path, capsys):
                  "--out", str(tmp_path)]) == 0
     core = (tmp_path / "bumprtl_sincos.core").read_text()
     assert core.startswith("CAPI=2:") and "bumprtl_sincos.v" in core
+    version = load(tmp_path / "bumprtl_sincos.json").schema_version     # the one it carries
+    assert f"# Sidecar bumprtl_sincos.json: schema_version {version} " in core
     assert all(f"-Wno-{w}" in core for w in VERILATOR_WAIVERS)
     for target in ("lint", "sim"):
         out = _fusesoc(tmp_path, target, "bumprtl_sincos")

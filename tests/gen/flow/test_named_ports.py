@@ -11,6 +11,7 @@ import pytest
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.emit import lint
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.runner import run_cocotb
@@ -42,7 +43,7 @@ def test_name_prefixes_the_top_and_every_submodule(tmp_path, capsys):
     assert all(m.startswith(("my_rot(", "\\my_rot.")) for m in re.findall(r"^module (\S+)", named, re.M))
     body = lambda t: t.split("\n", 2)[2]
     assert body(named) == body(text).replace("bumprtl_rotation", "my_rot")    # only the names
-    assert json.loads((tmp_path / "n" / "my_rot.json").read_text())["module"] == "my_rot"
+    assert load_sidecar(tmp_path / "n" / "my_rot.json").module == "my_rot"
     capsys.readouterr()
     for bad in ("9lives", "a-b", "x y"):
         assert main([*base, "--name", bad, "--out", str(tmp_path / "bad")]) == 2
@@ -62,8 +63,8 @@ def _top(wrappers):
             if n in ("clk", "rst"):
                 conns.append(f"    .{n}({n})")
                 continue
-            vec = f"{'signed ' if p['signed'] else ''}[{p['width'] - 1}:0] " if p["width"] > 1 else ""
-            decl.append(f"  {'input' if p['dir'] == 'in' else 'output'} wire {vec}{prefix}{n}")
+            vec = f"{'signed ' if p.signed else ''}[{p.width - 1}:0] " if p.width > 1 else ""
+            decl.append(f"  {'input' if p.dir == 'in' else 'output'} wire {vec}{prefix}{n}")
             conns.append(f"    .{n}({prefix}{n})")
         inst.append(f"  {module} u_{prefix}pipe (\n" + ",\n".join(conns) + "\n  );")
     return "module two_pipes (\n" + ",\n".join(decl) + "\n);\n" + "\n".join(inst) + "\nendmodule\n"
@@ -77,13 +78,13 @@ def side_by_side(tmp_path_factory):
         assert main(["emit", "pipeline", "--scene", "default", *_flags(over), "--load", load,
                      "--name", name, "--ports", "named", "--out", str(root / "rtl")]) == 0
         j = root / "rtl" / f"{name}.json"
-        meta = json.loads(j.read_text())
-        ports = meta["named_ports"]["ports"]
-        assert meta["named_ports"]["module"] == f"{name}_named" and meta["module"] == name
+        meta = load_sidecar(j)
+        ports = meta.named_ports.ports
+        assert meta.named_ports.module == f"{name}_named" and meta.module == name
         scene = load_scene_config("default", over)
         words = np.array([int(w, 16) for w in (root / "rtl" / f"{name}_map.hex").read_text().split()])
         inputs = random_inputs(scene, PIXELS, np.random.default_rng(len(units)))
-        stim = {n: inputs[p["field"]] for n, p in ports.items() if p["dir"] == "in" and p.get("field")}
+        stim = {n: inputs[p.field] for n, p in ports.items() if p.dir == "in" and p.field}
         assert len(stim) == len(inputs)          # every input field has its port
         if load == "port":                       # the map through the host write port
             stim.update({"setup.map_w_en": np.ones(len(words), np.int64),

@@ -8,12 +8,12 @@ The design is the scene pipeline with the most auxiliary files (palette shading 
 colour texture: bump map, texture and colour-table images) at tiny widths."""
 
 import itertools
-import json
 import re
 
 import pytest
 
 from bumprtl.gen.cli.main import main
+from bumprtl.rtl.sidecar import loads
 
 SCENE = """name = "names"
 shading = "palette"
@@ -48,7 +48,7 @@ def _named_files(path):
     if path.suffix == ".core":
         return set(re.findall(r"^\s*-\s*([\w.]+\.(?:v|hex|json))", text, re.M))
     if path.suffix == ".json":
-        return {img["file"] for img in json.loads(text).get("memory_images", {}).values()}
+        return {img["file"] for img in (loads(text).memory_images or {}).values()}
     return set()
 
 

@@ -5,7 +5,6 @@ pixels in physical units are encoded as docs/integration.md defines the binary a
 bad input is one line naming the parameter, exit 2, nothing written."""
 
 import csv
-import json
 import math
 import shlex
 import shutil
@@ -18,6 +17,7 @@ import pytest
 from bumprtl.gen.flow.vectors import MAX_COUNT, pipeline_vectors, pixel_columns
 from bumprtl.gen.flow.vectors_tb import run_commands
 from bumprtl.gen.tools.toolchain import tool_env
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.scenes.config import load_scene_config
 
 PIXELS = 120
@@ -84,13 +84,13 @@ def test_one_changed_expected_word_fails_naming_pixel_field_and_values(default_b
 def _stub(meta, valid):
     """A module with the named ports of ``meta`` that takes every pixel and never (or always)
     raises out_valid: a hung (or babbling) pipeline."""
-    ports = meta["named_ports"]["ports"]
-    decl = ",\n".join(f"  {'input' if p['dir'] == 'in' else 'output'} wire "
-                      f"{f'[{w - 1}:0] ' if (w := p['width']) > 1 else ''}{n}" for n, p in ports.items())
+    ports = meta.named_ports.ports
+    decl = ",\n".join(f"  {'input' if p.dir == 'in' else 'output'} wire "
+                      f"{f'[{w - 1}:0] ' if (w := p.width) > 1 else ''}{n}" for n, p in ports.items())
     value = {"in_ready": 1, "out_valid": int(valid)}          # every other output 0
     body = "\n".join(f"  assign {n} = {value.get(n, 0)};" for n, p in ports.items()
-                     if p["dir"] == "out")
-    return f"module {meta['named_ports']['module']} (\n{decl}\n);\n{body}\nendmodule\n"
+                     if p.dir == "out")
+    return f"module {meta.named_ports.module} (\n{decl}\n);\n{body}\nendmodule\n"
 
 
 @pytest.mark.parametrize("valid, verdict", [(False, f"FAIL timeout: 0 of {PIXELS} pixels out"),
@@ -98,7 +98,7 @@ def _stub(meta, valid):
 def test_a_hung_or_babbling_design_fails(default_bench, tmp_path, valid, verdict):
     out, _ = default_bench
     d = _copy(out, tmp_path / "stub")
-    meta = json.loads((d / "bumprtl_pipeline.json").read_text())
+    meta = load_sidecar(d / "bumprtl_pipeline.json")
     (d / "stub.v").write_text(_stub(meta, valid))
     shutil.copy(out / f"{TB}.v", d)
     t0 = time.perf_counter()
@@ -111,8 +111,8 @@ def test_expected_words_are_the_golden_models_of_the_stimulus(default_bench):
     """The files hold what they say: tags pass through, every field file has one word a
     pixel, and the sidecar's named ports all have a file (in_* stimulus, out_* expected)."""
     out, _ = default_bench
-    meta = json.loads((out / "bumprtl_pipeline.json").read_text())
-    fields = [n for n, p in meta["named_ports"]["ports"].items() if p["bits"] is not None]
+    meta = load_sidecar(out / "bumprtl_pipeline.json")
+    fields = [n for n, p in meta.named_ports.ports.items() if p.bits is not None]
     for n in fields:
         assert len((out / f"bumprtl_pipeline_{n}.hex").read_text().splitlines()) == PIXELS, n
     assert (out / "bumprtl_pipeline_in_tag.hex").read_text() == \

@@ -1,4 +1,3 @@
-import json
 import re
 
 import numpy as np
@@ -8,6 +7,7 @@ from bumprtl.gen.flow.memories import bram_blocks
 from bumprtl.gen.render.demo import DEMO_SCENES, demo_map_size, demo_methods, rtl_mismatch
 from bumprtl.gen.render.images import FIXED_METHODS, float_image
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.scenes.heightfields import brick_lines
@@ -74,12 +74,12 @@ def _check_rtl_section(out, report):
     rtl, golden, diff = (np.asarray(Image.open(out / f"{n}.png")) for n in ("rtl", "golden", "diff"))
     assert rtl.shape == (32, 32, 3) and rtl.tobytes() == golden.tobytes() and not diff.any()
     assert rtl.std() > 5                                           # a picture, not a blank
-    meta = json.loads((out / "pipeline" / "pipeline.json").read_text())
+    meta = load_sidecar(out / "pipeline" / "pipeline.json")
     assert (out / "pipeline" / "pipeline.v").read_text().lstrip().startswith(("//", "/*", "(*", "module"))
-    assert [b["unit"] for b in meta["built"]] == ["fetch", "rotation", "illumination"]
+    assert [b["unit"] for b in meta.built] == ["fetch", "rotation", "illumination"]
     m = re.search(r"(\d+) pixels in (\d+) cycles without stalls = ([\d.]+) cycles per pixel", report)
     pixels, cycles, cpp = int(m[1]), int(m[2]), float(m[3])
-    assert pixels == 32 * 32 and pixels < cycles <= pixels + meta["latency"] + 1
+    assert pixels == 32 * 32 and pixels < cycles <= pixels + meta.latency + 1
     assert abs(cpp - cycles / pixels) < 1e-4
     t = demo_map_size(32)                                          # the largest that fits: 32
     lines = [int(r) for r in brick_lines(t)[0]]                    # narrow map: on texel rows

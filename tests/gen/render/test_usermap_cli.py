@@ -20,6 +20,7 @@ from bumprtl.gen.render.images import fixed_image
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.report import recommend as rec
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.common import polar_to_cartesian
 from bumprtl.sim.scenes import heightfields
 from bumprtl.sim.scenes.config import load_scene_config
@@ -101,13 +102,13 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     v = (out / "bumprtl_pipeline.v").read_text()
     init = _initial_contents(v)
     assert [init.get(a, 0) for a in range(len(words))] == words.tolist()
-    meta = json.loads((out / "bumprtl_pipeline.json").read_text())
-    img = meta["memory_images"]["map"]
+    meta = load_sidecar(out / "bumprtl_pipeline.json")
+    img = meta.memory_images["map"]
     assert img["file"] == "bumprtl_pipeline_map.hex" and img["load"] == "initial" and img["width"] == 20
     assert "phi in bits [9:0], theta in bits [19:10]" in img["layout"]      # 10-bit angles
-    assert "port" not in img and "map_w_en" not in meta["ports"]   # built in: no write port
-    assert meta["scene"]["geometry"] == "sphere" and meta["scene"]["height_scale"] == 3.0
-    assert meta["block_ram"]["device"] == "LFE5U-85F"
+    assert "port" not in img and "map_w_en" not in meta.ports   # built in: no write port
+    assert meta.scene["geometry"] == "sphere" and meta.scene["height_scale"] == 3.0
+    assert meta.block_ram["device"] == "LFE5U-85F"
     assert lint(out / "bumprtl_pipeline.v") == []
     port = tmp_path / "b"
     assert main(["emit", "pipeline", "--scene", str(toml), "--load", "port", "--out", str(port)]) == 0
@@ -115,9 +116,9 @@ def test_emit_pipeline_from_a_toml_writes_readmemh_beside_the_verilog(tmp_path):
     assert not any(_initial_contents(pv).values())          # no map in the Verilog
     assert pv.splitlines()[0].endswith(f"--scene {toml} --load port")
     assert (port / "bumprtl_pipeline_map.hex").read_text() == (out / "bumprtl_pipeline_map.hex").read_text()
-    pmeta = json.loads((port / "bumprtl_pipeline.json").read_text())
-    assert pmeta["memory_images"]["map"]["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
-    assert {"map_w_en", "map_w_addr", "map_w_data"} <= set(pmeta["ports"])
+    pmeta = load_sidecar(port / "bumprtl_pipeline.json")
+    assert pmeta.memory_images["map"]["port"] == ["map_w_en", "map_w_addr", "map_w_data"]
+    assert {"map_w_en", "map_w_addr", "map_w_data"} <= set(pmeta.ports)
     again = tmp_path / "c"
     assert main(["emit", "pipeline", "--scene", str(toml), "--out", str(again)]) == 0
     for name in ("bumprtl_pipeline.v", "bumprtl_pipeline_map.hex"):
@@ -129,8 +130,8 @@ def test_emit_fetch_with_a_normal_map_and_flat_fetch_is_one_line(tmp_path, capsy
     write_png(tmp_path / "n.png", normals_to_rgb(polar_to_cartesian(bm.b_phi_map, bm.b_theta_map)))
     assert main(["emit", "fetch", "--normal-map", str(tmp_path / "n.png"), "--out",
                  str(tmp_path / "f")]) == 0
-    meta = json.loads((tmp_path / "f" / "bumprtl_fetch.json").read_text())
-    assert "port" not in meta["memory_images"]["map"] and "w_en" not in meta["ports"]
+    meta = load_sidecar(tmp_path / "f" / "bumprtl_fetch.json")
+    assert "port" not in meta.memory_images["map"] and "w_en" not in meta.ports
     assert len((tmp_path / "f" / "bumprtl_fetch_map.hex").read_text().split()) == 32 * 32
     _one_line_exit_2(capsys, ["emit", "fetch", "--scene", "flat", "--out", str(tmp_path / "g")],
                      "flat", "nothing to fetch")

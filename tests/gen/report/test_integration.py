@@ -1,6 +1,7 @@
 """``bumprtl report integration``: docs/integration.md's generated blocks from the sidecar
 of a pipeline emitted with named ports, and the page's Amaranth example."""
 
+import json
 import re
 from pathlib import Path
 
@@ -26,21 +27,31 @@ def test_blocks_cover_every_port_field_and_unit(small):
     out = blocks(small)
     assert out["made-at"].startswith("Made at: angle_bits=10, frac_bits=11 ")
     rows = [r for r in out["ports"].splitlines()[2:]]
-    named = small["named_ports"]["ports"]
+    named = small.named_ports.ports
     assert len(rows) == len(named)
-    for field, (off, width, _) in small["ports"]["i__payload"]["fields"].items():
+    for field, (off, width, _) in small.input_fields.items():
         port = "in_" + re.sub(r"\W", "_", field)
         assert any(r.startswith(f"| `{port}` | in | {width} | `i__payload[{off + width - 1}:{off}]`")
                    for r in rows), port
-    for field, (off, width, _) in small["ports"]["o__payload"]["fields"].items():
+    for field, (off, width, _) in small.output_fields.items():
         assert f"`o__payload[{off + width - 1}:{off}]`" in out["ports"], field
     assert "see rtl/layouts.py" not in out["ports"]          # every port has its meaning
-    for b in small["built"]:
+    for b in small.built:
         assert f'{b["unit"]}: {b["class"]}<br/>latency {b["latency"]}' in out["diagram"]
-    assert f"**{small['latency']} cycles**" in out["timing"]
+    assert f"**{small.latency} cycles**" in out["timing"]
     assert all(f".{p}" in out["verilog"] for p in named)
     assert "$readmemh(\"my_bump_map.hex\"" in out["load"]
     assert "--texture-size 16" in out["made-at"] and "--name my_bump" in out["made-at"]
+
+
+def test_the_sidecar_block_tables_every_key_of_the_file(small):
+    """Each key of the emitted sidecar (and of a payload field) has its row, the version
+    is the file's."""
+    out = blocks(small)["sidecar"]
+    for key in json.loads(small.dumps()):
+        assert f"| `{key}` |" in out, key
+    assert "| `ports.NAME.fields` |" in out
+    assert f"has `schema_version` **{small.schema_version}**" in out
 
 
 def test_write_doc_rewrites_only_the_blocks(small, tmp_path):
@@ -60,7 +71,7 @@ def test_write_doc_rewrites_only_the_blocks(small, tmp_path):
 
 def test_the_page_has_every_block_filled():
     text = DOC.read_text()
-    for name in ("made-at", "diagram", "ports", "timing", "example", "load", "verilog"):
+    for name in ("made-at", "diagram", "ports", "timing", "example", "load", "verilog", "sidecar"):
         body = re.search(rf"<!-- generated: {name} -->\n(.*?)<!-- end: {name} -->", text, re.S)
         assert body and body.group(1).strip(), name
     assert "bumprtl report integration" in text

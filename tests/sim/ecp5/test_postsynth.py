@@ -24,6 +24,7 @@ from bumprtl.gen.render.rtl import scene_stimulus, write_stimulus
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ECP5, RAM_LATENCY, RegisteredRAM
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sidecar import from_facts
 from bumprtl.sim.ecp5 import (
     ecp5_lockstep,
     enabled_delay,
@@ -112,7 +113,8 @@ def _postsynth_stream(component, label, inputs, build_dir, patterns, polygon=Non
     netlist = synth_netlist(text, label, build_dir / "synth")
     synth_s = time.perf_counter() - t0
     sidecar = build_dir / f"{label}.json"
-    sidecar.write_text(json.dumps({"ports": port_table(component)}))
+    from_facts(label, f"post-synthesis {label}", port_table(component),
+               {"config": {}, "latency": component.latency, "throughput": 1}).dump(sidecar)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, None)
     sources, includes = postsynth_sources(build_dir / "cells")

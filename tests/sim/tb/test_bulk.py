@@ -11,7 +11,6 @@ replaces the per-cycle 10^6-vector runs, keeping their units, methods, patterns 
 pipeline's stress cases).
 """
 
-import json
 import os
 
 import numpy as np
@@ -21,6 +20,7 @@ from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
@@ -69,7 +69,7 @@ def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
     size = FRAME[sim]
     scene, render, words, _, _, texels = _frame(size)
     v, j = emit_pipeline(scene, words, texels, build_dir, None, write_port=True)
-    meta = json.loads(j.read_text())
+    meta = load_sidecar(j)
     frame = coverage_frame(scene, words, texels, n=size * size)
     n = len(frame.inputs["tag"])
     assert n > size * size                                # the table-sensitivity pixels
@@ -78,8 +78,8 @@ def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
                  expected=golden, setup=frame.setup(meta))
     outs, cycles = r.outputs, r.cycles
     assert r.checked
-    assert set(golden) == set(meta["ports"]["o__payload"]["fields"])
-    latency = meta["latency"]
+    assert set(golden) == set(meta.output_fields)
+    latency = meta.latency
     for pattern in TRAFFIC:
         assert r.pixels[pattern] == n
         assert np.array_equal(outs[pattern]["tag"], frame.inputs["tag"]), pattern
@@ -162,7 +162,7 @@ def test_bulk_refuses_stimulus_that_does_not_match_the_sidecar(build_dir, monkey
     with pytest.raises(BumpError, match=r"'angle' is 16 bits wide, sincos.json i__payload "
                                         r"field 'angle' is 12 bits"):
         run_bulk("verilator", v, j, build_dir / "bulk", inputs=good, widths={"angle": 16})
-    assert check_stimulus(json.loads(j.read_text()), good) == n
+    assert check_stimulus(load_sidecar(j), good) == n
 
 
 def test_bulk_build_options_are_checked_before_the_build(build_dir, monkeypatch, sincos_rtl):

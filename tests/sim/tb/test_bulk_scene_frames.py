@@ -8,12 +8,12 @@ cycle from cocotb). This is the frame and the four traffic patterns the netlist 
 these scenes run (tests/mutants/netlist.py), so a mutant that frame kills is killed by
 make test."""
 
-import json
 
 import numpy as np
 import pytest
 
 from bumprtl.gen.render.rtl import emit_pipeline, scene_stimulus, scene_texels
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk import run_bulk
 from bumprtl.sim.tb.bulk_frame import coverage_frame
@@ -28,7 +28,7 @@ def _scene_frame(scene, build_dir):
     _, words, _, _, base = scene_stimulus(scene, 16)
     texels = scene_texels(scene, base)
     v, j = emit_pipeline(scene, words, texels, build_dir, None, write_port=True)
-    meta = json.loads(j.read_text())
+    meta = load_sidecar(j)
     frame = coverage_frame(scene, words, texels)
     return v, j, meta, frame, frame.expected(meta)
 
@@ -48,7 +48,7 @@ def _stream(v, j, meta, frame, golden, work):
 @pytest.mark.parametrize("name", ["diffuse", "flat", "textured", "two-lights"])
 def test_scene_coverage_frame_equals_golden(name, build_dir):
     v, j, meta, frame, golden = _scene_frame(load_scene_config(name), build_dir)
-    assert set(golden) == set(meta["ports"]["o__payload"]["fields"])      # every output
+    assert set(golden) == set(meta.output_fields)      # every output
     _stream(v, j, meta, frame, golden, build_dir / "bulk")
 
 

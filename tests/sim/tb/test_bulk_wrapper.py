@@ -3,7 +3,6 @@ sim/tb/bulk_wrapper.py fills it in, with Verilator -Wall and the project's waive
 each build the bulk path uses (own clock on Icarus, C++ clock with file or DPI I/O on
 Verilator)."""
 
-import json
 import subprocess
 
 import pytest
@@ -11,6 +10,7 @@ import pytest
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.tb.bulk_wrapper import HOOK, TEMPLATE, TOP, host_fields, wrapper_verilog
 
 BUILDS = {"own clock": ["-DBULK_OWN_CLOCK"], "cxx clock, file": [],
@@ -29,16 +29,16 @@ def _lint(wrapper, unit_v, parameters, defines):
 
 def _unit(name, cfg, build_dir):
     v, j = emit_unit(name, cfg, build_dir)
-    return v, json.loads(j.read_text())
+    return v, load_sidecar(j)
 
 
 @pytest.mark.parametrize("build", BUILDS)
 def test_template_as_it_stands_is_lint_clean(build, build_dir):
     """The .v file itself, hook unfilled, around a unit without host ports."""
     v, meta = _unit("sincos", Config(angle_bits=10, frac_bits=11), build_dir)
-    params = {"IW": meta["ports"]["i__payload"]["width"],
-              "OW": meta["ports"]["o__payload"]["width"], "DEPTH": 64}
-    defines = {"BULK_UNIT": meta["unit"]}
+    params = {"IW": meta.port("i__payload").width,
+              "OW": meta.port("o__payload").width, "DEPTH": 64}
+    defines = {"BULK_UNIT": meta.unit}
     defines.update({d[2:]: 1 for d in BUILDS[build]})
     assert _lint(TEMPLATE, v, params, defines) == []
 
@@ -64,7 +64,7 @@ def test_lint_catches_a_planted_width_error(build_dir):
     bad.parent.mkdir(exist_ok=True)
     bad.write_text(TEMPLATE.read_text().replace(".o__payload(out_payload)",
                                                 ".o__payload(out_payload[OW-2:0])"))
-    params = {"IW": meta["ports"]["i__payload"]["width"],
-              "OW": meta["ports"]["o__payload"]["width"], "DEPTH": 64}
-    problems = _lint(bad, v, params, {"BULK_UNIT": meta["unit"]})
+    params = {"IW": meta.port("i__payload").width,
+              "OW": meta.port("o__payload").width, "DEPTH": 64}
+    problems = _lint(bad, v, params, {"BULK_UNIT": meta.unit})
     assert any("out_payload" in line for line in problems), problems

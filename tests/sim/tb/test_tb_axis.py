@@ -2,7 +2,6 @@
 AxiStreamSource/AxiStreamSink, pauses on both sides, on Icarus and Verilator: bit-exact with
 the golden model, tlast and tuser on the same pixels. Plus the CLI's refusals."""
 
-import json
 
 import pytest
 
@@ -11,6 +10,7 @@ from bumprtl.gen.flow.axis import emit_axis
 from bumprtl.gen.flow.memories import memory_images
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
@@ -53,9 +53,9 @@ def test_axis_scene_pipeline_bit_exact_with_pauses(sim, build_dir):
     AXI4-Stream ports: bit-exact against the golden pipeline, tlast/tuser on their pixels."""
     v, j, hexes = _scene_axis(SCENE, build_dir / "rtl")
     assert [h.name for h in hexes] == ["pipeline_axis_map.hex"]
-    meta = json.loads(j.read_text())
-    assert meta["memory_images"]["map"]["file"] == "pipeline_axis_map.hex"
-    assert meta["command"].startswith("bumprtl emit pipeline --scene default")
+    meta = load_sidecar(j)
+    assert meta.memory_images["map"]["file"] == "pipeline_axis_map.hex"
+    assert meta.command.startswith("bumprtl emit pipeline --scene default")
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_axis", build_dir / sim,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 21})
     assert (run.tests, run.failures) == (1, 0)
@@ -75,18 +75,18 @@ def test_axis_scene_pipeline_volume(sim, scene, build_dir):
 
 def test_axis_ports_and_byte_aligned_packing(tmp_path):
     v, j, _ = emit_axis("rotation", SMALL, tmp_path)
-    meta = json.loads(j.read_text())
-    ports, axis = meta["ports"], meta["axis"]
+    meta = load_sidecar(j)
+    ports, axis = meta.ports, meta.axis
     for p in ("aclk", "aresetn", "s_axis_tdata", "s_axis_tvalid", "s_axis_tready", "s_axis_tuser",
               "s_axis_tlast", "m_axis_tdata", "m_axis_tvalid", "m_axis_tready", "m_axis_tuser",
               "m_axis_tlast"):
         assert p in ports, p
     assert "clk" not in ports and "i__valid" not in ports
     assert axis["tdata_width"] % 8 == 0 and axis["tdata_width"] >= axis["m_axis_tdata_bits"]
-    assert ports["s_axis_tdata"]["width"] == axis["tdata_width"] and ports["m_axis_tuser"]["width"] == 6
+    assert ports["s_axis_tdata"].width == axis["tdata_width"] and ports["m_axis_tuser"].width == 6
     fields = sorted(axis["s_axis_tdata_fields"].values())          # packed from bit 0, no gaps
     assert fields[0][0] == 0 and all(a[0] + a[1] == b[0] for a, b in zip(fields, fields[1:], strict=False))
-    assert meta["config"]["tag_bits"] == 6 and meta["command"].endswith("--interface axis")
+    assert meta.config["tag_bits"] == 6 and meta.command.endswith("--interface axis")
     assert "tag" not in axis["s_axis_tdata_fields"]
 
 

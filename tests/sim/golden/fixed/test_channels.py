@@ -1,5 +1,5 @@
 """Every output channel of the exact datapath against float64 on unquantized inputs, each
-under its own proven bound (the sidecar's ``error_bounds_lsb``, the registry's
+under its own proven bound (the sidecar's ``error_bounds.lsb_per_channel``, the registry's
 ``predicted_error_bound_lsb``) and each bound tight: the measured worst case (random,
 the adversarial search aimed at the channel, and for the specular term the search aimed
 at its arithmetic) reaches at least half of it; the arithmetic alone (float64 on the angles
@@ -56,7 +56,7 @@ def default_random():
 
 def test_default_random_within_each_bound_and_1_lsb_on_every_channel(default_random):
     cfg, got = default_random
-    bounds = build_unit("illumination", cfg)[1]["error_bounds_lsb"]
+    bounds = build_unit("illumination", cfg)[1].error_bounds.lsb_per_channel
     for c in CHANNELS:
         assert got[c] <= bounds[c] <= 2 * got[c], (c, got, bounds)      # held, and tight
     assert got == {"diffuse": 1, "specular": 1, "color": 1}, got
@@ -142,9 +142,9 @@ def test_wide_exponent_still_emits_with_its_larger_bound():
     """Widths that cannot reach 1 LSB are not refused: the sidecar states the larger bound,
     and at n = 1024 no widths in the Config's range prove 1 LSB (16-bit angles are the
     widest: the angle grid's error alone stays above it)."""
-    _, sidecar, _ = build_unit("illumination", Config(spec_exponent=1024))
-    assert sidecar["error_bounds_lsb"]["specular"] > 10 and sidecar["error_bound_lsb"] == max(sidecar["error_bounds_lsb"].values())
-    assert sidecar["faithful_widths"] is None
+    bounds = build_unit("illumination", Config(spec_exponent=1024))[1].error_bounds
+    assert bounds.lsb_per_channel["specular"] > 10 and bounds.lsb == max(bounds.lsb_per_channel.values())
+    assert bounds.faithful_widths_searched and bounds.faithful_widths is None
     widest = Config(angle_bits=ANGLE_BITS_RANGE[1], frac_bits=FRAC_BITS_MAX, spec_exponent=1024)
     assert error_bounds(widest)["specular"] == 2
 
@@ -157,7 +157,7 @@ def test_faithful_widths_are_the_narrowest_proven_and_measure_within_1_lsb(expon
     every channel -- the proof checked against float64 at widths far from the default."""
     angle_bits, frac_bits = faithful_widths(Config(spec_exponent=exponent))
     cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits, spec_exponent=exponent)
-    assert build_unit("illumination", Config(spec_exponent=exponent))[1]["faithful_widths"] == \
+    assert build_unit("illumination", Config(spec_exponent=exponent))[1].error_bounds.faithful_widths == \
         {"angle_bits": angle_bits, "frac_bits": frac_bits}
     assert error_bounds(cfg) == {"diffuse": 1, "specular": 1, "color": 1}
     assert max(error_bounds(cfg.replace(frac_bits=frac_bits - 1)).values()) > 1
@@ -257,7 +257,7 @@ def test_multi_light_and_texture_sidecars_state_every_channel():
                                   ({"name": "t", "texture": True}, 1, True)):
         scene = load_scene_config(spec)
         sidecar = build_unit("pipeline", scene)[1]
-        assert sidecar["error_bounds_lsb"] == error_bounds(scene.config, lights, texture)
+        assert sidecar.error_bounds.lsb_per_channel == error_bounds(scene.config, lights, texture)
     assert error_bounds(Config(), 1, texture=True)["color"] == 1
 
 
@@ -295,7 +295,7 @@ def test_default_widths_are_the_faithful_ones_for_one_light_and_two():
     for name in ("two-lights", "full"):
         scene = load_scene_config(name)
         assert scene.lights == 2 and (scene.angle_bits, scene.frac_bits) == TWO_LIGHT_WIDTHS
-        assert set(build_unit("pipeline", scene)[1]["error_bounds_lsb"].values()) == {1}
+        assert set(build_unit("pipeline", scene)[1].error_bounds.lsb_per_channel.values()) == {1}
 
 
 # --- the arithmetic alone: float64 on the angles the hardware receives -----------------------

@@ -14,7 +14,7 @@ exact_fixed = METHODS["exact"].datapath_fixed       # rotation then illumination
 
 
 def sidecar_bound(cfg):
-    return build_unit("illumination", cfg)[1]["error_bounds_lsb"]["diffuse"]
+    return build_unit("illumination", cfg)[1].error_bounds.lsb_per_channel["diffuse"]
 
 
 @pytest.fixture(scope="module")
