@@ -27,6 +27,7 @@ from bumprtl.gen.cli.main import build_parser, main
 from bumprtl.gen.report.table1 import TABLE1_ORDER
 from bumprtl.gen.report.fpga import fpga_units
 from bumprtl.rtl.config import Config
+from bumprtl.rtl.sidecar import load
 from bumprtl.sim.formal.targets import TARGETS
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 out = Path(sys.argv[1])
@@ -35,9 +36,9 @@ for unit in ("rotation", "illumination"):
     with contextlib.redirect_stdout(io.StringIO()):
         found[f"emit {{unit}}"] = main(["emit", unit, "--method", "toy", "--angle-bits", "8",
                                        "--frac-bits", "8", "--out", str(out)]) == 0
-    found[f"sidecar {{unit}}"] = json.loads((out / f"bumprtl_{{unit}}.json").read_text()
-                                            if (out / f"bumprtl_{{unit}}.json").exists() else
-                                            (out / f"{{unit}}.json").read_text())["method"] == "toy"
+    found[f"sidecar {{unit}}"] = load((out / f"bumprtl_{{unit}}.json")
+                                      if (out / f"bumprtl_{{unit}}.json").exists() else
+                                      (out / f"{{unit}}.json")).method == "toy"
 help_text = io.StringIO()
 with contextlib.redirect_stdout(help_text):
     try:
