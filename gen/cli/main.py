@@ -19,8 +19,8 @@ from bumprtl.rtl.config import BumpError
 # command, its module and the pip extra that holds the packages it needs beyond the core
 # (amaranth, numpy, Pillow, SciPy, scikit-image, tqdm: emit and the golden render).
 COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
-            ("demo", "bumprtl.gen.render.demo", "sim"),
-            ("render", "bumprtl.gen.render.images", "sim"),
+            ("demo", "bumprtl.gen.cli.demo", "sim"),
+            ("render", "bumprtl.gen.cli.render", "sim"),
             ("emit", "bumprtl.gen.cli.emit", "sim"),
             ("vectors", "bumprtl.gen.cli.vectors", "sim"),
             ("bench", "bumprtl.gen.cli.bench", "bench"),

@@ -118,21 +118,21 @@ def rtl_mismatch(rtl, golden):
             f"{int(np.count_nonzero(diff.max(axis=-1)))} pixels (max |difference| {int(diff.max())})")
 
 
-def _rtl_section(args, out):
+def _rtl_section(out, size, simulator, verbose):
     """Emit, render through the simulator, compare, count. Returns (report lines, error)."""
-    t = demo_map_size(args.size)
+    t = demo_map_size(size)
     scene = load_scene_config(DEMO_PIPELINE).replace(texture_size=t)
     blocks, have = check_scene_fits(scene, DEMO_DEVICE)
-    n = args.size * args.size
+    n = size * size
     require_sim()
-    label = (f"rtl: {args.size}x{args.size} {scene.image} ({t}^2 map) through the emitted "
-             f"pipeline of scene {scene.name!r} on {args.simulator}")
-    if args.verbose:
+    label = (f"rtl: {size}x{size} {scene.image} ({t}^2 map) through the emitted "
+             f"pipeline of scene {scene.name!r} on {simulator}")
+    if verbose:
         print(label, flush=True)
-    with tool_log(out / "sim" / "tools.log", label, args.verbose):
-        r = render_rtl(scene, args.size, args.simulator, out / "sim", progress=args.verbose,
+    with tool_log(out / "sim" / "tools.log", label, verbose):
+        r = render_rtl(scene, size, simulator, out / "sim", progress=verbose,
                        rtl_dir=out / "pipeline", load=DEMO_LOAD)
-    reference, _ = float_image(scene, "conventional", args.size, progress=False)
+    reference, _ = float_image(scene, "conventional", size, progress=False)
     save_png(out / "rtl.png", r.image)
     save_png(out / "golden.png", r.golden)
     save_png(out / "rtl_vs_float64.png", side_by_side(reference, r.image))
@@ -148,7 +148,7 @@ def _rtl_section(args, out):
              f"  map {t}x{t} x {2 * scene.angle_bits} bits: {blocks} of {have} DP16KD on "
              f"{DEMO_DEVICE} with the pipeline's tables (the largest power-of-two map up to the "
              f"image size that fits)",
-             f"  image {scene.image} {args.size}x{args.size}, simulator {args.simulator} (cocotb, bulk path), "
+             f"  image {scene.image} {size}x{size}, simulator {simulator} (cocotb, bulk path), "
              f"same stimulus as the fixed-point golden render (sim/golden/fixed/pipeline.py)",
              "  units built: " + "; ".join(f"{b['unit']} ({b['class']}, latency {b['latency']})"
                                           for b in meta.built),
@@ -159,7 +159,7 @@ def _rtl_section(args, out):
              f"RAM bits {sum(x['bits'] for x in counts.rams)}, register bits {c['register_bits']}",
              f"  latency {meta.latency} cycles; {n} pixels in {r.cycles} cycles without stalls "
              f"= {r.cycles / n:.4f} cycles per pixel (the pipe fills once, then 1 pixel per clock)",
-             f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {args.simulator}, "
+             f"  simulation {r.seconds:.1f} s = {n / r.seconds:.0f} pixels/s on {simulator}, "
              f"streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:.0f} pixels/s "
              f"(build {r.build_seconds:.1f} s{', cached' if r.cached else ''})",
              "  rtl.png vs golden.png: " + ("identical bytes, max |difference| 0" if error is None
@@ -169,28 +169,31 @@ def _rtl_section(args, out):
              f"{psnr(reference, r.image):.2f} dB, max difference {max_diff(reference, r.image)}"]
     # the terminal: units and latency, resources, speed and the two comparisons (all of it
     # in report.txt; every line with --verbose)
-    for line in (lines if args.verbose else [lines[4], *lines[6:]]):
+    for line in (lines if verbose else [lines[4], *lines[6:]]):
         print(line, flush=True)
     return lines, error
 
 
-def run(args):
-    load_scene(DEMO_SCENES[0], size=args.size)         # bad --size fails before any work
-    if args.rtl:
-        require_sim(args.simulator)                     # no [sim] extra: one line, before any work
-    cfg, out, methods = Config(), Path(args.out), demo_methods()
+def run_demo(out, size=512, rtl=True, simulator="verilator", verbose=False):
+    """``bumprtl demo``: writes the PNGs and ``report.txt`` under ``out`` (the render through
+    the pipeline on ``simulator`` unless not ``rtl``; every line of its section printed with
+    ``verbose``). Returns 0, or 1 when the RTL image differs from the golden one."""
+    load_scene(DEMO_SCENES[0], size=size)         # bad --size fails before any work
+    if rtl:
+        require_sim(simulator)                     # no [sim] extra: one line, before any work
+    cfg, out, methods = Config(), Path(out), demo_methods()
     start = time.perf_counter()
-    lines = [f"bumprtl demo: {args.size}x{args.size} pixels, directional light at elevation "
+    lines = [f"bumprtl demo: {size}x{size} pixels, directional light at elevation "
              f"45 deg, azimuth 30 deg, default Config",
-             f"command: bumprtl demo --out {out} --size {args.size}"
-             + ("" if args.rtl else " --no-rtl") +
-             (f" --simulator {args.simulator}" if args.rtl and args.simulator != "verilator" else ""),
+             f"command: bumprtl demo --out {out} --size {size}"
+             + ("" if rtl else " --no-rtl") +
+             (f" --simulator {simulator}" if rtl and simulator != "verilator" else ""),
              "",
              f"{'scene':<8} {'method':<13} {'PSNR dB':>8} {'max diff':>9} {'fixed dB':>9} "
              f"{'fixed max':>9} {'seconds':>8} {'Mpix/s':>8}  file"]
     print(lines[-1], flush=True)                      # the table's header, then its rows
     for name in DEMO_SCENES:
-        for line in _render_scene(name, args.size, methods, cfg, out):
+        for line in _render_scene(name, size, methods, cfg, out):
             lines.append(line)
             print(line, flush=True)
     fixed = [m for m in methods if m in FIXED_METHODS]
@@ -200,8 +203,8 @@ def run(args):
               f"hardware); *_compare.png panels: {REFERENCE} | method | |difference| x10; "
               f"*_fixed.png the fixed-point renders."]
     error, pngs = None, len(DEMO_SCENES) * (2 * len(methods) - 1 + len(fixed))
-    if args.rtl:
-        rtl_lines, error = _rtl_section(args, out)
+    if rtl:
+        rtl_lines, error = _rtl_section(out, size, simulator, verbose)
         lines += rtl_lines
         pngs += 4
     lines.append(f"total {time.perf_counter() - start:.1f} s")
@@ -212,25 +215,3 @@ def run(args):
         print(f"bumprtl demo: error: {error} (see {out / 'diff.png'})", file=sys.stderr)
         return 1
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("demo", help="render the demo scenes with every method, write PNGs + report",
-                       description="The main job on the default scene: renders the demo scenes "
-                                   f"({', '.join(DEMO_SCENES)}) with every method, writes PNGs, "
-                                   "comparison panels and report.txt (PSNR / max difference vs "
-                                   "conventional, timings), then renders the default scene "
-                                   "through its emitted pipeline on a simulator and checks the "
-                                   "image equals the fixed-point golden one byte for byte.")
-    p.add_argument("--out", type=Path, default=Path("build/demo"), help="output directory (default: build/demo)")
-    p.add_argument("--size", type=int, default=512,
-                   help="image size, power of two in [16, 4096] (default: 512)")
-    p.add_argument("--no-rtl", dest="rtl", action="store_false",
-                   help="skip the render through the emitted pipeline")
-    p.add_argument("--simulator", default="verilator", choices=["verilator", "icarus"],
-                   help="simulator of the RTL render (default: verilator)")
-    p.add_argument("--verbose", action="store_true",
-                   help="print the simulator's build and run output (by default it goes to "
-                        "OUT/sim/tools.log, shown in full only on a failure) and the whole "
-                        "RTL section of the report")
-    p.set_defaults(func=run)

@@ -313,34 +313,32 @@ def require_sim(simulator=None):
         require({"icarus": "iverilog", "verilator": "verilator"}[simulator])
 
 
-def cli_render(args, scene=None):
-    """``bumprtl render --rtl``: the scene (``--pipeline``, a built-in scene class or TOML,
-    with the flags that were given: ``gen/render/images.render_scene``) rendered through its
-    emitted pipeline; writes the RTL image and checks it against the golden render. A map
-    that does not fit ``--device``'s block RAM is refused before anything is built."""
-    scene = load_scene_config(args.pipeline or "default") if scene is None else scene
-    check_scene_fits(scene, getattr(args, "device", None) or DEFAULT_DEVICE)
-    light = {"azimuth": args.light_azimuth, "light_elevation": args.light_elevation,
-             "light": args.light}
-    require_sim(args.simulator)
+def rtl_render_png(scene, size, out, simulator="verilator", *, device=DEFAULT_DEVICE,
+                   per_cycle=False, load="initial", verbose=False, azimuth=30.0,
+                   light_elevation=45.0, light="directional"):
+    """``bumprtl render --rtl``: ``scene`` rendered through its emitted pipeline at ``size``
+    x ``size`` pixels on ``simulator``; writes the RTL image to ``out``, prints one line of
+    counts and one of the comparison with the golden render, and returns 0 when the two are
+    the same bytes, else 1. A map that does not fit ``device``'s block RAM is refused before
+    anything is built."""
+    check_scene_fits(scene, device)
+    light = {"azimuth": azimuth, "light_elevation": light_elevation, "light": light}
+    require_sim(simulator)
     t0 = time.perf_counter()
-    per_cycle = getattr(args, "per_cycle", False)
-    load = getattr(args, "load", None) or "initial"
     build_dir = Path("build/render_rtl") / _dir_name(scene)
-    verbose = getattr(args, "verbose", False)
-    with tool_log(build_dir / "tools.log", f"rtl: {args.size}x{args.size} through the "
-                  f"{scene.name} pipeline on {args.simulator}", verbose):
-        r = render_rtl(scene, args.size, args.simulator, build_dir, progress=verbose,
+    with tool_log(build_dir / "tools.log", f"rtl: {size}x{size} through the "
+                  f"{scene.name} pipeline on {simulator}", verbose):
+        r = render_rtl(scene, size, simulator, build_dir, progress=verbose,
                        per_cycle=per_cycle, load=load, **light)
-    out = save_png(args.out, r.image)
+    out = save_png(out, r.image)
     same = r.image.tobytes() == r.golden.tobytes()
-    n = args.size ** 2
+    n = size ** 2
     path = "per-cycle cocotb" if per_cycle else "bulk"
     build = (f"build {r.build_seconds:.1f} s" if not r.cached else
              f"build cached (took {r.build_seconds:.1f} s once)")
     stream = "" if r.stream_seconds is None else \
         f"; streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:,.0f} pix/s"
-    print(f"rtl ({args.simulator}, {path}, map load {load}): {args.size}x{args.size} "
+    print(f"rtl ({simulator}, {path}, map load {load}): {size}x{size} "
           f"{scene.picture} ({scene.texture_size}^2 map) with pipeline {scene.name}: {r.cycles} "
           f"cycles; {build}; simulation {r.seconds:.2f} s = {n / r.seconds:,.0f} pix/s{stream}; "
           f"total {time.perf_counter() - t0:.1f} s -> {out}")
@@ -357,7 +355,7 @@ SCENES_TABLE_SIZE = 256
 
 
 def _built_units(scene):
-    dut = BumpPipeline(scene)
+    dut = BumpPipeline(scene.hardware)
     for unit in (dut, *dut.units.values()):        # only the plan is read, never elaborated
         unit._MustUse__silence = True
     return ", ".join(u["unit"] for u in dut.built)

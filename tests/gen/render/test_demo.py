@@ -118,7 +118,7 @@ def test_rtl_mismatch_names_the_difference():
 def test_demo_flags():
     import argparse
 
-    from bumprtl.gen.render import demo
+    from bumprtl.gen.cli import demo
     sub = argparse.ArgumentParser().add_subparsers()
     demo.add_parser(sub)
     parser = sub.choices["demo"]
