@@ -39,6 +39,7 @@ from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
@@ -124,7 +125,8 @@ class BoardCore(Elaboratable):
     (clock) each shift cycle; ``underflow``, ``order_error``: sticky status; ``frame``: the
     source's light step."""
 
-    def __init__(self, scene, mode, words, constants, table, texels=None, target=None):
+    def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
+                 target=None):
         self.mode = mode
         self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target)
         self.scene = self.pipeline.scene

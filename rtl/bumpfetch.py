@@ -19,6 +19,7 @@ from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
+from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.targets import is_spread
 from bumprtl.rtl.texture import rgb_layout
 
@@ -126,7 +127,7 @@ class BumpMapFetch(wiring.Component):
 
     Parameters
     ----------
-    scene : SceneConfig
+    scene : HardwareScene
         Reads ``texture_size`` T (power of two), ``addressing`` (wrap | clamp),
         ``mip_levels``, ``shading`` (palette: store indices) and the Config widths.
     out_layout : data.StructLayout, optional
@@ -167,7 +168,7 @@ class BumpMapFetch(wiring.Component):
     stalled.
     """
 
-    def __init__(self, scene, out_layout=None, init=None, texture=None, target=None,
+    def __init__(self, scene: HardwareScene, out_layout=None, init=None, texture=None, target=None,
                  lockstep=None, write_port=True):
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
         self.write_port = write_port

@@ -1,4 +1,4 @@
-"""BumpPipeline: the per-pixel system a scene needs, generated from a SceneConfig
+"""BumpPipeline: the per-pixel system a scene needs, generated from a HardwareScene
 (docs/architecture.md, Scenes decide what is built).
 
 texel coordinates + world N, L, H in; shaded pixels out. Only what the scene needs is built:
@@ -56,6 +56,7 @@ from bumprtl.rtl.pipe import (
     pipe_observer,
 )
 from bumprtl.rtl.rotation import VectorRotation
+from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.tables import (
     COLOR_FRAC_BITS,
     KD_FRAC_BITS,
@@ -127,7 +128,7 @@ class LightSum(wiring.Component):
     # products (kd, ks), the terms' sum, the colour.
     latency = PRODUCT_LATENCY + 3
 
-    def __init__(self, scene, target=None, lockstep=None):
+    def __init__(self, scene: HardwareScene, target=None, lockstep=None):
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
         self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
@@ -186,9 +187,9 @@ class BumpPipeline(wiring.Component):
 
     Parameters
     ----------
-    scene : SceneConfig
-        What to build (sim/scenes/config.py's ``SceneConfig``; the hardware reads only its
-        switches and its ``config``).
+    scene : HardwareScene
+        What to build (rtl/scene.py; ``SceneConfig.hardware`` of a scene file or built-in
+        scene).
     init : sequence of int, optional
         Bump map / index map words of the fetch unit (``BumpMapFetch`` ``init``).
     texture : sequence of int, optional
@@ -243,7 +244,8 @@ class BumpPipeline(wiring.Component):
     sim/formal's lemmas.
     """
 
-    def __init__(self, scene, init=None, texture=None, target=None, write_port=True):
+    def __init__(self, scene: HardwareScene, init=None, texture=None, target=None,
+                 write_port=True):
         self.scene = scene
         self.write_port = write_port
         self.cfg = cfg = scene.config

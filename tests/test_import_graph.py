@@ -7,7 +7,11 @@
     module also runs its packages' ``__init__``);
 (c) the layers point one way, lowest first: rtl/, gen/tools/ (running the external tools),
     sim/, the rest of gen/; a module imports its own layer and those below it only
-    (function-level imports and ``importlib.import_module("bumprtl.gen...")`` included).
+    (function-level imports and ``importlib.import_module("bumprtl.gen...")`` included);
+(d) no function or class of rtl/ has a parameter (a dataclass field included) whose
+    annotation or default names a type of sim/ or gen/: names resolved through the module's
+    imports, string annotations parsed, and a bare name in a string that is not imported
+    matched against the classes sim/ and gen/ define.
 
 Each check names the offending module, file and line. The ``*_is_caught`` tests run the
 same checks on a small package with one planted offence each, so every check is shown to
@@ -204,6 +208,111 @@ def wrong_way_imports(mods, root=ROOT):
     return bad
 
 
+def _import_names(tree):
+    """``{local name: dotted name}`` of the module-level imports of ``tree`` (absolute)."""
+    names = {}
+    for node, func in imports(tree):
+        if func is not None:
+            continue
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.asname:
+                    names[a.asname] = a.name
+                else:
+                    names[a.name.split(".")[0]] = a.name.split(".")[0]
+        elif not node.level:
+            for a in node.names:
+                names[a.asname or a.name] = f"{node.module}.{a.name}"
+    return names
+
+
+def _upper_classes(mods):
+    """``{class name: dotted name}`` of the classes sim/ and gen/ define at module level."""
+    return {n.name: f"{name}.{n.name}" for name, (_, tree, _) in mods.items()
+            if _layer(name) is not None and _layer(name) > 0
+            for n in tree.body if isinstance(n, ast.ClassDef)}
+
+
+def _named_types(expr, names, upper, local):
+    """The dotted names of sim/ or gen/ that annotation or default ``expr`` mentions."""
+    found, todo = [], [expr]
+    while todo:
+        node = todo.pop(0)
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            try:
+                inner = ast.parse(node.value, mode="eval").body
+            except SyntaxError:
+                continue
+            found += _named_types(inner, names, upper, local)
+            for n in ast.walk(inner):       # a bare name no import brings: a class above?
+                if isinstance(n, ast.Name) and n.id not in names and n.id not in local \
+                        and n.id in upper:
+                    found.append(upper[n.id])
+            continue
+        parts, head = [], node
+        while isinstance(head, ast.Attribute):        # a dotted name: resolved as a whole
+            parts.insert(0, head.attr)
+            head = head.value
+        if isinstance(head, ast.Name):
+            dotted = ".".join([names.get(head.id, ""), *parts])
+            if head.id in names and (_layer(dotted) or 0) > 0:
+                found.append(dotted)
+            continue
+        todo.extend(ast.iter_child_nodes(node))
+    return found
+
+
+def _parameters(tree):
+    """``(owner, parameter, annotation or default)`` of every function and class of ``tree``:
+    the arguments of functions and lambdas, the annotated fields of class bodies."""
+    out = []
+
+    def visit(node, owner):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, FUNCTIONS):
+                name = f"{owner}.{getattr(child, 'name', '<lambda>')}".lstrip(".")
+                a = child.args
+                params = [*a.posonlyargs, *a.args, *a.kwonlyargs,
+                          *([a.vararg] if a.vararg else []), *([a.kwarg] if a.kwarg else [])]
+                out.extend((child, name, p.arg, p.annotation) for p in params if p.annotation)
+                positional = [*a.posonlyargs, *a.args]
+                out.extend((child, name, p.arg, d) for p, d in
+                           zip(positional[len(positional) - len(a.defaults):], a.defaults, strict=True))
+                out.extend((child, name, p.arg, d) for p, d in zip(a.kwonlyargs, a.kw_defaults, strict=True)
+                           if d is not None)
+                visit(child, name)
+            elif isinstance(child, ast.ClassDef):
+                name = f"{owner}.{child.name}".lstrip(".")
+                for field in child.body:
+                    if isinstance(field, ast.AnnAssign) and isinstance(field.target, ast.Name):
+                        out.append((field, name, field.target.id, field.annotation))
+                        if field.value is not None:
+                            out.append((field, name, field.target.id, field.value))
+                visit(child, name)
+            else:
+                visit(child, owner)
+
+    visit(tree, "")
+    return out
+
+
+def upper_typed_parameters(mods, root=ROOT):
+    """Lines ``file:line owner(parameter): dotted name`` where a function or class of rtl/
+    has a parameter annotated with (or defaulting to) a type of sim/ or gen/."""
+    upper, bad = _upper_classes(mods), []
+    for name, (path, tree, _) in mods.items():
+        if _layer(name) != 0:
+            continue
+        names = _import_names(tree)
+        local = {n.name for n in ast.walk(tree) if isinstance(n, (ast.ClassDef, *FUNCTIONS[:2]))}
+        for node, owner, param, expr in _parameters(tree):
+            for dotted in _named_types(expr, names, upper, local):
+                line = f"{_where(path, node, root)} {owner}({param}): {dotted}"
+                if line not in bad:
+                    bad.append(line)
+    return bad
+
+
 MODULES = modules(package_dirs())
 
 
@@ -229,6 +338,22 @@ def test_layers_point_one_way():
     assert not bad, ("rtl/ must not depend on sim/ or gen/, gen/tools/ not on sim/ or the rest of "
                      "gen/, sim/ not on gen/ outside gen/tools/:\n  "
                      + "\n  ".join(bad))
+
+
+def test_no_rtl_parameter_takes_a_type_from_above():
+    bad = upper_typed_parameters(MODULES)
+    assert not bad, ("rtl/ functions and classes must not take a sim/ or gen/ type (the hardware "
+                     "takes rtl types, e.g. rtl/scene.HardwareScene):\n  " + "\n  ".join(bad))
+
+
+def test_the_scene_units_take_the_hardware_scene():
+    """BumpPipeline's and BumpMapFetch's ``scene`` is annotated with the rtl type."""
+    found = {(owner, param): ast.unparse(expr) for name in ("bumprtl.rtl.pipeline", "bumprtl.rtl.bumpfetch")
+             for node, owner, param, expr in _parameters(MODULES[name][1])}
+    assert found[("BumpPipeline.__init__", "scene")] == "HardwareScene"
+    assert found[("BumpMapFetch.__init__", "scene")] == "HardwareScene"
+    assert _import_names(MODULES["bumprtl.rtl.pipeline"][1])["HardwareScene"] == \
+        "bumprtl.rtl.scene.HardwareScene"
 
 
 # ---- the checks fail when they should -----------------------------------------------
@@ -312,3 +437,30 @@ def test_rtl_importing_sim_is_caught(tmp_path):
         "bumprtl.rtl.methods (rtl/methods.py:1) imports bumprtl.sim.golden.fixed",
         "bumprtl.rtl.scene (rtl/scene.py:5) imports bumprtl.sim",
         "bumprtl.rtl.scene (rtl/scene.py:6) imports bumprtl.sim.scenes.usermap dynamically"]
+
+
+def test_an_rtl_parameter_typed_from_above_is_caught(tmp_path):
+    """An annotation (plain, dotted, string, inside a union), a default, or a dataclass
+    field naming a sim/ or gen/ type is an offence; rtl types and sim's own are not."""
+    mods = _tree(tmp_path, {
+        "sim/scenes/__init__.py": "",
+        "sim/scenes/config.py": "class SceneConfig:\n    pass\n",
+        "gen/flow/__init__.py": "", "gen/flow/emit.py": "class Job:\n    pass\n",
+        "rtl/scene.py": "class HardwareScene:\n    pass\n",
+        "rtl/a.py": "from bumprtl.sim.scenes.config import SceneConfig\n"
+                    "import bumprtl.gen.flow.emit as emit\n"
+                    "from bumprtl.rtl.scene import HardwareScene\n\n\n"
+                    "class Top:\n"
+                    "    def __init__(self, scene: SceneConfig, ok: HardwareScene, *, job=emit.Job):\n"
+                    "        pass\n\n\n"
+                    "def f(x: 'SceneConfig | None' = None, y: list[HardwareScene] = ()):\n"
+                    "    return x, y\n",
+        "rtl/b.py": "from dataclasses import dataclass\n\n\n@dataclass\n"
+                    "class Holder:\n    scene: 'SceneConfig'\n    n: int = 1\n",
+        "sim/c.py": "from bumprtl.sim.scenes.config import SceneConfig\n\n\n"
+                    "def g(s: SceneConfig):\n    return s\n"})
+    assert upper_typed_parameters(mods, tmp_path) == [
+        "rtl/a.py:7 Top.__init__(scene): bumprtl.sim.scenes.config.SceneConfig",
+        "rtl/a.py:7 Top.__init__(job): bumprtl.gen.flow.emit.Job",
+        "rtl/a.py:11 f(x): bumprtl.sim.scenes.config.SceneConfig",
+        "rtl/b.py:6 Holder(scene): bumprtl.sim.scenes.config.SceneConfig"]

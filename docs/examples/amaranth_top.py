@@ -43,7 +43,7 @@ class BumpTop(wiring.Component):
     """
 
     def __init__(self, scene, words):
-        self._bump = BumpPipeline(scene)          # no init: the map comes through the port
+        self._bump = BumpPipeline(scene.hardware)  # no init: the map comes through the port
         self._words = [int(w) for w in words]
         super().__init__({"i": In(stream.Signature(self._bump.i.payload.shape())),
                           "o": Out(stream.Signature(self._bump.o.payload.shape())),

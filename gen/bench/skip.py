@@ -67,7 +67,7 @@ def _golden(scene, size, flat_like=None):
 def _cost(scene, work):
     """Yosys counts of the scene's BumpPipeline, cached by the digest of its Verilog (a
     changed datapath is counted anew)."""
-    text = verilog.convert(BumpPipeline(scene), name="pipeline", emit_src=False)
+    text = verilog.convert(BumpPipeline(scene.hardware), name="pipeline", emit_src=False)
     digest = _digest(text)
     netlist = work / "netlist" / scene.name
 
@@ -89,7 +89,7 @@ def skip_rows(names, size, work):
 
 def _skipped(scene):
     """The units the scene's pipeline skips (asked of a pipeline that is never elaborated)."""
-    pipeline = BumpPipeline(scene)
+    pipeline = BumpPipeline(scene.hardware)
     for unit in (pipeline, *pipeline.units.values()):
         unit._MustUse__silence = True
     return [s["unit"] for s in pipeline.skipped if s["unit"] != "colour-texture blend"]

@@ -54,14 +54,14 @@ def board_data(scene):
 
 def board_core(scene, mode, target=None, data=None):
     words, texels, constants, table = board_data(scene) if data is None else data
-    return BoardCore(scene, mode, words, constants, table, texels, target)
+    return BoardCore(scene.hardware, mode, words, constants, table, texels, target)
 
 
 def bram_budget(scene, mode, device):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
     tables (as gen/flow/memories.check_fits counts them), the light table, the
     elastic buffer; and the device's."""
-    p = BumpPipeline(scene)
+    p = BumpPipeline(scene.hardware)
     maps, tables = memory_blocks(unit_memories(p))
     need = {"map": maps, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),

@@ -162,10 +162,10 @@ UNITS = {
                     ("palette_size", "color_bits", "palette_blend", "tag_bits")),
     # These two take a SceneConfig (``bumprtl emit pipeline --scene FILE|NAME``).
     "pipeline": Unit("pipeline", "BumpPipeline: the units a scene needs (--scene FILE|NAME)",
-                     lambda scene, target=None: BumpPipeline(scene, target=target),
+                     lambda scene, target=None: BumpPipeline(scene.hardware, target=target),
                      _pipeline_sidecar, ("scene",)),
     "fetch": Unit("fetch", "BumpMapFetch: (u, v[, level]) -> N' or palette index (--scene FILE|NAME)",
-                  lambda scene, target=None: BumpMapFetch(scene, target=target), _fetch_sidecar,
+                  lambda scene, target=None: BumpMapFetch(scene.hardware, target=target), _fetch_sidecar,
                   ("scene",)),
 }
 SCENE_UNITS = ("pipeline", "fetch")

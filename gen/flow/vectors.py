@@ -111,7 +111,7 @@ def pipeline_fields(scene: SceneConfig):
     """``(input fields, output fields, ports)`` of ``BumpPipeline(scene)``: the payload
     field tables ``{path: Field}`` and ``{name: Port}`` (rtl/sidecar.py, from
     gen/flow/emit.port_table), read off its signature without elaborating it."""
-    ports = ports_from_table(port_table(_silenced(BumpPipeline(scene))))
+    ports = ports_from_table(port_table(_silenced(BumpPipeline(scene.hardware))))
     return ports["i__payload"].fields, ports["o__payload"].fields, ports
 
 

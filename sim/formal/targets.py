@@ -88,7 +88,7 @@ def _scene(name, bits):
 
 
 def _fetch(bits):
-    return BumpMapFetch(_scene("default", bits))
+    return BumpMapFetch(_scene("default", bits).hardware)
 
 
 def _texture_blend(bits):
@@ -97,7 +97,7 @@ def _texture_blend(bits):
 
 def _pipeline(name):
     def build(bits):
-        return BumpPipeline(_scene(name, bits))
+        return BumpPipeline(_scene(name, bits).hardware)
     return build
 
 

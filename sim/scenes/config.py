@@ -14,16 +14,20 @@ from pathlib import Path
 
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL, get
+from bumprtl.rtl.scene import (
+    ADDRESSING,
+    BUMP_MAPS,
+    ROTATIONS,
+    SHADINGS,
+    HardwareScene,
+    derived_rotation,
+)
 from bumprtl.sim.scenes import GEOMETRIES, SCENES
 from bumprtl.sim.scenes.usermap import CONVENTIONS, DEFAULT_HEIGHT_SCALE, map_size
 
 __all__ = ["SceneConfig", "SceneError", "BUILTIN", "load_scene_config", "ADDRESSING",
            "BUMP_MAPS", "SHADINGS", "ROTATIONS", "MAP_KEYS", "flag_name"]
 
-ADDRESSING = ("wrap", "clamp")
-BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
-SHADINGS = ("per-pixel", "palette")      # Lee/exact per-pixel rotation, or Tarini's palette
-ROTATIONS = ("per-pixel", "per-polygon", "none")
 MAP_KEYS = ("height_map", "normal_map")  # a user's map file instead of a procedural image
 _CONFIG_KEYS = ("method", "angle_bits", "frac_bits", "tag_bits", "spec_exponent",
                 "spec_index_bits", "ka", "kd", "ks", "lights", "specular", "palette_size")
@@ -35,7 +39,8 @@ class SceneError(BumpError):
 
 @dataclass(frozen=True)
 class SceneConfig:
-    """The switches of one scene class.
+    """The switches of one scene class: the hardware's (:attr:`hardware`, an
+    ``rtl/scene.HardwareScene``) with the map's source and the geometry.
 
     Parameters
     ----------
@@ -206,15 +211,22 @@ class SceneConfig:
 
     @property
     def derived_rotation(self):
-        if self.shading == "palette":
-            return "none"
-        return "per-pixel" if self.bump_map == "varying" else "per-polygon"
+        return derived_rotation(self.shading, self.bump_map)
 
     @property
     def config(self) -> Config:
         """The datapath Config of this scene (widths, method, lights, terms)."""
         return Config(**{k: getattr(self, k) for k in _CONFIG_KEYS},
                       palette_blend=self.texture and self.shading == "palette")
+
+    @property
+    def hardware(self) -> HardwareScene:
+        """The switches the hardware reads (rtl/scene.py): what BumpPipeline, BumpMapFetch
+        and BoardCore are built from; the map's source and the geometry stay here."""
+        return HardwareScene(name=self.name, shading=self.shading, bump_map=self.bump_map,
+                             rotation=self.rotation, texture=self.texture,
+                             texture_size=self.texture_size, addressing=self.addressing,
+                             mip_levels=self.mip_levels, config=self.config)
 
     @property
     def texture_bits(self):

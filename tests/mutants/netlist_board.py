@@ -62,7 +62,7 @@ def _default_scene():
     scene = load_scene_config("default")
     # only its input stream and its numbers are used: the pipeline itself is not emitted
     warnings.filterwarnings("ignore", message=".*created but never used")
-    return scene, BumpPipeline(scene)
+    return scene, BumpPipeline(scene.hardware)
 
 
 def _leaves(layout, base=0, prefix=""):

@@ -43,7 +43,7 @@ def scene_data():
 
 def unelaborated_pipeline(scene):
     """A BumpPipeline read for its latency and ports only, never elaborated."""
-    pipeline = BumpPipeline(scene)
+    pipeline = BumpPipeline(scene.hardware)
     for unit in (pipeline, *pipeline.units.values()):
         unit._MustUse__silence = True
     return pipeline
@@ -84,7 +84,7 @@ def run_core(scene, data, mode, depth=None):
     """(underflow, order_error) after one frame of BoardCore in ``mode`` with the buffer
     ``depth`` deep (its own depth when None)."""
     words, constants, table, texels = data
-    core = BoardCore(scene, mode, words, constants, table, texels)
+    core = BoardCore(scene.hardware, mode, words, constants, table, texels)
     if depth is not None:
         core.depth = depth
     flags = []

@@ -51,7 +51,7 @@ def test_fetch_streams_bit_exact(keys, pattern):
     field = "index" if scene.shading == "palette" else "b"
     payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
                 for n in range(500)]
-    dut = BumpMapFetch(scene, init=words)
+    dut = BumpMapFetch(scene.hardware, init=words)
     out, cycles = simulate_stream(dut, payloads, pattern, pipe_handshake=True)
     want = fetch_fixed(inputs["u"], inputs["v"], inputs.get("level"), words, scene)
     flat = {"b": lambda o: o["b.phi"] | (o["b.theta"] << scene.angle_bits), "index": lambda o: o["index"]}
@@ -64,7 +64,7 @@ def test_host_write_port_replaces_texels():
     """Words written through the host port are what later lookups return."""
     from amaranth.sim import Simulator
     scene = load_scene_config({"texture_size": 16})
-    dut = BumpMapFetch(scene)
+    dut = BumpMapFetch(scene.hardware)
     writes = {3: 0xABCDE, 17: 0x12345, 255: 0xFFFFFF}
     got = {}
 
@@ -92,7 +92,7 @@ def test_host_write_port_replaces_texels():
 
 def test_init_of_the_wrong_size_is_rejected():
     with pytest.raises(ValueError, match="words"):
-        BumpMapFetch(load_scene_config({"texture_size": 16}), init=[0] * 10)
+        BumpMapFetch(load_scene_config({"texture_size": 16}).hardware, init=[0] * 10)
 
 
 @pytest.mark.parametrize("keys", [{"texture": True, "mip_levels": 2, "addressing": "clamp"},
@@ -108,7 +108,7 @@ def test_texture_ram_read_at_the_same_address(keys):
     inputs = random_inputs(scene, 300, rng)
     payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
                 for n in range(300)]
-    dut = BumpMapFetch(scene, init=words, texture=texels)
+    dut = BumpMapFetch(scene.hardware, init=words, texture=texels)
     assert ("w_en" in dut.signature.members) == (words is not None)
     out, _ = simulate_stream(dut, payloads, "backpressure", pipe_handshake=True)
     got = [o["texel.r"] | (o["texel.g"] << 8) | (o["texel.b"] << 16) for o in out]
@@ -121,7 +121,7 @@ def test_texture_ram_read_at_the_same_address(keys):
 
 def test_texture_words_need_a_textured_scene():
     with pytest.raises(ValueError, match="texture = false"):
-        BumpMapFetch(load_scene_config({"texture_size": 16}), texture=[0] * 256)
+        BumpMapFetch(load_scene_config({"texture_size": 16}).hardware, texture=[0] * 256)
 
 
 @pytest.mark.parametrize("name, outputs", [("default", ["b"]), ("palette", ["index"]),
@@ -152,7 +152,7 @@ def test_fetch_every_mip_level_of_a_full_chain(size):
         coords += [(int(a) * step, int(b) * step) for a, b in rng.integers(0, size // step, (12, 2))]
         payloads += [{"u": u, "v": v, "level": level, "tag": len(payloads) + k}
                      for k, (u, v) in enumerate(coords)]
-    out, _ = simulate_stream(BumpMapFetch(scene, init=words), payloads, "no_stall", pipe_handshake=True)
+    out, _ = simulate_stream(BumpMapFetch(scene.hardware, init=words), payloads, "no_stall", pipe_handshake=True)
     got = [o["b.phi"] | (o["b.theta"] << scene.angle_bits) for o in out]
     want = [reference_word(words, p["u"], p["v"], p["level"], scene) for p in payloads]
     assert [o["tag"] for o in out] == [p["tag"] for p in payloads]
@@ -166,7 +166,7 @@ def test_host_writes_reach_every_mip_level(size, levels):
     words need the full port width), read back at that level."""
     from amaranth.sim import Simulator
     scene = load_scene_config({"texture_size": size, "mip_levels": levels})
-    dut = BumpMapFetch(scene)
+    dut = BumpMapFetch(scene.hardware)
     assert len(dut.w_addr) == (memory_depth(scene) - 1).bit_length()
     assert memory_depth(scene) - 1 in [b + ((size >> l) ** 2 - 1) for l, b in enumerate(level_bases(scene))]
     rng = np.random.default_rng(levels)
@@ -209,7 +209,7 @@ def test_pipeline_host_ports_address_every_mip_level(keys):
     level: ceil(log2(depth)) bits, one more than a single level's T x T words need."""
     from bumprtl.rtl.pipeline import BumpPipeline
     scene = load_scene_config({"texture_size": 16, **keys})
-    dut = BumpPipeline(scene)
+    dut = BumpPipeline(scene.hardware)
     dut._MustUse__silence = True                   # only its ports are read
     depth = memory_depth(scene)
     assert depth > 16 * 16 and (depth - 1).bit_length() == 9
@@ -230,14 +230,14 @@ def test_without_write_port_the_built_in_words_are_read_and_no_host_port_exists(
     rng = np.random.default_rng(5)
     words = random_map(scene, rng)
     texels = random_texture(scene, rng) if scene.texture else None
-    dut = BumpMapFetch(scene, init=words, texture=texels, write_port=False)
+    dut = BumpMapFetch(scene.hardware, init=words, texture=texels, write_port=False)
     host = {"w_en", "w_addr", "w_data", "tex_w_en", "tex_w_addr", "tex_w_data"}
     assert not host & set(dut.signature.members)
-    pipe = BumpPipeline(scene, init=words, texture=texels, write_port=False)
+    pipe = BumpPipeline(scene.hardware, init=words, texture=texels, write_port=False)
     pipe._MustUse__silence = True                  # only its ports are read
     assert not {f"map_{p}" for p in host if not p.startswith("tex")} & set(pipe.signature.members)
     assert not {p for p in host if p.startswith("tex")} & set(pipe.signature.members)
-    assert "map_w_en" in BumpPipeline(scene, init=words, texture=texels).signature.members
+    assert "map_w_en" in BumpPipeline(scene.hardware, init=words, texture=texels).signature.members
     inputs = random_inputs(scene, 200, rng)
     payloads = [{k: int(inputs[k][n]) for k in ("u", "v", "level", "tag") if k in inputs}
                 for n in range(200)]

@@ -205,7 +205,7 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15):
     words = random_map(scene, nrng)
     inputs = random_inputs(scene, n, nrng)
     index = pipeline_fixed(inputs, scene, words)["index"]
-    dut = BumpPipeline(scene, init=words)
+    dut = BumpPipeline(scene.hardware, init=words)
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
     model = PaletteLUTModel(cfg)

@@ -304,11 +304,11 @@ UNITS = {
     "sincos": lambda: SinCos(Config()),
     "rotation-lee": lambda: VectorRotation(Config(method="lee")),
     "illumination-exact": lambda: Illumination(Config()),
-    "fetch": lambda: BumpMapFetch(load_scene_config({"name": "t", "texture_size": 16})),
+    "fetch": lambda: BumpMapFetch(load_scene_config({"name": "t", "texture_size": 16}).hardware),
     "palette-blend": lambda: PaletteLUT(Config(palette_size=16, palette_blend=True)),
     "texture": lambda: TextureBlend(Config(), lights=2),
-    "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2})),
-    "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16})),
+    "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2}).hardware),
+    "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}).hardware),
 }
 
 
@@ -419,7 +419,7 @@ def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
     angles and B = 16 hold the sine above its line, seven blocks: not spread, but wider than
     NEAR_BLOCKS, so their reads take the extra address register too (one more stage in the
     rotation). The default scene's memories (at most seven blocks) get no enable copy."""
-    dut = BumpPipeline(load_scene_config("full"))
+    dut = BumpPipeline(load_scene_config("full").hardware)
     sim, units = _enable_copies(dut)
     copies = [(name, run, c) for name, (run, cs) in units.items() for c in cs]
     per_unit = {name: len(cs) for name, (_, cs) in units.items() if cs}
@@ -428,7 +428,7 @@ def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
         mem = dut.units[name].memories[copy.name.removesuffix("_run")]
         words = mem["depth"] - (mem["depth"] % 2 == 1 and mem["depth"] > 1)   # the spill word
         assert rom_blocks(words, mem["width"]) > SPREAD_BLOCKS, (name, copy.name, mem)
-    narrow = BumpPipeline(load_scene_config("default"))
+    narrow = BumpPipeline(load_scene_config("default").hardware)
     assert not any(cs for _, cs in _enable_copies(narrow)[1].values())
     for name in ("fetch", "rotation"):
         assert dut.units[name].latency == narrow.units[name].latency + 1, name

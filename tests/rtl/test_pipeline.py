@@ -115,7 +115,7 @@ def run(scene, n, pattern, seed=0):
         else:
             looked = [model.lookup(i) for i in golden["index"]]
         golden = {k: [d[k] for d in looked] for k in looked[0]}
-    dut = BumpPipeline(scene, init=words, texture=texels)
+    dut = BumpPipeline(scene.hardware, init=words, texture=texels)
     payloads = as_payload_list(inputs)
     out, cycles = simulate_stream(_Host(dut, polygon, table), payloads, pattern, seed=seed)
     assert_bit_exact(out, golden, payloads)
@@ -176,7 +176,7 @@ def test_extra_lights_are_an_array_after_light_0(keys):
     {l, [h]} (extra_lights); the lights' angles lie one after the other in the payload, the
     bits the golden model and the stimulus address through light_keys."""
     scene = load_scene_config({"name": "t", "texture_size": 16, "lights": 3, **keys})
-    layout = BumpPipeline(scene).i.payload.shape()
+    layout = BumpPipeline(scene.hardware).i.payload.shape()
     extra = layout["extra_lights"].shape
     assert isinstance(extra, data.ArrayLayout) and extra.length == 2
     assert extra.elem_shape == light_layout(scene.config)
@@ -257,7 +257,7 @@ def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys
     rng = random.Random(7)
     valid = [rng.random() < 0.7 for _ in range(400)]
     ready = [rng.random() < 0.5 for _ in range(400)]
-    _, tags = _ports(BumpPipeline(scene), 400, valid.__getitem__, ready.__getitem__)
+    _, tags = _ports(BumpPipeline(scene.hardware), 400, valid.__getitem__, ready.__getitem__)
     top = 1 << scene.config.tag_bits
     assert len(tags) > 100 and tags == [n % top for n in range(len(tags))]
 
@@ -267,18 +267,18 @@ def test_one_consumer_stall_does_not_stop_the_input():
     and i.ready stays high (the enable only falls once the buffer is full); held low, the
     pipe fills up to latency + BUFFER_DEPTH pixels and i.ready falls."""
     scene = load_scene_config({"name": "t", "texture_size": 16})
-    dut = BumpPipeline(scene)
+    dut = BumpPipeline(scene.hardware)
     n = dut.latency
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: c != n + 2)
     assert all(readies) and len(tags) == 3 * n - n - 1
-    dut = BumpPipeline(scene)
+    dut = BumpPipeline(scene.hardware)
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: False)
     assert tags == [] and sum(readies) == n + BUFFER_DEPTH and not any(readies[n + BUFFER_DEPTH:])
 
 
 def _plan(keys):
     """Built and skipped lists of a pipeline that is never elaborated."""
-    dut = BumpPipeline(load_scene_config({"name": "t", "texture_size": 16, **keys}))
+    dut = BumpPipeline(load_scene_config({"name": "t", "texture_size": 16, **keys}).hardware)
     for unit in (dut, *dut.units.values()):
         unit._MustUse__silence = True
     return [b["unit"] for b in dut.built], [k["unit"] for k in dut.skipped], dut
@@ -308,7 +308,7 @@ def test_textured_scene_the_texture_reaches_the_output():
     colors = {}
     for name, value in (("white", 0xFFFFFF), ("black", 0)):
         texels = np.full(memory_depth(scene), value)
-        out, _ = simulate_stream(BumpPipeline(scene, init=words, texture=texels), payloads)
+        out, _ = simulate_stream(BumpPipeline(scene.hardware, init=words, texture=texels), payloads)
         golden = pipeline_fixed(inputs, scene, words, None, texels)
         assert_bit_exact(out, golden, payloads)
         colors[name] = np.array([o["color.g"] for o in out])

@@ -35,7 +35,7 @@ def _fetches(scene):
     """Whether the scene has a fetch unit of its own (a flat map without texture has none:
     ``bumprtl emit fetch`` refuses it)."""
     try:
-        BumpMapFetch(scene)._MustUse__silence = True
+        BumpMapFetch(scene.hardware)._MustUse__silence = True
     except BumpError:
         return False
     return True
@@ -84,7 +84,7 @@ def test_memories_keep_roms_and_rams_apart():
 
 def _port_less(scene):
     """The pipeline's Sidecar without the map's host write port (``--load initial``)."""
-    dut = BumpPipeline(scene, write_port=False)
+    dut = BumpPipeline(scene.hardware, write_port=False)
     facts = {"config": scene.config.to_dict(), **UNITS["pipeline"].sidecar(scene, dut)}
     return from_facts("pipeline", "bumprtl emit pipeline", port_table(dut), facts)
 

@@ -94,7 +94,7 @@ def test_the_latency_the_page_states_is_the_simulated_one():
 
     from bumprtl.rtl.pipeline import BumpPipeline
     scene = load_scene_config("default", {"texture_size": 16, "angle_bits": 10, "frac_bits": 11})
-    dut, seen = BumpPipeline(scene), {}
+    dut, seen = BumpPipeline(scene.hardware), {}
 
     async def bench(ctx):
         ctx.set(dut.o.ready, 1)

@@ -169,7 +169,7 @@ def test_postsynth_scene_pipeline_bit_exact(size, n, patterns, build_dir):
     scene = load_scene_config("default")
     inputs, words, polygon, table, base = scene_stimulus(scene, size)
     inputs = {k: v[:n] for k, v in inputs.items()}
-    comp = BumpPipeline(scene, init=words, target=ECP5())
+    comp = BumpPipeline(scene.hardware, init=words, target=ECP5())
     outs = _postsynth_stream(comp, "scene_default", inputs, build_dir, patterns, polygon)
     golden = pipeline_fixed(inputs, scene, words, polygon, None)
     assert len(inputs["tag"]) == n

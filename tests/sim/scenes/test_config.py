@@ -8,6 +8,7 @@ import pytest
 from bumprtl.gen.cli.main import main
 from bumprtl.rtl import methods
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import HardwareScene
 from bumprtl.sim.scenes.config import BUILTIN, SceneConfig, load_scene_config
 
 
@@ -351,3 +352,19 @@ def test_defaults_fill_only_the_keys_nothing_sets():
                              defaults={"texture_size": 32}).texture_size == 16
     own = SceneConfig().texture_size
     assert load_scene_config({"name": "t"}, defaults={"texture_size": None}).texture_size == own
+
+
+@pytest.mark.parametrize("name", BUILTIN)
+def test_the_scene_composes_its_hardware(name):
+    """``SceneConfig.hardware`` carries the switches the hardware reads and nothing of the
+    map's source: two scenes that differ only in picture or geometry build the same hardware."""
+    scene = load_scene_config(name)
+    hw = scene.hardware
+    assert isinstance(hw, HardwareScene) and hw.config == scene.config
+    for key in ("name", "shading", "bump_map", "rotation", "texture", "texture_size",
+                "addressing", "mip_levels", "lights", "specular", "texture_bits"):
+        assert getattr(hw, key) == getattr(scene, key), key
+    other = scene.replace(image="wood" if scene.image != "wood" else "bricks",
+                          geometry="sphere")
+    assert other.hardware == hw
+    assert scene.replace(texture_size=32).hardware != hw

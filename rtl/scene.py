@@ -1,0 +1,118 @@
+"""HardwareScene: the switches of one scene that decide what the hardware builds.
+
+:class:`~bumprtl.rtl.pipeline.BumpPipeline`, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`
+and :class:`~bumprtl.rtl.board.BoardCore` take one; the units they build (fetch, rotation,
+illumination, palette, texture blend) read its ``config``. Where the map comes from (a
+procedural image or a user's file, its height scale, resampling) and the surface the
+renderer draws are not the hardware's: ``sim/scenes/config.SceneConfig`` holds those and
+composes a HardwareScene (``SceneConfig.hardware``).
+
+A bad value raises a one-line :class:`BumpError` naming the field and its allowed values.
+"""
+
+from dataclasses import dataclass
+
+from bumprtl.rtl.config import BumpError, Config
+
+__all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
+           "TEXTURE_SIZES", "derived_rotation"]
+
+ADDRESSING = ("wrap", "clamp")
+BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
+SHADINGS = ("per-pixel", "palette")      # Lee/exact per-pixel rotation, or Tarini's palette
+ROTATIONS = ("per-pixel", "per-polygon", "none")
+TEXTURE_SIZES = (16, 4096)               # a power of two in this range
+
+
+def derived_rotation(shading, bump_map):
+    """The rotation of N' that ``shading`` and ``bump_map`` imply."""
+    if shading == "palette":
+        return "none"
+    return "per-pixel" if bump_map == "varying" else "per-polygon"
+
+
+def _choice(key, value, allowed):
+    if value not in allowed:
+        raise BumpError(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+
+
+@dataclass(frozen=True)
+class HardwareScene:
+    """What the hardware of one scene builds.
+
+    Parameters
+    ----------
+    name : str
+        Label of the scene (error messages).
+    shading : str
+        ``per-pixel`` (rotation + illumination per pixel) or ``palette`` (a per-texel
+        palette index and a colour-table lookup).
+    bump_map : str
+        ``varying`` (a map in block RAM, fetched per pixel) or ``flat`` (one N' per polygon).
+    rotation : str or None
+        ``per-pixel``, ``per-polygon`` or ``none``; None: :func:`derived_rotation`; any
+        other value than the derived one is an error.
+    texture : bool
+        Build the colour texture memory and its blend.
+    texture_size : int
+        Map side T, a power of two in :data:`TEXTURE_SIZES` (texel addressing by bit slicing).
+    addressing : str
+        ``wrap`` or ``clamp`` for texel coordinates outside the map.
+    mip_levels : int
+        Levels of the map in block RAM, 1 to log2(T) + 1.
+    config : Config
+        The datapath widths, method, lights, specular, terms and palette size.
+    """
+
+    name: str = "default"
+    shading: str = "per-pixel"
+    bump_map: str = "varying"
+    rotation: str | None = None
+    texture: bool = False
+    texture_size: int = 64
+    addressing: str = "wrap"
+    mip_levels: int = 1
+    config: Config = Config()
+
+    def __post_init__(self):
+        if not isinstance(self.config, Config):
+            raise BumpError(f"config must be a Config, got {type(self.config).__name__}", "config")
+        for key, allowed in (("shading", SHADINGS), ("bump_map", BUMP_MAPS),
+                             ("addressing", ADDRESSING)):
+            _choice(key, getattr(self, key), allowed)
+        if not isinstance(self.texture, bool):
+            raise BumpError(f"texture must be true or false, got {self.texture!r}", "texture")
+        t, (lo, hi) = self.texture_size, TEXTURE_SIZES
+        if isinstance(t, bool) or not isinstance(t, int) or not lo <= t <= hi or t & (t - 1):
+            raise BumpError(f"texture_size must be a power of two in [{lo}, {hi}] (texel "
+                            f"addressing by bit slicing), got {t!r}", "texture_size")
+        top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
+        if isinstance(self.mip_levels, bool) or not isinstance(self.mip_levels, int) \
+                or not 1 <= self.mip_levels <= top:
+            raise BumpError(f"mip_levels must be an integer in [1, {top}] for texture_size "
+                            f"{t}, got {self.mip_levels!r}", "mip_levels")
+        derived = derived_rotation(self.shading, self.bump_map)
+        if self.rotation is None:
+            object.__setattr__(self, "rotation", derived)
+        elif self.rotation != derived:
+            _choice("rotation", self.rotation, ROTATIONS)
+            raise BumpError(f"rotation = {self.rotation!r} is impossible with shading = "
+                            f"{self.shading!r}, bump_map = {self.bump_map!r}: allowed rotation = "
+                            f"{derived!r}", "rotation")
+
+    @property
+    def texture_bits(self):
+        """log2 of ``texture_size``."""
+        return self.texture_size.bit_length() - 1
+
+    @property
+    def lights(self):
+        return self.config.lights
+
+    @property
+    def specular(self):
+        return self.config.specular
+
+    @property
+    def angle_bits(self):
+        return self.config.angle_bits
