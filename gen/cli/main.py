@@ -25,7 +25,7 @@ COMMANDS = [("doctor", "bumprtl.gen.cli.doctor", None),
             ("vectors", "bumprtl.gen.cli.vectors", "sim"),
             ("bench", "bumprtl.gen.cli.bench", "bench"),
             ("report", "bumprtl.gen.cli.report", "fpga"),
-            ("recommend", "bumprtl.gen.report.recommend", "bench"),
+            ("recommend", "bumprtl.gen.cli.recommend", "bench"),
             ("formal", "bumprtl.gen.cli.formal", "formal"),
             ("board", "bumprtl.gen.cli.board", "board")]
 # Top-level modules of the optional packages -> the extra that installs them.

@@ -7,12 +7,10 @@ the accuracy of each design's bit-exact golden model (:func:`.table1.accuracy`),
 critical paths and a cost-against-error plot.
 """
 
-import argparse
 import json
-import os
+from dataclasses import dataclass
 from pathlib import Path
 
-from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.fpga import (
     DEVICES,
     NOT_PLACED,
@@ -28,14 +26,32 @@ from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["fpga_units", "fpga_report", "write_report", "worst_run", "add_parser"]
+__all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run"]
+
+
+@dataclass(frozen=True)
+class FpgaRun:
+    """What a placement run is asked: the ECP5 ``device``, the report ``out``, the
+    placement cache ``work``, the accuracy ``samples``, the units placed (``unit``: all
+    when empty), the nextpnr ``seeds`` (``scene_seeds`` for the scene pipelines' rows
+    when given), the local ``jobs`` or a ``scheduler`` address, and a ``job_timeout``
+    in seconds."""
+    device: str = "LFE5U-85F"
+    out: Path = Path("docs/report.md")
+    work: Path = Path("build/fpga_cache")
+    samples: int = 100_000
+    unit: tuple = ()
+    seeds: tuple = (1,)
+    scene_seeds: tuple = ()
+    jobs: int = 1
+    job_timeout: float | None = None
+    scheduler: str | None = None
 
 
 def fpga_units(cfg):
@@ -52,16 +68,18 @@ def fpga_units(cfg):
                for s in BUILTIN])
 
 
-def run_fpga(args):
-    check_device(args.device)
-    scheduler_address(args.scheduler)           # a malformed address: one line, exit 2
-    check_samples(args.samples)
-    cfg = config_from_args(args)
+def fpga_run(cfg, run: FpgaRun):
+    """``bumprtl report fpga``: refuses a bad device, scheduler address, sample count or unit
+    name (BumpError, one line), then places the units of ``run`` (all when ``run.unit`` is
+    empty) and writes the report (:func:`fpga_report`); returns 0."""
+    check_device(run.device)
+    scheduler_address(run.scheduler)            # a malformed address: one line, exit 2
+    check_samples(run.samples)
     names = [n for n, _, _ in fpga_units(cfg)]
-    for unit in args.unit or ():
+    for unit in run.unit or ():
         if unit not in names:
             raise BumpError(f"unit must be one of {', '.join(names)}, got {unit!r}")
-    fpga_report(cfg, args, [u for u in fpga_units(cfg) if not args.unit or u[0] in args.unit])
+    fpga_report(cfg, run, [u for u in fpga_units(cfg) if not run.unit or u[0] in run.unit])
     return 0
 
 
@@ -69,22 +87,22 @@ def _component(design, row, cfg):
     """The ECP5 form (``target=ECP5()``) of row ``row`` of ``design`` (a method name)."""
     target = ECP5()
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
-        return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
+        return BumpPipeline(load_scene_config(row.split(":", 1)[1]), target=target)
     cfg = cfg.replace(method=design)
     if row == "pipeline":
         return pipeline_component(cfg, target)
     return build_unit({"setup": "rotation", "illumination": "illumination"}[row], cfg, target)[0]
 
 
-def fpga_report(cfg, args, units):
-    """Place ``units`` ((label, design, row) triples of :func:`fpga_units`) on ``args.device``
-    and write ``args.out`` (markdown table + cost-against-error plot). Each placement not in
-    the cache (``args.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
-    ``args.jobs`` workers, or ``args.scheduler``'s."""
-    placed = place_all(cfg, args, [(u, seed) for u in units for seed in _row_seeds(args, u[2])])
+def fpga_report(cfg, run: FpgaRun, units):
+    """Place ``units`` ((label, design, row) triples of :func:`fpga_units`) on ``run.device``
+    and write ``run.out`` (markdown table + cost-against-error plot). Each placement not in
+    the cache (``run.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
+    ``run.jobs`` workers, or ``run.scheduler``'s."""
+    placed = place_all(cfg, run, [(u, seed) for u in units for seed in _row_seeds(run, u[2])])
     rows = []
     for label, design, row in units:
-        runs = [placed[((label, design, row), s)] for s in _row_seeds(args, row)]
+        runs = [placed[((label, design, row), s)] for s in _row_seeds(run, row)]
         ok = [r for r in runs if "error" not in r]
         if not ok:
             rows.append({"unit": label, "design": design, "row": row, "error": runs[0]["error"]})
@@ -93,8 +111,8 @@ def fpga_report(cfg, args, units):
             rows.append({**worst, "unit": label, "design": design, "row": row,
                          "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}})
         print(f"{label}: {rows[-1]}", flush=True)
-    acc = {d: accuracy(d, cfg, args.samples) for d in {r["design"] for r in rows}}
-    write_report(args, rows, acc, cfg)
+    acc = {d: accuracy(d, cfg, run.samples) for d in {r["design"] for r in rows}}
+    write_report(run, rows, acc, cfg)
 
 
 def worst_run(runs):
@@ -103,27 +121,27 @@ def worst_run(runs):
     return min(runs, key=lambda r: (r["fmax_mhz"] or 0, r["seed"]))
 
 
-def place_all(cfg, args, tasks):
+def place_all(cfg, run: FpgaRun, tasks):
     """``{(unit, seed): row or {"error": reason, "seed": seed}}`` for ``tasks``: the cached
     rows read here, the others placed as jobs (one job per distinct Verilog: Ernst's
     pipeline is Peercy's hardware and is placed once). The client elaborates each design
     and submits it at once, so elaboration overlaps the placements already running."""
     placed, waiting = {}, {}           # waiting: job name -> [(task, Placement)]
-    timeout = getattr(args, "job_timeout", None)
+    timeout = run.job_timeout
 
     def jobs():
         by_key = {}
         for task in tasks:
             (label, design, row), seed = task
             try:
-                p = Placement(_component(design, row, cfg), label, args.device, args.work, seed=seed)
+                p = Placement(_component(design, row, cfg), label, run.device, run.work, seed=seed)
             except FpgaError as e:
                 placed[task] = {"error": str(e), "seed": seed}
                 continue
             if p.cached is not None:
                 placed[task] = {**p.cached, "seed": seed}
                 continue
-            name = job_name("place", args.device, label, f"seed{seed}")
+            name = job_name("place", run.device, label, f"seed{seed}")
             if p.key in by_key:                     # the same hardware: placed once
                 waiting[by_key[p.key]].append((task, p))
                 continue
@@ -141,41 +159,40 @@ def place_all(cfg, args, tasks):
             else:
                 placed[task] = {**outcome.value["row"], "unit": p.label, "seed": seed}
 
-    with Runner(scheduler_address(getattr(args, "scheduler", None)),
-                getattr(args, "jobs", None) or 1) as runner:
+    with Runner(scheduler_address(run.scheduler), run.jobs or 1) as runner:
         runner.run(jobs(), desc="place", on_done=done)
     return placed
 
 
-def _row_seeds(args, row):
-    """The nextpnr seeds of a row: ``--scene-seeds`` for the scene pipelines when given,
-    else ``--seeds``."""
-    seeds = list(getattr(args, "seeds", None) or [1])
-    scene = getattr(args, "scene_seeds", None)
+def _row_seeds(run, row):
+    """The nextpnr seeds of a row: ``run.scene_seeds`` for the scene pipelines when given,
+    else ``run.seeds``."""
+    seeds = list(run.seeds or [1])
+    scene = run.scene_seeds
     return list(scene) if scene and row.startswith("scene:") else seeds
 
 
-def write_report(args, rows, acc, cfg):
-    out = Path(args.out)
+def write_report(run: FpgaRun, rows, acc, cfg):
+    out = Path(run.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot = out.parent / "img" / "cost_vs_error.png"
-    seeds = list(getattr(args, "seeds", None) or [1])
-    scene_seeds = list(getattr(args, "scene_seeds", None) or [])
-    command = (f"bumprtl report fpga --device {args.device} --samples {args.samples}"
+    seeds = list(run.seeds or [1])
+    scene_seeds = list(run.scene_seeds or [])
+    command = (f"bumprtl report fpga --device {run.device} --samples {run.samples}"
                + (f" --seeds {','.join(map(str, seeds))}" if seeds != [1] else "")
                + (f" --scene-seeds {','.join(map(str, scene_seeds))}" if scene_seeds else "")
-               + "".join(f" --unit {u}" for u in args.unit or ()))
+               + "".join(f" --unit {u}" for u in run.unit or ()))
     seed_text = ", ".join(map(str, seeds)) + (
         f" (scene pipelines: {', '.join(map(str, scene_seeds))})" if scene_seeds else "")
     lines = ["# FPGA cost of every design", "",
              f"Generated by `{command}`: Yosys `synth_ecp5`, then `nextpnr-ecp5` "
-             f"{DEVICES[args.device]} --package {PACKAGE} --out-of-context with "
+             f"{DEVICES[run.device]} --package {PACKAGE} --out-of-context with "
              f"`constraints/ecp5.lpf` ({lpf_mhz():g} MHz clock target), nextpnr seed(s) "
              f"{seed_text}: Fmax is the minimum over a row's seeds (each seed's in the last "
              "column); every design takes 1 pixel per clock, so Mpixel/s = Fmax. LUT4 = "
              "TRELLIS_COMB (LUT halves incl. carry chains), DSP = MULT18X18D, BRAM = DP16KD. "
              "Accuracy: diffuse error of the design's bit-exact golden model against float64, "
-             f"8-bit LSB, {args.samples} random valid pixels (seed 11).", "",
+             f"8-bit LSB, {run.samples} random valid pixels (seed 11).", "",
              made_at(cfg, _scene_widths(rows)), "",
              "| unit | LUT4 | FF | DSP | BRAM | Fmax (MHz) = Mpixel/s | target met | max LSB | mean LSB | Fmax by seed |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -209,7 +226,7 @@ def write_report(args, rows, acc, cfg):
     print(f"wrote {out}")
     data = out.parent / "data" / "fpga.json"         # read by report table1
     data.parent.mkdir(parents=True, exist_ok=True)
-    data.write_text(json.dumps({"command": command, "device": args.device, "rows": rows,
+    data.write_text(json.dumps({"command": command, "device": run.device, "rows": rows,
                                 "accuracy": acc}, indent=1, sort_keys=True) + "\n")
 
 
@@ -349,37 +366,3 @@ FPGA_NOTES = """
 - Units are placed out of context: no I/O buffers, ports are internal nets, so paths
   from a unit's input ports are not timed (the pipelines time them between units).
 """
-
-
-def _seeds(text):
-    try:
-        seeds = [int(s) for s in text.split(",")]
-    except ValueError:
-        seeds = []
-    if not seeds or any(s < 1 for s in seeds):
-        raise argparse.ArgumentTypeError(f"must be comma-separated positive integers, got {text!r}")
-    return seeds
-
-
-def add_parser(kinds):
-    """The ``fpga`` kind of ``bumprtl report`` (registered by gen/cli/report.py)."""
-    f = kinds.add_parser("fpga", help="ECP5 place and route of every design -> docs/report.md")
-    f.add_argument("--device", default="LFE5U-85F", help="LFE5U-25F, LFE5U-45F or LFE5U-85F")
-    f.add_argument("--unit", action="append", help="place only this unit (repeatable)")
-    f.add_argument("--out", type=Path, default=Path("docs/report.md"))
-    f.add_argument("--work", type=Path, default=Path("build/fpga_cache"),
-                   help="placements, cached by Verilog digest (shared with bench sweep --fpga; "
-                        "default: build/fpga_cache)")
-    f.add_argument("--samples", type=int, default=100_000)
-    f.add_argument("--seeds", type=_seeds, default=[1],
-                   help="nextpnr seeds, comma-separated (default 1); Fmax is their minimum")
-    f.add_argument("--scene-seeds", type=_seeds, default=None,
-                   help="nextpnr seeds of the scene pipelines' rows (default: --seeds)")
-    f.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                   help="local worker processes, one placement each at a time (default: the "
-                        "number of cores; ignored with --scheduler)")
-    f.add_argument("--job-timeout", type=float, default=None, metavar="SECONDS",
-                   help="a placement running longer fails with a timeout on its row (default: none)")
-    add_job_arguments(f)
-    add_config_flags(f, ("angle_bits", "frac_bits", "specular"))
-    f.set_defaults(func=run_fpga)

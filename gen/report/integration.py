@@ -45,7 +45,7 @@ from bumprtl.sim.golden.fixed.common import angle_codes
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 
-__all__ = ["emit_for_integration", "blocks", "write_doc", "made_at", "add_parser", "NAME",
+__all__ = ["emit_for_integration", "blocks", "write_doc", "made_at", "integration_report", "NAME",
            "example_pixel", "pack_payload"]
 
 DOC = Path("docs/integration.md")
@@ -348,25 +348,10 @@ def write_doc(doc, generated):
     return doc
 
 
-def run(args):
-    meta = emit_for_integration(args.scene, args.out, args.name)
-    path = write_doc(args.doc, blocks(meta))
+def integration_report(scene="default", out=Path("build/integration"), doc=DOC, name=NAME):
+    """``bumprtl report integration``: emits ``scene``'s pipeline under ``out`` (port
+    prefix ``name``) and writes the generated blocks of ``doc``; returns 0."""
+    meta = emit_for_integration(scene, out, name)
+    path = write_doc(doc, blocks(meta))
     print(f"wrote {path} ({made_at(meta)})")
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("integration", help="the generated parts of docs/integration.md",
-                       description="Emit the scene's pipeline with named ports (--load port --name "
-                                   f"{NAME} --ports named) and "
-                                   "write docs/integration.md's generated blocks from its "
-                                   "sidecar: block diagram, port table, latency, memory images, "
-                                   "instantiation template.")
-    p.add_argument("--scene", default="default", metavar="FILE|NAME",
-                   help="scene whose pipeline the page describes (default: default)")
-    p.add_argument("--out", type=Path, default=Path("build/integration"),
-                   help="where the pipeline is emitted (default: build/integration)")
-    p.add_argument("--doc", type=Path, default=DOC, help=f"the page (default: {DOC})")
-    p.add_argument("--name", default=NAME, metavar="PREFIX",
-                   help=f"the --name the page's pipeline is emitted under (default: {NAME})")
-    p.set_defaults(func=run)

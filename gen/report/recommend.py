@@ -28,7 +28,7 @@ from bumprtl.gen.bench.sweep import (
 )
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["recommend", "rank_key", "add_parser", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
+__all__ = ["recommend", "rank_key", "recommend_report", "LOCAL_SWEEP", "SHIPPED_SWEEP", "sweep_path", "not_evidence",
            "evidence_line"]
 
 LOCAL_SWEEP = Path("build/bench/sweep.json")          # what `bumprtl bench sweep` writes
@@ -157,16 +157,20 @@ def _flags(p):
     return f"--method {c['method']} --angle-bits {c['angle_bits']} --frac-bits {c['frac_bits']}"
 
 
-def run(args):
-    path, note = sweep_path(args.sweep)
+def recommend_report(max_error_lsb, device=None, sweep=None):
+    """``bumprtl recommend``: prints the cheapest configuration of the sweep JSON ``sweep``
+    (default: :func:`sweep_path`'s) whose worst measured colour error is at most
+    ``max_error_lsb``, ranked by ECP5 cost on ``device`` when given, with the evidence;
+    returns 0 (none meets the bound: BumpError)."""
+    path, note = sweep_path(sweep)
     if note:
         print(note + "\n")
-    args.sweep = path
+    sweep = path
     data = _load(path)
-    best, meeting = recommend(data, args.max_error_lsb, args.device)
-    order = ("DSP, block RAM, LUT4 on " + args.device if args.device else
+    best, meeting = recommend(data, max_error_lsb, device)
+    order = ("DSP, block RAM, LUT4 on " + device if device else
              "multipliers + dividers + square roots, then ROM+RAM bits, then adders")
-    print(f"cheapest configuration with worst measured colour error <= {args.max_error_lsb} LSB "
+    print(f"cheapest configuration with worst measured colour error <= {max_error_lsb} LSB "
           f"(cheapest by {order}):\n")
     print(f"  {point_label(best)}: {_flags(best)}")
     print("\n".join(_evidence(best)))
@@ -178,23 +182,10 @@ def run(args):
     if len(meeting) > 1:
         print("\nnext cheapest meeting the bound:")
         for p in meeting[1:4]:
-            print(f"  {point_label(p)}: error {error_lsb(p)}, cost key {cost_key(p, args.device)}")
+            print(f"  {point_label(p)}: error {error_lsb(p)}, cost key {cost_key(p, device)}")
     print("\n" + evidence_line(data))
     for p in not_evidence(data):
         print(f"not counted: {point_label(p)} held every distinct normal of the maps measured "
               f"(no quantization happened: not evidence for a larger map)")
-    print(f"evidence from {args.sweep}, made by `{data.get('command', 'bumprtl bench sweep')}`")
+    print(f"evidence from {sweep}, made by `{data.get('command', 'bumprtl bench sweep')}`")
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("recommend", help="cheapest configuration meeting an error bound (from the sweep)",
-                       description="Reads the `bumprtl bench sweep` JSON and prints the cheapest "
-                                   "configuration whose worst measured colour error is within the bound, "
-                                   "with the evidence. Exits 2 when none meets it.")
-    p.add_argument("--max-error-lsb", type=float, required=True, help="bound on the worst colour error, 8-bit LSB")
-    p.add_argument("--device", default=None, help="rank by ECP5 cost on this device (needs sweep --fpga)")
-    p.add_argument("--sweep", type=Path, default=None,
-                   help=f"sweep JSON (default: {LOCAL_SWEEP}, else the sweep shipped in "
-                        f"docs/data/sweep.json)")
-    p.set_defaults(func=run)

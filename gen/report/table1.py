@@ -9,19 +9,16 @@ accuracy of each design's bit-exact golden model against float64, and the paper'
 """
 
 import json
-import os
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from bumprtl.gen.cli.flags import add_config_flags, config_from_args
 from bumprtl.gen.flow.resources import count_unit, count_verilog
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.accuracy import diffuse_error_lsb
 from bumprtl.sim.golden.common import PixelInputs
@@ -29,7 +26,7 @@ from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 
 __all__ = ["PAPER", "TABLE1_ORDER", "paper_multiplier_savings", "netlist_multiplier_savings",
            "count_design", "accuracy", "check_samples",
-           "table1_markdown", "add_parser"]
+           "table1_markdown", "table1_report", "count_all"]
 
 # Lee et al. 2003, Table 1 (per pixel, L and H). None = "Not Available" in the paper.
 PAPER = {
@@ -259,22 +256,22 @@ def count_text(text, top):
         return {"counts": counts, "log": log.read_text(errors="replace") if log.is_file() else ""}
 
 
-def count_all(cfg, args):
+def count_all(cfg, work, jobs=1, scheduler=None):
     """``(counts, failed)``: each design's setup and illumination units emitted here (under
-    ``args.work``) and counted as jobs (a local cluster of ``args.jobs`` workers, or
-    ``args.scheduler``'s); ``counts[design][row]`` for the designs whose two counts both
+    ``work``) and counted as jobs (a local cluster of ``jobs`` workers, or
+    ``scheduler``'s); ``counts[design][row]`` for the designs whose two counts both
     came back, ``failed`` [(design, row, reason)] for the others."""
-    def jobs():
+    def count_jobs():
         for d in TABLE1_ORDER:
             for row, unit in UNITS:
-                v_path, _ = emit_unit(unit, cfg.replace(method=d), Path(args.work) / d / row)
+                v_path, _ = emit_unit(unit, cfg.replace(method=d), Path(work) / d / row)
                 yield Job(job_name("count", d, row), count_text, (v_path.read_text(), unit))
 
-    scheduler = scheduler_address(getattr(args, "scheduler", None))
+    scheduler = scheduler_address(scheduler)
     if scheduler is None:
         yosys.binary()                      # the local workers are this machine: say so at once
-    with Runner(scheduler, getattr(args, "jobs", None) or 1) as runner:
-        out = runner.run(jobs(), desc="count")
+    with Runner(scheduler, jobs or 1) as runner:
+        out = runner.run(count_jobs(), desc="count")
     counts, failed = {}, []
     for d in TABLE1_ORDER:
         got = {row: out[job_name("count", d, row)] for row, _ in UNITS}
@@ -284,19 +281,20 @@ def count_all(cfg, args):
     return counts, failed
 
 
-def run_table1(args):
-    check_samples(args.samples)
-    scheduler_address(getattr(args, "scheduler", None))   # a malformed address: exit 2
-    cfg = config_from_args(args)
-    counts, failed = count_all(cfg, args)
-    acc = {"samples": args.samples,
-           "designs": {d: accuracy(d, cfg, args.samples) for d in TABLE1_ORDER}}
-    command = f"bumprtl report table1 --samples {args.samples}"
+def table1_report(cfg, out, work, samples=100_000, jobs=1, scheduler=None):
+    """``bumprtl report table1``: counts every design's units (:func:`count_all`) and writes
+    Table 1 with each design's accuracy over ``samples`` pixels to ``out``; returns 0."""
+    check_samples(samples)
+    counts, failed = count_all(cfg, work, jobs, scheduler)
+    acc = {"samples": samples,
+           "designs": {d: accuracy(d, cfg, samples) for d in TABLE1_ORDER}}
+    command = f"bumprtl report table1 --samples {samples}"
     text = table1_markdown(cfg, counts, acc, command, failed)
-    text += fpga_section(Path(args.out).parent / "data" / "fpga.json")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text + STATUS)
-    print(f"wrote {args.out}")
+    text += fpga_section(Path(out).parent / "data" / "fpga.json")
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text + STATUS)
+    print(f"wrote {out}")
     return 0
 
 
@@ -337,17 +335,3 @@ Peercy, Ernst and Kim are real RTL (`rtl/baselines/`) with bit-exact golden mode
 `tests/rtl/test_baselines_*.py` and under cocotb in `tests/sim/tb/test_tb_datapath.py`.
 Kugler's scheme (3 MB of light maps) is taken from the paper's description only.
 """
-
-
-def add_parser(kinds):
-    """The ``table1`` kind of ``bumprtl report`` (registered by gen/cli/report.py)."""
-    t = kinds.add_parser("table1", help="recount Lee et al. Table 1 -> docs/table1.md")
-    t.add_argument("--out", type=Path, default=Path("docs/table1.md"))
-    t.add_argument("--work", type=Path, default=Path("build/report/table1"))
-    t.add_argument("--samples", type=int, default=100_000)
-    t.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                   help="local worker processes, one Yosys count each at a time (default: the "
-                        "number of cores; ignored with --scheduler)")
-    add_job_arguments(t)
-    add_config_flags(t, ("angle_bits", "frac_bits", "specular"))
-    t.set_defaults(func=run_table1)

@@ -22,7 +22,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
 
-__all__ = ["simulate", "wavedrom", "scenarios", "write_timing", "add_parser"]
+__all__ = ["simulate", "wavedrom", "scenarios", "write_timing", "timing_report"]
 
 
 def simulate(dut, cycles, offer, ready):
@@ -104,7 +104,7 @@ def wavedrom(trace, start, stop, title, foot="", nodes=None, edges=()):
     return out
 
 
-def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default").hardware)):
+def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default"))):
     """``{name: (wavedrom source, facts)}`` of the three diagrams, from real traces."""
     out = {}
     dut = dut_factory()
@@ -152,24 +152,16 @@ def write_timing(out_dir=Path("docs/timing")):
     return facts
 
 
-def run_timing(args):
-    facts = write_timing(args.out)
+def timing_report(out=Path("docs/timing"), doc=None):
+    """``bumprtl report timing``: writes the diagrams under ``out`` and, when ``doc`` is an
+    existing page, its Made-at record; prints what it wrote and the latency; returns 0."""
+    facts = write_timing(out)
     for name in facts:
-        print(f"wrote {args.out / name}.json and .svg")
-    if args.doc is not None and args.doc.is_file():
-        write_section(args.doc, "made-at", made_at(Config(), f"`bumprtl report timing`: the "
+        print(f"wrote {out / name}.json and .svg")
+    if doc is not None and doc.is_file():
+        write_section(doc, "made-at", made_at(Config(), f"`bumprtl report timing`: the "
                       f"default pipeline's latency is {facts['latency']['latency']} cycles"))
-        print(f"wrote the record of {args.doc}")
+        print(f"wrote the record of {doc}")
     print(f"default pipeline latency: {facts['latency']['latency']} cycles "
           f"(o.valid in cycle {facts['latency']['first_out']} for i.valid in cycle 1)")
     return 0
-
-
-def add_parser(kinds):
-    """The ``timing`` kind of ``bumprtl report`` (registered by gen/cli/report.py)."""
-    t = kinds.add_parser("timing", help="WaveDrom handshake/stall/latency diagrams of the "
-                                        "default pipeline -> docs/timing/")
-    t.add_argument("--out", type=Path, default=Path("docs/timing"))
-    t.add_argument("--doc", type=Path, default=Path("docs/timing.md"),
-                   help="the page whose Made-at record is rewritten (when it exists)")
-    t.set_defaults(func=run_timing)

