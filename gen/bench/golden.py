@@ -24,7 +24,7 @@ def _timed(fn):
     return time.perf_counter() - t0
 
 
-def _sim_rate(cfg, sim, unit, samples, work):
+def unit_sim_rate(cfg, sim, unit, samples, work):
     work = Path(work).resolve()          # cocotb runs in its build directory
     v, j = emit_unit(unit, cfg, work / "rtl")
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_datapath", work / f"{sim}_{unit}",
@@ -55,7 +55,7 @@ def run(args):
         for method in methods:
             for unit in ("rotation", "illumination"):
                 for sim in SIMULATORS:
-                    rate, build = _sim_rate(Config(method=method), sim, unit, args.sim_samples,
+                    rate, build = unit_sim_rate(Config(method=method), sim, unit, args.sim_samples,
                                             Path(tmp) / method)
                     print(f"| {method} | {unit} | {sim} | {rate:,.0f} | {build:.1f} |", flush=True)
     return 0

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from amaranth.back import verilog
 
-from bumprtl.gen.bench.sweep import _cached, _digest
+from bumprtl.gen.bench.sweep import cached_json, text_digest
 from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.render.rtl import scene_stimulus, scene_texels
 from bumprtl.gen.tools.docs import write_section
@@ -68,7 +68,7 @@ def _cost(scene, work):
     """Yosys counts of the scene's BumpPipeline, cached by the digest of its Verilog (a
     changed datapath is counted anew)."""
     text = verilog.convert(BumpPipeline(scene.hardware), name="pipeline", emit_src=False)
-    digest = _digest(text)
+    digest = text_digest(text)
     netlist = work / "netlist" / scene.name
 
     def compute():
@@ -79,7 +79,7 @@ def _cost(scene, work):
         return {**{k: s[k] for k in ("multipliers", "adders", "table_bits", "register_bits")},
                 "ram_bits": sum(r["bits"] for r in c.rams)}
 
-    return _cached(work / "cost" / f"{scene.name}_{digest}.json", compute)
+    return cached_json(work / "cost" / f"{scene.name}_{digest}.json", compute)
 
 
 def skip_rows(names, size, work):

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from bumprtl.gen.bench.golden import _sim_rate
+from bumprtl.gen.bench.golden import unit_sim_rate
 from bumprtl.gen.flow.fpga import (
     NOT_PLACED,
     FpgaError,
@@ -230,7 +230,8 @@ def perpixel_speed(ctx, cfg):
     return {"golden_mpix_s": round(len(ctx.px) / _best_time(lambda: datapath_fixed(codes, cfg)) / 1e6, 3)}
 
 
-def _cached(path, compute):
+def cached_json(path, compute):
+    """The JSON value stored at ``path``, else ``compute()`` stored there and returned."""
     if path.is_file():
         return json.loads(path.read_text())
     value = compute()
@@ -248,7 +249,7 @@ def _summary(counts):
     return {**{k: s[k] for k in COST_FIELDS if k in s}, "ram_bits": sum(r["bits"] for r in counts.rams)}
 
 
-def _digest(*texts):
+def text_digest(*texts):
     """Cache key of generated Verilog: a changed datapath never reuses an old count."""
     h = hashlib.sha256()
     for t in texts:
@@ -267,8 +268,8 @@ def unit_cost(units, cfg, work):
             total = c if total is None else total + c
         return _summary(total)
 
-    key = _digest(*(v.read_text() for v in paths.values()))
-    return _cached(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}_{key}.json", compute)
+    key = text_digest(*(v.read_text() for v in paths.values()))
+    return cached_json(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}_{key}.json", compute)
 
 
 def fpga_cost(component_fn, label, cfg, device, work):
@@ -312,7 +313,7 @@ def _palette_unit(cfg, target=None):
 def sim_rate(cfg, work):
     """cocotb pixels/s on Verilator of the rotation and illumination units (scoreboard
     included), the slower of the two (gen/bench/golden.py's measurement)."""
-    rates = [_sim_rate(cfg, "verilator", u, 2000, work / "sim" / _tag(cfg))[0]
+    rates = [unit_sim_rate(cfg, "verilator", u, 2000, work / "sim" / _tag(cfg))[0]
              for u in ("rotation", "illumination")]
     return round(min(rates))
 

@@ -18,12 +18,13 @@ def table(rows):
     return "\n".join(lines)
 
 
-def write_doc(path, rows, args=""):
-    """Replace the table section of ``path`` (the prose around it stays)."""
-    if "--merge" in args.split():
+def write_doc(path, rows, command=""):
+    """Replace the table section of ``path`` (the prose around it stays); ``command``: the
+    flags the run was given (with ``--merge``, the page names them)."""
+    if "--merge" in command.split():
         how = (f"Produced by `make formal` (`python -m bumprtl.gen.formal.run -j 2 --doc "
                f"docs/formal.md`; `bumprtl formal` is the same command); the rows it names "
-               f"re-checked by `python -m bumprtl.gen.formal.run {args}`, the others kept "
+               f"re-checked by `python -m bumprtl.gen.formal.run {command}`, the others kept "
                f"from the previous run's `results.json`")
     else:
         how = ("Produced by `make formal` (`python -m bumprtl.gen.formal.run -j 2 "

@@ -245,8 +245,8 @@ def test_sim_rate_with_a_relative_work_dir(tmp_path, monkeypatch):
     cocotb runs in its own build directory."""
     from pathlib import Path
 
-    from bumprtl.gen.bench.golden import _sim_rate
+    from bumprtl.gen.bench.golden import unit_sim_rate
     monkeypatch.chdir(tmp_path)
-    rate, build_s = _sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))
+    rate, build_s = unit_sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))
     assert rate > 0 and build_s >= 0
     assert (tmp_path / "rel" / "rtl" / "rotation.json").is_file()
