@@ -79,8 +79,8 @@ class AxisWrapper(wiring.Component):
     Parameters
     ----------
     build : callable
-        Config (or SceneConfig) -> unit with ``i``/``o`` streams and a ``tag`` field.
-    cfg : Config or SceneConfig
+        Config (or HardwareScene) -> unit with ``i``/``o`` streams and a ``tag`` field.
+    cfg : Config or rtl/scene.HardwareScene
         ``tag_bits`` is the ``tuser`` width; the unit is built with ``tag_bits + 1``.
     tdata_width : int, optional
         Width of both ``tdata`` buses, a multiple of 8 (default: the wider payload rounded

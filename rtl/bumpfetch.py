@@ -19,7 +19,7 @@ from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
-from bumprtl.rtl.scene import HardwareScene
+from bumprtl.rtl.scene import HardwareScene, check_scene
 from bumprtl.rtl.targets import is_spread
 from bumprtl.rtl.texture import rgb_layout
 
@@ -170,6 +170,7 @@ class BumpMapFetch(wiring.Component):
 
     def __init__(self, scene: HardwareScene, out_layout=None, init=None, texture=None, target=None,
                  lockstep=None, write_port=True):
+        check_scene(self, scene)
         self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
         self.write_port = write_port
         self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)

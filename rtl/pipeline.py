@@ -56,7 +56,7 @@ from bumprtl.rtl.pipe import (
     pipe_observer,
 )
 from bumprtl.rtl.rotation import VectorRotation
-from bumprtl.rtl.scene import HardwareScene
+from bumprtl.rtl.scene import HardwareScene, check_scene
 from bumprtl.rtl.tables import (
     COLOR_FRAC_BITS,
     KD_FRAC_BITS,
@@ -129,6 +129,7 @@ class LightSum(wiring.Component):
     latency = PRODUCT_LATENCY + 3
 
     def __init__(self, scene: HardwareScene, target=None, lockstep=None):
+        check_scene(self, scene)
         self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
         self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
@@ -246,7 +247,7 @@ class BumpPipeline(wiring.Component):
 
     def __init__(self, scene: HardwareScene, init=None, texture=None, target=None,
                  write_port=True):
-        self.scene = scene
+        self.scene = check_scene(self, scene)
         self.write_port = write_port
         self.cfg = cfg = scene.config
         self.target = target

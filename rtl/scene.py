@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
-           "TEXTURE_SIZES", "derived_rotation"]
+           "TEXTURE_SIZES", "derived_rotation", "check_scene"]
 
 ADDRESSING = ("wrap", "clamp")
 BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
@@ -29,6 +29,17 @@ def derived_rotation(shading, bump_map):
     if shading == "palette":
         return "none"
     return "per-pixel" if bump_map == "varying" else "per-polygon"
+
+
+def check_scene(unit, scene):
+    """``scene`` itself when it is a :class:`HardwareScene`; else a one-line TypeError
+    naming ``unit``'s class (a SceneConfig gives its ``hardware``), ``unit`` silenced so
+    that the half-built component raises no unused-elaboratable warning."""
+    if not isinstance(scene, HardwareScene):
+        unit._MustUse__silence = True
+        raise TypeError(f"{type(unit).__name__} takes a HardwareScene (rtl/scene.py; a "
+                        f"SceneConfig's is its hardware), got {type(scene).__name__}")
+    return scene
 
 
 def _choice(key, value, allowed):
@@ -100,6 +111,15 @@ class HardwareScene:
                             f"{self.shading!r}, bump_map = {self.bump_map!r}: allowed rotation = "
                             f"{derived!r}", "rotation")
 
+    def replace(self, **changes):
+        """A copy with some switches or Config fields changed (both checked again)."""
+        own = {k: changes.pop(k) for k in list(changes) if k in self.__dataclass_fields__}
+        config = own.pop("config", self.config)
+        if changes:
+            config = config.replace(**changes)
+        keys = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        return HardwareScene(**{**keys, "rotation": None, **own, "config": config})
+
     @property
     def texture_bits(self):
         """log2 of ``texture_size``."""
@@ -116,3 +136,7 @@ class HardwareScene:
     @property
     def angle_bits(self):
         return self.config.angle_bits
+
+    @property
+    def tag_bits(self):
+        return self.config.tag_bits

@@ -31,13 +31,16 @@ def axis_name(name):
 
 
 def _builder(name, images):
-    """Config -> the unit, with the initial contents of ``images`` for a scene unit."""
-    if name not in SCENE_UNITS or not images:
+    """Config (a scene unit: HardwareScene) -> the unit, with the initial contents of
+    ``images`` for a scene unit."""
+    if name not in SCENE_UNITS:
         return lambda c: UNITS[name].build(c, target=None)
+    if not images:
+        return BumpPipeline if name == "pipeline" else BumpMapFetch
     init = lambda n: images[n]["words"] if n in images and images[n]["load"] == "initial" else None
     cls = BumpPipeline if name == "pipeline" else BumpMapFetch
-    return lambda scene: cls(scene, init=init("map"), texture=init("texture"),
-                             write_port=has_write_port(images))
+    return lambda hardware: cls(hardware, init=init("map"), texture=init("texture"),
+                                write_port=has_write_port(images))
 
 
 def build_axis(name, cfg, tdata_width=None, images=None, module=None):
@@ -48,7 +51,8 @@ def build_axis(name, cfg, tdata_width=None, images=None, module=None):
     if name not in UNITS:
         raise BumpError(f"unit must be one of {', '.join(UNITS)}, got {name!r}")
     unit = UNITS[name]
-    wrapper = AxisWrapper(_builder(name, images), cfg, tdata_width)
+    wrapper = AxisWrapper(_builder(name, images), cfg.hardware if name in SCENE_UNITS else cfg,
+                          tdata_width)
     inner = unit.sidecar(cfg.replace(tag_bits=cfg.tag_bits + 1), wrapper.unit)
     facts = {**inner, "config": cfg.config.to_dict() if name in SCENE_UNITS else cfg.to_dict(),
                "interface": "axis", "axis": wrapper.sidecar()}

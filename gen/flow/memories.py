@@ -108,7 +108,7 @@ def check_fits(roms, device, what):
 def check_scene_fits(scene, device, unit="pipeline"):
     """:func:`check_fits` for the memories of ``scene``'s pipeline (or fetch unit)."""
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
-    return check_fits(unit_memories(build(scene)), device, scene.picture or scene.name)
+    return check_fits(unit_memories(build(scene.hardware)), device, scene.picture or scene.name)
 
 
 def hex_text(words, width):
@@ -247,7 +247,7 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
     fit = None
     if device is not None:                      # before building a large map's contents
         fit = check_scene_fits(scene, device, unit)
-    dut = build(scene, init=init("map"), texture=init("texture"), write_port=write_port)
+    dut = build(scene.hardware, init=init("map"), texture=init("texture"), write_port=write_port)
     facts = {"config": scene.config.to_dict(), **spec.sidecar(scene, dut)}
     if fit is not None:
         facts["block_ram"] = {"device": device, "dp16kd_needed": fit[0],

@@ -1,8 +1,12 @@
 """rtl/scene.HardwareScene: the hardware's switches, checked where they are defined."""
 
+import warnings
+
 import pytest
 
+from bumprtl.rtl.bumpfetch import BumpMapFetch
 from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.pipeline import BumpPipeline, LightSum
 from bumprtl.rtl.scene import HardwareScene
 
 
@@ -36,4 +40,32 @@ def test_the_top_mip_level_is_allowed_and_rotation_is_derived():
 
 def test_lights_and_widths_come_from_the_config():
     s = HardwareScene(config=Config(lights=2, specular=False, angle_bits=12))
-    assert (s.lights, s.specular, s.angle_bits) == (2, False, 12)
+    assert (s.lights, s.specular, s.angle_bits, s.tag_bits) == (2, False, 12, s.config.tag_bits)
+
+
+@pytest.mark.parametrize("unit", ["BumpPipeline", "BumpMapFetch", "LightSum"])
+def test_a_scene_unit_refuses_anything_but_a_hardware_scene(unit):
+    """A duck-typed look-alike (e.g. sim/'s SceneConfig) is refused by name."""
+    cls = {"BumpPipeline": BumpPipeline, "BumpMapFetch": BumpMapFetch, "LightSum": LightSum}[unit]
+
+    class LookAlike:
+        def __getattr__(self, name):
+            return getattr(HardwareScene(config=Config(lights=2)), name)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(TypeError, match=f"{unit} takes a HardwareScene.*got LookAlike"):
+            cls(LookAlike())
+    unit = cls(HardwareScene(config=Config(lights=2)))
+    unit._MustUse__silence = True
+    assert unit.scene.lights == 2 if hasattr(unit, "scene") else unit.lights == 2
+
+
+def test_replace_changes_switches_and_config_fields_and_checks_them():
+    s = HardwareScene(shading="palette", texture_size=32)
+    t = s.replace(tag_bits=9, texture_size=16, shading="per-pixel")
+    assert (t.config.tag_bits, t.texture_size, t.rotation) == (9, 16, "per-pixel")
+    assert t.config.replace(tag_bits=s.config.tag_bits) == s.config
+    with pytest.raises(BumpError) as e:
+        s.replace(mip_levels=7)
+    assert e.value.field == "mip_levels"
