@@ -17,12 +17,14 @@ from bumprtl.sim.golden.methods import datapath_fixed
 WIDTHS = ((8, 7), (10, 9), (10, 13), (12, 13), (12, 16), (14, 18), (16, 24))
 
 
-def run(args):
-    print(f"bumprtl bench lee-widths --samples {args.samples} --seed {args.seed}")
-    px = PixelInputs.random(args.samples, np.random.default_rng(args.seed))
+def lee_widths_bench(*, samples, seed):
+    """``bumprtl bench lee-widths``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
+    print(f"bumprtl bench lee-widths --samples {samples} --seed {seed}")
+    px = PixelInputs.random(samples, np.random.default_rng(seed))
     reference = to_8bit(conventional(px, Config()).diffuse).astype(np.int64)
     float_lee = np.abs(to_8bit(lee_corrected(px, Config()).diffuse).astype(np.int64) - reference)
-    print(f"{args.samples} random valid inputs (seed {args.seed}); diffuse error in 8-bit LSB")
+    print(f"{samples} random valid inputs (seed {seed}); diffuse error in 8-bit LSB")
     print(f"float64 lee_corrected vs exact: mean {float_lee.mean():.3g}, max {float_lee.max()}\n")
     print("| angle_bits (k+2) | frac_bits B | lee vs exact: mean | max | exact datapath vs exact: max "
           "| lee vs float64 lee_corrected (same angles): max |")
@@ -39,13 +41,3 @@ def run(args):
         print(f"| {angle_bits} | {frac_bits} | {err.mean():.3g} | {err.max()} | "
               f"{np.abs(exact - reference).max()} | {track} |")
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("lee-widths", help="lee datapath error against width",
-                       description="Diffuse error of the bit-exact lee datapath against the exact "
-                                   "reference for a range of widths, beside the exact datapath at "
-                                   "the same widths: the lee error is in the geometry, not the bits.")
-    p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.set_defaults(func=run)

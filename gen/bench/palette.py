@@ -120,34 +120,22 @@ def images(cfg, out_dir, size):
         print(f"{tag} -> {save_png(Path(out_dir) / f'palette_{tag}.png', img)}")
 
 
-def run(args):
+def palette_bench(*, what, sizes, palettes, scenes, size, plot, images_dir):
+    """``bumprtl bench palette``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
     cfg = Config()
-    command = f"bumprtl bench palette --what {' '.join(args.what)}"
-    if "accuracy" in args.what or "images" in args.what:
-        command += f" --size {args.size}"
-    if "accuracy" in args.what:
-        command += f" --scenes {' '.join(args.scenes)}"
+    command = f"bumprtl bench palette --what {' '.join(what)}"
+    if "accuracy" in what or "images" in what:
+        command += f" --size {size}"
+    if "accuracy" in what:
+        command += f" --scenes {' '.join(scenes)}"
     print(command)                     # the command that reproduces the tables below
-    if "speed" in args.what:
+    if "speed" in what:
         print("\nPer-frame cost, numpy, best of 3 (Phong, one light):\n")
-        speed(cfg, args.sizes, args.palettes)
-    if "accuracy" in args.what:
-        print(f"\nPSNR / max difference (8-bit) against conventional, {args.size}x{args.size}:\n")
-        accuracy(cfg, args.scenes, ACC_PALETTES, args.size, args.plot)
-    if "images" in args.what:
-        images(cfg, args.images_dir, args.size)
+        speed(cfg, sizes, palettes)
+    if "accuracy" in what:
+        print(f"\nPSNR / max difference (8-bit) against conventional, {size}x{size}:\n")
+        accuracy(cfg, scenes, ACC_PALETTES, size, plot)
+    if "images" in what:
+        images(cfg, images_dir, size)
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("palette", help="palette method: per-frame cost and accuracy vs per-pixel",
-                       description="Palette method of Tarini et al.: colour table + lookup against "
-                                   "per-pixel shading (speed), PSNR vs sN (accuracy), demo renders.")
-    p.add_argument("--what", nargs="+", default=["speed", "accuracy"], choices=["speed", "accuracy", "images"])
-    p.add_argument("--sizes", nargs="+", type=int, default=list(SPEED_SIZES), help="speed: image sizes")
-    p.add_argument("--palettes", nargs="+", type=int, default=list(SPEED_PALETTES), help="speed: sN values")
-    p.add_argument("--scenes", nargs="+", default=list(ACC_SCENES), help="accuracy: scenes")
-    p.add_argument("--size", type=int, default=256, help="accuracy/images: image size (default 256)")
-    p.add_argument("--plot", type=Path, default=None, help="accuracy: write the PSNR plot here")
-    p.add_argument("--images-dir", type=Path, default=Path("build/palette"), help="images: output dir")
-    p.set_defaults(func=run)

@@ -28,7 +28,7 @@ from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 
-__all__ = ["BULK_BUILDS", "rtl_sim_rows", "markdown", "add_parser"]
+__all__ = ["BULK_BUILDS", "rtl_sim_rows", "markdown", "rtl_sim_bench"]
 
 # The bulk builds measured per simulator, in order (build options of sim/tb/bulk.py;
 # {} = the simulator's default). Verilator: the first bulk build, then one change a row
@@ -80,7 +80,7 @@ def rtl_sim_rows(scene_name, size, simulators, work, quick=False, repeat=3):
         builds = ({},) if quick else BULK_BUILDS[sim]
         for given in builds:
             opts = build_options(sim, **given)
-            label = _label(opts)
+            label = build_label(opts)
             print(f"  {sim} bulk ({label}) ...", flush=True)
             row, outs = _bulk_row(scene, stim, sim, opts, Path(work) / _dir(sim, opts),
                                   repeat if sim == "verilator" else 1)
@@ -103,7 +103,8 @@ def rtl_sim_rows(scene_name, size, simulators, work, quick=False, repeat=3):
     return rows
 
 
-def _label(opts):
+def build_label(opts):
+    """A build's options in one line: clock, io, g++ flags, extra arguments."""
     return ", ".join([f"clock {opts['clock']}", f"io {opts['io']}",
                       *([f"g++ {opts['opt_fast']}"] if opts["opt_fast"] else []),
                       *([" ".join(opts["extra"])] if opts["extra"] else [])])
@@ -171,39 +172,22 @@ def markdown(rows, command, scene, size, repeat):
     return "\n".join(lines)
 
 
-def run(args):
-    sims = args.simulators
-    if args.repeat < 1:
-        raise BumpError(f"--repeat must be >= 1, got {args.repeat}")
-    command = f"bumprtl bench rtl-sim --size {args.size} --scene {args.scene}" + \
+def rtl_sim_bench(*, simulators, docs, repeat, scene, size, work, quick):
+    """``bumprtl bench rtl-sim``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
+    sims = simulators
+    if repeat < 1:
+        raise BumpError(f"--repeat must be >= 1, got {repeat}")
+    command = f"bumprtl bench rtl-sim --size {size} --scene {scene}" + \
         (f" --simulators {' '.join(sims)}" if list(sims) != list(SIMULATORS) else "") + \
-        (" --quick" if args.quick else "") + \
-        (f" --repeat {args.repeat}" if args.repeat != 3 else "")
+        (" --quick" if quick else "") + \
+        (f" --repeat {repeat}" if repeat != 3 else "")
     print(command, flush=True)
-    rows = rtl_sim_rows(args.scene, args.size, sims, args.work, args.quick, args.repeat)
-    (Path(args.work) / "rows.json").write_text(json.dumps(rows, indent=1) + "\n")
-    text = markdown(rows, command, args.scene, args.size, args.repeat)
-    if args.docs:
-        write_section(args.docs, "rtl-sim", text)
-        print(f"wrote {args.docs}")
+    rows = rtl_sim_rows(scene, size, sims, work, quick, repeat)
+    (Path(work) / "rows.json").write_text(json.dumps(rows, indent=1) + "\n")
+    text = markdown(rows, command, scene, size, repeat)
+    if docs:
+        write_section(docs, "rtl-sim", text)
+        print(f"wrote {docs}")
     print(text)
     return 0 if all(r["same"] for r in rows) else 1
-
-
-def add_parser(sub):
-    p = sub.add_parser("rtl-sim", help="RTL simulation speed: bulk path against per-cycle cocotb",
-                       description="Renders one frame through the emitted pipeline with the bulk "
-                                   "path (several Verilator builds) and the per-cycle cocotb "
-                                   "path on Icarus and Verilator, side by side in one run: "
-                                   "pixels per second and the ratios.")
-    p.add_argument("--size", type=int, default=256, help="frame size (default: 256)")
-    p.add_argument("--scene", default="default", help="scene class (default: default)")
-    p.add_argument("--simulators", nargs="+", default=list(SIMULATORS), choices=SIMULATORS)
-    p.add_argument("--quick", action="store_true",
-                   help="only the default bulk build of each simulator "
-                        f"(Verilator: {_label(build_options('verilator'))})")
-    p.add_argument("--repeat", type=int, default=3,
-                   help="bulk runs per build, the best (least streaming CPU) reported (default: 3)")
-    p.add_argument("--work", type=Path, default=Path("build/bench/rtl_sim"))
-    p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
-    p.set_defaults(func=run)

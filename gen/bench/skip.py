@@ -16,7 +16,6 @@ section goes into docs/bench.md.
 """
 
 import time
-from pathlib import Path
 
 import numpy as np
 from amaranth.back import verilog
@@ -31,7 +30,7 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.fixed.pipeline import map_words, pipeline_fixed
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["unskipped", "skip_rows", "markdown", "add_parser"]
+__all__ = ["unskipped", "skip_rows", "markdown", "skip_bench"]
 
 
 def unskipped(scene):
@@ -145,25 +144,16 @@ def markdown(rows, command, size):
     return "\n".join(lines)
 
 
-def run(args):
-    command = f"bumprtl bench skip --size {args.size}"
+def skip_bench(*, docs, size, work, scenes):
+    """``bumprtl bench skip``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
+    command = f"bumprtl bench skip --size {size}"
     print(command)
-    rows = skip_rows(args.scenes or list(BUILTIN), args.size, args.work)
-    text = markdown(rows, command, args.size)
-    if args.docs:
-        write_section(args.docs, "skip", text)
-        print(f"wrote {args.docs}")
+    rows = skip_rows(scenes or list(BUILTIN), size, work)
+    text = markdown(rows, command, size)
+    if docs:
+        write_section(docs, "skip", text)
+        print(f"wrote {docs}")
     else:
         print(text)
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("skip", help="scene skipping: golden time and cost with skipping on and off",
-                       description="Per scene class, the generated pipeline beside the same scene "
-                                   "with nothing skipped: golden-model time and Yosys cost, one run.")
-    p.add_argument("--size", type=int, default=128, help="frame size for the golden model (default: 128)")
-    p.add_argument("--scenes", nargs="+", default=None, help="scene classes (default: all built-in)")
-    p.add_argument("--work", type=Path, default=Path("build/bench/skip"))
-    p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
-    p.set_defaults(func=run)

@@ -16,7 +16,6 @@ inputs (unquantized; sim/golden/accuracy.py). Cost: words x width and DP16KD cou
 (1024 x 18 or 2048 x 9 words a block; a 2^s + 1-th word in flip-flops), multipliers.
 """
 
-from pathlib import Path
 
 import numpy as np
 
@@ -30,7 +29,7 @@ from bumprtl.sim.golden.fixed.common import specular_fine_fixed
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels
 
-__all__ = ["CANDIDATES", "candidate_fine", "run", "add_parser"]
+__all__ = ["CANDIDATES", "candidate_fine", "specular_bench"]
 
 F = SPEC_FRAC_BITS
 
@@ -84,18 +83,20 @@ def _cost(name, cfg):
     return f"{words} x {width}", blocks, mults
 
 
-def run(args):
-    print(f"bumprtl bench specular --samples {args.samples} --spec-exponent "
-          f"{' '.join(map(str, args.spec_exponent))}")
+def specular_bench(*, spec_exponent, samples, work):
+    """``bumprtl bench specular``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
+    print(f"bumprtl bench specular --samples {samples} --spec-exponent "
+          f"{' '.join(map(str, spec_exponent))}")
     print(f"\nspecular term and 8-bit specular output against float64, 8-bit LSB, at angle bits "
           f"{Config().angle_bits}, B = {Config().frac_bits}: 'term' = max |fine / 2^F - 255 x^n| over every N'.H on the B-bit grid; "
-          f"random = {args.samples} random valid pixels (seed 11), adversarial = the search "
+          f"random = {samples} random valid pixels (seed 11), adversarial = the search "
           f"aimed at the specular term (seed 7)\n")
     print("| n | candidate | table (words x bits) | DP16KD | multipliers | term max | random max / mean "
           "| adversarial max / mean |")
     print("|---|---|---|---|---|---|---|---|")
-    px = PixelInputs.random(args.samples, np.random.default_rng(11))
-    for n in args.spec_exponent:
+    px = PixelInputs.random(samples, np.random.default_rng(11))
+    for n in spec_exponent:
         cfg = Config(spec_exponent=n)
         grid = np.arange(cfg.one + 1)
         exact = 255.0 * (grid / cfg.one) ** n
@@ -112,22 +113,10 @@ def run(args):
                   f"{errs['random'].max()} / {errs['random'].mean():.4f} | "
                   f"{errs['adversarial'].max()} / {errs['adversarial'].mean():.4f} |", flush=True)
     print("\nstep of the kept table (2^-t) per n: "
-          + ", ".join(f"n={n}: t={specular_step_bits(Config(spec_exponent=n))}" for n in args.spec_exponent))
-    counts = count_unit("illumination", Config(), args.work).summary()
+          + ", ".join(f"n={n}: t={specular_step_bits(Config(spec_exponent=n))}" for n in spec_exponent))
+    counts = count_unit("illumination", Config(), work).summary()
     print("\nIllumination at the default widths, Yosys coarse netlist (gen/flow/resources.py): "
           + ", ".join(f"{k} {counts[k]}" for k in ("multipliers", "const_multipliers", "tables",
                                                    "table_bits", "table_reads", "adders",
                                                    "register_bits")))
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("specular", help="the specular-term candidates side by side",
-                       description="cos^n by a nearest-entry table, an interpolated table, an "
-                                   "interpolated table finer near 1 and repeated squaring: error "
-                                   "against float64 and cost per exponent.")
-    p.add_argument("--samples", type=int, default=1_000_000)
-    p.add_argument("--spec-exponent", type=int, nargs="+", default=[1, 2, 16, 64, 256, 1024])
-    p.add_argument("--work", type=Path, default=Path("build/bench/specular"),
-                   help="netlist of the Illumination unit counted at the end")
-    p.set_defaults(func=run)

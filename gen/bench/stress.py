@@ -8,14 +8,13 @@ models: pixels with some value outside its payload field width (the RTL would wr
 model that raises is recorded with its exception, never hidden.
 """
 
-from pathlib import Path
 
 from bumprtl.sim.golden.float.conventional import conventional
 from bumprtl.sim.golden.float.models import FLOAT_MODELS
 from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 from bumprtl.sim.golden.stress import CASES, STRESS_CONFIGS, check_fixed, float_stats, stress_case
 
-__all__ = ["stress_rows", "markdown", "add_parser"]
+__all__ = ["stress_rows", "markdown", "stress_bench"]
 
 # Float64 results do not depend on the widths: they run at these configurations only.
 FLOAT_CONFIGS = ("default", "spec_n=1", "spec_n=1024")
@@ -118,26 +117,17 @@ def summary(rows):
     return out
 
 
-def run(args):
-    command = f"bumprtl bench stress --samples {args.samples} --seed {args.seed}"
+def stress_bench(*, samples, seed, out):
+    """``bumprtl bench stress``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
+    command = f"bumprtl bench stress --samples {samples} --seed {seed}"
     print(command)
-    rows = stress_rows(args.samples, args.seed)
-    text = markdown(rows, command, args.samples)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
+    rows = stress_rows(samples, seed)
+    text = markdown(rows, command, samples)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
     crashes = [r for r in rows if "crash" in r[3]]
-    print(f"wrote {args.out}: {len(rows)} rows, {len(crashes)} crashes, "
+    print(f"wrote {out}: {len(rows)} rows, {len(crashes)} crashes, "
           f"{sum(r[3].get('nan', 0) for r in rows)} NaN pixels, "
           f"{sum(r[3].get('overflow', 0) for r in rows)} overflow pixels")
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("stress", help="golden models on degenerate inputs and extreme configs",
-                       description="Every golden model on the stress cases of sim/golden/stress.py "
-                                   "at the narrowest/widest widths and extreme specular exponents: "
-                                   "max error, NaN and overflow counts -> docs/stability.md.")
-    p.add_argument("--samples", type=int, default=20_000, help="pixels per case (default: 20000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--out", type=Path, default=Path("docs/stability.md"))
-    p.set_defaults(func=run)

@@ -1,7 +1,10 @@
 """``bumprtl bench KIND``: benchmarks (speed is measured here, never asserted in tests).
 
-Each kind lives in its own module with ``add_parser(subparsers)``; register it in BENCHES.
+Each kind's sub-parser is added by a function here, registered in BENCHES; the benchmark
+itself is a function of gen/bench/ with the flags as keyword arguments.
 """
+
+from pathlib import Path
 
 from bumprtl.gen.bench import (
     accuracy,
@@ -15,21 +18,142 @@ from bumprtl.gen.bench import (
     stress,
     sweep,
 )
+from bumprtl.gen.bench.palette import ACC_SCENES, SPEED_PALETTES, SPEED_SIZES
+from bumprtl.gen.bench.rtl_sim import build_label
 from bumprtl.gen.flow.quiet import quiet_commands
+from bumprtl.sim.golden.methods import PER_PIXEL
+from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 
-# kind -> module of gen/bench/ providing add_parser(subparsers); each benchmark module adds
-# its own line here.
+
+def run_lee_widths(args):
+    return lee_widths.lee_widths_bench(samples=args.samples, seed=args.seed)
+
+
+def run_golden(args):
+    return golden.golden_bench(methods=args.methods, pixels=args.pixels, sim_samples=args.sim_samples)
+
+
+def run_stress(args):
+    return stress.stress_bench(samples=args.samples, seed=args.seed, out=args.out)
+
+
+def run_specular(args):
+    return specular.specular_bench(spec_exponent=args.spec_exponent, samples=args.samples, work=args.work)
+
+
+def run_skip(args):
+    return skip.skip_bench(docs=args.docs, size=args.size, work=args.work, scenes=args.scenes)
+
+
+def run_rtl_sim(args):
+    return rtl_sim.rtl_sim_bench(simulators=args.simulators, docs=args.docs, repeat=args.repeat, scene=args.scene, size=args.size, work=args.work, quick=args.quick)
+
+
+def run_palette(args):
+    return palette.palette_bench(what=args.what, sizes=args.sizes, palettes=args.palettes, scenes=args.scenes, size=args.size, plot=args.plot, images_dir=args.images_dir)
+
+
+def add_lee_widths(kinds):
+    p = kinds.add_parser("lee-widths", help="lee datapath error against width",
+                       description="Diffuse error of the bit-exact lee datapath against the exact "
+                                   "reference for a range of widths, beside the exact datapath at "
+                                   "the same widths: the lee error is in the geometry, not the bits.")
+    p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
+    p.add_argument("--seed", type=int, default=1)
+    p.set_defaults(func=run_lee_widths)
+
+
+def add_golden(kinds):
+    p = kinds.add_parser("golden", help="fixed-point golden model and cocotb simulation throughput",
+                       description="Pixels per second of the bit-exact golden model per method, "
+                                   "and of cocotb simulation under Icarus and Verilator, in one run.")
+    p.add_argument("--pixels", type=int, default=1_000_000, help="golden-model batch (default: 10^6)")
+    p.add_argument("--sim-samples", type=int, default=5000,
+                   help="random vectors per traffic pattern in the simulations (default: 5000)")
+    p.add_argument("--methods", nargs="+", default=list(PER_PIXEL), choices=PER_PIXEL)
+    p.set_defaults(func=run_golden)
+
+
+def add_stress(kinds):
+    p = kinds.add_parser("stress", help="golden models on degenerate inputs and extreme configs",
+                       description="Every golden model on the stress cases of sim/golden/stress.py "
+                                   "at the narrowest/widest widths and extreme specular exponents: "
+                                   "max error, NaN and overflow counts -> docs/stability.md.")
+    p.add_argument("--samples", type=int, default=20_000, help="pixels per case (default: 20000)")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--out", type=Path, default=Path("docs/stability.md"))
+    p.set_defaults(func=run_stress)
+
+
+def add_specular(kinds):
+    p = kinds.add_parser("specular", help="the specular-term candidates side by side",
+                       description="cos^n by a nearest-entry table, an interpolated table, an "
+                                   "interpolated table finer near 1 and repeated squaring: error "
+                                   "against float64 and cost per exponent.")
+    p.add_argument("--samples", type=int, default=1_000_000)
+    p.add_argument("--spec-exponent", type=int, nargs="+", default=[1, 2, 16, 64, 256, 1024])
+    p.add_argument("--work", type=Path, default=Path("build/bench/specular"),
+                   help="netlist of the Illumination unit counted at the end")
+    p.set_defaults(func=run_specular)
+
+
+def add_skip(kinds):
+    p = kinds.add_parser("skip", help="scene skipping: golden time and cost with skipping on and off",
+                       description="Per scene class, the generated pipeline beside the same scene "
+                                   "with nothing skipped: golden-model time and Yosys cost, one run.")
+    p.add_argument("--size", type=int, default=128, help="frame size for the golden model (default: 128)")
+    p.add_argument("--scenes", nargs="+", default=None, help="scene classes (default: all built-in)")
+    p.add_argument("--work", type=Path, default=Path("build/bench/skip"))
+    p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
+    p.set_defaults(func=run_skip)
+
+
+def add_rtl_sim(kinds):
+    p = kinds.add_parser("rtl-sim", help="RTL simulation speed: bulk path against per-cycle cocotb",
+                       description="Renders one frame through the emitted pipeline with the bulk "
+                                   "path (several Verilator builds) and the per-cycle cocotb "
+                                   "path on Icarus and Verilator, side by side in one run: "
+                                   "pixels per second and the ratios.")
+    p.add_argument("--size", type=int, default=256, help="frame size (default: 256)")
+    p.add_argument("--scene", default="default", help="scene class (default: default)")
+    p.add_argument("--simulators", nargs="+", default=list(SIMULATORS), choices=SIMULATORS)
+    p.add_argument("--quick", action="store_true",
+                   help="only the default bulk build of each simulator "
+                        f"(Verilator: {build_label(build_options('verilator'))})")
+    p.add_argument("--repeat", type=int, default=3,
+                   help="bulk runs per build, the best (least streaming CPU) reported (default: 3)")
+    p.add_argument("--work", type=Path, default=Path("build/bench/rtl_sim"))
+    p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
+    p.set_defaults(func=run_rtl_sim)
+
+
+def add_palette(kinds):
+    p = kinds.add_parser("palette", help="palette method: per-frame cost and accuracy vs per-pixel",
+                       description="Palette method of Tarini et al.: colour table + lookup against "
+                                   "per-pixel shading (speed), PSNR vs sN (accuracy), demo renders.")
+    p.add_argument("--what", nargs="+", default=["speed", "accuracy"], choices=["speed", "accuracy", "images"])
+    p.add_argument("--sizes", nargs="+", type=int, default=list(SPEED_SIZES), help="speed: image sizes")
+    p.add_argument("--palettes", nargs="+", type=int, default=list(SPEED_PALETTES), help="speed: sN values")
+    p.add_argument("--scenes", nargs="+", default=list(ACC_SCENES), help="accuracy: scenes")
+    p.add_argument("--size", type=int, default=256, help="accuracy/images: image size (default 256)")
+    p.add_argument("--plot", type=Path, default=None, help="accuracy: write the PSNR plot here")
+    p.add_argument("--images-dir", type=Path, default=Path("build/palette"), help="images: output dir")
+    p.set_defaults(func=run_palette)
+
+
+# kind -> the function adding its sub-parser (modules of gen/bench/ not moved yet: the module,
+# which has add_parser), in `--help` order.
 BENCHES = {
     "float64": float64,
-    "golden": golden,
+    "golden": add_golden,
     "accuracy": accuracy,
-    "specular": specular,
-    "lee-widths": lee_widths,
-    "palette": palette,
+    "specular": add_specular,
+    "lee-widths": add_lee_widths,
+    "palette": add_palette,
     "sweep": sweep,
-    "stress": stress,
-    "skip": skip,
-    "rtl-sim": rtl_sim,
+    "stress": add_stress,
+    "skip": add_skip,
+    "rtl-sim": add_rtl_sim,
 }
 
 
@@ -38,6 +162,6 @@ def add_parser(sub):
                        description="Benchmarks. Ratios are measured side by side in one run.")
     kinds = p.add_subparsers(dest="kind", metavar="KIND")
     kinds.required = True
-    for module in BENCHES.values():
-        module.add_parser(kinds)
+    for add in BENCHES.values():
+        (add.add_parser if hasattr(add, "add_parser") else add)(kinds)
     quiet_commands(kinds, "build/bench")      # the tools' output to build/bench/KIND.log
