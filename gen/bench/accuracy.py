@@ -14,7 +14,7 @@ A measured error (either measure) above its bound is a failure: the offending in
 printed and the command exits 1.
 """
 
-from dataclasses import fields, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -38,10 +38,28 @@ from bumprtl.sim.golden.accuracy import (
 from bumprtl.sim.golden.common import PixelInputs, to_8bit
 from bumprtl.sim.golden.fixed.common import input_angle_error, phong_sum_fixed, term_bounds_lsb
 from bumprtl.sim.golden.float.conventional import conventional
-from bumprtl.sim.golden.methods import METHODS, datapath_fixed, encode_pixels, get
+from bumprtl.sim.golden.methods import datapath_fixed, encode_pixels, get
 from bumprtl.sim.scenes import SCENES, load_scene
 
-__all__ = ["measure", "light_sums", "run", "add_parser"]
+__all__ = ["AccuracyOptions", "measure", "light_sums", "accuracy_bench"]
+
+
+@dataclass(frozen=True)
+class AccuracyOptions:
+    """What ``bumprtl bench accuracy`` measures (its flags of the same names): ``method`` at
+    every (``angle_bits``, ``frac_bits``, ``spec_exponent``) of the grid, or with
+    ``faithful_widths`` each exponent at the widths its bound proves within 1 LSB, over
+    ``samples`` random pixels; the light-sum, blend and scene tables at ``scene_widths``
+    (angle bits, frac bits; None: Config's) and the scenes at ``scene_size`` (0: none)."""
+    method: str = "exact"
+    samples: int = 1_000_000
+    angle_bits: tuple = (12, 13, 14, 15)
+    frac_bits: tuple = (13, 15, 16)
+    spec_exponent: tuple = (16,)
+    spec_index_bits: int = 10
+    faithful_widths: bool = False
+    scene_size: int = 128
+    scene_widths: tuple | None = None
 
 
 def _stats(err):
@@ -100,27 +118,27 @@ def _grid_cell(row):
     return "—" if g is None else " / ".join(str(g[k]["max"]) for k in KINDS)
 
 
-def _width_points(args):
+def _width_points(opts):
     """The Configs to measure: every valid (angle bits, frac bits, n) of the grid, or with
     ``--faithful-widths`` each n at the widths the method's bound proves within 1 LSB (the
     sidecar's ``faithful_widths``; a line saying so for an n that has none)."""
-    base = Config(method=args.method, spec_index_bits=args.spec_index_bits)
-    if args.faithful_widths:
-        rule = get(args.method).faithful_widths
+    base = Config(method=opts.method, spec_index_bits=opts.spec_index_bits)
+    if opts.faithful_widths:
+        rule = get(opts.method).faithful_widths
         if rule is None:
-            raise BumpError(f"--faithful-widths: method {args.method} has no faithful widths "
+            raise BumpError(f"--faithful-widths: method {opts.method} has no faithful widths "
                             f"(only exact searches them)")
         points = []
-        for n in args.spec_exponent:
+        for n in opts.spec_exponent:
             widths = rule(base.replace(spec_exponent=n))
             points.append(f"n = {n}: no widths in the Config's range prove every channel within "
                           f"1 LSB" if widths is None else
                           base.replace(angle_bits=widths[0], frac_bits=widths[1], spec_exponent=n))
         return points
     points = []
-    for a in args.angle_bits:
-        for b in args.frac_bits:
-            for n in args.spec_exponent:
+    for a in opts.angle_bits:
+        for b in opts.frac_bits:
+            for n in opts.spec_exponent:
                 try:
                     points.append(base.replace(angle_bits=a, frac_bits=b, spec_exponent=n))
                 except ConfigError:
@@ -128,21 +146,23 @@ def _width_points(args):
     return points
 
 
-def run(args):
-    for n in args.spec_exponent:                 # a bad exponent is an error, not a skipped row
-        Config(spec_exponent=n, spec_index_bits=args.spec_index_bits)
-    _scene_config(args)                          # bad --scene-widths: one line, exit 2
-    size = args.scene_size
+def accuracy_bench(opts: AccuracyOptions):
+    """``bumprtl bench accuracy``: prints the tables; returns 1 when an error exceeds its
+    bound (the offending inputs printed), else 0."""
+    for n in opts.spec_exponent:                 # a bad exponent is an error, not a skipped row
+        Config(spec_exponent=n, spec_index_bits=opts.spec_index_bits)
+    _scene_config(opts)                          # bad --scene-widths: one line, exit 2
+    size = opts.scene_size
     if size and not (16 <= size <= 4096 and size & (size - 1) == 0):
         raise BumpError(f"scene_size must be 0 or a power of two in [16, 4096], got {size}")
-    points = _width_points(args)
-    widths = ("--faithful-widths" if args.faithful_widths else
-              f"--angle-bits {' '.join(map(str, args.angle_bits))} --frac-bits {' '.join(map(str, args.frac_bits))}")
-    print(f"bumprtl bench accuracy --method {args.method} --samples {args.samples} {widths} "
-          f"--spec-exponent {' '.join(map(str, args.spec_exponent))} --spec-index-bits {args.spec_index_bits} "
-          f"--scene-size {args.scene_size}"
-          + (f" --scene-widths {' '.join(map(str, args.scene_widths))}" if args.scene_widths else ""))
-    print(f"\nerror in 8-bit LSB per output channel, on {args.samples} random valid pixels (seed "
+    points = _width_points(opts)
+    widths = ("--faithful-widths" if opts.faithful_widths else
+              f"--angle-bits {' '.join(map(str, opts.angle_bits))} --frac-bits {' '.join(map(str, opts.frac_bits))}")
+    print(f"bumprtl bench accuracy --method {opts.method} --samples {opts.samples} {widths} "
+          f"--spec-exponent {' '.join(map(str, opts.spec_exponent))} --spec-index-bits {opts.spec_index_bits} "
+          f"--scene-size {opts.scene_size}"
+          + (f" --scene-widths {' '.join(map(str, opts.scene_widths))}" if opts.scene_widths else ""))
+    print(f"\nerror in 8-bit LSB per output channel, on {opts.samples} random valid pixels (seed "
           f"11), the adversarial search aimed at the channel (seed 7) and the search aimed at "
           f"the dot product's arithmetic error (on-grid N', H near N', seed 5), and the worst-"
           f"case search aimed at the proof's bound (every angle just under half a grid step off on "
@@ -156,7 +176,7 @@ def run(args):
           "| end-to-end adversarial max / mean | end-to-end search max | end-to-end worst-case max "
           "| arithmetic max (random / adversarial / search / worst-case) | bound | worst / bound |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
-    px = PixelInputs.random(args.samples, np.random.default_rng(11))
+    px = PixelInputs.random(opts.samples, np.random.default_rng(11))
     failures, summary = [], []
     for cfg in points:
         if isinstance(cfg, str):                 # an exponent without faithful widths
@@ -180,9 +200,9 @@ def run(args):
                              if row["grid"][k]["max"] > row["bound"]]
         summary.append(_summary(cfg, result))
     print("\n" + "\n".join(summary))
-    failures += _lights(args, px)
-    if args.scene_size:
-        _scenes(args)
+    failures += _lights(opts, px)
+    if opts.scene_size:
+        _scenes(opts)
     for line in failures:
         print(line)
     return 1 if failures else 0
@@ -270,11 +290,11 @@ def light_sums(cfg: Config, px: PixelInputs, lights=(1, 2)):
     return out
 
 
-def _lights(args, px):
+def _lights(opts, px):
     """The light-sum and blend table: one and two lights at the default widths of
-    ``args.method`` (or ``--scene-widths``), and two lights at the two-light scenes' widths
+    ``opts.method`` (or ``--scene-widths``), and two lights at the two-light scenes' widths
     (rtl/config.TWO_LIGHT_WIDTHS); returns the failure lines."""
-    cfg = _scene_config(args)
+    cfg = _scene_config(opts)
     two = cfg.replace(angle_bits=TWO_LIGHT_WIDTHS[0], frac_bits=TWO_LIGHT_WIDTHS[1])
     print(f"\nthe outputs summed over m lights (LightSum) and the texture blend (TextureBlend, "
           f"random texels), rounded once, n = {cfg.spec_exponent}: random = the {len(px)} pixels "
@@ -325,54 +345,29 @@ def _light_row(cfg, m, output, row):
     return failures
 
 
-def _scene_config(args):
+def _scene_config(opts):
     """The Config of the light-sum, blend and scene tables: ``--scene-widths`` (angle bits,
     frac bits) when given, else Config's default widths."""
-    widths = dict(zip(("angle_bits", "frac_bits"), args.scene_widths or (), strict=False))
-    return Config(method=args.method, spec_index_bits=args.spec_index_bits, **widths)
+    widths = dict(zip(("angle_bits", "frac_bits"), opts.scene_widths or (), strict=False))
+    return Config(method=opts.method, spec_index_bits=opts.spec_index_bits, **widths)
 
 
-def _scenes(args):
+def _scenes(opts):
     """Every built-in scene and the unseen crater map (sim/golden/accuracy.crater_scene)
-    shaded at the default widths of ``args.method``: eq. 2's colour image and, where the
+    shaded at the default widths of ``opts.method``: eq. 2's colour image and, where the
     scene has a colour texture, the texture blend on its 8-bit albedo
     (sim/golden/accuracy.scene_error), over the pixels the geometry covers."""
-    cfg = _scene_config(args)
-    print(f"\nscenes at {args.scene_size}x{args.scene_size} (angle bits {cfg.angle_bits}, frac bits "
+    cfg = _scene_config(opts)
+    print(f"\nscenes at {opts.scene_size}x{opts.scene_size} (angle bits {cfg.angle_bits}, frac bits "
           f"{cfg.frac_bits}, n = {cfg.spec_exponent}): PSNR (dB) / max LSB against float64 "
           f"`conventional` on the unquantized inputs\n")
     print("| scene | colour (eq. 2) | texture blend |")
     print("|---|---|---|")
     for name in (*SCENES, "craters"):
-        scene = (crater_scene(size=args.scene_size) if name == "craters" else
-                 load_scene(name, size=args.scene_size))
+        scene = (crater_scene(size=opts.scene_size) if name == "craters" else
+                 load_scene(name, size=opts.scene_size))
         rows = [scene_error(scene, cfg, datapath_fixed)]
         if scene.albedo is not None:
             rows.append(scene_error(scene, cfg, datapath_fixed, blend=True))
         cells = [f"{r['psnr_db']} / {r['max_lsb']}" for r in rows] + ["—"] * (2 - len(rows))
         print(f"| {name} | {' | '.join(cells)} |", flush=True)
-
-
-def add_parser(sub):
-    p = sub.add_parser("accuracy", help="fixed-point error against float64 per channel, over widths",
-                       description="Max and mean error (8-bit LSB) of the diffuse, specular and "
-                                   "colour outputs of the bit-exact golden model against float64 "
-                                   "on random inputs and on adversarial searches aimed at each, "
-                                   "beside the proven bound of each. Exits 1, printing the "
-                                   "offending input, if an error exceeds its bound.")
-    p.add_argument("--method", default="exact", choices=tuple(METHODS))
-    p.add_argument("--samples", type=int, default=1_000_000)
-    p.add_argument("--angle-bits", type=int, nargs="+", default=[12, 13, 14, 15])
-    p.add_argument("--frac-bits", type=int, nargs="+", default=[13, 15, 16])
-    p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
-                   help="Phong exponents n (default: 16)")
-    p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
-    p.add_argument("--faithful-widths", action="store_true",
-                   help="measure each --spec-exponent at the narrowest widths the bound proves "
-                        "within 1 LSB on every channel (the sidecar's faithful_widths) instead of "
-                        "the --angle-bits x --frac-bits grid")
-    p.add_argument("--scene-size", type=int, default=128,
-                   help="also shade every built-in scene at this size, default widths (0: no scenes)")
-    p.add_argument("--scene-widths", type=int, nargs=2, metavar=("ANGLE_BITS", "FRAC_BITS"),
-                   help="widths of the light-sum, blend and scene tables (default: Config's)")
-    p.set_defaults(func=run)

@@ -33,46 +33,37 @@ def _model_table(px, cfg):
         print(f"| {name} | {lcols} | {_cols(s['diffuse_lsb'])} | {s['diffuse_lsb']['nan']} | {rate:.2f} |")
 
 
-def _theta_n_table(args, cfg):
+def _theta_n_table(samples, seed, cfg):
     print("\nlee_corrected by theta_N (the rigid circle of Lee Sec. 3.1.2 is exact at theta_N = 0)\n")
     print("| theta_N (deg) | pixels | L' err mean (deg) | p99 | max | diffuse err mean (LSB) | p99 | max |")
     print("|---|---|---|---|---|---|---|---|")
-    for lo, hi, count, s in error_by_theta_n("lee_corrected", args.samples, args.seed, 15, cfg):
+    for lo, hi, count, s in error_by_theta_n("lee_corrected", samples, seed, 15, cfg):
         print(f"| {lo}-{hi} | {count} | {_cols(s['l_prime_deg'])} | {_cols(s['diffuse_lsb'])} |")
 
 
-def _approximations(args, cfg):
-    at = {deg: error_at_theta_n("lee_corrected", np.radians(deg), args.samples, args.seed, cfg)
+def _approximations(samples, seed, cfg):
+    at = {deg: error_at_theta_n("lee_corrected", np.radians(deg), samples, seed, cfg)
           for deg in (0, 90, 180)}
     print(f"\nlinear proportion (eqs 10-13) alone, closed-form worst case: "
           f"{proportion_worst_case_deg():.3g} deg")
     print("lee_corrected max L' error (deg) / max diffuse error (LSB) with theta_N fixed at "
           + ", ".join(f"{deg} deg: {s['l_prime_deg']['max']:.3g} / {s['diffuse_lsb']['max']:.3g}"
                       for deg, s in at.items()))
-    w = worst_pixel("lee_corrected", args.samples, args.seed, cfg)
+    w = worst_pixel("lee_corrected", samples, seed, cfg)
     pair = lambda key: f"({w[key][0]:.1f}, {w[key][1]:.1f})"
     print(f"lee_corrected worst L' pixel (phi, theta in deg): N {pair('N')}, L {pair('L')}, D = {w['D']:.1f}; "
           f"L' {pair('l_prime_ref')}, lee_corrected gives {pair('l_prime')}: {w['l_prime_deg']:.3g} deg, "
           f"{w['diffuse_lsb']:.3g} LSB")
 
 
-def run(args):
+def float64_bench(*, samples, seed):
+    """``bumprtl bench float64``: the arguments are its flags' (gen/cli/bench.py);
+    returns the exit status."""
     cfg = Config()
-    px = random_pixels(args.samples, args.seed)
-    print(f"bumprtl bench float64 --samples {args.samples} --seed {args.seed}")
-    print(f"{args.samples} random valid inputs (seed {args.seed}); errors against 'conventional'\n")
+    px = random_pixels(samples, seed)
+    print(f"bumprtl bench float64 --samples {samples} --seed {seed}")
+    print(f"{samples} random valid inputs (seed {seed}); errors against 'conventional'\n")
     _model_table(px, cfg)
-    _theta_n_table(args, cfg)
-    _approximations(args, cfg)
+    _theta_n_table(samples, seed, cfg)
+    _approximations(samples, seed, cfg)
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("float64", help="error and speed of the float64 golden models",
-                       description="Mean, p99 and max of the L' angle error (degrees) and of the "
-                                   "diffuse error (8-bit LSB) of every float64 model against the "
-                                   "Cartesian reference, and each model's speed, in one run; "
-                                   "then lee_corrected's errors binned by theta_N.")
-    p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.set_defaults(func=run)

@@ -20,9 +20,22 @@ from bumprtl.gen.bench import (
 )
 from bumprtl.gen.bench.palette import ACC_SCENES, SPEED_PALETTES, SPEED_SIZES
 from bumprtl.gen.bench.rtl_sim import build_label
-from bumprtl.gen.flow.quiet import quiet_commands
-from bumprtl.sim.golden.methods import PER_PIXEL
+from bumprtl.gen.cli.quiet import quiet_commands
+from bumprtl.sim.golden.methods import METHODS, PER_PIXEL
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
+
+
+def run_float64(args):
+    return float64.float64_bench(samples=args.samples, seed=args.seed)
+
+
+def run_accuracy(args):
+    return accuracy.accuracy_bench(accuracy.AccuracyOptions(
+        method=args.method, samples=args.samples, angle_bits=tuple(args.angle_bits),
+        frac_bits=tuple(args.frac_bits), spec_exponent=tuple(args.spec_exponent),
+        spec_index_bits=args.spec_index_bits, faithful_widths=args.faithful_widths,
+        scene_size=args.scene_size,
+        scene_widths=None if args.scene_widths is None else tuple(args.scene_widths)))
 
 
 def run_lee_widths(args):
@@ -61,6 +74,42 @@ def add_lee_widths(kinds):
     p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
     p.add_argument("--seed", type=int, default=1)
     p.set_defaults(func=run_lee_widths)
+
+
+def add_float64(kinds):
+    p = kinds.add_parser("float64", help="error and speed of the float64 golden models",
+                       description="Mean, p99 and max of the L' angle error (degrees) and of the "
+                                   "diffuse error (8-bit LSB) of every float64 model against the "
+                                   "Cartesian reference, and each model's speed, in one run; "
+                                   "then lee_corrected's errors binned by theta_N.")
+    p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
+    p.add_argument("--seed", type=int, default=1)
+    p.set_defaults(func=run_float64)
+
+
+def add_accuracy(kinds):
+    p = kinds.add_parser("accuracy", help="fixed-point error against float64 per channel, over widths",
+                       description="Max and mean error (8-bit LSB) of the diffuse, specular and "
+                                   "colour outputs of the bit-exact golden model against float64 "
+                                   "on random inputs and on adversarial searches aimed at each, "
+                                   "beside the proven bound of each. Exits 1, printing the "
+                                   "offending input, if an error exceeds its bound.")
+    p.add_argument("--method", default="exact", choices=tuple(METHODS))
+    p.add_argument("--samples", type=int, default=1_000_000)
+    p.add_argument("--angle-bits", type=int, nargs="+", default=[12, 13, 14, 15])
+    p.add_argument("--frac-bits", type=int, nargs="+", default=[13, 15, 16])
+    p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
+                   help="Phong exponents n (default: 16)")
+    p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
+    p.add_argument("--faithful-widths", action="store_true",
+                   help="measure each --spec-exponent at the narrowest widths the bound proves "
+                        "within 1 LSB on every channel (the sidecar's faithful_widths) instead of "
+                        "the --angle-bits x --frac-bits grid")
+    p.add_argument("--scene-size", type=int, default=128,
+                   help="also shade every built-in scene at this size, default widths (0: no scenes)")
+    p.add_argument("--scene-widths", type=int, nargs=2, metavar=("ANGLE_BITS", "FRAC_BITS"),
+                   help="widths of the light-sum, blend and scene tables (default: Config's)")
+    p.set_defaults(func=run_accuracy)
 
 
 def add_golden(kinds):
@@ -144,9 +193,9 @@ def add_palette(kinds):
 # kind -> the function adding its sub-parser (modules of gen/bench/ not moved yet: the module,
 # which has add_parser), in `--help` order.
 BENCHES = {
-    "float64": float64,
+    "float64": add_float64,
     "golden": add_golden,
-    "accuracy": accuracy,
+    "accuracy": add_accuracy,
     "specular": add_specular,
     "lee-widths": add_lee_widths,
     "palette": add_palette,

@@ -9,7 +9,7 @@ import os
 from pathlib import Path
 
 from bumprtl.gen.cli.flags import add_config_flags, config_from_args
-from bumprtl.gen.flow.quiet import quiet_commands
+from bumprtl.gen.cli.quiet import quiet_commands
 from bumprtl.gen.report.fpga import FpgaRun, fpga_run
 from bumprtl.gen.report.integration import DOC, NAME, integration_report
 from bumprtl.gen.report.table1 import check_samples, table1_report

@@ -7,7 +7,6 @@ progress line and the result. The log is shown in full when the work fails, and
 as child processes (and cocotb's runner, and Python's own prints) all land in the log.
 """
 
-import functools
 import os
 import sys
 import threading
@@ -15,7 +14,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["tool_log", "quiet_commands"]
+__all__ = ["tool_log"]
 
 
 def _ticker(term, label, stop):
@@ -100,26 +99,3 @@ def tool_log(path, label, verbose=False, python=False):
                 sys.stderr.write(f"--- {path} ---\n{path.read_text(errors='replace')}--- end of "
                                  f"{path} ---\n")
                 sys.stderr.flush()
-
-
-def quiet_commands(kinds, log_dir):
-    """Give every subcommand parser of ``kinds`` (an argparse subparsers action) a
-    ``--verbose`` flag and run its ``func`` inside :func:`tool_log` (``python=True``): the
-    child processes' output goes to ``log_dir/KIND.log``, the command's own tables and
-    progress bars stay on the terminal."""
-    for kind, parser in kinds.choices.items():
-        parser.add_argument("--verbose", action="store_true",
-                            help="let the tools' output through (by default it goes to "
-                                 f"{log_dir}/{kind}.log, shown in full on a failure)")
-        parser.set_defaults(func=_quiet(parser.get_default("func"), Path(log_dir) / f"{kind}.log",
-                                        f"{Path(log_dir).name} {kind}"))
-
-
-def _quiet(func, log, label):
-    @functools.wraps(func)
-    def run(args):
-        if args.verbose:
-            return func(args)
-        with tool_log(log, label, python=True):
-            return func(args)
-    return run

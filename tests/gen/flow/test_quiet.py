@@ -77,7 +77,7 @@ def test_python_mode_keeps_the_table_on_the_terminal(tmp_path):
 
 _CMD = """
 import argparse, subprocess, sys
-from bumprtl.gen.flow.quiet import quiet_commands
+from bumprtl.gen.cli.quiet import quiet_commands
 p = argparse.ArgumentParser()
 kinds = p.add_subparsers(dest="kind")
 k = kinds.add_parser("work")
