@@ -26,7 +26,6 @@ Output: ``build/bench/sweep.json`` (``--out``), Pareto plots and a markdown tabl
 
 import hashlib
 import json
-import os
 import sys
 import time
 from dataclasses import dataclass, replace
@@ -49,7 +48,6 @@ from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.gen.tools.docs import write_section
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
-from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.tools.yosys import SynthesisError
 from bumprtl.rtl.config import BumpError, Config, ConfigError
 from bumprtl.rtl.pipe import ECP5
@@ -66,7 +64,7 @@ from bumprtl.sim.golden.methods import BASELINES, PER_PIXEL, datapath_fixed, enc
 from bumprtl.sim.scenes import SCENES, load_scene
 from bumprtl.sim.scenes.imaging import max_diff, psnr
 
-__all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "markdown", "plot",
+__all__ = ["GRIDS", "Grid", "pareto_front", "error_lsb", "cost_key", "sweep", "SweepOptions", "sweep_bench", "markdown", "plot",
            "parse_maps", "map_key", "MAP_SIZES"]
 
 
@@ -614,15 +612,16 @@ def plot(data, path):
     return path
 
 
-def command_line(args):
-    parts = ["bumprtl bench sweep"] + (["--quick"] if args.quick else [])
-    if set(args.methods) != set(METHOD_CHOICES):
-        parts += ["--methods", *args.methods]
-    if getattr(args, "maps", None):
-        parts += ["--maps", *args.maps]
-    if args.fpga:
-        parts += ["--fpga", "--device", args.device, "--fpga-points", args.fpga_points]
-    if args.sim:
+def command_line(opts):
+    """The ``bumprtl bench sweep`` command line that makes ``opts``' sweep."""
+    parts = ["bumprtl bench sweep"] + (["--quick"] if opts.quick else [])
+    if set(opts.methods) != set(METHOD_CHOICES):
+        parts += ["--methods", *opts.methods]
+    if opts.maps:
+        parts += ["--maps", *opts.maps]
+    if opts.fpga:
+        parts += ["--fpga", "--device", opts.device, "--fpga-points", opts.fpga_points]
+    if opts.sim:
         parts.append("--sim")
     return " ".join(parts)
 
@@ -630,63 +629,54 @@ def command_line(args):
 METHOD_CHOICES = (*PER_PIXEL, "palette", "baselines")
 
 
-def run(args):
-    if args.fpga:
-        check_device(args.device)
-        scheduler_address(args.scheduler)        # a malformed address: one line, exit 2
-    grid = GRIDS["quick" if args.quick else "default"]
-    if args.maps:
-        grid = replace(grid, maps=parse_maps(args.maps))
-    command = command_line(args)
+@dataclass(frozen=True)
+class SweepOptions:
+    """What ``bumprtl bench sweep`` measures and writes (its flags of the same names): the
+    ``quick`` grid or the default one, the ``methods`` (METHOD_CHOICES), the scene ``maps``
+    ("NAME:SIZE"; None: the grid's), ECP5 placements (``fpga`` on ``device``, the
+    ``fpga_points``, ``jobs`` local workers or a ``scheduler``), cocotb speed (``sim``);
+    the JSON to ``out``, the cache under ``work``, the section of the page ``docs`` (and
+    the JSON copied to ``data_copy``)."""
+    quick: bool = False
+    methods: tuple = METHOD_CHOICES
+    maps: tuple | None = None
+    fpga: bool = False
+    device: str = "LFE5U-85F"
+    fpga_points: str = "default"
+    sim: bool = False
+    jobs: int = 1
+    scheduler: str | None = None
+    out: Path = Path("build/bench/sweep.json")
+    work: Path = Path("build/bench/sweep")
+    docs: Path | None = None
+    data_copy: Path | None = None
+    no_progress: bool = False
+
+
+def sweep_bench(opts: SweepOptions):
+    """``bumprtl bench sweep``: writes the JSON and the table (or the page's section);
+    returns 0."""
+    if opts.fpga:
+        check_device(opts.device)
+        scheduler_address(opts.scheduler)        # a malformed address: one line, exit 2
+    grid = GRIDS["quick" if opts.quick else "default"]
+    if opts.maps:
+        grid = replace(grid, maps=parse_maps(opts.maps))
+    command = command_line(opts)
     print(command)
-    data = sweep(grid, args, args.work, progress=not args.no_progress)
+    data = sweep(grid, opts, opts.work, progress=not opts.no_progress)
     data["command"] = command
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(data, indent=1))
-    print(f"wrote {args.out}")
-    if args.docs:
-        img = args.docs.parent / "img"
+    opts.out.parent.mkdir(parents=True, exist_ok=True)
+    opts.out.write_text(json.dumps(data, indent=1))
+    print(f"wrote {opts.out}")
+    if opts.docs:
+        img = opts.docs.parent / "img"
         plots = [("error against cost and run time", plot(data, img / "bench_pareto.png"))]
-        write_section(args.docs, "sweep", "## Error, cost and speed sweep\n\n" + markdown(data, command, plots))
-        if args.data_copy:
-            args.data_copy.parent.mkdir(parents=True, exist_ok=True)
-            args.data_copy.write_text(json.dumps(data, indent=1))
-        print(f"wrote {args.docs}")
+        write_section(opts.docs, "sweep", "## Error, cost and speed sweep\n\n" + markdown(data, command, plots))
+        if opts.data_copy:
+            opts.data_copy.parent.mkdir(parents=True, exist_ok=True)
+            opts.data_copy.write_text(json.dumps(data, indent=1))
+        print(f"wrote {opts.docs}")
     else:
         print(markdown(data, command))
     return 0
-
-
-def add_parser(sub):
-    p = sub.add_parser("sweep", help="error against cost against run time over widths and methods",
-                       description="For exact/lee over angle and value widths, the palette over "
-                                   "palette sizes, and the baselines: error vs float64, Yosys cost "
-                                   "(optionally ECP5), golden/simulation/hardware speed. JSON, "
-                                   "Pareto plot, markdown table.")
-    p.add_argument("--quick", action="store_true", help="small grid (angle 10,12 x frac 11,13; sN 16,256)")
-    p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
-    p.add_argument("--maps", nargs="+", default=None, metavar="NAME:SIZE",
-                   help="the maps the scene errors are measured on, each a scene of `bumprtl render "
-                        f"--help` at SIZE x SIZE texels (a power of two in [{MAP_SIZES[0]}, "
-                        f"{MAP_SIZES[1]}]), one pixel per texel (default: "
-                        f"{' '.join(f'{n}:{z}' for n, z in DEFAULT_MAPS)}; --quick: bricks:64)")
-    p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
-    p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
-    p.add_argument("--fpga-points", default="default", choices=FPGA_POINTS,
-                   help="with --fpga: which width points to place: the default widths of every "
-                        "method (default), the i-th angle width with the i-th value width "
-                        "(diagonal; baselines at the default widths), or all; palette sizes always")
-    p.add_argument("--sim", action="store_true",
-                   help="cocotb/Verilator pixels/s for the points at the default widths")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                   help="with --fpga: local worker processes, one placement each at a time "
-                        "(default: the number of cores; ignored with --scheduler)")
-    add_job_arguments(p)
-    p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
-    p.add_argument("--work", type=Path, default=Path("build/bench/sweep"),
-                   help="netlists and cached cost per config")
-    p.add_argument("--docs", type=Path, default=None, help="write the sweep section of this markdown file "
-                                                           "(docs/bench.md) and docs/img/bench_pareto.png")
-    p.add_argument("--data-copy", type=Path, default=None, help="also copy the JSON here (docs/data/)")
-    p.add_argument("--no-progress", action="store_true")
-    p.set_defaults(func=run)

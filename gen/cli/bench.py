@@ -4,6 +4,7 @@ Each kind's sub-parser is added by a function here, registered in BENCHES; the b
 itself is a function of gen/bench/ with the flags as keyword arguments.
 """
 
+import os
 from pathlib import Path
 
 from bumprtl.gen.bench import (
@@ -20,7 +21,9 @@ from bumprtl.gen.bench import (
 )
 from bumprtl.gen.bench.palette import ACC_SCENES, SPEED_PALETTES, SPEED_SIZES
 from bumprtl.gen.bench.rtl_sim import build_label
+from bumprtl.gen.bench.sweep import DEFAULT_MAPS, FPGA_POINTS, MAP_SIZES, METHOD_CHOICES
 from bumprtl.gen.cli.quiet import quiet_commands
+from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.golden.methods import METHODS, PER_PIXEL
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 
@@ -36,6 +39,15 @@ def run_accuracy(args):
         spec_index_bits=args.spec_index_bits, faithful_widths=args.faithful_widths,
         scene_size=args.scene_size,
         scene_widths=None if args.scene_widths is None else tuple(args.scene_widths)))
+
+
+def run_sweep(args):
+    return sweep.sweep_bench(sweep.SweepOptions(
+        quick=args.quick, methods=tuple(args.methods),
+        maps=None if args.maps is None else tuple(args.maps), fpga=args.fpga,
+        device=args.device, fpga_points=args.fpga_points, sim=args.sim, jobs=args.jobs,
+        scheduler=args.scheduler, out=args.out, work=args.work, docs=args.docs,
+        data_copy=args.data_copy, no_progress=args.no_progress))
 
 
 def run_lee_widths(args):
@@ -110,6 +122,41 @@ def add_accuracy(kinds):
     p.add_argument("--scene-widths", type=int, nargs=2, metavar=("ANGLE_BITS", "FRAC_BITS"),
                    help="widths of the light-sum, blend and scene tables (default: Config's)")
     p.set_defaults(func=run_accuracy)
+
+
+def add_sweep(kinds):
+    p = kinds.add_parser("sweep", help="error against cost against run time over widths and methods",
+                       description="For exact/lee over angle and value widths, the palette over "
+                                   "palette sizes, and the baselines: error vs float64, Yosys cost "
+                                   "(optionally ECP5), golden/simulation/hardware speed. JSON, "
+                                   "Pareto plot, markdown table.")
+    p.add_argument("--quick", action="store_true", help="small grid (angle 10,12 x frac 11,13; sN 16,256)")
+    p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
+    p.add_argument("--maps", nargs="+", default=None, metavar="NAME:SIZE",
+                   help="the maps the scene errors are measured on, each a scene of `bumprtl render "
+                        f"--help` at SIZE x SIZE texels (a power of two in [{MAP_SIZES[0]}, "
+                        f"{MAP_SIZES[1]}]), one pixel per texel (default: "
+                        f"{' '.join(f'{n}:{z}' for n, z in DEFAULT_MAPS)}; --quick: bricks:64)")
+    p.add_argument("--fpga", action="store_true", help="also place each point on an ECP5 (slow)")
+    p.add_argument("--device", default="LFE5U-85F", help="ECP5 device for --fpga")
+    p.add_argument("--fpga-points", default="default", choices=FPGA_POINTS,
+                   help="with --fpga: which width points to place: the default widths of every "
+                        "method (default), the i-th angle width with the i-th value width "
+                        "(diagonal; baselines at the default widths), or all; palette sizes always")
+    p.add_argument("--sim", action="store_true",
+                   help="cocotb/Verilator pixels/s for the points at the default widths")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="with --fpga: local worker processes, one placement each at a time "
+                        "(default: the number of cores; ignored with --scheduler)")
+    add_job_arguments(p)
+    p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
+    p.add_argument("--work", type=Path, default=Path("build/bench/sweep"),
+                   help="netlists and cached cost per config")
+    p.add_argument("--docs", type=Path, default=None, help="write the sweep section of this markdown file "
+                                                           "(docs/bench.md) and docs/img/bench_pareto.png")
+    p.add_argument("--data-copy", type=Path, default=None, help="also copy the JSON here (docs/data/)")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=run_sweep)
 
 
 def add_golden(kinds):
@@ -190,8 +237,7 @@ def add_palette(kinds):
     p.set_defaults(func=run_palette)
 
 
-# kind -> the function adding its sub-parser (modules of gen/bench/ not moved yet: the module,
-# which has add_parser), in `--help` order.
+# kind -> the function adding its sub-parser, in `--help` order.
 BENCHES = {
     "float64": add_float64,
     "golden": add_golden,
@@ -199,7 +245,7 @@ BENCHES = {
     "specular": add_specular,
     "lee-widths": add_lee_widths,
     "palette": add_palette,
-    "sweep": sweep,
+    "sweep": add_sweep,
     "stress": add_stress,
     "skip": add_skip,
     "rtl-sim": add_rtl_sim,
@@ -212,5 +258,5 @@ def add_parser(sub):
     kinds = p.add_subparsers(dest="kind", metavar="KIND")
     kinds.required = True
     for add in BENCHES.values():
-        (add.add_parser if hasattr(add, "add_parser") else add)(kinds)
+        add(kinds)
     quiet_commands(kinds, "build/bench")      # the tools' output to build/bench/KIND.log
