@@ -228,46 +228,52 @@ def add_arguments(p):
                    help="write the table into this Markdown file (docs/formal.md)")
 
 
-def execute(args):
-    unknown = [u for u in args.units if u not in TARGETS]
+def execute(*, units=(), props=None, mutants=True, quick=False, jobs=1, job_timeout=None,
+            scheduler=None, out=Path("build/formal"), merge=False, from_results=False, doc=None):
+    """Check ``units`` (default: every target; with ``quick`` not the slow ones), their
+    ``props`` (default: all) and, with ``mutants``, the broken units; rows kept in
+    ``out``/results.json (``merge``: the rows not re-checked kept; ``from_results``: nothing
+    run). Prints the table, writes it into ``doc`` when given; returns 0, 1 on a failed
+    check, 2 on a bad target or scheduler address (one line on stderr)."""
+    unknown = [u for u in units if u not in TARGETS]
     if unknown:
         print(f"error: unknown formal target {unknown[0]!r}: allowed {', '.join(TARGETS)}",
               file=sys.stderr)
         return 2
     try:
-        scheduler = scheduler_address(args.scheduler)
+        address = scheduler_address(scheduler)
     except SchedulerError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    names = args.units or [n for n, t in TARGETS.items() if not (args.quick and t.slow)]
+    names = units or [n for n, t in TARGETS.items() if not (quick and t.slow)]
     t0 = time.perf_counter()
-    results = args.out / "results.json"
+    results = out / "results.json"
     base = [Row(**r) for r in json.loads(results.read_text())] \
-        if (args.merge or args.from_results) and results.exists() else []
+        if (merge or from_results) and results.exists() else []
 
     def merged(rows):
         new = {(r.unit, r.prop): r for r in rows}
         return _ordered([new.pop((r.unit, r.prop), r) for r in base] + list(new.values()))
 
     def save(rows):
-        args.out.mkdir(parents=True, exist_ok=True)
+        out.mkdir(parents=True, exist_ok=True)
         results.write_text(json.dumps([asdict(r) for r in merged(rows)], indent=1) + "\n")
 
-    if args.from_results:
+    if from_results:
         rows = base
     else:
         try:
-            rows = merged(run(names, args.props, args.mutants, args.out, args.jobs, save=save,
-                              scheduler=scheduler, timeout=args.job_timeout))
+            rows = merged(run(names, props, mutants, out, jobs, save=save,
+                              scheduler=address, timeout=job_timeout))
         except SchedulerError as e:             # unreachable: one line, exit 2
             print(f"error: {e}", file=sys.stderr)
             return 2
     print()
     print(table(rows))
     print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")
-    if args.doc is not None:
-        write_doc(args.doc, rows, " ".join(sys.argv[1:]))
-        print(f"wrote {args.doc}")
+    if doc is not None:
+        write_doc(doc, rows, " ".join(sys.argv[1:]))
+        print(f"wrote {doc}")
     return 1 if report_failures(rows) else 0
 
 
@@ -275,7 +281,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m bumprtl.gen.formal.run", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(p)
-    return execute(p.parse_args(argv))
+    return execute(**vars(p.parse_args(argv)))
 
 
 if __name__ == "__main__":
