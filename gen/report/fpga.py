@@ -87,7 +87,7 @@ def _component(design, row, cfg):
     """The ECP5 form (``target=ECP5()``) of row ``row`` of ``design`` (a method name)."""
     target = ECP5()
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
-        return BumpPipeline(load_scene_config(row.split(":", 1)[1]), target=target)
+        return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
     cfg = cfg.replace(method=design)
     if row == "pipeline":
         return pipeline_component(cfg, target)

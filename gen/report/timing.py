@@ -104,7 +104,7 @@ def wavedrom(trace, start, stop, title, foot="", nodes=None, edges=()):
     return out
 
 
-def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default"))):
+def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default").hardware)):
     """``{name: (wavedrom source, facts)}`` of the three diagrams, from real traces."""
     out = {}
     dut = dut_factory()
