@@ -23,6 +23,7 @@ from bumprtl.gen.bench.palette import ACC_SCENES, SPEED_PALETTES, SPEED_SIZES
 from bumprtl.gen.bench.rtl_sim import build_label
 from bumprtl.gen.bench.sweep import DEFAULT_MAPS, FPGA_POINTS, MAP_SIZES, METHOD_CHOICES
 from bumprtl.gen.cli.quiet import quiet_commands
+from bumprtl.gen.render.rtl import require_sim
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.sim.golden.methods import METHODS, PER_PIXEL
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
@@ -55,6 +56,8 @@ def run_lee_widths(args):
 
 
 def run_golden(args):
+    if args.sim_samples:            # the simulations need [sim]'s cocotb: refuse before any work
+        require_sim()
     return golden.golden_bench(methods=args.methods, pixels=args.pixels, sim_samples=args.sim_samples)
 
 

@@ -1,5 +1,5 @@
 """``bumprtl report timing``: WaveDrom timing diagrams of the default pipeline from a real
-simulation trace (the Amaranth simulator on ``BumpPipeline(load_scene_config("default"))``).
+simulation trace (the Amaranth simulator on ``BumpPipeline(load_scene_config("default").hardware)``).
 
 Three diagrams, each sampled cycle by cycle (clk, i.valid, i.ready, i.tag, o.valid,
 o.ready, o.tag), written as WaveDrom JSON and rendered to SVG with ``yowasp-wavedrom``:

@@ -202,7 +202,7 @@ class UncarriedBankPipeline(BumpPipeline):
         keys = {**BUILTIN["palette"], "texture_size": 16, "palette_size": cfg.palette_size,
                 "angle_bits": cfg.angle_bits, "frac_bits": cfg.frac_bits,
                 "spec_index_bits": cfg.spec_index_bits, "tag_bits": cfg.tag_bits}
-        super().__init__(load_scene_config(keys))
+        super().__init__(load_scene_config(keys).hardware)
 
     def _elaborate_palette(self, m):
         lut, f = self.units["palette"], self.units["fetch"]

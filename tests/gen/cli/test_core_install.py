@@ -42,7 +42,8 @@ NEEDS_EXTRA = [(["render", "--rtl", "--size", "16", "--out", "rtl.png"], "sim"),
                (["report", "timing", "--out", "timing"], "docs"),  # the only extra with WaveDrom
                (["emit", "pipeline", "--lint", "--out", "lint"], "sim"),
                (["formal", "--out", "formal"], "formal"),
-               (["board", "ulx3s", "--out", "board"], "board")]
+               (["board", "ulx3s", "--out", "board"], "board"),
+               (["bench", "golden", "--pixels", "1000", "--sim-samples", "10"], "bench")]
 
 
 def test_the_hidden_set_is_what_a_core_install_lacks():
@@ -94,8 +95,10 @@ def _refusal_problem(argv, extra, r, work):
         return f"exit {r['code']}, {len(err)} stderr lines {r['err'][-300:]!r}"
     if not (err[0].startswith("bumprtl: error: ") and f"pip install 'bumprtl[{extra}]'" in err[0]):
         return f"does not name [{extra}]: {err[0]!r}"
-    if (work / argv[argv.index("--out") + 1]).exists():
+    if "--out" in argv and (work / argv[argv.index("--out") + 1]).exists():
         return "wrote its --out"
+    if r["out"]:                                       # refused before doing any work
+        return f"printed before refusing: {r['out'][:200]!r}"
     return None
 
 
