@@ -65,9 +65,10 @@ def _extra(command_extra, need, name):
 
 
 class _Parser(argparse.ArgumentParser):
+    """argparse's refusals in the one-line form of every other refusal: the message and
+    where the usage is (``PROG --help``) on one stderr line, exit 2."""
     def error(self, message):
-        self.print_usage(sys.stderr)
-        print(f"bumprtl: error: {message}", file=sys.stderr)
+        print(f"bumprtl: error: {message} (see: {self.prog} --help)", file=sys.stderr)
         raise SystemExit(2)
 
 

@@ -170,12 +170,19 @@ def test_a_config_flag_no_scene_takes_exits_2_naming_the_flag(capsys):
     assert "--palette-blend" in _one_error_line(capsys)
 
 
-def test_a_bad_flag_prints_usage_and_one_error_line_on_stderr(capsys):
-    """argparse's refusal: the usage, then ``bumprtl: error: ...``, both on stderr; exit 2."""
-    with pytest.raises(SystemExit) as e:
-        cli_main.main(["emit", "pipeline", "--tag-bits"])
-    assert e.value.code == 2
-    out, err = capsys.readouterr()
-    lines = err.splitlines()
-    assert out == "" and lines[0].startswith("usage: bumprtl emit")
-    assert lines[-1].startswith("bumprtl: error: ") and "--tag-bits" in lines[-1]
+def test_a_bad_flag_is_one_error_line_naming_the_help(capsys):
+    """argparse's refusal in the one-line form: ``bumprtl: error: ...`` naming the flag and
+    the subcommand's ``--help``, nothing else on stderr or stdout; exit 2."""
+    for argv, flag, prog in ((["emit", "pipeline", "--tag-bits"], "--tag-bits", "bumprtl emit"),
+                             (["emit", "pipeline", "--no-such-flag"], "--no-such-flag",
+                              "bumprtl"),
+                             (["nosuchcommand"], "nosuchcommand", "bumprtl"),
+                             (["bench", "golden", "--methods", "nosuch"], "nosuch",
+                              "bumprtl bench golden")):
+        with pytest.raises(SystemExit) as e:
+            cli_main.main(argv)
+        assert e.value.code == 2
+        out, err = capsys.readouterr()
+        assert out == "" and len(err.splitlines()) == 1, (argv, err)
+        assert err.startswith("bumprtl: error: ") and flag in err, (argv, err)
+        assert err.rstrip().endswith(f"(see: {prog} --help)"), (argv, err)

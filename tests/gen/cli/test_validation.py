@@ -184,7 +184,8 @@ def test_no_command_is_an_error_naming_command(capsys):
         cli_main.main([])
     assert e.value.code == 2
     out, err = capsys.readouterr()
-    assert out == "" and err.splitlines()[-1] == "bumprtl: error: the following arguments are required: COMMAND"
+    assert out == "" and err.splitlines() == [
+        "bumprtl: error: the following arguments are required: COMMAND (see: bumprtl --help)"]
 
 
 def test_a_command_returning_nothing_exits_0_and_its_status_otherwise(monkeypatch):
