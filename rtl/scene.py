@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
-           "TEXTURE_SIZES", "derived_rotation", "check_scene"]
+           "TEXTURE_SIZES", "derived_rotation", "check_scene", "check_choice",
+           "check_map_size"]
 
 ADDRESSING = ("wrap", "clamp")
 BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
@@ -42,9 +43,25 @@ def check_scene(unit, scene):
     return scene
 
 
-def _choice(key, value, allowed):
+def check_choice(key, value, allowed, error=BumpError):
+    """``value`` of ``key`` is one of ``allowed``; else ``error`` (a BumpError class) naming
+    the key and the allowed values."""
     if value not in allowed:
-        raise BumpError(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+        raise error(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+
+
+def check_map_size(texture_size, mip_levels, error=BumpError):
+    """The map side T is a power of two in :data:`TEXTURE_SIZES` and ``mip_levels`` in
+    [1, log2(T) + 1]; else ``error`` (a BumpError class) naming the key and its range."""
+    t, (lo, hi) = texture_size, TEXTURE_SIZES
+    if isinstance(t, bool) or not isinstance(t, int) or not lo <= t <= hi or t & (t - 1):
+        raise error(f"texture_size must be a power of two in [{lo}, {hi}] (texel "
+                    f"addressing by bit slicing), got {t!r}", "texture_size")
+    top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
+    if isinstance(mip_levels, bool) or not isinstance(mip_levels, int) \
+            or not 1 <= mip_levels <= top:
+        raise error(f"mip_levels must be an integer in [1, {top}] for texture_size "
+                    f"{t}, got {mip_levels!r}", "mip_levels")
 
 
 @dataclass(frozen=True)
@@ -90,23 +107,15 @@ class HardwareScene:
             raise BumpError(f"config must be a Config, got {type(self.config).__name__}", "config")
         for key, allowed in (("shading", SHADINGS), ("bump_map", BUMP_MAPS),
                              ("addressing", ADDRESSING)):
-            _choice(key, getattr(self, key), allowed)
+            check_choice(key, getattr(self, key), allowed)
         if not isinstance(self.texture, bool):
             raise BumpError(f"texture must be true or false, got {self.texture!r}", "texture")
-        t, (lo, hi) = self.texture_size, TEXTURE_SIZES
-        if isinstance(t, bool) or not isinstance(t, int) or not lo <= t <= hi or t & (t - 1):
-            raise BumpError(f"texture_size must be a power of two in [{lo}, {hi}] (texel "
-                            f"addressing by bit slicing), got {t!r}", "texture_size")
-        top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
-        if isinstance(self.mip_levels, bool) or not isinstance(self.mip_levels, int) \
-                or not 1 <= self.mip_levels <= top:
-            raise BumpError(f"mip_levels must be an integer in [1, {top}] for texture_size "
-                            f"{t}, got {self.mip_levels!r}", "mip_levels")
+        check_map_size(self.texture_size, self.mip_levels)
         derived = derived_rotation(self.shading, self.bump_map)
         if self.rotation is None:
             object.__setattr__(self, "rotation", derived)
         elif self.rotation != derived:
-            _choice("rotation", self.rotation, ROTATIONS)
+            check_choice("rotation", self.rotation, ROTATIONS)
             raise BumpError(f"rotation = {self.rotation!r} is impossible with shading = "
                             f"{self.shading!r}, bump_map = {self.bump_map!r}: allowed rotation = "
                             f"{derived!r}", "rotation")

@@ -20,6 +20,8 @@ from bumprtl.rtl.scene import (
     ROTATIONS,
     SHADINGS,
     HardwareScene,
+    check_choice,
+    check_map_size,
     derived_rotation,
 )
 from bumprtl.sim.scenes import GEOMETRIES, SCENES
@@ -131,15 +133,7 @@ class SceneConfig:
         if isinstance(self.lights, int) and not isinstance(self.lights, bool) and self.lights < 1:
             raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])",
                              "lights")
-        t = self.texture_size
-        if isinstance(t, bool) or not isinstance(t, int) or not 16 <= t <= 4096 or t & (t - 1):
-            raise SceneError(f"texture_size must be a power of two in [16, 4096] (texel "
-                             f"addressing by bit slicing), got {t!r}", "texture_size")
-        top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
-        if isinstance(self.mip_levels, bool) or not isinstance(self.mip_levels, int) \
-                or not 1 <= self.mip_levels <= top:
-            raise SceneError(f"mip_levels must be an integer in [1, {top}] for texture_size "
-                             f"{t}, got {self.mip_levels!r}", "mip_levels")
+        check_map_size(self.texture_size, self.mip_levels, SceneError)
         try:
             _ = self.config       # derive it now: a bad width is the scene's error
         except BumpError as e:
@@ -249,8 +243,7 @@ class SceneConfig:
 
 
 def _choice(key, value, allowed):
-    if value not in allowed:
-        raise SceneError(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+    check_choice(key, value, allowed, SceneError)
 
 
 def flag_name(key):
