@@ -13,38 +13,17 @@ import sys
 
 import numpy as np
 import pytest
-from amaranth.sim import Simulator
 from cocotbext.dvi.tmds import TMDS
 
 from bumprtl.gen.flow.board import board_data, check_board, check_frames
-from bumprtl.rtl.tmds import CONTROL, TMDSEncoder
+from bumprtl.rtl.tmds import CONTROL
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import golden_frame, light_table
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.tb_board import timing_errors
+from tests.rtl.test_tmds import encode_rtl
 
 SMALL = {"angle_bits": 10, "texture_size": 16}
-
-
-def _encode(values, de):
-    """Run TMDSEncoder on (value, de, c0, c1) tuples; the 10-bit words in order."""
-    enc = TMDSEncoder()
-    words = []
-
-    async def bench(ctx):
-        for v, d, c0, c1 in values + [(0, 0, 0, 0)] * enc.latency:
-            ctx.set(enc.data, v)
-            ctx.set(enc.de, d)
-            ctx.set(enc.c0, c0)
-            ctx.set(enc.c1, c1)
-            await ctx.tick()
-            words.append(ctx.get(enc.q))
-
-    sim = Simulator(enc)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
-    return words[enc.latency - 1:enc.latency - 1 + len(values)]
 
 
 def test_tmds_words_decode_with_cocotbext_tables_and_stay_dc_balanced():
@@ -52,7 +31,7 @@ def test_tmds_words_decode_with_cocotbext_tables_and_stay_dc_balanced():
     data = [int(x) for x in rng.integers(0, 256, 2000)] + [0, 255] * 50 + [0x10] * 40
     values = [(v, 1, 0, 0) for v in data]
     values += [(0, 0, c & 1, c >> 1) for c in range(4)]
-    words = _encode(values, 1)
+    words = encode_rtl([v if d else (c1, c0) for v, d, c0, c1 in values])
     dec = TMDS()
     disparity, worst = 0, 0
     for (v, d, c0, c1), w in zip(values, words, strict=False):
