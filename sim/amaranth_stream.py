@@ -18,17 +18,17 @@ from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads
 from bumprtl.sim.traffic import PATTERNS
 
-__all__ = ["PATTERNS", "simulate_stream", "assert_bit_exact", "check_rotation",
+__all__ = ["PATTERNS", "flatten_payload", "simulate_stream", "assert_bit_exact", "check_rotation",
            "check_illumination", "check_datapath"]
 
 
-def _flatten(value, prefix=""):
+def flatten_payload(value, prefix=""):
     """A payload View -> {dotted name: Value}; an ArrayLayout's elements are ``name.j``."""
     out = {}
     for name, _ in value.shape():
         v = value[name]
         if isinstance(v, data.View):
-            out.update(_flatten(v, f"{prefix}{name}."))
+            out.update(flatten_payload(v, f"{prefix}{name}."))
         else:
             out[f"{prefix}{name}"] = v
     return out
@@ -52,8 +52,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     state = {"cycles": 0}
 
     async def testbench(ctx):
-        in_fields = _flatten(dut.i.payload)
-        out_fields = _flatten(dut.o.payload)
+        in_fields = flatten_payload(dut.i.payload)
+        out_fields = flatten_payload(dut.o.payload)
         pending = list(inputs)
         offered = None
         while len(outputs) < len(inputs):

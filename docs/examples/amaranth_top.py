@@ -20,12 +20,13 @@ import argparse
 import sys
 
 from amaranth import Module, Signal
-from amaranth.lib import data, memory, stream, wiring
+from amaranth.lib import memory, stream, wiring
 from amaranth.lib.wiring import In, Out
 from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.vectors import pipeline_vectors
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.amaranth_stream import flatten_payload
 from bumprtl.sim.scenes.config import load_scene_config
 
 
@@ -75,25 +76,13 @@ class BumpTop(wiring.Component):
         return m
 
 
-def _fields(view, prefix=""):
-    """A payload View -> {dotted field name: Value}, the golden model's names."""
-    out = {}
-    for name, _ in view.shape():
-        v = view[name]
-        if isinstance(v, data.View):
-            out.update(_fields(v, f"{prefix}{name}."))
-        else:
-            out[f"{prefix}{name}"] = v
-    return out
-
-
 def simulate(pixels=8, seed=1, scene=None):
     """``(got, expected)``: ``pixels`` random pixels through ``BumpTop`` in the Amaranth
     simulator, and the golden model's outputs of them (lists of ``{field: int}``)."""
     scene = scene or load_scene_config("default", {"texture_size": 16})
     vec = pipeline_vectors(scene, "random", pixels, seed)
     dut = BumpTop(scene, vec.words)
-    ins, outs = _fields(dut.i.payload), _fields(dut.o.payload)
+    ins, outs = flatten_payload(dut.i.payload), flatten_payload(dut.o.payload)
     mask = {k: (1 << len(v)) - 1 for k, v in ins.items()}
     got = []
 
