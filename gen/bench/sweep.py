@@ -659,6 +659,9 @@ def sweep_bench(opts: SweepOptions):
     if opts.fpga:
         check_device(opts.device)
         scheduler_address(opts.scheduler)        # a malformed address: one line, exit 2
+    elif opts.scheduler is not None:             # accepted, it would change nothing
+        raise BumpError("--scheduler applies to --fpga (the placements are its jobs), not to a "
+                        "sweep without it")
     grid = GRIDS["quick" if opts.quick else "default"]
     if opts.maps:
         grid = replace(grid, maps=parse_maps(opts.maps))

@@ -155,6 +155,17 @@ def test_bad_maps_exit_2_naming_the_flag(spec, capsys):
     assert "--maps" in err and "[16, 2048]" in err and len(err.splitlines()) == 1
 
 
+def test_a_scheduler_without_fpga_is_refused(capsys, tmp_path):
+    """--scheduler places the --fpga points as jobs; without --fpga it would change nothing:
+    one line naming both flags, exit 2, nothing written."""
+    out = tmp_path / "x.json"
+    assert main(["bench", "sweep", "--quick", "--scheduler", "tcp://127.0.0.1:8786",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--scheduler" in err[0] and "--fpga" in err[0], err
+    assert not out.exists()
+
+
 def test_parse_maps():
     assert parse_maps(["gravel:1024", "moon:512"]) == (("gravel", 1024), ("moon", 512))
     with pytest.raises(BumpError, match="twice"):
