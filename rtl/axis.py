@@ -130,7 +130,7 @@ class AxisWrapper(wiring.Component):
 
     @property
     def latency(self):
-        return self.unit.latency
+        return self.unit.port_latency
 
     def sidecar(self):
         """The AXI4-Stream facts of the JSON sidecar."""

@@ -10,15 +10,15 @@ int64 arrays in ``sim/golden/fixed/pipeline.py``, so both address alike.
 """
 
 import numpy as np
-from amaranth.hdl import Cat, Module, Shape, Signal, Value, ValueCastable, signed, unsigned
-from amaranth.lib import data, stream, wiring
-from amaranth.lib.wiring import In, Out
+from amaranth.hdl import Cat, Shape, Signal, Value, ValueCastable, signed, unsigned
+from amaranth.lib import data
+from amaranth.lib.wiring import In
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.fixed import Q, saturate
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
+from bumprtl.rtl.pipe import RAM_LATENCY, PipeUnit
 from bumprtl.rtl.scene import HardwareScene, check_scene
 from bumprtl.rtl.targets import is_spread
 from bumprtl.rtl.texture import rgb_layout
@@ -122,7 +122,7 @@ def fetch_latency(scene):
     return 2 + RAM_LATENCY + spread_fetch(scene)
 
 
-class BumpMapFetch(wiring.Component):
+class BumpMapFetch(PipeUnit):
     """Bump vector map (or palette index map) in block RAM, one texel per clock.
 
     Parameters
@@ -169,11 +169,9 @@ class BumpMapFetch(wiring.Component):
     """
 
     def __init__(self, scene: HardwareScene, out_layout=None, init=None, texture=None, target=None,
-                 lockstep=None, write_port=True):
+                 credit=True, fifo_depth=None, write_port=True):
         check_scene(self, scene)
-        self.scene, self.cfg, self.target, self.memories = scene, scene.config, target, {}
-        self.write_port = write_port
-        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
+        self.scene, self.write_port = scene, write_port
         self.fetched = fetched_fields(scene)
         if not self.fetched:
             self._MustUse__silence = True
@@ -181,9 +179,9 @@ class BumpMapFetch(wiring.Component):
                             f"nothing to fetch (BumpMapFetch needs bump_map = 'varying', "
                             f"shading = 'palette' or texture = true)")
         if out_layout is None:
-            shapes = {fetched_field(scene): texel_shape(scene), "texel": rgb_layout(self.cfg)}
+            shapes = {fetched_field(scene): texel_shape(scene), "texel": rgb_layout(scene.config)}
             out_layout = data.StructLayout({**{f: shapes[f] for f in self.fetched},
-                                            "tag": unsigned(self.cfg.tag_bits)})
+                                            "tag": unsigned(scene.config.tag_bits)})
         self.out_layout = out_layout
         fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
         if scene.mip_levels > 1:
@@ -201,26 +199,22 @@ class BumpMapFetch(wiring.Component):
         if self.texture and not scene.texture:
             self._MustUse__silence = True
             raise ValueError("texture words given but the scene has texture = false")
-        ports = {"i": In(stream.Signature(data.StructLayout(fields))),
-                 "o": Out(stream.Signature(out_layout))}
+        ports = {}
         if has_map(scene) and write_port:
             ports.update({"w_en": In(1), "w_addr": In(range(self.depth)),
                           "w_data": In(self.word_bits)})
         if scene.texture and write_port:
             ports.update({"tex_w_en": In(1), "tex_w_addr": In(range(self.depth)),
                           "tex_w_data": In(TEXEL_BITS)})
-        super().__init__(ports)
+        super().__init__(scene.config, data.StructLayout(fields), out_layout, target, credit,
+                         fifo_depth, ports)
 
     @property
     def memory_bits(self):
         return self.depth * (self.word_bits + (TEXEL_BITS if self.scene.texture else 0))
 
-    def elaborate(self, platform):
+    def build(self, m, pipe):
         scene = self.scene
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
-        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         mems = {}                                   # output field -> (RAM, host port prefix)
         if has_map(scene):
             mem = pipe.ram("map", self.depth, unsigned(self.word_bits), self.init,
@@ -253,8 +247,7 @@ class BumpMapFetch(wiring.Component):
             m.d.comb += mem.r_addr.eq(addr_d1)      # then: read; the output register
             # stage 4: the word once more beside the block RAM, so the route to the next
             # unit has a cycle of its own wherever the placer puts the RAM
-            m.d.comb += self.o.payload[field].eq(pipe.register(mem.r_data, f"{field}_word"))
+            m.d.comb += pipe.o.payload[field].eq(pipe.register(mem.r_data, f"{field}_word"))
         for name, _ in self.out_layout:
             if name not in self.fetched:
-                m.d.comb += self.o.payload[name].eq(pipe.delay(px[name], self.latency, name))
-        return m
+                m.d.comb += pipe.o.payload[name].eq(pipe.delay(px[name], self.latency, name))

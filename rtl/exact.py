@@ -107,14 +107,14 @@ class ExactRotation(PipeUnit):
     10 where the sine ROM is spread), two adder levels; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         self.latency = rotation_latency(cfg)
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, credit, fifo_depth)
 
     def build(self, m, pipe):
         cfg = self.cfg
         rom = SineBank(m, pipe, cfg)
-        px, o = self.i.payload, self.o.payload
+        px, o = self.i.payload, pipe.o.payload
         t, bt, bp = px.n.theta, px.b.theta, px.b.phi
         bits = cfg.angle_bits                  # input stage: a, b registered (mod 2**bits)
         a, b = pipe.register((bt + bp)[:bits], "a"), pipe.register((bt - bp)[:bits], "b")
@@ -149,8 +149,8 @@ class ExactIllumination(IlluminationDatapath):
     SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
-        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
+        super().__init__(cfg, rotated_layout(cfg), target, credit, fifo_depth)
 
     @property
     def wide(self):

@@ -13,7 +13,7 @@ from bumprtl.rtl.methods import get
 __all__ = ["Illumination"]
 
 
-def Illumination(cfg: Config, target=None, lockstep=None):
+def Illumination(cfg: Config, target=None, credit=True, fifo_depth=None):
     """The illumination datapath of ``cfg.method``: an instance of
     ``methods.get(cfg.method).illumination`` (a ``wiring.Component``).
 
@@ -22,4 +22,4 @@ def Illumination(cfg: Config, target=None, lockstep=None):
     specular_fine, tag). ``latency`` depends on
     the method; 1 pixel per clock. ``target``: None (generic) or ``pipe.ECP5()``.
     """
-    return get(cfg.method).illumination(cfg, target=target, lockstep=lockstep)
+    return get(cfg.method).illumination(cfg, target=target, credit=credit, fifo_depth=fifo_depth)

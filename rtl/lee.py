@@ -94,7 +94,7 @@ def _select(cond, a, b):
 
 
 def _same(value, name):
-    """The golden model's stage: none (the RTL passes a registering one, StallPipe.register)."""
+    """The golden model's stage: none (the RTL passes a registering one, Pipe.register)."""
     return value
 
 
@@ -169,7 +169,7 @@ def phi_quadrant(atan, z_negative, y_negative, cfg: Config, stage=_same):
 
 def prop_term(abs_z, prop, cfg: Config, mul=_times):
     """Eq. 19's (90 - |Z|) theta_prop, rounded to the angle grid (``mul``: the plain product
-    for the golden model, a registered one, StallPipe.multiply, in the RTL)."""
+    for the golden model, a registered one, Pipe.multiply, in the RTL)."""
     return round_shift(mul((1 << cfg.k) - abs_z, prop), cfg.frac_bits)
 
 
@@ -236,7 +236,7 @@ def block_rom(pipe, init, shape, name, ports):
     """A :class:`BlockROM` with ``ports`` read ports enabled by ``adv``, recorded in the pipe's
     ``memories`` as ``pipe.rom`` records its ROMs."""
     rom = pipe.memory(name, BlockROM(init, shape, ports, name, target=pipe.target))
-    pipe.m.d.comb += rom.en.eq(pipe.adv)
+    pipe.m.d.comb += rom.en.eq(pipe.en)
     return rom
 
 
@@ -294,7 +294,7 @@ class LeeRotation(PipeUnit):
     Input ``pixel_layout(cfg)``; output :func:`rotated_layout`. Every table read is a
     :class:`BlockROM` (DP16KD blocks with their output registers on ECP5) behind an address
     register, every product registered (``pipe.multiply``; the two by a reciprocal, wider
-    than a DSP input, ``StallPipe.wide_multiply``, and eq. 19's as well when its operands,
+    than a DSP input, ``Pipe.wide_multiply``, and eq. 19's as well when its operands,
     :func:`prop_operands`, outgrow a DSP input), and at most one carry chain or half a mux
     chain lies between two registers. Per vector, in ``adv`` stages (S = SINE_STAGES,
     R = ROM_STAGES, W = WIDE_PRODUCT_LATENCY, P = ``pipe.product_latency`` of
@@ -325,13 +325,13 @@ class LeeRotation(PipeUnit):
     reads is sequential; every link of it has a register of its own.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         self.prop_latency = product_latency(*prop_operands(cfg))              # P
         self.latency = S + 8 + 3 * ROM_STAGES + W + self.prop_latency
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, credit, fifo_depth)
 
     def build(self, m, pipe):
-        px, o = self.i.payload, self.o.payload
+        px, o = self.i.payload, pipe.o.payload
         for v in vectors(self.cfg):
             phi, theta = self._rotate(m, pipe, v, px[v], px.n)
             m.d.comb += [o[v].phi.eq(phi), o[v].theta.eq(theta)]
@@ -397,10 +397,10 @@ class LeeIllumination(IlluminationDatapath):
     (1): ``dot_latency``, plus SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         self.product_latency = product_latency(*dot_operands(cfg))
         self.dot_latency = REGISTERED_SINE_LATENCY + self.product_latency + 2
-        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
+        super().__init__(cfg, rotated_layout(cfg), target, credit, fifo_depth)
 
     def dots(self, m, pipe, payload):
         return {v: self._dot(m, pipe, v, payload[v], payload.b) for v in vectors(self.cfg)}

@@ -11,13 +11,13 @@ writes it here; per pixel only a table lookup remains, optionally blended with a
 colour by eq. 2 (Sec. 7.2).
 """
 
-from amaranth.hdl import Module, Mux, Signal, unsigned
-from amaranth.lib import data, stream, wiring
+from amaranth.hdl import Mux, Signal, unsigned
+from amaranth.lib import data
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import Q, mul_round, round_shift, saturate
-from bumprtl.rtl.pipe import RAM_LATENCY, StallPipe, pipe_observer
+from bumprtl.rtl.pipe import RAM_LATENCY, PipeUnit
 
 __all__ = ["PaletteLUT", "READ_LATENCY", "rgba_layout", "index_bits", "mul8", "blend_eq1", "blend_eq2", "CHANNELS"]
 
@@ -74,7 +74,7 @@ def _channels(word, cfg):
     return {c: word[n * b:(n + 1) * b] for n, c in enumerate(CHANNELS)}
 
 
-class PaletteLUT(wiring.Component):
+class PaletteLUT(PipeUnit):
     """Colour-table lookup, one pixel per clock, double-buffered host-written table.
 
     Parameters
@@ -122,9 +122,9 @@ class PaletteLUT(wiring.Component):
     """
 
 
-    def __init__(self, cfg: Config, target=None, bank_in=False, lockstep=None):
-        self.cfg, self.target, self.memories, self.bank_in = cfg, target, {}, bank_in
-        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
+    def __init__(self, cfg: Config, target=None, bank_in=False, credit=True, fifo_depth=None):
+        self.bank_in = bank_in
+        self.latency = READ_LATENCY + cfg.palette_blend
         ib = index_bits(cfg)
         fields = {"index": unsigned(ib)}
         if cfg.palette_blend:
@@ -132,10 +132,9 @@ class PaletteLUT(wiring.Component):
         if bank_in:
             fields["bank"] = unsigned(1)
         fields["tag"] = unsigned(cfg.tag_bits)
-        super().__init__({
-            "i": In(stream.Signature(data.StructLayout(fields))),
-            "o": Out(stream.Signature(data.StructLayout({
-                "color": rgba_layout(cfg), "oor": unsigned(1), "tag": unsigned(cfg.tag_bits)}))),
+        out = {"color": rgba_layout(cfg), "oor": unsigned(1), "tag": unsigned(cfg.tag_bits)}
+        super().__init__(cfg, data.StructLayout(fields), data.StructLayout(out), target, credit,
+                         fifo_depth, {
             "w_en": In(1),
             "w_addr": In(ib),
             "w_data": In(rgba_layout(cfg)),
@@ -144,22 +143,14 @@ class PaletteLUT(wiring.Component):
         })
 
     @property
-    def latency(self):
-        return READ_LATENCY + self.cfg.palette_blend
-
-    @property
     def memory_bits(self):
         return 2 * self.cfg.palette_size * 4 * self.cfg.color_bits
 
-    def elaborate(self, platform):
+    def build(self, m, pipe):
         cfg, size = self.cfg, self.cfg.palette_size
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
         # The table's read data is registered (on ECP5 in the block RAM's own output register):
         # the RAM's clock-to-out alone takes most of a cycle.
         table = pipe.ram("table", 2 * size, unsigned(4 * cfg.color_bits))
-        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         front = Signal(name="front")
         with m.If(self.swap):
             m.d.sync += front.eq(~front)
@@ -184,7 +175,6 @@ class PaletteLUT(wiring.Component):
             oor = pipe.register(oor, f"oor_d{READ_LATENCY + 1}")
         else:
             color = entry
-        m.d.comb += [getattr(self.o.payload.color, c).eq(color[c]) for c in CHANNELS]
-        m.d.comb += [self.o.payload.oor.eq(oor),
-                     self.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag"))]
-        return m
+        m.d.comb += [getattr(pipe.o.payload.color, c).eq(color[c]) for c in CHANNELS]
+        m.d.comb += [pipe.o.payload.oor.eq(oor),
+                     pipe.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag"))]

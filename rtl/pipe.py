@@ -1,19 +1,26 @@
-"""Stall-safe pipeline bookkeeping shared by every unit (docs/architecture.md, Interfaces).
+"""Free-running pipes with credit flow control at their edges (docs/architecture.md,
+Interfaces and The credit loop).
 
-A unit on its own advances its whole pipe when the output is empty or being taken,
-``adv = ~o.valid | o.ready``; every register, including the ROM read ports, is enabled by
-``adv``, so a stall freezes the pipe and never drops a lookup. ``o.valid`` comes straight
-from a register and never depends on ``o.ready`` (stream rule 1). Inside a
-``BumpPipeline`` (rtl/pipeline.py) the units run in *lock-step mode* instead: ``adv`` is
-an enable the pipeline gives (a register of its own), so the stall rule is not a chain of
-``o.valid`` terms across the units.
+The datapath never stops: every register, product and memory read of a unit is clocked
+every cycle (no clock enable), and a valid bit travels with each pixel; a bubble is a pixel
+with valid low. Flow control lives only at the edges (:class:`CreditEdge`): the input takes
+a pixel only while a credit is free, and a FIFO behind the last stage, one entry per
+credit, gives the credit back when its pixel leaves. A unit on its own (``credit=True``,
+the default) has its own edge; inside a ``BumpPipeline`` (rtl/pipeline.py) the units are
+built with ``credit=False`` and chained valid to valid, and the pipeline has the one edge.
+Either way the ports obey the stream rules: ``o.valid`` and ``o.payload`` come from the
+FIFO's output register and never depend on ``o.ready``; ``i.ready`` is a register ("a
+credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cycle.
 """
 
-from amaranth.hdl import Const, Module, Mux, Shape, Signal, Value
+from amaranth.hdl import Const, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
+from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
-# The registered elements a StallPipe builds, and the targets that build them (rtl/targets.py);
+from bumprtl.rtl.config import BumpError
+
+# The registered elements a Pipe builds, and the targets that build them (rtl/targets.py);
 # the names are also read from here by the units.
 from bumprtl.rtl.targets import (
     DP16KD_MODES,
@@ -34,44 +41,66 @@ from bumprtl.rtl.targets import (
     read_port,
 )
 
-__all__ = ["StallPipe", "PipeUnit", "RegisteredProduct", "WideProduct", "RegisteredROM",
+__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth",
+           "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
-           "limb_products", "lockstep_buffer", "lockstep_enables", "BUFFER_DEPTH", "PRODUCT_LATENCY",
+           "limb_products", "PRODUCT_LATENCY",
            "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY", "ECP5", "dp16kd_initvals",
            "DP16KD_MODES", "pipe_observer"]
+
+# Cycles from a pixel written into the edge's FIFO to the same pixel offered at ``o``:
+# the write (SyncFIFOBuffered's memory), then its output register.
+EDGE_LATENCY = 2
+# Cycles from a pixel taken at ``o`` to its credit free at ``i``: the credit count is a
+# register, so the credit is counted the cycle after the pixel leaves.
+CREDIT_RETURN = 1
+
+
+def min_fifo_depth(latency):
+    """The least FIFO depth (= credits) that keeps a pipe of ``latency`` stages at one pixel
+    a clock while the sink takes one a clock: a credit spent in cycle t comes back in cycle
+    t + latency + EDGE_LATENCY + CREDIT_RETURN (the pixel's stages, the FIFO, the count), so
+    that many pixels are between the input and the credit count at once
+    (docs/architecture.md, The credit loop)."""
+    return latency + EDGE_LATENCY + CREDIT_RETURN
+
+
+def check_fifo_depth(latency, depth=None):
+    """``depth`` (None: :func:`min_fifo_depth` ``(latency)``); BumpError naming both numbers
+    when it is below that minimum or not an int."""
+    need = min_fifo_depth(latency)
+    if depth is None:
+        return need
+    if not isinstance(depth, int) or isinstance(depth, bool) or depth < need:
+        raise BumpError(f"fifo_depth {depth!r} is below the minimum {need} for a pipe of "
+                        f"latency {latency} (latency + {EDGE_LATENCY} FIFO stages + "
+                        f"{CREDIT_RETURN} credit return)")
+    return depth
 
 
 def pipe_observer(platform):
     """The observer of the pipes an elaboration builds: the ``pipe_observer`` attribute of
     the ``platform`` it was given (the formal contract's, sim/formal/contract.py), else None.
-    Every unit passes it to its :class:`StallPipe`; ``platform`` reaches every submodule's
+    Every unit passes it to its :class:`Pipe`; ``platform`` reaches every submodule's
     ``elaborate``, so one elaboration's observer sees only its own pipes."""
     return getattr(platform, "pipe_observer", None)
 
 
-class StallPipe:
-    """Valid chain and delay lines of a ``depth``-stage pipe from stream ``i`` to ``o``.
+class Pipe:
+    """Valid chain and delay lines of a free-running ``depth``-stage pipe into stream ``o``.
 
     Parameters
     ----------
     m : Module
-    i, o : stream interfaces of the enclosing component (``i`` flipped, ``o`` not)
+    valid : Value
+        The valid bit of the pixel entering stage 1 this cycle.
+    o : stream interface
+        Its ``valid`` is driven with the last stage's valid bit; the unit drives
+        ``o.payload`` from the pipe's registers. ``o.ready`` is never read.
     depth : int
-        Number of register stages between ``i`` and ``o`` (the latency).
+        Number of register stages from the input to ``o`` (the latency).
     target : None or ECP5
         Passed to every RegisteredROM and RegisteredProduct built through the pipe.
-    enable : None or Value
-        None (the default): the pipe stalls on its own, ``adv = ~o.valid | o.ready``.
-        Given: lock-step mode, ``adv = enable`` and ``o.ready`` is not read: the pipe
-        shifts exactly when ``enable`` is high, bubbles included, so units given the same
-        enable move as one shift register (``BumpPipeline`` gives every unit a copy of one
-        registered enable). ``i.ready`` is ``adv`` in both modes.
-    enable_next : None or callable
-        Lock-step mode only: ``enable_next(copy)`` is the next state of a copy of the
-        registered ``enable`` (:func:`lockstep_buffer` gives it to the units it chains). Given,
-        every spread memory the pipe builds (:meth:`rom`, :meth:`ram`; ``spread``: more than
-        targets.SPREAD_BLOCKS block RAMs side by side) is enabled by a copy of its own, so no
-        one flip-flop drives the clock enables of every such block of a unit.
     observer : None or object
         Told what the pipe builds, for assertions about it (the formal contract's lemmas):
         ``pipe(pipe)`` once the valid chain exists, ``register(pipe, name, reg)`` for every
@@ -79,73 +108,60 @@ class StallPipe:
         memory, and the RAM's ``ram_built(unit, memory)`` when its generic form elaborates.
         None (the default) builds the same hardware and tells no one.
 
+    Every register is loaded every cycle (no enable); only the valid bits are reset, the
+    payload registers are ``reset_less`` (a pixel's payload is read only with its valid
+    bit). Every element's ``en`` is :attr:`en`, the constant 1.
+
     ``memories`` records every memory built through the pipe (:meth:`rom`, :meth:`memory`):
-    name -> {kind ("rom", or "ram" when written through a port), depth, width, bits}. A
-    unit keeps it as its own ``memories`` when it elaborates (the memories of
-    gen/flow/units.py's sidecar).
+    name -> {kind ("rom", or "ram" when written through a port), depth, width, bits}.
     """
 
-    def __init__(self, m, i, o, depth, target=None, enable=None, observer=None, enable_next=None):
+    en = Const(1, 1)      # the enable of every element: the pipe never stops
+
+    def __init__(self, m, valid, o, depth, target=None, observer=None):
         if depth < 1:
             raise ValueError(f"pipeline depth must be >= 1, got {depth}")
-        self.m = m
+        self.m, self.o = m, o
         self.depth = depth
         self.target = target
         self.observer = observer
         self.memories = {}
-        self.enable_next = enable_next if enable is not None else None
-        self.enable_copies = []
-        self.adv = Signal(name="adv")
-        adv = ~o.valid | o.ready if enable is None else enable
-        m.d.comb += [self.adv.eq(adv), i.ready.eq(self.adv)]
-        self.valid = [i.valid]
+        self.valid = [Value.cast(valid)]
         for n in range(1, depth + 1):
             v = Signal(name=f"stage{n}_valid")
-            with m.If(self.adv):
-                m.d.sync += v.eq(self.valid[-1])
+            m.d.sync += v.eq(self.valid[-1])
             self.valid.append(v)
         m.d.comb += o.valid.eq(self.valid[depth])
         if observer is not None:
             observer.pipe(self)
 
     def register(self, value, name):
-        """``value`` delayed by one ``adv``-enabled register."""
+        """``value`` delayed by one register (loaded every cycle)."""
         value = Value.cast(value)
-        reg = Signal(value.shape(), name=name)
-        with self.m.If(self.adv):
-            self.m.d.sync += reg.eq(value)
+        reg = Signal(value.shape(), name=name, reset_less=True)
+        self.m.d.sync += reg.eq(value)
         if self.observer is not None:
             self.observer.register(self, name, reg)
         return reg
-
-    def _memory_enable(self, name):
-        """``adv``, or in lock-step mode with ``enable_next`` a copy of the enable of the
-        memory's own (same initial and next state: equal to ``adv`` in every cycle)."""
-        if self.enable_next is None:
-            return self.adv
-        copy = Signal(init=1, name=f"{name}_run", attrs={"keep": 1})
-        self.m.d.sync += copy.eq(self.enable_next(copy))
-        self.enable_copies.append(copy)
-        return copy
 
     def _record(self, name, depth, width):
         self.memories[name] = {"kind": "rom", "depth": depth, "width": width, "bits": depth * width}
 
     def rom(self, init, shape, name, ports=2):
-        """A :class:`RegisteredROM` with ``ports`` read ports enabled by ``adv``."""
+        """A :class:`RegisteredROM` with ``ports`` read ports, read every cycle."""
         unit = RegisteredROM(init, shape, ports, name, target=self.target)
         self.m.submodules[name] = unit
-        self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
+        self.m.d.comb += unit.en.eq(self.en)
         self._record(name, unit.depth, unit.width)
         return unit
 
     def ram(self, name, depth, shape, init=None, writable=True):
-        """A :class:`RegisteredRAM` whose read is enabled by ``adv``; the caller drives its
-        ``r_addr`` and write port (none when not ``writable``) and reads ``r_data``
-        RAM_LATENCY stages later."""
+        """A :class:`RegisteredRAM` read every cycle; the caller drives its ``r_addr`` and
+        write port (none when not ``writable``) and reads ``r_data`` RAM_LATENCY stages
+        later."""
         unit = RegisteredRAM(depth, shape, name, init, target=self.target, writable=writable)
         self.m.submodules[name] = unit
-        self.m.d.comb += unit.en.eq(self._memory_enable(name) if unit.spread else self.adv)
+        self.m.d.comb += unit.en.eq(self.en)
         self._record(name, depth, unit.width)
         self.memories[name]["kind"] = "ram" if writable else "rom"     # written through a port
         if self.observer is not None:
@@ -161,22 +177,22 @@ class StallPipe:
         return memory
 
     def multiply(self, a, b, name):
-        """``a * b`` PRODUCT_LATENCY ``adv`` stages later (:class:`RegisteredProduct`)."""
+        """``a * b`` PRODUCT_LATENCY stages later (:class:`RegisteredProduct`)."""
         a, b = Value.cast(a), Value.cast(b)
         const = b.value if isinstance(b, Const) else None
         unit = RegisteredProduct(a.shape(), b.shape(), name, b_const=const, target=self.target)
         self.m.submodules[name] = unit
-        self.m.d.comb += [unit.a.eq(a), unit.en.eq(self.adv)]
+        self.m.d.comb += [unit.a.eq(a), unit.en.eq(self.en)]
         if const is None:
             self.m.d.comb += unit.b.eq(b)
         return unit.p
 
     def wide_multiply(self, a, b, name):
-        """``a * b`` WIDE_PRODUCT_LATENCY ``adv`` stages later (:class:`WideProduct`)."""
+        """``a * b`` WIDE_PRODUCT_LATENCY stages later (:class:`WideProduct`)."""
         a, b = Value.cast(a), Value.cast(b)
         unit = WideProduct(a.shape(), b.shape(), name, target=self.target)
         self.m.submodules[name] = unit
-        self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.adv)]
+        self.m.d.comb += [unit.a.eq(a), unit.b.eq(b), unit.en.eq(self.en)]
         return unit.p
 
     def multiplier(self, *shapes):
@@ -186,15 +202,65 @@ class StallPipe:
         return self.multiply if fits_dsp(*shapes) else self.wide_multiply
 
     def delay(self, value, stages, name):
-        """``value`` delayed by ``stages`` ``adv``-enabled registers (0 returns it as is)."""
+        """``value`` delayed by ``stages`` registers (0 returns it as is)."""
         for n in range(stages):
             value = self.register(value, f"{name}_d{n + 1}")
         return value
 
 
+class CreditEdge(wiring.Component):
+    """The flow control of a free-running pipe of ``latency`` stages: credits at its input,
+    a FIFO of ``depth`` entries at its output.
+
+    Members
+    -------
+    i_valid : In(1)
+        The producer offers a pixel (the enclosing component's ``i.valid``).
+    i_ready : Out(1)
+        A credit is free (a register): the pixel offered is taken, and enters the pipe.
+    core : In(stream.Signature(layout))
+        The pipe's last stage (``ready`` is 1: the FIFO always has room, see below).
+    o : Out(stream.Signature(layout))
+        The FIFO's head (SyncFIFOBuffered: ``valid`` and ``payload`` from its output
+        register).
+
+    ``credits`` starts at ``depth``; a pixel taken spends one, a pixel leaving ``o`` gives
+    one back (counted the next cycle). In every cycle credits + pixels in the pipe + FIFO
+    occupancy = ``depth``, so the FIFO never overflows (sim/formal proves it by induction).
+    ``depth`` below :func:`min_fifo_depth` ``(latency)`` is refused (BumpError naming both).
+    """
+
+    def __init__(self, layout, latency, depth=None):
+        depth = check_fifo_depth(latency, depth)
+        self.layout, self.latency, self.depth = layout, latency, depth
+        super().__init__({"i_valid": In(1), "i_ready": Out(1),
+                          "core": In(stream.Signature(layout)),
+                          "o": Out(stream.Signature(layout))})
+        self.credits = Signal(range(depth + 1), init=depth, name="credits")
+        self.level = Signal(range(depth + 1), name="fifo_level")     # the FIFO's occupancy
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.fifo = fifo = SyncFIFOBuffered(width=Shape.cast(self.layout).width,
+                                                    depth=self.depth)
+        m.d.comb += self.level.eq(fifo.level)
+        free = Signal(init=1, name="credit_free")           # credits != 0, registered
+        take = self.i_valid & free
+        give = self.o.valid & self.o.ready
+        after = Signal.like(self.credits, name="credits_next")
+        m.d.comb += after.eq(self.credits - take + give)
+        m.d.sync += [self.credits.eq(after), free.eq(after != 0)]
+        m.d.comb += [self.i_ready.eq(free), self.core.ready.eq(1),
+                     fifo.w_en.eq(self.core.valid), fifo.w_data.eq(self.core.payload),
+                     self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data),
+                     fifo.r_en.eq(self.o.ready)]
+        return m
+
+
 class PipeUnit(wiring.Component):
-    """A unit that is one :class:`StallPipe` from stream ``i`` to stream ``o``: the base of
-    every method's datapath (rtl/exact.py, rtl/lee.py, rtl/baselines/).
+    """The base of every unit: one free-running :class:`Pipe` from stream ``i`` to stream
+    ``o``, with its own :class:`CreditEdge` when ``credit`` (a unit on its own) or none
+    (``credit=False``: inside a chain whose owner holds the credits, ``BumpPipeline``).
 
     Parameters
     ----------
@@ -203,98 +269,64 @@ class PipeUnit(wiring.Component):
         Payloads of ``i`` and ``o``.
     target : None or ECP5
         Elaboration target of the pipe's ROMs and products (None: the generic form).
+    credit : bool
+        True (the default): ``i.ready`` is "a credit is free" and ``o`` is the edge's FIFO
+        (:attr:`port_latency` = ``latency`` + EDGE_LATENCY). False: ``i.ready`` is 1 and
+        ``o.ready`` is not read: ``o.valid`` is the pixel's valid bit ``latency`` cycles
+        after ``i.valid``; the chain's owner must only offer pixels it has a credit for.
+    fifo_depth : None or int
+        The edge's FIFO depth (None: :func:`min_fifo_depth` of the latency); below that,
+        BumpError at construction.
+    ports : dict
+        More members of the signature (host write ports and the like).
 
-    Members: ``i`` In(stream.Signature(in_layout)), ``o`` Out(stream.Signature(out_layout)).
-    Subclasses give ``latency`` (the pipe's depth) and ``build(m, pipe)``. After elaboration
-    ``memories`` holds the pipe's record of the memories built (name -> depth, width, bits).
-    1 pixel per clock when not stalled.
-
-    lockstep : None or Value
-        None (the default: the unit stalls on its own) or a 1-bit enable (the
-        :class:`StallPipe` ``enable``: lock-step mode; ``BumpPipeline`` gives each unit its
-        copy of ``run``, :func:`lockstep_enables`).
+    Subclasses set ``latency`` (the pipe's depth) before calling this constructor and
+    give ``build(m, pipe)``, which drives ``pipe.o.payload`` from ``self.i.payload``.
+    The edge is the same for every unit, so a unit on its own and a pipeline have one port
+    contract. After elaboration ``memories`` holds the pipe's record of the memories built.
     """
 
-    def __init__(self, cfg, in_layout, out_layout, target=None, lockstep=None):
-        self.cfg, self.target, self.memories, self.lockstep = cfg, target, {}, lockstep
+    def __init__(self, cfg, in_layout, out_layout, target=None, credit=True, fifo_depth=None,
+                 ports=None):
+        self.cfg, self.target, self.credit = cfg, target, credit
+        self.memories = {}
+        self.fifo_depth = None
+        if credit:
+            try:
+                self.fifo_depth = check_fifo_depth(self.latency, fifo_depth)
+            except BumpError:
+                self._MustUse__silence = True
+                raise
+        elif fifo_depth is not None:
+            self._MustUse__silence = True
+            raise BumpError("fifo_depth is given but credit=False (the chain's owner holds "
+                            "the FIFO)")
         super().__init__({"i": In(stream.Signature(in_layout)),
-                          "o": Out(stream.Signature(out_layout))})
+                          "o": Out(stream.Signature(out_layout)), **(ports or {})})
+
+    @property
+    def port_latency(self):
+        """Cycles from a pixel taken at ``i`` to the pixel offered at ``o`` with the FIFO
+        empty: ``latency``, plus EDGE_LATENCY with the unit's own edge."""
+        return self.latency + (EDGE_LATENCY if self.credit else 0)
 
     def build(self, m, pipe):
         raise NotImplementedError
 
     def elaborate(self, platform):
         m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
+        if self.credit:
+            layout = self.o.payload.shape()
+            m.submodules.edge = edge = CreditEdge(layout, self.latency, self.fifo_depth)
+            core = stream.Signature(layout).create(path=("core",))
+            m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready)]
+            wiring.connect(m, core, edge.core)
+            wiring.connect(m, edge.o, wiring.flipped(self.o))
+            valid = self.i.valid & edge.i_ready
+        else:
+            core, valid = self.o, self.i.valid
+            m.d.comb += self.i.ready.eq(1)
+        pipe = Pipe(m, valid, core, self.latency, self.target, pipe_observer(platform))
         self.build(m, pipe)
-        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
+        self.memories = pipe.memories
         return m
-
-
-# Entries of the output buffer of :func:`lockstep_buffer`. ``run`` is registered and falls
-# the cycle after the buffer fills. Two entries keep the pipe running through a one-cycle
-# stall of the consumer and in the cycle a waiting pixel is taken; with one (``run`` = empty)
-# every stall would also stop the input for a cycle, which only a full pipe (no input gaps)
-# does not notice.
-BUFFER_DEPTH = 2
-
-
-def lockstep_enables(names):
-    """The registered enables ``run`` of a lock-step chain of units ``names``: one copy per
-    unit (given to its constructor as ``lockstep``) and ``"pipeline"`` for the buffer's and
-    ``i.ready``'s own; :func:`lockstep_buffer` drives them."""
-    return {name: Signal(init=1, name=f"run_{name}", attrs={"keep": 1})
-            for name in ("pipeline", *names)}
-
-
-def lockstep_buffer(m, units, runs, last, i, o):
-    """Units chained in lock step on a registered enable, with an output buffer: the stall
-    rule of a chain of units (``BumpPipeline``, the placed rotation -> illumination pipe of
-    gen/flow/fpga.py) without a chain of ``o.valid`` terms across them.
-
-    ``units``: name -> unit, each built with ``lockstep=runs[name]`` (run as a
-    :class:`StallPipe` in lock-step mode); ``runs``: :func:`lockstep_enables` of the units;
-    ``last``: the stream out of the last unit; ``i``, ``o``: the chain's own streams (``i``
-    flipped). Every unit has its own copy of the registered enable ``run`` (as ``lockstep``
-    and as its ``o.ready``: a pixel leaves a unit whenever the chain runs), so no one
-    flip-flop drives every register of the chain. The
-    last unit feeds a :data:`BUFFER_DEPTH`-entry buffer, bypassed while empty (the latency
-    is the units'). ``i.ready`` = ``run`` = (at most one pixel in the buffer): high whenever
-    ``o.valid`` is low, never a function of ``o.ready`` in the same cycle. The caller feeds
-    the first unit's ``i.valid`` from ``i.valid`` and chains the units' valid and payload.
-    Returns ``{count, entries (oldest first), runs}`` (``runs``: the copies by unit name,
-    ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by sim/formal's lemmas."""
-    count = Signal(range(BUFFER_DEPTH + 1), name="out_count")
-    entries = [Signal(last.payload.shape(), name=f"out_entry{n}") for n in range(BUFFER_DEPTH)]
-    runs = {name: runs[name] for name in ("pipeline", *units)}
-    run = runs["pipeline"]
-    for name, unit in units.items():
-        if unit.lockstep is not runs[name]:
-            raise ValueError(f"unit {name!r} must be built with lockstep=runs[{name!r}]")
-        m.d.comb += unit.o.ready.eq(runs[name])
-    held = count != 0
-    taken = o.valid & o.ready
-    m.d.comb += [i.ready.eq(run), o.valid.eq(held | last.valid),
-                 o.payload.eq(Mux(held, entries[0], last.payload))]       # bypass when empty
-    # Next run = (the buffer not full next cycle). Each copy counts the pixel leaving the
-    # last unit with its own value (all copies are equal): the copies' next states differ in
-    # form, so synthesis keeps one register per unit.
-    def next_run(copy):
-        return count + (last.valid & copy) < BUFFER_DEPTH + taken
-
-    for copy in runs.values():
-        m.d.sync += copy.eq(next_run(copy))
-    for unit in units.values():     # each spread memory of a unit gets a copy (StallPipe enable_next)
-        unit.lockstep_next = next_run
-    left = last.valid & run                      # the pixel in the last stage moves on
-    m.d.sync += count.eq(count + left - taken)
-    pop = held & o.ready
-    with m.If(pop):
-        m.d.sync += [entries[n].eq(entries[n + 1]) for n in range(BUFFER_DEPTH - 1)]
-    slot = Signal.like(count, name="out_slot")   # the first free entry after the pop
-    m.d.comb += slot.eq(count - pop)
-    for n in range(BUFFER_DEPTH):                # kept unless taken directly (count stays 0)
-        with m.If(left & (slot == n if n else ~slot.any())):
-            m.d.sync += entries[n].eq(last.payload)
-    return {"count": count, "entries": entries, "runs": runs}

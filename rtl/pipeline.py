@@ -17,19 +17,15 @@ texel coordinates + world N, L, H in; shaded pixels out. Only what the scene nee
   the shape of Tarini et al.'s eq. 2), which also sums the lights; palette shading blends it
   in PaletteLUT's eq. 2 as the base colour. Without a texture none of this is built.
 
-Lock step and the output buffer (rtl/pipe.lockstep_buffer): every unit runs in lock-step
-mode (rtl/pipe.StallPipe ``enable``): all of them shift on one registered enable ``run``,
-bubbles included, so the units form one shift register and no unit's ``o.valid``
-reaches another unit's clock enables. Each unit gets its own copy of the ``run`` register
-(same next state, so each copy drives the clock enables of one unit only). Behind the last unit sits a 2-entry
-output buffer: ``run`` = the buffer holds at most one pixel, a function of registers
-only; ``i.ready`` = ``run``. With the buffer empty the output is the last unit's output
-itself (bypass), so with ``o.ready`` held high the buffer stays empty and the latency is
-the units' sum; a pixel the consumer does not take in the cycle it leaves the last unit
-waits in the buffer, and two waiting pixels stop the pipe one cycle later (``run`` low).
-At the ports: ``i.ready`` is high whenever ``o.valid`` is low (the buffer is then empty)
-and never depends on ``o.ready`` in the same cycle; ``o.valid``/``o.payload`` come from
-registers through the bypass mux and never depend on ``o.ready``.
+Free-running units and one credit edge (rtl/pipe.py): every unit is built with
+``credit=False``, so none has a clock enable and none reads a ``ready``: the units form one
+shift register, valid bit beside payload, and a bubble is a pixel with valid low. The
+pipeline has one :class:`~bumprtl.rtl.pipe.CreditEdge`: ``i.ready`` is "a credit is free"
+(a register), the first unit sees ``i.valid & i.ready``, and the last unit writes a FIFO of
+``fifo_depth`` entries (at least ``min_fifo_depth(latency)``) whose head is ``o``; a pixel
+taken at ``o`` gives its credit back. At the ports: ``i.ready`` never depends on ``i.valid``
+or ``o.ready`` in the same cycle; ``o.valid``/``o.payload`` come from the FIFO's output
+register and never depend on ``o.ready``.
 """
 
 from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
@@ -37,6 +33,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
+from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.exact import (
     SineBank,
     rotated_layout,
@@ -48,12 +45,11 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.layouts import angle_shape, light_fields, light_layout, pixel_layout, shade_layout
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (
-    BUFFER_DEPTH,
+    EDGE_LATENCY,
     PRODUCT_LATENCY,
-    StallPipe,
-    lockstep_buffer,
-    lockstep_enables,
-    pipe_observer,
+    CreditEdge,
+    PipeUnit,
+    check_fifo_depth,
 )
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import HardwareScene, check_scene
@@ -66,14 +62,14 @@ from bumprtl.rtl.tables import (
 )
 from bumprtl.rtl.texture import TexelDelay, TextureBlend, rgb_layout, sum_product
 
-__all__ = ["BumpPipeline", "VectorTerms", "LightSum", "BUFFER_DEPTH"]
+__all__ = ["BumpPipeline", "VectorTerms", "LightSum"]
 
 
 def _vector_layout(cfg):
     return rotated_layout(cfg)["l"].shape
 
 
-class VectorTerms(wiring.Component):
+class VectorTerms(PipeUnit):
     """The per-vector half of the exact rotation (docs/architecture.md, The exact angular
     method) for each vector A of ``count`` lights:
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D, 2p = s(X) + s(Y), 2y = c(Y) - c(X),
@@ -83,24 +79,19 @@ class VectorTerms(wiring.Component):
     count), tag}. ``first``: the pipeline's number of the first of these lights (its
     registers are named ``l_*``, ``l1_*``, ... after the pipeline's lights)."""
 
-    def __init__(self, cfg, count, first=0, target=None, lockstep=None):
-        self.cfg, self.count, self.first, self.target, self.memories = cfg, count, first, target, {}
+    def __init__(self, cfg, count, first=0, target=None, credit=True, fifo_depth=None):
+        self.count, self.first = count, first
         self.latency = rotation_latency(cfg)
-        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
         terms = data.StructLayout({v: _vector_layout(cfg) for v, _ in light_layout(cfg)})
         fields_in = {"n_phi": angle_shape(cfg), "lights": data.ArrayLayout(light_layout(cfg), count),
                      "tag": unsigned(cfg.tag_bits)}
         fields_out = {"lights": data.ArrayLayout(terms, count), "tag": unsigned(cfg.tag_bits)}
-        super().__init__({"i": In(stream.Signature(data.StructLayout(fields_in))),
-                          "o": Out(stream.Signature(data.StructLayout(fields_out)))})
+        super().__init__(cfg, data.StructLayout(fields_in), data.StructLayout(fields_out), target,
+                         credit, fifo_depth)
 
-    def elaborate(self, platform):
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
-        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
+    def build(self, m, pipe):
         rom = SineBank(m, pipe, self.cfg)
-        px, out = self.i.payload, self.o.payload
+        px, out = self.i.payload, pipe.o.payload
         for k in range(self.count):
             j = self.first + k                     # the pipeline's light number
             for v, _ in light_layout(self.cfg):
@@ -108,10 +99,9 @@ class VectorTerms(wiring.Component):
                 terms = vector_terms(pipe, rom, px.lights[k][v], px.n_phi, label, self.latency)
                 m.d.comb += [out.lights[k][v][name].eq(value) for name, value in terms.items()]
         m.d.comb += out.tag.eq(pipe.delay(px.tag, self.latency, "tag"))
-        return m
 
 
-class LightSum(wiring.Component):
+class LightSum(PipeUnit):
     """m lights' unrounded diffuse and specular terms -> the pixel (eq. 2 summed over the
     lights, rounded once). Input {d: ArrayLayout(unsigned(B + 1), m), s: ArrayLayout(
     unsigned(8 + F), m) (light j's ``diffuse_fine``, ``specular_fine`` at index j), tag};
@@ -128,20 +118,16 @@ class LightSum(wiring.Component):
     # products (kd, ks), the terms' sum, the colour.
     latency = PRODUCT_LATENCY + 3
 
-    def __init__(self, scene: HardwareScene, target=None, lockstep=None):
+    def __init__(self, scene: HardwareScene, target=None, credit=True, fifo_depth=None):
         check_scene(self, scene)
-        self.cfg, self.lights, self.target, self.memories = scene.config, scene.lights, target, {}
-        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
-        fields = {"d": data.ArrayLayout(unsigned(self.cfg.frac_bits + 1), self.lights),
+        cfg, self.lights = scene.config, scene.lights
+        fields = {"d": data.ArrayLayout(unsigned(cfg.frac_bits + 1), self.lights),
                   "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), self.lights),
-                  "tag": unsigned(self.cfg.tag_bits)}
-        super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
-                          "o": Out(stream.Signature(shade_layout(self.cfg, fine=False)))})
+                  "tag": unsigned(cfg.tag_bits)}
+        super().__init__(cfg, data.StructLayout(fields), shade_layout(cfg, fine=False), target,
+                         credit, fifo_depth)
 
-    def elaborate(self, platform):
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
+    def build(self, m, pipe):
         px, b, g = self.i.payload, self.cfg.frac_bits, COLOR_FRAC_BITS
         d = pipe.register(sum(px.d[j] for j in range(self.lights)), "diffuse_sum")
         s = pipe.register(sum(px.s[j] for j in range(self.lights)), "specular_sum")
@@ -166,20 +152,27 @@ class LightSum(wiring.Component):
         ks_term = pipe.register(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - g), "ks_phong")
         terms = pipe.register(kd_term + ks_term, "phong_terms")                    # stage 4
         total = (terms + (ka + (1 << (g - 1)))) >> g
-        m.d.comb += [self.o.payload.color.eq(pipe.register(sat(total), "color")),  # 5
-                     self.o.payload.diffuse.eq(pipe.delay(d8, self.latency - 3, "diffuse")),
-                     self.o.payload.specular.eq(pipe.delay(s8, self.latency - 3, "specular")),
-                     self.o.payload.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
-        return m
+        o = pipe.o.payload
+        m.d.comb += [o.color.eq(pipe.register(sat(total), "color")),                # 5
+                     o.diffuse.eq(pipe.delay(d8, self.latency - 3, "diffuse")),
+                     o.specular.eq(pipe.delay(s8, self.latency - 3, "specular")),
+                     o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
 
 
-def _lockstep(m, src, dsts):
-    """Feed one stream's valid to units that run in lock step (their ready is the enable)."""
+class _Entry:
+    """A valid bit and a payload: the source of a unit's input in the chain."""
+
+    def __init__(self, valid, payload):
+        self.valid, self.payload = valid, payload
+
+
+def _same_valid(m, src, dsts):
+    """Feed one stream's valid to the free-running units of one layer."""
     m.d.comb += [dst.valid.eq(src.valid) for dst in dsts]
 
 
 def _feed(m, src, dst):
-    """``src`` into ``dst`` of the next layer: valid and payload (both run on the enable)."""
+    """``src`` into ``dst`` of the next layer: valid and payload."""
     m.d.comb += [dst.valid.eq(src.valid), dst.payload.eq(src.payload)]
 
 
@@ -232,27 +225,25 @@ class BumpPipeline(wiring.Component):
         in the fetch stages to read the back bank (at most the fetch latency after the swap
         without backpressure); before the first pixel and between frames it is high.
 
-    ``latency`` is the sum of the units' latencies; 1 pixel per clock when not stalled.
+    ``latency`` is the sum of the units' latencies (the free-running chain);
+    ``port_latency`` adds the edge's EDGE_LATENCY (a pixel taken at ``i`` is offered at
+    ``o`` that many cycles later with the FIFO empty); 1 pixel per clock while the sink
+    takes one per clock. ``fifo_depth`` (None: the least, ``min_fifo_depth(latency)``) is
+    the FIFO's depth and the number of credits.
     ``built`` lists the units and why each was built; after elaboration ``memories`` lists
     every unit's memories (``unit.name`` -> depth, width, bits).
 
-    Every unit runs in lock-step mode on its copy of the registered enable ``run`` and the
-    last one feeds a :data:`BUFFER_DEPTH`-entry output buffer (module docstring):
-    ``i.ready`` = ``run`` = (at most one pixel in the buffer), high whenever ``o.valid`` is
-    low, never a function of ``o.ready`` in the same cycle. After elaboration ``buffer``
-    holds its registers (``count``, ``entries`` oldest first, ``runs``: the copies of
-    ``run`` by unit, ``"pipeline"`` for the buffer's and ``i.ready``'s own), read by
-    sim/formal's lemmas.
-    """
+    The edge (submodule ``edge``, :class:`~bumprtl.rtl.pipe.CreditEdge`: its ``credits``
+    and ``level``) is read by sim/formal's credit invariant.
+"""
 
     def __init__(self, scene: HardwareScene, init=None, texture=None, target=None,
-                 write_port=True):
+                 write_port=True, fifo_depth=None):
         self.scene = check_scene(self, scene)
         self.write_port = write_port
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
-        self._runs = lockstep_enables([])     # run: the buffer's and i.ready's own, then one per unit
         self._texture = texture
         ports = {}
         if scene.shading == "palette":
@@ -267,7 +258,13 @@ class BumpPipeline(wiring.Component):
         else:                                       # flat map: the light vectors and the tag
             in_layout = data.StructLayout({**light_fields(cfg), "tag": unsigned(cfg.tag_bits)})
         ports["i"] = In(stream.Signature(in_layout))
-        ports["o"] = Out(stream.Signature(self.units[self._last].o.payload.shape()))
+        out_layout = self.units[self._last].o.payload.shape()
+        ports["o"] = Out(stream.Signature(out_layout))
+        try:
+            self.fifo_depth = check_fifo_depth(self.latency, fifo_depth)
+        except BumpError:
+            self._MustUse__silence = True
+            raise
         if "fetch" in self.units and has_map(scene) and write_port:
             f = self.units["fetch"]
             ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
@@ -286,10 +283,6 @@ class BumpPipeline(wiring.Component):
         super().__init__(ports)
 
     # --- planning: which units, and why -----------------------------------------------------
-    def _run(self, name):
-        """Unit ``name``'s copy of the registered enable ``run`` (its ``lockstep``)."""
-        return self._runs.setdefault(name, lockstep_enables([name])[name])
-
     def _add(self, name, unit, why):
         self.units[name] = unit
         self.built.append({"unit": name, "class": type(unit).__name__, "latency": unit.latency,
@@ -304,13 +297,13 @@ class BumpPipeline(wiring.Component):
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
             (["texture = true: the RGB colour texel"] if s.texture else [])
         self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target,
-                                        lockstep=self._run("fetch"),
+                                        credit=False,
                                         write_port=self.write_port),
                   f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):
-        lut = PaletteLUT(self.cfg, self.target, bank_in=True, lockstep=self._run("palette"))
+        lut = PaletteLUT(self.cfg, self.target, bank_in=True, credit=False)
         self._fetch(lut.i.payload.shape(), init, "a palette index")
         if self.scene.texture:
             self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
@@ -329,7 +322,7 @@ class BumpPipeline(wiring.Component):
             tag = fields.pop("tag")
             fields.update(light_fields(cfg))   # l, h stay in place; extra_lights after b
             self._fetch(data.StructLayout({**fields, "tag": tag}), init, "N' (polar angles)")
-            self._add("rotation", VectorRotation(cfg, self.target, self._run("rotation")),
+            self._add("rotation", VectorRotation(cfg, self.target, credit=False),
                       f"rotation = 'per-pixel': N' rotated into N's frame every pixel ({spec})")
             rot_layer.append("rotation")
             first = 1                          # light 0 rides in the rotation
@@ -343,30 +336,30 @@ class BumpPipeline(wiring.Component):
                    "terms" if s.rotation == "per-polygon" else
                    f"lights = {s.lights}: lights 1..{s.lights - 1} share light 0's rotated normal")
             self._add("terms", VectorTerms(cfg, s.lights - first, first, self.target,
-                                          self._run("terms")), why)
+                                          credit=False), why)
             rot_layer.append("terms")
         ill = []
         for j in range(s.lights):
             name = f"illumination{j}" if s.lights > 1 else "illumination"
-            self._add(name, Illumination(cfg, self.target, self._run(name)),
+            self._add(name, Illumination(cfg, self.target, credit=False),
                       f"light {j}: N'.L' (and N'.H') and the shade of eq. 2 ({spec})")
             ill.append(self.built[-1]["unit"])
         if s.texture:                          # the texel rides beside both layers
             for name, layer in (("texel_r", rot_layer), ("texel_i", ill)):
                 latency = self.units[layer[0]].latency
-                self._add(name, TexelDelay(cfg, latency, self.target, self._run(name)),
+                self._add(name, TexelDelay(cfg, latency, self.target, credit=False),
                           f"texture = true: the texel waits {latency} stages beside {layer[0]}")
                 layer.append(name)
         self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
         self._rot_layer, self._ill_layer = rot_layer, ill
         if s.texture:
-            self._add("blend", TextureBlend(cfg, s.lights, self.target, self._run("blend")),
+            self._add("blend", TextureBlend(cfg, s.lights, self.target, credit=False),
                       "texture = true: out_c = tex_c min(1, ka + kd d) + ks s (Lee eq. 2 with a "
                       "textured albedo, Tarini eq. 2's shape)" +
                       (f", summed over the {s.lights} lights" if s.lights > 1 else ""))
             self._layers.append(["blend"])
         elif s.lights > 1:
-            self._add("lightsum", LightSum(s, self.target, self._run("lightsum")),
+            self._add("lightsum", LightSum(s, self.target, credit=False),
                       f"lights = {s.lights}: eq. 2 summed over the lights")
             self._layers.append(["lightsum"])
         self._first, self._last = self._layers[0][0], self._layers[-1][0]
@@ -400,6 +393,10 @@ class BumpPipeline(wiring.Component):
         return sum(self.units[layer[0]].latency for layer in self._layers)
 
     @property
+    def port_latency(self):
+        return self.latency + EDGE_LATENCY
+
+    @property
     def memories(self):
         """Every unit's memories, ``unit.name`` -> {depth, width, bits} (after elaboration)."""
         return {f"{unit}.{name}": size for unit, u in self.units.items()
@@ -408,7 +405,12 @@ class BumpPipeline(wiring.Component):
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()
-        self._output_buffer(m)
+        m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency,
+                                              self.fifo_depth)
+        m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready)]
+        last = self.units[self._last].o
+        m.d.comb += [edge.core.valid.eq(last.valid), edge.core.payload.eq(last.payload)]
+        wiring.connect(m, edge.o, wiring.flipped(self.o))
         for name, unit in self.units.items():
             m.submodules[name] = unit
         s, u = self.scene, self.units
@@ -421,30 +423,28 @@ class BumpPipeline(wiring.Component):
             self._elaborate_palette(m)
             return m
         if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
-            _feed(m, self.i, u["fetch"].i)
+            _feed(m, self._taken(), u["fetch"].i)
             _feed(m, u["fetch"].o, u["rotation"].i)
             _feed(m, u["rotation"].o, u["illumination"].i)
             return m
         self._elaborate_layers(m)
         return m
 
-    def _output_buffer(self, m):
-        """``run`` (one copy per unit), the lock-step enables and the output buffer behind
-        the last unit (``pipe.lockstep_buffer``)."""
-        self.buffer = lockstep_buffer(m, self.units, self._runs, self.units[self._last].o,
-                                      self.i, self.o)
+    def _taken(self):
+        """The pixel entering the first unit: ``i``'s payload, valid when it is taken."""
+        return _Entry(self.i.valid & self.i.ready, self.i.payload)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg
         vectors = [v for v, _ in light_layout(cfg)]
         if "fetch" in u:
-            _feed(m, self.i, u["fetch"].i)
+            _feed(m, self._taken(), u["fetch"].i)
             src = u["fetch"].o
         else:
-            src = self.i
+            src = self._taken()
         rot_layer, ill_layer = self._rot_layer, self._ill_layer
         poly = self._poly_reg(m) if s.rotation == "per-polygon" else None
-        _lockstep(m, src, [u[n].i for n in rot_layer])
+        _same_valid(m, src, [u[n].i for n in rot_layer])
         if "rotation" in u:
             m.d.comb += [u["rotation"].i.payload[f].eq(src.payload[f])
                          for f, _ in pixel_layout(cfg)]
@@ -460,7 +460,7 @@ class BumpPipeline(wiring.Component):
         if s.texture:
             m.d.comb += u["texel_r"].i.payload.texel.eq(src.payload.texel)
         lead = u[rot_layer[0]].o
-        _lockstep(m, lead, [u[n].i for n in ill_layer])
+        _same_valid(m, lead, [u[n].i for n in ill_layer])
         n_src = u["rotation"].o.payload.n if poly is None else poly.n
         # light j's rotated l, h: light 0's from the rotation (varying map), the rest from terms
         rotated = ([u["rotation"].o.payload] if "rotation" in u else []) + \
@@ -475,7 +475,7 @@ class BumpPipeline(wiring.Component):
         if s.lights == 1 and not s.texture:
             return
         total = u["blend"] if s.texture else u["lightsum"]
-        _lockstep(m, lead, [total.i])
+        _same_valid(m, lead, [total.i])
         for j, n in enumerate(ill_layer[:s.lights]):
             m.d.comb += [total.i.payload.d[j].eq(u[n].o.payload.diffuse_fine),
                          total.i.payload.s[j].eq(u[n].o.payload.specular_fine)]
@@ -486,7 +486,7 @@ class BumpPipeline(wiring.Component):
     def _elaborate_palette(self, m):
         """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel."""
         lut, f = self.units["palette"], self.units["fetch"]
-        m.d.comb += [f.i.valid.eq(self.i.valid), f.i.payload.bank.eq(lut.bank)]
+        m.d.comb += [f.i.valid.eq(self._taken().valid), f.i.payload.bank.eq(lut.bank)]
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
         if self.scene.texture:                 # Tarini eq. 2: the texel is the base colour
             m.d.comb += [lut.i.valid.eq(f.o.valid), lut.i.payload.index.eq(f.o.payload.index),

@@ -12,7 +12,7 @@ from bumprtl.rtl.methods import get
 __all__ = ["VectorRotation"]
 
 
-def VectorRotation(cfg: Config, target=None, lockstep=None):
+def VectorRotation(cfg: Config, target=None, credit=True, fifo_depth=None):
     """Per-pixel rotation into the tangent frame of N: an instance of
     ``methods.get(cfg.method).rotation`` (a ``wiring.Component``).
 
@@ -24,4 +24,4 @@ def VectorRotation(cfg: Config, target=None, lockstep=None):
     tag), Cartesian vectors for Peercy and Ernst. ``latency`` depends on the method;
     1 pixel per clock. ``target``: None (generic) or ``pipe.ECP5()``.
     """
-    return get(cfg.method).rotation(cfg, target=target, lockstep=lockstep)
+    return get(cfg.method).rotation(cfg, target=target, credit=credit, fifo_depth=fifo_depth)

@@ -123,15 +123,15 @@ class IlluminationDatapath(PipeUnit):
 
     dot_latency = None
 
-    def __init__(self, cfg: Config, in_layout, target=None, lockstep=None):
-        super().__init__(cfg, in_layout, shade_layout(cfg), target, lockstep)
+    def __init__(self, cfg: Config, in_layout, target=None, credit=True, fifo_depth=None):
+        super().__init__(cfg, in_layout, shade_layout(cfg), target, credit, fifo_depth)
 
     @property
     def latency(self):
         return self.dot_latency + SHADE_LATENCY
 
     def build(self, m, pipe):
-        i, o = self.i.payload, self.o.payload
+        i, o = self.i.payload, pipe.o.payload
         dots = self.dots(m, pipe, i)
         shade = shade_stages(m, pipe, self.cfg, dots["l"], dots.get("h", 0))
         m.d.comb += [o[k].eq(v) for k, v in shade.items()]
@@ -145,10 +145,10 @@ class BackEnd(IlluminationDatapath):
 
     dot_latency = 1
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         b = cfg.frac_bits
         super().__init__(cfg, data.StructLayout({"l": signed(b + 2), "h": signed(b + 2),
-                                                 "tag": unsigned(cfg.tag_bits)}), target, lockstep)
+                                                 "tag": unsigned(cfg.tag_bits)}), target, credit, fifo_depth)
 
     def dots(self, m, pipe, payload):
         return {v: pipe.register(payload[v], f"{v}_dot") for v in ("l", "h")}

@@ -1,12 +1,11 @@
 """Quarter-wave sine/cosine unit: the toolchain vertical slice (docs/architecture.md, Number formats)."""
 
-from amaranth.hdl import Cat, Const, Module, Mux, signed, unsigned
-from amaranth.lib import data, stream, wiring
+from amaranth.hdl import Cat, Const, Mux, signed, unsigned
+from amaranth.lib import data
 from amaranth.lib.memory import Memory
-from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.pipe import ROM_LATENCY, StallPipe, pipe_observer
+from bumprtl.rtl.pipe import ROM_LATENCY, PipeUnit
 from bumprtl.rtl.tables import quarter_sine, quarter_sine_above_line
 from bumprtl.rtl.targets import NEAR_BLOCKS, is_spread, rom_blocks
 
@@ -47,7 +46,7 @@ def spread_sine(cfg: Config):
     """The registered quarter-wave ROM (2**k words and the spill word, :func:`sine_rom_table`)
     is spread over more than targets.SPREAD_BLOCKS block RAMs (16-bit angles at B = 16:
     fourteen 16384 x 1 blocks of the sine above its line): its clock enable is a flip-flop of
-    its own (pipe.StallPipe.rom)."""
+    its own (pipe.Pipe.rom)."""
     return is_spread(1 << cfg.k, sine_rom_table(cfg)[1])
 
 
@@ -114,7 +113,7 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
         negative = pipe.delay(quadrant[1], 2 + near + ROM_LATENCY, f"{name}_negative")
         value = pipe.register(port.data, f"{name}_data")
     else:
-        m.d.comb += [port.addr.eq(address), port.en.eq(pipe.adv)]
+        m.d.comb += [port.addr.eq(address), port.en.eq(pipe.en)]
         negative = pipe.register(quadrant[1], f"{name}_negative")
         value = port.data
     return pipe.register(Mux(negative, -value, value), name)
@@ -141,7 +140,7 @@ def _sine_above_line(pipe, port, address, negative, cfg: Config, name, near):
     return pipe.register(value[:cfg.sincos_width].as_signed(), name)
 
 
-class SinCos(wiring.Component):
+class SinCos(PipeUnit):
     """Sine and cosine of a binary angle from one quarter-wave ROM.
 
     Parameters
@@ -162,39 +161,25 @@ class SinCos(wiring.Component):
     output register, data register, sign); throughput 1 angle per clock when not stalled.
     """
 
-    def __init__(self, cfg: Config, target=None):
-        self.cfg, self.target, self.memories = cfg, target, {}
-        super().__init__({
-            "i": In(stream.Signature(data.StructLayout({
-                "angle": unsigned(cfg.angle_bits),
-                "tag": unsigned(cfg.tag_bits),
-            }))),
-            "o": Out(stream.Signature(data.StructLayout({
-                "sin": signed(cfg.sincos_width),
-                "cos": signed(cfg.sincos_width),
-                "tag": unsigned(cfg.tag_bits),
-            }))),
-        })
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
+        self.latency = registered_sine_latency(cfg)
+        super().__init__(cfg, data.StructLayout({"angle": unsigned(cfg.angle_bits),
+                                                 "tag": unsigned(cfg.tag_bits)}),
+                         data.StructLayout({"sin": signed(cfg.sincos_width),
+                                            "cos": signed(cfg.sincos_width),
+                                            "tag": unsigned(cfg.tag_bits)}),
+                         target, credit, fifo_depth)
 
-    @property
-    def latency(self):
-        return registered_sine_latency(self.cfg)
-
-    def elaborate(self, platform):
+    def build(self, m, pipe):
         cfg, k = self.cfg, self.cfg.k
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target,
-                         observer=pipe_observer(platform))
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
-        self.memories, self.enable_copies = pipe.memories, pipe.enable_copies
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
         outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
                                    registered=True, angle_stage=False, near=near_sine(cfg),
                                    line=sine_line(cfg))
                    for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)), strict=False)}
         m.d.comb += [
-            self.o.payload.sin.eq(outputs["sin"]),
-            self.o.payload.cos.eq(outputs["cos"]),
-            self.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag")),
+            pipe.o.payload.sin.eq(outputs["sin"]),
+            pipe.o.payload.cos.eq(outputs["cos"]),
+            pipe.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag")),
         ]
-        return m

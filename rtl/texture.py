@@ -25,13 +25,12 @@ coefficients' quantization and the floors of the products: :func:`blend_error_bo
 """
 
 import numpy as np
-from amaranth.hdl import Module, Mux, Value, ValueCastable, unsigned
-from amaranth.lib import data, stream, wiring
-from amaranth.lib.wiring import In, Out
+from amaranth.hdl import Mux, Value, ValueCastable, unsigned
+from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.fixed import round_shift
-from bumprtl.rtl.pipe import ECP5, StallPipe, pipe_observer
+from bumprtl.rtl.pipe import ECP5, PipeUnit
 from bumprtl.rtl.tables import (
     KS_FRAC_BITS,
     LIT_FRAC_BITS,
@@ -112,7 +111,7 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     ``diffuse_fine``, ``specular_fine``); ``texel``: {r, g, b} 8-bit. ``reg(value, name)`` is
     called after each stage (a pipeline register in the RTL, identity in the golden model).
     ``mul(value, other, name)`` is value * other two stages after its operands (default
-    reg(reg(value) * reg(other)); the RTL's StallPipe.multiply: one DSP block whose operand
+    reg(reg(value) * reg(other)); the RTL's Pipe.multiply: one DSP block whose operand
     registers stand for the stage-1 (stage-5) registers the products read).
     Returns ``(out, diffuse8, specular8)``: {r, g, b} and the light sums rounded to 8 bits,
     min(255, round(255 sum d_j)) and min(255, round(sum s_j / 2**F)), these two
@@ -157,7 +156,7 @@ def blend_error_bound_lsb(cfg: Config, lights=1):
     return 0.5 + coefficient_error_lsb(cfg, lights, blend=True)
 
 
-class TextureBlend(wiring.Component):
+class TextureBlend(PipeUnit):
     """m lights' diffuse and specular terms and the texel colour -> the RGB pixel.
 
     Input {d: ArrayLayout(unsigned(B + 1), lights), s: ArrayLayout(unsigned(8 + F), lights)
@@ -169,50 +168,39 @@ class TextureBlend(wiring.Component):
 
     latency = BLEND_LATENCY
 
-    def __init__(self, cfg: Config, lights=1, target=None, lockstep=None):
-        # lockstep: None or an enable: lock-step mode (rtl/pipe.StallPipe, BumpPipeline)
-        self.cfg, self.lights, self.target, self.memories = cfg, lights, target, {}
-        self.lockstep = lockstep
+    def __init__(self, cfg: Config, lights=1, target=None, credit=True, fifo_depth=None):
+        self.lights = lights
         u8, tag = unsigned(8), unsigned(cfg.tag_bits)
         fields = {"d": data.ArrayLayout(unsigned(cfg.frac_bits + 1), lights),
                   "s": data.ArrayLayout(unsigned(8 + SPEC_FRAC_BITS), lights),
                   "texel": rgb_layout(cfg), "tag": tag}
         out = {"diffuse": u8, "specular": u8, "color": rgb_layout(cfg), "tag": tag}
-        super().__init__({"i": In(stream.Signature(data.StructLayout(fields))),
-                          "o": Out(stream.Signature(data.StructLayout(out)))})
+        super().__init__(cfg, data.StructLayout(fields), data.StructLayout(out), target, credit,
+                         fifo_depth)
 
-    def elaborate(self, platform):
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
+    def build(self, m, pipe):
         px = self.i.payload
         color, d, s = texture_blend([px.d[j] for j in range(self.lights)],
                                     [px.s[j] for j in range(self.lights)],
                                     {c: px.texel[c] for c in RGB}, self.cfg, pipe.register,
                                     pipe.multiply)
-        o = self.o.payload
+        o = pipe.o.payload
         m.d.comb += [o.color[c].eq(color[c]) for c in RGB]
         m.d.comb += [o.diffuse.eq(pipe.delay(d, self.latency - SUMS8_STAGE, "diffuse")),
                      o.specular.eq(pipe.delay(s, self.latency - SUMS8_STAGE, "specular")),
                      o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
-        return m
 
 
-class TexelDelay(wiring.Component):
+class TexelDelay(PipeUnit):
     """The fetched texel carried beside a layer of ``latency`` stages (rotation or
     illumination) in lock step, so it meets that pixel's shade at the blend.
     Input/output {texel: rgb}."""
 
 
-    def __init__(self, cfg: Config, latency, target=None, lockstep=None):
-        self.cfg, self.latency, self.target, self.memories = cfg, latency, target, {}
-        self.lockstep = lockstep          # None or an enable: lock-step mode (rtl/pipe.StallPipe)
+    def __init__(self, cfg: Config, latency, target=None, credit=True, fifo_depth=None):
+        self.latency = latency
         layout = data.StructLayout({"texel": rgb_layout(cfg)})
-        super().__init__({"i": In(stream.Signature(layout)), "o": Out(stream.Signature(layout))})
+        super().__init__(cfg, layout, layout, target, credit, fifo_depth)
 
-    def elaborate(self, platform):
-        m = Module()
-        pipe = StallPipe(m, self.i, self.o, self.latency, self.target, self.lockstep,
-                         pipe_observer(platform), getattr(self, "lockstep_next", None))
-        m.d.comb += self.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))
-        return m
+    def build(self, m, pipe):
+        m.d.comb += pipe.o.payload.texel.eq(pipe.delay(self.i.payload.texel, self.latency, "texel"))

@@ -41,15 +41,17 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     Each input is a dict ``{field: int}`` (dotted names for nested layouts). Outputs come
     back as dicts of ints in the same naming. Valid never waits on ready; the payload is held
     until it is taken (stream rules). ``pipe_handshake``: also assert, every cycle, the
-    handshake of a StallPipe (rtl/pipe.py) or a chain of them, ``i.ready == ~o.valid |
-    o.ready``: the pipe stalls only while its output is held, a bubble never stalls it (a
-    stall enable of ``o.ready`` alone is bit-exact and fails only this check).
+    credit rule of a unit or pipeline with a credit edge (rtl/pipe.CreditEdge): ``i.ready``
+    is high exactly while fewer than ``dut.fifo_depth`` pixels are inside (taken at ``i``
+    before this cycle and not taken at ``o`` before it), and an output offered and not taken
+    is offered again the next cycle (a ready that waits on ``o.ready``, or a credit lost or
+    made, is bit-exact and fails only this check).
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
     outputs = []
     limit = max_cycles or 20 * (len(inputs) + 50)
-    state = {"cycles": 0}
+    state = {"cycles": 0, "inside": 0, "held": False}
 
     async def testbench(ctx):
         in_fields = flatten_payload(dut.i.payload)
@@ -64,12 +66,17 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
                 for name, value in offered.items():
                     ctx.set(in_fields[name], value)
             ctx.set(dut.o.ready, rng.random() >= bp_p)
-            _, _, i_ready, o_valid, o_ready, *o_vals = await ctx.tick().sample(
-                dut.i.ready, dut.o.valid, dut.o.ready, *out_fields.values())
+            _, _, i_valid, i_ready, o_valid, o_ready, *o_vals = await ctx.tick().sample(
+                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, *out_fields.values())
             if pipe_handshake:
-                assert i_ready == (not o_valid or o_ready), (
-                    f"cycle {state['cycles']}: i.ready {i_ready} with o.valid {o_valid}, "
-                    f"o.ready {o_ready} (a pipe must advance when its output is empty or taken)")
+                inside = state["inside"]
+                assert bool(i_ready) == (inside < dut.fifo_depth), (
+                    f"cycle {state['cycles']}: i.ready {i_ready} with {inside} pixels inside "
+                    f"and {dut.fifo_depth} credits (ready must be exactly a free credit)")
+                assert o_valid or not state["held"], (
+                    f"cycle {state['cycles']}: an output offered and not taken was withdrawn")
+                state["inside"] += bool(i_valid and i_ready) - bool(o_valid and o_ready)
+                state["held"] = bool(o_valid and not o_ready)
             if offered is not None and i_ready:
                 offered = None
             if o_valid and o_ready:
@@ -108,7 +115,7 @@ def check_rotation(cfg, codes, pattern="no_stall", seed=0):
     dut = VectorRotation(cfg)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=seed, pipe_handshake=True)
     assert_bit_exact(out, rotation_fixed(codes, cfg), inputs)
-    return dut.latency, cycles
+    return dut.port_latency, cycles
 
 
 def check_illumination(cfg, codes, pattern="no_stall", seed=0):
@@ -119,7 +126,7 @@ def check_illumination(cfg, codes, pattern="no_stall", seed=0):
     dut = Illumination(cfg)
     out, cycles = simulate_stream(dut, inputs, pattern, seed=seed, pipe_handshake=True)
     assert_bit_exact(out, illumination_fixed(rot, cfg), inputs)
-    return dut.latency, cycles
+    return dut.port_latency, cycles
 
 
 def check_datapath(cfg, codes, pattern="no_stall", seed=0):

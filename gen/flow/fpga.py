@@ -29,7 +29,7 @@ from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.gen.tools.yosys import run_yosys
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.pipe import ECP5, lockstep_buffer, lockstep_enables
+from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, CreditEdge
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
 
@@ -125,28 +125,31 @@ def fpga_unit(name, cfg, device, work_dir, lpf=LPF):
 def pipeline_component(cfg, target=None):
     """The rotation unit feeding the illumination unit of ``cfg.method`` (one stream in,
     one out, 1 pixel per clock): what a scene with one light pays per pixel. The two units
-    run in lock step behind an output buffer (``rtl.pipe.lockstep_buffer``, as in a scene's
-    ``BumpPipeline``), so no stall enable is a chain of ``o.valid`` terms across them.
+    run free (``credit=False``) behind one credit edge (``rtl.pipe.CreditEdge``, as in a
+    scene's ``BumpPipeline``), so no enable and no ``ready`` crosses them.
     ``target``: None (generic) or ``ECP5()`` (:func:`place_component`)."""
     class Pipeline(wiring.Component):
         def __init__(self):
             self.target = target
-            self.runs = lockstep_enables(["rotation", "illumination"])
-            self.rotation = VectorRotation(cfg, target, self.runs["rotation"])
-            self.illumination = Illumination(cfg, target, self.runs["illumination"])
+            self.rotation = VectorRotation(cfg, target, credit=False)
+            self.illumination = Illumination(cfg, target, credit=False)
             self.latency = self.rotation.latency + self.illumination.latency
+            self.port_latency = self.latency + EDGE_LATENCY
             super().__init__({"i": In(self.rotation.i.signature.flip()),
                               "o": Out(self.illumination.o.signature)})
 
         def elaborate(self, platform):
             m = Module()
-            units = {"rotation": self.rotation, "illumination": self.illumination}
-            self.buffer = lockstep_buffer(m, units, self.runs, self.illumination.o, self.i, self.o)
+            m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
-            m.d.comb += [self.rotation.i.valid.eq(self.i.valid),
+            m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready),
+                         self.rotation.i.valid.eq(self.i.valid & edge.i_ready),
                          self.rotation.i.payload.eq(self.i.payload),
                          self.illumination.i.valid.eq(self.rotation.o.valid),
-                         self.illumination.i.payload.eq(self.rotation.o.payload)]
+                         self.illumination.i.payload.eq(self.rotation.o.payload),
+                         edge.core.valid.eq(self.illumination.o.valid),
+                         edge.core.payload.eq(self.illumination.o.payload)]
+            wiring.connect(m, edge.o, wiring.flipped(self.o))
             return m
 
     return Pipeline()

@@ -133,12 +133,12 @@ def _times(a, b):
 
 
 def _same(value, name):
-    """The golden model's stage: none (the RTL passes a registering one, StallPipe.register)."""
+    """The golden model's stage: none (the RTL passes a registering one, Pipe.register)."""
     return value
 
 
 # Every helper that multiplies takes ``mul``: the plain product for the golden model, a
-# registered product (StallPipe.multiply, PRODUCT_LATENCY stages) in the RTL. All the terms a
+# registered product (Pipe.multiply, PRODUCT_LATENCY stages) in the RTL. All the terms a
 # helper adds are products, so they arrive together. A helper that takes ``stage(value,
 # name)`` calls it on every value that crosses one of its steps: nothing in the golden
 # model, a register in the RTL (the arithmetic is the same either way).
@@ -268,7 +268,7 @@ def dot_sum(cc, ss, cphi, cfg: Config, mul=_times):
 # --- The datapaths ---------------------------------------------------------------------------
 
 def _multiplier(pipe, prefix):
-    """``mul`` for the helpers: each product a RegisteredProduct (StallPipe.multiply) named
+    """``mul`` for the helpers: each product a RegisteredProduct (Pipe.multiply) named
     ``{prefix}_mul{n}``, PRODUCT_LATENCY stages after its operands."""
     count = itertools.count()
     return lambda a, b: pipe.multiply(a, b, f"{prefix}_mul{next(count)}")
@@ -320,12 +320,12 @@ class KimRotation(PipeUnit):
 
     latency = 2 * S + 4 * P + 14 + 3 * R
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
-        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, lockstep)
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
+        super().__init__(cfg, pixel_layout(cfg), rotated_layout(cfg), target, credit, fifo_depth)
 
     def build(self, m, pipe):
         cfg, k = self.cfg, self.cfg.k
-        px, o = self.i.payload, self.o.payload
+        px, o = self.i.payload, pipe.o.payload
         rom = sine_rom(pipe, cfg, "n_sincos_rom", ports=4)
         n = tuple(sine_value(m, pipe, port, angle, cfg, name)
                   for port, (angle, name) in zip(rom.ports, (
@@ -393,8 +393,8 @@ class KimIllumination(IlluminationDatapath):
 
     dot_latency = REGISTERED_SINE_LATENCY + 2 * P + 2
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
-        super().__init__(cfg, rotated_layout(cfg), target, lockstep)
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
+        super().__init__(cfg, rotated_layout(cfg), target, credit, fifo_depth)
 
     def dots(self, m, pipe, payload):
         cfg, k = self.cfg, self.cfg.k

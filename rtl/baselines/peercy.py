@@ -35,9 +35,9 @@ so a transformed component needs signed(B + 5) (18 bits at B = 13: one 18x18 DSP
 square), s < 2**(2B+9), r < 2**(B+6), and |q'| <= sqrt(2) 2**B + 1 (2|a|/r <= 2 sqrt(s) /
 floor(2 sqrt(s)) <= sqrt 2 for s >= 1), which fits the signed(B + 2) output.
 
-Timing: every product is a ``StallPipe.multiply`` (operand and product registers, one
+Timing: every product is a ``Pipe.multiply`` (operand and product registers, one
 MULT18X18D on ECP5) when both operands fit one 18-bit DSP input (all 30 of them at B = 13),
-else a ``StallPipe.wide_multiply`` (a ``pipe.WideProduct``: on ECP5 17-bit limbs, one
+else a ``Pipe.wide_multiply`` (a ``pipe.WideProduct``: on ECP5 17-bit limbs, one
 MULT18X18D per pair, their sum in two registers of its own), two stages more on every
 target: the squares of the (B + 5)-bit components from B = 14, the transform and the dots of
 the (B + 2)-bit inputs from B = 17 (:func:`product_latencies`). The square root and the
@@ -150,7 +150,7 @@ def dot_latency(cfg: Config):
 
 
 def sum3_rounded(reg, p, b, name):
-    """round((p0 + p1 + p2) / 2**b) two ``reg`` stages later (``reg``: a StallPipe's
+    """round((p0 + p1 + p2) / 2**b) two ``reg`` stages later (``reg``: a Pipe's
     ``register``): one 2-operand carry chain a cycle, the rounding half of
     rtl/fixed.round_shift riding in the first, so three products leaving their DSP
     blocks are not summed in one cycle."""
@@ -261,14 +261,14 @@ class PeercyRotation(PipeUnit):
     + 5 + 22 + 18 = 51 at B = 16); 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         self.latency = rotation_latency(cfg)
-        super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target, lockstep)
+        super().__init__(cfg, setup_input_layout(cfg), setup_output_layout(cfg), target, credit, fifo_depth)
 
     def build(self, m, pipe):
         cfg, b = self.cfg, self.cfg.frac_bits
         reg = pipe.register
-        px, out = self.i.payload, self.o.payload
+        px, out = self.i.payload, pipe.o.payload
         cw, ns, nq = component_width(cfg), sqrt_stages(cfg), quotient_bits(cfg)
         ops, sq_lat = _operands(cfg), product_latencies(cfg)["square"]
         mul, square = pipe.multiplier(*ops["product"]), pipe.multiplier(*ops["square"])
@@ -288,12 +288,12 @@ class PeercyRotation(PipeUnit):
             s = reg(reg(sq[0] + sq[1], f"{v}t_len2_xy") + reg(sq[2], f"{v}t_len2_z"),
                     f"{v}t_len2")                                                    # + 2
             m.submodules[f"{v}_sqrt"] = root = PeercySqrt(square_bits(cfg) + 2)
-            m.d.comb += [root.radicand.eq(s << 2), root.en.eq(pipe.adv)]
+            m.d.comb += [root.radicand.eq(s << 2), root.en.eq(pipe.en)]
             r = root.root                                                            # + ns
             for c in AXES:
                 num = pipe.delay(mag[c], 2 + ns, f"{v}t_{c}_num").shift_left(b + 2)
                 m.submodules[f"{v}_{c}_div"] = div = PeercyDivider(len(num), len(r), nq)
-                m.d.comb += [div.dividend.eq(num), div.divisor.eq(r), div.en.eq(pipe.adv)]
+                m.d.comb += [div.dividend.eq(num), div.divisor.eq(r), div.en.eq(pipe.en)]
                 q = round_shift(div.quotient, 1)                                     # + nq
                 m.d.comb += out[v][c].eq(reg(Mux(neg[c], -q, q)[:cfg.sincos_width],
                                              f"{v}n_{c}"))                           # + 1
@@ -313,9 +313,9 @@ class PeercyIllumination(IlluminationDatapath):
     :func:`sum3_rounded`), then SHADE_LATENCY; 1 pixel per clock.
     """
 
-    def __init__(self, cfg: Config, target=None, lockstep=None):
+    def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
         self.dot_latency = dot_latency(cfg)
-        super().__init__(cfg, setup_output_layout(cfg), target, lockstep)
+        super().__init__(cfg, setup_output_layout(cfg), target, credit, fifo_depth)
 
     def dots(self, m, pipe, payload):
         n, dots = payload.np, {}

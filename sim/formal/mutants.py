@@ -13,7 +13,7 @@ from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import wiring
 
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import StallPipe
+from bumprtl.rtl.pipe import Pipe as StallPipe  # (being reworked for the credit edge)
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config

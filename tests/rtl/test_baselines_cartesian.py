@@ -14,7 +14,7 @@ from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.resources import count_component, count_verilog, multiplier_pairs
 from bumprtl.gen.flow.units import build_unit, emit_unit
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.pipe import PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
+from bumprtl.rtl.pipe import EDGE_LATENCY, PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY
 from bumprtl.rtl.shade import SHADE_LATENCY, BackEnd
 from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.amaranth_stream import check_illumination, check_rotation
@@ -161,7 +161,7 @@ def test_cli_emit_rotation_method_peercy(tmp_path, run_cli):
     assert meta.method == "peercy"
     # products and squares (B + 2 and B + 5 bits: one DSP each at B = 11), sums, the square
     # root (B + 6 stages: a bit a stage) and the divider (B + 2)
-    assert meta.latency == 2 * PRODUCT_LATENCY + 5 + (b + 6) + (b + 2)
+    assert meta.latency == 2 * PRODUCT_LATENCY + 5 + (b + 6) + (b + 2) + EDGE_LATENCY
     assert meta.error_bounds.lsb == max(fixed_peercy.predicted_error_bound_lsb(cfg, c)
                                           for c in ("diffuse", "specular", "color"))
     assert sorted(meta.input_fields) == sorted(

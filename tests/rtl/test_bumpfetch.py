@@ -57,7 +57,7 @@ def test_fetch_streams_bit_exact(keys, pattern):
     flat = {"b": lambda o: o["b.phi"] | (o["b.theta"] << scene.angle_bits), "index": lambda o: o["index"]}
     assert_bit_exact([{"word": flat[field](o), "tag": o["tag"]} for o in out], {"word": want}, payloads)
     if pattern == "no_stall":
-        assert cycles <= 500 + dut.latency + 1
+        assert cycles <= 500 + dut.port_latency + 1
 
 
 def test_host_write_port_replaces_texels():
@@ -74,7 +74,7 @@ def test_host_write_port_replaces_texels():
             await ctx.tick()
         ctx.set(dut.w_en, 0)
         ctx.set(dut.o.ready, 1)
-        for addr in [*writes] + [None] * dut.latency:
+        for addr in [*writes] + [None] * dut.port_latency:
             ctx.set(dut.i.valid, addr is not None)
             if addr is not None:
                 ctx.set(dut.i.payload.u, addr % 16), ctx.set(dut.i.payload.v, addr // 16)
@@ -184,7 +184,7 @@ def test_host_writes_reach_every_mip_level(size, levels):
             await ctx.tick()
         ctx.set(dut.w_en, 0)
         ctx.set(dut.o.ready, 1)
-        for k in [*range(len(writes)), None, None, None, None]:
+        for k in [*range(len(writes)), *[None] * dut.port_latency]:
             ctx.set(dut.i.valid, k is not None)
             if k is not None:
                 u, v, level, _ = list(writes.values())[k]

@@ -21,6 +21,7 @@ from bumprtl.rtl.palette import (
     index_bits,
     mul8,
 )
+from bumprtl.rtl.pipe import EDGE_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs, random_map
@@ -189,7 +190,8 @@ def test_emit_lint_and_sidecar(cfg, build_dir):
     v, _ = emit_unit("palette", cfg, build_dir)
     assert lint(v) == []
     dut, side, command = build_unit("palette", cfg)
-    assert side.latency == dut.latency == READ_LATENCY + cfg.palette_blend
+    assert side.latency == dut.port_latency == dut.latency + EDGE_LATENCY
+    assert dut.latency == READ_LATENCY + cfg.palette_blend
     assert side.memory_bits == 2 * cfg.palette_size * 32
     assert side.rams["table"].depth == 2 * cfg.palette_size and not side.roms
     assert f"--palette-size {cfg.palette_size}" in command

@@ -1,10 +1,12 @@
 """rtl/pipe.py's registered primitives: RegisteredProduct and RegisteredROM give the value
 of their inputs PRODUCT_LATENCY / ROM_LATENCY enabled cycles later (checked in the
 Amaranth simulator with a random enable), and their ECP5 form is the block the generic
-form stands for (DP16KD contents compared with Yosys' own block-RAM mapping). The stall
-rule ``adv = ~o.valid | o.ready`` of StallPipe is checked as a throughput property on the
-units built from it: a pipe fills while its output waits, and under traffic on both sides
-the cycle count stays within the bound derived in :func:`test_cycles_within_the_stall_bound`."""
+form stands for (DP16KD contents compared with Yosys' own block-RAM mapping). The credit
+rule of rtl/pipe.CreditEdge is checked from the ports of every kind of unit and of a
+pipeline: a pipe takes exactly ``fifo_depth`` pixels while its output waits, runs at one
+pixel a clock while the sink takes one a clock, and under traffic on both sides ``i.ready``
+is high exactly while fewer than ``fifo_depth`` pixels are inside, with every pixel out once
+and in order."""
 
 import json
 import subprocess
@@ -32,7 +34,7 @@ from bumprtl.rtl.pipe import (
     fits_dsp,
     product_latency,
 )
-from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline, LightSum
+from bumprtl.rtl.pipeline import BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import (
     REGISTERED_SINE_LATENCY,
@@ -298,7 +300,7 @@ def test_units_register_the_limb_sums_of_wide_products(cfg):
         assert _split_products(unit) == []
 
 
-# --- the stall rule as a throughput property ---------------------------------------------------
+# --- the credit rule, seen from the ports ------------------------------------------------------
 
 UNITS = {
     "sincos": lambda: SinCos(Config()),
@@ -309,14 +311,17 @@ UNITS = {
     "texture": lambda: TextureBlend(Config(), lights=2),
     "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2}).hardware),
     "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}).hardware),
+    "pipeline-deep-fifo": lambda: BumpPipeline(
+        load_scene_config({"name": "t", "texture_size": 16}).hardware, fifo_depth=40),
 }
 
 
 def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
-    """Offer ``n`` (all-zero) payloads to ``dut.i`` with input gaps of probability ``gap_p``
-    and hold ``dut.o.ready`` low with probability ``bp_p`` (valid never waits on ready);
-    returns the per-cycle samples ``(i.valid, i.ready, o.valid, o.ready)`` of every cycle
-    until the n-th output is taken, or of ``max_cycles`` cycles."""
+    """Offer ``n`` payloads, tag k on the k-th (tags wrap at the tag width), to ``dut.i``
+    with input gaps of probability ``gap_p`` and hold ``dut.o.ready`` low with probability
+    ``bp_p`` (valid never waits on ready); returns the per-cycle samples ``(i.valid, i.ready,
+    o.valid, o.ready, o.tag)`` of every cycle until the n-th output is taken, or of
+    ``max_cycles`` cycles."""
     rng = np.random.default_rng(seed)
     samples = []
 
@@ -326,10 +331,11 @@ def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
             if not offered and pending and rng.random() >= gap_p:
                 offered = True
             ctx.set(dut.i.valid, offered)
+            ctx.set(dut.i.payload.tag, n - pending)
             ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
-            _, _, i_valid, i_ready, o_valid, o_ready = await ctx.tick().sample(
-                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready)
-            samples.append((bool(i_valid), bool(i_ready), bool(o_valid), bool(o_ready)))
+            _, _, i_valid, i_ready, o_valid, o_ready, tag = await ctx.tick().sample(
+                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, dut.o.payload.tag)
+            samples.append((bool(i_valid), bool(i_ready), bool(o_valid), bool(o_ready), int(tag)))
             if i_valid and i_ready:
                 offered, pending = False, pending - 1
             if o_valid and o_ready:
@@ -345,39 +351,53 @@ def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
 
 
 @pytest.mark.parametrize("unit", list(UNITS))
-def test_pipe_fills_while_its_output_waits(unit):
-    """o.ready low from reset, a pixel offered every cycle: the pipe accepts exactly
-    ``latency`` pixels (one per stage; a chain of pipes, its total latency; a BumpPipeline
-    also fills its BUFFER_DEPTH-entry output buffer) and then holds. With ``adv = o.ready``
-    it would accept none: nothing moves while the consumer waits."""
+def test_pipe_takes_its_credits_while_its_output_waits(unit):
+    """o.ready low from reset, a pixel offered every cycle: the unit takes exactly
+    ``fifo_depth`` pixels (one per credit) and then holds ``i.ready`` low; its first output
+    appears ``port_latency`` cycles after the first pixel was taken."""
     dut = UNITS[unit]()
-    holds = dut.latency + (BUFFER_DEPTH if isinstance(dut, BumpPipeline) else 0)
-    samples = run_traffic(dut, dut.latency + 20, 0.0, 1.0, 0, max_cycles=dut.latency + 20)
-    accepted = sum(v and r for v, r, _, _ in samples)
-    assert accepted == holds, (unit, accepted, holds)
-    assert samples[-1][2] and not any(o_valid for _, _, o_valid, _ in samples[:dut.latency])
+    cycles = dut.fifo_depth + dut.port_latency + 20
+    samples = run_traffic(dut, cycles, 0.0, 1.0, 0, max_cycles=cycles)
+    accepted = sum(v and r for v, r, *_ in samples)
+    assert accepted == dut.fifo_depth, (unit, accepted, dut.fifo_depth)
+    first = next(c for c, s in enumerate(samples) if s[2])
+    assert first == dut.port_latency, (unit, first)
+    assert all(s[2] for s in samples[first:])              # held, never withdrawn
 
 
 @pytest.mark.parametrize("unit", list(UNITS))
-def test_cycles_within_the_stall_bound(unit):
-    """Traffic on both sides (sim/traffic.py ``both``). Every cycle either hands over an
-    output (N of them), or holds an output that is not taken (S: o.valid, not o.ready), or
-    has no output (E: not o.valid). With ``adv = ~o.valid | o.ready`` a cycle without output
-    advances the pipe and drops one bubble off its end; the bubbles ahead of the last pixel
-    are the L stages empty at reset plus one per cycle without input before the last pixel
-    is taken (G), so E <= L + G and the whole run takes at most N + L + S + G cycles. A pipe
-    that does not advance while empty and not ready breaks it."""
-    gap_p, bp_p = PATTERNS["both"]
+def test_one_pixel_a_clock_while_the_sink_takes_one(unit):
+    """No gaps, no backpressure: ``n`` pixels are through in ``port_latency + n`` cycles and
+    ``i.ready`` never falls (the credits cover the loop: min_fifo_depth)."""
+    dut = UNITS[unit]()
+    n = 3 * dut.fifo_depth
+    samples = run_traffic(dut, n, 0.0, 0.0, 1, max_cycles=4 * (n + dut.port_latency))
+    assert len(samples) == dut.port_latency + n, (unit, len(samples))
+    assert all(r for _, r, *_ in samples[:n]), unit
+
+
+@pytest.mark.parametrize("unit", list(UNITS))
+@pytest.mark.parametrize("pattern", ["input_gaps", "backpressure", "both"])
+def test_ready_is_a_free_credit_and_no_pixel_is_lost(unit, pattern):
+    """Traffic (sim/traffic.py): in every cycle ``i.ready`` is high exactly while fewer than
+    ``fifo_depth`` pixels are inside (taken before this cycle, minus those taken from ``o``
+    before it: a credit comes back the cycle after its pixel leaves), ``o.valid`` once high
+    stays high until taken, and the pixels leave once each, in order."""
+    gap_p, bp_p = PATTERNS[pattern]
     dut = UNITS[unit]()
     n = 200
     samples = run_traffic(dut, n, gap_p, bp_p, seed=list(UNITS).index(unit),
-                          max_cycles=20 * (n + dut.latency))
-    taken = sum(o_valid and o_ready for _, _, o_valid, o_ready in samples)
-    assert taken == n, (unit, taken)
-    last_in = max(c for c, (v, r, _, _) in enumerate(samples) if v and r)
-    held = sum(o_valid and not o_ready for _, _, o_valid, o_ready in samples)
-    gaps = sum(not v for v, _, _, _ in samples[:last_in])
-    assert len(samples) <= n + dut.latency + held + gaps, (unit, len(samples), held, gaps)
+                          max_cycles=20 * (n + dut.port_latency))
+    inside, tags = 0, []
+    for c, (v, r, ov, orr, tag) in enumerate(samples):
+        assert r == (inside < dut.fifo_depth), (unit, c, inside)
+        if c and samples[c - 1][2] and not samples[c - 1][3]:
+            assert ov, (unit, c)                            # an offered pixel stays offered
+        inside += (v and r) - (ov and orr)
+        if ov and orr:
+            tags.append(tag)
+    width = len(dut.o.payload.tag)
+    assert tags == [k % (1 << width) for k in range(n)], unit
 
 
 @pytest.mark.parametrize("angle_bits,frac_bits", [(a, b) for a in (10, 12, 13, 14, 15, 16)
@@ -403,48 +423,17 @@ def test_spread_rule_follows_the_roms_block_count(angle_bits, frac_bits):
     assert SinCos(cfg).latency == REGISTERED_SINE_LATENCY + near
 
 
-def _enable_copies(dut):
-    """A simulator of ``dut`` (its construction elaborates the units' pipes) and every
-    unit's lock-step enable with the block-RAM enable copies its pipe made."""
-    sim = Simulator(dut)
-    return sim, {name: (unit.lockstep, getattr(unit, "enable_copies", []))
-                 for name, unit in dut.units.items()}
-
-
-def test_spread_memories_run_on_enable_copies_equal_to_their_units_enable():
-    """The full scene's map (15 blocks) and texture (12 blocks) are spread: in its
-    BumpPipeline each gets a flip-flop enable of its own (rtl/pipe.StallPipe.rom / ram), which
-    must equal its unit's enable in every cycle under traffic on both sides, and their reads
-    take the extra address register (one more stage in the fetch). Its sine ROMs at 15-bit
+def test_spread_memories_take_one_more_address_register():
+    """The full scene's map (15 blocks) and texture (12 blocks) are spread: their reads take
+    the extra address register (one more stage in the fetch). Its sine ROMs at 15-bit
     angles and B = 16 hold the sine above its line, seven blocks: not spread, but wider than
     NEAR_BLOCKS, so their reads take the extra address register too (one more stage in the
-    rotation). The default scene's memories (at most seven blocks) get no enable copy."""
+    rotation)."""
     dut = BumpPipeline(load_scene_config("full").hardware)
-    sim, units = _enable_copies(dut)
-    copies = [(name, run, c) for name, (run, cs) in units.items() for c in cs]
-    per_unit = {name: len(cs) for name, (_, cs) in units.items() if cs}
-    assert per_unit == {"fetch": 2}, per_unit
-    for name, _, copy in copies:           # each copy is named after its memory: "<memory>_run"
-        mem = dut.units[name].memories[copy.name.removesuffix("_run")]
-        words = mem["depth"] - (mem["depth"] % 2 == 1 and mem["depth"] > 1)   # the spill word
-        assert rom_blocks(words, mem["width"]) > SPREAD_BLOCKS, (name, copy.name, mem)
     narrow = BumpPipeline(load_scene_config("default").hardware)
-    assert not any(cs for _, cs in _enable_copies(narrow)[1].values())
+    Fragment.get(dut, None)                 # elaborates the units: their memories' record
+    spread = {name: mem for name, mem in dut.units["fetch"].memories.items()
+              if rom_blocks(mem["depth"], mem["width"]) > SPREAD_BLOCKS}
+    assert set(spread) == {"map", "texture"}, dut.units["fetch"].memories
     for name in ("fetch", "rotation"):
         assert dut.units[name].latency == narrow.units[name].latency + 1, name
-
-    gap_p, bp_p = PATTERNS["both"]
-    rng = np.random.default_rng(5)
-    differ = []
-
-    async def bench(ctx):
-        for cycle in range(6 * dut.latency):
-            ctx.set(dut.i.valid, bool(rng.random() >= gap_p))
-            ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
-            await ctx.tick()
-            differ.extend((cycle, name) for name, run, c in copies if ctx.get(c) != ctx.get(run))
-
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
-    assert not differ, differ[:5]

@@ -18,7 +18,7 @@ from bumprtl.gen.flow.units import emit_unit
 from bumprtl.rtl.layouts import layout_fields, light_keys, light_layout
 from bumprtl.rtl.methods import PER_PIXEL
 from bumprtl.rtl.palette import index_bits
-from bumprtl.rtl.pipeline import BUFFER_DEPTH, BumpPipeline
+from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel
@@ -263,9 +263,9 @@ def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys
 
 
 def test_one_consumer_stall_does_not_stop_the_input():
-    """With the output buffer empty, o.ready low for one cycle parks one pixel in the buffer
-    and i.ready stays high (the enable only falls once the buffer is full); held low, the
-    pipe fills up to latency + BUFFER_DEPTH pixels and i.ready falls."""
+    """o.ready low for one cycle parks one pixel in the FIFO and i.ready stays high (a
+    credit is free: the FIFO has room beyond the loop's pixels); held low, the pipe takes
+    exactly fifo_depth pixels (its credits) and i.ready falls."""
     scene = load_scene_config({"name": "t", "texture_size": 16})
     dut = BumpPipeline(scene.hardware)
     n = dut.latency
@@ -273,7 +273,8 @@ def test_one_consumer_stall_does_not_stop_the_input():
     assert all(readies) and len(tags) == 3 * n - n - 1
     dut = BumpPipeline(scene.hardware)
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: False)
-    assert tags == [] and sum(readies) == n + BUFFER_DEPTH and not any(readies[n + BUFFER_DEPTH:])
+    d = dut.fifo_depth
+    assert tags == [] and sum(readies) == d and not any(readies[d:])
 
 
 def _plan(keys):

@@ -37,7 +37,7 @@ def test_one_angle_per_clock_without_stalls():
     cfg = Config(angle_bits=8, frac_bits=8, tag_bits=8)
     dut = SinCos(cfg)
     _, cycles = simulate_stream(dut, [{"angle": a, "tag": 0} for a in range(200)], "no_stall")
-    assert cycles == 200 + dut.latency
+    assert cycles == 200 + dut.port_latency
 
 
 def test_exhaustive_sine_above_line():

@@ -93,7 +93,7 @@ def _unit_bit_exact(cfg, lights, pattern, n):
 def test_unit_bit_exact(pattern):
     dut, cycles, n = _unit_bit_exact(Config(lights=2), 2, pattern, 300)
     if pattern == "no_stall":
-        assert cycles <= n + dut.latency + 1
+        assert cycles <= n + dut.port_latency + 1
 
 
 @pytest.mark.parametrize("frac_bits, lights", [(13, 1), (13, 2), (16, 1), (16, 3)])

@@ -28,7 +28,7 @@ def test_cli_emits_header_sidecar_and_lints_clean(tmp_path):
     meta = load_sidecar(out / "bumprtl_sincos.json")
     unit = SinCos(Config())
     unit._MustUse__silence = True                  # read for its latency only, never elaborated
-    assert meta.config["angle_bits"] == 12 and meta.latency == unit.latency
+    assert meta.config["angle_bits"] == 12 and meta.latency == unit.port_latency
     assert meta.roms["quarter_sine"].depth == 1025
     assert {"clk", "rst", "i__payload", "i__valid", "i__ready", "o__payload", "o__valid", "o__ready"} <= set(meta.ports)
     assert lint(out / "bumprtl_sincos.v") == []

@@ -117,4 +117,4 @@ def test_the_latency_the_page_states_is_the_simulated_one():
     sim.add_testbench(bench)
     sim.run()
     assert seen["reset"] == (1, 0)                     # after reset: in_ready high, out_valid low
-    assert seen["edges"] == dut.latency
+    assert seen["edges"] == dut.port_latency
