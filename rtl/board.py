@@ -13,11 +13,12 @@ registers). Per pixel of the active raster, in order:
    computed outside rtl/ and passed in; so is the bump map (the pipeline's block-RAM
    initial contents).
 2. The scene's :class:`~bumprtl.rtl.pipeline.BumpPipeline` shades it.
-3. An elastic buffer (``amaranth.lib.fifo.SyncFIFOBuffered``) of ``depth`` pixels sits between
-   the pipeline and the scan-out. The source runs ahead of the display on credits: it
-   issues a pixel only while (pixels issued - pixels shown) < ``depth``, so the buffer
-   never overflows and the pipeline is never stalled (its ``o.ready`` is the buffer's
-   ``w_rdy``, always high). ``depth`` >= latency + 8 keeps the display fed
+3. The pipeline's own credit edge is the elastic buffer: its FIFO, ``depth`` pixels deep
+   (the pipeline's ``fifo_depth``), sits between its last unit and the scan-out, and the
+   source runs ahead of the display on the pipeline's credits: it offers a pixel every
+   cycle and the pipeline takes it while a credit is free (``i.ready``), so the FIFO never
+   overflows; the display takes ``o`` while it shows the active raster (``o.ready`` =
+   ``de``). ``depth`` = latency + BUFFER_MARGIN keeps the display fed
    (:func:`buffer_depth`, docs/board.md has the derivation); ``underflow`` (sticky) says if
    it ever was not, ``order_error`` (sticky) if a pixel reached the screen out of order (the
    pipeline's tag carries the pixel count).
@@ -35,7 +36,6 @@ k) and ``tmds_clk_p``.
 from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Mux, Signal
 from amaranth.lib import wiring
 from amaranth.lib.cdc import ResetSynchronizer
-from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.pipeline import BumpPipeline
@@ -126,11 +126,14 @@ class BoardCore(Elaboratable):
     source's light step."""
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
-                 target=None):
+                 target=None, depth=None):
+        """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
+        below ``min_fifo_depth`` of the latency the pipeline refuses it)."""
         self.mode = mode
-        self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target)
+        self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target,
+                                     fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
-        self.depth = buffer_depth(self.pipeline.latency)
+        self.depth = self.pipeline.fifo_depth
         self.source = PixelSource(self.pipeline, mode, constants, table)
         self.underflow = Signal()
         self.order_error = Signal()
@@ -142,29 +145,23 @@ class BoardCore(Elaboratable):
         m.submodules.pipeline = p
         m.submodules.source = src = self.source
         m.submodules.timing = t = VideoTiming(self.mode)
-        m.submodules.buffer = fifo = SyncFIFOBuffered(width=24 + tag_bits, depth=self.depth)
         # the pixel's colour: grey from the shade, or the colour-texture blend's RGB
         o = p.o.payload
         if self.scene.texture:
             rgb = Cat(o.color.b, o.color.g, o.color.r)
         else:
             rgb = Cat(o.color, o.color, o.color)
-        m.d.comb += [fifo.w_data.eq(Cat(rgb, o.tag)), fifo.w_en.eq(p.o.valid),
-                     p.o.ready.eq(fifo.w_rdy)]
-        # credits: pixels issued and not yet shown
-        credit = Signal(range(self.depth + 1), name="in_flight")
-        take = t.de & fifo.r_rdy
-        issue = p.i.valid & p.i.ready
-        m.d.comb += [src.allow.eq(credit < self.depth), fifo.r_en.eq(t.de)]
-        m.d.sync += credit.eq(credit + issue - take)
+        # the source offers a pixel every cycle; the pipeline's credits decide when it is taken
+        take = t.de & p.o.valid
+        m.d.comb += [src.allow.eq(1), p.o.ready.eq(t.de)]
         shown = Signal(tag_bits, name="shown_count")
         with m.If(take):
             m.d.sync += shown.eq(shown + 1)
-            with m.If(fifo.r_data[24:] != shown):
+            with m.If(o.tag != shown):
                 m.d.sync += self.order_error.eq(1)
-        with m.If(t.de & ~fifo.r_rdy):
+        with m.If(t.de & ~p.o.valid):
             m.d.sync += self.underflow.eq(1)
-        pixel = Mux(take, fifo.r_data[:24], 0)        # bytes: blue, green, red
+        pixel = Mux(take, rgb, 0)                     # bytes: blue, green, red
         words = []
         for lane in range(3):
             enc = TMDSEncoder()

@@ -228,8 +228,8 @@ class BumpPipeline(wiring.Component):
     ``latency`` is the sum of the units' latencies (the free-running chain);
     ``port_latency`` adds the edge's EDGE_LATENCY (a pixel taken at ``i`` is offered at
     ``o`` that many cycles later with the FIFO empty); 1 pixel per clock while the sink
-    takes one per clock. ``fifo_depth`` (None: the least, ``min_fifo_depth(latency)``) is
-    the FIFO's depth and the number of credits.
+    takes one per clock. ``fifo_depth`` (None: the least, ``min_fifo_depth(latency)``; or a
+    function of ``latency`` giving it) is the FIFO's depth and the number of credits.
     ``built`` lists the units and why each was built; after elaboration ``memories`` lists
     every unit's memories (``unit.name`` -> depth, width, bits).
 
@@ -260,6 +260,8 @@ class BumpPipeline(wiring.Component):
         ports["i"] = In(stream.Signature(in_layout))
         out_layout = self.units[self._last].o.payload.shape()
         ports["o"] = Out(stream.Signature(out_layout))
+        if callable(fifo_depth):                    # a function of the latency
+            fifo_depth = fifo_depth(self.latency)
         try:
             self.fifo_depth = check_fifo_depth(self.latency, fifo_depth)
         except BumpError:

@@ -61,11 +61,11 @@ def bram_budget(scene, mode, device):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
     tables (as gen/flow/memories.check_fits counts them), the light table, the
     elastic buffer; and the device's."""
-    p = BumpPipeline(scene.hardware)
+    p = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
     maps, tables = memory_blocks(unit_memories(p))
     need = {"map": maps, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
-            "buffer": bram_blocks(buffer_depth(p.latency), 24 + scene.tag_bits)}
+            "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
     return need, DEVICE_BRAM[device]
 
 

@@ -49,7 +49,7 @@ __all__ = ["Counts", "SCRIPT", "count_netlist", "count_verilog",
 
 # The coarse, technology-independent synthesis the counts are taken from (memories kept as
 # memories).
-SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt *_div; flatten; "
+SCRIPT = ("proc; opt_expr; opt_clean; setattr -mod -set keep_hierarchy 1 *sqrt *_div *.edge; flatten; "
           "opt; wreduce; alumacc; opt; memory -nomap; opt_clean")
 
 _FF_TYPES = {"$dff", "$dffe", "$adff", "$adffe", "$sdff", "$sdffe", "$sdffce", "$aldff",

@@ -1,12 +1,12 @@
-"""rtl/board.py's elastic buffer at its derived least depth and the light table's wrap, in
-the Amaranth simulator.
+"""rtl/board.py's elastic buffer (the pipeline's own credit FIFO) at its derived least
+depth and the light table's wrap, in the Amaranth simulator.
 
 The buffer (docs/board.md, "The elastic buffer"): the display taking pixel n at clock t
 returns a credit; the source issues pixel n + D with it one clock later (the registered
 credit count), the pipeline gives it back L clocks after that (its ``latency``), and
 ``SyncFIFOBuffered`` shows an entry FIFO_DELAY clocks after its write. The display wants
 pixel n + D at clock t + D, so on a line longer than the buffer D >= 1 + L + FIFO_DELAY is
-needed and enough. The reduced mode's 32-pixel lines hide a shallow buffer (a line is over
+needed and enough: rtl/pipe.min_fifo_depth, below which the pipeline refuses the depth. The reduced mode's 32-pixel lines hide a shallow buffer (a line is over
 before the shortage shows), so the check runs a mode with lines longer than the buffer and
 blanking shorter than the pipeline.
 
@@ -25,6 +25,8 @@ from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.board import board_data
 from bumprtl.rtl.board import BoardCore, PixelSource, buffer_depth, payload_field
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipe import min_fifo_depth
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import STEPS, frame_inputs, light_table
@@ -84,9 +86,7 @@ def run_core(scene, data, mode, depth=None):
     """(underflow, order_error) after one frame of BoardCore in ``mode`` with the buffer
     ``depth`` deep (its own depth when None)."""
     words, constants, table, texels = data
-    core = BoardCore(scene.hardware, mode, words, constants, table, texels)
-    if depth is not None:
-        core.depth = depth
+    core = BoardCore(scene.hardware, mode, words, constants, table, texels, depth=depth)
     flags = []
 
     async def bench(ctx):
@@ -100,13 +100,16 @@ def run_core(scene, data, mode, depth=None):
     return tuple(flags)
 
 
-def test_buffer_at_its_least_depth_keeps_long_lines_fed_and_starves_one_below(scene_data):
+def test_buffer_at_its_least_depth_keeps_long_lines_fed_and_one_below_is_refused(scene_data):
     scene, data = scene_data
     latency = unelaborated_pipeline(scene).latency
     least = 1 + latency + FIFO_DELAY
+    assert min_fifo_depth(latency) == least
     mode = long_line_mode(least, latency)
     assert run_core(scene, data, mode, least) == (0, 0)
-    assert run_core(scene, data, mode, least - 1)[0] == 1, "one below the least depth starves"
+    words, constants, table, texels = data
+    with pytest.raises(BumpError, match=f"fifo_depth {least - 1} is below the minimum {least}"):
+        BoardCore(scene.hardware, mode, words, constants, table, texels, depth=least - 1)
 
 
 def test_board_buffer_depth_keeps_long_lines_fed(scene_data):

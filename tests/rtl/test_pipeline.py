@@ -119,7 +119,7 @@ def run(scene, n, pattern, seed=0):
     payloads = as_payload_list(inputs)
     out, cycles = simulate_stream(_Host(dut, polygon, table), payloads, pattern, seed=seed)
     assert_bit_exact(out, golden, payloads)
-    return cycles, dut.latency
+    return cycles, dut.port_latency
 
 
 def pairwise(combos):
@@ -213,12 +213,13 @@ def _ports(dut, cycles, valid, ready):
     (held until taken), ``o.ready`` = ``ready(cycle)``, consecutive tags. Every cycle, before
     choosing ``o.ready``, the pipeline's stream rule is checked: ``i.ready``, ``o.valid`` and
     ``o.payload`` are the same whether ``o.ready`` is 0 or 1 in that cycle, and ``i.ready``
-    is high whenever ``o.valid`` is low. Returns (i.ready per cycle, tags out)."""
+    is high exactly while fewer than ``fifo_depth`` pixels are inside (a free credit).
+    Returns (i.ready per cycle, tags out)."""
     top = 1 << len(dut.i.payload.tag)
     readies, tags = [], []
 
     async def testbench(ctx):
-        sent, offered = 0, False
+        sent, offered, inside = 0, False, 0
         for cycle in range(cycles):
             offered = offered or valid(cycle)
             ctx.set(dut.i.valid, offered)
@@ -230,12 +231,14 @@ def _ports(dut, cycles, valid, ready):
                              ctx.get(dut.o.payload.as_value())))
             assert seen[0] == seen[1], f"cycle {cycle}: i.ready/o.valid/o.payload follow o.ready"
             i_ready, o_valid, _ = seen[0]
-            assert o_valid or i_ready, f"cycle {cycle}: i.ready low while o.valid low"
+            assert i_ready == (inside < dut.fifo_depth), \
+                f"cycle {cycle}: i.ready {i_ready} with {inside} of {dut.fifo_depth} inside"
             ctx.set(dut.o.ready, ready(cycle))
             if o_valid and ready(cycle):
                 tags.append(ctx.get(dut.o.payload.tag))
+                inside -= 1
             if offered and i_ready:
-                offered, sent = False, sent + 1
+                offered, sent, inside = False, sent + 1, inside + 1
             readies.append(i_ready)
             await ctx.tick()
 
@@ -248,9 +251,9 @@ def _ports(dut, cycles, valid, ready):
 
 @pytest.mark.parametrize("keys", [{"lights": 2, "texture": True}, {"shading": "palette"},
                                   {"bump_map": "flat"}], ids=["lights2-texture", "palette", "flat"])
-def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys):
-    """The pipeline's handshake (units in lock step, output buffer): per cycle i.ready does
-    not depend on o.ready and is high whenever o.valid is low; o.valid and o.payload do not
+def test_ready_is_a_free_credit_and_never_waits_on_o_ready(keys):
+    """The pipeline's handshake (free-running units, one credit edge): per cycle i.ready does
+    not depend on o.ready and is high exactly while a credit is free; o.valid and o.payload do not
     depend on o.ready; under random gaps and backpressure every pixel comes out once, in
     order (the payloads are checked bit for bit by test_stalls_lose_nothing)."""
     scene = load_scene_config({"name": "t", "texture_size": 16, **keys})
@@ -262,15 +265,20 @@ def test_ready_is_high_while_the_output_is_empty_and_never_waits_on_o_ready(keys
     assert len(tags) > 100 and tags == [n % top for n in range(len(tags))]
 
 
-def test_one_consumer_stall_does_not_stop_the_input():
-    """o.ready low for one cycle parks one pixel in the FIFO and i.ready stays high (a
-    credit is free: the FIFO has room beyond the loop's pixels); held low, the pipe takes
-    exactly fifo_depth pixels (its credits) and i.ready falls."""
+def test_one_consumer_stall_costs_one_input_cycle_at_the_least_depth():
+    """At the least FIFO depth every credit is in the loop at full rate, so o.ready low for
+    one cycle holds one credit back and i.ready falls for exactly one cycle; one entry more
+    and the same stall does not reach the input. Held low, the pipe takes exactly
+    fifo_depth pixels (its credits) and i.ready falls."""
     scene = load_scene_config({"name": "t", "texture_size": 16})
     dut = BumpPipeline(scene.hardware)
-    n = dut.latency
-    readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: c != n + 2)
-    assert all(readies) and len(tags) == 3 * n - n - 1
+    n = dut.port_latency
+    stall = 2 * n
+    readies, tags = _ports(dut, 4 * n, lambda c: True, lambda c: c != stall)
+    assert [c for c, r in enumerate(readies) if not r] == [stall + 1], readies
+    deeper = BumpPipeline(scene.hardware, fifo_depth=dut.fifo_depth + 1)
+    readies, tags = _ports(deeper, 4 * n, lambda c: True, lambda c: c != stall)
+    assert all(readies) and len(tags) == 4 * n - n - 1
     dut = BumpPipeline(scene.hardware)
     readies, tags = _ports(dut, 3 * n, lambda c: True, lambda c: False)
     d = dut.fifo_depth
