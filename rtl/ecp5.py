@@ -144,6 +144,32 @@ def dp16kd_rom_block(m, name, words, bits, shift, en, reads):
     return outs
 
 
+def _rom_columns(m, rom, mode, sides, name):
+    """The first ``words`` of ``rom``'s table in DP16KD blocks of ``mode`` (bits, words,
+    shift) side by side for the width, read through ``sides`` ((side, port) pairs), the
+    block of column c named ``name(c)``: yields (lo, hi, {side: 18-bit data}) per column,
+    the column's bits lo..hi - 1."""
+    bits, words, shift = mode
+    for col in range(-(-rom.width // bits)):
+        lo, hi = col * bits, min(rom.width, (col + 1) * bits)
+        yield lo, hi, dp16kd_rom_block(m, name(col),
+                                       [(x >> lo) & ((1 << (hi - lo)) - 1) for x in rom.init[:words]],
+                                       bits, shift, rom.en,
+                                       [(side, port.addr, f"{port.addr.name}_{side}{col}")
+                                        for side, port in sides])
+
+
+def _spill_select(m, rom, port, words):
+    """A register, enabled by ``rom.en``, that is high when the data of ``port`` is the spill
+    word's (:func:`stored_words`): its address was ``words``, ROM_LATENCY enabled cycles
+    before (the blocks read word 0 then)."""
+    last = Signal(name=f"{port.addr.name}_last")
+    last_d = Signal(name=f"{port.addr.name}_last_d")
+    with m.If(rom.en):
+        m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
+    return last_d
+
+
 class ECP5Lowering:
     """The ECP5 forms of the registered elements, a method per primitive as in
     ``rtl/targets.Generic``, whose methods (reached through ``super()``) build whatever this
@@ -215,25 +241,16 @@ class ECP5Lowering:
         if mode is None:
             super().rom(m, rom)
             return
-        bits, words, shift = mode
+        words = mode[1]
         sides = list(zip("AB", rom.ports + rom.ports[:1], strict=False))[:max(2, len(rom.ports))]
         douts = {side: Signal(rom.width, name=f"{port.addr.name}_do{side}") for side, port in sides}
-        for col in range(-(-rom.width // bits)):
-            lo, hi = col * bits, min(rom.width, (col + 1) * bits)
-            outs = dp16kd_rom_block(m, f"bram{col}" if col else "bram",
-                                    [(x >> lo) & ((1 << (hi - lo)) - 1) for x in rom.init[:words]],
-                                    bits, shift, rom.en,
-                                    [(side, port.addr, f"{port.addr.name}_{side}{col}")
-                                     for side, port in sides])
+        for lo, hi, outs in _rom_columns(m, rom, mode, sides, lambda c: f"bram{c}" if c else "bram"):
             for side, dout in outs.items():
                 m.d.comb += douts[side][lo:hi].eq(dout[:hi - lo])
         for side, port in sides[:len(rom.ports)]:
             data = douts[side]
             if rom.depth > words:               # the last word: address wrapped to word 0 (= 0)
-                last = Signal(name=f"{port.addr.name}_last")
-                last_d = Signal(name=f"{port.addr.name}_last_d")
-                with m.If(rom.en):
-                    m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
+                last_d = _spill_select(m, rom, port, words)
                 data = data | Mux(last_d, rom.init[words], 0)
             m.d.comb += port.data.eq(data)
 
@@ -248,26 +265,18 @@ class ECP5Lowering:
         if self.rom_mode(rom) is not None or mode is None:
             self.rom(m, rom)
             return
-        bits, words, shift = mode
+        words = mode[1]
         for group in range(0, len(rom.ports), 2):
             ports = rom.ports[group:group + 2]
             columns = [[] for _ in ports]
-            for col in range(-(-rom.width // bits)):
-                lo, hi = col * bits, min(rom.width, (col + 1) * bits)
-                outs = dp16kd_rom_block(m, f"bram{group // 2}_{col}",
-                                        [(x >> lo) & ((1 << (hi - lo)) - 1) for x in rom.init[:words]],
-                                        bits, shift, rom.en,
-                                        [(side, port.addr, f"{port.addr.name}_{side}{col}")
-                                         for side, port in zip("AB", ports, strict=False)])
+            for lo, hi, outs in _rom_columns(m, rom, mode, list(zip("AB", ports, strict=False)),
+                                             lambda c, g=group // 2: f"bram{g}_{c}"):
                 for out, dout in zip(columns, outs.values(), strict=False):
                     out.append(dout[:hi - lo])
             for port, out in zip(ports, columns, strict=False):
                 data = Cat(*out)
                 if rom.depth > words:           # the last word: the address wrapped to word 0
-                    last = Signal(name=f"{port.addr.name}_last")
-                    last_d = Signal(name=f"{port.addr.name}_last_d")
-                    with m.If(rom.en):
-                        m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
+                    last_d = _spill_select(m, rom, port, words)
                     data = Mux(last_d, rom.init[words], data)
                 m.d.comb += port.data.eq(data)
 

@@ -213,7 +213,9 @@ class Generic:
     writes. A method per primitive builds it into ``m``: :meth:`product` (operand registers
     and a product register), :meth:`split` (the operand limbs of a wide product: none),
     :meth:`rom` and :meth:`ram` (an Amaranth Memory with its registers), :meth:`block_rom`
-    (a table with more read ports: the same Memory)."""
+    (a table with more read ports: the same Memory). A target subclasses it and overrides
+    what it builds otherwise (:class:`ECP5`; :meth:`limb_sum` for one whose multipliers are
+    narrower than the operands)."""
 
     def product(self, m, unit):
         """:class:`RegisteredProduct` ``unit``: operand registers, product register."""
