@@ -48,7 +48,7 @@ the previous table's output within the pixel, which makes the setup deep, not sl
 """
 
 import numpy as np
-from amaranth.hdl import Cat, Module, Mux, Signal, Value, ValueCastable, signed, unsigned
+from amaranth.hdl import Module, Mux, Signal, Value, ValueCastable, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
@@ -76,7 +76,7 @@ from bumprtl.rtl.tables import (
     lee_reciprocal_table,
     quarter_sine,
 )
-from bumprtl.rtl.targets import dp16kd_rom_block, form
+from bumprtl.rtl.targets import form
 
 __all__ = ["LeeRotation", "LeeIllumination", "rotated_layout", "BlockROM", "block_rom", "rom_read",
            "ROM_STAGES", "SINE_STAGES", "sine_rom", "sine_value", "prop_operands", "dot_operands",
@@ -189,47 +189,21 @@ def rotated_layout(cfg: Config):
     return data.StructLayout(fields)
 
 
-# --- ECP5 form of the tables RegisteredROM leaves to Yosys ------------------------------------
+# --- The tables with more read ports than a block RAM ------------------------------------
 
 class BlockROM(RegisteredROM):
     """A :class:`pipe.RegisteredROM`: the same read ports, ROM_LATENCY, and the same generic
-    form (one Memory with every read port: one table in gen/flow/resources.py's counts). Its
-    ECP5 form also covers the tables RegisteredROM leaves to Yosys' block-RAM inference (more
-    than two read ports, wider than 18 bits, deeper than 1024 words), which maps them without
-    the block RAM's output register: here each pair of read ports gets the table in the
-    widest DP16KD mode (rtl/targets.DP16KD_MODES) that holds ``depth - 1`` words, blocks side by side
-    for the width, each with its output register (REGMODE OUTREG); a last word past the
-    mode's depth sits in a flip-flop, as in RegisteredROM."""
+    form (one Memory with every read port: one table in gen/flow/resources.py's counts),
+    built by its target's ``block_rom`` (``rtl/targets.form``). Its ECP5 form
+    (``ECP5Lowering.block_rom``, rtl/ecp5.py) also covers the tables RegisteredROM leaves
+    to Yosys' block-RAM inference (more than two read ports, wider than 18 bits, deeper
+    than 1024 words): each pair of read ports gets the table in DP16KD blocks with their
+    output registers."""
 
     def elaborate(self, platform):
         m = Module()
         form(self.target).block_rom(m, self)
         return m
-
-    def dp16kd_pairs(self, m, bits, words, shift):
-        """The ECP5 form (``ECP5.block_rom``): each pair of read ports in DP16KD mode
-        (``bits``, ``words``, ``shift``)."""
-        for group in range(0, len(self.ports), 2):
-            ports = self.ports[group:group + 2]
-            columns = [[] for _ in ports]
-            for col in range(-(-self.width // bits)):
-                lo, hi = col * bits, min(self.width, (col + 1) * bits)
-                outs = dp16kd_rom_block(m, f"bram{group // 2}_{col}",
-                                        [(x >> lo) & ((1 << (hi - lo)) - 1) for x in self.init[:words]],
-                                        bits, shift, self.en,
-                                        [(side, port.addr, f"{port.addr.name}_{side}{col}")
-                                         for side, port in zip("AB", ports, strict=False)])
-                for out, dout in zip(columns, outs.values(), strict=False):
-                    out.append(dout[:hi - lo])
-            for port, out in zip(ports, columns, strict=False):
-                data = Cat(*out)
-                if self.depth > words:          # the last word: the address wrapped to word 0
-                    last = Signal(name=f"{port.addr.name}_last")
-                    last_d = Signal(name=f"{port.addr.name}_last_d")
-                    with m.If(self.en):
-                        m.d.sync += [last.eq(port.addr == words), last_d.eq(last)]
-                    data = Mux(last_d, self.init[words], data)
-                m.d.comb += port.data.eq(data)
 
 
 def block_rom(pipe, init, shape, name, ports):

@@ -26,7 +26,8 @@ ROOT = mutate.ROOT
 COVERED = ("rtl/sincos.py", "rtl/exact.py", "rtl/lee.py", "rtl/baselines/peercy.py",
            "rtl/baselines/kim.py", "rtl/palette.py", "rtl/bumpfetch.py", "rtl/texture.py",
            "rtl/pipeline.py", "rtl/shade.py", "rtl/pipe.py", "rtl/fixed.py", "rtl/tables.py",
-           "gen/flow/resources.py", "rtl/config.py", "sim/scenes/config.py")
+           "gen/flow/resources.py", "rtl/config.py", "sim/scenes/config.py", "rtl/targets.py",
+           "rtl/ecp5.py")
 
 
 @pytest.fixture(scope="module")

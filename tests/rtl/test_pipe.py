@@ -406,13 +406,13 @@ def test_spread_rule_follows_the_roms_block_count(angle_bits, frac_bits):
     """sincos.spread_sine (what gives the ROM an enable of its own, before any ROM is built)
     says the same as RegisteredROM.spread of the quarter-wave table, sincos.near_sine (what
     sets the sine reads' latency) holds for every spread ROM, and rom_blocks counts the
-    blocks of the ECP5 form's mode (RegisteredROM.mode): columns of ``width / bits``."""
+    blocks of the ECP5 form's mode (ECP5.rom_mode): columns of ``width / bits``."""
     cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
     table, width = sine_rom_table(cfg)
     rom = RegisteredROM(table.tolist(), unsigned(width), 2, "r")
     assert spread_sine(cfg) == rom.spread
     blocks = rom_blocks(rom.depth - 1, rom.width)
-    mode = rom.mode(ECP5)
+    mode = ECP5().rom_mode(rom)
     if mode is None:                 # too many blocks for the DP16KD form: Yosys maps it
         assert blocks > ROM_MAX_BLOCKS and rom.spread
     else:

@@ -150,7 +150,7 @@ def test_registered_rom_ecp5_form_every_word(depth, nports, build_dir):
     init = [0] + rng.integers(0, 1 << 18, depth - 1).tolist()
     if depth in (1025, 2049):
         init[-1] = (1 << 18) - 1                 # the spill word: every bit set
-    assert RegisteredROM(init, unsigned(18), nports, "rom").mode(ECP5()) is not None
+    assert ECP5().rom_mode(RegisteredROM(init, unsigned(18), nports, "rom")) is not None
     n = int(depth / 0.6) + 200
     en, addrs, generic, ecp5 = _rom_lockstep(init, nports, build_dir, n, seed=depth)
     for p in range(nports):

@@ -2,7 +2,7 @@
 MULT18X18D, ...) run under Icarus with Yosys' cells_sim.v and the sim/ecp5 models.
 
 make test: Yosys' own block-RAM mapping of a ROM in the x4 mode (x9 and x2: make fpga)
-agrees with the DP16KD model's word layout (rtl/pipe.dp16kd_initvals packs the same way), and
+agrees with the DP16KD model's word layout (rtl/ecp5.dp16kd_initvals packs the same way), and
 rtl/pipe.RegisteredRAM's ECP5 form equals its generic form under random writes and reads;
 the default scene's BumpPipeline after synth_ecp5 renders one 16 x 16 frame bit-exact.
 make fpga: the ECP5 form of the exact rotation -> illumination pipeline and of the default
@@ -70,7 +70,7 @@ def test_registered_ram_ecp5_form(depth, width, build_dir):
     n = depth + 1500
     en, r_addr, w_en, w_addr, w_data = _ram_vectors(depth, width, n, seed=width)
     make = lambda t: RegisteredRAM(depth, unsigned(width), "ram", init, target=t)
-    assert make(ECP5()).mode() is not None
+    assert ECP5().ram_mode(make(ECP5())) is not None
     abits = (depth - 1).bit_length()
     ports = lambda u: [u.en, u.r_addr, u.r_data, u.w_en, u.w_addr, u.w_data]
     generic, ecp5 = ecp5_lockstep(make, {"ram_en": (1, en), "ram_r_addr": (abits, r_addr),
