@@ -7,7 +7,8 @@ build a :class:`Sidecar` and :meth:`Sidecar.dump` it, readers :func:`load` it an
 attributes and accessors (:attr:`Sidecar.input_fields`, :meth:`Sidecar.port`...).
 
 Schema version :data:`SCHEMA_VERSION` (the ``schema_version`` key). Version 1 was the
-untyped sidecar (no ``schema_version`` key); what changed from it is :data:`CHANGES_FROM_1`.
+untyped sidecar (no ``schema_version`` key); what changed from it is :data:`CHANGES_FROM_1`,
+and from version 2 :data:`CHANGES_FROM_2`.
 :func:`load` refuses a file of another version, an unknown key and a missing key with one
 line (:class:`~bumprtl.rtl.config.BumpError`) naming the key and the supported version.
 Every key is written in every file (``null`` where a fact does not apply to the unit), so a
@@ -20,16 +21,24 @@ from pathlib import Path
 
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["SCHEMA_VERSION", "CHANGES_FROM_1", "SCHEMA", "Field", "Port", "NamedPort", "NamedPorts",
+__all__ = ["SCHEMA_VERSION", "CHANGES_FROM_1", "CHANGES_FROM_2", "SCHEMA", "Field", "Port", "NamedPort", "NamedPorts",
            "Memory", "ErrorBounds", "Sidecar", "load", "loads", "from_facts", "ports_from_table"]
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 CHANGES_FROM_1 = ("version 1 had no schema_version; a payload field is "
                   "{offset, width, signed} instead of [offset, width, signed]; roms became "
                   "memories, each with kind rom or ram; the error facts moved under error_bounds; "
                   "palette, fetch and pipeline facts under palette, fetch and pipeline; every "
                   "key is present (null where it does not apply)")
+
+CHANGES_FROM_2 = ("version 3 adds fifo_depth (the credit edge's FIFO depth, also its "
+                  "credits); latency is from a pixel taken at i to its result offered at o "
+                  "through the free-running pipe and its credit edge (the edge's FIFO adds two "
+                  "cycles to version 2's latency)")
+
+# What a reader of an older version is told changed since it.
+CHANGES = {1: f"{CHANGES_FROM_1}; {CHANGES_FROM_2}", 2: CHANGES_FROM_2}
 
 MEMORY_KINDS = ("rom", "ram")
 
@@ -45,7 +54,10 @@ SCHEMA = {
     "ports": ("object", "port name -> {dir: in or out, width, fields}"),
     "ports.NAME.fields": ("object or null", "a packed payload's fields: path -> {offset, "
                                             "width, signed}, bits [offset, offset + width)"),
-    "latency": ("int", "cycles from a pixel taken to its result offered"),
+    "latency": ("int", "cycles from a pixel taken at i to its result offered at o (the FIFO "
+                       "empty)"),
+    "fifo_depth": ("int", "the credit edge's FIFO depth, also its credits: pixels inside at "
+                          "once (docs/architecture.md, The credit loop)"),
     "throughput": ("int", "items per clock while the output is ready"),
     "config": ("object", "the Config (widths, method, coefficients)"),
     "scene": ("object or null", "the SceneConfig of a pipeline or fetch unit"),
@@ -165,6 +177,7 @@ class Sidecar:
     pipeline: dict | None            # pipeline: {"built": [...], "skipped": [...]}
     palette: dict | None             # palette: index_bits, blend, double_buffered, ...
     fetch: dict | None               # fetch: outputs, level_bases, addressing
+    fifo_depth: int                  # the credit edge's FIFO depth (= its credits)
     schema_version: int = SCHEMA_VERSION
 
     # -- accessors ---------------------------------------------------------------------
@@ -271,10 +284,11 @@ def _from_dict(d):
     version = d.get("schema_version") if isinstance(d, dict) else None
     if not isinstance(d, dict) or "schema_version" not in d:
         raise BumpError(f"sidecar schema_version missing: a version-1 (untyped) sidecar; this "
-                        f"bumprtl reads schema_version {SCHEMA_VERSION} only ({CHANGES_FROM_1}); "
+                        f"bumprtl reads schema_version {SCHEMA_VERSION} only ({CHANGES[1]}); "
                         f"re-emit it with its command")
     if not isinstance(version, int) or isinstance(version, bool) or version != SCHEMA_VERSION:
-        changed = f" ({CHANGES_FROM_1})" if version == 1 else ""
+        changed = f" ({CHANGES[version]})" if version in (1, 2) and not isinstance(version, bool) \
+            else ""
         raise BumpError(f"sidecar schema_version must be {SCHEMA_VERSION}, got {version!r}"
                         f"{changed}; re-emit it with its command")
     _keys(d, _TOP, "")
@@ -333,7 +347,7 @@ _ERROR_KEYS = ("error_bound_lsb", "error_bounds_lsb", "error_bound_ulp", "error_
 _PALETTE_KEYS = ("index_bits", "blend", "double_buffered", "out_of_range_index")
 _FETCH_KEYS = ("outputs", "level_bases", "addressing")
 _PIPELINE_KEYS = ("built", "skipped")
-_OTHER_KEYS = ("config", "scene", "latency", "throughput", "method", "roms", "memory_bits",
+_OTHER_KEYS = ("config", "scene", "latency", "fifo_depth", "throughput", "method", "roms", "memory_bits",
                "interface", "axis", "memory_images", "block_ram")
 
 
@@ -373,7 +387,8 @@ def from_facts(unit, command, ports, facts, module=None):
         unit=unit, module=module or unit, command=command,
         interface=facts.get("interface", "stream"),
         ports=ports_from_table(ports),
-        latency=int(facts["latency"]), throughput=int(facts["throughput"]),
+        latency=int(facts["latency"]), fifo_depth=int(facts["fifo_depth"]),
+        throughput=int(facts["throughput"]),
         config=_plain(facts["config"]), scene=_plain(facts.get("scene")),
         method=facts.get("method"),
         memories={n: _memory(m) for n, m in sorted((facts.get("roms") or {}).items())},

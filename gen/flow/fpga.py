@@ -29,7 +29,7 @@ from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.gen.tools.yosys import run_yosys
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, CreditEdge
+from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, CreditEdge, min_fifo_depth
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
 
@@ -135,12 +135,14 @@ def pipeline_component(cfg, target=None):
             self.illumination = Illumination(cfg, target, credit=False)
             self.latency = self.rotation.latency + self.illumination.latency
             self.port_latency = self.latency + EDGE_LATENCY
+            self.fifo_depth = min_fifo_depth(self.latency)
             super().__init__({"i": In(self.rotation.i.signature.flip()),
                               "o": Out(self.illumination.o.signature)})
 
         def elaborate(self, platform):
             m = Module()
-            m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency)
+            m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency,
+                                                  self.fifo_depth)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
             m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready),
                          self.rotation.i.valid.eq(self.i.valid & edge.i_ready),

@@ -26,6 +26,11 @@ The unit's Verilog is synthesized by Yosys at the coarse, technology-independent
 * **square roots**: instances of a submodule whose name ends in ``sqrt``.
   Square roots and ``_div`` dividers are kept as black boxes while flattening: their inner
   adders are not counted as adders, their inner registers are counted as register bits.
+* **the credit edge** (a unit's submodule ``edge``, rtl/pipe.CreditEdge: credit count and
+  output FIFO) is flow control, not the datapath Table 1 counts: kept as a black box too,
+  its register bits counted apart (``edge_register_bits``; its FIFO's storage is not a
+  table). A design emitted flattened (a scene pipeline) has no such box: its edge is
+  counted with the rest.
 * **register bits**: the widths of all flip-flop cells (``$dff``, ``$sdffe``, ...).
 """
 
@@ -70,6 +75,7 @@ class Counts:
     tables: list = field(default_factory=list)             # {name, depth, width, bits, read_ports}
     rams: list = field(default_factory=list)
     register_bits: int = 0
+    edge_register_bits: int = 0                            # the credit edge's, apart
     cells: dict = field(default_factory=dict)              # raw cell-type histogram
 
     @property
@@ -95,6 +101,7 @@ class Counts:
             setattr(out, f, getattr(self, f) + getattr(other, f))
         out.sqrts = self.sqrts + other.sqrts
         out.register_bits = self.register_bits + other.register_bits
+        out.edge_register_bits = self.edge_register_bits + other.edge_register_bits
         out.cells = dict(Counter(self.cells) + Counter(other.cells))
         return out
 
@@ -178,6 +185,17 @@ def _count_memory(counts, name, cell):
     (counts.tables if _int(p["WR_PORTS"]) == 0 else counts.rams).append(entry)
 
 
+def _read_registers(module):
+    """Bits of the registered read ports of the memories of one netlist module (the FIFO's
+    output register: flip-flops once placed, its storage LUT RAM)."""
+    bits = 0
+    for c in module["cells"].values():
+        if c["type"] == "$mem_v2":
+            p = c["parameters"]
+            bits += bin(_int(p["RD_CLK_ENABLE"])).count("1") * _int(p["WIDTH"])
+    return bits
+
+
 def _register_bits(module):
     """Flip-flop bits of the cells of one netlist module."""
     return sum(_int(c["parameters"]["WIDTH"]) for c in module["cells"].values()
@@ -223,6 +241,8 @@ def count_netlist(netlist, top):
         elif kind in modules and kind.endswith("sqrt"):
             counts.sqrts += 1
             counts.register_bits += _register_bits(modules[kind])
+        elif kind in modules and kind.endswith(".edge"):
+            counts.edge_register_bits += _register_bits(modules[kind]) + _read_registers(modules[kind])
         elif kind in modules and kind.endswith("_div"):
             a, b = (len(modules[kind]["netnames"][n]["bits"]) for n in ("dividend", "divisor"))
             counts.dividers.append(f"{a}/{b}")

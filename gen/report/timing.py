@@ -6,7 +6,8 @@ o.ready, o.tag), written as WaveDrom JSON and rendered to SVG with ``yowasp-wave
 
 ``handshake``  pixels streamed back to back with o.ready high: one pixel per clock;
 ``stall``      the consumer drops o.ready for a few cycles: o.valid and o.tag are held,
-               i.ready falls with it and the producer holds its pixel;
+               i.ready falls a cycle later (no credit comes back) and the producer
+               holds its pixel;
 ``latency``    one pixel alone: o.valid rises exactly ``latency`` cycles after i.valid.
 
 docs/timing.md embeds the SVGs and names this command.
@@ -108,7 +109,7 @@ def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default").hard
     """``{name: (wavedrom source, facts)}`` of the three diagrams, from real traces."""
     out = {}
     dut = dut_factory()
-    lat = dut.latency
+    lat = dut.port_latency
     # handshake: 6 pixels back to back, o.ready high.
     tr = simulate(dut, lat + 10, offer=lambda n: 1 <= n <= 6, ready=lambda n: 1)
     out["handshake"] = (wavedrom(tr, 0, lat + 10, "Handshake: one pixel per clock, o.ready high",
@@ -120,11 +121,12 @@ def scenarios(dut_factory=lambda: BumpPipeline(load_scene_config("default").hard
     tr = simulate(dut, lat + 14, offer=lambda n: n >= 1, ready=lambda n: n not in stall)
     out["stall"] = (wavedrom(tr, lat - 1, lat + 12,
                              "Stall: o.ready low for 4 cycles",
-                             "o.valid and o.tag are held while o.valid & ~o.ready; the output "
-                             "buffer takes the two pixels still on their way, then the registered "
-                             "run enable falls (i.ready two cycles after o.ready), the whole pipe "
-                             "freezes and the producer holds its pixel; i.ready rises the cycle "
-                             "after o.ready does"),
+                             "o.valid and o.tag are held while o.valid & ~o.ready; the pipe "
+                             "never stops: the FIFO takes the pixels still on their way, and at "
+                             "the least FIFO depth every credit is in the loop, so i.ready "
+                             "falls the cycle after o.ready (no credit came back) and the "
+                             "producer holds its pixel; i.ready rises the cycle after o.ready "
+                             "does"),
                     {"latency": lat, "stall": list(stall), "trace": tr})
     dut = dut_factory()
     tr = simulate(dut, lat + 5, offer=lambda n: n == 1, ready=lambda n: 1)

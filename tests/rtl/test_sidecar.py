@@ -19,6 +19,7 @@ from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sidecar import (
     CHANGES_FROM_1,
+    CHANGES_FROM_2,
     SCHEMA_VERSION,
     Field,
     Memory,
@@ -99,13 +100,14 @@ def _text(**changes):
     return json.dumps(d)
 
 
-@pytest.mark.parametrize("version", [0, 1, 99, "2", 2.0, True])
+@pytest.mark.parametrize("version", [0, 1, 2, 99, "3", 3.0, True])
 def test_another_version_is_refused_in_one_line(version):
     with pytest.raises(BumpError) as e:
         loads(_text(schema_version=version), "x.json")
     msg = str(e.value)
-    assert "\n" not in msg and msg.startswith("x.json: sidecar schema_version must be 2")
-    assert (CHANGES_FROM_1 in msg) == (version == 1)
+    assert "\n" not in msg and msg.startswith("x.json: sidecar schema_version must be 3")
+    assert (CHANGES_FROM_1 in msg) == (version == 1 and version is not True)
+    assert (CHANGES_FROM_2 in msg) == (version in (1, 2) and version is not True)
 
 
 def test_untyped_version_1_is_refused_saying_what_changed():
@@ -114,7 +116,7 @@ def test_untyped_version_1_is_refused_saying_what_changed():
            "ports": {"i__payload": {"dir": "in", "width": 24,
                                     "fields": {"angle": [0, 8, False], "tag": [8, 16, False]}}}}
     with pytest.raises(BumpError, match=r"^old.json: sidecar schema_version missing: a "
-                       r"version-1 \(untyped\) sidecar; this bumprtl reads schema_version 2 "
+                       r"version-1 \(untyped\) sidecar; this bumprtl reads schema_version 3 "
                        r"only \(version 1 had no schema_version; .*roms became memories"):
         loads(json.dumps(old), "old.json")
 
@@ -123,7 +125,7 @@ def test_untyped_version_1_is_refused_saying_what_changed():
                                  "named_ports"])
 def test_a_missing_key_is_refused(key):
     with pytest.raises(BumpError, match=rf"^sidecar: sidecar lacks key {key} \(schema_version "
-                                        rf"2\)$"):
+                                        rf"3\)$"):
         loads(_text(**{key: None}))
 
 
@@ -134,7 +136,7 @@ def test_a_missing_or_unknown_nested_key_is_refused(tmp_path):
         loads(json.dumps(d))
     d = json.loads(_text())
     d["roms"] = {}
-    with pytest.raises(BumpError, match=r"key roms is unknown to schema_version 2"):
+    with pytest.raises(BumpError, match=r"key roms is unknown to schema_version 3"):
         loads(json.dumps(d))
     d = json.loads(_text())
     d["memories"]["quarter_sine"]["kind"] = "flash"

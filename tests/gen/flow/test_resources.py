@@ -1,6 +1,7 @@
 """The resource counter on hand-written Amaranth modules whose contents are known."""
 
 import json
+import re
 
 import pytest
 from amaranth.hdl import Module, signed, unsigned
@@ -137,7 +138,9 @@ def test_zero_initialised_ram_counts_the_same_without_its_init(tmp_path):
     counts = count_verilog(v, "palette", tmp_path / "a")
     assert counts.rams == [{"name": "table.mem", "depth": 128, "width": 32, "bits": 4096, "read_ports": 1}]
     rom, _ = emit_unit("sincos", Config(angle_bits=6, frac_bits=5), tmp_path / "rom")
-    assert strip_zero_init(rom.read_text()) == rom.read_text()       # non-zero contents stay
+    words = lambda t: [l for l in t.splitlines() if re.search(r"\] = \d+'[dh]0*[1-9a-f]", l)]
+    assert words(rom.read_text()) and \
+        words(strip_zero_init(rom.read_text())) == words(rom.read_text())  # non-zero contents stay
 
 
 def _macc(products, addends=(), y_width=16):

@@ -114,7 +114,8 @@ def _postsynth_stream(component, label, inputs, build_dir, patterns, polygon=Non
     synth_s = time.perf_counter() - t0
     sidecar = build_dir / f"{label}.json"
     from_facts(label, f"post-synthesis {label}", port_table(component),
-               {"config": {}, "latency": component.latency, "throughput": 1}).dump(sidecar)
+               {"config": {}, "latency": component.port_latency, "fifo_depth": component.fifo_depth,
+                "throughput": 1}).dump(sidecar)
     stim, result = build_dir / "stimulus.npz", build_dir / "result.npz"
     write_stimulus(stim, inputs, polygon, None)
     sources, includes = postsynth_sources(build_dir / "cells")
