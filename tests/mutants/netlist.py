@@ -66,6 +66,7 @@ import netlist_board as nb  # noqa: E402  (the board's units and their bench)
 import netlist_cone as nc  # noqa: E402  (steps 4 and 5, beside this file)
 import netlist_pdr as npdr  # noqa: E402  (step 8)
 import netlist_rel as nrel  # noqa: E402  (steps 6 and 7)
+from harness_ports import Design  # noqa: E402  (a target's top module and ports)
 
 ROOT = Path(__file__).resolve().parents[2]
 UNITS = ("sincos", "rotation", "illumination", "palette", "fetch")
@@ -217,9 +218,10 @@ def mutation_list(v, unit, n, seed, work):
 MUTATED_STAMP = "mutated.json"   # the script and shim the kept mutated.v was built from
 
 
-def mutated_netlist(v, meta, lines, work, reuse=False, passes=()):
-    """``mutated.v``: the flattened unit renamed ``<unit>__mutated`` with a ``mutsel`` input
-    selecting mutation I (1-based; 0 = none), and the shim module ``<unit>``. With ``reuse``
+def mutated_netlist(v, design, lines, work, reuse=False, passes=()):
+    """``mutated.v``: the flattened unit (``design``, a :class:`harness_ports.Design`)
+    renamed ``<module>__mutated`` with a ``mutsel`` input selecting mutation I (1-based; 0 =
+    none), and the shim module ``<module>`` with the design's ports. With ``reuse``
     a ``mutated.v`` in ``work`` is kept when MUTATED_STAMP says it was built by this same
     script and shim (else it is built again from ``prepped.il``).
 
@@ -230,18 +232,15 @@ def mutated_netlist(v, meta, lines, work, reuse=False, passes=()):
     mutation list (``mutate -list`` on the prepared netlist) is unchanged. ``passes``: Yosys
     commands run after those (the board's units: ``pmuxtree``, since Icarus reads the
     function write_verilog makes of a $pmux named ``\\$procmux$N`` as a system function)."""
-    unit = meta["unit"]
+    unit = design.module
     width = max(1, len(lines).bit_length())
     script = ["read_rtlil prepped.il"]
     script += [f"mutate -ctrl mutsel {width} {i} " + l[len("mutate "):]
                for i, l in enumerate(lines, 1)]
     script += ["setundef -zero", *passes, "opt_clean", f"rename {unit} {unit}__mutated",
                "write_verilog -noattr -norename mutated_core.v"]
-    ports = meta["ports"]
-    decl = []
-    for name, p in sorted(ports.items()):
-        rng = f"[{p['width'] - 1}:0] " if p["width"] > 1 else ""
-        decl.append(f"  {'input' if p['dir'] == 'in' else 'output'} wire {rng}{name};")
+    ports = design.ports
+    decl = [design.declaration(name) for name in sorted(ports)]
     conn = ",\n".join(f"    .{name}({name})" for name in sorted(ports))
     shim = f"""
 // bumprtl netlist mutation: the unit's own ports around the mutated netlist; mutsel (0 =
@@ -331,22 +330,23 @@ def _proved(how, stream):
     return f"equivalent ({how})"
 
 
-def _wrappers(ports, unit):
+def _wrappers(design):
     """Verilog of the modules ``gold_s`` and ``gate_s``: ``gold`` / ``gate`` with each stream
     payload output masked by its valid (the stream contract's don't-care, made explicit)."""
-    masked = {n for n in ports if n.endswith("__payload") and ports[n]["dir"] == "out"
-              and ports.get(n[:-len("payload")] + "valid", {}).get("dir") == "out"}
+    ports = design.ports
+    outs = set(design.names("out"))
+    masked = {n for n in outs if n.endswith("__payload") and n[:-len("payload")] + "valid" in outs}
     text = []
     for core in ("gold", "gate"):
         decl, conn, body = [], [], []
         for name, p in sorted(ports.items()):
-            rng = f"[{p['width'] - 1}:0] " if p["width"] > 1 else ""
-            decl.append(f"  {'input' if p['dir'] == 'in' else 'output'} wire {rng}{name};")
+            rng = f"[{p.width - 1}:0] " if p.width > 1 else ""
+            decl.append(design.declaration(name))
             if name in masked:
                 decl.append(f"  wire {rng}{name}__core;")
                 conn.append(f"    .{name}({name}__core)")
                 valid = name[:-len("payload")] + "valid"
-                body.append(f"  assign {name} = {valid} ? {name}__core : {p['width']}'d0;")
+                body.append(f"  assign {name} = {valid} ? {name}__core : {p.width}'d0;")
             else:
                 conn.append(f"    .{name}({name})")
         text.append(f"module {core}_s({', '.join(sorted(ports))});\n" + "\n".join(decl)
@@ -431,11 +431,11 @@ def _miter(unit, line, work, timeout, stream):
 STEPS = ("structural", "stream", "miter", "cone", "cut", "never", "rel", "pdr")
 
 
-def _cone_steps(meta, line, work, timeout, has_stream, steps):
+def _cone_steps(design, line, work, timeout, has_stream, steps):
     """Steps 4 and 5 (tests/mutants/netlist_cone.py), on the mutated cell's cone only:
     ``(verdict, why)``, the verdict None when neither proves the mutant equivalent."""
     try:
-        net = nc.Netlist(nc.load(work, meta["unit"], line))
+        net = nc.Netlist(nc.load(work, design.module, line))
     except Exception as e:      # noqa: BLE001  (any failure is the step's undecided)
         return None, tool_error("cone: the -ctrl netlist was not built", e)
     why = []
@@ -472,7 +472,7 @@ def _cone_steps(meta, line, work, timeout, has_stream, steps):
     if {"never", "rel", "pdr"} & set(steps):
         # steps 6 to 8 read the netlist with its memories' read registers kept apart
         try:
-            net = nc.Netlist(nc.load(work, meta["unit"], line, passes=("memory_nordff",)))
+            net = nc.Netlist(nc.load(work, design.module, line, passes=("memory_nordff",)))
         except Exception as e:  # noqa: BLE001
             return None, "; ".join(why + [tool_error("never/rel/pdr: the -ctrl netlist was "
                                                      "not built", e)])
@@ -537,8 +537,9 @@ def _pdr_step(net, work, timeout, has_stream):
                    f"mutant safe, memories cut to free read data, {how}", has_stream), None
 
 
-def equivalence(v, meta, line, work, timeout, steps=STEPS):
-    """``"equivalent ..."``, ``"not equivalent ..."`` or ``"undecided: why"`` of one mutation.
+def equivalence(v, design, line, work, timeout, steps=STEPS):
+    """``"equivalent ..."``, ``"not equivalent ..."`` or ``"undecided: why"`` of one mutation
+    of ``design`` (a :class:`harness_ports.Design`), on the prepared netlist in ``work``.
 
     1. Yosys's structural passes on the two netlists, every output compared in every cycle:
        a proof gives ``"equivalent (equiv_simple/equiv_induct)"``;
@@ -571,14 +572,14 @@ def equivalence(v, meta, line, work, timeout, steps=STEPS):
     that proved it. Never raises: a step whose tool or parser fails leaves the survivor
     ``"undecided: <step>: tool error: ..."`` (:func:`tool_error`), counted as a survivor."""
     try:
-        return _equivalence(meta, line, work, timeout, steps)
+        return _equivalence(design, line, work, timeout, steps)
     except Exception as e:      # noqa: BLE001  (whatever failed, the verdict says so)
         return "undecided: " + tool_error("equivalence", e)
 
 
-def _equivalence(meta, line, work, timeout, steps):
-    unit = meta["unit"]
-    wrappers, has_stream = _wrappers(meta["ports"], unit)
+def _equivalence(design, line, work, timeout, steps):
+    unit = design.module
+    wrappers, has_stream = _wrappers(design)
     (Path(work) / "equiv_wrappers.v").write_text(wrappers)
     if "structural" in steps and _structural(unit, line, work, timeout, False):
         return "equivalent (equiv_simple/equiv_induct, every output every cycle)"
@@ -589,7 +590,7 @@ def _equivalence(meta, line, work, timeout, steps):
         return _proved("miter + sat -tempinduct", has_stream)
     if verdict == "not equivalent":
         return "not equivalent (counterexample from the miter)"
-    proved, why = _cone_steps(meta, line, work, timeout, has_stream, steps)
+    proved, why = _cone_steps(design, line, work, timeout, has_stream, steps)
     if proved:
         return proved
     if verdict is None:
@@ -646,9 +647,10 @@ def run_board_target(target, n, seed, out, jobs, eq_timeout, log=print, steps=ST
     if work.exists():
         shutil.rmtree(work)
     rtl = work / "rtl"
-    v, meta, bench = nb.bench(target, rtl, seed)
-    lines = mutation_list(v, meta["unit"], n, seed, rtl)
-    mv, _ = mutated_netlist(v, meta, lines, rtl, passes=("pmuxtree",))
+    v, design, bench = nb.bench(target, rtl, seed)
+    design.dump(rtl)
+    lines = mutation_list(v, design.module, n, seed, rtl)
+    mv, _ = mutated_netlist(v, design, lines, rtl, passes=("pmuxtree",))
     bench.build(mv, rtl)
     base = bench.run(work / "run0", 0)
     if base != "passed":
@@ -662,7 +664,7 @@ def run_board_target(target, n, seed, out, jobs, eq_timeout, log=print, steps=ST
     survivors = []
     for i, r in sorted(results.items()):
         if r == "passed":
-            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout, steps)
+            verdict = equivalence(v, design, lines[i - 1], rtl, eq_timeout, steps)
         elif r.startswith("undecided"):
             verdict = r
         else:
@@ -697,14 +699,16 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
         work.mkdir(parents=True)
         v, j, job = emit_target(target, work / "rtl", stim_n, seed)
         rtl = Path(v).parent
-    meta = json.loads(Path(j).read_text())
-    unit = meta["unit"]
+    # the sidecar's module is the Verilog's top; the harness keeps its own record of it
+    # (Design.dump), the one file --recheck reads
+    design = Design.from_sidecar(j)
+    design.dump(rtl)
     if kept is None:
-        mutation_list(v, unit, n, seed, rtl)
+        mutation_list(v, design.module, n, seed, rtl)
         (rtl / SAMPLE_STAMP).write_text(json.dumps({"sample": n, "seed": seed}))
     # a kept mutated.v is used only when today's script and shim built it; else it is built
     # again from the kept prepared netlist and mutation list
-    mutated_netlist(v, meta, _listed(rtl), rtl, reuse=kept is not None)
+    mutated_netlist(v, design, _listed(rtl), rtl, reuse=kept is not None)
     lines = _listed(rtl)
     mv = rtl / "mutated.v"
     base = run_one(mv, j, job, work / "run0", 0, sim)
@@ -721,7 +725,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
     survivors = []
     for i, r in sorted(results.items()):
         if r == "passed":
-            verdict = equivalence(v, meta, lines[i - 1], rtl, eq_timeout, steps)
+            verdict = equivalence(v, design, lines[i - 1], rtl, eq_timeout, steps)
             survivors.append({"index": i, "mutation": _short(lines[i - 1]), "verdict": verdict})
         elif r.startswith("undecided"):
             # the simulation itself failed: neither killed nor checked, counted
@@ -858,7 +862,8 @@ def _without_notes(verdict, steps):
 
 def recheck(path, out, timeout, steps=STEPS):
     """The equivalence checks ``steps`` of the survivors in ``path`` (a netlist_results.json)
-    again, each on the netlist its run kept (``out/<target>/rtl``); the JSON is rewritten.
+    again, each on the netlist its run kept (``out/<target>/rtl``, with the Design of
+    harness_ports.FILE the run wrote there); the JSON is rewritten.
     With only some of the steps, a survivor they leave undecided keeps its earlier verdict
     (the steps it ran then), what the new ones said appended."""
     saved = json.loads(path.read_text())
@@ -867,10 +872,9 @@ def recheck(path, out, timeout, steps=STEPS):
             continue
         rtl = out / r["target"].replace(":", "_") / "rtl"
         try:
-            meta = next(m for m in (json.loads(p.read_text()) for p in sorted(rtl.glob("*.json")))
-                        if isinstance(m, dict) and "ports" in m and "unit" in m)
+            design = Design.load(rtl)
             lines = _listed(rtl)
-        except (OSError, StopIteration, ValueError) as e:
+        except (OSError, ValueError) as e:
             print(f"  {r['target']}: not rechecked: {tool_error('recheck', e)} (in {rtl})",
                   flush=True)
             continue
@@ -878,7 +882,7 @@ def recheck(path, out, timeout, steps=STEPS):
             if s["verdict"].startswith(("equivalent", "not equivalent")) and tuple(steps) != STEPS:
                 continue            # decided by an earlier step: the new steps come after it
             t0 = time.perf_counter()
-            verdict = equivalence(None, meta, lines[s["index"] - 1], rtl, timeout, steps)
+            verdict = equivalence(None, design, lines[s["index"] - 1], rtl, timeout, steps)
             if tuple(steps) != STEPS and verdict.startswith("undecided"):
                 new = verdict[len("undecided: "):]
                 verdict = f"{_without_notes(s['verdict'], steps)}; {new}"

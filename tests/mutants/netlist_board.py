@@ -31,7 +31,6 @@ does not finish in its time is undecided (reason given).
 """
 
 import functools
-import json
 import shutil
 import subprocess
 import sys
@@ -39,6 +38,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from harness_ports import Design
 
 HERE = Path(__file__).resolve().parent
 TARGETS = ("board:timing", "board:tmds", "board:buffer", "board:source")
@@ -123,13 +123,14 @@ def _unit(target):
     u = Unit()
     return u, [(u.allow, "in"), (u.ready, "in"), (u.valid, "out"), (u.payload, "out"),
                (u.step, "out")], {"mode": mode, "constants": constants, "table": table,
-                                  "fields": list(_leaves(layout)), "size": scene.texture_size,
+                                  "leaves": list(_leaves(layout)), "size": scene.texture_size,
                                   "tag_bits": pipe.cfg.tag_bits}
 
 
 def emit(target, out):
-    """Emit ``target``'s Verilog into ``out``: (path, meta, context); meta as a sidecar's
-    ``{"unit", "ports": {name: {"dir", "width"}}}`` with clk and rst."""
+    """Emit ``target``'s Verilog into ``out``: (path, Design, context), the
+    :class:`harness_ports.Design` of the module's ports with clk and rst (a board unit
+    emitted alone has no sidecar: netlist.py keeps the Design in its run directory)."""
     from amaranth.back import verilog
     unit = UNIT[target]
     u, ports, ctx = _unit(target)
@@ -137,12 +138,7 @@ def emit(target, out):
     text = verilog.convert(u, name=unit, ports=[s for s, _ in ports], emit_src=False)
     path = out / f"{unit}.v"
     path.write_text(text)
-    meta = {"unit": unit, "ports": {"clk": {"dir": "in", "width": 1},
-                                    "rst": {"dir": "in", "width": 1},
-                                    **{s.name: {"dir": d, "width": len(s)} for s, d in ports}}}
-    # beside the Verilog as a unit's sidecar is: netlist.py --recheck reads it there
-    (out / f"{unit}.json").write_text(json.dumps(meta, indent=1))
-    return path, meta, ctx
+    return path, Design.from_signals(unit, ports), ctx
 
 
 # --- stimulus and oracles ------------------------------------------------------------------
@@ -259,7 +255,7 @@ def _buffer(ctx, rng):
 
 def _source(ctx, rng):
     from bumprtl.rtl.board import texel_coords
-    md, table, fields = ctx["mode"], ctx["table"], ctx["fields"]
+    md, table, fields = ctx["mode"], ctx["table"], ctx["leaves"]
     n = int(2.0 * md.pixels * (LIGHT_STEPS + 1))
     ins = {"allow": (rng.random(n) < 0.8).astype(np.int64),
            "o__ready": (rng.random(n) < 0.8).astype(np.int64), "rst": _reset_at(rng, n)}
@@ -306,23 +302,22 @@ class Bench:
     drives the stimulus cycle by cycle and writes every output each cycle, built once with
     the mutated netlist; :meth:`run` runs it with ``mutsel`` = idx."""
 
-    def __init__(self, target, meta, ctx, seed):
-        self.target, self.meta = target, meta
+    def __init__(self, target, design, ctx, seed):
+        self.target, self.design = target, design
         rng = np.random.default_rng(seed)
         self.inputs, self.expected, self.care = ORACLE[target](ctx, rng)
-        self.ins = [p for p, d in sorted(meta["ports"].items())
-                    if d["dir"] == "in" and p != "clk"]
-        self.outs = [p for p, d in sorted(meta["ports"].items()) if d["dir"] == "out"]
+        self.ins = [p for p in design.names("in") if p != "clk"]
+        self.outs = design.names("out")
         self.cycles = len(next(iter(self.inputs.values())))
         self.words = (f"{self.cycles} cycles of seeded stimulus (seed {seed}) with a reset "
                       f"pulse, every output compared each cycle with {_ORACLE_WORDS[target]}, "
                       f"on Icarus")
 
     def testbench(self):
-        ports = self.meta["ports"]
-        width = sum(ports[p]["width"] for p in self.ins)
-        regs = "\n".join(f"  reg [{ports[p]['width'] - 1}:0] {p};" for p in self.ins)
-        wires = "\n".join(f"  wire [{ports[p]['width'] - 1}:0] {p};" for p in self.outs)
+        ports = self.design.ports
+        width = sum(ports[p].width for p in self.ins)
+        regs = "\n".join(f"  reg [{ports[p].width - 1}:0] {p};" for p in self.ins)
+        wires = "\n".join(f"  wire [{ports[p].width - 1}:0] {p};" for p in self.outs)
         conn = ", ".join(f".{p}({p})" for p in ["clk", *self.ins, *self.outs])
         fmt = " ".join("%h" for _ in self.outs)
         return f"""`timescale 1ns/1ps
@@ -332,7 +327,7 @@ module bench;
 {wires}
   reg [{width - 1}:0] stim [0:{self.cycles - 1}];
   integer t, fd;
-  {self.meta['unit']} dut({conn});
+  {self.design.module} dut({conn});
   initial begin
     $readmemh("stim.hex", stim);
     fd = $fopen("outputs.txt", "w");
@@ -350,14 +345,14 @@ endmodule
 
     def build(self, mutated, work):
         """Icarus: the mutated netlist and the testbench into ``work``/bench.vvp."""
-        ports = self.meta["ports"]
+        ports = self.design.ports
         (work / "bench.v").write_text(self.testbench())
-        hexw = (sum(ports[p]["width"] for p in self.ins) + 3) // 4
+        hexw = (sum(ports[p].width for p in self.ins) + 3) // 4
         lines = []
         for t in range(self.cycles):
             word = 0
             for p in self.ins:
-                word = (word << ports[p]["width"]) | int(self.inputs[p][t])
+                word = (word << ports[p].width) | int(self.inputs[p][t])
             lines.append(f"{word:0{hexw}x}")
         (work / "stim.hex").write_text("\n".join(lines) + "\n")
         iverilog = shutil.which("iverilog")
@@ -415,9 +410,9 @@ _ORACLE_WORDS = {
 
 
 def bench(target, rtl, seed):
-    """Emit ``target`` into ``rtl``: (Verilog path, meta, Bench)."""
-    v, meta, ctx = emit(target, rtl)
-    return v, meta, Bench(target, meta, ctx, seed)
+    """Emit ``target`` into ``rtl``: (Verilog path, Design, Bench)."""
+    v, design, ctx = emit(target, rtl)
+    return v, design, Bench(target, design, ctx, seed)
 
 
 if __name__ == "__main__":

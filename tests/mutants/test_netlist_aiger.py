@@ -17,6 +17,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist  # noqa: E402
 import netlist_pdr as npdr  # noqa: E402
+from harness_ports import Design  # noqa: E402
+
+from bumprtl.rtl.sidecar import Port
 
 # M=12 I=2 L=3 O=1 A=4 B=1 C=1 J=1 F=1. Inputs 2, 4; latches 6 (reset 0, two numbers),
 # 8 (reset 1), 10 (uninitialized: its own literal); output 13; bad 14; constraint 3;
@@ -177,9 +180,8 @@ def test_spacer_reads_bad_states_and_constraints(tmp_path):
 
 # --- the undecided path: a failing tool or parser is a verdict, never a traceback ----------
 
-META = {"unit": "pipe", "ports": {"clk": {"dir": "in", "width": 1},
-                                  "o__valid": {"dir": "out", "width": 1},
-                                  "o__payload": {"dir": "out", "width": 4}}}
+META = Design("pipe", {"clk": Port("in", 1), "o__valid": Port("out", 1),
+                       "o__payload": Port("out", 4)})
 
 
 def test_a_step_that_raises_leaves_the_survivor_undecided(tmp_path, monkeypatch):
@@ -220,6 +222,6 @@ def test_a_target_that_fails_is_an_undecided_row_of_the_table():
 
 def test_a_step_out_of_time_leaves_the_survivor_undecided_with_its_limit(tmp_path):
     from test_netlist_pdr import PIPE, reset_value_mutant
-    meta, line = reset_value_mutant(tmp_path, PIPE)     # pdr proves it in its time (60 s)
-    verdict = netlist.equivalence(None, meta, line, tmp_path, 1, steps=("pdr",))
+    design, line = reset_value_mutant(tmp_path, PIPE)     # pdr proves it in its time (60 s)
+    verdict = netlist.equivalence(None, design, line, tmp_path, 1, steps=("pdr",))
     assert verdict == "undecided: pdr: no proof within 1 s (no depth run)", verdict

@@ -22,9 +22,9 @@ import netlist_board as nb  # noqa: E402
     pytest.param("board:source", marks=pytest.mark.regress)])
 def test_the_bench_passes_the_design_and_kills_mutants(tmp_path, target):
     rtl = tmp_path / "rtl"
-    v, meta, bench = nb.bench(target, rtl, 3)
-    lines = netlist.mutation_list(v, meta["unit"], 4, 3, rtl)
-    mv, _ = netlist.mutated_netlist(v, meta, lines, rtl, passes=("pmuxtree",))
+    v, design, bench = nb.bench(target, rtl, 3)
+    lines = netlist.mutation_list(v, design.module, 4, 3, rtl)
+    mv, _ = netlist.mutated_netlist(v, design, lines, rtl, passes=("pmuxtree",))
     bench.build(mv, rtl)
     assert bench.run(tmp_path / "run0", 0) == "passed"
     said = [bench.run(tmp_path / f"run{i}", i) for i in range(1, len(lines) + 1)]
@@ -35,9 +35,9 @@ def test_a_wrong_oracle_kills_the_design(tmp_path):
     # the timing's oracle with de one cycle late: the unmutated design no longer matches
     # (the bench compares what it claims to)
     rtl = tmp_path / "rtl"
-    v, meta, bench = nb.bench("board:timing", rtl, 3)
+    v, design, bench = nb.bench("board:timing", rtl, 3)
     bench.expected["de"] = [0] + bench.expected["de"][:-1]
-    lines = netlist.mutation_list(v, meta["unit"], 1, 3, rtl)
-    mv, _ = netlist.mutated_netlist(v, meta, lines, rtl, passes=("pmuxtree",))
+    lines = netlist.mutation_list(v, design.module, 1, 3, rtl)
+    mv, _ = netlist.mutated_netlist(v, design, lines, rtl, passes=("pmuxtree",))
     bench.build(mv, rtl)
     assert bench.run(tmp_path / "run0", 0).startswith("killed: de at cycle ")

@@ -12,6 +12,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlist  # noqa: E402
 import netlist_cone as nc  # noqa: E402
+from harness_ports import Design  # noqa: E402
+
+from bumprtl.rtl.sidecar import Port
 
 PIPE = """
 module pipe(input clk, input rst, input i__valid, input [3:0] i__payload,
@@ -56,9 +59,9 @@ def _prepare(tmp_path, verilog):
     il, js = _PREPARED[verilog]
     (tmp_path / "prepped.il").write_text(il)
     mod = json.loads(js)["modules"]["pipe"]
-    ports = {n: {"dir": "in" if p["direction"] == "input" else "out", "width": len(p["bits"])}
-             for n, p in mod["ports"].items()}
-    return mod, {"unit": "pipe", "ports": ports}
+    ports = {n: Port("in" if p["direction"] == "input" else "out", len(p["bits"]))
+             for n, p in mod["ports"].items()}     # a Yosys JSON module's ports
+    return mod, Design("pipe", ports)
 
 
 def _net_name(mod, name):
@@ -78,49 +81,49 @@ def _cell_driving(mod, bits):
 
 
 def reset_value_mutant(tmp_path, pipe):
-    """``pipe`` prepared, and the mutation inverting bit 2 of ``d``'s reset value: (meta,
+    """``pipe`` prepared, and the mutation inverting bit 2 of ``d``'s reset value: (design,
     the mutate line)."""
-    mod, meta = _prepare(tmp_path, pipe)
+    mod, design = _prepare(tmp_path, pipe)
     # the mux that gives d its reset value 0: input B (rst = 1) is the constant 4'b0000
     d_ff = _cell_driving(mod, _net_name(mod, "d"))
     rst_mux = _cell_driving(mod, mod["cells"][d_ff]["connections"]["D"])
     assert mod["cells"][rst_mux]["connections"]["B"] == ["0"] * 4
-    return meta, f"mutate -mode inv -module pipe -cell {rst_mux} -port B -portbit 2"
+    return design, f"mutate -mode inv -module pipe -cell {rst_mux} -port B -portbit 2"
 
 
 def test_pdr_proves_a_reset_value_no_valid_payload_reads(tmp_path):
-    meta, line = reset_value_mutant(tmp_path, PIPE)
+    design, line = reset_value_mutant(tmp_path, PIPE)
     # pdr alone (the cut's invariant "every register bit equal but R" fails at the payload:
     # test_netlist_rel's reset test); pdr finds "d differs only while v is 0, o__payload
     # only while o__valid is 0"
-    verdict = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("pdr",))
+    verdict = netlist.equivalence(None, design, line, tmp_path, 60, steps=("pdr",))
     assert verdict.startswith("equivalent under the stream contract (pdr:"), verdict
 
 
 def test_pdr_proves_a_flip_under_a_bit_a_range_never_sets(tmp_path):
-    mod, meta = _prepare(tmp_path, RANGE)
+    mod, design = _prepare(tmp_path, RANGE)
     b_ff = _cell_driving(mod, _net_name(mod, "b"))
     hold_mux = _cell_driving(mod, mod["cells"][b_ff]["connections"]["D"])
     assert mod["cells"][hold_mux]["connections"]["B"] == _net_name(mod, "b")
     # the held value's bit 0 flipped while its bit 3 is set: b = c = a + 2 <= 7 never sets
     # it, but only the range a <= 5 says so (a's bits 0 to 2 are each set at times)
     line = f"mutate -mode cnot1 -module pipe -cell {hold_mux} -port B -portbit 0 -ctrlbit 3"
-    cut = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("cut",))
+    cut = netlist.equivalence(None, design, line, tmp_path, 60, steps=("cut",))
     assert cut.startswith("undecided"), cut
-    verdict = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("pdr",))
+    verdict = netlist.equivalence(None, design, line, tmp_path, 60, steps=("pdr",))
     assert verdict.startswith("equivalent (pdr:"), verdict
 
 
 def payload_mutant(tmp_path, pipe):
     """``pipe`` prepared, and the mutation inverting bit 0 of its adder's sum, which every
-    valid payload carries: (meta, the mutate line)."""
-    mod, meta = _prepare(tmp_path, pipe)
+    valid payload carries: (design, the mutate line)."""
+    mod, design = _prepare(tmp_path, pipe)
     add = next(n for n, c in mod["cells"].items() if c["type"] == "$add")
-    return meta, f"mutate -mode inv -module pipe -cell {add} -port Y -portbit 0"
+    return design, f"mutate -mode inv -module pipe -cell {add} -port Y -portbit 0"
 
 
 def test_pdr_refuses_a_mutant_that_changes_a_valid_payload(tmp_path):
-    meta, line = payload_mutant(tmp_path, PIPE)
-    verdict = netlist.equivalence(None, meta, line, tmp_path, 60, steps=("pdr",))
+    design, line = payload_mutant(tmp_path, PIPE)
+    verdict = netlist.equivalence(None, design, line, tmp_path, 60, steps=("pdr",))
     assert verdict.startswith("undecided"), verdict
     assert re.search(r"pdr: a counterexample", verdict), verdict

@@ -24,7 +24,7 @@ from bumprtl.gen.render.rtl import scene_stimulus, write_stimulus
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ECP5, RAM_LATENCY, RegisteredRAM
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.rtl.sidecar import from_facts
+from bumprtl.rtl.sidecar import from_facts, ports_from_table
 from bumprtl.sim.ecp5 import (
     ecp5_lockstep,
     enabled_delay,
@@ -146,7 +146,7 @@ def test_postsynth_exact_pipeline_bit_exact(build_dir):
     inputs = {**{k: np.asarray(v) for k, v in codes.items()},
               "tag": np.arange(n) & ((1 << cfg.tag_bits) - 1)}
     comp = pipeline_component(cfg, ECP5())
-    fields = [f for f in port_table(comp)["i__payload"]["fields"]]
+    fields = list(ports_from_table(port_table(comp))["i__payload"].fields)
     inputs = {k: inputs[k] for k in fields}
     outs = _postsynth_stream(comp, "exact_pipeline", inputs, build_dir, PATTERNS)
     golden = illumination_fixed(rotation_fixed({k: v for k, v in inputs.items() if k != "tag"}, cfg), cfg)
