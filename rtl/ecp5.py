@@ -300,7 +300,7 @@ class ECP5Lowering:
             dout = Signal(18, name=f"{ram.name}_do{col}")
             din = Signal(18, name=f"{ram.name}_di{col}")
             m.d.comb += [din.eq(w_data[lo:hi]), r_data[lo:hi].eq(dout[:hi - lo])]
-            ports = dict(i_CLKA=ClockSignal(), i_CEA=ram.w_en, i_OCEA=one, i_WEA=ram.w_en,
+            ports = dict(i_CLKA=ClockSignal(), i_CEA=one, i_OCEA=one, i_WEA=ram.w_en,
                          i_RSTA=zero, i_CLKB=ClockSignal(), i_CEB=ram.en, i_OCEB=ram.en,
                          i_WEB=zero, i_RSTB=zero)
             for side, addr in (("A", w_addr), ("B", r_addr)):

@@ -249,7 +249,13 @@ class CreditEdge(wiring.Component):
         give = self.o.valid & self.o.ready
         after = Signal.like(self.credits, name="credits_next")
         m.d.comb += after.eq(self.credits - take + give)
-        m.d.sync += [self.credits.eq(after), free.eq(after != 0)]
+        m.d.sync += self.credits.eq(after)
+        # free's next state without after's carry chain: a credit spent and none back
+        # leaves one free unless this was the last; one back and none spent frees one
+        with m.If(take & ~give):
+            m.d.sync += free.eq(self.credits != 1)
+        with m.Elif(give & ~take):
+            m.d.sync += free.eq(1)
         m.d.comb += [self.i_ready.eq(free), self.core.ready.eq(1),
                      fifo.w_en.eq(self.core.valid), fifo.w_data.eq(self.core.payload),
                      self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data),

@@ -10,7 +10,7 @@ illumination datapath is an :class:`IlluminationDatapath` (its dot products, the
 method's class from the registry (rtl/methods.py).
 """
 
-from amaranth.hdl import Mux, signed, unsigned
+from amaranth.hdl import Const, Mux, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
@@ -31,19 +31,29 @@ from bumprtl.rtl.tables import (
 
 __all__ = ["IlluminationDatapath", "BackEnd", "SHADE_LATENCY", "shade_stages"]
 
-# Registers of shade_stages: clamp, table offset (and the 8-bit diffuse), the two table
+# Registers of shade_stages: clamp (CLAMP_STAGES), table offset (and the 8-bit diffuse), the two table
 # addresses, table read and table output register (ROM_LATENCY), the two table words once
 # more, the word difference, the interpolation product (PRODUCT_LATENCY), the interpolated
 # specular, the Phong products KS s and KD d (PRODUCT_LATENCY; d waits beside the table),
 # the Phong sum, its rounding and clamp. The registers on both sides of the block RAM let
 # a table placed far from its arithmetic spend a whole cycle on each route.
-FINE_STAGE = 3 + ROM_LATENCY + 2 + PRODUCT_LATENCY + 1     # specular_fine's register
+CLAMP_STAGES = 2        # the sign and x > 1.0 registered beside x, then the select
+FINE_STAGE = CLAMP_STAGES + 2 + ROM_LATENCY + 2 + PRODUCT_LATENCY + 1     # specular_fine's
 SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 
 
-def _clamp01(x, cfg):
-    """clamp(x, 0, 1.0) of a signed value with frac_bits fractional bits, as unsigned B+1."""
-    return Mux(x[-1], 0, Mux(x > cfg.one, cfg.one, x))[:cfg.frac_bits + 1]
+def _clamp01(pipe, x, cfg, name):
+    """clamp(x, 0, 1.0) of a signed value with frac_bits fractional bits, as unsigned B+1,
+    CLAMP_STAGES registers later: first x's sign and x > 1.0 (a carry chain) registered
+    beside x's low bits, then the select as AND/OR terms of those registers (no multiplexer
+    to a constant, which synthesis would turn into a synchronous reset routed to every
+    bit's LSR pin)."""
+    w = cfg.frac_bits + 1
+    negative = pipe.register(x[-1], f"{name}_negative")
+    over = pipe.register(x > cfg.one, f"{name}_over")
+    low = pipe.register(x[:w], f"{name}_low")
+    keep, top = ~(negative | over), over & ~negative
+    return pipe.register((low & keep.replicate(w)) | (Const(cfg.one, w) & top.replicate(w)), name)
 
 
 def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
@@ -61,24 +71,24 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     """
     b, f, g = cfg.frac_bits, SPEC_FRAC_BITS, COLOR_FRAC_BITS
     ka, kd, ks = phong_coefficients(cfg)
-    d = pipe.register(_clamp01(ndotl, cfg), "diffuse_clamped")                   # stage 1
+    d = _clamp01(pipe, ndotl, cfg, "diffuse_clamped")                           # stage C
     # 255 d as (d << 8) - d: a carry chain instead of a DSP block (same integers as d * 255).
-    diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage 2
+    diffuse = pipe.register(round_shift((d << 8) - d, b)[:8], "diffuse")         # stage C + 1
     # d waits beside the table path (and leaves as diffuse_fine); KD d is taken where KS s is
-    d_late = pipe.delay(d, FINE_STAGE - 1, "diffuse_fine_d")                     # FINE_STAGE
+    d_late = pipe.delay(d, FINE_STAGE - CLAMP_STAGES, "diffuse_fine_d")          # FINE_STAGE
     kd_term = pipe.multiply(d_late, kd, "kd_diffuse")                            # + PRODUCT
     if cfg.specular:
         s_bits, r = specular_index_bits(cfg), b - specular_step_bits(cfg)
         x0 = specular_base(cfg)
-        h = pipe.register(_clamp01(ndoth, cfg), "spec_clamped")                  # stage 1
+        h = _clamp01(pipe, ndoth, cfg, "spec_clamped")                            # stage C
         # h - x0, or 0 below x0 (word 0 of the table is 0 there)
         offset = Mux(h < x0, 0, h - x0)[:b + 1] if x0 else h
-        above = pipe.register(offset, "spec_offset")                            # stage 2
+        above = pipe.register(offset, "spec_offset")                            # stage C + 1
         rom = pipe.rom(specular_table(cfg).tolist(), unsigned(8 + f), "specular_table", ports=2)
         j = above[r:]
         # word j + 1; at j = 2**s (h = 1, so the fraction is 0) any word will do: j's low
         # s bits + 1 = word 1 keeps the address inside the table.
-        m.d.comb += [rom.ports[0].addr.eq(pipe.register(j, "spec_addr0")),        # stage 3
+        m.d.comb += [rom.ports[0].addr.eq(pipe.register(j, "spec_addr0")),        # stage C + 2
                      rom.ports[1].addr.eq(pipe.register(j[:s_bits] + 1, "spec_addr1"))]
         # both words registered beside the block RAM before any arithmetic
         t0 = pipe.register(rom.ports[0].data, "spec_word0")                       # 3 + ROM + 1
@@ -103,7 +113,7 @@ def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     terms = pipe.register((kd_term >> (KD_FRAC_BITS + b - g)) + ks_term, "phong_terms")  # + 1
     total = (terms + (ka + (1 << (g - 1)))) >> g
     color = pipe.register(Mux(total > 255, 255, total)[:8], "color")              # + 2
-    return {"diffuse": pipe.delay(diffuse, SHADE_LATENCY - 2, "diffuse_out"),
+    return {"diffuse": pipe.delay(diffuse, SHADE_LATENCY - CLAMP_STAGES - 1, "diffuse_out"),
             "specular": specular, "color": color,
             "diffuse_fine": pipe.delay(d_late, SHADE_LATENCY - FINE_STAGE, "diffuse_fine_out"),
             "specular_fine": fine}

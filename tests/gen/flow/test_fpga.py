@@ -25,7 +25,7 @@ def test_sincos_places_on_the_smallest_device(build_dir):
     assert row["DSP"] == 0                            # no multiplier in sincos
     assert row["BRAM"] >= 1                           # the quarter-wave ROM stays a block RAM
     assert row["LUT4"] > 0 and row["fmax_mhz"] > 0
-    assert row["target_mhz"] == fpga.lpf_mhz() == 150
+    assert row["target_mhz"] == fpga.lpf_mhz() == 200
 
 
 def test_unknown_device_names_the_choices(build_dir):
