@@ -20,10 +20,9 @@ the wrapper does not make ``tlast`` up: ``s_axis_tlast`` rides with its pixel th
 pipe, as the top bit of the internal tag, and comes out as ``m_axis_tlast`` on the same
 pixel (end of line or end of frame: whatever the producer marked). Transfers are
 ``tvalid & tready``; ``m_axis_tvalid`` never waits for ``m_axis_tready`` and
-``s_axis_tready`` is high while ``m_axis_tvalid`` is low: it is the unit's advance (high
-while the output is empty or being taken) or, for a ``BumpPipeline``, its registered
-lock-step enable (high while its output buffer holds at most one pixel, never a function
-of ``m_axis_tready`` in the same cycle; rtl/pipeline.py). One transfer is one pixel: ``tkeep``/``tstrb`` are all ones and left
+``s_axis_tready`` is the unit's (or ``BumpPipeline``'s) ``i.ready``: a register, high
+while one of its credits is free (rtl/pipe.CreditEdge), never a function of
+``m_axis_tvalid`` or ``m_axis_tready`` in the same cycle. One transfer is one pixel: ``tkeep``/``tstrb`` are all ones and left
 out. A config whose fields do not fit ``tdata_width`` raises :class:`AxisError` naming
 the widths.
 """

@@ -25,10 +25,9 @@ DP16KD_MODES = ((18, 1024, 4), (9, 2048, 3), (4, 4096, 2), (2, 8192, 1), (1, 163
 # x2 blocks, read without an output multiplexer (the generic form, which Yosys maps with
 # one, is slower: docs/report.md).
 ROM_MAX_BLOCKS = 9
-# A memory of more DP16KD than this side by side is "spread" over the die: it gets an enable
-# flip-flop of its own in lock step (pipe.StallPipe.rom / ram) and its reads a second address
-# register (sincos.near_sine, bumpfetch.BumpMapFetch), so neither the clock enable nor the
-# address crosses the spread in the cycle that computes it. The threshold is the widest
+# A memory of more DP16KD than this side by side is "spread" over the die: its reads take a
+# second address register (sincos.near_sine, bumpfetch.BumpMapFetch), so the address does
+# not cross the spread in the cycle that computes it. The threshold is the widest
 # memory whose rows place without it (bumprtl report fpga, docs/report.md).
 SPREAD_BLOCKS = 8
 # A quarter-wave sine ROM of more DP16KD than this side by side has its reads take a second

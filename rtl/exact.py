@@ -43,7 +43,7 @@ def rotated_layout(cfg: Config):
 
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
-    a value read appears ``latency`` ``adv`` stages after its angle (angle register,
+    a value read appears ``latency`` pipe stages after its angle (angle register,
     address register, [its near copy for a wide ROM,] read, block-RAM output register,
     data register, sign: sincos.registered_sine_latency)."""
 
@@ -77,7 +77,7 @@ def vector_terms(pipe, bank, vec, n_phi, name, latency):
     """The per-vector half of the exact rotation for a vector A = ``vec`` (polar angles):
     D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A)
-    read from ``bank`` (a :class:`SineBank`) and delayed to ``latency`` ``adv`` stages
+    read from ``bank`` (a :class:`SineBank`) and delayed to ``latency`` pipe stages
     after the input. Shared by :class:`ExactRotation` and ``pipeline.VectorTerms``, so units
     built from it run in lock step."""
     bits = bank.cfg.angle_bits                          # binary angles wrap (mod 2**bits)

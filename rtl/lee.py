@@ -207,7 +207,7 @@ class BlockROM(RegisteredROM):
 
 
 def block_rom(pipe, init, shape, name, ports):
-    """A :class:`BlockROM` with ``ports`` read ports enabled by ``adv``, recorded in the pipe's
+    """A :class:`BlockROM` with ``ports`` read ports read every cycle, recorded in the pipe's
     ``memories`` as ``pipe.rom`` records its ROMs."""
     rom = pipe.memory(name, BlockROM(init, shape, ports, name, target=pipe.target))
     pipe.m.d.comb += rom.en.eq(pipe.en)
@@ -224,7 +224,7 @@ def rom_read(pipe, name, table, width, address):
     """One read of a :class:`BlockROM` at ``address``: the address is registered first and the
     data once more after the ROM's own output register (the routes to the block RAM's
     address pins and from its data pins each get a cycle of their own), so the data comes
-    ROM_STAGES ``adv`` stages after ``address``."""
+    ROM_STAGES pipe stages after ``address``."""
     rom = block_rom(pipe, np.asarray(table).tolist(), unsigned(width), name, ports=1)
     pipe.m.d.comb += rom.ports[0].addr.eq(pipe.register(address, f"{name}_address"))
     return pipe.register(rom.ports[0].data, f"{name}_data")
@@ -238,7 +238,7 @@ SINE_STAGES = REGISTERED_SINE_LATENCY
 
 
 def sine_value(m, pipe, port, angle, cfg: Config, name):
-    """``sin(angle)`` through ``port`` of a :func:`sine_rom`, SINE_STAGES ``adv`` stages later:
+    """``sin(angle)`` through ``port`` of a :func:`sine_rom`, SINE_STAGES pipe stages later:
     sincos.sine_read(registered=True) (angle, mirrored address, read, output register, the
     word registered once more before the sign's carry chain as :func:`rom_read` does, sign;
     bit-exact with tables.sin_lookup). ``cos(a)`` is ``sin(a + 2**k)``."""
@@ -270,7 +270,7 @@ class LeeRotation(PipeUnit):
     register, every product registered (``pipe.multiply``; the two by a reciprocal, wider
     than a DSP input, ``Pipe.wide_multiply``, and eq. 19's as well when its operands,
     :func:`prop_operands`, outgrow a DSP input), and at most one carry chain or half a mux
-    chain lies between two registers. Per vector, in ``adv`` stages (S = SINE_STAGES,
+    chain lies between two registers. Per vector, in pipe stages (S = SINE_STAGES,
     R = ROM_STAGES, W = WIDE_PRODUCT_LATENCY, P = ``pipe.product_latency`` of
     :func:`prop_operands`: PRODUCT_LATENCY up to angle_bits 15 and B = 16, else W):
 

@@ -15,7 +15,7 @@ credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cyc
 
 from amaranth.hdl import Const, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
-from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.config import BumpError
@@ -49,7 +49,7 @@ __all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "m
            "DP16KD_MODES", "pipe_observer"]
 
 # Cycles from a pixel written into the edge's FIFO to the same pixel offered at ``o``:
-# the write (SyncFIFOBuffered's memory), then its output register.
+# the write (the FIFO's memory), then its output register.
 EDGE_LATENCY = 2
 # Cycles from a pixel taken at ``o`` to its credit free at ``i``: the credit count is a
 # register, so the credit is counted the cycle after the pixel leaves.
@@ -221,8 +221,13 @@ class CreditEdge(wiring.Component):
     core : In(stream.Signature(layout))
         The pipe's last stage (``ready`` is 1: the FIFO always has room, see below).
     o : Out(stream.Signature(layout))
-        The FIFO's head (SyncFIFOBuffered: ``valid`` and ``payload`` from its output
-        register).
+        The FIFO's head: ``valid`` and ``payload`` from its output register.
+
+    The FIFO: a memory of ``2**ceil(log2(depth))`` words written whenever ``core.valid``
+    (no full flag: the credits guarantee room) at a write pointer that wraps by overflow,
+    read asynchronously (LUT RAM on ECP5) at a read pointer into the output register
+    whenever the register is empty or being taken and the memory holds a pixel. Its
+    occupancy ``level`` counts the memory's pixels and the output register's.
 
     ``credits`` starts at ``depth``; a pixel taken spends one, a pixel leaving ``o`` gives
     one back (counted the next cycle). In every cycle credits + pixels in the pipe + FIFO
@@ -241,9 +246,22 @@ class CreditEdge(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        m.submodules.fifo = fifo = SyncFIFOBuffered(width=Shape.cast(self.layout).width,
-                                                    depth=self.depth)
-        m.d.comb += self.level.eq(fifo.level)
+        width, bits = Shape.cast(self.layout).width, (self.depth - 1).bit_length()
+        m.submodules.fifo = fifo = Memory(shape=width, depth=1 << bits, init=[])
+        wp = Signal(bits, name="fifo_write")
+        rp = Signal(bits, name="fifo_read")
+        head = Signal(width, name="fifo_head", reset_less=True)
+        held = Signal(name="fifo_head_valid")
+        write, read = fifo.write_port(), fifo.read_port(domain="comb")
+        m.d.comb += [write.addr.eq(wp), write.data.eq(self.core.payload),
+                     write.en.eq(self.core.valid), read.addr.eq(rp)]
+        m.d.sync += wp.eq(wp + self.core.valid)            # wraps: the credits leave room
+        load = (wp != rp) & (~held | self.o.ready)
+        with m.If(load):
+            m.d.sync += [head.eq(read.data), rp.eq(rp + 1), held.eq(1)]
+        with m.Elif(self.o.ready):
+            m.d.sync += held.eq(0)
+        m.d.comb += self.level.eq((wp - rp)[:bits] + held)
         free = Signal(init=1, name="credit_free")           # credits != 0, registered
         take = self.i_valid & free
         give = self.o.valid & self.o.ready
@@ -257,9 +275,7 @@ class CreditEdge(wiring.Component):
         with m.Elif(give & ~take):
             m.d.sync += free.eq(1)
         m.d.comb += [self.i_ready.eq(free), self.core.ready.eq(1),
-                     fifo.w_en.eq(self.core.valid), fifo.w_data.eq(self.core.payload),
-                     self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data),
-                     fifo.r_en.eq(self.o.ready)]
+                     self.o.valid.eq(held), self.o.payload.eq(head)]
         return m
 
 

@@ -58,7 +58,7 @@ def _clamp01(pipe, x, cfg, name):
 
 def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):
     """Eq. (2) from the dot products; returns {diffuse, specular, color, diffuse_fine,
-    specular_fine}, SHADE_LATENCY ``adv`` stages after ``ndotl``/``ndoth`` (signed,
+    specular_fine}, SHADE_LATENCY pipe stages after ``ndotl``/``ndoth`` (signed,
     ``frac_bits`` fractional bits). With d = clamp(N'.L), h = clamp(N'.H) (B fractional bits):
 
     diffuse_fine  = d                                                    (B fractional bits)

@@ -81,7 +81,7 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
 def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True,
               near=False, line=False):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
-    appears two ``adv`` stages later (ROM read, then sign) from a Memory read port, or
+    appears two pipe stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
     ``registered`` (the angle, the address, ROM read, block-RAM output register, a data
     register, then sign: the angle's adder, the mirrored address ``2**k - i``, the route to

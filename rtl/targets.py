@@ -1,6 +1,6 @@
 """The elaboration targets and the registered elements they build (docs/architecture.md,
-Interfaces): a product, a wide product, a ROM and a RAM, each enabled by one ``en`` (a
-StallPipe's ``adv``, rtl/pipe.py), and a target object per target with a method per
+Interfaces): a product, a wide product, a ROM and a RAM, each enabled by one ``en`` (the
+enclosing Pipe's constant 1, rtl/pipe.py), and a target object per target with a method per
 primitive: :class:`Generic` (``target=None``: what every simulator runs and ``bumprtl
 emit`` writes) and :class:`ECP5` (rtl/ecp5.py's MULT18X18D and DP16KD blocks with their
 registers, for the ECP5 flow). An element holds its contract (ports, latency, contents)
@@ -33,7 +33,7 @@ __all__ = ["Generic", "ECP5", "GENERIC", "form", "RegisteredProduct", "WideProdu
            "SPREAD_BLOCKS", "NEAR_BLOCKS", "rom_blocks", "is_spread",
            "DSP_WIDTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY"]
 
-# Stages of StallPipe.multiply: operand registers, product register.
+# Stages of Pipe.multiply: operand registers, product register.
 PRODUCT_LATENCY = 2
 # Stages of a RegisteredROM read: the synchronous read, the output register.
 ROM_LATENCY = 2
@@ -123,8 +123,8 @@ def limb_products(m, a, b, en, target):
 
 def product_latency(*shapes):
     """Stages of a registered product of operands of ``shapes``: PRODUCT_LATENCY
-    (:meth:`StallPipe.multiply`) when they fit one DSP input (:func:`fits_dsp`), else
-    WIDE_PRODUCT_LATENCY (:meth:`StallPipe.wide_multiply`, which registers the limbs' sum)."""
+    (:meth:`Pipe.multiply`) when they fit one DSP input (:func:`fits_dsp`), else
+    WIDE_PRODUCT_LATENCY (:meth:`Pipe.wide_multiply`, which registers the limbs' sum)."""
     return PRODUCT_LATENCY if fits_dsp(*shapes) else WIDE_PRODUCT_LATENCY
 
 
@@ -279,7 +279,7 @@ def form(target):
 
 class ECP5(ECP5Lowering, Generic):
     """The ECP5 target, passed as ``target=ECP5()`` to a unit's constructor by the ECP5 flow
-    (gen/flow/fpga.py) and threaded down to its StallPipe, RegisteredROM and
+    (gen/flow/fpga.py) and threaded down to its Pipe, RegisteredROM and
     RegisteredProduct (``target=None``, the default, is the generic form): the methods of
     rtl/ecp5.py's :class:`ECP5Lowering` (products as MULT18X18D blocks, tables as DP16KD
     block RAMs, each with its registers), the generic form (:class:`Generic`) for whatever

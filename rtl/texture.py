@@ -25,7 +25,7 @@ coefficients' quantization and the floors of the products: :func:`blend_error_bo
 """
 
 import numpy as np
-from amaranth.hdl import Mux, Value, ValueCastable, unsigned
+from amaranth.hdl import Const, Mux, Value, ValueCastable, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
@@ -48,7 +48,7 @@ RGB = ("r", "g", "b")
 # and spec), lit (registered before it is the albedo product's operand), the texel product
 # (operand and product registers), the output sum (taken from the DSP's output alone), its
 # rounding and clamp.
-BLEND_LATENCY = 8
+BLEND_LATENCY = 9
 # The stage texture_blend's 8-bit light sums leave at (rounded at 2, clamped at 3).
 SUMS8_STAGE = 3
 
@@ -94,6 +94,19 @@ def sum_product(terms, width, k, mul, name):
     return sum(prods[1:], prods[0])
 
 
+def _select(over, top, x):
+    """``top`` where ``over``, else ``x``: AND/OR terms of two registers (Amaranth), not a
+    multiplexer to a constant (which synthesis turns into a reset on every bit's LSR pin),
+    and ``where`` on int64 arrays."""
+    if isinstance(x, (Value, ValueCastable)):
+        x = Value.cast(x)
+        w = max(x.shape().width, top.bit_length())
+        over = Value.cast(over)
+        out = (x & (~over).replicate(w)) | (Const(top, w) & over.replicate(w))
+        return out[:top.bit_length()]
+    return np.where(over, top, x)
+
+
 def _sat(x, top):
     """min(x, top) of a non-negative value (Amaranth or int64): every term here is unsigned."""
     if isinstance(x, (Value, ValueCastable)):
@@ -137,14 +150,18 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     kd_sum = reg(kd_term >> b, "kd_lit")                                        # stage 3
     spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
     d8, s8 = reg(_sat(d8, u8), "diffuse8"), reg(_sat(s8, u8), "specular8")      # clamped
-    lit = reg(_sat(ka + kd_sum, 1 << gl), "lit")                                # stage 4
-    for n in (3, 4):
+    # min(1, ka + kd_sum) in two stages, one carry chain each: the sum beside the compare
+    # kd_sum > 1 - ka (the same test), then the select as AND/OR terms (_select)
+    top = 1 << gl
+    over = reg(kd_sum > top - ka, "lit_over")                                   # stage 4
+    lit = reg(_select(over, top, reg(ka + kd_sum, "lit_sum")), "lit")           # stage 5
+    for n in (3, 4, 5):
         tex = {c: reg(tex[c], f"texel_{c}_d{n}") for c in RGB}
-    prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 6
-    for n in (4, 5, 6):
+    prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 7
+    for n in (4, 5, 6, 7):
         spec = reg(spec, f"spec_d{n}")
-    shade = {c: reg(prod[c] + spec, f"shade_{c}") for c in RGB}                  # stage 7
-    out = {c: reg(_sat(round_shift(shade[c], gl), u8), f"color_{c}") for c in RGB}  # 8
+    shade = {c: reg(prod[c] + spec, f"shade_{c}") for c in RGB}                  # stage 8
+    out = {c: reg(_sat(round_shift(shade[c], gl), u8), f"color_{c}") for c in RGB}  # 9
     return out, d8, s8
 
 

@@ -9,7 +9,7 @@ named`` itself (in process, into ``--out``), and from its sidecar (``built`` uni
 
 ``made-at``   the configuration and the command (``Made at: angle_bits=..., frac_bits=...``);
 ``diagram``   a Mermaid block diagram: the built units in order with their latencies and
-              memories, the host write ports, the output buffer;
+              memories, the host write ports, the credit edge;
 ``ports``     the port table: every port of the named wrapper with its bits in the packed
               payload, its format and meaning;
 ``timing``    latency, throughput and the memory images;
@@ -38,7 +38,7 @@ from bumprtl.gen.flow.named import named_ports
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import docs
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.sidecar import CHANGES_FROM_1, SCHEMA, SCHEMA_VERSION
+from bumprtl.rtl.sidecar import CHANGES_FROM_1, CHANGES_FROM_2, SCHEMA, SCHEMA_VERSION
 from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.common import cartesian_to_polar, polar_to_cartesian
 from bumprtl.sim.golden.fixed.common import angle_codes
@@ -142,19 +142,21 @@ def _unit_memories(meta, unit):
 
 
 def diagram(meta):
-    """Mermaid flowchart: input stream -> built units -> output buffer -> output stream."""
+    """Mermaid flowchart: input stream -> credits -> built units -> FIFO -> output stream."""
     fin = ", ".join(sorted({f.split(".")[0] for f in meta.input_fields}))
     fout = ", ".join(sorted({f.split(".")[0] for f in meta.output_fields}))
     lines = ["```mermaid", "flowchart LR",
-             f'  IN(["in: {fin}<br/>valid / ready"])']
-    prev = "IN"
+             f'  IN(["in: {fin}<br/>valid / ready"])',
+             f'  CR{{"credits<br/>{meta.fifo_depth}"}}', "  IN --> CR"]
+    prev = "CR"
     for i, b in enumerate(meta.built):
         node = f"U{i}"
         lines.append(f'  {node}["{b["unit"]}: {b["class"]}<br/>latency {b["latency"]}'
                      f'{_unit_memories(meta, b["unit"])}"]')
         lines.append(f"  {prev} --> {node}")
         prev = node
-    lines += ['  BUF["output buffer<br/>2 entries"]', f"  {prev} --> BUF",
+    lines += [f'  BUF["FIFO<br/>{meta.fifo_depth} entries"]', f"  {prev} --> BUF",
+              "  BUF -. credit back .-> CR",
               f'  OUT(["out: {fout}<br/>valid / ready"])', "  BUF --> OUT"]
     for img in (meta.memory_images or {}).values():
         host = img["port"][0].rsplit("_w_en", 1)[0]
@@ -309,7 +311,7 @@ def load_template(meta):
 
 def sidecar_schema(meta):
     """The sidecar's schema table (rtl/sidecar.py ``SCHEMA``), its version, what changed from
-    the untyped version 1, and the facts of this design's sidecar."""
+    the untyped version 1 and from version 2, and the facts of this design's sidecar."""
     rows = ["| Key | JSON type | Meaning |", "|---|---|---|"]
     rows += [f"| `{k}` | {t} | {m} |" for k, (t, m) in SCHEMA.items()]
     fin, fout = meta.input_fields, meta.output_fields
@@ -320,8 +322,8 @@ def sidecar_schema(meta):
         f"file of another version, with a missing or an unknown key, in one line naming the key "
         f"and the version it reads.", "", *rows, "",
         f"Changed from version 1 (the untyped sidecar of bumprtl 0.2 and before): "
-        f"{CHANGES_FROM_1}.", "",
-        f"This design's sidecar: latency {meta.latency}, ROMs {len(meta.roms)}, RAMs "
+        f"{CHANGES_FROM_1}. Changed from version 2: {CHANGES_FROM_2}.", "",
+        f"This design's sidecar: latency {meta.latency}, FIFO depth {meta.fifo_depth}, ROMs {len(meta.roms)}, RAMs "
         f"{len(meta.rams)}, `i__payload` {meta.port('i__payload').width} bits in "
         f"{len(fin)} fields, `o__payload` {meta.port('o__payload').width} bits in {len(fout)} "
         f"fields, {len(meta.named_ports.ports)} named ports."])

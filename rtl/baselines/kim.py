@@ -275,7 +275,7 @@ def _multiplier(pipe, prefix):
 
 
 def _stage(pipe, prefix):
-    """``stage`` for the helpers: one ``adv`` register named ``{prefix}_{name}``."""
+    """``stage`` for the helpers: one pipe register named ``{prefix}_{name}``."""
     return lambda value, name: pipe.register(value, f"{prefix}_{name}")
 
 
@@ -291,7 +291,7 @@ class KimRotation(PipeUnit):
     register, data register, sign), every other table read lee.rom_read (R = ROM_STAGES:
     address register, read, output register, data register), every product a
     RegisteredProduct (P = PRODUCT_LATENCY), and at most one carry chain or half a mux chain
-    lies between two registers. Per vector, in ``adv`` stages:
+    lies between two registers. Per vector, in pipe stages:
 
     ========================  ==================================================
     stage                     what is registered

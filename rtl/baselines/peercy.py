@@ -42,7 +42,7 @@ MULT18X18D per pair, their sum in two registers of its own), two stages more on 
 target: the squares of the (B + 5)-bit components from B = 14, the transform and the dots of
 the (B + 2)-bit inputs from B = 17 (:func:`product_latencies`). The square root and the
 dividers are pipelined by hand, one result bit per stage with a register after each, every
-register enabled by the pipe's ``adv`` (B. Parhami, Computer Arithmetic: Algorithms and
+register enabled by the pipe's ``en`` (the constant 1) (B. Parhami, Computer Arithmetic: Algorithms and
 Hardware Designs, ch. 13, restoring division, and ch. 21, the restoring shift/subtract
 square root): :func:`sqrt_stages` = B + 6 stages of at most a (B + 8)-bit subtractor,
 :func:`quotient_bits` = B + 2 stages of a (B + 7)-bit one. B + 2 quotient bits are exact:
@@ -159,7 +159,7 @@ def sum3_rounded(reg, p, b, name):
 
 
 def _stage(m, en, value, name):
-    """``value`` through one register enabled by ``en`` (the enclosing pipe's ``adv``)."""
+    """``value`` through one register enabled by ``en`` (the enclosing pipe's ``en``, the constant 1)."""
     value = Value.cast(value)
     reg = Signal(value.shape(), name=name)
     with m.If(en):
@@ -172,7 +172,7 @@ class PeercySqrt(Elaboratable):
     one bit of the root per stage (try (root << 2) | 1 against the remainder with the next
     two radicand bits shifted in; Parhami ch. 21), a register after each. ``root`` comes
     ``stages`` (= ``root_bits``) ``en`` cycles after ``radicand``; ``en`` is the enclosing
-    pipe's ``adv``, so a stall freezes every stage.
+    pipe's ``en`` (the constant 1: the pipe never stops).
 
     Its Amaranth submodule name ends in ``sqrt`` so that gen/flow/resources.py keeps it as a
     black box and counts it as one square root (Table 1's "SQRt").
@@ -210,7 +210,7 @@ class PeercyDivider(Elaboratable):
     pipelined: restoring division, one quotient bit per stage, most significant first (the
     remainder with the next dividend bit shifted in, less the divisor if it fits; Parhami
     ch. 13), a register after each. ``quotient`` comes ``stages`` (= ``quotient_bits``)
-    ``en`` cycles after the operands; ``en`` is the enclosing pipe's ``adv``.
+    ``en`` cycles after the operands; ``en`` is the enclosing pipe's ``en`` (the constant 1).
 
     ``quotient_bits`` (default: the dividend's width, exact for every input) may be fewer
     when the caller knows ``dividend < divisor * 2**quotient_bits``; then the remainder stays
