@@ -247,21 +247,34 @@ class CreditEdge(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         width, bits = Shape.cast(self.layout).width, (self.depth - 1).bit_length()
-        m.submodules.fifo = fifo = Memory(shape=width, depth=1 << bits, init=[])
+        # LUT RAM (its read is asynchronous): a block RAM would put `load` on its clock enable
+        m.submodules.fifo = fifo = Memory(shape=width, depth=1 << bits, init=[],
+                                          attrs={"ram_style": "distributed"})
         wp = Signal(bits, name="fifo_write")
         rp = Signal(bits, name="fifo_read")
         head = Signal(width, name="fifo_head", reset_less=True)
         held = Signal(name="fifo_head_valid")
-        write, read = fifo.write_port(), fifo.read_port(domain="comb")
-        m.d.comb += [write.addr.eq(wp), write.data.eq(self.core.payload),
-                     write.en.eq(self.core.valid), read.addr.eq(rp)]
-        m.d.sync += wp.eq(wp + self.core.valid)            # wraps: the credits leave room
-        load = (wp != rp) & (~held | self.o.ready)
+        wport, rport = fifo.write_port(), fifo.read_port(domain="comb")
+        m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.core.payload),
+                     wport.en.eq(self.core.valid), rport.addr.eq(rp)]
+        # stored: the memory holds a pixel, a register of its own whose next state needs no
+        # carry chain (as credit_free's below), so the head's load is one gate of registers
+        # and o.ready
+        stored = Signal(name="fifo_stored")
+        count = Signal(bits + 1, name="fifo_count")          # pixels in the memory
+        write = self.core.valid
+        load = stored & (~held | self.o.ready)
+        m.d.sync += [wp.eq(wp + write), rp.eq(rp + load),   # wrap: the credits leave room
+                     count.eq(count + write - load)]
+        with m.If(write & ~load):
+            m.d.sync += stored.eq(1)
+        with m.Elif(load & ~write):
+            m.d.sync += stored.eq(count != 1)
         with m.If(load):
-            m.d.sync += [head.eq(read.data), rp.eq(rp + 1), held.eq(1)]
+            m.d.sync += [head.eq(rport.data), held.eq(1)]
         with m.Elif(self.o.ready):
             m.d.sync += held.eq(0)
-        m.d.comb += self.level.eq((wp - rp)[:bits] + held)
+        m.d.comb += self.level.eq(count + held)
         free = Signal(init=1, name="credit_free")           # credits != 0, registered
         take = self.i_valid & free
         give = self.o.valid & self.o.ready

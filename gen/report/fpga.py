@@ -318,20 +318,21 @@ FPGA_NOTES = """
   rotation -> illumination, 64^2 bump map in block RAM). The bump-map and colour-texture
   reads are registered like the ROMs (`rtl/pipe.RegisteredRAM`: DP16KD blocks with the
   write port on port A and REGMODE OUTREG on the read port; the fetch's latency is 3).
-  The units of a BumpPipeline run in lock step on a registered `run` enable, one copy per
-  unit, with a 2-entry output buffer behind the last unit (`rtl/pipe.lockstep_buffer`), so
-  no combinational stall enable crosses the design; before, `adv = ~o.valid | o.ready`
-  fanned out from the last unit's `o.valid` to every clock enable of the whole pipeline and
-  held scene_full at 97.8 MHz (mostly routing delay). The blend registers `lit` before its
+  The units of a BumpPipeline run free: no register, DSP or block RAM has a clock enable
+  (`tests/rtl/test_no_clock_enable.py`), a valid bit rides with each pixel, and flow
+  control is one credit edge (`rtl/pipe.CreditEdge`: a credit count at the input, a
+  LUT-RAM FIFO behind the last unit, docs/architecture.md, The credit loop). Before, a
+  registered lock-step enable, one copy per unit, still reached the CE pin of every
+  register, DSP and DP16KD, and the output buffer's count -> an output entry's CE held
+  scene_default and the exact pipeline near 154 MHz; before that, `adv = ~o.valid |
+  o.ready` fanned out from the last unit's `o.valid` to every clock enable and held
+  scene_full at 97.8 MHz. The blend registers `lit` before its
   albedo products, the light sum registers the Phong terms' sum before the rounding and
   clamp, and the palette table's read is registered (each one more stage).
 - A memory more than eight DP16KD wide (`rtl/targets.SPREAD_BLOCKS`: the full scene's
-  15-block map and 12-block texture) is spread over the die. In lock step it runs on an
-  enable flip-flop of its own (`rtl/pipe.StallPipe`: each copy has the unit copy's next
-  state), and its reads take a second address register, a plain copy the placer puts
-  beside the blocks (`rtl/bumpfetch.BumpMapFetch`): one more stage in the fetch. Without
-  both, the rotation's enable fanned out to 108 block RAMs (the quarter-wave ROMs of 15-bit
-  angles at B = 16, then nine 8192 x 2 blocks each) and held scene_full at 121.1 MHz.
+  15-block map and 12-block texture) is spread over the die: its reads take a second
+  address register, a plain copy the placer puts beside the blocks
+  (`rtl/bumpfetch.BumpMapFetch`): one more stage in the fetch.
 - At 15-bit angles and B = 16 (scene_full, scene_two_lights) each quarter-wave ROM stores
   the sine minus the line under it, `floor(i * 2**B / 2**k)`, in 14 bits instead of 17
   (`rtl/sincos.sine_line`, `rtl/tables.quarter_sine_above_line`): seven 8192 x 2 blocks
@@ -344,9 +345,9 @@ FPGA_NOTES = """
   still in the sum's stage the data register -> sum route held scene_two_lights at
   144.3 MHz (seed 2; docs/fixed_point.md has the table). Rows whose memories are at most
   six blocks wide are unchanged.
-- The `<method>_pipeline` rows chain the method's two units the same way, in lock step
-  behind a 2-entry output buffer (`gen/flow/fpga.pipeline_component`); with
-  `wiring.connect` each unit's `adv = ~o.valid | o.ready` chained through both, and where
+- The `<method>_pipeline` rows chain the method's two units the same way, free-running
+  behind one credit edge (`gen/flow/fpga.pipeline_component`); with `wiring.connect`
+  each unit's `adv = ~o.valid | o.ready` once chained through both, and where
   a unit carries thousands of delay-line flip-flops (the baselines' N', tag and |a| riding
   through the square root and divider) that fan-out was their limit (lee 132.8, Kim 117.3,
   Peercy and Ernst 122.1 MHz at 12-bit angles, B = 13). Lee and Kim are pipelined with registers only (`rtl/lee.py`,
@@ -358,8 +359,8 @@ FPGA_NOTES = """
   illumination's, its limbs' sum in registers of its own: summed in the cycle after the
   DSP blocks (`RegisteredProduct`'s ECP5 form, one stage less) it held lee at 108.7 and
   Peercy and Ernst at 103.1 MHz. Kim's products still sum their limbs in that cycle; its
-  limit is elsewhere (the critical-path list). What stops the baselines short of 150 MHz
-  now is named there: Peercy's divider's last quotient bit into the rounded, signed output;
+  limit is elsewhere (the critical-path list). What stopped the baselines short of 150 MHz
+  before the free-running datapath is named here; the critical-path list has today's: Peercy's divider's last quotient bit into the rounded, signed output;
   in lee's pipeline the proportional table's address after l_y_k (6.4 ns of routing: at
   14-bit angles its tables take 153 DP16KD, 75 at 13 / 16), in lee's setup alone the
   atan-table address after the reciprocal product; Kim's l_p -> l_qn stage.
