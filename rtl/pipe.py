@@ -72,9 +72,9 @@ def check_fifo_depth(latency, depth=None):
     if depth is None:
         return need
     if not isinstance(depth, int) or isinstance(depth, bool) or depth < need:
-        raise BumpError(f"fifo_depth {depth!r} is below the minimum {need} for a pipe of "
+        raise BumpError(f"fifo_depth must be an int >= {need}, the minimum for a pipe of "
                         f"latency {latency} (latency + {EDGE_LATENCY} FIFO stages + "
-                        f"{CREDIT_RETURN} credit return)")
+                        f"{CREDIT_RETURN} credit return), got {depth!r}")
     return depth
 
 

@@ -20,11 +20,13 @@ from amaranth.sim import Simulator
 
 from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.rtl.bumpfetch import BumpMapFetch
-from bumprtl.rtl.config import Config
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (
+    CREDIT_RETURN,
     ECP5,
+    EDGE_LATENCY,
     PRODUCT_LATENCY,
     ROM_LATENCY,
     WIDE_PRODUCT_LATENCY,
@@ -32,6 +34,7 @@ from bumprtl.rtl.pipe import (
     RegisteredROM,
     WideProduct,
     fits_dsp,
+    min_fifo_depth,
     product_latency,
 )
 from bumprtl.rtl.pipeline import BumpPipeline, LightSum
@@ -437,3 +440,22 @@ def test_spread_memories_take_one_more_address_register():
     assert set(spread) == {"map", "texture"}, dut.units["fetch"].memories
     for name in ("fetch", "rotation"):
         assert dut.units[name].latency == narrow.units[name].latency + 1, name
+
+
+@pytest.mark.parametrize("make", [
+    lambda d: SinCos(Config(), fifo_depth=d),
+    lambda d: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}).hardware,
+                           fifo_depth=d)], ids=["unit", "pipeline"])
+def test_a_fifo_below_the_credit_loop_is_refused_naming_both_numbers(make):
+    """fifo_depth below min_fifo_depth(latency) (or not an int) is refused at construction,
+    one line naming the depth given and the least; the least itself is accepted."""
+    least = make(None).fifo_depth
+    latency = least - EDGE_LATENCY - CREDIT_RETURN
+    assert least == min_fifo_depth(latency)
+    for bad in (least - 1, 0, -3, 2.5, True):
+        with pytest.raises(BumpError) as e:
+            make(bad)
+        msg = str(e.value)
+        assert "\n" not in msg and msg.endswith(f"got {bad!r}") and f">= {least}" in msg
+        assert f"latency {latency}" in msg
+    assert make(least).fifo_depth == least and make(least + 5).fifo_depth == least + 5
