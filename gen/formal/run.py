@@ -269,20 +269,24 @@ def execute(*, units=(), props=None, mutants=True, quick=False, jobs=1, job_time
         out.mkdir(parents=True, exist_ok=True)
         results.write_text(json.dumps([asdict(r) for r in merged(rows)], indent=1) + "\n")
 
+    ran = None
     if from_results:
         rows = base
     else:
         try:
-            rows = merged(run(names, props, mutants, out, jobs, save=save,
-                              scheduler=address, timeout=job_timeout))
+            ran = run(names, props, mutants, out, jobs, save=save, scheduler=address,
+                      timeout=job_timeout)
+            rows = merged(ran)
         except SchedulerError as e:             # unreachable: one line, exit 2
             print(f"error: {e}", file=sys.stderr)
             return 2
     print()
     print(table(rows))
-    print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")
+    seconds = time.perf_counter() - t0
+    print(f"\n{len(rows)} checks in {seconds:.0f} s")
     if doc is not None:
-        write_doc(doc, rows, " ".join(sys.argv[1:]))
+        write_doc(doc, rows, " ".join(sys.argv[1:]),
+                  None if ran is None else seconds, None if ran is None else len(ran))
         print(f"wrote {doc}")
     return 1 if report_failures(rows) else 0
 

@@ -184,26 +184,39 @@ class _Edge:
         self.instance = instance if ok else None
         self.storage = instance.origins[0] if ok else None
         self.inner_depth = self.fifo.depth - 1 if ok else 0
+        self._slots = None
 
     @property
     def inner_level(self):
         """Entries in the inner queue (the memory): the occupancy less the output register."""
         return (self.fifo.level - self.fifo.r_rdy)[:len(self.fifo.level)]
 
-    def entries(self, m, layout):
-        """The inner queue's entries, oldest first: ``[(valid, View(layout) of its data)]``,
-        read through one asynchronous read port each, at the read pointer + j."""
+    def slots(self, m, layout):
+        """The inner queue's memory word at every address, as ``View(layout)``: one
+        asynchronous read port at each constant address (added once)."""
+        if self._slots is None:
+            self._slots = []
+            for a in range(self.inner_depth):
+                word = Signal(len(self.fifo.w_data), name=f"fifo_slot{a}")
+                self.instance.read_port(domain="comb", addr=Const(a, ceil_log2(self.inner_depth)),
+                                        data=word, en=Const(1), transparent_for=())
+                self._slots.append(data.View(layout, word))
+        return self._slots
+
+    def holds(self, a):
+        """Address ``a`` holds an entry: between the read and the write pointer, around the
+        end of the memory when they have wrapped (comparisons only, no subtraction)."""
+        produce = self.storage.write_ports[0].addr
         consume = self.storage.read_ports[0].addr
-        out = []
-        for j in range(self.inner_depth):
-            addr = Signal(ceil_log2(self.inner_depth), name=f"fifo_entry{j}_addr")
-            at = consume + j
-            m.d.comb += addr.eq(Mux(at >= self.inner_depth, at - self.inner_depth, at))
-            word = Signal(len(self.fifo.w_data), name=f"fifo_entry{j}")
-            self.instance.read_port(domain="comb", addr=addr, data=word, en=Const(1),
-                                    transparent_for=())
-            out.append((self.inner_level > j, data.View(layout, word)))
-        return out
+        return Mux(self.inner_level == self.inner_depth, 1,
+                   Mux(consume <= produce, (consume <= a) & (a < produce),
+                       (a >= consume) | (a < produce)))
+
+    def offset(self, a):
+        """How many entries address ``a`` is behind the oldest one (the read pointer's),
+        mod the inner depth: ``a`` holds an entry when this is below the inner occupancy."""
+        consume = self.storage.read_ports[0].addr
+        return Mux(a >= consume, a - consume, a + self.inner_depth - consume)
 
 
 def find_edge(fragment):
@@ -352,7 +365,7 @@ class StreamContract(Elaboratable):
         stages, lockstep = self._stages()
         for lead, other in lockstep:
             self._lemma(m, lead == other, "units fed one valid have equal valid chains")
-        self._chain = self._pixels(m, stages) if stages else None
+        self._chain, self._chain_valid = self._pixels(m, stages) if stages else (None, None)
         if self.edge is not None and self._chain is not None and self.prop != "credit":
             self._credit_loop(m, self._lemma)
         getattr(self, f"_{self.prop}")(m, i, o, take_in, take_out, stages)
@@ -366,36 +379,40 @@ class StreamContract(Elaboratable):
         return (max(len(stages), self.port_latency, self.fifo_depth or 0) + 2).bit_length() + 1
 
     def _pixels(self, m, stages):
-        """The valid stages of the chain counted in runs of at most CHUNK stages:
-        ``[popcount of run k]`` (comb sums), each tied by a lemma to a ghost counter that
-        gains the valid bit entering the run and loses the one leaving it every cycle (the
-        chain shifts every cycle): small sums instead of one long one (counting is what SAT
-        solvers find hard)."""
+        """The valid stages of the chain, counted in runs of at most CHUNK stages, each run
+        by a ghost counter that gains the valid bit entering it and loses the one leaving
+        it every cycle (the chain shifts every cycle), tied by a lemma to the run's valid
+        stages: ``(sum of the ghost counters, sum of the runs' valid stages)``. The lemmas
+        about the chain use the first (small sums of registers: counting is what SAT
+        solvers find hard), the ``credit`` property states the second."""
         width = self._width(stages)
         valids = [self._valid_in] + [v for v, _ in stages]
-        counts = []
+        ghosts, counts = [], []
         for first in range(1, len(valids), CHUNK):
             last = min(first + CHUNK, len(valids)) - 1
             ghost = Signal(width, name=f"in_flight_stages{first}_{last}")
             m.d.sync += ghost.eq(ghost + valids[first - 1] - valids[last])
             _ahead, count = self._ahead(m, width, stages[first - 1:last], f"stages{first}_{last}_")
             self._lemma(m, ghost == count, "valid stages of a run = its ghost counter")
+            ghosts.append(ghost)
             counts.append(count)
-        total = Signal(width, name="in_chain")
-        m.d.comb += total.eq(sum(counts))
-        return total
+        total, valid = Signal(width, name="in_chain"), Signal(width, name="valid_in_chain")
+        m.d.comb += [total.eq(sum(ghosts)), valid.eq(sum(counts))]
+        return total, valid
 
-    def _credit_loop(self, m, claim):
+    def _credit_loop(self, m, claim, chain=None):
         """The credit loop's invariant, each fact through ``claim`` (:meth:`_lemma`, or
         :meth:`_check` for the ``credit`` property): the FIFO never holds more than its
-        depth and fills its output register first; credits + pixels in the chain + FIFO
-        occupancy = depth; ``i.ready`` = credits != 0; the FIFO has room when written."""
+        depth and fills its output register first; credits + pixels in the chain (``chain``;
+        default the ghost counters' sum) + FIFO occupancy = depth; ``i.ready`` = credits !=
+        0; the FIFO has room when written."""
         edge, fifo = self.edge.edge, self.edge.fifo
         depth = edge.depth
+        chain = self._chain if chain is None else chain
         claim(m, edge.level <= depth, "credit: the FIFO holds at most its depth")
         claim(m, fifo.r_rdy | (edge.level <= 1),
               "credit: the FIFO's output register is full when it holds two or more")
-        claim(m, edge.credits + self._chain + edge.level == depth,
+        claim(m, edge.credits + chain + edge.level == depth,
               "credit: credits + pixels in the chain + FIFO occupancy != depth")
         claim(m, edge.i_ready == (edge.credits != 0), "credit: i.ready is not credits != 0")
         claim(m, ~fifo.w_en | fifo.w_rdy, "credit: the FIFO written while full")
@@ -403,7 +420,11 @@ class StreamContract(Elaboratable):
     def _credit(self, m, i, o, take_in, take_out, stages):
         if self.edge is None or self._chain is None:
             raise ValueError("credit: the unit has no credit edge and chain to check")
-        self._credit_loop(m, self._check)
+        # The statement counts the chain's valid stages; the lemmas (k-induction) the same
+        # with the ghost counters of its runs.
+        self._lemma(m, self.edge.edge.credits + self._chain + self.edge.edge.level == self.edge.edge.depth,
+                    "credits + the runs' ghost counters + FIFO occupancy = depth")
+        self._credit_loop(m, self._check, self._chain_valid)
         edge = self.edge.edge
         fell = Signal(name="ready_fell")
         with m.If(~edge.i_ready):
@@ -423,15 +444,25 @@ class StreamContract(Elaboratable):
         self._lemma(m, produce == Mux(at >= n, at - n, at),
                     "the FIFO's write pointer = read pointer + its inner occupancy")
 
-    def _queue(self, m):
-        """The FIFO's entries as stages, input -> output: ``[(valid, View)]`` (the inner
-        queue youngest first, then the output register); None without an edge."""
+    def _fifo(self, m):
+        """The edge, with the FIFO's pointer lemmas asserted, when its entries may be
+        stated (lemmas on, a FIFO with a memory); else None."""
         if self.edge is None or self.edge.storage is None or not self.lemmas:
             return None
         self._fifo_lemmas(m)
+        return self.edge
+
+    def _in_fifo(self, m, field, k):
+        """``field`` of the FIFO's ``k``-th oldest pixel: the output register's when it is
+        full and ``k`` is 0, else the inner entry ``k - r_rdy`` places behind the oldest."""
+        edge, fifo = self.edge, self.edge.fifo
         layout = self.dut.o.payload.shape()
-        fifo = self.edge.fifo
-        return [*reversed(self.edge.entries(m, layout)), (fifo.r_rdy, data.View(layout, fifo.r_data))]
+        head = getattr(data.View(layout, fifo.r_data), field).as_value()
+        behind = (k - fifo.r_rdy)[:len(k)]
+        there = Const(0, len(head))
+        for a, word in enumerate(edge.slots(m, layout)):
+            there = Mux(edge.offset(a) == behind, getattr(word, field).as_value(), there)
+        return Mux(fifo.r_rdy & (k == 0), head, there)
 
     # --- the properties ---------------------------------------------------------------------
     def _hold(self, m, i, o, take_in, take_out, stages):
@@ -488,16 +519,36 @@ class StreamContract(Elaboratable):
         m.d.comb += Assume(~i.valid | (i.payload.tag == n_in))
         self._check(m, ~o.valid | (o.payload.tag == n_out), "order: output tag out of sequence")
         self._exercise(m, take_out & (n_out == 1), "order: two pixels enter and leave in order")
-        queue = self._queue(m)
-        if queue is None or not stages:
+        edge = self._fifo(m)
+        if edge is None or not stages:
             return
-        # Consecutive valid stages and FIFO entries hold consecutive tags, the one nearest
-        # the output holds n_out and the next input gets one past the youngest: a chain of
-        # muxes from the output backwards (no counting, which SAT solvers find hard).
-        expect = n_out
-        chain = [*stages, *((v, entry.tag) for v, entry in queue)]
-        for j in reversed(range(len(chain))):
-            valid, tag = chain[j]
+        # The FIFO's output register holds n_out (the property), the oldest inner entry
+        # (at the read pointer) n_out + r_rdy, and every other entry one more than the
+        # entry at the address before it: lemmas per address, local (no offsets).
+        n = edge.inner_depth
+        produce = edge.storage.write_ports[0].addr
+        consume = edge.storage.read_ports[0].addr
+        inner = edge.inner_level
+        slots = edge.slots(m, o.payload.shape())
+        head = Signal(bits, name="tag_fifo_head")
+        m.d.comb += head.eq(n_out + edge.fifo.r_rdy)
+        youngest = head                  # the tag after the FIFO's youngest pixel
+        for a, word in enumerate(slots):
+            after = (a + 1) % n
+            self._lemma(m, ~((consume == a) & (inner != 0)) | (word.tag == head),
+                        "the FIFO's oldest entry holds the tag after the output's")
+            self._lemma(m, ~(edge.holds(after) & (consume != after)) |
+                        (slots[after].tag == (word.tag + 1)[:bits]),
+                        "the FIFO's entries hold consecutive tags")
+            youngest = Mux((inner != 0) & (produce == after), (word.tag + 1)[:bits], youngest)
+        # Consecutive valid stages of the chain hold consecutive tags, the one nearest the
+        # FIFO the tag after the FIFO's youngest, and the next input gets one past the
+        # youngest: a chain of muxes from the output backwards (no counting, which SAT
+        # solvers find hard).
+        expect = Signal(bits, name="tag_after_fifo")
+        m.d.comb += expect.eq(youngest)
+        for j in reversed(range(len(stages))):
+            valid, tag = stages[j]
             if tag is None:
                 return
             self._lemma(m, ~valid | (tag == expect), "valid stages hold consecutive tags")
@@ -527,16 +578,17 @@ class StreamContract(Elaboratable):
             self._lemma(m, v == valid[n], "stage n valid = i.valid n cycles ago")
             if t is not None:
                 self._lemma(m, ~v | (t == tag[n]), "stage n tag = i.tag n cycles ago")
-        queue = self._queue(m)
-        if queue is None or self.port_latency != self.latency + 2:
+        edge = self._fifo(m)
+        if edge is None or self.port_latency != self.latency + 2:
             return
         # The FIFO drains every cycle: its inner queue holds at most the pixel the chain
         # wrote in the last cycle, its output register the one before.
-        entry = queue[-2][1]              # the oldest inner entry
         after = valid[self.latency + 1]
-        self._lemma(m, self.edge.inner_level == after, "the FIFO holds the last cycle's pixel only")
-        self._lemma(m, ~after | (entry.tag == tag[self.latency + 1]),
-                    "the FIFO's entry is the chain's output of the last cycle")
+        self._lemma(m, edge.inner_level == after, "the FIFO holds the last cycle's pixel only")
+        for a, word in enumerate(edge.slots(m, o.payload.shape())):
+            consume = edge.storage.read_ports[0].addr
+            self._lemma(m, ~after | (consume != a) | (word.tag == tag[self.latency + 1]),
+                        "the FIFO's entry is the chain's output of the last cycle")
 
     def _cover(self, m, i, o, take_in, take_out, stages):
         stalled = Signal(name="was_stalled")
@@ -619,8 +671,7 @@ class StreamContract(Elaboratable):
         # is, with what it will read.
         rec = self._record(dut if lut is None else lut)
         ports = rec["memories"].get("table") if rec else None
-        queue = self._queue(m)
-        if not ports or queue is None:
+        if not ports or self._fifo(m) is None:
             return
         for b, port in enumerate(ports):
             m.d.comb += port.addr.eq(sel + b * size)
@@ -648,7 +699,7 @@ class StreamContract(Elaboratable):
         level = self.edge.edge.level
         # Past the LUT: in the FIFO (its entry ``ahead``, oldest first) or in a LUT stage
         # behind the FIFO's pixels.
-        self._lemma(m, ~(watching & ~before) | (((ahead < level) & (~match | (self._entry_color(queue, ahead) == expected))) |
+        self._lemma(m, ~(watching & ~before) | (((ahead < level) & (~match | (self._in_fifo(m, "color", ahead) == expected))) |
                                                 ((ahead >= level) & in_lut(level, match))),
                     "past the fetch it waits in the FIFO or the LUT with its entry")
         if lut is None:
@@ -674,16 +725,3 @@ class StreamContract(Elaboratable):
             in_flight = in_flight + v
         self._lemma(m, ~waiting_f | (ahead == ahead_f + in_flight + level), "pixels ahead of it")
         self._lemma(m, watching | ~before, "only the watched pixel is followed")
-
-    def _entry_color(self, queue, k):
-        """The colour of the FIFO's ``k``-th oldest pixel (``queue``: :meth:`_queue`): the
-        output register first when it is full, then the inner queue oldest first."""
-        fifo = self.edge.fifo
-        inner = [entry.color.as_value() for _v, entry in queue[-2::-1]]
-        head = queue[-1][1].color.as_value()
-        there = Const(0, len(head))
-        for n in reversed(range(len(inner) + 1)):
-            after_head = head if n == 0 else inner[n - 1]
-            without = inner[n] if n < len(inner) else Const(0, len(head))
-            there = Mux(k == n, Mux(fifo.r_rdy, after_head, without), there)
-        return there

@@ -111,12 +111,15 @@ def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir,
 
 def test_lemmas_come_from_the_units_own_registers():
     """The order lemmas cover every stage and every FIFO entry: one tag register per stage
-    of SinCos's chain, one per entry of its edge's FIFO (``fifo_depth``), plus the next
-    input tag; and the credit loop's invariant is among them."""
+    of SinCos's chain, two per address of its edge's FIFO memory (``fifo_depth - 1``: the
+    output register is the property itself; the oldest entry, and each entry after the one
+    before it), plus the next input tag; and the credit loop's invariant is among them."""
     top = StreamContract(TARGETS["sincos"].unit(), "order")
     rtlil.convert(top, name="top", ports=top.free_inputs())
     said = Counter(top.lemma_names)
-    assert said["valid stages hold consecutive tags"] == top.dut.latency + top.dut.fifo_depth
+    assert said["valid stages hold consecutive tags"] == top.dut.latency
+    assert said["the FIFO's entries hold consecutive tags"] == top.dut.fifo_depth - 1
+    assert said["the FIFO's oldest entry holds the tag after the output's"] == top.dut.fifo_depth - 1
     assert said["next input tag is one past the youngest in flight"] == 1
     assert said["credit: credits + pixels in the chain + FIFO occupancy != depth"] == 1
 
@@ -184,3 +187,20 @@ def test_a_long_pipe_counts_its_pixels_in_runs():
 def test_kim_setup_is_quiet_by_induction(build_dir):
     row = check(TARGETS["rotation_kim"], "quiet", build_dir)
     assert row.result == "proved" and row.depth == 2, row
+
+
+def test_the_page_names_the_run_time_beside_the_command(tmp_path):
+    """The table's section names the command, and the run's checks and wall time beside it
+    (a page reprinted from results.json names none)."""
+    from types import SimpleNamespace
+
+    from bumprtl.gen.formal.doc import write_doc
+    row = SimpleNamespace(unit="sincos", prop="credit", result="proved", depth=2, latency=6,
+                          lemmas=1, seconds=1.5)
+    doc = tmp_path / "formal.md"
+    write_doc(doc, [row, row], "-j 2 --doc docs/formal.md", seconds=1234.4, checked=2)
+    text = doc.read_text()
+    assert "`python -m bumprtl.gen.formal.run -j 2 --doc docs/formal.md`" in text
+    assert "that run: 2 checks in 1234 s of wall time" in text
+    write_doc(doc, [row], "--from-results --doc docs/formal.md")
+    assert "that run" not in doc.read_text()
