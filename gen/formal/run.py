@@ -3,8 +3,8 @@
 ``python -m bumprtl.gen.formal.run`` or ``bumprtl formal`` (``make formal`` runs all of it
 and writes docs/formal.md). Each (unit, property) is one sby job under ``build/formal/``:
 k-induction (``mode prove``) first; a property whose induction does not close at the
-induction depth is checked by BMC to ``latency + fifo_depth + BMC_MARGIN`` instead (every
-credit spent and the FIFO filled) and reported as *bounded*. A failed property prints its message and the counterexample trace and the run
+induction depth is checked by BMC to ``latency + BMC_MARGIN`` instead (every pixel reaches
+the output; not deep enough to spend every credit) and reported as *bounded*. A failed property prints its message and the counterexample trace and the run
 exits 1. The broken units of :mod:`bumprtl.sim.formal.mutants` must each fail theirs.
 """
 
@@ -27,7 +27,7 @@ from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
 __all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
-BMC_MARGIN = 6               # cover depth = latency + this (every pixel reaches the output)
+BMC_MARGIN = 6               # cover, BMC depth = latency + this (every pixel reaches the output)
 PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
 BANK_MARGIN = 7              # palette bank BMC fallback depth = latency + this (docs/formal.md)
 FILL = ("credit",)           # covers that fill the FIFO: depth latency + fifo_depth + BMC_MARGIN
@@ -92,8 +92,7 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         # induction did not close: fall back to BMC without the lemmas
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
-        res = _job(top, workdir, f"{prop}_bmc", "bmc", _fill_depth(dut) + margin - BMC_MARGIN,
-                   script=script)
+        res = _job(top, workdir, f"{prop}_bmc", "bmc", dut.latency + margin, script=script)
         return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
     return _row(target, prop, res.status, res, top, dut, t0)
 
