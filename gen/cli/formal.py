@@ -14,8 +14,9 @@ def add_parser(sub):
                        description="k-induction (BMC where it does not close) of the stream "
                                    "contract with SymbiYosys: payload held under stall, every "
                                    "pixel once and in order, latency without bubbles, i.ready "
-                                   "while the output is empty, no output without input, the "
-                                   "palette's double buffer; broken units must fail. Prints the "
+                                   "while a credit is free, no output without input, the credit "
+                                   "loop's invariant (no FIFO overflow), the palette's double "
+                                   "buffer; broken units must fail. Prints the "
                                    "proof table; exit 1 and the counterexample trace on failure.")
     add_arguments(p)
     p.set_defaults(func=run)

@@ -3,8 +3,8 @@
 ``python -m bumprtl.gen.formal.run`` or ``bumprtl formal`` (``make formal`` runs all of it
 and writes docs/formal.md). Each (unit, property) is one sby job under ``build/formal/``:
 k-induction (``mode prove``) first; a property whose induction does not close at the
-induction depth is checked by BMC to ``latency + BMC_MARGIN`` instead and reported as
-*bounded*. A failed property prints its message and the counterexample trace and the run
+induction depth is checked by BMC to ``latency + BMC_MARGIN`` instead (every pixel reaches
+the output; not deep enough to spend every credit) and reported as *bounded*. A failed property prints its message and the counterexample trace and the run
 exits 1. The broken units of :mod:`bumprtl.sim.formal.mutants` must each fail theirs.
 """
 
@@ -27,9 +27,15 @@ from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
 __all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
-BMC_MARGIN = 6               # BMC depth = latency + this (every pixel reaches the output)
+BMC_MARGIN = 6               # cover, BMC depth = latency + this (every pixel reaches the output)
 PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
 BANK_MARGIN = 7              # palette bank BMC fallback depth = latency + this (docs/formal.md)
+FILL = ("credit",)           # covers that fill the FIFO: depth latency + fifo_depth + BMC_MARGIN
+
+
+def _fill_depth(dut):
+    """BMC depth that spends every credit and fills the FIFO, then drains a pixel."""
+    return dut.latency + dut.fifo_depth + BMC_MARGIN
 
 
 @dataclass
@@ -68,7 +74,9 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         dut = target.unit()
         top = StreamContract(dut, base, lemmas=False)
         bank = base == "bank"
-        res = _job(top, workdir, prop, "cover", dut.latency + (BANK_MARGIN + 2 if bank else BMC_MARGIN),
+        depth = _fill_depth(dut) if base in FILL else \
+            dut.latency + (BANK_MARGIN + 2 if bank else BMC_MARGIN)
+        res = _job(top, workdir, prop, "cover", depth,
                    script=("memory_map", "opt -fast") if bank else ())
         result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
         return _row(target, prop, result, res, top, dut, t0)
@@ -98,13 +106,14 @@ def _row(target, prop, result, res, top, dut, t0):
 
 
 def check_mutant(name, root, cfg=None):
-    """A broken unit against the property it breaks (BMC): the row says whether it failed."""
+    """A broken unit against the property it breaks (BMC to ``latency + fifo_depth`` + the
+    margin: every credit spent, the FIFO filled): the row says whether it failed."""
     cls, prop = MUTANTS[name]
     cfg = cfg or Config(**SMALL)
     dut = cls(cfg)
     top = StreamContract(dut, prop, lemmas=False)
     t0 = time.perf_counter()
-    depth = dut.latency + (BANK_MARGIN if prop == "bank" else BMC_MARGIN)
+    depth = _fill_depth(dut) + (BANK_MARGIN - BMC_MARGIN if prop == "bank" else 0)
     script = ("memory_map", "opt -fast") if prop == "bank" else ()
     res = run_sby(top, Path(root) / "mutants", name, mode="bmc", depth=depth, script=script)
     result = "fails as expected" if res.status == "FAIL" and res.trace else \
@@ -259,20 +268,24 @@ def execute(*, units=(), props=None, mutants=True, quick=False, jobs=1, job_time
         out.mkdir(parents=True, exist_ok=True)
         results.write_text(json.dumps([asdict(r) for r in merged(rows)], indent=1) + "\n")
 
+    ran = None
     if from_results:
         rows = base
     else:
         try:
-            rows = merged(run(names, props, mutants, out, jobs, save=save,
-                              scheduler=address, timeout=job_timeout))
+            ran = run(names, props, mutants, out, jobs, save=save, scheduler=address,
+                      timeout=job_timeout)
+            rows = merged(ran)
         except SchedulerError as e:             # unreachable: one line, exit 2
             print(f"error: {e}", file=sys.stderr)
             return 2
     print()
     print(table(rows))
-    print(f"\n{len(rows)} checks in {time.perf_counter() - t0:.0f} s")
+    seconds = time.perf_counter() - t0
+    print(f"\n{len(rows)} checks in {seconds:.0f} s")
     if doc is not None:
-        write_doc(doc, rows, " ".join(sys.argv[1:]))
+        write_doc(doc, rows, " ".join(sys.argv[1:]),
+                  None if ran is None else seconds, None if ran is None else len(ran))
         print(f"wrote {doc}")
     return 1 if report_failures(rows) else 0
 

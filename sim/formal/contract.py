@@ -7,44 +7,52 @@ free input of the model, so the solver plays every producer, consumer and host t
 One wrapper checks one property (:data:`PROPERTIES`):
 
 ``hold``     o.payload and o.valid are held while ``o.valid & ~o.ready`` (stream rule 2);
-``ready``    ``i.ready`` is high while ``o.valid`` is low: a slow consumer never stops the
-             pipe from filling (the mutation ``adv = o.ready`` of rtl/pipe.py fails it);
+``ready``    ``i.ready`` is high exactly while fewer than ``fifo_depth`` pixels are accepted
+             and not yet delivered (counted at the ports up to the last cycle): it depends
+             on the past only, never on ``o.ready`` or ``i.valid`` in the same cycle, and a
+             slow consumer stops the input only once every credit is spent;
 ``order``    every accepted input comes out exactly once and in order: the inputs carry
              consecutive tags (assumed), the n-th output must carry tag n;
 ``quiet``    no output without an input: with nothing in flight (accepted minus delivered
              is 0, counted from reset) ``o.valid`` is low;
-``latency``  with ``o.ready`` held high the output is the input ``latency`` cycles later,
-             valid for valid and tag for tag (no bubble added, none removed);
+``latency``  with ``o.ready`` held high the output is the input ``port_latency`` cycles
+             later, valid for valid and tag for tag (no bubble added, none removed);
+``credit``   the credit loop of the unit's :class:`~bumprtl.rtl.pipe.CreditEdge`: in every
+             cycle credits + pixels in the free-running chain (its valid stages 1..latency)
+             + the FIFO's occupancy = ``fifo_depth``, ``i.ready`` = (credits != 0), and the
+             FIFO never overflows (a write only while it has room, occupancy <= depth);
 ``cover``    vacuity check: a transfer, a stall and a transfer after a stall are reachable.
 ``bank``     PaletteLUT's double buffer (units with ``swap``/``w_*``/``bank`` ports, and
              palette scene pipelines with ``lut_*`` ports): a pixel reads the entry of the
              bank that was in front in the cycle it was accepted (by the pipeline, at its
              input, ahead of the fetch), whatever the host writes (the writes the unit
              took: ``lut_w_en & lut_w_ready`` for a pipeline) or swaps while it is in flight
-             or stalled. The swap strobe is the frame boundary (the host strobes it between frames; PaletteLUT
-             has no frame signal of its own), so all pixels of a frame read one bank and a
-             swap strobed while the last pixels of a frame are still in the pipe takes
-             effect only for the pixels accepted after it. A symbolic entry (any address,
-             fixed for the trace) is shadowed in both banks and one symbolic pixel reading
-             it is followed to the output.
+             or stalled. The swap strobe is the frame boundary (the host strobes it between
+             frames; PaletteLUT has no frame signal of its own), so all pixels of a frame
+             read one bank and a swap strobed while the last pixels of a frame are still in
+             the pipe takes effect only for the pixels accepted after it. A symbolic entry
+             (any address, fixed for the trace) is shadowed in both banks and one symbolic
+             pixel reading it is followed to the output.
 
 k-induction needs the contract to be inductive, so the wrapper also asserts *lemmas* about
-the unit's own pipeline registers: the number of valid stages equals the pixels in flight,
-the tag held in each valid stage is the one the order says, units that run in lock step
-have equal valid chains; for a scene pipeline (units in lock step on copies of one
-registered enable, an output buffer behind the last unit: ``BumpPipeline.buffer``) every
-copy of the enable is (buffer holds at most one pixel less than its depth), the buffer's
-occupancy counts as pixels in flight and its entries, oldest first, hold the tags that
-follow the order (with ``o.ready`` held high, ``latency``: the buffer stays empty); and
-(``bank``) the shadows are the table's watched entries (two
-asynchronous read ports added to the memory while it elaborates), the bank bits in flight
-are what the pipeline's ``lut_w_ready`` counters count, and the watched pixel sits where
-its position says with the bank of its acceptance. It finds those registers through the
-observer every :class:`bumprtl.rtl.pipe.StallPipe` takes (:class:`PipeObserver`, passed
-in with the elaboration's platform by :func:`observe_pipes`: the valid chain and the
-``tag`` delay line of every pipe, keyed by its input valid), so no unit carries
-formal-only code and nothing is patched. ``lemmas=False`` leaves them out (plain BMC, and the broken
-units of :mod:`bumprtl.sim.formal.mutants`, whose failure must be the property itself).
+the unit's own registers: the credit loop's invariant (above) with the pixels of the chain
+counted in runs of at most CHUNK stages (a ghost counter each, equal to its valid stages),
+the FIFO's output register full whenever it holds two or more, its pointers a queue of its
+occupancy, the pixels accepted and not delivered = valid stages + FIFO occupancy, the tags
+held in the valid stages and the FIFO's entries (oldest first) the ones the order says; with
+``o.ready`` held high (``latency``) stage n holds the input of n cycles ago and the FIFO at
+most the pixel written in the last cycle; units of one layer of a scene pipeline (fed one
+valid) have equal valid chains; and (``bank``) the shadows are the table's watched entries,
+the bank bits in flight are what the pipeline's ``lut_w_ready`` counters count, and the
+watched pixel sits where its position says with the bank of its acceptance. The chain's
+registers come from the observer every :class:`bumprtl.rtl.pipe.Pipe` takes
+(:class:`PipeObserver`, passed in with the elaboration's platform by :func:`observe_pipes`:
+the valid chain and the ``tag`` delay line of every pipe, keyed by the module it builds
+into); the edge, its FIFO and the FIFO's memory are found in the elaborated fragment (by
+their origins), and the FIFO's entries are read through asynchronous read ports added to
+that memory. No unit carries formal-only code and nothing is patched. ``lemmas=False``
+leaves the lemmas out (plain BMC, and the broken units of
+:mod:`bumprtl.sim.formal.mutants`, whose failure must be the property itself).
 """
 
 import re
@@ -56,44 +64,51 @@ from amaranth.hdl import (
     Cover,
     Elaboratable,
     Fragment,
+    MemoryInstance,
     Module,
     Mux,
     Signal,
     Value,
     ValueCastable,
 )
-from amaranth.lib import wiring
+from amaranth.lib import data, wiring
+from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.utils import ceil_log2
 
-__all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers"]
+from bumprtl.rtl.pipe import CreditEdge
 
-PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "cover", "bank")
+__all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers",
+           "find_edge", "CHUNK"]
+
+PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "credit", "cover", "bank")
 
 _TAG_REG = re.compile(r"(tag|bank|oor)_d(\d+)$")
-CHUNK = 12          # stages per ghost counter of one long pipe (quiet's occupancy lemma)
+CHUNK = 12          # stages per ghost counter of the chain (the pixels-in-flight lemmas)
 
 
 class PipeObserver:
     """What the contract learns of a unit's pipes while it elaborates: passed to every
-    :class:`~bumprtl.rtl.pipe.StallPipe` as its ``observer`` (through the elaboration's
-    platform, :func:`bumprtl.rtl.pipe.pipe_observer`). ``seen`` maps ``id(input valid
-    signal) -> {"valid": [i.valid, stage1, ...], "adv": adv, "tags": {n: tag register of
-    stage n}, "banks": {n: bank register of stage n}, "oors": {n: oor register of stage n},
-    "memories": {name: [comb read port, ...]}, "reads": {name: [read data 1, 2 stages after
-    the address]}}``; ``read_ports``: that many asynchronous read ports are added to every
-    memory a pipe adds with ``StallPipe.memory`` or ``StallPipe.ram`` (generic form), for
-    assertions about its contents. One observer per elaboration: nothing process-wide, so
-    elaborations may run in parallel threads (``make formal -j 2``)."""
+    :class:`~bumprtl.rtl.pipe.Pipe` as its ``observer`` (through the elaboration's
+    platform, :func:`bumprtl.rtl.pipe.pipe_observer`). ``seen`` maps ``id(the Module the
+    pipe builds into) -> {"valid": [valid into stage 1, stage1, ...], "o": the stream the
+    last stage drives, "tags": {n: tag register of stage n}, "banks": {n: bank register of
+    stage n}, "oors": {n: oor register of stage n}, "memories": {name: [comb read port,
+    ...]}, "reads": {name: [read data 1, 2 stages after the address]}}`` (the unit's
+    fragment has that Module among its origins: :meth:`StreamContract._record`);
+    ``read_ports``: that many asynchronous read ports are added to every memory a pipe adds
+    with ``Pipe.memory`` or ``Pipe.ram`` (generic form), for assertions about its contents.
+    One observer per elaboration: nothing process-wide, so elaborations may run in parallel
+    threads (``make formal -j 2``)."""
 
     def __init__(self, read_ports=0):
         self.read_ports, self.seen, self._rams = read_ports, {}, {}
 
     def pipe(self, pipe):
-        pipe_rec = {"valid": list(pipe.valid), "adv": pipe.adv, "tags": {}, "banks": {},
-                    "oors": {}, "memories": {}, "reads": {}, "enables": pipe.enable_copies}
-        self.seen[id(pipe.valid[0])] = pipe_rec
+        self.seen[id(pipe.m)] = {"valid": list(pipe.valid), "o": pipe.o, "tags": {}, "banks": {},
+                                 "oors": {}, "memories": {}, "reads": {}}
 
     def _record(self, pipe):
-        return self.seen[id(pipe.valid[0])]
+        return self.seen[id(pipe.m)]
 
     def register(self, pipe, name, reg):
         match = _TAG_REG.match(str(name))
@@ -119,23 +134,103 @@ class PipeObserver:
             ports.extend(mem.read_port(domain="comb") for _ in range(self.read_ports))
 
 
-class _Observing:
-    """The platform an observed elaboration is given: it carries the observer only."""
+class _Observing(str):
+    """The platform an observed elaboration is given: it carries the observer, and with
+    ``formal`` it is the string "formal", for which amaranth.lib.fifo's FIFOs add their own
+    assertions (their pointers in range and a queue of their occupancy: lemmas of the FIFO
+    behind every credit edge)."""
 
-    def __init__(self, observer):
-        self.pipe_observer = observer
+    def __new__(cls, observer, formal=False):
+        platform = super().__new__(cls, "formal" if formal else "")
+        platform.pipe_observer = observer
+        return platform
 
 
-def observe_pipes(dut, read_ports=0):
-    """Elaborate ``dut`` with a :class:`PipeObserver`: ``(fragment, seen)``."""
+def observe_pipes(dut, read_ports=0, formal=False):
+    """Elaborate ``dut`` with a :class:`PipeObserver` (and, with ``formal``, the library's
+    own FIFO assertions): ``(fragment, seen)``."""
     observer = PipeObserver(read_ports)
-    fragment = Fragment.get(dut, _Observing(observer))
+    fragment = Fragment.get(dut, _Observing(observer, formal))
     return fragment, observer.seen
 
 
+def _origins(fragment, found=None):
+    """``id(elaboratable or Module) -> fragment`` over the elaborated tree."""
+    found = {} if found is None else found
+    for obj in fragment.origins or ():
+        found[id(obj)] = fragment
+    for sub, _name, _src_loc in fragment.subfragments:
+        _origins(sub, found)
+    return found
+
+
+def _subfragment(fragment, name):
+    return next((sub for sub, n, _ in fragment.subfragments if n == name), None)
+
+
+class _Edge:
+    """A :class:`~bumprtl.rtl.pipe.CreditEdge` found in an elaborated fragment, with its
+    FIFO (``SyncFIFOBuffered``: an inner queue of ``depth - 1`` entries in a memory, then
+    the output register ``r_data``/``r_rdy``) and that memory: ``instance`` (the elaborated
+    MemoryInstance, to add read ports to) and ``storage`` (its ``lib.memory.Memory``, whose
+    ports' addresses are the FIFO's write and read pointers)."""
+
+    def __init__(self, edge, fragment):
+        self.edge = edge
+        fifo_fragment = _subfragment(fragment, "fifo")
+        self.fifo = fifo_fragment.origins[0] if fifo_fragment is not None else None
+        instance = _subfragment(fifo_fragment, "storage") if fifo_fragment is not None else None
+        ok = isinstance(self.fifo, SyncFIFOBuffered) and isinstance(instance, MemoryInstance)
+        self.instance = instance if ok else None
+        self.storage = instance.origins[0] if ok else None
+        self.inner_depth = self.fifo.depth - 1 if ok else 0
+        self._slots = None
+
+    @property
+    def inner_level(self):
+        """Entries in the inner queue (the memory): the occupancy less the output register."""
+        return (self.fifo.level - self.fifo.r_rdy)[:len(self.fifo.level)]
+
+    def slots(self, m, layout):
+        """The inner queue's memory word at every address, as ``View(layout)``: one
+        asynchronous read port at each constant address (added once)."""
+        if self._slots is None:
+            self._slots = []
+            for a in range(self.inner_depth):
+                word = Signal(len(self.fifo.w_data), name=f"fifo_slot{a}")
+                self.instance.read_port(domain="comb", addr=Const(a, ceil_log2(self.inner_depth)),
+                                        data=word, en=Const(1), transparent_for=())
+                self._slots.append(data.View(layout, word))
+        return self._slots
+
+    def holds(self, a):
+        """Address ``a`` holds an entry: between the read and the write pointer, around the
+        end of the memory when they have wrapped (comparisons only, no subtraction)."""
+        produce = self.storage.write_ports[0].addr
+        consume = self.storage.read_ports[0].addr
+        return Mux(self.inner_level == self.inner_depth, 1,
+                   Mux(consume <= produce, (consume <= a) & (a < produce),
+                       (a >= consume) | (a < produce)))
+
+    def offset(self, a):
+        """How many entries address ``a`` is behind the oldest one (the read pointer's),
+        mod the inner depth: ``a`` holds an entry when this is below the inner occupancy."""
+        consume = self.storage.read_ports[0].addr
+        return Mux(a >= consume, a - consume, a + self.inner_depth - consume)
+
+
+def find_edge(fragment):
+    """The one CreditEdge of an elaborated unit or pipeline (:class:`_Edge`), or None when
+    there is none or more than one."""
+    found = [(frag.origins[0], frag) for frag in _origins(fragment).values()
+             if frag.origins and isinstance(frag.origins[0], CreditEdge)]
+    found = list({id(e): (e, f) for e, f in found}.values())
+    return _Edge(*found[0]) if len(found) == 1 else None
+
+
 def pipeline_layers(dut):
-    """The lock-step layers of a :class:`~bumprtl.rtl.pipeline.BumpPipeline` (first unit
-    of each layer carries the tag), or ``[[dut]]`` for a single unit."""
+    """The layers of a :class:`~bumprtl.rtl.pipeline.BumpPipeline` (units fed one valid;
+    the first unit of each layer carries the tag), or ``[[dut]]`` for a single unit."""
     layers = getattr(dut, "_layers", None)
     if layers is None or not hasattr(dut, "units"):
         return [[dut]]
@@ -157,14 +252,15 @@ class StreamContract(Elaboratable):
 
     Parameters
     ----------
-    dut : wiring.Component with ``i``/``o`` streams whose payloads have a ``tag`` field.
+    dut : wiring.Component with ``i``/``o`` streams whose payloads have a ``tag`` field;
+        ``latency`` (its chain's stages), ``port_latency`` and ``fifo_depth`` (its edge's).
     prop : str
     latency : int, optional
-        Defaults to ``dut.latency``.
+        The chain's stages; defaults to ``dut.latency``.
     layers : list of lists of units, optional
-        The lock-step layers the pixels pass (default :func:`pipeline_layers`).
+        The layers the pixels pass (default :func:`pipeline_layers`).
     lemmas : bool
-        Assert the pipeline-register lemmas that make the property k-inductive.
+        Assert the lemmas that make the property k-inductive.
     """
 
     def __init__(self, dut, prop, latency=None, layers=None, lemmas=True):
@@ -172,8 +268,11 @@ class StreamContract(Elaboratable):
             raise ValueError(f"property must be one of {', '.join(PROPERTIES)}, got {prop!r}")
         self.dut, self.prop, self.lemmas = dut, prop, lemmas
         self.latency = dut.latency if latency is None else latency
+        self.port_latency = getattr(dut, "port_latency", self.latency)
+        self.fifo_depth = getattr(dut, "fifo_depth", None)
         self.layers = layers if layers is not None else pipeline_layers(dut)
         self.lemma_count = 0
+        self.lemma_names = []        # what each lemma says, one entry per lemma asserted
         self.messages = {}
         self.exercised = []          # what each property's covers show (_exercise)
         self._free = []
@@ -184,48 +283,38 @@ class StreamContract(Elaboratable):
             self.watch_pick = Signal(name="watch_pick")                    # any sequence
             self._free = [self.watch_addr, self.watch_pick]
 
-    # --- the unit's pipeline registers ------------------------------------------------------
-    def _stages(self, pipes):
-        """Chain stages input -> output: ``[(valid, tag or None)]``, and the lock-step pairs
-        ``[(lead valid, other valid)]``. A scene pipeline's output buffer adds its entries
-        (oldest last: nearest the output) as the last layer's stages."""
+    # --- the unit's registers ---------------------------------------------------------------
+    def _record(self, unit):
+        """The observer's record of ``unit``'s pipe (None when it built none); for the unit
+        under test that is a wrapper around one pipe (the broken units), that pipe's."""
+        frag = self._frags.get(id(unit))
+        for origin in (frag.origins if frag is not None else ()):
+            if id(origin) in self._pipes:
+                return self._pipes[id(origin)]
+        if unit is self.dut and len(self._pipes) == 1:
+            return next(iter(self._pipes.values()))
+        return None
+
+    def _stages(self):
+        """The chain's stages input -> output: ``[(valid, tag or None)]`` (each layer's lead
+        unit's stages 1..depth in turn), and the pairs ``[(lead valid, other valid)]`` of
+        the units fed one valid. ``self._valid_in``: the valid into stage 1."""
         stages, lockstep = [], []
-        self._layer_stages, self._layer_takes, self._buffer_stages = [], [], 0
-        self._lead_pipes = []
+        self._valid_in = None
+        self._lead_records = []
         for layer in self.layers:
-            recs = [pipes.get(id(unit.i.valid)) for unit in layer]
+            recs = [self._record(unit) for unit in layer]
             lead = recs[0]
-            if lead is None:             # not built on a StallPipe: no lemmas (BMC only)
+            if lead is None:             # not built on a Pipe: no chain (BMC only)
                 return [], []
-            for n in range(1, len(lead["valid"])):
-                stages.append((lead["valid"][n], lead["tags"].get(n)))
-            self._layer_stages.append(len(lead["valid"]) - 1)
-            self._lead_pipes.append(lead)
-            unit = layer[0]
-            self._layer_takes.append((unit.i.valid & unit.i.ready, unit.o.valid & unit.o.ready))
+            if self._valid_in is None:
+                self._valid_in = lead["valid"][0]
+            stages += [(lead["valid"][n], lead["tags"].get(n)) for n in range(1, len(lead["valid"]))]
+            self._lead_records.append(lead)
             for rec in recs[1:]:
                 if rec is not None:
                     lockstep += list(zip(lead["valid"][1:], rec["valid"][1:], strict=False))
-        if self.buffer is not None:
-            count, entries = self.buffer["count"], self.buffer["entries"]
-            for n in reversed(range(len(entries))):
-                stages.append((count > n, entries[n].tag))
-            self._layer_stages.append(len(entries))
-            last = self.layers[-1][0].o
-            self._layer_takes.append((last.valid & last.ready, self.dut.o.valid & self.dut.o.ready))
-            self._buffer_stages = len(entries)
         return stages, lockstep
-
-    def _buffer_lemmas(self, m):
-        """The output buffer's count is at most its depth and every copy of the enable is
-        (count < depth): the units run exactly while the buffer has room for two."""
-        count, entries = self.buffer["count"], self.buffer["entries"]
-        self._lemma(m, count <= len(entries), "the output buffer holds at most its depth")
-        copies = [*self.buffer["runs"].values(),
-                  *(c for rec in self._pipes.values() for c in rec.get("enables", ()))]
-        for run in copies:
-            self._lemma(m, run == (count < len(entries)),
-                        "every copy of the enable = the output buffer has room")
 
     def free_inputs(self):
         """Every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports) and
@@ -244,7 +333,11 @@ class StreamContract(Elaboratable):
         m.d.comb += check
 
     def _lemma(self, m, test, what):
+        """A lemma (only with ``lemmas``)."""
+        if not self.lemmas:
+            return
         self.lemma_count += 1
+        self.lemma_names.append(what)
         self._check(m, test, f"lemma ({what})", src_loc_at=2)
 
     def _exercise(self, m, test, what):
@@ -261,25 +354,115 @@ class StreamContract(Elaboratable):
     def elaborate(self, platform):
         m = Module()
         dut = self.dut
-        ports = 2 if self.prop == "bank" else 0          # the watched entry of both banks
-        if self.lemmas:
-            fragment, pipes = observe_pipes(dut, ports)
-        else:
-            fragment, pipes = Fragment.get(dut, platform), {}
-        self._pipes = pipes
+        ports = 2 if self.prop == "bank" and self.lemmas else 0   # the watched entry of both banks
+        fragment, self._pipes = observe_pipes(dut, ports, formal=self.lemmas)
+        self._frags = _origins(fragment)
+        self.edge = find_edge(fragment)
         m.submodules.dut = _Built(fragment)
         i, o = dut.i, dut.o
         take_in = i.valid & i.ready
         take_out = o.valid & o.ready
-        self.buffer = getattr(dut, "buffer", None) if self.lemmas else None
-        stages, lockstep = self._stages(pipes) if self.lemmas else ([], [])
-        if self.lemmas:
-            for lead, other in lockstep:
-                self._lemma(m, lead == other, "lock-step units have equal valid chains")
-            if self.buffer is not None and stages:
-                self._buffer_lemmas(m)
+        stages, lockstep = self._stages()
+        for lead, other in lockstep:
+            self._lemma(m, lead == other, "units fed one valid have equal valid chains")
+        self._chain, self._chain_valid = self._pixels(m, stages) if stages else (None, None)
+        if self.edge is not None and self._chain is not None and self.prop != "credit":
+            self._credit_loop(m, self._lemma)
         getattr(self, f"_{self.prop}")(m, i, o, take_in, take_out, stages)
         return m
+
+    # --- the credit loop --------------------------------------------------------------------
+    def _width(self, stages=()):
+        """Wide enough for every pixel that can be accepted and not delivered (at most
+        ``fifo_depth``, one per stage without an edge), even without the lemmas (BMC), where
+        a wrapping counter would be a false failure."""
+        return (max(len(stages), self.port_latency, self.fifo_depth or 0) + 2).bit_length() + 1
+
+    def _pixels(self, m, stages):
+        """The valid stages of the chain, counted in runs of at most CHUNK stages, each run
+        by a ghost counter that gains the valid bit entering it and loses the one leaving
+        it every cycle (the chain shifts every cycle), tied by a lemma to the run's valid
+        stages: ``(sum of the ghost counters, sum of the runs' valid stages)``. The lemmas
+        about the chain use the first (small sums of registers: counting is what SAT
+        solvers find hard), the ``credit`` property states the second."""
+        width = self._width(stages)
+        valids = [self._valid_in] + [v for v, _ in stages]
+        ghosts, counts = [], []
+        for first in range(1, len(valids), CHUNK):
+            last = min(first + CHUNK, len(valids)) - 1
+            ghost = Signal(width, name=f"in_flight_stages{first}_{last}")
+            m.d.sync += ghost.eq(ghost + valids[first - 1] - valids[last])
+            _ahead, count = self._ahead(m, width, stages[first - 1:last], f"stages{first}_{last}_")
+            self._lemma(m, ghost == count, "valid stages of a run = its ghost counter")
+            ghosts.append(ghost)
+            counts.append(count)
+        total, valid = Signal(width, name="in_chain"), Signal(width, name="valid_in_chain")
+        m.d.comb += [total.eq(sum(ghosts)), valid.eq(sum(counts))]
+        return total, valid
+
+    def _credit_loop(self, m, claim, chain=None):
+        """The credit loop's invariant, each fact through ``claim`` (:meth:`_lemma`, or
+        :meth:`_check` for the ``credit`` property): the FIFO never holds more than its
+        depth and fills its output register first; credits + pixels in the chain (``chain``;
+        default the ghost counters' sum) + FIFO occupancy = depth; ``i.ready`` = credits !=
+        0; the FIFO has room when written."""
+        edge, fifo = self.edge.edge, self.edge.fifo
+        depth = edge.depth
+        chain = self._chain if chain is None else chain
+        claim(m, edge.level <= depth, "credit: the FIFO holds at most its depth")
+        claim(m, fifo.r_rdy | (edge.level <= 1),
+              "credit: the FIFO's output register is full when it holds two or more")
+        claim(m, edge.credits + chain + edge.level == depth,
+              "credit: credits + pixels in the chain + FIFO occupancy != depth")
+        claim(m, edge.i_ready == (edge.credits != 0), "credit: i.ready is not credits != 0")
+        claim(m, ~fifo.w_en | fifo.w_rdy, "credit: the FIFO written while full")
+
+    def _credit(self, m, i, o, take_in, take_out, stages):
+        if self.edge is None or self._chain is None:
+            raise ValueError("credit: the unit has no credit edge and chain to check")
+        # The statement counts the chain's valid stages; the lemmas (k-induction) the same
+        # with the ghost counters of its runs.
+        self._lemma(m, self.edge.edge.credits + self._chain + self.edge.edge.level == self.edge.edge.depth,
+                    "credits + the runs' ghost counters + FIFO occupancy = depth")
+        self._credit_loop(m, self._check, self._chain_valid)
+        edge = self.edge.edge
+        fell = Signal(name="ready_fell")
+        with m.If(~edge.i_ready):
+            m.d.sync += fell.eq(1)
+        self._exercise(m, edge.credits == 0, "credit: every credit spent")
+        self._exercise(m, edge.level == edge.depth, "credit: the FIFO full")
+        self._exercise(m, fell & i.ready & take_in, "credit: i.ready falls and rises again")
+
+    def _fifo_lemmas(self, m):
+        """The FIFO's pointers are a queue of its inner occupancy: the write pointer is the
+        read pointer + inner occupancy (mod the inner depth), both in range."""
+        n = self.edge.inner_depth
+        produce = self.edge.storage.write_ports[0].addr
+        consume = self.edge.storage.read_ports[0].addr
+        at = consume + self.edge.inner_level
+        self._lemma(m, (produce < n) & (consume < n), "the FIFO's pointers are in range")
+        self._lemma(m, produce == Mux(at >= n, at - n, at),
+                    "the FIFO's write pointer = read pointer + its inner occupancy")
+
+    def _fifo(self, m):
+        """The edge, with the FIFO's pointer lemmas asserted, when its entries may be
+        stated (lemmas on, a FIFO with a memory); else None."""
+        if self.edge is None or self.edge.storage is None or not self.lemmas:
+            return None
+        self._fifo_lemmas(m)
+        return self.edge
+
+    def _in_fifo(self, m, field, k):
+        """``field`` of the FIFO's ``k``-th oldest pixel: the output register's when it is
+        full and ``k`` is 0, else the inner entry ``k - r_rdy`` places behind the oldest."""
+        edge, fifo = self.edge, self.edge.fifo
+        layout = self.dut.o.payload.shape()
+        head = getattr(data.View(layout, fifo.r_data), field).as_value()
+        behind = (k - fifo.r_rdy)[:len(k)]
+        there = Const(0, len(head))
+        for a, word in enumerate(edge.slots(m, layout)):
+            there = Mux(edge.offset(a) == behind, getattr(word, field).as_value(), there)
+        return Mux(fifo.r_rdy & (k == 0), head, there)
 
     # --- the properties ---------------------------------------------------------------------
     def _hold(self, m, i, o, take_in, take_out, stages):
@@ -294,8 +477,14 @@ class StreamContract(Elaboratable):
         self._exercise(m, stalled & o.valid, "hold: a pixel held through a stall")
 
     def _ready(self, m, i, o, take_in, take_out, stages):
-        self._check(m, o.valid | i.ready, "ready: i.ready low while o.valid low")
-        self._exercise(m, ~o.valid & take_in, "ready: a pixel taken while the output is empty")
+        occ = self._occupancy(m, take_in, take_out)
+        depth = self.fifo_depth
+        if depth is None:
+            raise ValueError("ready: the unit has no fifo_depth")
+        self._check(m, i.ready == (occ < depth),
+                    "ready: i.ready is not 'fewer than fifo_depth pixels in flight'")
+        self._exercise(m, take_in & o.valid & ~o.ready,
+                       "ready: a pixel taken while the output is stalled")
 
     def _ahead(self, m, width, stages, prefix=""):
         """``ahead[j]``: valid stages downstream of stage ``j``, as comb signals summed from
@@ -308,56 +497,18 @@ class StreamContract(Elaboratable):
             run = nxt
         return ahead, run
 
-    def _occupancy(self, m, take_in, take_out, stages):
-        # Wide enough for every pixel that can be in flight (at most one per stage) even
-        # without the lemmas (BMC), where a wrapping counter would be a false failure.
-        width = (max(len(stages), self.latency) + 2).bit_length() + 1
-        occ = Signal(width, name="in_flight")
+    def _occupancy(self, m, take_in, take_out):
+        """Pixels accepted and not delivered, counted at the ports from reset; lemma: the
+        chain's valid stages + the FIFO's occupancy."""
+        occ = Signal(self._width(), name="in_flight")
         m.d.sync += occ.eq(occ + take_in - take_out)
-        runs = self._runs(stages) if self.lemmas and stages else []
-        if runs:
-            # One ghost counter per run of stages equal to its valid stages, and their sum
-            # equal to the whole count: small sums instead of one long one (counting is what
-            # SAT solvers find hard).
-            total = Const(0, width)
-            for name, took, gave, first, count, what in runs:
-                occ_r = Signal(width, name=f"in_flight_{name}")
-                m.d.sync += occ_r.eq(occ_r + took - gave)
-                _ahead, in_run = self._ahead(m, width, stages[first:first + count], f"{name}_")
-                self._lemma(m, occ_r == in_run, what)
-                total = (total + occ_r)[:width]
-            self._lemma(m, occ == total, "pixels in flight = sum over the runs")
-        elif self.lemmas and stages:
-            _ahead, total = self._ahead(m, width, stages)
-            self._lemma(m, occ == total, "valid stages = pixels in flight")
+        if self.edge is not None and self._chain is not None:
+            self._lemma(m, occ == self._chain + self.edge.edge.level,
+                        "pixels in flight = valid stages + FIFO occupancy")
         return occ
 
-    def _runs(self, stages):
-        """The runs of the occupancy lemma, ``(name, took, gave, first stage, stages, what)``:
-        a pipeline's layers (each counted by its lead unit's handshakes; the output buffer's
-        by the last unit's output and the pipeline's); one long StallPipe (Kim's setup: 46
-        stages at the formal widths) in runs of CHUNK stages, each gaining valid[first - 1]
-        and losing valid[last] on every adv (valid[n] <= valid[n - 1]; valid[0] is i.valid
-        and adv is i.ready). None of them (one count over every stage) for a short pipe."""
-        if len(self._layer_takes) > 1:
-            starts = [sum(self._layer_stages[:n]) for n in range(len(self._layer_stages))]
-            return [(f"layer{n}", took, gave, first, count,
-                     "valid stages of a layer = its pixels in flight")
-                    for n, ((took, gave), first, count)
-                    in enumerate(zip(self._layer_takes, starts, self._layer_stages, strict=False))]
-        if len(stages) > CHUNK and len(self._lead_pipes) == 1:
-            valid, adv = self._lead_pipes[0]["valid"], self._lead_pipes[0]["adv"]
-            runs = []
-            for first in range(1, len(valid), CHUNK):
-                last = min(first + CHUNK, len(valid)) - 1
-                runs.append((f"stages{first}_{last}", adv & valid[first - 1], adv & valid[last],
-                             first - 1, last - first + 1,
-                             "valid stages of a run = its pixels in flight"))
-            return runs
-        return []
-
     def _quiet(self, m, i, o, take_in, take_out, stages):
-        occ = self._occupancy(m, take_in, take_out, stages)
+        occ = self._occupancy(m, take_in, take_out)
         self._check(m, ~o.valid | (occ != 0), "quiet: o.valid with nothing in flight")
         self._exercise(m, take_out, "quiet: a pixel leaves")
 
@@ -368,43 +519,76 @@ class StreamContract(Elaboratable):
         m.d.comb += Assume(~i.valid | (i.payload.tag == n_in))
         self._check(m, ~o.valid | (o.payload.tag == n_out), "order: output tag out of sequence")
         self._exercise(m, take_out & (n_out == 1), "order: two pixels enter and leave in order")
-        if self.lemmas and stages:
-            # Consecutive valid stages hold consecutive tags, the one nearest the output
-            # holds n_out and the next input gets one past the youngest: a chain of muxes
-            # from the output backwards (no counting, which SAT solvers find hard).
-            expect = n_out
-            for j in reversed(range(len(stages))):
-                valid, tag = stages[j]
-                if tag is None:
-                    return
-                self._lemma(m, ~valid | (tag == expect), "valid stages hold consecutive tags")
-                nxt = Signal(bits, name=f"tag_after_stage{j + 1}")
-                m.d.comb += nxt.eq(Mux(valid, tag + 1, expect))
-                expect = nxt
-            self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
+        edge = self._fifo(m)
+        if edge is None or not stages:
+            return
+        # The FIFO's output register holds n_out (the property), the oldest inner entry
+        # (at the read pointer) n_out + r_rdy, and every other entry one more than the
+        # entry at the address before it: lemmas per address, local (no offsets).
+        n = edge.inner_depth
+        produce = edge.storage.write_ports[0].addr
+        consume = edge.storage.read_ports[0].addr
+        inner = edge.inner_level
+        slots = edge.slots(m, o.payload.shape())
+        head = Signal(bits, name="tag_fifo_head")
+        m.d.comb += head.eq(n_out + edge.fifo.r_rdy)
+        youngest = head                  # the tag after the FIFO's youngest pixel
+        for a, word in enumerate(slots):
+            after = (a + 1) % n
+            self._lemma(m, ~((consume == a) & (inner != 0)) | (word.tag == head),
+                        "the FIFO's oldest entry holds the tag after the output's")
+            self._lemma(m, ~(edge.holds(after) & (consume != after)) |
+                        (slots[after].tag == (word.tag + 1)[:bits]),
+                        "the FIFO's entries hold consecutive tags")
+            youngest = Mux((inner != 0) & (produce == after), (word.tag + 1)[:bits], youngest)
+        # Consecutive valid stages of the chain hold consecutive tags, the one nearest the
+        # FIFO the tag after the FIFO's youngest, and the next input gets one past the
+        # youngest: a chain of muxes from the output backwards (no counting, which SAT
+        # solvers find hard).
+        expect = Signal(bits, name="tag_after_fifo")
+        m.d.comb += expect.eq(youngest)
+        for j in reversed(range(len(stages))):
+            valid, tag = stages[j]
+            if tag is None:
+                return
+            self._lemma(m, ~valid | (tag == expect), "valid stages hold consecutive tags")
+            nxt = Signal(bits, name=f"tag_after_stage{j + 1}")
+            m.d.comb += nxt.eq(Mux(valid, tag + 1, expect))
+            expect = nxt
+        self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""
         m.d.comb += Assume(o.ready)
         self._check(m, i.ready, "latency: i.ready low with o.ready held high")
         valid, tag = [i.valid], [i.payload.tag]
-        for n in range(1, self.latency + 1):
+        for n in range(1, self.port_latency + 1):
             v, t = Signal(name=f"ref_valid{n}"), Signal.like(i.payload.tag, name=f"ref_tag{n}")
             m.d.sync += [v.eq(valid[-1]), t.eq(tag[-1])]
             valid.append(v)
             tag.append(t)
-        self._check(m, o.valid == valid[-1], "latency: o.valid is not i.valid delayed by latency")
+        self._check(m, o.valid == valid[-1],
+                    "latency: o.valid is not i.valid delayed by port_latency")
         self._check(m, ~o.valid | (o.payload.tag == tag[-1]),
-                           "latency: o.tag is not i.tag delayed by latency")
+                    "latency: o.tag is not i.tag delayed by port_latency")
         self._exercise(m, take_out, "latency: a pixel enters and leaves")
-        if self.buffer is not None and stages:
-            self._lemma(m, self.buffer["count"] == 0, "the output buffer stays empty")
-            stages = stages[:len(stages) - self._buffer_stages]
-        if self.lemmas and len(stages) == self.latency:
-            for n, (v, t) in enumerate(stages, start=1):
-                self._lemma(m, v == valid[n], "stage n valid = i.valid n cycles ago")
-                if t is not None:
-                    self._lemma(m, ~v | (t == tag[n]), "stage n tag = i.tag n cycles ago")
+        if len(stages) != self.latency:
+            return
+        for n, (v, t) in enumerate(stages, start=1):
+            self._lemma(m, v == valid[n], "stage n valid = i.valid n cycles ago")
+            if t is not None:
+                self._lemma(m, ~v | (t == tag[n]), "stage n tag = i.tag n cycles ago")
+        edge = self._fifo(m)
+        if edge is None or self.port_latency != self.latency + 2:
+            return
+        # The FIFO drains every cycle: its inner queue holds at most the pixel the chain
+        # wrote in the last cycle, its output register the one before.
+        after = valid[self.latency + 1]
+        self._lemma(m, edge.inner_level == after, "the FIFO holds the last cycle's pixel only")
+        for a, word in enumerate(edge.slots(m, o.payload.shape())):
+            consume = edge.storage.read_ports[0].addr
+            self._lemma(m, ~after | (consume != a) | (word.tag == tag[self.latency + 1]),
+                        "the FIFO's entry is the chain's output of the last cycle")
 
     def _cover(self, m, i, o, take_in, take_out, stages):
         stalled = Signal(name="was_stalled")
@@ -440,7 +624,7 @@ class StreamContract(Elaboratable):
                 m.d.sync += shadow[0].eq(w_data.as_value())
             with m.Else():
                 m.d.sync += shadow[1].eq(w_data.as_value())
-        occ = self._occupancy(m, take_in, take_out, stages)
+        occ = self._occupancy(m, take_in, take_out)
         watching, ahead = Signal(name="watching"), Signal.like(occ, name="watch_ahead")
         expected = Signal(word, name="watch_expected")
         # Which index the watched pixel looks up: a PaletteLUT's input carries it; a scene
@@ -449,7 +633,7 @@ class StreamContract(Elaboratable):
         lut = getattr(dut, "units", {}).get("palette")
         if lut is None:
             start = take_in & (i.payload.index == sel) & ~watching & pick
-            match = Const(1)
+            match, before = Const(1), Const(0)
         else:
             start = take_in & ~watching & pick
             take_lut = lut.i.valid & lut.i.ready
@@ -485,24 +669,23 @@ class StreamContract(Elaboratable):
         # Lemmas (k-induction): the shadows are the memory's entries (read through two
         # asynchronous ports observe_pipes added to the table), and where the watched pixel
         # is, with what it will read.
-        rec = self._pipes.get(id((dut if lut is None else lut).i.valid))
+        rec = self._record(dut if lut is None else lut)
         ports = rec["memories"].get("table") if rec else None
-        if not ports:
+        if not ports or self._fifo(m) is None:
             return
         for b, port in enumerate(ports):
             m.d.comb += port.addr.eq(sel + b * size)
             self._lemma(m, shadow[b] == port.data, "the shadow of the watched entry is the table's")
         # The LUT's stages, input -> output, with the entry each holds: the table is read
         # at the LUT's input, so stage n < depth holds its n-th read register (an in-range
-        # index: oor low), the last stage (depth) the output colour.
-        unit = dut if lut is None else lut
+        # index: oor low), the last stage (depth) the chain's output colour.
         reads = rec["reads"].get("table", [])
         depth = len(rec["valid"]) - 1
         lut_stages = [(rec["valid"][n], ~rec["oors"][n] & (reads[n - 1] == expected))
                       for n in range(1, min(depth - 1, len(reads)) + 1)]
         if len(lut_stages) != depth - 1:
             return                       # a stage whose entry is not known: no lemmas
-        lut_stages.append((rec["valid"][-1], unit.o.payload.color.as_value() == expected))
+        lut_stages.append((rec["valid"][-1], rec["o"].payload.color.as_value() == expected))
 
         def in_lut(offset, matched):
             """The watched pixel is in a LUT stage with ``offset`` + (valid stages downstream)
@@ -513,11 +696,15 @@ class StreamContract(Elaboratable):
                 downstream = downstream + v
             return found
 
+        level = self.edge.edge.level
+        # Past the LUT: in the FIFO (its entry ``ahead``, oldest first) or in a LUT stage
+        # behind the FIFO's pixels.
+        self._lemma(m, ~(watching & ~before) | (((ahead < level) & (~match | (self._in_fifo(m, "color", ahead) == expected))) |
+                                                ((ahead >= level) & in_lut(level, match))),
+                    "past the fetch it waits in the FIFO or the LUT with its entry")
         if lut is None:
-            self._lemma(m, ~watching | in_lut(0, Const(1)),
-                        "the watched pixel waits in the LUT with its entry")
             return
-        fetch = self._pipes[id(dut.units["fetch"].i.valid)]
+        fetch = self._record(dut.units["fetch"])
         valid = fetch["valid"][1:]
         banks = [fetch["banks"][n] for n in range(1, len(valid) + 1)]
         for b, pending in enumerate(dut.lut_pending):
@@ -533,17 +720,8 @@ class StreamContract(Elaboratable):
                     "the watched pixel is in the fetch with the bank of its acceptance")
         self._lemma(m, ~waiting_f | (Mux(wbank, ports[1].data, ports[0].data) == expected),
                     "its entry is unchanged while it waits")
-        count, entries = self.buffer["count"], self.buffer["entries"]
         in_flight = Const(0, len(occ))
         for v, _ in lut_stages:
             in_flight = in_flight + v
-        self._lemma(m, ~waiting_f | (ahead == ahead_f + in_flight + count), "pixels ahead of it")
-        # Past the LUT: in the output buffer (entry ``ahead``) or in a LUT stage behind the
-        # buffered pixels.
-        there = Const(0, word)
-        for n in reversed(range(len(entries))):
-            there = Mux(ahead == n, entries[n].color.as_value(), there)
-        self._lemma(m, ~(watching & ~before) | (((ahead < count) & (~match | (there == expected))) |
-                                                ((ahead >= count) & in_lut(count, match))),
-                    "past the LUT it waits in the output buffer or the LUT with its entry")
+        self._lemma(m, ~waiting_f | (ahead == ahead_f + in_flight + level), "pixels ahead of it")
         self._lemma(m, watching | ~before, "only the watched pixel is followed")

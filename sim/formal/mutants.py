@@ -1,69 +1,105 @@
 """Deliberately broken units: each must fail one property of the stream contract, so every
-property is shown to be able to fail (tests/sim/formal/test_mutants.py, ``make formal``).
+property is shown to be able to fail (tests/sim/formal/test_formal.py, ``make formal``).
 
 Built around :class:`~bumprtl.rtl.sincos.SinCos` (and PaletteLUT for the bank property);
-rtl/ is never edited: the stall-enable mutation swaps ``StallPipe.__init__`` for the
-duration of one elaboration only.
+rtl/ is never edited and nothing is patched: the credit mutants put a broken copy of the
+credit edge (:class:`BrokenEdge`, one mutation each) around SinCos's free-running chain
+(``credit=False``), the way a scene pipeline puts its one edge around its units.
 """
 
-import contextlib
-from types import SimpleNamespace
-
 from amaranth.hdl import Module, Mux, Signal
-from amaranth.lib import wiring
+from amaranth.lib import stream, wiring
+from amaranth.lib.fifo import SyncFIFOBuffered
+from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import Pipe as StallPipe  # (being reworked for the credit edge)
+from bumprtl.rtl.pipe import EDGE_LATENCY, CreditEdge, min_fifo_depth
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["MUTANTS", "EagerStallSinCos", "Dropper", "Duplicator", "Glitcher", "ExtraStage",
-           "Spontaneous", "SwapAheadPalette", "UncarriedBankPipeline"]
+__all__ = ["MUTANTS", "EDGE_MUTATIONS", "BrokenEdge", "BrokenEdgeSinCos", "Dropper",
+           "Duplicator", "Glitcher", "ExtraStage", "Spontaneous", "SwapAheadPalette",
+           "UncarriedBankPipeline"]
+
+# mutation of the credit edge -> what is broken
+EDGE_MUTATIONS = {
+    "late": "a pixel's credit is counted two cycles after it leaves, not one",
+    "early": "the credit of a pixel leaving is free in the same cycle (i.ready reads o.ready)",
+    "twice": "a pixel leaving gives two credits back",
+    "ungated": "i.ready is 1: the input is not gated by the credits",
+    "read_unready": "the FIFO is read whether or not the consumer is ready",
+    "one_more": "the credit count starts at depth + 1",
+}
 
 
-_INIT = StallPipe.__init__
+class BrokenEdge(CreditEdge):
+    """rtl/pipe.py's CreditEdge with one mutation of :data:`EDGE_MUTATIONS`: the same
+    members and attributes (``credits``, ``level``), the same FIFO (submodule ``fifo``)."""
 
-
-def _eager_init(self, m, i, o, depth, *args, **kwargs):
-    """StallPipe.__init__ with the mutation ``adv = o.ready`` (instead of ``~o.valid | o.ready``):
-    the real __init__ runs into a scratch module (so every other attribute is as usual),
-    then the valid chain is built again with the mutated enable."""
-    scratch = Module()
-    scratch._MustUse__silence = True
-    port = lambda: SimpleNamespace(valid=Signal(), ready=Signal())
-    _INIT(self, scratch, port(), port(), depth, *args, **kwargs)
-    self.m = m
-    self.adv = Signal(name="adv")
-    m.d.comb += [self.adv.eq(o.ready), i.ready.eq(self.adv)]
-    self.valid = [i.valid]
-    for n in range(1, depth + 1):
-        v = Signal(name=f"stage{n}_valid")
-        with m.If(self.adv):
-            m.d.sync += v.eq(self.valid[-1])
-        self.valid.append(v)
-    m.d.comb += o.valid.eq(self.valid[depth])
-
-
-@contextlib.contextmanager
-def eager_stall():
-    """rtl/pipe.py's stall enable mutated to ``adv = o.ready`` while the block runs."""
-    init = StallPipe.__init__
-    StallPipe.__init__ = _eager_init
-    try:
-        yield
-    finally:
-        StallPipe.__init__ = init
-
-
-class EagerStallSinCos(SinCos):
-    """SinCos elaborated with ``adv = o.ready``: an empty pipe no longer fills while the
-    consumer is slow. Breaks ``ready`` (and only that: nothing is lost, duplicated or
-    changed)."""
+    def __init__(self, layout, latency, mutation):
+        if mutation not in EDGE_MUTATIONS:
+            raise ValueError(f"mutation must be one of {', '.join(EDGE_MUTATIONS)}, got {mutation!r}")
+        super().__init__(layout, latency)
+        self.mutation = mutation
+        if mutation == "one_more":        # room for depth + 1
+            self.credits = Signal(range(self.depth + 2), init=self.depth + 1, name="credits")
 
     def elaborate(self, platform):
-        with eager_stall():
-            return super().elaborate(platform)
+        m = Module()
+        mutation = self.mutation
+        m.submodules.fifo = fifo = SyncFIFOBuffered(width=len(self.core.payload.as_value()),
+                                                    depth=self.depth)
+        m.d.comb += self.level.eq(fifo.level)
+        free = Signal(init=1, name="credit_free")
+        take = self.i_valid & self.i_ready
+        give = self.o.valid & self.o.ready
+        if mutation == "late":
+            late = Signal(name="give_late")
+            m.d.sync += late.eq(give)
+            give = late
+        elif mutation == "twice":
+            give = give << 1
+        after = Signal.like(self.credits, name="credits_next")
+        m.d.comb += after.eq(self.credits - take + give)
+        m.d.sync += [self.credits.eq(after), free.eq(after != 0)]
+        ready = {"early": free | give, "ungated": 1}.get(mutation, free)
+        m.d.comb += [self.i_ready.eq(ready), self.core.ready.eq(1),
+                     fifo.w_en.eq(self.core.valid), fifo.w_data.eq(self.core.payload),
+                     self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data),
+                     fifo.r_en.eq(1 if mutation == "read_unready" else self.o.ready)]
+        return m
+
+
+class BrokenEdgeSinCos(wiring.Component):
+    """SinCos's free-running chain (``credit=False``) behind a :class:`BrokenEdge`: a unit
+    with SinCos's ports, ``latency``, ``port_latency`` and ``fifo_depth``."""
+
+    mutation = None
+
+    def __init__(self, cfg):
+        self.inner, self.cfg = SinCos(cfg, credit=False), cfg
+        self.latency = self.inner.latency
+        self.port_latency = self.latency + EDGE_LATENCY
+        self.fifo_depth = min_fifo_depth(self.latency)
+        super().__init__({"i": In(stream.Signature(self.inner.i.payload.shape())),
+                          "o": Out(stream.Signature(self.inner.o.payload.shape()))})
+
+    def elaborate(self, platform):
+        m = Module()
+        m.submodules.inner = inner = self.inner
+        m.submodules.edge = edge = BrokenEdge(self.o.payload.shape(), self.latency, self.mutation)
+        m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready),
+                     inner.i.valid.eq(self.i.valid & edge.i_ready),
+                     inner.i.payload.eq(self.i.payload),
+                     edge.core.valid.eq(inner.o.valid), edge.core.payload.eq(inner.o.payload)]
+        wiring.connect(m, edge.o, wiring.flipped(self.o))
+        return m
+
+
+def _broken_edge(mutation):
+    return type(f"BrokenEdgeSinCos_{mutation}", (BrokenEdgeSinCos,), {"mutation": mutation,
+                "__doc__": f"SinCos behind a broken edge: {EDGE_MUTATIONS[mutation]}."})
 
 
 class _Around(wiring.Component):
@@ -78,6 +114,14 @@ class _Around(wiring.Component):
     @property
     def latency(self):
         return self.inner.latency
+
+    @property
+    def port_latency(self):
+        return self.inner.port_latency
+
+    @property
+    def fifo_depth(self):
+        return self.inner.fifo_depth
 
     def elaborate(self, platform):
         m = Module()
@@ -134,8 +178,8 @@ class Glitcher(_Around):
 
 
 class ExtraStage(_Around):
-    """A correct elastic output register after SinCos (one more cycle than ``latency``
-    says): a bubble the unit does not own up to. Breaks ``latency`` only."""
+    """A correct elastic output register after SinCos (one more cycle than
+    ``port_latency`` says): a bubble the unit does not own up to. Breaks ``latency`` only."""
 
     def elaborate(self, platform):
         m = Module()
@@ -177,6 +221,14 @@ class SwapAheadPalette(wiring.Component):
     def latency(self):
         return self.inner.latency + 1
 
+    @property
+    def port_latency(self):
+        return self.inner.port_latency + 1
+
+    @property
+    def fifo_depth(self):
+        return self.inner.fifo_depth
+
     def elaborate(self, platform):
         m = Module()
         m.submodules.inner = inner = self.inner
@@ -206,7 +258,7 @@ class UncarriedBankPipeline(BumpPipeline):
 
     def _elaborate_palette(self, m):
         lut, f = self.units["palette"], self.units["fetch"]
-        m.d.comb += f.i.valid.eq(self.i.valid)
+        m.d.comb += f.i.valid.eq(self.i.valid & self.i.ready)
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
         m.d.comb += [lut.i.valid.eq(f.o.valid),
                      lut.i.payload.index.eq(f.o.payload.index), lut.i.payload.tag.eq(f.o.payload.tag),
@@ -218,7 +270,12 @@ class UncarriedBankPipeline(BumpPipeline):
 
 # mutant -> the property it must fail
 MUTANTS = {
-    "eager_stall": (EagerStallSinCos, "ready"),
+    "credit_late": (_broken_edge("late"), "ready"),
+    "credit_early": (_broken_edge("early"), "ready"),
+    "credit_twice": (_broken_edge("twice"), "credit"),
+    "ungated": (_broken_edge("ungated"), "credit"),
+    "read_unready": (_broken_edge("read_unready"), "hold"),
+    "credit_one_more": (_broken_edge("one_more"), "credit"),
     "drop": (Dropper, "order"),
     "duplicate": (Duplicator, "order"),
     "glitch": (Glitcher, "hold"),

@@ -2,8 +2,9 @@
 widths (the properties are about the handshake; widths only change the payload).
 
 A :class:`Target` builds a fresh unit per check (a unit elaborates once). Its tag is wide
-enough that the tags in flight never alias (``2**tag_bits > latency + 1``), so a dropped
-or duplicated pixel always shows in the order check.
+enough that the tags in flight never alias (``2**tag_bits > fifo_depth + 1``: at most
+``fifo_depth`` pixels are accepted and not delivered, one per credit), so a dropped or
+duplicated pixel always shows in the order check.
 """
 
 from collections.abc import Callable
@@ -26,8 +27,8 @@ __all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "target"]
 SMALL = {"angle_bits": 6, "frac_bits": 6, "tag_bits": 4, "spec_index_bits": 4, "palette_size": 16}
 SMALL_SCENE = {**SMALL, "texture_size": 16}
 
-STREAM = ("hold", "ready", "order", "quiet", "latency", "cover", "hold_cover", "ready_cover",
-          "order_cover", "quiet_cover", "latency_cover")
+STREAM = ("hold", "ready", "order", "quiet", "latency", "credit", "cover", "hold_cover",
+          "ready_cover", "order_cover", "quiet_cover", "latency_cover", "credit_cover")
 
 
 @dataclass(frozen=True)
@@ -40,10 +41,10 @@ class Target:
     config: dict = field(default_factory=dict)
 
     def unit(self):
-        """A fresh unit with a tag wide enough for its latency."""
+        """A fresh unit with a tag wide enough for its pixels in flight."""
         bits = SMALL["tag_bits"]
         dut = self.build(bits)
-        while (1 << bits) <= dut.latency + 1:
+        while (1 << bits) <= dut.fifo_depth + 1:
             bits += 1
             _discard(dut)
             dut = self.build(bits)

@@ -1,9 +1,11 @@
-"""The quick subset of `make formal` (sim/formal/) in `make test`: SinCos's order and
-latency and one scene pipeline's order and palette double buffer proved by k-induction,
-two broken units caught (the stall enable of the issue, and the palette pipeline's old
-bank wiring), and the runner's failure report. The rest (the other broken units here,
-marked ``formal``; every unit and scene pipeline in the table) is `make formal`."""
+"""The quick subset of `make formal` (sim/formal/) in `make test`: SinCos's order, latency
+and credit loop and one scene pipeline's order, palette double buffer and credit loop
+proved by k-induction, three broken units caught (a credit edge whose i.ready reads
+o.ready, the palette pipeline's old bank wiring, a unit dropping a pixel), and the lemma
+bookkeeping without sby. The rest (the other broken units here, marked ``formal``; every
+unit and scene pipeline in the table) is `make formal`."""
 
+from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -12,35 +14,35 @@ from amaranth.back import rtlil
 
 from bumprtl.gen.formal import run as formal_run
 from bumprtl.gen.formal.run import check, check_mutant
-from bumprtl.rtl.pipe import StallPipe
-from bumprtl.sim.formal.contract import CHUNK, StreamContract, observe_pipes
-from bumprtl.sim.formal.mutants import MUTANTS, Glitcher
+from bumprtl.rtl.pipe import Pipe
+from bumprtl.sim.formal.contract import CHUNK, StreamContract, find_edge, observe_pipes
+from bumprtl.sim.formal.mutants import EDGE_MUTATIONS, MUTANTS, Glitcher
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
 
-_REGISTER = StallPipe.register
+_REGISTER = Pipe.register
 
 
-@pytest.mark.parametrize("prop", ["order", "latency"])
+@pytest.mark.parametrize("prop", ["order", "latency", "credit"])
 def test_sincos_contract_is_proved_by_induction(prop, build_dir):
     row = check(TARGETS["sincos"], prop, build_dir)
     assert row.result == "proved", row
-    if prop != "ready":
-        assert row.lemmas > 0          # the pipeline-register lemmas were found and asserted
+    assert row.lemmas > 0              # the chain's lemmas were found and asserted
 
 
 # the dropping unit is here so that a weakened order assumption (no pixel ever enters: the
 # proofs pass vacuously) fails make test too: its order no longer fails
-QUICK_MUTANTS = ("eager_stall", "uncarried_bank", "drop")
+QUICK_MUTANTS = ("credit_early", "uncarried_bank", "drop")
 
 
-@pytest.mark.parametrize("prop", ["order", "bank"])
+@pytest.mark.parametrize("prop", ["order", "bank", "credit"])
 def test_scene_pipeline_is_proved_by_induction(prop, build_dir):
-    """The palette scene pipeline (fetch -> LUT, two layers): order with its layer lemmas,
-    and the double buffer (each pixel reads the bank in front when the pipeline accepted
-    it) with the lemmas about the bank bits in flight and the table's watched entry."""
+    """The palette scene pipeline (fetch -> LUT, two layers behind one credit edge): order
+    with the tags of its stages and FIFO entries, the double buffer (each pixel reads the
+    bank in front when the pipeline accepted it) with the lemmas about the bank bits in
+    flight and the table's watched entry, and the credit loop's invariant."""
     row = check(TARGETS["pipeline_palette"], prop, build_dir)
     assert row.result == "proved", row
-    assert row.lemmas > 4
+    assert row.lemmas > 0
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=() if n in QUICK_MUTANTS else pytest.mark.formal)
@@ -53,15 +55,22 @@ def test_broken_unit_fails_its_property(name, build_dir):
     assert row.detail.startswith(MUTANTS[name][1]), row.detail    # that property, no other
 
 
+def test_every_edge_mutation_is_a_broken_unit():
+    """Each mutation of the credit edge is one of the broken units checked above."""
+    mutations = {cls.mutation for cls, _prop in MUTANTS.values() if hasattr(cls, "mutation")}
+    assert mutations == set(EDGE_MUTATIONS)
+
 
 # order's cover in make test (with the dropping unit: its assumption is the one that went
-# vacuous); latency's and hold's in make formal (pytest marker formal)
-@pytest.mark.parametrize("prop", ["order", pytest.param("latency", marks=pytest.mark.formal),
-                                  pytest.param("hold", marks=pytest.mark.formal)])
+# vacuous); the others in make formal (pytest marker formal)
+@pytest.mark.parametrize("prop", ["order"] + [pytest.param(p, marks=pytest.mark.formal)
+                                              for p in ("latency", "hold", "ready", "credit")])
 def test_sincos_properties_are_exercised(prop, build_dir):
     """Each property's own cover (its assumptions in force) is reached: two pixels enter
-    and leave in order, a pixel goes through the latency, a pixel is held through a stall.
-    A proof of a property whose assumption shuts every pixel out would pass; this fails."""
+    and leave in order, a pixel goes through the latency, a pixel is held through a stall,
+    a pixel is taken while the output is stalled, every credit is spent, the FIFO fills and
+    i.ready falls and rises again. A proof of a property whose assumption shuts every pixel
+    out would pass; this fails."""
     row = check(TARGETS["sincos"], f"{prop}_cover", build_dir)
     assert row.result == "covered", row
 
@@ -101,12 +110,31 @@ def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir,
 
 
 def test_lemmas_come_from_the_units_own_registers():
-    """The order lemmas cover every stage: one tag register per stage of SinCos, plus the
-    next input tag."""
+    """The order lemmas cover every stage and every FIFO entry: one tag register per stage
+    of SinCos's chain, two per address of its edge's FIFO memory (``fifo_depth - 1``: the
+    output register is the property itself; the oldest entry, and each entry after the one
+    before it), plus the next input tag; and the credit loop's invariant is among them."""
     top = StreamContract(TARGETS["sincos"].unit(), "order")
     rtlil.convert(top, name="top", ports=top.free_inputs())
-    latency = top.dut.latency
-    assert top.lemma_count == latency + 1
+    said = Counter(top.lemma_names)
+    assert said["valid stages hold consecutive tags"] == top.dut.latency
+    assert said["the FIFO's entries hold consecutive tags"] == top.dut.fifo_depth - 1
+    assert said["the FIFO's oldest entry holds the tag after the output's"] == top.dut.fifo_depth - 1
+    assert said["next input tag is one past the youngest in flight"] == 1
+    assert said["credit: credits + pixels in the chain + FIFO occupancy != depth"] == 1
+
+
+@pytest.mark.parametrize("name", ["sincos", "pipeline_palette"])
+def test_the_credit_edge_is_found_in_the_elaborated_unit(name):
+    """The contract finds the one CreditEdge of a unit (its own) and of a scene pipeline
+    (the one around its units), with its FIFO of ``fifo_depth`` entries and that FIFO's
+    memory (an inner queue of one entry less)."""
+    dut = TARGETS[name].unit()
+    fragment, _seen = observe_pipes(dut)
+    edge = find_edge(fragment)
+    assert edge is not None and edge.edge.depth == dut.fifo_depth
+    assert edge.fifo.depth == dut.fifo_depth and edge.inner_depth == dut.fifo_depth - 1
+    assert edge.storage.depth == dut.fifo_depth - 1
 
 
 def test_parallel_elaborations_each_observe_every_stage():
@@ -131,26 +159,48 @@ def test_the_observer_sees_only_its_own_elaboration():
     unit's pipes (keyed by their input valid), none of the other's; without an observer the
     unit builds the same pipes and nobody records them."""
     a, b = TARGETS["rotation_exact"].unit(), TARGETS["sincos"].unit()
+    assert a.latency != b.latency
     with ThreadPoolExecutor(max_workers=2) as pool:
         (_, seen_a), (_, seen_b) = pool.map(observe_pipes, (a, b))
-    assert id(a.i.valid) in seen_a and id(a.i.valid) not in seen_b
-    assert id(b.i.valid) in seen_b and id(b.i.valid) not in seen_a
-    assert len(seen_a[id(a.i.valid)]["valid"]) == a.latency + 1
-    assert seen_a[id(a.i.valid)]["tags"] and not StallPipe.__dict__.get("_formal")
-    assert StallPipe.register is _REGISTER            # StallPipe itself is never replaced
+    assert not set(seen_a) & set(seen_b)
+    assert [len(r["valid"]) for r in seen_a.values()] == [a.latency + 1]
+    assert [len(r["valid"]) for r in seen_b.values()] == [b.latency + 1]
+    assert all(r["tags"] for r in [*seen_a.values(), *seen_b.values()])
+    assert not Pipe.__dict__.get("_formal")
+    assert Pipe.register is _REGISTER                 # Pipe itself is never replaced
 
 
 def test_a_long_pipe_counts_its_pixels_in_runs():
-    """quiet's occupancy lemma on one long StallPipe (Kim's setup, 46 stages at the formal
-    widths) is a ghost counter per run of CHUNK stages plus their sum: one count over all
-    46 stages made the induction run past its 600 s limit."""
+    """The pixels in a long chain (Kim's setup, 46 stages at the formal widths) are counted
+    by a ghost counter per run of CHUNK stages: one count over all 46 stages made the
+    induction of quiet run past its 600 s limit."""
     top = StreamContract(TARGETS["rotation_kim"].unit(), "quiet")
     rtlil.convert(top, name="top", ports=top.free_inputs())
     stages = top.dut.latency
-    assert stages > CHUNK and top.lemma_count == -(-stages // CHUNK) + 1
+    said = Counter(top.lemma_names)
+    assert stages > CHUNK
+    assert said["valid stages of a run = its ghost counter"] == -(-stages // CHUNK)
+    assert said["pixels in flight = valid stages + FIFO occupancy"] == 1
 
 
 @pytest.mark.formal
 def test_kim_setup_is_quiet_by_induction(build_dir):
     row = check(TARGETS["rotation_kim"], "quiet", build_dir)
     assert row.result == "proved" and row.depth == 2, row
+
+
+def test_the_page_names_the_run_time_beside_the_command(tmp_path):
+    """The table's section names the command, and the run's checks and wall time beside it
+    (a page reprinted from results.json names none)."""
+    from types import SimpleNamespace
+
+    from bumprtl.gen.formal.doc import write_doc
+    row = SimpleNamespace(unit="sincos", prop="credit", result="proved", depth=2, latency=6,
+                          lemmas=1, seconds=1.5)
+    doc = tmp_path / "formal.md"
+    write_doc(doc, [row, row], "-j 2 --doc docs/formal.md", seconds=1234.4, checked=2)
+    text = doc.read_text()
+    assert "`python -m bumprtl.gen.formal.run -j 2 --doc docs/formal.md`" in text
+    assert "that run: 2 checks in 1234 s of wall time" in text
+    write_doc(doc, [row], "--from-results --doc docs/formal.md")
+    assert "that run" not in doc.read_text()
