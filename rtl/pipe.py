@@ -13,7 +13,7 @@ FIFO's output register and never depend on ``o.ready``; ``i.ready`` is a registe
 credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cycle.
 """
 
-from amaranth.hdl import Const, Module, Shape, Signal, Value
+from amaranth.hdl import Assert, Const, Elaboratable, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -41,7 +41,7 @@ from bumprtl.rtl.targets import (
     read_port,
 )
 
-__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth",
+__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO",
            "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
            "limb_products", "PRODUCT_LATENCY",
@@ -208,6 +208,59 @@ class Pipe:
         return value
 
 
+class CreditFIFO(Elaboratable):
+    """The credit edge's FIFO of ``depth`` pixels of ``width`` bits, with
+    ``amaranth.lib.fifo``'s port names (``w_en``, ``w_data``, ``w_rdy``, ``r_en``,
+    ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
+    guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
+    of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
+    read asynchronously (LUT RAM on ECP5) at the read pointer into the output register
+    ``r_data`` whenever that is empty or being taken and the memory holds a pixel (a
+    register of its own, ``stored``, whose next state needs no carry chain). ``level``
+    counts the memory's pixels and the output register's. Written to an empty FIFO in
+    cycle t, a pixel is offered in cycle t + 2 (EDGE_LATENCY)."""
+
+    def __init__(self, width, depth):
+        self.width, self.depth = width, depth
+        self.bits = (depth - 1).bit_length()
+        self.w_en, self.w_rdy = Signal(), Signal()
+        self.w_data = Signal(width)
+        self.r_en, self.r_rdy = Signal(), Signal(name="fifo_head_valid")
+        self.r_data = Signal(width, name="fifo_head", reset_less=True)
+        self.level = Signal(range(depth + 1))
+        self.count = Signal(self.bits + 1, name="fifo_count")      # pixels in the memory
+        self.stored = Signal(name="fifo_stored")                    # count != 0
+
+    def elaborate(self, platform):
+        m, bits = Module(), self.bits
+        # LUT RAM (its read is asynchronous): a block RAM would put the load on its CE
+        m.submodules.storage = storage = Memory(shape=self.width, depth=1 << bits, init=[],
+                                                attrs={"ram_style": "distributed"})
+        wp = Signal(bits, name="fifo_write")
+        rp = Signal(bits, name="fifo_read")
+        wport, rport = storage.write_port(), storage.read_port(domain="comb")
+        m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
+                     rport.addr.eq(rp), self.w_rdy.eq(self.count != (1 << bits)),
+                     self.level.eq(self.count + self.r_rdy)]
+        load = self.stored & (~self.r_rdy | self.r_en)
+        m.d.sync += [wp.eq(wp + self.w_en), rp.eq(rp + load),   # wrap: the credits leave room
+                     self.count.eq(self.count + self.w_en - load)]
+        with m.If(self.w_en & ~load):
+            m.d.sync += self.stored.eq(1)
+        with m.Elif(load & ~self.w_en):
+            m.d.sync += self.stored.eq(self.count != 1)
+        with m.If(load):
+            m.d.sync += [self.r_data.eq(rport.data), self.r_rdy.eq(1)]
+        with m.Elif(self.r_en):
+            m.d.sync += self.r_rdy.eq(0)
+        if platform == "formal":         # as amaranth.lib.fifo states its own pointers
+            m.d.comb += [Assert(self.stored == (self.count != 0)),
+                         Assert(wp == (rp + self.count)[:bits]),
+                         Assert(self.count + self.r_rdy <= self.depth),
+                         Assert(self.r_rdy | (self.count <= 1))]
+        return m
+
+
 class CreditEdge(wiring.Component):
     """The flow control of a free-running pipe of ``latency`` stages: credits at its input,
     a FIFO of ``depth`` entries at its output.
@@ -246,35 +299,9 @@ class CreditEdge(wiring.Component):
 
     def elaborate(self, platform):
         m = Module()
-        width, bits = Shape.cast(self.layout).width, (self.depth - 1).bit_length()
-        # LUT RAM (its read is asynchronous): a block RAM would put `load` on its clock enable
-        m.submodules.fifo = fifo = Memory(shape=width, depth=1 << bits, init=[],
-                                          attrs={"ram_style": "distributed"})
-        wp = Signal(bits, name="fifo_write")
-        rp = Signal(bits, name="fifo_read")
-        head = Signal(width, name="fifo_head", reset_less=True)
-        held = Signal(name="fifo_head_valid")
-        wport, rport = fifo.write_port(), fifo.read_port(domain="comb")
-        m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.core.payload),
-                     wport.en.eq(self.core.valid), rport.addr.eq(rp)]
-        # stored: the memory holds a pixel, a register of its own whose next state needs no
-        # carry chain (as credit_free's below), so the head's load is one gate of registers
-        # and o.ready
-        stored = Signal(name="fifo_stored")
-        count = Signal(bits + 1, name="fifo_count")          # pixels in the memory
-        write = self.core.valid
-        load = stored & (~held | self.o.ready)
-        m.d.sync += [wp.eq(wp + write), rp.eq(rp + load),   # wrap: the credits leave room
-                     count.eq(count + write - load)]
-        with m.If(write & ~load):
-            m.d.sync += stored.eq(1)
-        with m.Elif(load & ~write):
-            m.d.sync += stored.eq(count != 1)
-        with m.If(load):
-            m.d.sync += [head.eq(rport.data), held.eq(1)]
-        with m.Elif(self.o.ready):
-            m.d.sync += held.eq(0)
-        m.d.comb += self.level.eq(count + held)
+        m.submodules.fifo = fifo = CreditFIFO(Shape.cast(self.layout).width, self.depth)
+        m.d.comb += [fifo.w_en.eq(self.core.valid), fifo.w_data.eq(self.core.payload),
+                     fifo.r_en.eq(self.o.ready), self.level.eq(fifo.level)]
         free = Signal(init=1, name="credit_free")           # credits != 0, registered
         take = self.i_valid & free
         give = self.o.valid & self.o.ready
@@ -288,7 +315,7 @@ class CreditEdge(wiring.Component):
         with m.Elif(give & ~take):
             m.d.sync += free.eq(1)
         m.d.comb += [self.i_ready.eq(free), self.core.ready.eq(1),
-                     self.o.valid.eq(held), self.o.payload.eq(head)]
+                     self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data)]
         return m
 
 

@@ -75,7 +75,7 @@ from amaranth.lib import data, wiring
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.utils import ceil_log2
 
-from bumprtl.rtl.pipe import CreditEdge
+from bumprtl.rtl.pipe import CreditEdge, CreditFIFO
 
 __all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers",
            "find_edge", "CHUNK"]
@@ -170,8 +170,8 @@ def _subfragment(fragment, name):
 
 class _Edge:
     """A :class:`~bumprtl.rtl.pipe.CreditEdge` found in an elaborated fragment, with its
-    FIFO (``SyncFIFOBuffered``: an inner queue of ``depth - 1`` entries in a memory, then
-    the output register ``r_data``/``r_rdy``) and that memory: ``instance`` (the elaborated
+    FIFO (``rtl/pipe.CreditFIFO``, or ``SyncFIFOBuffered``: an inner queue in a memory,
+    then the output register ``r_data``/``r_rdy``) and that memory: ``instance`` (the elaborated
     MemoryInstance, to add read ports to) and ``storage`` (its ``lib.memory.Memory``, whose
     ports' addresses are the FIFO's write and read pointers)."""
 
@@ -180,10 +180,11 @@ class _Edge:
         fifo_fragment = _subfragment(fragment, "fifo")
         self.fifo = fifo_fragment.origins[0] if fifo_fragment is not None else None
         instance = _subfragment(fifo_fragment, "storage") if fifo_fragment is not None else None
-        ok = isinstance(self.fifo, SyncFIFOBuffered) and isinstance(instance, MemoryInstance)
+        ok = isinstance(self.fifo, (CreditFIFO, SyncFIFOBuffered)) and \
+            isinstance(instance, MemoryInstance)
         self.instance = instance if ok else None
         self.storage = instance.origins[0] if ok else None
-        self.inner_depth = self.fifo.depth - 1 if ok else 0
+        self.inner_depth = self.storage.depth if ok else 0
         self._slots = None
 
     @property

@@ -86,9 +86,9 @@ def _check_rtl_section(out, report):
     green = rtl[..., 1].astype(float).mean(axis=1)                 # mortar is grey: more green
     assert min(green[lines]) > max(np.delete(green, lines)) + 10   # rtl.png shows the courses
     w = 2 * Config().angle_bits                                    # a map word: phi and theta
-    # the map and the credit edge's FIFO storage (SyncFIFOBuffered: depth - 1 words and its
-    # output register) are the RAMs of the flattened pipeline
-    fifo = (meta.fifo_depth - 1) * meta.port("o__payload").width
+    # the map and the credit edge's FIFO storage (rtl/pipe.CreditFIFO: the next power of two
+    # words at least fifo_depth) are the RAMs of the flattened pipeline
+    fifo = (1 << (meta.fifo_depth - 1).bit_length()) * meta.port("o__payload").width
     assert t == 32 and f"map {t}x{t} x {w} bits" in report and f"RAM bits {t * t * w + fifo}" in report
     assert "identical bytes" in report and "multipliers" in report
     assert (out / "pipeline" / "pipeline_map.hex").read_text().count("\n") == t * t

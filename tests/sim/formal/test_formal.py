@@ -111,15 +111,17 @@ def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir,
 
 def test_lemmas_come_from_the_units_own_registers():
     """The order lemmas cover every stage and every FIFO entry: one tag register per stage
-    of SinCos's chain, two per address of its edge's FIFO memory (``fifo_depth - 1``: the
-    output register is the property itself; the oldest entry, and each entry after the one
-    before it), plus the next input tag; and the credit loop's invariant is among them."""
+    of SinCos's chain, two per address of its edge's FIFO memory (rtl/pipe.CreditFIFO: the
+    next power of two words at least ``fifo_depth``; the output register is the property
+    itself; the oldest entry, and each entry after the one before it), plus the next input
+    tag; and the credit loop's invariant is among them."""
     top = StreamContract(TARGETS["sincos"].unit(), "order")
     rtlil.convert(top, name="top", ports=top.free_inputs())
     said = Counter(top.lemma_names)
     assert said["valid stages hold consecutive tags"] == top.dut.latency
-    assert said["the FIFO's entries hold consecutive tags"] == top.dut.fifo_depth - 1
-    assert said["the FIFO's oldest entry holds the tag after the output's"] == top.dut.fifo_depth - 1
+    words = 1 << (top.dut.fifo_depth - 1).bit_length()
+    assert said["the FIFO's entries hold consecutive tags"] == words
+    assert said["the FIFO's oldest entry holds the tag after the output's"] == words
     assert said["next input tag is one past the youngest in flight"] == 1
     assert said["credit: credits + pixels in the chain + FIFO occupancy != depth"] == 1
 
@@ -128,13 +130,14 @@ def test_lemmas_come_from_the_units_own_registers():
 def test_the_credit_edge_is_found_in_the_elaborated_unit(name):
     """The contract finds the one CreditEdge of a unit (its own) and of a scene pipeline
     (the one around its units), with its FIFO of ``fifo_depth`` entries and that FIFO's
-    memory (an inner queue of one entry less)."""
+    memory (rtl/pipe.CreditFIFO: the next power of two words at least ``fifo_depth``)."""
     dut = TARGETS[name].unit()
     fragment, _seen = observe_pipes(dut)
     edge = find_edge(fragment)
     assert edge is not None and edge.edge.depth == dut.fifo_depth
-    assert edge.fifo.depth == dut.fifo_depth and edge.inner_depth == dut.fifo_depth - 1
-    assert edge.storage.depth == dut.fifo_depth - 1
+    words = 1 << (dut.fifo_depth - 1).bit_length()
+    assert edge.fifo.depth == dut.fifo_depth and edge.inner_depth == words >= dut.fifo_depth
+    assert edge.storage.depth == words
 
 
 def test_parallel_elaborations_each_observe_every_stage():
