@@ -12,9 +12,9 @@ numpy int64 arrays (in ``sim/golden``), so the two cannot drift apart:
 from dataclasses import dataclass
 
 import numpy as np
-from amaranth.hdl import Mux, Value, ValueCastable, signed, unsigned
+from amaranth.hdl import Const, Mux, Value, ValueCastable, signed, unsigned
 
-__all__ = ["Q", "round_shift", "mul_round", "saturate"]
+__all__ = ["Q", "round_shift", "mul_round", "saturate", "select_constant"]
 
 
 @dataclass(frozen=True)
@@ -85,3 +85,14 @@ def saturate(x, q: Q):
         clamped = Mux(x > q.max, q.max, Mux(x < q.min, q.min, x))[:q.width]
         return clamped.as_signed() if q.signed else clamped
     return np.clip(np.asarray(x, dtype=np.int64), q.min, q.max)
+
+
+def select_constant(cond, constant, x, width):
+    """``constant`` where the 1-bit ``cond``, else ``x``, ``width`` bits: AND/OR terms
+    (Amaranth), not a multiplexer to a constant, which synthesis turns into a synchronous
+    set/reset routed to every bit's LSR pin; ``numpy.where`` on int arrays."""
+    if isinstance(x, (Value, ValueCastable)):
+        x, cond = Value.cast(x), Value.cast(cond)
+        keep = (x & (~cond).replicate(width)) | (Const(constant, width) & cond.replicate(width))
+        return keep[:width]
+    return np.where(cond, constant, x)

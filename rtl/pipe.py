@@ -41,7 +41,7 @@ from bumprtl.rtl.targets import (
     read_port,
 )
 
-__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO",
+__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO", "add_credit_edge",
            "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
            "limb_products", "PRODUCT_LATENCY",
@@ -274,13 +274,8 @@ class CreditEdge(wiring.Component):
     core : In(stream.Signature(layout))
         The pipe's last stage (``ready`` is 1: the FIFO always has room, see below).
     o : Out(stream.Signature(layout))
-        The FIFO's head: ``valid`` and ``payload`` from its output register.
-
-    The FIFO: a memory of ``2**ceil(log2(depth))`` words written whenever ``core.valid``
-    (no full flag: the credits guarantee room) at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at a read pointer into the output register
-    whenever the register is empty or being taken and the memory holds a pixel. Its
-    occupancy ``level`` counts the memory's pixels and the output register's.
+        The FIFO's head (:class:`CreditFIFO`): ``valid`` and ``payload`` from its output
+        register; ``level`` is its occupancy.
 
     ``credits`` starts at ``depth``; a pixel taken spends one, a pixel leaving ``o`` gives
     one back (counted the next cycle). In every cycle credits + pixels in the pipe + FIFO
@@ -317,6 +312,18 @@ class CreditEdge(wiring.Component):
         m.d.comb += [self.i_ready.eq(free), self.core.ready.eq(1),
                      self.o.valid.eq(fifo.r_rdy), self.o.payload.eq(fifo.r_data)]
         return m
+
+
+def add_credit_edge(m, i, o, latency, depth=None):
+    """A :class:`CreditEdge` (submodule ``edge`` of ``m``) between the stream ``i`` (flipped)
+    and the stream ``o`` of a free-running chain of ``latency`` stages: ``i.ready`` is its
+    free credit, ``o`` its FIFO's head. Returns ``(valid, core)``: the valid bit of the pixel
+    entering the chain's first stage (``i.valid`` when taken) and the edge's ``core``
+    stream, whose ``valid`` and ``payload`` the chain's last stage drives."""
+    m.submodules.edge = edge = CreditEdge(o.payload.shape(), latency, depth)
+    m.d.comb += [edge.i_valid.eq(i.valid), i.ready.eq(edge.i_ready)]
+    wiring.connect(m, edge.o, wiring.flipped(o))
+    return i.valid & edge.i_ready, edge.core
 
 
 class PipeUnit(wiring.Component):
@@ -378,13 +385,7 @@ class PipeUnit(wiring.Component):
     def elaborate(self, platform):
         m = Module()
         if self.credit:
-            layout = self.o.payload.shape()
-            m.submodules.edge = edge = CreditEdge(layout, self.latency, self.fifo_depth)
-            core = stream.Signature(layout).create(path=("core",))
-            m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready)]
-            wiring.connect(m, core, edge.core)
-            wiring.connect(m, edge.o, wiring.flipped(self.o))
-            valid = self.i.valid & edge.i_ready
+            valid, core = add_credit_edge(m, self.i, self.o, self.latency, self.fifo_depth)
         else:
             core, valid = self.o, self.i.valid
             m.d.comb += self.i.ready.eq(1)

@@ -47,8 +47,8 @@ from bumprtl.rtl.palette import PaletteLUT
 from bumprtl.rtl.pipe import (
     EDGE_LATENCY,
     PRODUCT_LATENCY,
-    CreditEdge,
     PipeUnit,
+    add_credit_edge,
     check_fifo_depth,
 )
 from bumprtl.rtl.rotation import VectorRotation
@@ -407,12 +407,8 @@ class BumpPipeline(wiring.Component):
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()
-        m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency,
-                                              self.fifo_depth)
-        m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready)]
-        last = self.units[self._last].o
-        m.d.comb += [edge.core.valid.eq(last.valid), edge.core.payload.eq(last.payload)]
-        wiring.connect(m, edge.o, wiring.flipped(self.o))
+        _, core = add_credit_edge(m, self.i, self.o, self.latency, self.fifo_depth)
+        _feed(m, self.units[self._last].o, core)
         for name, unit in self.units.items():
             m.submodules[name] = unit
         s, u = self.scene, self.units

@@ -10,11 +10,11 @@ illumination datapath is an :class:`IlluminationDatapath` (its dot products, the
 method's class from the registry (rtl/methods.py).
 """
 
-from amaranth.hdl import Const, Mux, signed, unsigned
+from amaranth.hdl import Mux, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.fixed import round_shift, select_constant
 from bumprtl.rtl.layouts import shade_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 from bumprtl.rtl.tables import (
@@ -45,15 +45,14 @@ SHADE_LATENCY = FINE_STAGE + PRODUCT_LATENCY + 2
 def _clamp01(pipe, x, cfg, name):
     """clamp(x, 0, 1.0) of a signed value with frac_bits fractional bits, as unsigned B+1,
     CLAMP_STAGES registers later: first x's sign and x > 1.0 (a carry chain) registered
-    beside x's low bits, then the select as AND/OR terms of those registers (no multiplexer
-    to a constant, which synthesis would turn into a synchronous reset routed to every
-    bit's LSR pin)."""
+    beside x's low bits, then the select as AND/OR terms of those registers
+    (:func:`~bumprtl.rtl.fixed.select_constant`, and 0 where negative)."""
     w = cfg.frac_bits + 1
     negative = pipe.register(x[-1], f"{name}_negative")
     over = pipe.register(x > cfg.one, f"{name}_over")
     low = pipe.register(x[:w], f"{name}_low")
-    keep, top = ~(negative | over), over & ~negative
-    return pipe.register((low & keep.replicate(w)) | (Const(cfg.one, w) & top.replicate(w)), name)
+    clamped = select_constant(over, cfg.one, low, w) & (~negative).replicate(w)
+    return pipe.register(clamped, name)
 
 
 def shade_stages(m, pipe, cfg: Config, ndotl, ndoth):

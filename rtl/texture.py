@@ -25,11 +25,11 @@ coefficients' quantization and the floors of the products: :func:`blend_error_bo
 """
 
 import numpy as np
-from amaranth.hdl import Const, Mux, Value, ValueCastable, unsigned
+from amaranth.hdl import Mux, Value, ValueCastable, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.fixed import round_shift
+from bumprtl.rtl.fixed import round_shift, select_constant
 from bumprtl.rtl.pipe import ECP5, PipeUnit
 from bumprtl.rtl.tables import (
     KS_FRAC_BITS,
@@ -94,19 +94,6 @@ def sum_product(terms, width, k, mul, name):
     return sum(prods[1:], prods[0])
 
 
-def _select(over, top, x):
-    """``top`` where ``over``, else ``x``: AND/OR terms of two registers (Amaranth), not a
-    multiplexer to a constant (which synthesis turns into a reset on every bit's LSR pin),
-    and ``where`` on int64 arrays."""
-    if isinstance(x, (Value, ValueCastable)):
-        x = Value.cast(x)
-        w = max(x.shape().width, top.bit_length())
-        over = Value.cast(over)
-        out = (x & (~over).replicate(w)) | (Const(top, w) & over.replicate(w))
-        return out[:top.bit_length()]
-    return np.where(over, top, x)
-
-
 def _sat(x, top):
     """min(x, top) of a non-negative value (Amaranth or int64): every term here is unsigned."""
     if isinstance(x, (Value, ValueCastable)):
@@ -151,10 +138,10 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
     d8, s8 = reg(_sat(d8, u8), "diffuse8"), reg(_sat(s8, u8), "specular8")      # clamped
     # min(1, ka + kd_sum) in two stages, one carry chain each: the sum beside the compare
-    # kd_sum > 1 - ka (the same test), then the select as AND/OR terms (_select)
+    # kd_sum > 1 - ka (the same test), then the select as AND/OR terms (select_constant)
     top = 1 << gl
     over = reg(kd_sum > top - ka, "lit_over")                                   # stage 4
-    lit = reg(_select(over, top, reg(ka + kd_sum, "lit_sum")), "lit")           # stage 5
+    lit = reg(select_constant(over, top, reg(ka + kd_sum, "lit_sum"), gl + 1), "lit")  # 5
     for n in (3, 4, 5):
         tex = {c: reg(tex[c], f"texel_{c}_d{n}") for c in RGB}
     prod = {c: mul(tex[c], lit, f"albedo_{c}") for c in RGB}                    # stage 7

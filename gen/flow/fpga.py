@@ -29,7 +29,7 @@ from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.gen.tools.yosys import run_yosys
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, CreditEdge, min_fifo_depth
+from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, add_credit_edge, min_fifo_depth
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
 
@@ -141,17 +141,14 @@ def pipeline_component(cfg, target=None):
 
         def elaborate(self, platform):
             m = Module()
-            m.submodules.edge = edge = CreditEdge(self.o.payload.shape(), self.latency,
-                                                  self.fifo_depth)
+            valid, core = add_credit_edge(m, self.i, self.o, self.latency, self.fifo_depth)
             m.submodules.rotation, m.submodules.illumination = self.rotation, self.illumination
-            m.d.comb += [edge.i_valid.eq(self.i.valid), self.i.ready.eq(edge.i_ready),
-                         self.rotation.i.valid.eq(self.i.valid & edge.i_ready),
+            m.d.comb += [self.rotation.i.valid.eq(valid),
                          self.rotation.i.payload.eq(self.i.payload),
                          self.illumination.i.valid.eq(self.rotation.o.valid),
                          self.illumination.i.payload.eq(self.rotation.o.payload),
-                         edge.core.valid.eq(self.illumination.o.valid),
-                         edge.core.payload.eq(self.illumination.o.payload)]
-            wiring.connect(m, edge.o, wiring.flipped(self.o))
+                         core.valid.eq(self.illumination.o.valid),
+                         core.payload.eq(self.illumination.o.payload)]
             return m
 
     return Pipeline()

@@ -42,9 +42,15 @@ class Unit:
     flags: tuple = ("angle_bits", "frac_bits", "tag_bits")   # Config fields on the CLI
 
 
+def _flow(dut):
+    """The flow facts every unit's sidecar states: its port latency (credit edge included),
+    its FIFO depth (= credits) and one item a clock."""
+    return {"latency": dut.port_latency, "fifo_depth": dut.fifo_depth, "throughput": 1}
+
+
 def _sincos_sidecar(cfg, dut):
     width = sine_rom_table(cfg)[1]
-    return {"latency": dut.port_latency, "fifo_depth": dut.fifo_depth, "throughput": 1,
+    return {**_flow(dut),
             "roms": {"quarter_sine": {"depth": cfg.sincos_depth, "width": width,
                                       "bits": cfg.sincos_depth * width}},
             "error_bound_ulp": 0.5}
@@ -53,7 +59,7 @@ def _sincos_sidecar(cfg, dut):
 def _method_sidecar(cfg, dut):
     """A rotation or illumination unit: its method's error bound and note (rtl/methods.py)."""
     method = get(cfg.method)
-    return {"latency": dut.port_latency, "fifo_depth": dut.fifo_depth, "throughput": 1, "method": cfg.method, "roms": unit_memories(dut),
+    return {**_flow(dut), "method": cfg.method, "roms": unit_memories(dut),
             **bound_fields(error_bounds(cfg)), **faithful_widths(cfg),
             "error_note": method.error_note}
 
@@ -121,7 +127,7 @@ def unit_memories(dut):
 
 
 def _palette_sidecar(cfg, dut):
-    return {"latency": dut.port_latency, "fifo_depth": dut.fifo_depth, "throughput": 1, "index_bits": index_bits(cfg),
+    return {**_flow(dut), "index_bits": index_bits(cfg),
             "blend": "eq2" if cfg.palette_blend else None, "roms": unit_memories(dut),
             "memory_bits": dut.memory_bits, "double_buffered": True,
             "out_of_range_index": "reads as all zeros (rgba = 0) and sets oor = 1; "
@@ -130,8 +136,8 @@ def _palette_sidecar(cfg, dut):
 
 def _pipeline_sidecar(scene, dut):
     """Which units were built and why, which were skipped, latency, memories."""
-    out = {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.port_latency, "fifo_depth": dut.fifo_depth,
-           "throughput": 1, "built": dut.built, "skipped": dut.skipped, "roms": unit_memories(dut)}
+    out = {"config": scene.config.to_dict(), "scene": scene.to_dict(), **_flow(dut),
+           "built": dut.built, "skipped": dut.skipped, "roms": unit_memories(dut)}
     if scene.shading == "per-pixel":
         out.update(bound_fields(error_bounds(scene.config, scene.lights, scene.texture)))
         out.update(faithful_widths(scene.config))
@@ -139,8 +145,8 @@ def _pipeline_sidecar(scene, dut):
 
 
 def _fetch_sidecar(scene, dut):
-    return {"config": scene.config.to_dict(), "scene": scene.to_dict(), "latency": dut.port_latency, "fifo_depth": dut.fifo_depth,
-            "throughput": 1, "outputs": fetched_fields(scene), "level_bases": level_bases(scene),
+    return {"config": scene.config.to_dict(), "scene": scene.to_dict(), **_flow(dut),
+            "outputs": fetched_fields(scene), "level_bases": level_bases(scene),
             "memory_bits": dut.memory_bits, "addressing": scene.addressing}
 
 
