@@ -32,8 +32,10 @@ ROM_MAX_BLOCKS = 9
 SPREAD_BLOCKS = 8
 # A quarter-wave sine ROM of more DP16KD than this side by side has its reads take a second
 # address register beside its blocks (sincos.near_sine): without it the angle -> mirrored
-# address route across the blocks is the worst path of the widest sine ROMs (docs/report.md).
-NEAR_BLOCKS = 6
+# address route to the blocks is a worst path at 200 MHz even for a ROM of one to four
+# blocks (the address register sits at the block RAM, the angle's adder far from it;
+# docs/report.md), so every sine ROM takes it.
+NEAR_BLOCKS = 0
 
 
 def fits_dsp(*shapes, width=DSP_WIDTH):

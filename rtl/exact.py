@@ -45,7 +45,7 @@ class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
     a value read appears ``latency`` pipe stages after its angle (angle register,
     address register, [its near copy for a wide ROM,] read, block-RAM output register,
-    data register, sign: sincos.registered_sine_latency)."""
+    data register, its copy, sign: sincos.registered_sine_latency)."""
 
     def __init__(self, m, pipe, cfg):
         self.m, self.pipe, self.cfg, self.roms, self.pending = m, pipe, cfg, [], []
@@ -69,8 +69,10 @@ class SineBank:
 
 def rotation_latency(cfg: Config):
     """Stages of :class:`ExactRotation` (and ``pipeline.VectorTerms``, in lock step beside
-    it): the input sums, ``SineBank.latency``, two adder levels."""
-    return 1 + registered_sine_latency(cfg) + 2
+    it): the input sums, ``SineBank.latency``, two adder levels, the output register (a
+    plain copy of the second level, which feeds every light's illumination: the adders'
+    route does not cross to them in the cycle that sums)."""
+    return 1 + registered_sine_latency(cfg) + 3
 
 
 def vector_terms(pipe, bank, vec, n_phi, name, latency):
@@ -103,8 +105,8 @@ class ExactRotation(PipeUnit):
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
     Latency :func:`rotation_latency`: the input sums (a, b, D), SineBank.latency (read
-    angle, ROM address, ROM read, block-RAM output register, data register, sign: 9 in all,
-    10 where the sine ROM is spread), two adder levels; 1 pixel per clock.
+    angle, ROM address, its near copy, ROM read, block-RAM output register, data register,
+    its copy, sign: 11 in all), two adder levels, the output register; 1 pixel per clock.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
@@ -131,7 +133,7 @@ class ExactRotation(PipeUnit):
                 "y2": reg(c["c0"] - c["c1"], "y2_a"),
                 "z4": -(z[0] + z[1]) + 2 * z[2]}
         for name, value in sums.items():
-            m.d.comb += o.n[name].eq(reg(value, f"n_{name}"))
+            m.d.comb += o.n[name].eq(reg(reg(value, f"n_{name}_sum"), f"n_{name}"))
         for v in vectors(cfg):
             for name, value in vector_terms(pipe, rom, px[v], px.n.phi, v, self.latency).items():
                 m.d.comb += o[v][name].eq(value)

@@ -364,7 +364,7 @@ class LeeIllumination(IlluminationDatapath):
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``. Each cosine table is a
     one-port :func:`sine_rom` (one DP16KD with its output register on ECP5) read
-    by sincos.sine_read (angle sum, address, read, output register, data register, sign:
+    by sincos.sine_read (angle sum, address, read, output register, data register, its copy, sign:
     REGISTERED_SINE_LATENCY stages); then c- + c+ and c- - c+ (1), the registered product
     (``pipe.product_latency`` of :func:`dot_operands`: PRODUCT_LATENCY up to B = 15, else a
     ``pipe.WideProduct``, WIDE_PRODUCT_LATENCY, on every target), the sum and its rounding

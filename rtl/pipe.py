@@ -54,6 +54,8 @@ EDGE_LATENCY = 2
 # Cycles from a pixel taken at ``o`` to its credit free at ``i``: the credit count is a
 # register, so the credit is counted the cycle after the pixel leaves.
 CREDIT_RETURN = 1
+# Bits of the FIFO's word read at one copy of its read pointer (CreditFIFO).
+READ_SLICE = 16
 
 
 def min_fifo_depth(latency):
@@ -214,7 +216,7 @@ class CreditFIFO(Elaboratable):
     ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
     guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
     of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at the read pointer into the output register
+    read asynchronously (LUT RAM on ECP5) at the read pointer (a copy per READ_SLICE bits) into the output register
     ``r_data`` whenever that is empty or being taken and the memory holds a pixel (a
     register of its own, ``stored``, whose next state needs no carry chain). ``level``
     counts the memory's pixels and the output register's. Written to an empty FIFO in
@@ -237,27 +239,41 @@ class CreditFIFO(Elaboratable):
         m.submodules.storage = storage = Memory(shape=self.width, depth=1 << bits, init=[],
                                                 attrs={"ram_style": "distributed"})
         wp = Signal(bits, name="fifo_write")
-        rp = Signal(bits, name="fifo_read")
-        wport, rport = storage.write_port(), storage.read_port(domain="comb")
+        wport = storage.write_port()
         m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
-                     rport.addr.eq(rp), self.w_rdy.eq(self.count != (1 << bits)),
+                     self.w_rdy.eq(self.count != (1 << bits)),
                      self.level.eq(self.count + self.r_rdy)]
         load = self.stored & (~self.r_rdy | self.r_en)
-        m.d.sync += [wp.eq(wp + self.w_en), rp.eq(rp + load),   # wrap: the credits leave room
+        m.d.sync += [wp.eq(wp + self.w_en),                     # wrap: the credits leave room
                      self.count.eq(self.count + self.w_en - load)]
+        # One read pointer per READ_SLICE bits of the word, each its own counter (so no
+        # tool merges them), each addressing only its slice's LUT RAMs and output muxes: a
+        # wide pixel's read address would otherwise fan out to every bit of the word.
+        pointers = []
+        for k, lo in enumerate(range(0, self.width, READ_SLICE)):
+            hi = min(lo + READ_SLICE, self.width)
+            rp = Signal(bits, name=f"fifo_read{k}" if k else "fifo_read")
+            rport = storage.read_port(domain="comb")
+            m.d.comb += rport.addr.eq(rp)
+            m.d.sync += rp.eq(rp + load)
+            with m.If(load):
+                m.d.sync += self.r_data[lo:hi].eq(rport.data[lo:hi])
+            pointers.append(rp)
         with m.If(self.w_en & ~load):
             m.d.sync += self.stored.eq(1)
         with m.Elif(load & ~self.w_en):
             m.d.sync += self.stored.eq(self.count != 1)
         with m.If(load):
-            m.d.sync += [self.r_data.eq(rport.data), self.r_rdy.eq(1)]
+            m.d.sync += self.r_rdy.eq(1)
         with m.Elif(self.r_en):
             m.d.sync += self.r_rdy.eq(0)
         if platform == "formal":         # as amaranth.lib.fifo states its own pointers
+            rp = pointers[0]
             m.d.comb += [Assert(self.stored == (self.count != 0)),
                          Assert(wp == (rp + self.count)[:bits]),
                          Assert(self.count + self.r_rdy <= self.depth),
                          Assert(self.r_rdy | (self.count <= 1))]
+            m.d.comb += [Assert(copy == rp) for copy in pointers[1:]]
         return m
 
 

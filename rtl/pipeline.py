@@ -110,8 +110,8 @@ class LightSum(PipeUnit):
     color = min(255, round((KA + floor(KD D / 2**B) + floor(KS S / 2**16)) / 2**G))
     (rtl/shade.py's Phong sum). Output ``shade_layout(cfg, fine=False)``.
     Latency 5 (products, each product sum alone, the Phong terms' sum, its rounding and
-    clamp: the two 2-operand stages of rtl/shade.shade_stages; the 8-bit sums rounded, then
-    clamped); bit-exact with
+    clamp: the two 2-operand stages of rtl/shade.shade_stages; the 8-bit sums: 255 D, the
+    rounding, the clamp); bit-exact with
     ``sim/golden/fixed/pipeline.combine_lights_fixed``."""
 
     # Registers: the products' operands and outputs (PRODUCT_LATENCY), the sums of the split
@@ -139,10 +139,12 @@ class LightSum(PipeUnit):
         ks_term = sum_product([px.s[j] for j in range(self.lights)], 8 + SPEC_FRAC_BITS, ks,
                               pipe.multiply, "ks_sum")
         sat = lambda x: Mux(x > 255, 255, x)[:8]
-        # the 8-bit sums: the rounding, then the clamp (one carry chain a cycle)
-        d8 = pipe.register(round_shift((d << 8) - d, b), "diffuse8_round")         # stage 2
+        # the 8-bit sums: 255 D, the rounding, then the clamp (one carry chain a cycle)
+        d255 = pipe.register((d << 8) - d, "diffuse255")                             # stage 2
         s8 = pipe.register(round_shift(s, SPEC_FRAC_BITS), "specular8_round")
-        d8, s8 = pipe.register(sat(d8), "diffuse8"), pipe.register(sat(s8), "specular8")  # 3
+        d8 = pipe.register(round_shift(d255, b), "diffuse8_round")                  # stage 3
+        s8 = pipe.register(s8, "specular8_round_d3")
+        d8, s8 = pipe.register(sat(d8), "diffuse8"), pipe.register(sat(s8), "specular8")  # 4
         # KD d, KS s: stage PRODUCT_LATENCY = 2
         # round_shift(KA + kd + ks, G) as in shade_stages: the terms' sum, then KA and the
         # rounding half (one constant), the shift and the clamp.
@@ -154,8 +156,8 @@ class LightSum(PipeUnit):
         total = (terms + (ka + (1 << (g - 1)))) >> g
         o = pipe.o.payload
         m.d.comb += [o.color.eq(pipe.register(sat(total), "color")),                # 5
-                     o.diffuse.eq(pipe.delay(d8, self.latency - 3, "diffuse")),
-                     o.specular.eq(pipe.delay(s8, self.latency - 3, "specular")),
+                     o.diffuse.eq(pipe.delay(d8, self.latency - 4, "diffuse")),
+                     o.specular.eq(pipe.delay(s8, self.latency - 4, "specular")),
                      o.tag.eq(pipe.delay(px.tag, self.latency, "tag"))]
 
 

@@ -14,8 +14,8 @@ __all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_re
            "sine_rom_table"]
 
 # sine_read(registered=True): angle register, address register, ROM read, block-RAM
-# output register, data register, sign.
-REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 2
+# output register, data register, its copy, sign.
+REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 3
 
 
 def _width(words):
@@ -52,8 +52,8 @@ def spread_sine(cfg: Config):
 
 def near_sine(cfg: Config):
     """The registered quarter-wave ROM spans more than targets.NEAR_BLOCKS block RAMs side by
-    side (15-bit angles at B = 16: seven 8192 x 2 blocks), so :func:`sine_read` gives its
-    reads a second address register beside the blocks (``near``)."""
+    side (every ROM at NEAR_BLOCKS = 0), so :func:`sine_read` gives its reads a second
+    address register beside the blocks (``near``)."""
     return rom_blocks(1 << cfg.k, sine_rom_table(cfg)[1]) > NEAR_BLOCKS
 
 
@@ -84,9 +84,10 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     appears two pipe stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
     ``registered`` (the angle, the address, ROM read, block-RAM output register, a data
-    register, then sign: the angle's adder, the mirrored address ``2**k - i``, the route to
-    the block RAM's address pins, its clock-to-out and the route from its data pins, which
-    is long where a table spans two blocks side by side, each get a cycle of their own;
+    register beside the block RAM, its copy beside the adder, then sign: the angle's adder,
+    the mirrored address ``2**k - i``, the route to the block RAM's address pins, its
+    clock-to-out and the route from its data pins, which is long where a table spans two
+    blocks side by side or the ROM sits far from its reader, each get a cycle of their own;
     ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
     stage; ``near``: one more address register, a plain copy the placer puts beside the
     ROM's blocks, for a wide ROM: :func:`near_sine`; ``line``: the ROM holds the sine minus
@@ -110,8 +111,8 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
         m.d.comb += port.addr.eq(address)
         if line:
             return _sine_above_line(pipe, port, address, quadrant[1], cfg, name, near)
-        negative = pipe.delay(quadrant[1], 2 + near + ROM_LATENCY, f"{name}_negative")
-        value = pipe.register(port.data, f"{name}_data")
+        negative = pipe.delay(quadrant[1], 3 + near + ROM_LATENCY, f"{name}_negative")
+        value = pipe.register(pipe.register(port.data, f"{name}_data"), f"{name}_word")
     else:
         m.d.comb += [port.addr.eq(address), port.en.eq(pipe.en)]
         negative = pipe.register(quadrant[1], f"{name}_negative")
@@ -125,15 +126,17 @@ def _sine_above_line(pipe, port, address, negative, cfg: Config, name, near):
     quadrant's sign ``s`` (0 or -1 in every bit), ``-(a + b) = ~a + ~b + 2``, so the line is
     taken as ``(line ^ s) - 2s`` and the word as ``above ^ s`` in the data register, a stage
     ahead, and the sum is theirs."""
-    stages = 2 + near + ROM_LATENCY                    # the quadrant's bit to the sign stage
-    at_data = pipe.delay(negative, stages - 1, f"{name}_negative")
-    negative = pipe.register(at_data, f"{name}_negative_d{stages}")
+    stages = 3 + near + ROM_LATENCY                    # the quadrant's bit to the sign stage
+    at_data = pipe.delay(negative, stages - 2, f"{name}_negative")   # beside the word read
     above = pipe.register(port.data ^ at_data.replicate(len(port.data)), f"{name}_data")
+    at_word = pipe.register(at_data, f"{name}_negative_d{stages - 1}")
+    above = pipe.register(above, f"{name}_word")       # the route to the adder: a cycle
+    negative = pipe.register(at_word, f"{name}_negative_d{stages}")
     width = cfg.sincos_width + 1
     line = ((address << cfg.frac_bits) >> cfg.k)[:cfg.frac_bits + 1]     # 0 .. 2**B
-    under = pipe.delay(line, ROM_LATENCY, f"{name}_line")
+    under = pipe.delay(line, ROM_LATENCY + 1, f"{name}_line")
     under = Cat(under, Const(0, width - len(under)))
-    under = pipe.register(Mux(at_data, (~under).as_signed() + 2, under.as_signed())[:width]
+    under = pipe.register(Mux(at_word, (~under).as_signed() + 2, under.as_signed())[:width]
                           .as_signed(), f"{name}_signed_line")
     above = Cat(above, negative.replicate(width - len(above)))         # above ^ s
     value = under + above.as_signed()                               # |value| <= 2**B
@@ -157,8 +160,8 @@ class SinCos(PipeUnit):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency REGISTERED_SINE_LATENCY = 6 cycles (angle, address, ROM read, block-RAM
-    output register, data register, sign); throughput 1 angle per clock when not stalled.
+    Latency REGISTERED_SINE_LATENCY = 7 cycles (angle, address, ROM read, block-RAM
+    output register, data register, its copy, sign); throughput 1 angle per clock when not stalled.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):

@@ -49,8 +49,8 @@ RGB = ("r", "g", "b")
 # (operand and product registers), the output sum (taken from the DSP's output alone), its
 # rounding and clamp.
 BLEND_LATENCY = 9
-# The stage texture_blend's 8-bit light sums leave at (rounded at 2, clamped at 3).
-SUMS8_STAGE = 3
+# The stage texture_blend's 8-bit light sums leave at (255 D at 2, rounded at 3, clamped at 4).
+SUMS8_STAGE = 4
 
 
 def rgb_layout(cfg: Config):
@@ -128,15 +128,16 @@ def texture_blend(diffuse, specular, texel, cfg: Config, reg=_identity, mul=None
     tex = {c: reg(texel[c], f"texel_{c}_d1") for c in RGB}
     kd_term = sum_product(diffuse, b + 1, kd, mul, "kd_sum")                    # stage 2
     ks_term = sum_product(specular, 8 + SPEC_FRAC_BITS, ks, mul, "ks_sum")
-    d8 = reg(round_shift((d << 8) - d, b), "diffuse8_round")                    # the 8-bit sums:
-    s8 = reg(round_shift(s, SPEC_FRAC_BITS), "specular8_round")                 # rounded, then
-    tex = {c: reg(tex[c], f"texel_{c}_d2") for c in RGB}
+    d255 = reg((d << 8) - d, "diffuse255")                                      # the 8-bit sums:
+    s8 = reg(round_shift(s, SPEC_FRAC_BITS), "specular8_round")                 # 255 D, rounded,
+    tex = {c: reg(tex[c], f"texel_{c}_d2") for c in RGB}                        # then clamped
     # The products' sums (of up to MAX_SPLIT products) alone in a cycle after the products'
     # registers, then ka and the clamp: lit is registered before it is the albedo product's
     # operand, so no DSP output reaches another DSP's input within a cycle.
     kd_sum = reg(kd_term >> b, "kd_lit")                                        # stage 3
     spec = reg(ks_term >> (KS_FRAC_BITS + SPEC_FRAC_BITS - gl), "spec")
-    d8, s8 = reg(_sat(d8, u8), "diffuse8"), reg(_sat(s8, u8), "specular8")      # clamped
+    d8, s8 = reg(round_shift(d255, b), "diffuse8_round"), reg(s8, "specular8_round_d3")
+    d8, s8 = reg(_sat(d8, u8), "diffuse8"), reg(_sat(s8, u8), "specular8")      # stage 4
     # min(1, ka + kd_sum) in two stages, one carry chain each: the sum beside the compare
     # kd_sum > 1 - ka (the same test), then the select as AND/OR terms (select_constant)
     top = 1 << gl

@@ -288,7 +288,7 @@ class KimRotation(PipeUnit):
     through, polar binary angles, as rtl/lee.py).
 
     Every sin/cos read is lee.sine_value (S = SINE_STAGES: angle, address, read, output
-    register, data register, sign), every other table read lee.rom_read (R = ROM_STAGES:
+    register, data register, its copy, sign), every other table read lee.rom_read (R = ROM_STAGES:
     address register, read, output register, data register), every product a
     RegisteredProduct (P = PRODUCT_LATENCY), and at most one carry chain or half a mux chain
     lies between two registers. Per vector, in pipe stages:

@@ -5,7 +5,7 @@ import pytest
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.sincos import SinCos, near_sine, sine_line, sine_rom_table, spread_sine
 from bumprtl.rtl.tables import cos_lookup, sin_lookup
-from bumprtl.rtl.targets import rom_blocks
+from bumprtl.rtl.targets import NEAR_BLOCKS, rom_blocks
 from bumprtl.sim.amaranth_stream import simulate_stream
 from bumprtl.sim.traffic import PATTERNS
 
@@ -57,12 +57,12 @@ def test_exhaustive_sine_above_line():
 def test_sine_line_where_it_saves_block_rams(angle_bits, frac_bits, line, width, blocks):
     """DP16KD holds 1024 x 18 ... 16384 x 1 (18 Kbit): the ROM stores the sine above its line
     (B - 2 bits) only where that takes fewer blocks side by side than the sine (B + 1); more
-    than six blocks take a near address register (one more stage), more than eight an enable
-    of their own."""
+    than NEAR_BLOCKS (none: every ROM) take a near address register (one more stage), more
+    than eight an enable of their own."""
     cfg = Config(angle_bits=angle_bits, frac_bits=frac_bits)
     assert sine_line(cfg) is line
     assert sine_rom_table(cfg)[1] == width
     assert rom_blocks(1 << cfg.k, width) == blocks
     assert spread_sine(cfg) == (blocks > 8)
-    assert near_sine(cfg) == (blocks > 6)
-    assert SinCos(cfg).latency == 6 + near_sine(cfg)
+    assert near_sine(cfg) == (blocks > NEAR_BLOCKS)
+    assert SinCos(cfg).latency == 7 + near_sine(cfg)
