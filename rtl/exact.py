@@ -59,12 +59,12 @@ class SineBank:
             self.pending = list(rom.ports)
         return self.pending.pop(0)
 
-    def sin(self, angle, name):
+    def sin(self, angle, name, quarters=0):
         return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True,
-                         near=self.near, line=self.line)
+                         near=self.near, line=self.line, quarters=quarters)
 
     def cos(self, angle, name):
-        return self.sin(angle + (1 << self.cfg.k), name)       # cos a = sin(a + 90 deg)
+        return self.sin(angle, name, quarters=1)                # cos a = sin(a + 90 deg)
 
 
 def rotation_latency(cfg: Config):

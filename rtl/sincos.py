@@ -79,7 +79,7 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
 
 
 def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True,
-              near=False, line=False):
+              near=False, line=False, quarters=0):
     """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
     appears two pipe stages later (ROM read, then sign) from a Memory read port, or
     REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
@@ -93,7 +93,9 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     ROM's blocks, for a wide ROM: :func:`near_sine`; ``line``: the ROM holds the sine minus
     the line under it, :func:`sine_line`, and the line ``(address << B) >> k``, delayed beside
     the read and signed a stage ahead, is added in the sign's stage, one carry chain as the
-    sign alone is: :func:`_sine_above_line`). ``cos(a)`` is ``sin(a + 2**k)``.
+    sign alone is: :func:`_sine_above_line`). ``cos(a)`` is ``sin(a + 2**k)``: ``quarters``
+    (0 to 3) quarter turns added to ``angle`` after its register, to the two quadrant bits
+    alone (no carry chain behind the angle's adder).
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.
@@ -103,6 +105,8 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     if registered and angle_stage:
         a = pipe.register(a, f"{name}_angle")
     quadrant, index = a[k:], a[:k]
+    if quarters:                                        # angle + quarters * 2**k
+        quadrant = (quadrant + quarters)[:2]
     address = Mux(quadrant[0], (1 << k) - index, index)
     if registered:             # the block RAM's address pins straight from a flip-flop
         address = pipe.register(address, f"{name}_address")

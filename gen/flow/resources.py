@@ -186,13 +186,18 @@ def _count_memory(counts, name, cell):
 
 
 def _read_registers(module):
-    """Bits of the registered read ports of the memories of one netlist module (the FIFO's
-    output register: flip-flops once placed, its storage LUT RAM)."""
-    bits = 0
+    """Bits of the registered read ports of the memories of one netlist module that
+    something reads (the FIFO's output register: flip-flops once placed, its storage LUT
+    RAM; a port that reads a slice of the word, rtl/pipe.CreditFIFO's, counts that slice)."""
+    bits, used = 0, _used_bits(module)
     for c in module["cells"].values():
         if c["type"] == "$mem_v2":
             p = c["parameters"]
-            bits += bin(_int(p["RD_CLK_ENABLE"])).count("1") * _int(p["WIDTH"])
+            width, enable = _int(p["WIDTH"]), _int(p["RD_CLK_ENABLE"])
+            data = c["connections"]["RD_DATA"]
+            for port in range(_int(p["RD_PORTS"])):
+                if enable >> port & 1:
+                    bits += sum(1 for b in data[port * width:(port + 1) * width] if b in used)
     return bits
 
 
