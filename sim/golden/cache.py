@@ -1,0 +1,85 @@
+"""The golden texture cache: rtl/cache.TextureCache's hits, misses, line fills and
+evictions, pixel by pixel, and every AXI read request it issues (docs/memory.md).
+
+The RTL serves pixels in order and blocks on a miss, so its AR stream is the sequence of
+misses: one INCR burst of a whole line (address of the line's first byte, ARLEN = beats - 1)
+a miss. Placement (:func:`rtl.cache.tiled_layout`) and replacement (tree pseudo-LRU,
+:func:`rtl.cache.plru_victim` / :func:`rtl.cache.plru_touch`) are the RTL's own functions;
+the texel a pixel gets is read from the map itself, not from the model's lines, so a fill
+of the wrong bytes or a stale line in the RTL differs from it.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bumprtl.rtl.cache import CacheGeometry, plru_touch, plru_victim, tiled_layout
+
+__all__ = ["CacheModel", "CacheRun", "run_cache"]
+
+
+@dataclass
+class CacheRun:
+    """What the cache did with a pixel sequence: per pixel ``texel`` and ``hit``; the AR
+    requests ``(araddr, arlen)`` in order; ``evictions`` (set, way, line evicted) in order."""
+    texel: np.ndarray
+    hit: np.ndarray
+    line_bytes: int
+    requests: list = field(default_factory=list)
+    evictions: list = field(default_factory=list)
+
+    @property
+    def hit_rate(self):
+        return float(self.hit.mean()) if self.hit.size else 0.0
+
+    @property
+    def bytes_fetched(self):
+        return len(self.requests) * self.line_bytes
+
+
+class CacheModel:
+    """The cache's state: the line held by each (set, way), or None, and the pseudo-LRU bits
+    of each set. :meth:`access` of one pixel's (line) returns ``(hit, way, evicted line or
+    None)`` and updates the state as the RTL does: a miss fills the victim way, then the
+    pixel hits there (the RTL's replay), and the hit turns the set's bits from that way."""
+
+    def __init__(self, geom: CacheGeometry):
+        self.geom = geom
+        self.lines = [[None] * geom.ways for _ in range(geom.sets)]
+        self.plru = [0] * geom.sets
+
+    def access(self, line):
+        g = self.geom
+        s = line % g.sets
+        held = self.lines[s]
+        evicted = None
+        if line in held:
+            way, hit = held.index(line), True
+        else:
+            way, hit = plru_victim(self.plru[s], g.ways), False
+            evicted = held[way]
+            held[way] = line
+        self.plru[s] = plru_touch(self.plru[s], way, g.ways)
+        return hit, way, evicted
+
+
+def run_cache(geom: CacheGeometry, u, v, level, levels):
+    """Run the pixels (level coordinates ``u``, ``v`` and ``level`` arrays; ``level`` past
+    the last reads the last) through a cold cache; ``levels[l]`` is level l's texel words
+    ([v, u]). Returns a :class:`CacheRun`."""
+    u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
+    level = np.minimum(np.asarray(level, np.int64), geom.mip_levels - 1)
+    model = CacheModel(geom)
+    n = len(u)
+    run = CacheRun(np.zeros(n, np.int64), np.zeros(n, bool), geom.line_bytes)
+    for k in range(n):
+        lv, uk, vk = int(level[k]), int(u[k]), int(v[k])
+        line, _ = tiled_layout(uk, vk, lv, geom)
+        hit, way, evicted = model.access(int(line))
+        run.hit[k] = hit
+        run.texel[k] = int(np.asarray(levels[lv])[vk, uk])
+        if not hit:
+            run.requests.append((geom.base + int(line) * geom.line_bytes, geom.beats - 1))
+            if evicted is not None:
+                run.evictions.append((int(line) % geom.sets, way, evicted))
+    return run
