@@ -20,8 +20,8 @@ golden model).
 from dataclasses import dataclass
 
 import numpy as np
-from amaranth.hdl import Array, Cat, Const, Module, Mux, Signal, Value, ValueCastable, unsigned
-from amaranth.lib import data, enum, stream, wiring
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, ValueCastable, unsigned
+from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
@@ -251,19 +251,13 @@ def plru_touch(bits, way, ways):
 
 
 def axi_read_signature(addr_bits, data_bits):
-    """An AXI4 read-only manager port (AR and R channels, single ID, the manager's view)."""
+    """An AXI4 read-only manager port (AR and R channels, the manager's view) with one ID:
+    ARID is 0 and RID is not read (bursts are served in order)."""
     return wiring.Signature({
-        "araddr": Out(addr_bits), "arlen": Out(8), "arsize": Out(3), "arburst": Out(2),
+        "arid": Out(1), "araddr": Out(addr_bits), "arlen": Out(8), "arsize": Out(3), "arburst": Out(2),
         "arvalid": Out(1), "arready": In(1),
-        "rdata": In(data_bits), "rresp": In(2), "rlast": In(1), "rvalid": In(1),
+        "rid": In(1), "rdata": In(data_bits), "rresp": In(2), "rlast": In(1), "rvalid": In(1),
         "rready": Out(1)})
-
-
-class _State(enum.Enum, shape=2):
-    LOOKUP = 0
-    AR = 1
-    FILL = 2
-    REPLAY = 3
 
 
 class TextureCache(wiring.Component):
@@ -293,8 +287,9 @@ class TextureCache(wiring.Component):
     pixel and drops ``i.ready`` while the line of the pseudo-LRU victim way is fetched, then
     re-reads the set and hits. ``i.ready`` depends on the lookup and ``o.ready`` in the
     same cycle (never on ``i.valid``). A miss costs 4 cycles plus the memory's AR-to-last-R
-    time. Lines stay valid across a reset (the map in memory must not change under the
-    cache).
+    time. A reset invalidates every line: the tags are cleared one set a cycle (``sets``
+    cycles, ``i.ready`` low) before the first lookup; the map in memory must not change
+    between resets.
     """
 
     def __init__(self, geom: CacheGeometry, extra=None):
@@ -340,7 +335,9 @@ class TextureCache(wiring.Component):
             tags.append((tmem.read_port(), tmem.write_port()))
             datas.append((dmem.read_port(), dmem.write_port()))
 
-        state = Signal(_State)
+        filling, replaying, flushing = Signal(), Signal(), Signal(init=1)
+        lookup = ~(self.axi.arvalid | filling | replaying | flushing)
+        flush_set = Signal(range(g.sets))
         # --- the pixel under lookup ---
         look_valid = Signal()
         look_line = Signal(g.line_bits)
@@ -367,12 +364,15 @@ class TextureCache(wiring.Component):
         for w, (drp, _) in enumerate(datas):
             with m.If(hits[w]):
                 m.d.comb += hit_word.eq(drp.data)
-        texel = hit_word.word_select(look_sel, g.data_bits // spb)[:g.texel_bits] if sel_bits \
-            else hit_word[:g.texel_bits]
+        texel = Signal(g.texel_bits)
+        with m.Switch(look_sel):                 # the pixel's slot of the word (every case)
+            for k in range(spb):
+                with m.Case(k):
+                    m.d.comb += texel.eq(hit_word.word_select(k, g.data_bits // spb))
 
         o_free = ~self.o.valid | self.o.ready
-        leave = (state == _State.LOOKUP) & look_valid & hit & o_free
-        m.d.comb += self.i.ready.eq((state == _State.LOOKUP) & (~look_valid | (hit & o_free)))
+        leave = lookup & look_valid & hit & o_free
+        m.d.comb += self.i.ready.eq(lookup & (~look_valid | (hit & o_free)))
         take = self.i.valid & self.i.ready
 
         # read addresses: the pixel taken, else the pixel held (re-read every cycle, so the
@@ -392,73 +392,66 @@ class TextureCache(wiring.Component):
         with m.Elif(self.o.ready):
             m.d.sync += self.o.valid.eq(0)
 
-        # --- replacement state: tree pseudo-LRU bits a set ---
+        # --- replacement state: tree pseudo-LRU bits a set (LUT RAM, read in the cycle) ---
         plru_width = max(1, g.ways - 1)
-        plru = Array(Signal(plru_width, name=f"plru{s}") for s in range(g.sets))
-        cur = plru[look_set]
-        touched = Signal(plru_width)
-        victim = Signal(range(g.ways))
-        hit_way = Signal(range(g.ways))
-        for w in range(g.ways):
-            with m.If(hits[w]):
-                m.d.comb += hit_way.eq(w)
-        self._plru_hdl(m, cur, hit_way, touched, victim)
-        if g.ways > 1:
-            with m.If(leave):
-                m.d.sync += cur.eq(touched)
+        m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
+                                          attrs={"ram_style": "distributed"})
+        plru_r, plru_w = plru.read_port(domain="comb"), plru.write_port()
+        victim, touched = self._plru_hdl(plru_r.data, hits)
+        m.d.comb += [plru_r.addr.eq(look_set), plru_w.addr.eq(look_set),
+                     plru_w.data.eq(touched), plru_w.en.eq(leave if g.ways > 1 else 0)]
+        with m.If(flushing):                     # the flush clears the bits with the tags
+            m.d.comb += [plru_w.addr.eq(flush_set), plru_w.data.eq(0), plru_w.en.eq(1)]
 
         # --- the miss: one INCR burst of the victim's line ---
-        fill_way = Signal(range(g.ways))
+        fill_way = Signal(g.ways)                   # one-hot
         line_shift = g.line_bytes.bit_length() - 1
         beat = Signal(range(g.beats))
         ax = self.axi
         m.d.comb += [ax.arlen.eq(g.beats - 1), ax.arsize.eq((g.data_bits // 8).bit_length() - 1),
-                     ax.arburst.eq(ARBURST_INCR), ax.rready.eq(state == _State.FILL)]
+                     ax.arburst.eq(ARBURST_INCR), ax.rready.eq(filling)]
+        beat_in = filling & ax.rvalid
         for w, (_, dwp) in enumerate(datas):
             m.d.comb += [dwp.addr.eq(Cat(beat, look_set) if g.beats > 1 else look_set),
-                         dwp.data.eq(ax.rdata),
-                         dwp.en.eq((state == _State.FILL) & ax.rvalid & (fill_way == w))]
+                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_way[w])]
+        # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
+        m.d.sync += flush_set.eq(flush_set + 1)
+        with m.If(flush_set == g.sets - 1):
+            m.d.sync += flushing.eq(0)
         for w, (_, twp) in enumerate(tags):
-            m.d.comb += [twp.addr.eq(look_set), twp.data.eq(Cat(look_tag, Const(1, 1))),
-                         twp.en.eq((state == _State.FILL) & ax.rvalid & ax.rlast
-                                   & (fill_way == w))]
-        with m.Switch(state):
-            with m.Case(_State.LOOKUP):
-                with m.If(look_valid & ~hit):
-                    m.d.sync += [state.eq(_State.AR), fill_way.eq(victim), ax.arvalid.eq(1),
-                                 ax.araddr.eq(g.base + Cat(Const(0, line_shift), look_line)),
-                                 beat.eq(0)]
-            with m.Case(_State.AR):
-                with m.If(ax.arready):
-                    m.d.sync += [ax.arvalid.eq(0), state.eq(_State.FILL)]
-            with m.Case(_State.FILL):
-                with m.If(ax.rvalid):
-                    m.d.sync += beat.eq(beat + 1)
-                    with m.If(ax.rlast):
-                        m.d.sync += state.eq(_State.REPLAY)
-            with m.Case(_State.REPLAY):
-                m.d.sync += state.eq(_State.LOOKUP)
+            m.d.comb += [twp.addr.eq(Mux(flushing, flush_set, look_set)),
+                         twp.data.eq(Mux(flushing, 0, Cat(look_tag, Const(1, 1)))),
+                         twp.en.eq(flushing | (beat_in & ax.rlast & fill_way[w]))]
+        # the states: lookup (none of these), AR offered, line filling, replay (one cycle)
+        m.d.sync += replaying.eq(beat_in & ax.rlast)
+        with m.If(lookup & look_valid & ~hit):
+            m.d.sync += [fill_way.eq(victim), ax.arvalid.eq(1), beat.eq(0),
+                         ax.araddr.eq(g.base + Cat(Const(0, line_shift), look_line))]
+        with m.If(ax.arvalid & ax.arready):
+            m.d.sync += [ax.arvalid.eq(0), filling.eq(1)]
+        with m.If(beat_in):
+            m.d.sync += beat.eq(beat + 1)
+            with m.If(ax.rlast):
+                m.d.sync += filling.eq(0)
         return m
 
-    def _plru_hdl(self, m, bits, way, touched, victim):
-        """:func:`plru_victim` and :func:`plru_touch` on Amaranth values."""
+    def _plru_hdl(self, bits, hits):
+        """:func:`plru_victim` (one-hot) and :func:`plru_touch` by the one-hot ``hits`` on
+        Amaranth values, with constant bit indices only (no shifter)."""
         ways = self.geom.ways
         depth = ways.bit_length() - 1
-        if depth == 0:
-            m.d.comb += [victim.eq(0), touched.eq(bits)]
-            return
-        node, path = Const(0, depth + 1), []
-        for _ in range(depth):
-            b = bits.bit_select(node, 1)
-            path.append(b)
-            node = (2 * node + 1 + b)[:depth + 1]
-        m.d.comb += victim.eq(node - (ways - 1))
-        new = [bits[n] for n in range(ways - 1)]
-        # node n at depth k is on way's path when way's top k bits select it
+
+        def victim(node, k):                 # the leaf under node n at depth k, one-hot
+            if k == depth:
+                return Const(1 << (node - (ways - 1)), ways)
+            return Mux(bits[node], victim(2 * node + 2, k + 1), victim(2 * node + 1, k + 1))
+
+        new = []
         for n in range(ways - 1):
-            k = (n + 1).bit_length() - 1               # depth of node n
-            index = n - ((1 << k) - 1)                 # its position in that depth
-            on_path = (way >> (depth - k)) == index
-            d = (way >> (depth - 1 - k))[0]
-            new[n] = Mux(on_path, ~d, bits[n])
-        m.d.comb += touched.eq(Cat(*new))
+            k = (n + 1).bit_length() - 1                     # depth of node n
+            span = ways >> k                                 # ways under it
+            first = (n - ((1 << k) - 1)) * span
+            left = hits[first:first + span // 2].any()
+            right = hits[first + span // 2:first + span].any()
+            new.append(Mux(left | right, left, bits[n]))     # point away from the way hit
+        return victim(0, 0), Cat(*new) if new else bits

@@ -15,7 +15,7 @@ import numpy as np
 
 from bumprtl.rtl.cache import CacheGeometry, plru_touch, plru_victim, tiled_layout
 
-__all__ = ["CacheModel", "CacheRun", "run_cache"]
+__all__ = ["CacheModel", "CacheRun", "run_cache", "random_levels", "cache_stimulus"]
 
 
 @dataclass
@@ -83,3 +83,26 @@ def run_cache(geom: CacheGeometry, u, v, level, levels):
             if evicted is not None:
                 run.evictions.append((int(line) % geom.sets, way, evicted))
     return run
+
+
+def random_levels(geom: CacheGeometry, seed=0):
+    """Random texel words for every level of ``geom`` (``[v, u]`` arrays)."""
+    rng = np.random.default_rng(seed)
+    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_side(lv), geom.level_side(lv)))
+            for lv in range(geom.mip_levels)]
+
+
+def cache_stimulus(geom: CacheGeometry, n, seed):
+    """``(u, v, level)`` arrays of ``n`` pixels a cache must serve: short raster runs (hits),
+    random jumps (misses and evictions), every level."""
+    rng = np.random.default_rng(seed)
+    u, v, level = [], [], []
+    while len(u) < n:
+        lv = int(rng.integers(0, geom.mip_levels))
+        side = geom.level_side(lv)
+        u0, v0, run = int(rng.integers(0, side)), int(rng.integers(0, side)), int(rng.integers(1, 12))
+        for k in range(run):
+            u.append((u0 + k) % side)
+            v.append(v0)
+            level.append(lv)
+    return np.array(u[:n]), np.array(v[:n]), np.array(level[:n])

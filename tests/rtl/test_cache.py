@@ -10,37 +10,15 @@ import pytest
 from bumprtl.rtl.cache import CacheGeometry, TextureCache, tiled_image
 from bumprtl.sim.amaranth_stream import simulate_stream
 from bumprtl.sim.axi_memory import AxiReadMemory
-from bumprtl.sim.golden.cache import run_cache
+from bumprtl.sim.golden.cache import cache_stimulus, random_levels, run_cache
 from bumprtl.sim.traffic import PATTERNS
-
-
-def random_levels(geom, seed=0):
-    rng = np.random.default_rng(seed)
-    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_side(lv), geom.level_side(lv)))
-            for lv in range(geom.mip_levels)]
-
-
-def cache_pixels(geom, n, seed):
-    """A mix the cache must serve: short raster runs (hits), random jumps (misses and
-    evictions) and every level; tags count the pixels."""
-    rng = np.random.default_rng(seed)
-    u, v, level = [], [], []
-    while len(u) < n:
-        lv = int(rng.integers(0, geom.mip_levels))
-        side = geom.level_side(lv)
-        u0, v0, run = int(rng.integers(0, side)), int(rng.integers(0, side)), int(rng.integers(1, 12))
-        for k in range(run):
-            u.append((u0 + k) % side)
-            v.append(v0)
-            level.append(lv)
-    return np.array(u[:n]), np.array(v[:n]), np.array(level[:n])
 
 
 def check_cache(geom, n=150, pattern="both", latency=2, ar_stall=0.3, r_stall=0.3, seed=0):
     """Run ``n`` pixels; assert bit-exact texels, tags in order and the golden AR stream.
     Returns (golden run, cycles)."""
     levels = random_levels(geom, seed)
-    u, v, level = cache_pixels(geom, n, seed)
+    u, v, level = cache_stimulus(geom, n, seed)
     golden = run_cache(geom, u, v, level, levels)
     dut = TextureCache(geom, extra={"tag": 8})
     mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, geom.base,

@@ -14,13 +14,7 @@ from bumprtl.rtl.cache import (
     tiled_image,
 )
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.golden.cache import CacheModel, run_cache
-
-
-def random_levels(geom, seed=0):
-    rng = np.random.default_rng(seed)
-    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_side(lv), geom.level_side(lv)))
-            for lv in range(geom.mip_levels)]
+from bumprtl.sim.golden.cache import CacheModel, random_levels, run_cache
 
 
 def reference_address(u, v, level, g):
