@@ -20,16 +20,34 @@ golden model).
 from dataclasses import dataclass
 
 import numpy as np
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value, ValueCastable, unsigned
+from amaranth.hdl import (
+    Cat,
+    Const,
+    Module,
+    Mux,
+    Shape,
+    Signal,
+    Value,
+    ValueCastable,
+    signed,
+    unsigned,
+)
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
+from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_coords, texel_shape
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import HardwareScene, check_scene
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
            "texel_byte_address", "tiled_image", "plru_victim", "plru_touch", "TextureCache",
-           "CACHE_DEFAULTS", "ARBURST_INCR"]
+           "CACHE_DEFAULTS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry", "scene_levels",
+           "CACHE_LATENCY"]
+
+# Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits: the
+# lookup register, then the output register.
+CACHE_LATENCY = 2
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -455,3 +473,93 @@ class TextureCache(wiring.Component):
             right = hits[first + span // 2:first + span].any()
             new.append(Mux(left | right, left, bits[n]))     # point away from the way hit
         return victim(0, 0), Cat(*new) if new else bits
+
+
+def scene_geometry(scene: HardwareScene, **cache):
+    """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
+    width) with the cache's parameters ``cache`` (sets, ways, block, data_bits, base,
+    addr_bits; :data:`CACHE_DEFAULTS` where omitted)."""
+    bits = Shape.cast(texel_shape(scene)).width
+    return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **cache)
+
+
+def scene_levels(scene: HardwareScene, words):
+    """The block-RAM image of a map (``bumpfetch.level_bases`` order) as one ``[v, u]``
+    array a level, what :func:`tiled_image` takes."""
+    words, out, base = np.asarray(words, np.int64), [], 0
+    for level in range(scene.mip_levels):
+        side = scene.texture_size >> level
+        out.append(words[base:base + side * side].reshape(side, side))
+        base += side * side
+    return out
+
+
+class AxiMapFetch(wiring.Component):
+    """BumpMapFetch's ports and function with the map in the user's memory: texel
+    coordinates are wrapped or clamped into their level (``bumpfetch.level_coords``, the
+    block-RAM fetch's own arithmetic) and looked up in a :class:`TextureCache`.
+
+    Parameters
+    ----------
+    scene : HardwareScene
+        ``map_memory = "axi"`` scenes (a varying N' map, per-pixel shading).
+    out_layout : data.StructLayout
+        As BumpMapFetch's: the fetched field plus fields carried unchanged.
+    cache : dict, optional
+        :class:`CacheGeometry` parameters (sets, ways, block, data_bits, base, addr_bits).
+
+    Members
+    -------
+    i : In(stream.Signature({u, v: signed(log2 T + 2), [level], <carried fields>}))
+    o : Out(stream.Signature(out_layout))
+    axi : Out(axi_read_signature(addr_bits, data_bits))
+
+    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss holds
+    the pixel and ``i.ready`` low while its line is read (:class:`TextureCache`). ``i.ready``
+    depends on the lookup in the same cycle (not a register as a credit edge's).
+    """
+
+    latency = CACHE_LATENCY
+
+    def __init__(self, scene: HardwareScene, out_layout, cache=None):
+        check_scene(self, scene)
+        self.scene, self.out_layout = scene, out_layout
+        self.geom = scene_geometry(scene, **(cache or {}))
+        self.field = fetched_field(scene)
+        g = self.geom
+        self.memories = {}                   # the cache's block RAM, as a Pipe records it
+        for w in range(g.ways):
+            for name, depth, width in ((f"cache_data{w}", g.sets * g.beats, g.data_bits),
+                                       (f"cache_tag{w}", g.sets, g.tag_bits + 1)):
+                self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
+                                       "bits": depth * width}
+        fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
+        if scene.mip_levels > 1:
+            fields["level"] = unsigned(level_bits(scene))
+        self.carried = {name: f.shape for name, f in out_layout if name != self.field}
+        super().__init__({
+            "i": In(stream.Signature(data.StructLayout({**fields, **self.carried}))),
+            "o": Out(stream.Signature(out_layout)),
+            "axi": Out(axi_read_signature(self.geom.addr_bits, self.geom.data_bits))})
+
+    def elaborate(self, platform):
+        m, scene = Module(), self.scene
+        m.submodules.cache = cache = TextureCache(self.geom, self.carried)
+        px, to = self.i.payload, cache.i.payload
+        last = scene.mip_levels - 1
+        if last == 0:
+            u_l, v_l = level_coords(px.u, px.v, 0, scene)
+            m.d.comb += [to.u.eq(u_l), to.v.eq(v_l)]
+        else:
+            with m.Switch(px.level):
+                for level in range(last + 1):
+                    with (m.Case(level) if level < last else m.Default()):
+                        u_l, v_l = level_coords(px.u, px.v, level, scene)
+                        m.d.comb += [to.u.eq(u_l), to.v.eq(v_l), to.level.eq(level)]
+        m.d.comb += [to[name].eq(px[name]) for name in self.carried]
+        m.d.comb += [cache.i.valid.eq(self.i.valid), self.i.ready.eq(cache.i.ready),
+                     self.o.valid.eq(cache.o.valid), cache.o.ready.eq(self.o.ready),
+                     self.o.payload[self.field].eq(cache.o.payload.texel)]
+        m.d.comb += [self.o.payload[name].eq(cache.o.payload[name]) for name in self.carried]
+        wiring.connect(m, wiring.flipped(self.axi), cache.axi)
+        return m

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
-           "TEXTURE_SIZES", "derived_rotation", "check_scene", "check_choice",
+           "TEXTURE_SIZES", "MAP_MEMORIES", "check_map_memory", "derived_rotation", "check_scene", "check_choice",
            "check_map_size"]
 
 ADDRESSING = ("wrap", "clamp")
@@ -23,6 +23,7 @@ BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
 SHADINGS = ("per-pixel", "palette")      # Lee/exact per-pixel rotation, or Tarini's palette
 ROTATIONS = ("per-pixel", "per-polygon", "none")
 TEXTURE_SIZES = (16, 4096)               # a power of two in this range
+MAP_MEMORIES = ("bram", "axi")           # the map in block RAM, or behind a cache on AXI4
 
 
 def derived_rotation(shading, bump_map):
@@ -48,6 +49,16 @@ def check_choice(key, value, allowed, error=BumpError):
     the key and the allowed values."""
     if value not in allowed:
         raise error(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+
+
+def check_map_memory(map_memory, shading, bump_map, texture, error=BumpError):
+    """``map_memory`` is one of :data:`MAP_MEMORIES`; ``axi`` (rtl/cache.py) holds a
+    varying N' map with per-pixel shading and no colour texture; else ``error`` naming it."""
+    check_choice("map_memory", map_memory, MAP_MEMORIES, error)
+    if map_memory == "axi" and (shading, bump_map, texture) != ("per-pixel", "varying", False):
+        raise error(f"map_memory = 'axi' needs shading = 'per-pixel', bump_map = 'varying' and "
+                    f"texture = false (got {shading!r}, {bump_map!r}, {texture}); allowed "
+                    f"otherwise: map_memory = 'bram'", "map_memory")
 
 
 def check_map_size(texture_size, mip_levels, error=BumpError):
@@ -88,6 +99,11 @@ class HardwareScene:
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
         Levels of the map in block RAM, 1 to log2(T) + 1.
+    map_memory : str
+        ``bram`` (the map in block RAM, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`) or
+        ``axi`` (the map in the user's memory behind a texel cache with an AXI4 read port,
+        :class:`~bumprtl.rtl.cache.AxiMapFetch`; per-pixel shading of a varying map, no
+        colour texture).
     config : Config
         The datapath widths, method, lights, specular, terms and palette size.
     """
@@ -100,6 +116,7 @@ class HardwareScene:
     texture_size: int = 64
     addressing: str = "wrap"
     mip_levels: int = 1
+    map_memory: str = "bram"
     config: Config = Config()
 
     def __post_init__(self):
@@ -111,6 +128,7 @@ class HardwareScene:
         if not isinstance(self.texture, bool):
             raise BumpError(f"texture must be true or false, got {self.texture!r}", "texture")
         check_map_size(self.texture_size, self.mip_levels)
+        check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture)
         derived = derived_rotation(self.shading, self.bump_map)
         if self.rotation is None:
             object.__setattr__(self, "rotation", derived)

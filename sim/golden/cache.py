@@ -13,9 +13,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bumprtl.rtl.cache import CacheGeometry, plru_touch, plru_victim, tiled_layout
+from bumprtl.rtl.bumpfetch import level_coords
+from bumprtl.rtl.cache import (
+    CacheGeometry,
+    plru_touch,
+    plru_victim,
+    scene_levels,
+    texel_byte_address,
+    tiled_layout,
+)
 
-__all__ = ["CacheModel", "CacheRun", "run_cache", "random_levels", "cache_stimulus"]
+__all__ = ["CacheModel", "CacheRun", "run_cache", "run_scene_cache", "random_levels",
+           "cache_stimulus", "image_words"]
 
 
 @dataclass
@@ -106,3 +115,32 @@ def cache_stimulus(geom: CacheGeometry, n, seed):
             v.append(v0)
             level.append(lv)
     return np.array(u[:n]), np.array(v[:n]), np.array(level[:n])
+
+
+def run_scene_cache(scene, geom: CacheGeometry, inputs, words):
+    """:func:`run_cache` of a ``map_memory = "axi"`` pipeline's pixels: ``inputs`` (arrays
+    ``u``, ``v``, [``level``], level-0 signed coordinates) wrapped or clamped into their
+    level as rtl/cache.AxiMapFetch does (``bumpfetch.level_coords``); ``words`` the map in
+    block-RAM order."""
+    u, v = np.asarray(inputs["u"], np.int64), np.asarray(inputs["v"], np.int64)
+    level = np.minimum(np.asarray(inputs.get("level", np.zeros_like(u)), np.int64),
+                       scene.mip_levels - 1)
+    u_l, v_l = np.zeros_like(u), np.zeros_like(v)
+    for n in range(scene.mip_levels):
+        cu, cv = level_coords(u, v, n, scene)
+        u_l, v_l = np.where(level == n, cu, u_l), np.where(level == n, cv, v_l)
+    return run_cache(geom, u_l, v_l, level, scene_levels(scene, words))
+
+
+def image_words(scene, geom: CacheGeometry, image):
+    """The map words in block-RAM order (``bumpfetch.level_bases``) read back from a memory
+    image (``bytes`` from ``base`` on, :func:`rtl.cache.tiled_image`'s layout)."""
+    buf = np.frombuffer(image, np.uint8)
+    out = []
+    for level in range(scene.mip_levels):
+        side = scene.texture_size >> level
+        v, u = np.mgrid[0:side, 0:side]
+        at = texel_byte_address(u.ravel(), v.ravel(), level, geom) - geom.base
+        word = sum(buf[at + k].astype(np.int64) << (8 * k) for k in range(geom.slot_bytes))
+        out.append(word & ((1 << geom.texel_bits) - 1))
+    return np.concatenate(out)

@@ -21,6 +21,7 @@ from bumprtl.rtl.scene import (
     SHADINGS,
     HardwareScene,
     check_choice,
+    check_map_memory,
     check_map_size,
     derived_rotation,
 )
@@ -86,6 +87,9 @@ class SceneConfig:
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
         Levels of the bump map in block RAM, 1 (no mipmaps) to log2(T) + 1.
+    map_memory : str
+        ``bram`` (the map in block RAM, the default) or ``axi`` (the map in the user's
+        memory, read through a texel cache with an AXI4 port: docs/memory.md).
     method, angle_bits, frac_bits, tag_bits, spec_exponent, spec_index_bits, ka, kd, ks,
     palette_size :
         Passed to :class:`Config` (checked there).
@@ -102,6 +106,7 @@ class SceneConfig:
     texture_size: int = 64
     addressing: str = "wrap"
     mip_levels: int = 1
+    map_memory: str = "bram"
     # Config's fields and defaults (rtl/config.py is the one source of both)
     method: str = Config.method
     angle_bits: int = Config.angle_bits
@@ -134,6 +139,7 @@ class SceneConfig:
             raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])",
                              "lights")
         check_map_size(self.texture_size, self.mip_levels, SceneError)
+        check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture, SceneError)
         try:
             _ = self.config       # derive it now: a bad width is the scene's error
         except BumpError as e:
@@ -220,7 +226,8 @@ class SceneConfig:
         return HardwareScene(name=self.name, shading=self.shading, bump_map=self.bump_map,
                              rotation=self.rotation, texture=self.texture,
                              texture_size=self.texture_size, addressing=self.addressing,
-                             mip_levels=self.mip_levels, config=self.config)
+                             mip_levels=self.mip_levels, map_memory=self.map_memory,
+                             config=self.config)
 
     @property
     def texture_bits(self):

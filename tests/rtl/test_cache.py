@@ -1,4 +1,4 @@
-"""TextureCache (rtl/cache.py) in the Amaranth simulator against a Python AXI memory
+"""TextureCache (rtl/cache.py), and BumpPipeline with map_memory = "axi", in the Amaranth simulator against a Python AXI memory
 (sim/axi_memory.py): every texel bit-exact and the AR request stream equal to the golden
 cache model's (sim/golden/cache.py), under random input gaps, output backpressure, AR and R
 stalls and memory latencies, without deadlock; the AXI4 manager rules are checked every
@@ -7,10 +7,19 @@ cycle by the memory."""
 import numpy as np
 import pytest
 
-from bumprtl.rtl.cache import CacheGeometry, TextureCache, tiled_image
-from bumprtl.sim.amaranth_stream import simulate_stream
+from bumprtl.rtl.cache import CacheGeometry, TextureCache, scene_levels, tiled_image
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.axi_memory import AxiReadMemory
-from bumprtl.sim.golden.cache import cache_stimulus, random_levels, run_cache
+from bumprtl.sim.golden.cache import cache_stimulus, random_levels, run_cache, run_scene_cache
+from bumprtl.sim.golden.fixed.pipeline import (
+    as_payload_list,
+    pipeline_fixed,
+    random_inputs,
+    random_map,
+)
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -75,3 +84,40 @@ def test_cache_hits_at_one_pixel_a_clock():
         assert len(mem.requests) == geom.lines
         cycles.append(n)
     assert cycles[1] - cycles[0] == len(one)
+
+
+# The default scene at small widths, two levels, wrap; the same with clamp addressing.
+AXI_SCENE = {"texture_size": 16, "angle_bits": 8, "frac_bits": 8, "tag_bits": 6, "mip_levels": 2,
+             "map_memory": "axi"}
+
+
+@pytest.mark.parametrize("addressing,latency,pattern", [("wrap", 2, "both"), ("clamp", 20, "both"),
+                                                        ("wrap", 60, "backpressure")])
+def test_pipeline_axi_bit_exact_under_memory_latency(addressing, latency, pattern):
+    """BumpPipeline with map_memory = "axi": its outputs bit-exact with the golden pipeline
+    (the same model as the block-RAM map's), the AR stream the golden cache model's, under
+    AR/R stalls, input gaps and backpressure; a miss stalls only the front."""
+    scene = load_scene_config({**AXI_SCENE, "addressing": addressing})
+    rng = np.random.default_rng(latency)
+    words = random_map(scene, rng)
+    inputs = random_inputs(scene, 80, rng)
+    dut = BumpPipeline(scene.hardware, cache={"sets": 4})
+    geom = dut.units["fetch"].geom
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
+                        latency=latency, ar_stall=0.3, r_stall=0.3, seed=latency)
+    payloads = as_payload_list(inputs)
+    out, _ = simulate_stream(dut, payloads, pattern, seed=latency, max_cycles=40_000,
+                             processes=[mem.process])
+    assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
+    golden = run_scene_cache(scene.hardware, geom, inputs, words)
+    assert mem.requests == golden.requests and golden.evictions
+
+
+def test_map_memory_refusals():
+    with pytest.raises(BumpError, match="map_memory must be one of bram, axi"):
+        load_scene_config({"map_memory": "dram"})
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs shading = 'per-pixel'"):
+        load_scene_config({"map_memory": "axi", "texture": True})
+    bram = BumpPipeline(load_scene_config({}).hardware)
+    bram._MustUse__silence = True                 # built for its ports only
+    assert "axi" not in bram.signature.members
