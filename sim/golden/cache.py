@@ -23,7 +23,7 @@ from bumprtl.rtl.cache import (
     tiled_layout,
 )
 
-__all__ = ["CacheModel", "CacheRun", "run_cache", "run_scene_cache", "random_levels",
+__all__ = ["CacheModel", "CacheRun", "run_cache", "pixel_lines", "miss_cycles", "stream_cycles", "run_scene_cache", "random_levels",
            "cache_stimulus", "image_words"]
 
 
@@ -44,6 +44,22 @@ class CacheRun:
     @property
     def bytes_fetched(self):
         return len(self.requests) * self.line_bytes
+
+
+def miss_cycles(geom: CacheGeometry, latency):
+    """Cycles a miss adds to its pixel's one: the AR offered (1), ``latency`` cycles to the
+    first beat, ``beats`` beats, the re-read (1). ``latency``: cycles from the AR handshake
+    to the first R beat offered (1 is the least AXI allows: RVALID after the handshake)."""
+    return latency + geom.beats + 2
+
+
+def stream_cycles(run, geom: CacheGeometry, latency):
+    """Cycles TextureCache takes for the pixels of ``run`` (a :class:`CacheRun`) offered
+    back to back, its output always taken, the memory never stalling and answering each
+    burst ``latency`` cycles after its AR handshake: one a pixel plus :func:`miss_cycles` a
+    miss (after the reset's flush, plus its 2-cycle latency: tests/rtl/test_cache.py checks
+    the count against the RTL's)."""
+    return len(run.hit) + len(run.requests) * miss_cycles(geom, latency)
 
 
 class CacheModel:
@@ -72,25 +88,41 @@ class CacheModel:
         return hit, way, evicted
 
 
-def run_cache(geom: CacheGeometry, u, v, level, levels):
+def pixel_lines(geom: CacheGeometry, u, v, level):
+    """The line (:func:`rtl.cache.tiled_layout`) of each pixel, int64 arrays in, out."""
+    u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
+    level = np.minimum(np.asarray(level, np.int64), geom.mip_levels - 1)
+    lines = np.zeros_like(u)
+    for lv in range(geom.mip_levels):
+        at = level == lv
+        lines[at] = tiled_layout(u[at], v[at], lv, geom)[0]
+    return lines
+
+
+def run_cache(geom: CacheGeometry, u, v, level, levels=None):
     """Run the pixels (level coordinates ``u``, ``v`` and ``level`` arrays; ``level`` past
     the last reads the last) through a cold cache; ``levels[l]`` is level l's texel words
-    ([v, u]). Returns a :class:`CacheRun`."""
+    ([v, u]; None: no texels, for hit rates alone). Returns a :class:`CacheRun`."""
     u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
     level = np.minimum(np.asarray(level, np.int64), geom.mip_levels - 1)
     model = CacheModel(geom)
     n = len(u)
     run = CacheRun(np.zeros(n, np.int64), np.zeros(n, bool), geom.line_bytes)
-    for k in range(n):
-        lv, uk, vk = int(level[k]), int(u[k]), int(v[k])
-        line, _ = tiled_layout(uk, vk, lv, geom)
-        hit, way, evicted = model.access(int(line))
+    prev = None
+    for k, line in enumerate(pixel_lines(geom, u, v, level).tolist()):
+        if line == prev:             # the line just used: a hit that leaves the bits as they are
+            run.hit[k] = True
+            continue
+        prev = line
+        hit, way, evicted = model.access(line)
         run.hit[k] = hit
-        run.texel[k] = int(np.asarray(levels[lv])[vk, uk])
         if not hit:
-            run.requests.append((geom.base + int(line) * geom.line_bytes, geom.beats - 1))
+            run.requests.append((geom.base + line * geom.line_bytes, geom.beats - 1))
             if evicted is not None:
-                run.evictions.append((int(line) % geom.sets, way, evicted))
+                run.evictions.append((line % geom.sets, way, evicted))
+    for lv in range(geom.mip_levels if levels is not None else 0):
+        at = level == lv
+        run.texel[at] = np.asarray(levels[lv], np.int64)[v[at], u[at]]
     return run
 
 

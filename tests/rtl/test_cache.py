@@ -12,7 +12,13 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.axi_memory import AxiReadMemory
-from bumprtl.sim.golden.cache import cache_stimulus, random_levels, run_cache, run_scene_cache
+from bumprtl.sim.golden.cache import (
+    cache_stimulus,
+    random_levels,
+    run_cache,
+    run_scene_cache,
+    stream_cycles,
+)
 from bumprtl.sim.golden.fixed.pipeline import (
     as_payload_list,
     pipeline_fixed,
@@ -84,6 +90,23 @@ def test_cache_hits_at_one_pixel_a_clock():
         assert len(mem.requests) == geom.lines
         cycles.append(n)
     assert cycles[1] - cycles[0] == len(one)
+
+
+@pytest.mark.parametrize("latency", [1, 9])
+@pytest.mark.parametrize("geom", [CacheGeometry(64, 3, 28, sets=8),
+                                  CacheGeometry(64, 3, 8, sets=4, data_bits=64)])
+def test_cycle_model_counts_the_rtl_cycles(geom, latency):
+    """sim/golden/cache.stream_cycles (what bumprtl bench memory reports) is the RTL's count
+    for a stall-free memory and sink: the reset's flush (sets cycles) and the 2-cycle
+    latency aside, exactly one cycle a pixel plus miss_cycles a miss."""
+    levels = random_levels(geom)
+    u, v, level = cache_stimulus(geom, 80, latency)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
+    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
+    _, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
+    assert cycles == geom.sets + stream_cycles(golden, geom, latency) + 2
 
 
 # The default scene at small widths, two levels, wrap; the same with clamp addressing.
