@@ -248,9 +248,10 @@ class BumpPipeline(wiring.Component):
     def __init__(self, scene: HardwareScene, init=None, texture=None, target=None,
                  write_port=True, fifo_depth=None, cache=None):
         self.scene = check_scene(self, scene)
+        self._front = scene.map_memory == "axi"     # the fetch before the credit edge
+        write_port = write_port and not self._front  # the map is in the user's memory
         self.write_port = write_port
         self.cache = cache
-        self._front = scene.map_memory == "axi"     # the fetch before the credit edge
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
@@ -279,7 +280,7 @@ class BumpPipeline(wiring.Component):
             raise
         if self._front:
             ports["axi"] = Out(self.units["fetch"].axi.signature)
-        elif "fetch" in self.units and has_map(scene) and write_port:
+        if "fetch" in self.units and has_map(scene) and write_port:
             f = self.units["fetch"]
             ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
                           "map_w_data": In(f.w_data.shape())})
@@ -458,8 +459,10 @@ class BumpPipeline(wiring.Component):
     def _taken(self):
         """The pixel entering the first unit: ``i``'s payload, valid when it is taken (the
         cache's output with ``map_memory = "axi"``)."""
-        i = self.units["fetch"].o if self._front else self.i
-        return _Entry(i.valid & i.ready, i.payload)
+        if self._front:
+            front = self.units["fetch"].o
+            return _Entry(front.valid & front.ready, front.payload)
+        return _Entry(self.i.valid & self.i.ready, self.i.payload)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg
