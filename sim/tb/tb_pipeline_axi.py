@@ -6,7 +6,9 @@ backpressure. Every output field is compared bit for bit with the golden pipelin
 (sim/golden/fixed/pipeline.py, the same model as the block-RAM map's) and the AR requests
 with the golden cache model's (sim/golden/cache.run_scene_cache).
 
-Environment: BUMPRTL_SIDECAR (the pipeline's sidecar), BUMPRTL_SAMPLES, BUMPRTL_PATTERN.
+Environment: BUMPRTL_SIDECAR (the pipeline's sidecar), BUMPRTL_SAMPLES, BUMPRTL_PATTERN,
+BUMPRTL_STIMULUS (``raster``: the pixels' texel coordinates a raster scan of a plane at one
+texel per pixel, :func:`raster`; default: random coordinates over the whole port range).
 """
 
 import itertools
@@ -21,9 +23,19 @@ from cocotbext.axi import AxiReadBus
 from bumprtl.rtl.cache import scene_geometry
 from bumprtl.sim.golden.cache import image_words, run_scene_cache
 from bumprtl.sim.golden.fixed.pipeline import as_payload_list, pipeline_fixed, random_inputs
+from bumprtl.sim.scenes import texel_coordinates
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.stream import load_sidecar, run_stream, samples
 from bumprtl.sim.tb.tb_cache import LATENCIES, LatentAxiRamRead
+
+
+def raster(size, n):
+    """``{u, v, level}`` of ``n`` pixels of a plane at one texel per pixel (a ``size`` x
+    ``size`` frame on the map) in raster order from the frame's centre row on."""
+    u, v, _ = texel_coordinates("plane", size, size)
+    top = max(0, size // 2 - n // (2 * size))
+    u, v = u[top:].ravel()[:n], v[top:].ravel()[:n]
+    return {"u": u, "v": v, "level": np.zeros_like(u)}
 
 
 def _pauses(rng, p):
@@ -42,6 +54,9 @@ async def pipeline_matches_golden_against_axi_ram(dut, latency):
     words = image_words(scene, geom, image)
     rng = np.random.default_rng(latency)
     inputs = random_inputs(scene, samples(150), rng)
+    if os.environ.get("BUMPRTL_STIMULUS") == "raster":
+        inputs.update({k: c for k, c in raster(scene.texture_size, len(inputs["u"])).items()
+                       if k in inputs})
     golden = pipeline_fixed(inputs, scene, words)
     cache = run_scene_cache(scene.hardware, geom, inputs, words)
 

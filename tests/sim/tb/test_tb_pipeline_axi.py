@@ -28,3 +28,17 @@ def test_pipeline_axi_cocotb_against_axi_ram(sim, build_dir):
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_pipeline_axi", build_dir / sim,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 150})
     assert (run.tests, run.failures) == (3, 0)
+
+
+@pytest.mark.regress
+def test_megatexel_pipeline_axi_raster_on_verilator(build_dir):
+    """A 2048² map at the default widths (16 MiB of _map.bin): two frame rows of a raster
+    scan at one texel per pixel, whose block rows do not fit the default cache (a miss every
+    fourth pixel), bit-exact and AR stream as the golden model's at latencies 2, 20, 60."""
+    scene = load_scene_config({**BUILTIN["default"], "texture_size": 2048, "map_memory": "axi"})
+    images = memory_images("pipeline", scene, *scene_memories(scene))
+    v, j, files = emit_scene_unit("pipeline", scene, build_dir / "rtl", images)
+    assert files[0].stat().st_size == 2048 * 2048 * 4
+    run = run_cocotb("verilator", v, "bumprtl.sim.tb.tb_pipeline_axi", build_dir / "verilator",
+                     {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 4096, "BUMPRTL_STIMULUS": "raster"})
+    assert (run.tests, run.failures) == (3, 0)
