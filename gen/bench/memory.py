@@ -158,6 +158,24 @@ stops, and its outputs are bit-exact with the golden model under any memory late
 (tests/rtl/test_cache.py, tests/sim/tb/test_tb_pipeline_axi.py against cocotbext-axi's
 AxiRam).
 
+## The AXI4 read port
+
+`bumprtl emit pipeline --map-memory axi` adds to the pipeline's stream ports the manager side
+of an AXI4 read channel (Amaranth's flattened names; `rtl/cache.axi_read_signature`):
+`axi__arid` (1 bit, always 0), `axi__araddr` (32 bits), `axi__arlen` (beats - 1),
+`axi__arsize` (log2 of the data bytes), `axi__arburst` (1, INCR), `axi__arvalid`,
+`axi__arready`, `axi__rid` and `axi__rresp` (not read), `axi__rdata` (32 bits by default),
+`axi__rlast`, `axi__rvalid`, `axi__rready`. One burst is outstanding at a time: a whole line,
+aligned to its size (never across 4 KiB); ARVALID stays high with a stable payload until
+ARREADY; RREADY is high while the line fills and the fill ends with RLAST. Put
+`<name>_map.bin` at byte `base` (0) of the memory the port reads; the sidecar's
+`memory_images.map` gives `file`, `base`, `bytes` and the `layout` in words. A reset clears
+the tags one set a cycle (`i.ready` low for `sets` cycles); the map must not change between
+resets. `i.ready` is the cache's: it falls in the cycle a miss is found, and it depends on
+the lookup and `o.ready` in the same cycle (never on `i.valid`).
+
+## Hit rates and throughput
+
 Method: each demo geometry (bricks: plane, globe: sphere, cylinder) at one texel per pixel
 (a T x T frame on a T x T map, level 0), the {BAND_ROWS} frame rows at its centre in raster
 order through a cold cache in the golden cache model (the RTL's hit/miss sequence). Cycles
@@ -165,7 +183,8 @@ per pixel: one a pixel plus `latency + beats + 2` a miss (`sim/golden/cache.stre
 the RTL's own count for a memory that never stalls and an output always taken); L is the
 memory's latency from the AR handshake to the first R beat, L = 1 the zero-wait memory.
 exact: 28-bit N' angle pairs in 4-byte slots; palette: {texel_bits("palette")}-bit indices
-in 1-byte slots.
+in 1-byte slots (the cache with the palette's texels; the pipeline builds `map_memory =
+"axi"` for per-pixel shading only so far).
 
 The cache blocks on a miss: throughput at L = 20 is far below the 95 % of the zero-wait
 memory that prefetching (Igehy et al., HWWS 1998) reaches; a raster scan of a map wider
