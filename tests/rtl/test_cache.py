@@ -25,7 +25,7 @@ from bumprtl.sim.golden.fixed.pipeline import (
     random_inputs,
     random_map,
 )
-from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.sim.traffic import PATTERNS
 
 
@@ -114,17 +114,20 @@ AXI_SCENE = {"texture_size": 16, "angle_bits": 8, "frac_bits": 8, "tag_bits": 6,
              "map_memory": "axi"}
 
 
-@pytest.mark.parametrize("addressing,latency,pattern", [("wrap", 2, "both"), ("clamp", 20, "both"),
-                                                        ("wrap", 60, "backpressure")])
-def test_pipeline_axi_bit_exact_under_memory_latency(addressing, latency, pattern):
+@pytest.mark.parametrize("base,addressing,latency,pattern,data_bits", [
+    ("default", "wrap", 2, "both", 32), ("default", "clamp", 20, "both", 32),
+    ("default", "wrap", 60, "backpressure", 32), ("two-lights", "clamp", 7, "both", 64)])
+def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, pattern,
+                                                     data_bits):
     """BumpPipeline with map_memory = "axi": its outputs bit-exact with the golden pipeline
     (the same model as the block-RAM map's), the AR stream the golden cache model's, under
-    AR/R stalls, input gaps and backpressure; a miss stalls only the front."""
-    scene = load_scene_config({**AXI_SCENE, "addressing": addressing})
+    AR/R stalls, input gaps and backpressure; a miss stalls only the front. Two lights take
+    the pipeline's layered wiring (the default scene its direct chain)."""
+    scene = load_scene_config({**BUILTIN[base], **AXI_SCENE, "addressing": addressing})
     rng = np.random.default_rng(latency)
     words = random_map(scene, rng)
     inputs = random_inputs(scene, 80, rng)
-    dut = BumpPipeline(scene.hardware, cache={"sets": 4})
+    dut = BumpPipeline(scene.hardware, cache={"sets": 4, "data_bits": data_bits})
     geom = dut.units["fetch"].geom
     mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
                         latency=latency, ar_stall=0.3, r_stall=0.3, seed=latency)
