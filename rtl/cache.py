@@ -38,6 +38,7 @@ from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_coords, texel_shape
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import CACHE_DEFAULTS as SCENE_CACHE
 from bumprtl.rtl.scene import HardwareScene, check_scene
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
@@ -53,9 +54,9 @@ AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
 MAX_BURST = 256                     # AXI4 INCR: ARLEN + 1 <= 256 beats
 AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
-# sets, ways, block side, AXI data bits: 64 sets x 2 ways x 16 texels = 2048 texels (8 KiB
-# of 28-bit texels in 32-bit slots), a line one 16-beat burst on a 32-bit bus.
-CACHE_DEFAULTS = {"sets": 64, "ways": 2, "block": 4, "data_bits": 32}
+# sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
+CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
+                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"]}
 
 
 def _pow2(x):
@@ -477,10 +478,13 @@ class TextureCache(wiring.Component):
 
 def scene_geometry(scene: HardwareScene, **cache):
     """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
-    width) with the cache's parameters ``cache`` (sets, ways, block, data_bits, base,
-    addr_bits; :data:`CACHE_DEFAULTS` where omitted)."""
+    width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
+    ``axi_data_bits``), the parameters ``cache`` (sets, ways, block, data_bits, base,
+    addr_bits) overriding them."""
     bits = Shape.cast(texel_shape(scene)).width
-    return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **cache)
+    own = {"sets": scene.cache_sets, "ways": scene.cache_ways, "block": scene.cache_block,
+           "data_bits": scene.axi_data_bits}
+    return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **{**own, **cache})
 
 
 def scene_levels(scene: HardwareScene, words):

@@ -109,7 +109,16 @@ def check_fits(roms, device, what):
 def check_scene_fits(scene, device, unit="pipeline"):
     """:func:`check_fits` for the memories of ``scene``'s pipeline (or fetch unit)."""
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
-    return check_fits(unit_memories(build(scene.hardware)), device, scene.picture or scene.name)
+    roms = unit_memories(build(scene.hardware))
+    if scene.map_memory == "axi" and device in DEVICE_BRAM:
+        cache = {k: v for k, v in roms.items() if k.startswith("fetch.cache_")}
+        need, other = memory_blocks(cache)[1], memory_blocks(roms)[1] - memory_blocks(cache)[1]
+        if need + other > DEVICE_BRAM[device]:
+            raise BumpError(f"cache_sets x cache_ways = {scene.cache_sets} x {scene.cache_ways} "
+                            f"lines need {need} DP16KD of 18 kbit beside {other} for the "
+                            f"pipeline's tables; {device} has {DEVICE_BRAM[device]}: fewer sets "
+                            f"or ways", "cache_sets")
+    return check_fits(roms, device, scene.picture or scene.name)
 
 
 def hex_text(words, width):
@@ -211,7 +220,8 @@ def host_writes(images, meta):
 _FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",
               "resample", "texture_size", "method", "angle_bits", "frac_bits", "tag_bits",
               "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights", "specular",
-              "palette_size", "map_memory")
+              "palette_size", "map_memory", "cache_sets", "cache_ways", "cache_block",
+              "axi_data_bits")
 
 
 _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",

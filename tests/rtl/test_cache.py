@@ -7,7 +7,14 @@ cycle by the memory."""
 import numpy as np
 import pytest
 
-from bumprtl.rtl.cache import CacheGeometry, TextureCache, scene_levels, tiled_image
+from bumprtl.gen.cli.main import main
+from bumprtl.rtl.cache import (
+    CacheGeometry,
+    TextureCache,
+    scene_geometry,
+    scene_levels,
+    tiled_image,
+)
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
@@ -144,6 +151,19 @@ def test_map_memory_refusals():
         load_scene_config({"map_memory": "dram"})
     with pytest.raises(BumpError, match="map_memory = 'axi' needs shading = 'per-pixel'"):
         load_scene_config({"map_memory": "axi", "texture": True})
+    with pytest.raises(BumpError, match="cache_ways: ways must be a power of two"):
+        load_scene_config({"map_memory": "axi", "cache_ways": 3})
+    with pytest.raises(BumpError, match="cache_sets = 16 applies to map_memory = 'axi'"):
+        load_scene_config({"cache_sets": 16})
+    scene = load_scene_config({"map_memory": "axi", "cache_sets": 16, "axi_data_bits": 64})
+    assert (scene_geometry(scene.hardware).sets, scene_geometry(scene.hardware).beats) == (16, 8)
     bram = BumpPipeline(load_scene_config({}).hardware)
     bram._MustUse__silence = True                 # built for its ports only
     assert "axi" not in bram.signature.members
+
+
+def test_cli_refuses_a_cache_larger_than_the_block_ram(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-sets", "4096",
+                 "--cache-ways", "16", "--out", str(out)]) == 2
+    assert "fewer sets or ways" in capsys.readouterr().err and not out.exists()
