@@ -152,7 +152,10 @@ of `rtl/cache.tiled_layout` (`bumprtl emit pipeline --map-memory axi` writes it 
 `<name>_map.bin`; the sidecar's `memory_images.map` gives its base, size and layout), and
 reads it through `TextureCache`: set-associative, {d["sets"]} sets x {d["ways"]} ways of
 {d["block"]} x {d["block"]}-texel lines by default, tree pseudo-LRU (LRU for 2 ways), one
-AXI4 INCR burst of a whole line ({d["data_bits"]}-bit data by default) a miss. A miss holds
+AXI4 INCR burst of a whole line ({d["data_bits"]}-bit data by default) a miss. The scene
+keys `cache_sets`, `cache_ways`, `cache_block` and `axi_data_bits` (flags `--cache-sets`,
+`--cache-ways`, `--cache-block`, `--axi-data-bits` of `bumprtl emit pipeline`) size it;
+a cache that does not fit the device's block RAM beside the pipeline's tables is refused. A miss holds
 the pixel at the pipeline's input; the free-running chain behind the credit edge never
 stops, and its outputs are bit-exact with the golden model under any memory latency
 (tests/rtl/test_cache.py, tests/sim/tb/test_tb_pipeline_axi.py against cocotbext-axi's
