@@ -23,7 +23,7 @@ from bumprtl.rtl.scene import HardwareScene, check_scene
 from bumprtl.rtl.targets import is_spread
 from bumprtl.rtl.texture import rgb_layout
 
-__all__ = ["BumpMapFetch", "texel_address", "level_bases", "memory_depth", "coord_bits",
+__all__ = ["BumpMapFetch", "texel_address", "level_coords", "level_bases", "memory_depth", "coord_bits",
            "level_bits", "texel_shape", "fetched_field", "fetched_fields", "has_map",
            "pack_texels", "pack_rgb", "spread_fetch", "fetch_latency", "TEXEL_BITS"]
 
@@ -92,17 +92,23 @@ def _wrap(x, bits):
     return x[:bits] if _is_hdl(x) else np.asarray(x, np.int64) & ((1 << bits) - 1)
 
 
-def texel_address(u, v, level, scene):
-    """Word address of texel (u, v) (level-0 coordinates, signed) at constant mip ``level``:
-    u_l = floor(u / 2**l), then wrap (modulo T_l) or clamp (to [0, T_l - 1]), then
-    base_l + v_l T_l + u_l."""
+def level_coords(u, v, level, scene):
+    """``(u_l, v_l)``, texel (u, v) (level-0 coordinates, signed) in constant mip ``level``:
+    u_l = floor(u / 2**l), then wrap (modulo T_l) or clamp (to [0, T_l - 1])."""
     bits = scene.texture_bits - level
     edge = Q(bits, 0, signed=False)
     coords = []
     for c in (u, v):
         c = c >> level                                     # arithmetic: floor for negatives
         coords.append(_wrap(c, bits) if scene.addressing == "wrap" else saturate(c, edge))
-    u_l, v_l = coords
+    return tuple(coords)
+
+
+def texel_address(u, v, level, scene):
+    """Word address of texel (u, v) (level-0 coordinates, signed) at constant mip ``level``:
+    (u_l, v_l) of :func:`level_coords`, then base_l + v_l T_l + u_l."""
+    bits = scene.texture_bits - level
+    u_l, v_l = level_coords(u, v, level, scene)
     base = level_bases(scene)[level]
     if _is_hdl(u_l):
         return Cat(u_l[:bits], v_l[:bits]) + base if bits else Value.cast(base)

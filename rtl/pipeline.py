@@ -33,6 +33,7 @@ from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import BumpMapFetch, has_map
+from bumprtl.rtl.cache import AxiMapFetch
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.exact import (
     SineBank,
@@ -237,12 +238,22 @@ class BumpPipeline(wiring.Component):
 
     The edge (submodule ``edge``, :class:`~bumprtl.rtl.pipe.CreditEdge`: its ``credits``
     and ``level``) is read by sim/formal's credit invariant.
+
+    With ``map_memory = "axi"`` the fetch is :class:`~bumprtl.rtl.cache.AxiMapFetch` (the
+    map in the user's memory behind a texel cache, port ``axi``, ``cache`` its
+    :class:`~bumprtl.rtl.cache.CacheGeometry` parameters) in front of the credit edge: a
+    miss stalls ``i`` alone and the free-running chain behind the edge keeps its contract;
+    ``i.ready`` is then the cache's (it depends on the lookup in the same cycle), and
+    ``port_latency`` adds the cache's hit latency.
 """
 
     def __init__(self, scene: HardwareScene, init=None, texture=None, target=None,
-                 write_port=True, fifo_depth=None):
+                 write_port=True, fifo_depth=None, cache=None):
         self.scene = check_scene(self, scene)
+        self._front = scene.map_memory == "axi"     # the fetch before the credit edge
+        write_port = write_port and not self._front  # the map is in the user's memory
         self.write_port = write_port
+        self.cache = cache
         self.cfg = cfg = scene.config
         self.target = target
         self.units, self.built = {}, []
@@ -269,6 +280,8 @@ class BumpPipeline(wiring.Component):
         except BumpError:
             self._MustUse__silence = True
             raise
+        if self._front:
+            ports["axi"] = Out(self.units["fetch"].axi.signature)
         if "fetch" in self.units and has_map(scene) and write_port:
             f = self.units["fetch"]
             ports.update({"map_w_en": In(1), "map_w_addr": In(f.w_addr.shape()),
@@ -298,6 +311,12 @@ class BumpPipeline(wiring.Component):
             fields = {f: out_layout[f].shape for f, _ in out_layout if f not in ("tag", "base")}
             out_layout = data.StructLayout({**fields, "texel": rgb_layout(self.cfg),
                                             "tag": out_layout["tag"].shape})
+        if self._front:
+            self._add("fetch", AxiMapFetch(s, out_layout, self.cache),
+                      f"bump_map = 'varying', map_memory = 'axi': {what} per texel from the "
+                      f"user's memory through a texel cache ({s.texture_size}^2 texels, "
+                      f"{s.mip_levels} level(s), {s.addressing} addressing)")
+            return
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
             (["texture = true: the RGB colour texel"] if s.texture else [])
         self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target,
@@ -354,7 +373,8 @@ class BumpPipeline(wiring.Component):
                 self._add(name, TexelDelay(cfg, latency, self.target, credit=False),
                           f"texture = true: the texel waits {latency} stages beside {layer[0]}")
                 layer.append(name)
-        self._layers = ([["fetch"]] if "fetch" in self.units else []) + [rot_layer, ill]
+        self._layers = ([["fetch"]] if "fetch" in self.units and not self._front else []) + \
+            [rot_layer, ill]
         self._rot_layer, self._ill_layer = rot_layer, ill
         if s.texture:
             self._add("blend", TextureBlend(cfg, s.lights, self.target, credit=False),
@@ -398,7 +418,7 @@ class BumpPipeline(wiring.Component):
 
     @property
     def port_latency(self):
-        return self.latency + EDGE_LATENCY
+        return self.latency + EDGE_LATENCY + (self.units["fetch"].latency if self._front else 0)
 
     @property
     def memories(self):
@@ -409,7 +429,12 @@ class BumpPipeline(wiring.Component):
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()
-        _, core = add_credit_edge(m, self.i, self.o, self.latency, self.fifo_depth)
+        if self._front:                       # the cache, then the edge and the chain
+            front = self.units["fetch"]
+            wiring.connect(m, wiring.flipped(self.i), front.i)
+            wiring.connect(m, wiring.flipped(self.axi), front.axi)
+        _, core = add_credit_edge(m, front.o if self._front else self.i, self.o, self.latency,
+                                  self.fifo_depth)
         _feed(m, self.units[self._last].o, core)
         for name, unit in self.units.items():
             m.submodules[name] = unit
@@ -423,21 +448,28 @@ class BumpPipeline(wiring.Component):
             self._elaborate_palette(m)
             return m
         if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
-            _feed(m, self._taken(), u["fetch"].i)
-            _feed(m, u["fetch"].o, u["rotation"].i)
+            if self._front:
+                _feed(m, self._taken(), u["rotation"].i)
+            else:
+                _feed(m, self._taken(), u["fetch"].i)
+                _feed(m, u["fetch"].o, u["rotation"].i)
             _feed(m, u["rotation"].o, u["illumination"].i)
             return m
         self._elaborate_layers(m)
         return m
 
     def _taken(self):
-        """The pixel entering the first unit: ``i``'s payload, valid when it is taken."""
+        """The pixel entering the first unit: ``i``'s payload, valid when it is taken (the
+        cache's output with ``map_memory = "axi"``)."""
+        if self._front:
+            front = self.units["fetch"].o
+            return _Entry(front.valid & front.ready, front.payload)
         return _Entry(self.i.valid & self.i.ready, self.i.payload)
 
     def _elaborate_layers(self, m):
         s, u, cfg = self.scene, self.units, self.cfg
         vectors = [v for v, _ in light_layout(cfg)]
-        if "fetch" in u:
+        if "fetch" in u and not self._front:
             _feed(m, self._taken(), u["fetch"].i)
             src = u["fetch"].o
         else:

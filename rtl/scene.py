@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from bumprtl.rtl.config import BumpError, Config
 
 __all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
-           "TEXTURE_SIZES", "derived_rotation", "check_scene", "check_choice",
+           "TEXTURE_SIZES", "MAP_MEMORIES", "CACHE_DEFAULTS", "check_map_memory", "derived_rotation", "check_scene", "check_choice",
            "check_map_size"]
 
 ADDRESSING = ("wrap", "clamp")
@@ -23,6 +23,11 @@ BUMP_MAPS = ("varying", "flat")          # does N' change from texel to texel?
 SHADINGS = ("per-pixel", "palette")      # Lee/exact per-pixel rotation, or Tarini's palette
 ROTATIONS = ("per-pixel", "per-polygon", "none")
 TEXTURE_SIZES = (16, 4096)               # a power of two in this range
+MAP_MEMORIES = ("bram", "axi")           # the map in block RAM, or behind a cache on AXI4
+# The texel cache of map_memory = "axi" (rtl/cache.CacheGeometry): sets, ways, side of a
+# line's square block of texels, AXI data bits. 64 x 2 lines of 4 x 4 texels: 8 KiB of
+# 28-bit texels in 4-byte slots, a line one 16-beat burst on a 32-bit bus.
+CACHE_DEFAULTS = {"cache_sets": 64, "cache_ways": 2, "cache_block": 4, "axi_data_bits": 32}
 
 
 def derived_rotation(shading, bump_map):
@@ -48,6 +53,22 @@ def check_choice(key, value, allowed, error=BumpError):
     the key and the allowed values."""
     if value not in allowed:
         raise error(f"{key} must be one of {', '.join(allowed)}, got {value!r}", key)
+
+
+def check_map_memory(map_memory, shading, bump_map, texture, cache=None, error=BumpError):
+    """``map_memory`` is one of :data:`MAP_MEMORIES`; ``axi`` (rtl/cache.py) holds a
+    varying N' map with per-pixel shading and no colour texture; the ``cache`` keys
+    (:data:`CACHE_DEFAULTS`) other than their defaults need ``axi``; else ``error`` naming
+    the key (rtl/cache.CacheGeometry checks their ranges)."""
+    check_choice("map_memory", map_memory, MAP_MEMORIES, error)
+    for key, value in (cache or {}).items():
+        if map_memory != "axi" and value != CACHE_DEFAULTS[key]:
+            raise error(f"{key} = {value!r} applies to map_memory = 'axi' (the texel cache), "
+                        f"the scene has map_memory = {map_memory!r}", key)
+    if map_memory == "axi" and (shading, bump_map, texture) != ("per-pixel", "varying", False):
+        raise error(f"map_memory = 'axi' needs shading = 'per-pixel', bump_map = 'varying' and "
+                    f"texture = false (got {shading!r}, {bump_map!r}, {texture}); allowed "
+                    f"otherwise: map_memory = 'bram'", "map_memory")
 
 
 def check_map_size(texture_size, mip_levels, error=BumpError):
@@ -88,6 +109,15 @@ class HardwareScene:
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
         Levels of the map in block RAM, 1 to log2(T) + 1.
+    map_memory : str
+        ``bram`` (the map in block RAM, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`) or
+        ``axi`` (the map in the user's memory behind a texel cache with an AXI4 read port,
+        :class:`~bumprtl.rtl.cache.AxiMapFetch`; per-pixel shading of a varying map, no
+        colour texture).
+    cache_sets, cache_ways, cache_block, axi_data_bits : int
+        With ``map_memory = "axi"``: the texel cache's sets, ways a set, side of a line's
+        square block of texels (powers of two) and AXI data width (32 or 64);
+        :data:`CACHE_DEFAULTS`.
     config : Config
         The datapath widths, method, lights, specular, terms and palette size.
     """
@@ -100,6 +130,11 @@ class HardwareScene:
     texture_size: int = 64
     addressing: str = "wrap"
     mip_levels: int = 1
+    map_memory: str = "bram"
+    cache_sets: int = CACHE_DEFAULTS["cache_sets"]
+    cache_ways: int = CACHE_DEFAULTS["cache_ways"]
+    cache_block: int = CACHE_DEFAULTS["cache_block"]
+    axi_data_bits: int = CACHE_DEFAULTS["axi_data_bits"]
     config: Config = Config()
 
     def __post_init__(self):
@@ -111,6 +146,8 @@ class HardwareScene:
         if not isinstance(self.texture, bool):
             raise BumpError(f"texture must be true or false, got {self.texture!r}", "texture")
         check_map_size(self.texture_size, self.mip_levels)
+        check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture,
+                         {k: getattr(self, k) for k in CACHE_DEFAULTS})
         derived = derived_rotation(self.shading, self.bump_map)
         if self.rotation is None:
             object.__setattr__(self, "rotation", derived)

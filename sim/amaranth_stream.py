@@ -35,7 +35,7 @@ def flatten_payload(value, prefix=""):
 
 
 def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None,
-                    pipe_handshake=False):
+                    pipe_handshake=False, processes=()):
     """Drive ``inputs`` into ``dut.i``; return ``(outputs, cycles)`` from ``dut.o``.
 
     Each input is a dict ``{field: int}`` (dotted names for nested layouts). Outputs come
@@ -45,7 +45,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     is high exactly while fewer than ``dut.fifo_depth`` pixels are inside (taken at ``i``
     before this cycle and not taken at ``o`` before it), and an output offered and not taken
     is offered again the next cycle (a ready that waits on ``o.ready``, or a credit lost or
-    made, is bit-exact and fails only this check).
+    made, is bit-exact and fails only this check). ``processes``: more testbenches run beside
+    the stream's (a memory model on another port, sim/axi_memory.py).
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
@@ -87,6 +88,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
+    for process in processes:
+        sim.add_testbench(process, background=True)
     if vcd:
         with sim.write_vcd(vcd):
             sim.run()

@@ -28,6 +28,7 @@ GENERATED = {
     "docs/formal.md": "make formal",
     "docs/mutation.md": "make mutate",
     "docs/scenes.md": "python -m bumprtl.gen.render.rtl --doc docs/scenes.md (make docs)",
+    "docs/memory.md": "bumprtl bench memory --doc docs/memory.md",
 }
 # Generated pages whose generator does not write the record yet.
 LACKING = set()

@@ -12,6 +12,7 @@ from bumprtl.gen.bench import (
     float64,
     golden,
     lee_widths,
+    memory,
     palette,
     rtl_sim,
     skip,
@@ -79,6 +80,33 @@ def run_rtl_sim(args):
 
 def run_palette(args):
     return palette.palette_bench(what=args.what, sizes=args.sizes, palettes=args.palettes, scenes=args.scenes, size=args.size, plot=args.plot, images_dir=args.images_dir)
+
+
+def run_memory(args):
+    return memory.memory_bench(scenes=args.scenes, sizes=args.sizes, caches=args.caches,
+                               methods=args.methods, latencies=args.latencies, rows=args.rows,
+                               doc=args.doc, plot=args.plot)
+
+
+def add_memory(kinds):
+    p = kinds.add_parser("memory", help="texel cache: hit rate, bytes and cycles per pixel",
+                         description="The texel cache of map_memory = axi on the demo scenes' "
+                                     "texel streams: hit rate, bytes fetched and cycles per "
+                                     "pixel, throughput against a zero-wait memory.")
+    p.add_argument("--scenes", nargs="+", default=list(memory.MEMORY_SCENES),
+                   help="demo scenes (their geometry decides the texel stream)")
+    p.add_argument("--sizes", nargs="+", type=int, default=list(memory.MAP_SIZES),
+                   help="map sides T (a T x T frame at one texel per pixel)")
+    p.add_argument("--caches", nargs="+", default=list(memory.CACHES), choices=list(memory.CACHES))
+    p.add_argument("--methods", nargs="+", default=list(memory.METHODS), choices=list(memory.METHODS))
+    p.add_argument("--latencies", nargs="+", type=int, default=list(memory.LATENCIES),
+                   help="memory latencies (cycles from the AR handshake to the first beat)")
+    p.add_argument("--rows", type=int, default=memory.BAND_ROWS,
+                   help="frame rows run through the cache (centred)")
+    p.add_argument("--doc", type=Path, default=None, help="write this page (docs/memory.md)")
+    p.add_argument("--plot", type=Path, default=None,
+                   help="the plot (default: img/memory.png beside --doc)")
+    p.set_defaults(func=run_memory)
 
 
 def add_lee_widths(kinds):
@@ -248,6 +276,7 @@ BENCHES = {
     "specular": add_specular,
     "lee-widths": add_lee_widths,
     "palette": add_palette,
+    "memory": add_memory,
     "sweep": add_sweep,
     "stress": add_stress,
     "skip": add_skip,

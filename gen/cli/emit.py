@@ -37,10 +37,12 @@ from bumprtl.gen.flow.units import (
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools.toolchain import require
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import CACHE_DEFAULTS, MAP_MEMORIES
 from bumprtl.rtl.sidecar import load
 from bumprtl.sim.scenes.config import flag_name
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+AXI_KEYS = ("map_memory", *CACHE_DEFAULTS)        # scene keys of the map in your memory
 
 
 def run(args):
@@ -53,10 +55,18 @@ def run(args):
         raise BumpError("--ports named applies to --interface stream (AXI4-Stream ports are "
                         "already named)")
     if args.unit in SCENE_UNITS:                     # built from a SceneConfig, not flags
-        cfg = scene_from_args(args, args.scene or "default")
+        cfg = scene_from_args(args, args.scene or "default",
+                              extra={k: getattr(args, k) for k in AXI_KEYS})
         _scene_flags_used(args, cfg)
+        if cfg.map_memory == "axi" and args.interface != "stream":
+            raise BumpError("--map-memory axi applies to --interface stream (the AXI4 read "
+                            "port sits beside the stream ports)")
+        if cfg.map_memory == "axi" and args.load is not None:
+            raise BumpError("--load applies to map_memory = 'bram' (with axi the map is "
+                            "UNIT_map.bin in your memory)")
     else:
-        given = map_overrides(args)
+        given = {**map_overrides(args),
+                 **{k: 1 for k in AXI_KEYS if getattr(args, k) is not None}}
         if given or args.load is not None or args.device is not None or args.scene is not None:
             flag = next(iter([*given, *(["load"] if args.load else []),
                               *(["device"] if args.device else []), "scene"]))
@@ -141,6 +151,8 @@ def _scene_flags_used(args, scene):
     if args.unit == "fetch":
         unread.update({k: "the fetch unit reads the map, not the shading (emit pipeline)"
                        for k in _SHADING_KEYS})
+        unread.update({k: "the fetch unit holds the map in block RAM (emit pipeline builds "
+                          "the cache)" for k in AXI_KEYS})
     if scene.shading == "per-pixel":
         unread["palette_size"] = "the scene has per-pixel shading (no colour table)"
     for key, why in unread.items():
@@ -208,6 +220,17 @@ def add_parser(sub):
                         "built-in initial contents, the same words as UNIT_map.hex; port = the "
                         "memories start at zero and the host writes UNIT_*.hex through the write "
                         "port before the first pixel (default: initial)")
+    g = p.add_argument_group("the map in your memory (docs/memory.md)")
+    g.add_argument("--map-memory", default=None, choices=MAP_MEMORIES,
+                   help="pipeline: bram = the map in block RAM (default); axi = the map in "
+                        "your memory, read through a texel cache with an AXI4 read port; "
+                        "writes UNIT_map.bin, the map in the cache's tiled layout")
+    for key, what in (("cache_sets", "sets of the texel cache, a power of two"),
+                      ("cache_ways", "ways a set, a power of two up to 16 (tree pseudo-LRU)"),
+                      ("cache_block", "side of a line's square block of texels, a power of two"),
+                      ("axi_data_bits", "AXI RDATA width, 32 or 64")):
+        g.add_argument(flag_name(key), type=int, default=None, metavar="N",
+                       help=f"--map-memory axi: {what} (default {CACHE_DEFAULTS[key]})")
     p.add_argument("--device", default=None, choices=sorted(DEVICE_BRAM),
                    help=f"pipeline/fetch: refuse memories that do not fit this ECP5's block RAM "
                         f"(default: {DEFAULT_DEVICE})")

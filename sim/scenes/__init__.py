@@ -17,7 +17,7 @@ from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar
 from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS, height_to_normals
 
 __all__ = ["SCENES", "GEOMETRIES", "REFERENCE_TEXTURE_SIZE", "Scene", "load_scene",
-           "light_direction", "bump_strength"]
+           "light_direction", "bump_strength", "texel_coordinates"]
 
 GEOMETRIES = ("plane", "sphere", "cylinder")
 # The map size the scenes' bump strengths were chosen at (the render default). A larger map
@@ -111,6 +111,14 @@ def _geometry(kind, size, tex):
     n = np.where(mask[..., None], n, [0, -1.0, 0])
     to_texel = lambda t: np.mod(np.floor(t).astype(np.int64), tex)
     return p, n, to_texel(u), to_texel(v), mask
+
+
+def texel_coordinates(geometry, size, texture_size):
+    """``(u, v, mask)`` of a ``size`` x ``size`` frame of ``geometry`` on a map of side
+    ``texture_size``: the texel each pixel reads (row-major, screen rows top first) and the
+    pixels the surface covers."""
+    _, _, u, v, mask = _geometry(geometry, size, texture_size)
+    return u, v, mask
 
 
 def _unit(v):

@@ -12,15 +12,18 @@ import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL, get
 from bumprtl.rtl.scene import (
     ADDRESSING,
     BUMP_MAPS,
+    CACHE_DEFAULTS,
     ROTATIONS,
     SHADINGS,
     HardwareScene,
     check_choice,
+    check_map_memory,
     check_map_size,
     derived_rotation,
 )
@@ -86,6 +89,12 @@ class SceneConfig:
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
         Levels of the bump map in block RAM, 1 (no mipmaps) to log2(T) + 1.
+    map_memory : str
+        ``bram`` (the map in block RAM, the default) or ``axi`` (the map in the user's
+        memory, read through a texel cache with an AXI4 port: docs/memory.md).
+    cache_sets, cache_ways, cache_block, axi_data_bits : int
+        ``axi``: the cache's sets, ways, line block side (powers of two) and AXI data width
+        (32 or 64); defaults 64, 2, 4, 32 (rtl/scene.CACHE_DEFAULTS).
     method, angle_bits, frac_bits, tag_bits, spec_exponent, spec_index_bits, ka, kd, ks,
     palette_size :
         Passed to :class:`Config` (checked there).
@@ -102,6 +111,11 @@ class SceneConfig:
     texture_size: int = 64
     addressing: str = "wrap"
     mip_levels: int = 1
+    map_memory: str = "bram"
+    cache_sets: int = CACHE_DEFAULTS["cache_sets"]
+    cache_ways: int = CACHE_DEFAULTS["cache_ways"]
+    cache_block: int = CACHE_DEFAULTS["cache_block"]
+    axi_data_bits: int = CACHE_DEFAULTS["axi_data_bits"]
     # Config's fields and defaults (rtl/config.py is the one source of both)
     method: str = Config.method
     angle_bits: int = Config.angle_bits
@@ -134,6 +148,15 @@ class SceneConfig:
             raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])",
                              "lights")
         check_map_size(self.texture_size, self.mip_levels, SceneError)
+        check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture,
+                         {k: getattr(self, k) for k in CACHE_DEFAULTS}, SceneError)
+        if self.map_memory == "axi":
+            try:
+                scene_geometry(self.hardware)        # the cache's keys, checked now
+            except BumpError as e:
+                key = {"sets": "cache_sets", "ways": "cache_ways", "block": "cache_block",
+                       "data_bits": "axi_data_bits"}.get(e.field, e.field)
+                raise SceneError(f"scene {self.name!r}: {key}: {e}", key) from None
         try:
             _ = self.config       # derive it now: a bad width is the scene's error
         except BumpError as e:
@@ -220,7 +243,9 @@ class SceneConfig:
         return HardwareScene(name=self.name, shading=self.shading, bump_map=self.bump_map,
                              rotation=self.rotation, texture=self.texture,
                              texture_size=self.texture_size, addressing=self.addressing,
-                             mip_levels=self.mip_levels, config=self.config)
+                             mip_levels=self.mip_levels, map_memory=self.map_memory,
+                             **{k: getattr(self, k) for k in CACHE_DEFAULTS},
+                             config=self.config)
 
     @property
     def texture_bits(self):

@@ -1,0 +1,569 @@
+"""TextureCache: a set-associative texel cache in front of an AXI4 read-only memory
+(docs/memory.md).
+
+The map lives in the user's memory in a tiled layout (:func:`tiled_layout`): each mip
+level is cut into square blocks of ``block`` x ``block`` texels, a block is one cache line
+(``block**2`` texel slots, row-major inside the block), the blocks of a level row-major,
+the levels one after the other from ``base``. A texel slot is the smallest power of two
+of bytes that holds a texel (a 28-bit N' angle pair: 4 bytes; an 8-bit palette index: 1
+byte). A level smaller than a block takes one whole line, its texels at their (u, v) slots.
+The same function places the texels in the RTL (line and slot of a pixel), in the golden
+model (sim/golden/cache.py) and in the memory image (:func:`tiled_image`), so the three
+cannot drift apart.
+
+Replacement: tree pseudo-LRU over the ``ways`` of a set (``ways - 1`` bits a set; exactly
+LRU for 2 ways): the victim is the leaf the bits point to; a pixel that hits turns the bits
+on its path away from its way (:func:`plru_victim`, :func:`plru_touch`, shared with the
+golden model).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from amaranth.hdl import (
+    Cat,
+    Const,
+    Module,
+    Mux,
+    Shape,
+    Signal,
+    Value,
+    ValueCastable,
+    signed,
+    unsigned,
+)
+from amaranth.lib import data, stream, wiring
+from amaranth.lib.memory import Memory
+from amaranth.lib.wiring import In, Out
+
+from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_coords, texel_shape
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import CACHE_DEFAULTS as SCENE_CACHE
+from bumprtl.rtl.scene import HardwareScene, check_scene
+
+__all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
+           "texel_byte_address", "tiled_image", "plru_victim", "plru_touch", "TextureCache",
+           "CACHE_DEFAULTS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry", "scene_levels",
+           "CACHE_LATENCY"]
+
+# Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits: the
+# lookup register, then the output register.
+CACHE_LATENCY = 2
+
+AXI_DATA_BITS = (32, 64)
+ARBURST_INCR = 1
+MAX_BURST = 256                     # AXI4 INCR: ARLEN + 1 <= 256 beats
+AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
+# sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
+CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
+                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"]}
+
+
+def _pow2(x):
+    return isinstance(x, int) and not isinstance(x, bool) and x >= 1 and not x & (x - 1)
+
+
+def _check_pow2(name, value, lo, hi):
+    if not _pow2(value) or not lo <= value <= hi:
+        raise BumpError(f"{name} must be a power of two in [{lo}, {hi}], got {value!r}", name)
+
+
+@dataclass(frozen=True)
+class CacheGeometry:
+    """The map in memory and the cache in front of it.
+
+    Parameters
+    ----------
+    texture_size : int
+        T, the side of mip level 0 (a power of two).
+    mip_levels : int
+        Levels stored, level l of side T >> l.
+    texel_bits : int
+        Bits of one stored texel (N' angle pair or palette index), <= ``data_bits``.
+    sets, ways, block : int
+        Powers of two: sets of the cache, lines a set, side of a line's square block.
+    data_bits : int
+        AXI RDATA width, 32 or 64.
+    base : int
+        Byte address of the image in the memory (a multiple of the line's bytes).
+    addr_bits : int
+        AXI ARADDR width; the image must end below 2**addr_bits.
+    """
+
+    texture_size: int
+    mip_levels: int
+    texel_bits: int
+    sets: int = CACHE_DEFAULTS["sets"]
+    ways: int = CACHE_DEFAULTS["ways"]
+    block: int = CACHE_DEFAULTS["block"]
+    data_bits: int = CACHE_DEFAULTS["data_bits"]
+    base: int = 0
+    addr_bits: int = 32
+
+    def __post_init__(self):
+        _check_pow2("texture_size", self.texture_size, 1, 1 << 16)
+        top = self.texture_size.bit_length()
+        if not isinstance(self.mip_levels, int) or not 1 <= self.mip_levels <= top:
+            raise BumpError(f"mip_levels must be an integer in [1, {top}], got "
+                            f"{self.mip_levels!r}", "mip_levels")
+        if self.data_bits not in AXI_DATA_BITS:
+            raise BumpError(f"data_bits must be one of 32, 64, got {self.data_bits!r}",
+                            "data_bits")
+        if not isinstance(self.texel_bits, int) or not 1 <= self.texel_bits <= self.data_bits:
+            raise BumpError(f"texel_bits must be an integer in [1, {self.data_bits}], got "
+                            f"{self.texel_bits!r}", "texel_bits")
+        _check_pow2("sets", self.sets, 1, 1 << 14)
+        _check_pow2("ways", self.ways, 1, 16)
+        _check_pow2("block", self.block, 2, min(16, self.texture_size))
+        if self.line_bytes < self.data_bits // 8 or self.beats > MAX_BURST \
+                or self.line_bytes > AXI_PAGE:
+            raise BumpError(f"block must make a line of {self.data_bits // 8} to "
+                            f"{min(AXI_PAGE, MAX_BURST * self.data_bits // 8)} bytes (one AXI "
+                            f"INCR burst), got {self.block} x {self.block} texels of "
+                            f"{self.slot_bytes} bytes", "block")
+        if not isinstance(self.base, int) or self.base < 0 or self.base % self.line_bytes:
+            raise BumpError(f"base must be a non-negative multiple of the line's "
+                            f"{self.line_bytes} bytes, got {self.base!r}", "base")
+        if not isinstance(self.addr_bits, int) or not 12 <= self.addr_bits <= 64:
+            raise BumpError(f"addr_bits must be an integer in [12, 64], got "
+                            f"{self.addr_bits!r}", "addr_bits")
+        if self.base + self.image_bytes > 1 << self.addr_bits:
+            raise BumpError(f"the map's image ends at byte {self.base + self.image_bytes}, "
+                            f"beyond the {self.addr_bits}-bit AXI address space (addr_bits "
+                            f"in [{(self.base + self.image_bytes - 1).bit_length()}, 64])",
+                            "addr_bits")
+
+    # --- the layout in memory ---
+    @property
+    def slot_bytes(self):
+        """Bytes of one texel slot: the least power of two >= texel_bits / 8."""
+        return 1 << max(0, (self.texel_bits - 1).bit_length() - 3)
+
+    @property
+    def block_bits(self):
+        return self.block.bit_length() - 1
+
+    @property
+    def line_texels(self):
+        return self.block * self.block
+
+    @property
+    def line_bytes(self):
+        return self.line_texels * self.slot_bytes
+
+    @property
+    def beats(self):
+        """Beats of one line's burst (ARLEN + 1)."""
+        return self.line_bytes * 8 // self.data_bits
+
+    @property
+    def slots_per_beat(self):
+        return self.data_bits // (8 * self.slot_bytes)
+
+    def level_side(self, level):
+        return self.texture_size >> level
+
+    def blocks_per_row(self, level):
+        return max(1, self.level_side(level) >> self.block_bits)
+
+    @property
+    def level_lines(self):
+        """The first line of each level (levels one after the other)."""
+        out, n = [], 0
+        for level in range(self.mip_levels):
+            out.append(n)
+            n += self.blocks_per_row(level) ** 2
+        return out
+
+    @property
+    def lines(self):
+        return self.level_lines[-1] + self.blocks_per_row(self.mip_levels - 1) ** 2
+
+    @property
+    def image_bytes(self):
+        return self.lines * self.line_bytes
+
+    # --- the cache ---
+    @property
+    def set_bits(self):
+        return self.sets.bit_length() - 1
+
+    @property
+    def tag_bits(self):
+        """Bits of a line's tag (line >> set_bits), at least 1."""
+        return max(1, (self.lines - 1).bit_length() - self.set_bits)
+
+    @property
+    def line_bits(self):
+        return max(1, (self.lines - 1).bit_length())
+
+    @property
+    def cache_bits(self):
+        """Block-RAM bits of the cache: data (ways x sets lines) and tags (+ valid bit)."""
+        return self.ways * self.sets * (self.line_bytes * 8 + self.tag_bits + 1)
+
+
+def _is_hdl(x):
+    return isinstance(x, (Value, ValueCastable))
+
+
+def tiled_layout(u, v, level, geom: CacheGeometry):
+    """``(line, slot)`` of texel (u, v) of constant mip ``level`` (level coordinates, in
+    [0, T >> level)): line = first line of the level + (v >> b) * blocks a row + (u >> b),
+    slot = (v mod B) * B + (u mod B) for blocks of B = 2**b. Amaranth values or int arrays."""
+    b, mask = geom.block_bits, geom.block - 1
+    row_bits = geom.blocks_per_row(level).bit_length() - 1
+    first = geom.level_lines[level]
+    if _is_hdl(u):
+        u, v = Value.cast(u), Value.cast(v)
+        side = geom.level_side(level).bit_length() - 1
+        inner = Cat(u[b:max(b, side)], v[b:max(b, side)]) if row_bits else Const(0, 1)
+        return inner + first, Cat(u[:b], v[:b])
+    u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
+    return first + ((v >> b) << row_bits) + (u >> b), ((v & mask) << b) | (u & mask)
+
+
+def texel_byte_address(u, v, level, geom: CacheGeometry):
+    """Byte address of texel (u, v) of ``level`` in the memory (int arrays)."""
+    line, slot = tiled_layout(u, v, level, geom)
+    return geom.base + line * geom.line_bytes + slot * geom.slot_bytes
+
+
+def tiled_image(geom: CacheGeometry, levels):
+    """The map's memory image (``bytes``, from ``base``: the image's first byte is at
+    ``base``): ``levels[l]`` is level l's texel words, a (T >> l) x (T >> l) array indexed
+    [v, u]; each word little-endian in its slot, unused slots zero."""
+    image = np.zeros(geom.lines * geom.line_texels, np.uint64)
+    for level in range(geom.mip_levels):
+        side = geom.level_side(level)
+        words = np.asarray(levels[level], np.int64)
+        if words.shape != (side, side):
+            raise BumpError(f"level {level} must be {side} x {side} texels, got "
+                            f"{words.shape}", "levels")
+        if words.size and (words.min() < 0 or words.max() >> geom.texel_bits):
+            raise BumpError(f"level {level} has words outside [0, 2**{geom.texel_bits})",
+                            "levels")
+        v, u = np.mgrid[0:side, 0:side]
+        line, slot = tiled_layout(u, v, level, geom)
+        image[line * geom.line_texels + slot] = words
+    dtype = {1: "<u1", 2: "<u2", 4: "<u4", 8: "<u8"}[geom.slot_bytes]
+    return image.astype(dtype).tobytes()
+
+
+def plru_victim(bits, ways):
+    """The way tree pseudo-LRU ``bits`` (an int, heap node n at bit n; 0: the left half is
+    older) point to."""
+    node = 0
+    for _ in range(ways.bit_length() - 1):
+        node = 2 * node + 1 + ((bits >> node) & 1)
+    return node - (ways - 1)
+
+
+def plru_touch(bits, way, ways):
+    """``bits`` after an access to ``way``: every node on its path points away from it."""
+    node, depth = 0, ways.bit_length() - 1
+    for level in range(depth):
+        d = (way >> (depth - 1 - level)) & 1
+        bits = (bits & ~(1 << node)) | ((1 - d) << node)
+        node = 2 * node + 1 + d
+    return bits
+
+
+def axi_read_signature(addr_bits, data_bits):
+    """An AXI4 read-only manager port (AR and R channels, the manager's view) with one ID:
+    ARID is 0 and RID is not read (bursts are served in order)."""
+    return wiring.Signature({
+        "arid": Out(1), "araddr": Out(addr_bits), "arlen": Out(8), "arsize": Out(3), "arburst": Out(2),
+        "arvalid": Out(1), "arready": In(1),
+        "rid": In(1), "rdata": In(data_bits), "rresp": In(2), "rlast": In(1), "rvalid": In(1),
+        "rready": Out(1)})
+
+
+class TextureCache(wiring.Component):
+    """Texel coordinates in, the stored texel word out, through a set-associative cache of
+    an AXI4 memory holding the map in the :func:`tiled_layout`.
+
+    Parameters
+    ----------
+    geom : CacheGeometry
+    extra : dict, optional
+        Payload fields (name -> shape) carried from ``i`` to ``o`` unchanged.
+
+    Members
+    -------
+    i : In(stream.Signature({u, v: unsigned(log2 T), level: unsigned (mip_levels > 1), extra}))
+        Coordinates of the level (already wrapped or clamped, in [0, T >> level)).
+    o : Out(stream.Signature({texel: unsigned(texel_bits), extra}))
+        Pixels in input order; ``o.valid``/``o.payload`` are a register.
+    axi : Out(axi_read_signature(addr_bits, data_bits))
+        The memory port: one INCR burst of ``beats`` beats per miss (ARLEN = beats - 1,
+        ARSIZE = log2(data_bits / 8)), ARVALID held with a stable payload until ARREADY,
+        RREADY high while a line fills, the fill ended by RLAST.
+
+    A pixel is looked up the cycle after it is taken (tags and data of every way read in
+    the cycle it is taken): a hit leaves for ``o`` and the next pixel is taken in the same
+    cycle, one pixel a clock while the pixels hit and ``o`` is taken; a miss holds the
+    pixel and drops ``i.ready`` while the line of the pseudo-LRU victim way is fetched, then
+    re-reads the set and hits. ``i.ready`` depends on the lookup and ``o.ready`` in the
+    same cycle (never on ``i.valid``). A miss costs 4 cycles plus the memory's AR-to-last-R
+    time. A reset invalidates every line: the tags are cleared one set a cycle (``sets``
+    cycles, ``i.ready`` low) before the first lookup; the map in memory must not change
+    between resets.
+    """
+
+    def __init__(self, geom: CacheGeometry, extra=None):
+        self.geom = geom
+        self.extra = dict(extra or {})
+        tb = geom.texture_size.bit_length() - 1
+        fields = {"u": unsigned(max(1, tb)), "v": unsigned(max(1, tb))}
+        if geom.mip_levels > 1:
+            fields["level"] = unsigned((geom.mip_levels - 1).bit_length())
+        super().__init__({
+            "i": In(stream.Signature(data.StructLayout({**fields, **self.extra}))),
+            "o": Out(stream.Signature(data.StructLayout({"texel": unsigned(geom.texel_bits),
+                                                         **self.extra}))),
+            "axi": Out(axi_read_signature(geom.addr_bits, geom.data_bits))})
+
+    def _locate(self, m, px):
+        """(line, slot) of the pixel ``px`` (a Switch on its level; past the last: the last)."""
+        g = self.geom
+        line, slot = Signal(g.line_bits), Signal(2 * g.block_bits)
+        if g.mip_levels == 1:
+            ln, sl = tiled_layout(px.u, px.v, 0, g)
+            m.d.comb += [line.eq(ln), slot.eq(sl)]
+            return line, slot
+        with m.Switch(px.level):
+            for level in range(g.mip_levels):
+                with (m.Case(level) if level < g.mip_levels - 1 else m.Default()):
+                    ln, sl = tiled_layout(px.u, px.v, level, g)
+                    m.d.comb += [line.eq(ln), slot.eq(sl)]
+        return line, slot
+
+    def elaborate(self, platform):
+        g = self.geom
+        m = Module()
+        spb = g.slots_per_beat
+        sel_bits = spb.bit_length() - 1           # slot within a data word
+
+        # --- memories: one tag and one data memory a way ---
+        tags, datas = [], []
+        for w in range(g.ways):
+            m.submodules[f"tag{w}"] = tmem = Memory(shape=g.tag_bits + 1, depth=g.sets, init=[])
+            m.submodules[f"data{w}"] = dmem = Memory(shape=g.data_bits, depth=g.sets * g.beats,
+                                                     init=[])
+            tags.append((tmem.read_port(), tmem.write_port()))
+            datas.append((dmem.read_port(), dmem.write_port()))
+
+        filling, replaying, flushing = Signal(), Signal(), Signal(init=1)
+        lookup = ~(self.axi.arvalid | filling | replaying | flushing)
+        flush_set = Signal(range(g.sets))
+        # --- the pixel under lookup ---
+        look_valid = Signal()
+        look_line = Signal(g.line_bits)
+        look_slot = Signal(2 * g.block_bits)
+        look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
+        in_line, in_slot = self._locate(m, self.i.payload)
+
+        def split(line, slot):
+            word = Cat(slot[sel_bits:], line[:g.set_bits]) if g.beats > 1 else line[:g.set_bits]
+            return line[:g.set_bits], line[g.set_bits:], word, slot[:sel_bits]
+
+        look_set, line_tag, look_word, look_sel = split(look_line, look_slot)
+        in_set, _, in_word, _ = split(in_line, in_slot)
+        if g.set_bits == 0:
+            look_set, in_set = Const(0, 1), Const(0, 1)
+        look_tag = Signal(g.tag_bits)          # as stored (a line index may have fewer bits)
+        m.d.comb += look_tag.eq(line_tag)
+
+        hits = Signal(g.ways)
+        for w, (rp, _) in enumerate(tags):
+            m.d.comb += hits[w].eq(rp.data[-1] & (rp.data[:g.tag_bits] == look_tag))
+        hit = hits.any()
+        hit_word = Signal(g.data_bits)
+        for w, (drp, _) in enumerate(datas):
+            with m.If(hits[w]):
+                m.d.comb += hit_word.eq(drp.data)
+        texel = Signal(g.texel_bits)
+        with m.Switch(look_sel):                 # the pixel's slot of the word (every case)
+            for k in range(spb):
+                with m.Case(k):
+                    m.d.comb += texel.eq(hit_word.word_select(k, g.data_bits // spb))
+
+        o_free = ~self.o.valid | self.o.ready
+        leave = lookup & look_valid & hit & o_free
+        m.d.comb += self.i.ready.eq(lookup & (~look_valid | (hit & o_free)))
+        take = self.i.valid & self.i.ready
+
+        # read addresses: the pixel taken, else the pixel held (re-read every cycle, so the
+        # lookup after a fill sees the line written)
+        for (trp, _), (drp, _) in zip(tags, datas, strict=True):
+            m.d.comb += [trp.addr.eq(Mux(take, in_set, look_set)),
+                         drp.addr.eq(Mux(take, in_word, look_word))]
+        with m.If(take):
+            m.d.sync += [look_valid.eq(1), look_line.eq(in_line), look_slot.eq(in_slot)]
+            m.d.sync += [look_extra[k].eq(self.i.payload[k]) for k in self.extra]
+        with m.Elif(leave):
+            m.d.sync += look_valid.eq(0)
+
+        with m.If(leave):
+            m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(texel)]
+            m.d.sync += [self.o.payload[k].eq(look_extra[k]) for k in self.extra]
+        with m.Elif(self.o.ready):
+            m.d.sync += self.o.valid.eq(0)
+
+        # --- replacement state: tree pseudo-LRU bits a set (LUT RAM, read in the cycle) ---
+        plru_width = max(1, g.ways - 1)
+        m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
+                                          attrs={"ram_style": "distributed"})
+        plru_r, plru_w = plru.read_port(domain="comb"), plru.write_port()
+        victim, touched = self._plru_hdl(plru_r.data, hits)
+        m.d.comb += [plru_r.addr.eq(look_set), plru_w.addr.eq(look_set),
+                     plru_w.data.eq(touched), plru_w.en.eq(leave if g.ways > 1 else 0)]
+        with m.If(flushing):                     # the flush clears the bits with the tags
+            m.d.comb += [plru_w.addr.eq(flush_set), plru_w.data.eq(0), plru_w.en.eq(1)]
+
+        # --- the miss: one INCR burst of the victim's line ---
+        fill_way = Signal(g.ways)                   # one-hot
+        line_shift = g.line_bytes.bit_length() - 1
+        beat = Signal(range(g.beats))
+        ax = self.axi
+        m.d.comb += [ax.arlen.eq(g.beats - 1), ax.arsize.eq((g.data_bits // 8).bit_length() - 1),
+                     ax.arburst.eq(ARBURST_INCR), ax.rready.eq(filling)]
+        beat_in = filling & ax.rvalid
+        for w, (_, dwp) in enumerate(datas):
+            m.d.comb += [dwp.addr.eq(Cat(beat, look_set) if g.beats > 1 else look_set),
+                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_way[w])]
+        # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
+        m.d.sync += flush_set.eq(flush_set + 1)
+        with m.If(flush_set == g.sets - 1):
+            m.d.sync += flushing.eq(0)
+        for w, (_, twp) in enumerate(tags):
+            m.d.comb += [twp.addr.eq(Mux(flushing, flush_set, look_set)),
+                         twp.data.eq(Mux(flushing, 0, Cat(look_tag, Const(1, 1)))),
+                         twp.en.eq(flushing | (beat_in & ax.rlast & fill_way[w]))]
+        # the states: lookup (none of these), AR offered, line filling, replay (one cycle)
+        m.d.sync += replaying.eq(beat_in & ax.rlast)
+        with m.If(lookup & look_valid & ~hit):
+            m.d.sync += [fill_way.eq(victim), ax.arvalid.eq(1), beat.eq(0),
+                         ax.araddr.eq(g.base + Cat(Const(0, line_shift), look_line))]
+        with m.If(ax.arvalid & ax.arready):
+            m.d.sync += [ax.arvalid.eq(0), filling.eq(1)]
+        with m.If(beat_in):
+            m.d.sync += beat.eq(beat + 1)
+            with m.If(ax.rlast):
+                m.d.sync += filling.eq(0)
+        return m
+
+    def _plru_hdl(self, bits, hits):
+        """:func:`plru_victim` (one-hot) and :func:`plru_touch` by the one-hot ``hits`` on
+        Amaranth values, with constant bit indices only (no shifter)."""
+        ways = self.geom.ways
+        depth = ways.bit_length() - 1
+
+        def victim(node, k):                 # the leaf under node n at depth k, one-hot
+            if k == depth:
+                return Const(1 << (node - (ways - 1)), ways)
+            return Mux(bits[node], victim(2 * node + 2, k + 1), victim(2 * node + 1, k + 1))
+
+        new = []
+        for n in range(ways - 1):
+            k = (n + 1).bit_length() - 1                     # depth of node n
+            span = ways >> k                                 # ways under it
+            first = (n - ((1 << k) - 1)) * span
+            left = hits[first:first + span // 2].any()
+            right = hits[first + span // 2:first + span].any()
+            new.append(Mux(left | right, left, bits[n]))     # point away from the way hit
+        return victim(0, 0), Cat(*new) if new else bits
+
+
+def scene_geometry(scene: HardwareScene, **cache):
+    """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
+    width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
+    ``axi_data_bits``), the parameters ``cache`` (sets, ways, block, data_bits, base,
+    addr_bits) overriding them."""
+    bits = Shape.cast(texel_shape(scene)).width
+    own = {"sets": scene.cache_sets, "ways": scene.cache_ways, "block": scene.cache_block,
+           "data_bits": scene.axi_data_bits}
+    return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **{**own, **cache})
+
+
+def scene_levels(scene: HardwareScene, words):
+    """The block-RAM image of a map (``bumpfetch.level_bases`` order) as one ``[v, u]``
+    array a level, what :func:`tiled_image` takes."""
+    words, out, base = np.asarray(words, np.int64), [], 0
+    for level in range(scene.mip_levels):
+        side = scene.texture_size >> level
+        out.append(words[base:base + side * side].reshape(side, side))
+        base += side * side
+    return out
+
+
+class AxiMapFetch(wiring.Component):
+    """BumpMapFetch's ports and function with the map in the user's memory: texel
+    coordinates are wrapped or clamped into their level (``bumpfetch.level_coords``, the
+    block-RAM fetch's own arithmetic) and looked up in a :class:`TextureCache`.
+
+    Parameters
+    ----------
+    scene : HardwareScene
+        ``map_memory = "axi"`` scenes (a varying N' map, per-pixel shading).
+    out_layout : data.StructLayout
+        As BumpMapFetch's: the fetched field plus fields carried unchanged.
+    cache : dict, optional
+        :class:`CacheGeometry` parameters (sets, ways, block, data_bits, base, addr_bits).
+
+    Members
+    -------
+    i : In(stream.Signature({u, v: signed(log2 T + 2), [level], <carried fields>}))
+    o : Out(stream.Signature(out_layout))
+    axi : Out(axi_read_signature(addr_bits, data_bits))
+
+    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss holds
+    the pixel and ``i.ready`` low while its line is read (:class:`TextureCache`). ``i.ready``
+    depends on the lookup in the same cycle (not a register as a credit edge's).
+    """
+
+    latency = CACHE_LATENCY
+
+    def __init__(self, scene: HardwareScene, out_layout, cache=None):
+        check_scene(self, scene)
+        self.scene, self.out_layout = scene, out_layout
+        self.geom = scene_geometry(scene, **(cache or {}))
+        self.field = fetched_field(scene)
+        g = self.geom
+        self.memories = {}                   # the cache's block RAM, as a Pipe records it
+        for w in range(g.ways):
+            for name, depth, width in ((f"cache_data{w}", g.sets * g.beats, g.data_bits),
+                                       (f"cache_tag{w}", g.sets, g.tag_bits + 1)):
+                self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
+                                       "bits": depth * width}
+        fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
+        if scene.mip_levels > 1:
+            fields["level"] = unsigned(level_bits(scene))
+        self.carried = {name: f.shape for name, f in out_layout if name != self.field}
+        super().__init__({
+            "i": In(stream.Signature(data.StructLayout({**fields, **self.carried}))),
+            "o": Out(stream.Signature(out_layout)),
+            "axi": Out(axi_read_signature(self.geom.addr_bits, self.geom.data_bits))})
+
+    def elaborate(self, platform):
+        m, scene = Module(), self.scene
+        m.submodules.cache = cache = TextureCache(self.geom, self.carried)
+        px, to = self.i.payload, cache.i.payload
+        last = scene.mip_levels - 1
+        if last == 0:
+            u_l, v_l = level_coords(px.u, px.v, 0, scene)
+            m.d.comb += [to.u.eq(u_l), to.v.eq(v_l)]
+        else:
+            with m.Switch(px.level):
+                for level in range(last + 1):
+                    with (m.Case(level) if level < last else m.Default()):
+                        u_l, v_l = level_coords(px.u, px.v, level, scene)
+                        m.d.comb += [to.u.eq(u_l), to.v.eq(v_l), to.level.eq(level)]
+        m.d.comb += [to[name].eq(px[name]) for name in self.carried]
+        m.d.comb += [cache.i.valid.eq(self.i.valid), self.i.ready.eq(cache.i.ready),
+                     self.o.valid.eq(cache.o.valid), cache.o.ready.eq(self.o.ready),
+                     self.o.payload[self.field].eq(cache.o.payload.texel)]
+        m.d.comb += [self.o.payload[name].eq(cache.o.payload[name]) for name in self.carried]
+        wiring.connect(m, wiring.flipped(self.axi), cache.axi)
+        return m

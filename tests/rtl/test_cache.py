@@ -1,0 +1,169 @@
+"""TextureCache (rtl/cache.py), and BumpPipeline with map_memory = "axi", in the Amaranth simulator against a Python AXI memory
+(sim/axi_memory.py): every texel bit-exact and the AR request stream equal to the golden
+cache model's (sim/golden/cache.py), under random input gaps, output backpressure, AR and R
+stalls and memory latencies, without deadlock; the AXI4 manager rules are checked every
+cycle by the memory."""
+
+import numpy as np
+import pytest
+
+from bumprtl.gen.cli.main import main
+from bumprtl.rtl.cache import (
+    CacheGeometry,
+    TextureCache,
+    scene_geometry,
+    scene_levels,
+    tiled_image,
+)
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.axi_memory import AxiReadMemory
+from bumprtl.sim.golden.cache import (
+    cache_stimulus,
+    random_levels,
+    run_cache,
+    run_scene_cache,
+    stream_cycles,
+)
+from bumprtl.sim.golden.fixed.pipeline import (
+    as_payload_list,
+    pipeline_fixed,
+    random_inputs,
+    random_map,
+)
+from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
+from bumprtl.sim.traffic import PATTERNS
+
+
+def check_cache(geom, n=150, pattern="both", latency=2, ar_stall=0.3, r_stall=0.3, seed=0):
+    """Run ``n`` pixels; assert bit-exact texels, tags in order and the golden AR stream.
+    Returns (golden run, cycles)."""
+    levels = random_levels(geom, seed)
+    u, v, level = cache_stimulus(geom, n, seed)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom, extra={"tag": 8})
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, geom.base,
+                        latency, ar_stall, r_stall, seed)
+    inputs = [{"u": int(u[k]), "v": int(v[k]), "tag": k & 255,
+               **({"level": int(level[k])} if geom.mip_levels > 1 else {})} for k in range(n)]
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed,
+                                  max_cycles=(n + 1) * (latency + 4 * geom.beats + 20),
+                                  processes=[mem.process])
+    assert [o["tag"] for o in out] == [k & 255 for k in range(n)]
+    bad = [k for k in range(n) if out[k]["texel"] != golden.texel[k]]
+    assert not bad, (f"{len(bad)} texels differ, first pixel {bad[0]}: RTL "
+                     f"{out[bad[0]]['texel']:#x}, golden {int(golden.texel[bad[0]]):#x}")
+    assert mem.requests == golden.requests
+    return golden, cycles
+
+
+@pytest.mark.parametrize("pattern", sorted(PATTERNS))
+def test_cache_bit_exact_default_geometry(pattern):
+    geom = CacheGeometry(64, 3, 28, sets=8, ways=2)
+    golden, _ = check_cache(geom, pattern=pattern, seed=len(pattern))
+    assert 0.3 < golden.hit_rate < 0.95 and golden.evictions      # both paths exercised
+
+
+@pytest.mark.parametrize("latency", [1, 7, 30])
+def test_cache_bit_exact_under_latency(latency):
+    geom = CacheGeometry(32, 2, 28, sets=4, ways=2, base=1 << 16)
+    check_cache(geom, n=100, latency=latency, seed=latency)
+
+
+@pytest.mark.parametrize("texel_bits,data_bits,ways,block", [(8, 32, 4, 4), (16, 64, 4, 4),
+                                                             (28, 64, 1, 4), (8, 64, 2, 8)])
+def test_cache_bit_exact_geometries(texel_bits, data_bits, ways, block):
+    """Several texels a beat (slot select), 4-way pseudo-LRU, direct-mapped (one level),
+    8 x 8 lines."""
+    geom = CacheGeometry(64, 1 if ways == 1 else 4, texel_bits, sets=4, ways=ways, block=block, data_bits=data_bits)
+    golden, _ = check_cache(geom, n=120, seed=texel_bits + ways)
+    assert golden.evictions
+
+
+def test_cache_hits_at_one_pixel_a_clock():
+    """A scan the cache holds after its first pass: the second pass hits every pixel and
+    takes one cycle a pixel (no input gaps, no backpressure)."""
+    geom = CacheGeometry(16, 1, 28, sets=16, ways=1)
+    v, u = np.mgrid[0:16, 0:16]
+    levels = random_levels(geom)
+    one = [{"u": int(a), "v": int(b)} for a, b in zip(u.ravel(), v.ravel(), strict=True)]
+    cycles = []
+    for inputs in (one, one + one):
+        dut = TextureCache(geom)
+        mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), 32)
+        out, n = simulate_stream(dut, inputs, processes=[mem.process])
+        assert [o["texel"] for o in out] == [int(w) for w in levels[0].ravel()] * (len(inputs) // 256)
+        assert len(mem.requests) == geom.lines
+        cycles.append(n)
+    assert cycles[1] - cycles[0] == len(one)
+
+
+@pytest.mark.parametrize("latency", [1, 9])
+@pytest.mark.parametrize("geom", [CacheGeometry(64, 3, 28, sets=8),
+                                  CacheGeometry(64, 3, 8, sets=4, data_bits=64)])
+def test_cycle_model_counts_the_rtl_cycles(geom, latency):
+    """sim/golden/cache.stream_cycles (what bumprtl bench memory reports) is the RTL's count
+    for a stall-free memory and sink: the reset's flush (sets cycles) and the 2-cycle
+    latency aside, exactly one cycle a pixel plus miss_cycles a miss."""
+    levels = random_levels(geom)
+    u, v, level = cache_stimulus(geom, 80, latency)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
+    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
+    _, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
+    assert cycles == geom.sets + stream_cycles(golden, geom, latency) + 2
+
+
+# The default scene at small widths, two levels, wrap; the same with clamp addressing.
+AXI_SCENE = {"texture_size": 16, "angle_bits": 8, "frac_bits": 8, "tag_bits": 6, "mip_levels": 2,
+             "map_memory": "axi"}
+
+
+@pytest.mark.parametrize("base,addressing,latency,pattern,data_bits", [
+    ("default", "wrap", 2, "both", 32), ("default", "clamp", 20, "both", 32),
+    ("default", "wrap", 60, "backpressure", 32), ("two-lights", "clamp", 7, "both", 64)])
+def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, pattern,
+                                                     data_bits):
+    """BumpPipeline with map_memory = "axi": its outputs bit-exact with the golden pipeline
+    (the same model as the block-RAM map's), the AR stream the golden cache model's, under
+    AR/R stalls, input gaps and backpressure; a miss stalls only the front. Two lights take
+    the pipeline's layered wiring (the default scene its direct chain)."""
+    scene = load_scene_config({**BUILTIN[base], **AXI_SCENE, "addressing": addressing})
+    rng = np.random.default_rng(latency)
+    words = random_map(scene, rng)
+    inputs = random_inputs(scene, 80, rng)
+    dut = BumpPipeline(scene.hardware, cache={"sets": 4, "data_bits": data_bits})
+    geom = dut.units["fetch"].geom
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
+                        latency=latency, ar_stall=0.3, r_stall=0.3, seed=latency)
+    payloads = as_payload_list(inputs)
+    out, _ = simulate_stream(dut, payloads, pattern, seed=latency, max_cycles=40_000,
+                             processes=[mem.process])
+    assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
+    golden = run_scene_cache(scene.hardware, geom, inputs, words)
+    assert mem.requests == golden.requests and golden.evictions
+
+
+def test_map_memory_refusals():
+    with pytest.raises(BumpError, match="map_memory must be one of bram, axi"):
+        load_scene_config({"map_memory": "dram"})
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs shading = 'per-pixel'"):
+        load_scene_config({"map_memory": "axi", "texture": True})
+    with pytest.raises(BumpError, match="cache_ways: ways must be a power of two"):
+        load_scene_config({"map_memory": "axi", "cache_ways": 3})
+    with pytest.raises(BumpError, match="cache_sets = 16 applies to map_memory = 'axi'"):
+        load_scene_config({"cache_sets": 16})
+    scene = load_scene_config({"map_memory": "axi", "cache_sets": 16, "axi_data_bits": 64})
+    assert (scene_geometry(scene.hardware).sets, scene_geometry(scene.hardware).beats) == (16, 8)
+    bram = BumpPipeline(load_scene_config({}).hardware)
+    bram._MustUse__silence = True                 # built for its ports only
+    assert "axi" not in bram.signature.members
+
+
+def test_cli_refuses_a_cache_larger_than_the_block_ram(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-sets", "4096",
+                 "--cache-ways", "16", "--out", str(out)]) == 2
+    assert "fewer sets or ways" in capsys.readouterr().err and not out.exists()

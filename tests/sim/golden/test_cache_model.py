@@ -1,0 +1,109 @@
+"""The tiled layout (rtl/cache.tiled_layout) and the golden cache model (sim/golden/cache.py):
+the layout is a bijection onto the image that :func:`tiled_image` writes, read back through
+an independent per-texel formula; the model's hit rate on scans and its evictions follow
+the stated pseudo-LRU."""
+
+import numpy as np
+import pytest
+
+from bumprtl.rtl.cache import (
+    CacheGeometry,
+    plru_touch,
+    plru_victim,
+    texel_byte_address,
+    tiled_image,
+)
+from bumprtl.rtl.config import BumpError
+from bumprtl.sim.golden.cache import CacheModel, random_levels, run_cache
+
+
+def reference_address(u, v, level, g):
+    """Plain Python: the byte of texel (u, v) of ``level``: whole lines of the earlier levels
+    (at least one each), then block row, block column, row and column inside the block."""
+    before = sum(max(1, (g.texture_size >> n) // g.block) ** 2 for n in range(level))
+    per_row = max(1, (g.texture_size >> level) // g.block)
+    line = before + (v // g.block) * per_row + u // g.block
+    slot = (v % g.block) * g.block + u % g.block
+    return g.base + line * g.line_bytes + slot * g.slot_bytes
+
+
+@pytest.mark.parametrize("texel_bits,block,levels", [(28, 4, 5), (8, 4, 6), (16, 8, 3), (28, 2, 1)])
+def test_layout_round_trip(texel_bits, block, levels):
+    g = CacheGeometry(texture_size=32, mip_levels=levels, texel_bits=texel_bits, block=block,
+                      base=4096)
+    words = random_levels(g, texel_bits)
+    image = tiled_image(g, words)
+    assert len(image) == g.image_bytes
+    seen = set()
+    for lv in range(levels):
+        side = g.level_side(lv)
+        v, u = np.mgrid[0:side, 0:side]
+        addr = texel_byte_address(u, v, lv, g)
+        for uu, vv, a in zip(u.ravel(), v.ravel(), addr.ravel(), strict=True):
+            assert a == reference_address(int(uu), int(vv), lv, g)
+            off = int(a) - g.base
+            got = int.from_bytes(image[off:off + g.slot_bytes], "little")
+            assert got == words[lv][vv, uu], (lv, uu, vv)
+            seen.add(off)
+    assert len(seen) == sum(g.level_side(lv) ** 2 for lv in range(levels))   # a bijection
+
+
+def test_geometry_refusals():
+    with pytest.raises(BumpError, match="ways must be a power of two"):
+        CacheGeometry(64, 1, 28, ways=3)
+    with pytest.raises(BumpError, match="data_bits must be one of 32, 64"):
+        CacheGeometry(64, 1, 28, data_bits=128)
+    with pytest.raises(BumpError, match="addr_bits"):
+        CacheGeometry(4096, 1, 28, addr_bits=20)
+    with pytest.raises(BumpError, match="block must make a line"):
+        CacheGeometry(64, 1, 8, block=2, data_bits=64)        # 4 bytes < one 8-byte beat
+
+
+def test_plru_is_lru_for_two_ways_and_tree_for_four():
+    bits = plru_touch(0, 0, 2)
+    assert plru_victim(bits, 2) == 1
+    assert plru_victim(plru_touch(bits, 1, 2), 2) == 0
+    bits = 0
+    for way in (0, 1, 2, 3):
+        bits = plru_touch(bits, way, 4)
+    assert plru_victim(bits, 4) == 0          # least recently used of the four
+    bits = plru_touch(bits, 0, 4)
+    assert plru_victim(bits, 4) == 2          # the tree: the other half's older leaf
+
+
+def test_evictions_follow_lru():
+    """Three lines of one set in a 2-way cache, A B A C: C evicts B (the least recent)."""
+    g = CacheGeometry(64, 1, 28, sets=4, ways=2)
+    model = CacheModel(g)
+    a, b, c = 1, 1 + 4, 1 + 8
+    assert model.access(a)[0] is False and model.access(b)[0] is False
+    assert model.access(a) == (True, 0, None)
+    hit, way, evicted = model.access(c)
+    assert (hit, way, evicted) == (False, 1, b)
+    assert model.access(a)[0] is True and model.access(b)[0] is False
+
+
+def test_scan_hit_rate_and_requests():
+    """A raster scan of a 64 x 64 level 0 that fits the cache: one miss a line (1/16 of the
+    pixels with 4 x 4 blocks), each request the line's first byte and a 16-beat burst."""
+    g = CacheGeometry(64, 1, 28, sets=128, ways=2)
+    v, u = np.mgrid[0:64, 0:64]
+    run = run_cache(g, u.ravel(), v.ravel(), np.zeros(u.size, int), random_levels(g))
+    assert run.hit_rate == 1 - 1 / 16
+    assert len(run.requests) == g.lines == 256 and not run.evictions
+    assert sorted(run.requests) == [(n * 64, 15) for n in range(256)]
+    assert run.bytes_fetched == 64 * 64 * 4
+
+
+def test_scan_of_a_map_larger_than_the_cache_evicts():
+    """The same scan of 256 x 256 through 16 sets x 2 ways: a block row (64 lines) does not
+    fit, so every texel row refetches its lines: a hit rate of 3/4, one eviction a miss
+    after the first 32."""
+    g = CacheGeometry(256, 1, 28, sets=16, ways=2)
+    v, u = np.mgrid[0:256, 0:256]
+    run = run_cache(g, u.ravel(), v.ravel(), np.zeros(u.size, int), random_levels(g))
+    assert run.hit_rate == 3 / 4
+    assert len(run.evictions) == len(run.requests) - 32
+    levels = random_levels(g, 5)
+    assert (run_cache(g, u.ravel(), v.ravel(), np.zeros(u.size, int), levels).texel
+            == levels[0][v.ravel(), u.ravel()]).all()
