@@ -19,7 +19,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from amaranth.back import verilog
-from amaranth.hdl import Module
+from amaranth.hdl import Const, Module, Signal, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -29,12 +29,20 @@ from bumprtl.gen.tools.toolchain import require, tool_env
 from bumprtl.gen.tools.yosys import run_yosys
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.illumination import Illumination
-from bumprtl.rtl.pipe import ECP5, EDGE_LATENCY, add_credit_edge, min_fifo_depth
+from bumprtl.rtl.pipe import (
+    ECP5,
+    EDGE_LATENCY,
+    RegisteredProduct,
+    RegisteredROM,
+    add_credit_edge,
+    min_fifo_depth,
+)
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import METHODS
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",
-           "Placement", "place_text", "place_component", "placement_key"]
+           "Placement", "place_text", "place_component", "placement_key", "PRIMITIVES",
+           "primitive_component"]
 
 # Device name -> nextpnr-ecp5 flag. All three come in the CABGA381 package.
 DEVICES = {"LFE5U-25F": "--25k", "LFE5U-45F": "--45k", "LFE5U-85F": "--85k"}
@@ -152,6 +160,50 @@ def pipeline_component(cfg, target=None):
             return m
 
     return Pipeline()
+
+
+# The registered primitives every design is built from, each placed alone between
+# flip-flops by primitive_component: the ceiling a design of them can reach on a device.
+PRIMITIVES = {
+    "dp16kd": "a 1024 x 18 DP16KD ROM with its output register (REGMODE OUTREG), read every "
+              "cycle: address from a register, word into a register",
+    "mult18x18d": "an 18 x 18 signed MULT18X18D with its input and output registers, "
+                  "operands from registers, product into a register",
+}
+
+
+def primitive_component(kind):
+    """One registered primitive of :data:`PRIMITIVES` alone (``kind``), in its ECP5 form,
+    between flip-flops: input ``i`` (registered), output ``o`` (registered). Its placed
+    Fmax is the primitive's own ceiling in nextpnr's timing model (no fan-out, no logic)."""
+    if kind not in PRIMITIVES:
+        raise BumpError(f"primitive must be one of {', '.join(PRIMITIVES)}, got {kind!r}")
+
+    class Alone(wiring.Component):
+        def __init__(self):
+            self.target = ECP5()
+            width = 10 if kind == "dp16kd" else 36
+            super().__init__({"i": In(width), "o": Out(36 if kind == "mult18x18d" else 18)})
+
+        def elaborate(self, platform):
+            m = Module()
+            src = Signal.like(self.i, name="src")
+            m.d.sync += src.eq(self.i)
+            if kind == "dp16kd":
+                table = [(a * 2654435761) >> 14 & 0x3FFFF for a in range(1024)]
+                m.submodules.rom = rom = RegisteredROM(table, unsigned(18), 1, "rom",
+                                                       target=self.target)
+                m.d.comb += [rom.en.eq(Const(1)), rom.ports[0].addr.eq(src)]
+                value = rom.ports[0].data
+            else:
+                m.submodules.product = unit = RegisteredProduct(signed(18), signed(18),
+                                                                "product", target=self.target)
+                m.d.comb += [unit.a.eq(src[:18]), unit.b.eq(src[18:]), unit.en.eq(Const(1))]
+                value = unit.p
+            m.d.sync += self.o.eq(value)
+            return m
+
+    return Alone()
 
 
 CACHE = Path("build/fpga_cache")

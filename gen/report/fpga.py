@@ -15,12 +15,14 @@ from bumprtl.gen.flow.fpga import (
     DEVICES,
     NOT_PLACED,
     PACKAGE,
+    PRIMITIVES,
     FpgaError,
     Placement,
     check_device,
     lpf_mhz,
     pipeline_component,
     place_text,
+    primitive_component,
 )
 from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
@@ -86,6 +88,8 @@ def fpga_run(cfg, run: FpgaRun):
 def _component(design, row, cfg):
     """The ECP5 form (``target=ECP5()``) of row ``row`` of ``design`` (a method name)."""
     target = ECP5()
+    if row.startswith("primitive:"):   # one registered primitive alone: the ceiling
+        return primitive_component(row.split(":", 1)[1])
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
         return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
     cfg = cfg.replace(method=design)
@@ -99,7 +103,16 @@ def fpga_report(cfg, run: FpgaRun, units):
     and write ``run.out`` (markdown table + cost-against-error plot). Each placement not in
     the cache (``run.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
     ``run.jobs`` workers, or ``run.scheduler``'s."""
-    placed = place_all(cfg, run, [(u, seed) for u in units for seed in _row_seeds(run, u[2])])
+    prims = [] if run.unit else [(f"{k}_alone", None, f"primitive:{k}") for k in PRIMITIVES]
+    placed = place_all(cfg, run, [(u, seed) for u in units + prims
+                                  for seed in _row_seeds(run, u[2])])
+    ceilings = {}
+    for label, design, row in prims:
+        ok = [r for s in _row_seeds(run, row)
+              if "error" not in (r := placed[((label, design, row), s)])]
+        if ok:
+            ceilings[row.split(":", 1)[1]] = {**worst_run(ok),
+                                              "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}}
     rows = []
     for label, design, row in units:
         runs = [placed[((label, design, row), s)] for s in _row_seeds(run, row)]
@@ -112,7 +125,7 @@ def fpga_report(cfg, run: FpgaRun, units):
                          "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}})
         print(f"{label}: {rows[-1]}", flush=True)
     acc = {d: accuracy(d, cfg, run.samples) for d in {r["design"] for r in rows}}
-    write_report(run, rows, acc, cfg)
+    write_report(run, rows, acc, cfg, ceilings)
 
 
 def worst_run(runs):
@@ -172,7 +185,32 @@ def _row_seeds(run, row):
     return list(scene) if scene and row.startswith("scene:") else seeds
 
 
-def write_report(run: FpgaRun, rows, acc, cfg):
+def _ceiling_lines(rows, ceilings):
+    """The section on the primitives placed alone, and how far each row under its target
+    is from the lower of their Fmax."""
+    if not ceilings:
+        return []
+    lines = ["", "## The primitives' own ceiling", "",
+             "Each registered primitive placed alone between flip-flops, same flow and seeds "
+             "(`gen/flow/fpga.primitive_component`): the Fmax nextpnr's timing model gives a "
+             "design of these primitives that has no fan-out, no logic and no distance.", "",
+             "| primitive | placed alone | Fmax (MHz) | Fmax by seed | path |", "|---|---|---|---|---|"]
+    for kind, r in ceilings.items():
+        lines.append(f"| {kind.upper()} | {PRIMITIVES[kind]} | {r['fmax_mhz']} | "
+                     + ", ".join(f"{k}: {v}" for k, v in sorted(r["fmax_by_seed"].items()))
+                     + f" | {r['critical_path']} |")
+    low = min(ceilings.values(), key=lambda r: r["fmax_mhz"] or 0)
+    under = [r for r in rows if "error" not in r and not r["met"]]
+    if under and low["fmax_mhz"]:
+        lines += ["", f"Rows under the target, as a share of the lower ceiling "
+                  f"({low['unit']}, {low['fmax_mhz']} MHz): "
+                  + "; ".join(f"{r['unit']} {r['fmax_mhz']} MHz "
+                              f"({100 * r['fmax_mhz'] / low['fmax_mhz']:.0f} %)" for r in under)
+                  + ". What binds each is its critical path above."]
+    return lines
+
+
+def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None):
     out = Path(run.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot = out.parent / "img" / "cost_vs_error.png"
@@ -210,6 +248,7 @@ def write_report(run: FpgaRun, rows, acc, cfg):
     lines += ["", "## Critical paths", "",
               "nextpnr's worst register-to-register path of each unit (start -> end cell.port):", ""]
     lines += [f"- {r['unit']}: {r['critical_path']}" for r in rows if "error" not in r]
+    lines += _ceiling_lines(rows, ceilings or {})
     target = [r for r in rows if r["unit"] == "exact_pipeline"]
     if target:
         r = target[0]
@@ -338,13 +377,29 @@ FPGA_NOTES = """
   (`rtl/sincos.sine_line`, `rtl/tables.quarter_sine_above_line`): seven 8192 x 2 blocks
   instead of nine, 148 and 129 DP16KD instead of 182 and 163. The read adds the line, a
   shift of the address, back in one carry chain: the quadrant's sign is folded into the
-  word's data register and into the line a stage ahead (`-(a + b) = ~a + ~b + 2`). Its
-  reads keep the second address register beside the blocks (`rtl/targets.NEAR_BLOCKS`:
-  more than six blocks; one more stage in the rotation and the light terms); without it
-  the angle -> mirrored address route held scene_full at 149.7 MHz, and with the sign
-  still in the sum's stage the data register -> sum route held scene_two_lights at
-  144.3 MHz (seed 2; docs/fixed_point.md has the table). Rows whose memories are at most
-  six blocks wide are unchanged.
+  word's data register and into the line a stage ahead (`-(a + b) = ~a + ~b + 2`); with
+  the sign still in the sum's stage the data register -> sum route held scene_two_lights
+  at 144.3 MHz (seed 2; docs/fixed_point.md has the table).
+- For 200 MHz (seed 1 placements of single rows, `bumprtl report fpga --device LFE5U-85F
+  --unit <row> --seeds 1`, each step measured after the one before): the edge's LUT-RAM
+  FIFO has one read pointer per 16 bits of the pixel (`rtl/pipe.READ_SLICE`), where one
+  pointer's fan-out to every bit held exact_pipeline, scene_default, scene_diffuse and
+  scene_flat near 188 MHz (`edge.fifo_read -> o__payload`); every sine read registers the
+  ROM's word twice, beside the block RAM and beside the adder (the word's route to the
+  sign's sum held exact_pipeline at 188.9 MHz), and takes the near address register
+  (`rtl/targets.NEAR_BLOCKS` = 0: every sine ROM; the angle -> mirrored address route held
+  scene_default at 195.6 and scene_diffuse at 194.3 MHz); a cosine adds its quarter turn
+  to the two quadrant bits after the angle register instead of to the angle before it
+  (two carry chains in a cycle held scene_default at 204.0 and scene_full at 182.0 MHz);
+  the exact rotation's n'' sums are registered once more before they fan out to every
+  light's products (the sums' route held scene_full at 157.2 and scene_two_lights at
+  174.9 MHz); the light sum and the blend register 255 D before its rounding
+  (scene_textured at 188.8 MHz). Each adds a stage where it sits: the exact sine reads two
+  (Lee's and Kim's one),
+  the rotation one more; the blend and light-sum latencies are unchanged.
+- The primitives' own ceiling above is nextpnr's timing model of one DP16KD or
+  MULT18X18D between flip-flops; Lattice's datasheet figures for the primitives are not
+  in that model and not quoted here.
 - The `<method>_pipeline` rows chain the method's two units the same way, free-running
   behind one credit edge (`gen/flow/fpga.pipeline_component`); with `wiring.connect`
   each unit's `adv = ~o.valid | o.ready` once chained through both, and where

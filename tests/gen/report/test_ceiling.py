@@ -1,0 +1,46 @@
+"""The primitives' own ceiling in docs/report.md (gen/report/fpga._ceiling_lines) and the
+designs it places (gen/flow/fpga.primitive_component): one primitive between flip-flops."""
+
+import re
+
+import pytest
+from amaranth.back import verilog
+
+from bumprtl.gen.flow.fpga import PRIMITIVES, primitive_component
+from bumprtl.gen.report.fpga import _ceiling_lines
+from bumprtl.rtl.config import BumpError
+
+
+def _row(unit, fmax, met, target=200.0):
+    return {"unit": unit, "fmax_mhz": fmax, "met": met, "target_mhz": target,
+            "critical_path": "a.Q -> b.D (1.00 ns logic + 1.00 ns routing)"}
+
+
+def test_rows_under_the_target_as_a_share_of_the_lower_ceiling():
+    ceilings = {"dp16kd": {**_row("dp16kd_alone", 400.0, True), "fmax_by_seed": {1: 400.0, 2: 410.0}},
+                "mult18x18d": {**_row("mult18x18d_alone", 300.0, True), "fmax_by_seed": {1: 300.0}}}
+    rows = [_row("scene_a", 150.0, False), _row("scene_b", 250.0, True), _row("scene_c", 199.9, False)]
+    text = "\n".join(_ceiling_lines(rows, ceilings))
+    assert "| DP16KD |" in text and "| 400.0 | 1: 400.0, 2: 410.0 |" in text
+    # the lower ceiling is the DSP's 300 MHz: 150 is half of it, 199.9 two thirds
+    assert "lower ceiling (mult18x18d_alone, 300.0 MHz)" in text
+    assert "scene_a 150.0 MHz (50 %)" in text and "scene_c 199.9 MHz (67 %)" in text
+    assert "scene_b" not in text                                   # met: not listed
+    assert _ceiling_lines(rows, {}) == []
+
+
+@pytest.mark.parametrize("kind, cell, registers", [
+    ("dp16kd", "DP16KD", ['.REGMODE_A("OUTREG")']),
+    ("mult18x18d", "MULT18X18D", ['.REG_INPUTA_CLK("CLK0")', '.REG_INPUTB_CLK("CLK0")',
+                                  '.REG_OUTPUT_CLK("CLK0")'])])
+def test_each_primitive_alone_is_its_registered_ecp5_cell(kind, cell, registers):
+    text = verilog.convert(primitive_component(kind), name=f"{kind}_alone", emit_src=False)
+    assert len(re.findall(rf"^\s*{cell} ", text, re.M)) == 1, text   # one cell, nothing else
+    for register in registers:                                   # with its own registers
+        assert register in text, register
+    assert kind in PRIMITIVES
+
+
+def test_an_unknown_primitive_is_refused_in_one_line():
+    with pytest.raises(BumpError, match="primitive must be one of dp16kd, mult18x18d, got 'lut4'"):
+        primitive_component("lut4")
