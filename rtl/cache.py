@@ -631,9 +631,10 @@ class AxiMapFetch(wiring.Component):
     o : Out(stream.Signature(out_layout))
     axi : Out(axi_read_signature(addr_bits, data_bits))
 
-    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss holds
-    the pixel and ``i.ready`` low while its line is read (:class:`TextureCache`). ``i.ready``
-    depends on the lookup in the same cycle (not a register as a credit edge's).
+    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss
+    issues its line's burst and queues the pixel, and the pixels behind it go on being
+    looked up (:class:`TextureCache`); ``i.ready`` falls while the looked-up pixel has to
+    wait, and depends on the lookup in the same cycle (not a register as a credit edge's).
     """
 
     latency = CACHE_LATENCY
@@ -650,6 +651,12 @@ class AxiMapFetch(wiring.Component):
                                        (f"cache_tag{w}", g.sets, g.tag_bits + 1)):
                 self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
                                        "bits": depth * width}
+        queue = TextureCache.queue_layout(g, {name: f.shape for name, f in out_layout
+                                              if name != fetched_field(scene)}).size
+        for name, depth, width in (("cache_queue", g.queue, queue),
+                                   ("cache_stamps", g.sets, g.ways * g.stamp_bits)):
+            self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
+                                   "bits": depth * width}
         fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
         if scene.mip_levels > 1:
             fields["level"] = unsigned(level_bits(scene))
