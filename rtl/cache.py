@@ -57,7 +57,7 @@ AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
 # sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
 CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
                   "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"],
-                  "queue": 128, "misses": 16}
+                  "queue": 256, "misses": 64}
 
 
 def _pow2(x):

@@ -227,8 +227,10 @@ the memory's bandwidth: a miss costs `beats` cycles of the R channel whatever th
 so a stream that misses more than once per `beats` pixels runs at the memory's pace
 (exact 4 x 4 lines of a 1024² map in the 64 x 2 cache: 16 beats every 4th pixel, 4 cycles a
 pixel). A raster scan of a map wider than the cache refetches each line for every texel
-row of its block. At L = 60 a stream that misses often is also held by the
-{d["misses"]} bursts outstanding (Little's law: {d["misses"]} lines every L + beats cycles).
+row of its block. The loss left at L = 60 is the queue's: a run of misses faster than the
+memory (the first texel row of each block row) fills its {d["queue"]} entries, and the
+latency shows once it is full. Fewer entries, or fewer bursts outstanding, hide less
+(Little's law: {d["queue"]} pixels, or {d["misses"]} lines, every L + beats cycles).
 
 ![throughput against latency]({plot})
 
