@@ -126,8 +126,9 @@ def stream_cycles(run, geom: CacheGeometry, latency):
 class CacheModel:
     """The cache's state: the line held by each (set, way), or None, and the pseudo-LRU bits
     of each set. :meth:`access` of one pixel's (line) returns ``(hit, way, evicted line or
-    None)`` and updates the state as the RTL does: a miss fills the victim way, then the
-    pixel hits there (the RTL's replay), and the hit turns the set's bits from that way."""
+    None)`` and updates the state as the RTL does at the lookup: a miss gives the victim way
+    to the line (the RTL writes the tag then; the burst fills the line later), and the
+    access turns the set's bits from the way it used."""
 
     def __init__(self, geom: CacheGeometry):
         self.geom = geom
