@@ -523,9 +523,11 @@ class TextureCache(wiring.Component):
         beat_in = ax.rready & ax.rvalid
         line_in = beat_in & ax.rlast
         fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
+        fill_hot = Signal(g.ways)                  # one-hot by a shift: lint-clean Verilog
+        m.d.comb += fill_hot.eq(Const(1, g.ways) << f_r.data.way[:max(1, g.way_bits)])
         for w, (_, dwp) in enumerate(datas):
             m.d.comb += [dwp.addr.eq(Cat(beat, fill_set) if g.beats > 1 else fill_set),
-                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & (f_r.data.way == w))]
+                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_hot[w])]
         with m.If(beat_in):
             m.d.sync += beat.eq(beat + 1)
         with m.If(line_in):
@@ -552,8 +554,10 @@ class TextureCache(wiring.Component):
             m.d.sync += [rd_valid.eq(pop), rd_way.eq(head.way), rd_sel.eq(head.sel)]
             m.d.sync += [rd_extra[k].eq(head[k]) for k in self.extra]
         word = Signal(g.data_bits)
+        rd_hot = Signal(g.ways)
+        m.d.comb += rd_hot.eq(Const(1, g.ways) << rd_way)
         for w, (drp, _) in enumerate(datas):
-            with m.If(rd_way == w):
+            with m.If(rd_hot[w]):
                 m.d.comb += word.eq(drp.data)
         texel = Signal(g.texel_bits)
         with m.Switch(rd_sel[:sel_bits] if sel_bits else Const(0, 1)):   # the pixel's slot
