@@ -46,9 +46,9 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "CACHE_DEFAULTS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry", "scene_levels",
            "CACHE_LATENCY"]
 
-# Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits: the
-# lookup register, then the output register.
-CACHE_LATENCY = 2
+# Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
+# queue is empty: the lookup register, the queue's read, the data read, the output register.
+CACHE_LATENCY = 4
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -56,7 +56,8 @@ MAX_BURST = 256                     # AXI4 INCR: ARLEN + 1 <= 256 beats
 AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
 # sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
 CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
-                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"]}
+                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"],
+                  "queue": 256, "misses": 64}
 
 
 def _pow2(x):
@@ -88,6 +89,11 @@ class CacheGeometry:
         Byte address of the image in the memory (a multiple of the line's bytes).
     addr_bits : int
         AXI ARADDR width; the image must end below 2**addr_bits.
+    queue : int
+        Pixels the non-blocking cache holds between its lookup and its output (a power of
+        two): what hides the memory's latency (docs/memory.md).
+    misses : int
+        Line fills (AXI bursts) outstanding at most (a power of two).
     """
 
     texture_size: int
@@ -99,6 +105,8 @@ class CacheGeometry:
     data_bits: int = CACHE_DEFAULTS["data_bits"]
     base: int = 0
     addr_bits: int = 32
+    queue: int = CACHE_DEFAULTS["queue"]
+    misses: int = CACHE_DEFAULTS["misses"]
 
     def __post_init__(self):
         _check_pow2("texture_size", self.texture_size, 1, 1 << 16)
@@ -127,6 +135,8 @@ class CacheGeometry:
         if not isinstance(self.addr_bits, int) or not 12 <= self.addr_bits <= 64:
             raise BumpError(f"addr_bits must be an integer in [12, 64], got "
                             f"{self.addr_bits!r}", "addr_bits")
+        _check_pow2("queue", self.queue, 2, 1024)
+        _check_pow2("misses", self.misses, 1, 64)
         if self.base + self.image_bytes > 1 << self.addr_bits:
             raise BumpError(f"the map's image ends at byte {self.base + self.image_bytes}, "
                             f"beyond the {self.addr_bits}-bit AXI address space (addr_bits "
@@ -196,6 +206,16 @@ class CacheGeometry:
     @property
     def line_bits(self):
         return max(1, (self.lines - 1).bit_length())
+
+    @property
+    def way_bits(self):
+        return self.ways.bit_length() - 1
+
+    @property
+    def stamp_bits(self):
+        """Bits of the sequence numbers of queued pixels (a stamp a line): wide enough that
+        a stale stamp rarely looks queued (that only delays a miss until the queue drains)."""
+        return max(16, self.queue.bit_length() + 1)
 
     @property
     def cache_bits(self):
@@ -280,8 +300,8 @@ def axi_read_signature(addr_bits, data_bits):
 
 
 class TextureCache(wiring.Component):
-    """Texel coordinates in, the stored texel word out, through a set-associative cache of
-    an AXI4 memory holding the map in the :func:`tiled_layout`.
+    """Texel coordinates in, the stored texel word out, through a non-blocking
+    set-associative cache of an AXI4 memory holding the map in the :func:`tiled_layout`.
 
     Parameters
     ----------
@@ -297,18 +317,26 @@ class TextureCache(wiring.Component):
         Pixels in input order; ``o.valid``/``o.payload`` are a register.
     axi : Out(axi_read_signature(addr_bits, data_bits))
         The memory port: one INCR burst of ``beats`` beats per miss (ARLEN = beats - 1,
-        ARSIZE = log2(data_bits / 8)), ARVALID held with a stable payload until ARREADY,
-        RREADY high while a line fills, the fill ended by RLAST.
+        ARSIZE = log2(data_bits / 8)), ARVALID held with a stable payload until ARREADY, up
+        to ``geom.misses`` bursts outstanding (one ID: the R beats come back in order),
+        RREADY high while a burst is outstanding.
 
-    A pixel is looked up the cycle after it is taken (tags and data of every way read in
-    the cycle it is taken): a hit leaves for ``o`` and the next pixel is taken in the same
-    cycle, one pixel a clock while the pixels hit and ``o`` is taken; a miss holds the
-    pixel and drops ``i.ready`` while the line of the pseudo-LRU victim way is fetched, then
-    re-reads the set and hits. ``i.ready`` depends on the lookup and ``o.ready`` in the
-    same cycle (never on ``i.valid``). A miss costs 4 cycles plus the memory's AR-to-last-R
-    time. A reset invalidates every line: the tags are cleared one set a cycle (``sets``
-    cycles, ``i.ready`` low) before the first lookup; the map in memory must not change
-    between resets.
+    Misses overlap (prefetching behind a reorder queue, Igehy, Eldridge & Proudfoot, HWWS
+    1998): the tags are checked the cycle after a pixel is taken, and a miss writes the new
+    tag and issues its line's burst at once; the pixel then waits in a queue of
+    ``geom.queue`` entries with its (set, way, word) while the pixels behind it are looked
+    up. A pixel leaves the queue in order; a miss's pixel only once its line has landed
+    (bursts land in order, so a count of lines landed suffices: a later hit to a line
+    still filling leaves after the miss that fetches it). A line a queued pixel still needs
+    is never evicted: each (set, way) keeps the sequence number of the last pixel queued
+    on it, and a miss whose pseudo-LRU victim is still referenced waits at the lookup
+    (so does a miss with ``misses`` bursts outstanding, a pixel with the queue full, or a
+    miss while ARVALID waits for ARREADY). The hit/miss sequence and the AR stream are the
+    blocking cache's (sim/golden/cache.py). ``i.ready`` depends on the lookup in the same
+    cycle (never on ``i.valid``). A hit leaves ``CACHE_LATENCY`` cycles after it is taken,
+    one pixel a clock. A reset invalidates every line: the tags are cleared one set a cycle
+    (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must not
+    change between resets.
     """
 
     def __init__(self, geom: CacheGeometry, extra=None):
@@ -323,6 +351,16 @@ class TextureCache(wiring.Component):
             "o": Out(stream.Signature(data.StructLayout({"texel": unsigned(geom.texel_bits),
                                                          **self.extra}))),
             "axi": Out(axi_read_signature(geom.addr_bits, geom.data_bits))})
+
+    @staticmethod
+    def queue_layout(geom: CacheGeometry, extra=None):
+        """One entry of the pixel queue: where its texel is (set, word, way, slot of the
+        word), whether it waits for a line fill (``miss``), and the carried fields."""
+        sel_bits = geom.slots_per_beat.bit_length() - 1
+        word_bits = geom.set_bits + (2 * geom.block_bits - sel_bits if geom.beats > 1 else 0)
+        return data.StructLayout({
+            "word": unsigned(max(1, word_bits)), "way": unsigned(max(1, geom.way_bits)),
+            "sel": unsigned(max(1, sel_bits)), "miss": unsigned(1), **dict(extra or {})})
 
     def _locate(self, m, px):
         """(line, slot) of the pixel ``px`` (a Switch on its level; past the last: the last)."""
@@ -344,18 +382,23 @@ class TextureCache(wiring.Component):
         m = Module()
         spb = g.slots_per_beat
         sel_bits = spb.bit_length() - 1           # slot within a data word
+        K = g.stamp_bits
+        ax = self.axi
 
-        # --- memories: one tag and one data memory a way ---
+        # --- memories: one tag and one data memory a way; the sequence stamps of a set ---
         tags, datas = [], []
         for w in range(g.ways):
             m.submodules[f"tag{w}"] = tmem = Memory(shape=g.tag_bits + 1, depth=g.sets, init=[])
             m.submodules[f"data{w}"] = dmem = Memory(shape=g.data_bits, depth=g.sets * g.beats,
                                                      init=[])
-            tags.append((tmem.read_port(), tmem.write_port()))
+            twp = tmem.write_port()
+            tags.append((tmem.read_port(transparent_for=(twp,)), twp))
             datas.append((dmem.read_port(), dmem.write_port()))
+        m.submodules.stamps = smem = Memory(shape=K * g.ways, depth=g.sets, init=[])
+        stamp_w = smem.write_port(granularity=K)
+        stamp_r = smem.read_port(transparent_for=(stamp_w,))
 
-        filling, replaying, flushing = Signal(), Signal(), Signal(init=1)
-        lookup = ~(self.axi.arvalid | filling | replaying | flushing)
+        flushing = Signal(init=1)
         flush_set = Signal(range(g.sets))
         # --- the pixel under lookup ---
         look_valid = Signal()
@@ -369,7 +412,7 @@ class TextureCache(wiring.Component):
             return line[:g.set_bits], line[g.set_bits:], word, slot[:sel_bits]
 
         look_set, line_tag, look_word, look_sel = split(look_line, look_slot)
-        in_set, _, in_word, _ = split(in_line, in_slot)
+        in_set, _, _, _ = split(in_line, in_slot)
         if g.set_bits == 0:
             look_set, in_set = Const(0, 1), Const(0, 1)
         look_tag = Signal(g.tag_bits)          # as stored (a line index may have fewer bits)
@@ -379,60 +422,80 @@ class TextureCache(wiring.Component):
         for w, (rp, _) in enumerate(tags):
             m.d.comb += hits[w].eq(rp.data[-1] & (rp.data[:g.tag_bits] == look_tag))
         hit = hits.any()
-        hit_word = Signal(g.data_bits)
-        for w, (drp, _) in enumerate(datas):
-            with m.If(hits[w]):
-                m.d.comb += hit_word.eq(drp.data)
-        texel = Signal(g.texel_bits)
-        with m.Switch(look_sel):                 # the pixel's slot of the word (every case)
-            for k in range(spb):
-                with m.Case(k):
-                    m.d.comb += texel.eq(hit_word.word_select(k, g.data_bits // spb))
-
-        o_free = ~self.o.valid | self.o.ready
-        leave = lookup & look_valid & hit & o_free
-        m.d.comb += self.i.ready.eq(lookup & (~look_valid | (hit & o_free)))
-        take = self.i.valid & self.i.ready
-
-        # read addresses: the pixel taken, else the pixel held (re-read every cycle, so the
-        # lookup after a fill sees the line written)
-        for (trp, _), (drp, _) in zip(tags, datas, strict=True):
-            m.d.comb += [trp.addr.eq(Mux(take, in_set, look_set)),
-                         drp.addr.eq(Mux(take, in_word, look_word))]
-        with m.If(take):
-            m.d.sync += [look_valid.eq(1), look_line.eq(in_line), look_slot.eq(in_slot)]
-            m.d.sync += [look_extra[k].eq(self.i.payload[k]) for k in self.extra]
-        with m.Elif(leave):
-            m.d.sync += look_valid.eq(0)
-
-        with m.If(leave):
-            m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(texel)]
-            m.d.sync += [self.o.payload[k].eq(look_extra[k]) for k in self.extra]
-        with m.Elif(self.o.ready):
-            m.d.sync += self.o.valid.eq(0)
 
         # --- replacement state: tree pseudo-LRU bits a set (LUT RAM, read in the cycle) ---
         plru_width = max(1, g.ways - 1)
         m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
                                           attrs={"ram_style": "distributed"})
         plru_r, plru_w = plru.read_port(domain="comb"), plru.write_port()
-        victim, touched = self._plru_hdl(plru_r.data, hits)
+        victim = self._plru_hdl(plru_r.data, hits)[0]
+        way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
+        m.d.comb += way_hot.eq(Mux(hit, hits, victim))
+        way = Signal(max(1, g.way_bits))
+        victim_valid, victim_stamp = Signal(), Signal(K)
+        for w in range(g.ways):
+            with m.If(way_hot[w]):
+                m.d.comb += way.eq(w)
+            with m.If(victim[w]):
+                m.d.comb += [victim_valid.eq(tags[w][0].data[-1]),
+                             victim_stamp.eq(stamp_r.data.word_select(w, K))]
+
+        # --- the pixel queue: pixels in[out_seq, in_seq) wait in order ---
+        in_seq, out_seq = Signal(K), Signal(K)
+        count = Signal(K)
+        m.d.comb += count.eq(in_seq - out_seq)
+        qb = g.queue.bit_length() - 1
+        layout = self.queue_layout(g, self.extra)
+        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
+        q_w = qmem.write_port()
+        q_r = qmem.read_port(transparent_for=(q_w,))
+        # a victim still referenced by a queued pixel (its last pixel not yet left)
+        locked = Signal()
+        m.d.comb += locked.eq(victim_valid & ((victim_stamp - out_seq)[:K] < count))
+
+        # --- the bursts outstanding: (set, way) of each, in AR order ---
+        fills = Signal(range(g.misses + 1))
+        landed = Signal(range(g.queue + 1))       # lines filled whose miss has not left
+        m.submodules.fillq = fmem = Memory(
+            shape=data.StructLayout({"set": unsigned(max(1, g.set_bits)),
+                                     "way": unsigned(max(1, g.way_bits))}),
+            depth=g.misses, init=[], attrs={"ram_style": "distributed"})
+        f_w, f_r = fmem.write_port(), fmem.read_port(domain="comb")
+        f_in, f_out = Signal(range(g.misses)), Signal(range(g.misses))
+
+        ar_free = ~ax.arvalid | ax.arready
+        can_miss = ar_free & (fills != g.misses) & ~locked
+        advance = Signal()
+        m.d.comb += advance.eq(~flushing & look_valid & (count != g.queue) & (hit | can_miss))
+        miss = advance & ~hit
+        m.d.comb += self.i.ready.eq(~flushing & (~look_valid | advance))
+        take = self.i.valid & self.i.ready
+
+        # read addresses: the pixel taken, else the pixel held (re-read every cycle)
+        for trp, _ in tags:
+            m.d.comb += trp.addr.eq(Mux(take, in_set, look_set))
+        m.d.comb += stamp_r.addr.eq(Mux(take, in_set, look_set))
+        with m.If(take):
+            m.d.sync += [look_valid.eq(1), look_line.eq(in_line), look_slot.eq(in_slot)]
+            m.d.sync += [look_extra[k].eq(self.i.payload[k]) for k in self.extra]
+        with m.Elif(advance):
+            m.d.sync += look_valid.eq(0)
+
+        # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
+        m.d.comb += [q_w.addr.eq(in_seq[:qb]), q_w.en.eq(advance),
+                     q_w.data.word.eq(look_word), q_w.data.way.eq(way),
+                     q_w.data.sel.eq(look_sel), q_w.data.miss.eq(~hit)]
+        m.d.comb += [q_w.data[k].eq(look_extra[k]) for k in self.extra]
+        m.d.comb += [stamp_w.addr.eq(look_set), stamp_w.data.eq(Cat(*[in_seq] * g.ways)),
+                     stamp_w.en.eq(Mux(advance, way_hot, 0))]
+        with m.If(advance):
+            m.d.sync += in_seq.eq(in_seq + 1)
+        touched = self._plru_hdl(plru_r.data, way_hot)[1]
         m.d.comb += [plru_r.addr.eq(look_set), plru_w.addr.eq(look_set),
-                     plru_w.data.eq(touched), plru_w.en.eq(leave if g.ways > 1 else 0)]
+                     plru_w.data.eq(touched), plru_w.en.eq(advance if g.ways > 1 else 0)]
         with m.If(flushing):                     # the flush clears the bits with the tags
             m.d.comb += [plru_w.addr.eq(flush_set), plru_w.data.eq(0), plru_w.en.eq(1)]
 
-        # --- the miss: one INCR burst of the victim's line ---
-        fill_way = Signal(g.ways)                   # one-hot
-        line_shift = g.line_bytes.bit_length() - 1
-        beat = Signal(range(g.beats))
-        ax = self.axi
-        m.d.comb += [ax.arlen.eq(g.beats - 1), ax.arsize.eq((g.data_bits // 8).bit_length() - 1),
-                     ax.arburst.eq(ARBURST_INCR), ax.rready.eq(filling)]
-        beat_in = filling & ax.rvalid
-        for w, (_, dwp) in enumerate(datas):
-            m.d.comb += [dwp.addr.eq(Cat(beat, look_set) if g.beats > 1 else look_set),
-                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_way[w])]
         # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
         m.d.sync += flush_set.eq(flush_set + 1)
         with m.If(flush_set == g.sets - 1):
@@ -440,18 +503,72 @@ class TextureCache(wiring.Component):
         for w, (_, twp) in enumerate(tags):
             m.d.comb += [twp.addr.eq(Mux(flushing, flush_set, look_set)),
                          twp.data.eq(Mux(flushing, 0, Cat(look_tag, Const(1, 1)))),
-                         twp.en.eq(flushing | (beat_in & ax.rlast & fill_way[w]))]
-        # the states: lookup (none of these), AR offered, line filling, replay (one cycle)
-        m.d.sync += replaying.eq(beat_in & ax.rlast)
-        with m.If(lookup & look_valid & ~hit):
-            m.d.sync += [fill_way.eq(victim), ax.arvalid.eq(1), beat.eq(0),
+                         twp.en.eq(flushing | (miss & victim[w]))]
+
+        # --- a miss: the victim's new tag (above), its burst and its fill entry ---
+        line_shift = g.line_bytes.bit_length() - 1
+        m.d.comb += [ax.arlen.eq(g.beats - 1), ax.arsize.eq((g.data_bits // 8).bit_length() - 1),
+                     ax.arburst.eq(ARBURST_INCR)]
+        with m.If(miss):
+            m.d.sync += [ax.arvalid.eq(1),
                          ax.araddr.eq(g.base + Cat(Const(0, line_shift), look_line))]
-        with m.If(ax.arvalid & ax.arready):
-            m.d.sync += [ax.arvalid.eq(0), filling.eq(1)]
+        with m.Elif(ax.arready):
+            m.d.sync += ax.arvalid.eq(0)
+        m.d.comb += [f_w.addr.eq(f_in), f_w.en.eq(miss), f_w.data.set.eq(look_set),
+                     f_w.data.way.eq(way), f_r.addr.eq(f_out)]
+
+        # --- the R beats: into the oldest outstanding burst's line ---
+        beat = Signal(range(g.beats))
+        m.d.comb += ax.rready.eq(fills != 0)
+        beat_in = ax.rready & ax.rvalid
+        line_in = beat_in & ax.rlast
+        fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
+        fill_hot = Signal(g.ways)                  # one-hot by a shift: lint-clean Verilog
+        m.d.comb += fill_hot.eq(Const(1, g.ways) << f_r.data.way[:max(1, g.way_bits)])
+        for w, (_, dwp) in enumerate(datas):
+            m.d.comb += [dwp.addr.eq(Cat(beat, fill_set) if g.beats > 1 else fill_set),
+                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_hot[w])]
         with m.If(beat_in):
             m.d.sync += beat.eq(beat + 1)
-            with m.If(ax.rlast):
-                m.d.sync += filling.eq(0)
+        with m.If(line_in):
+            m.d.sync += f_out.eq(f_out + 1)
+        with m.If(miss):
+            m.d.sync += f_in.eq(f_in + 1)
+        m.d.sync += fills.eq(fills + miss - line_in)
+
+        # --- the queue's head leaves in order: read its word, then the output register ---
+        head = q_r.data
+        o_free = ~self.o.valid | self.o.ready
+        rd_valid, rd_way, rd_sel = Signal(), Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
+        rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
+        rd_move = ~rd_valid | o_free
+        pop = Signal()
+        m.d.comb += pop.eq((count != 0) & (~head.miss | (landed != 0)) & rd_move)
+        m.d.comb += q_r.addr.eq(Mux(pop, out_seq[:qb] + 1, out_seq[:qb]) if qb else 0)
+        with m.If(pop):
+            m.d.sync += out_seq.eq(out_seq + 1)
+        m.d.sync += landed.eq(landed + line_in - (pop & head.miss))
+        for drp, _ in datas:
+            m.d.comb += [drp.addr.eq(head.word), drp.en.eq(rd_move)]
+        with m.If(rd_move):
+            m.d.sync += [rd_valid.eq(pop), rd_way.eq(head.way), rd_sel.eq(head.sel)]
+            m.d.sync += [rd_extra[k].eq(head[k]) for k in self.extra]
+        word = Signal(g.data_bits)
+        rd_hot = Signal(g.ways)
+        m.d.comb += rd_hot.eq(Const(1, g.ways) << rd_way)
+        for w, (drp, _) in enumerate(datas):
+            with m.If(rd_hot[w]):
+                m.d.comb += word.eq(drp.data)
+        texel = Signal(g.texel_bits)
+        with m.Switch(rd_sel[:sel_bits] if sel_bits else Const(0, 1)):   # the pixel's slot
+            for k in range(spb):
+                with m.Case(k):
+                    m.d.comb += texel.eq(word.word_select(k, g.data_bits // spb))
+        with m.If(rd_valid & o_free):
+            m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(texel)]
+            m.d.sync += [self.o.payload[k].eq(rd_extra[k]) for k in self.extra]
+        with m.Elif(self.o.ready):
+            m.d.sync += self.o.valid.eq(0)
         return m
 
     def _plru_hdl(self, bits, hits):
@@ -518,9 +635,10 @@ class AxiMapFetch(wiring.Component):
     o : Out(stream.Signature(out_layout))
     axi : Out(axi_read_signature(addr_bits, data_bits))
 
-    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss holds
-    the pixel and ``i.ready`` low while its line is read (:class:`TextureCache`). ``i.ready``
-    depends on the lookup in the same cycle (not a register as a credit edge's).
+    Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss
+    issues its line's burst and queues the pixel, and the pixels behind it go on being
+    looked up (:class:`TextureCache`); ``i.ready`` falls while the looked-up pixel has to
+    wait, and depends on the lookup in the same cycle (not a register as a credit edge's).
     """
 
     latency = CACHE_LATENCY
@@ -537,6 +655,12 @@ class AxiMapFetch(wiring.Component):
                                        (f"cache_tag{w}", g.sets, g.tag_bits + 1)):
                 self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
                                        "bits": depth * width}
+        queue = TextureCache.queue_layout(g, {name: f.shape for name, f in out_layout
+                                              if name != fetched_field(scene)}).size
+        for name, depth, width in (("cache_queue", g.queue, queue),
+                                   ("cache_stamps", g.sets, g.ways * g.stamp_bits)):
+            self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
+                                   "bits": depth * width}
         fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
         if scene.mip_levels > 1:
             fields["level"] = unsigned(level_bits(scene))

@@ -241,8 +241,9 @@ class BumpPipeline(wiring.Component):
 
     With ``map_memory = "axi"`` the fetch is :class:`~bumprtl.rtl.cache.AxiMapFetch` (the
     map in the user's memory behind a texel cache, port ``axi``, ``cache`` its
-    :class:`~bumprtl.rtl.cache.CacheGeometry` parameters) in front of the credit edge: a
-    miss stalls ``i`` alone and the free-running chain behind the edge keeps its contract;
+    :class:`~bumprtl.rtl.cache.CacheGeometry` parameters) in front of the credit edge: when
+    the cache has to wait (its queue full, a miss that cannot issue) it stalls ``i`` alone
+    and the free-running chain behind the edge keeps its contract;
     ``i.ready`` is then the cache's (it depends on the lookup in the same cycle), and
     ``port_latency`` adds the cache's hit latency.
 """

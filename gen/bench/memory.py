@@ -5,11 +5,12 @@ pixel (a frame of T x T pixels on a T x T map, level 0), each method's stored te
 exact method's N' angle pair, the palette's index), map size and cache geometry, the golden
 cache model (sim/golden/cache.py, the RTL's hit/miss sequence) runs a band of frame rows
 through a cold cache: hit rate and bytes fetched per pixel. Cycles per pixel follow from
-sim/golden/cache.stream_cycles (one a pixel, ``latency + beats + 2`` a miss; checked
-against the RTL's count by tests/rtl/test_cache.py) for a memory that never stalls and
-answers each burst ``latency`` cycles after its AR handshake; throughput is given against
-the zero-wait memory (latency 1: the first beat the cycle after the handshake) and against
-one pixel a clock (every pixel a hit).
+sim/golden/cache.stream_cycles (the non-blocking cache's schedule, misses overlapping;
+checked against the RTL's count by tests/rtl/test_cache.py) for a memory that never stalls
+and answers each burst ``latency`` cycles after its AR handshake, its beats one a clock;
+throughput is given against the zero-wait memory (latency 1: the first beat the cycle
+after the handshake), beside a blocking cache's with the same hits and misses
+(sim/golden/cache.blocking_cycles: one a pixel, ``latency + beats + 2`` a miss).
 """
 
 from dataclasses import dataclass
@@ -18,10 +19,10 @@ from pathlib import Path
 import numpy as np
 
 from bumprtl.gen.tools.docs import made_at
-from bumprtl.rtl.cache import CACHE_DEFAULTS, CacheGeometry
+from bumprtl.rtl.cache import CACHE_DEFAULTS, CACHE_LATENCY, CacheGeometry
 from bumprtl.rtl.config import BumpError, Config
 from bumprtl.rtl.palette import index_bits
-from bumprtl.sim.golden.cache import run_cache, stream_cycles
+from bumprtl.sim.golden.cache import blocking_cycles, run_cache, stream_cycles
 from bumprtl.sim.scenes import SCENES, texel_coordinates
 
 __all__ = ["MEMORY_SCENES", "MAP_SIZES", "LATENCIES", "CACHES", "METHODS", "MemoryRow",
@@ -48,7 +49,8 @@ def texel_bits(method, cfg=None):
 @dataclass(frozen=True)
 class MemoryRow:
     """One point: ``pixels`` run, ``hit_rate``, ``bytes_per_pixel`` fetched, and per latency
-    (``LATENCIES``) ``cycles_per_pixel``; ``cache_kib`` the cache's data and tag bits."""
+    (``LATENCIES``) ``cycles_per_pixel`` and a blocking cache's ``blocking_cycles_per_pixel``;
+    ``cache_kib`` the cache's data and tag bits."""
     scene: str
     method: str
     size: int
@@ -58,12 +60,14 @@ class MemoryRow:
     hit_rate: float
     bytes_per_pixel: float
     cycles_per_pixel: dict
+    blocking_cycles_per_pixel: dict
 
-    def ratio(self, latency, against=ZERO_WAIT):
+    def ratio(self, latency, against=ZERO_WAIT, blocking=False):
         """Throughput at ``latency`` against the zero-wait memory's (or, ``against`` None,
-        against one pixel a clock)."""
-        ref = 1.0 if against is None else self.cycles_per_pixel[against]
-        return ref / self.cycles_per_pixel[latency]
+        against one pixel a clock); ``blocking``: a blocking cache's."""
+        cycles = self.blocking_cycles_per_pixel if blocking else self.cycles_per_pixel
+        ref = 1.0 if against is None else cycles[against]
+        return ref / cycles[latency]
 
 
 def band(geometry, size, rows=BAND_ROWS):
@@ -99,7 +103,8 @@ def memory_rows(scenes=MEMORY_SCENES, sizes=MAP_SIZES, caches=tuple(CACHES), met
                     out.append(MemoryRow(
                         name, method, size, cache, geom.cache_bits / 8192, n, run.hit_rate,
                         run.bytes_fetched / n,
-                        {lat: stream_cycles(run, geom, lat) / n for lat in latencies}))
+                        {lat: stream_cycles(run, geom, lat) / n for lat in latencies},
+                        {lat: blocking_cycles(run, geom, lat) / n for lat in latencies}))
     return out
 
 
@@ -107,15 +112,25 @@ def _table(rows, latencies):
     head = ("| scene | method | map | cache (sets x ways, line) | KiB | hit rate | bytes/px | "
             + " | ".join(f"cycles/px L={lat}" for lat in latencies)
             + " | " + " | ".join(f"vs zero-wait L={lat}" for lat in latencies if lat != ZERO_WAIT)
+            + " | " + " | ".join(f"blocking L={lat}" for lat in latencies if lat >= 20)
             + " |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         cells = [r.scene, r.method, f"{r.size}²", r.cache, f"{r.cache_kib:.1f}",
                  f"{100 * r.hit_rate:.2f} %", f"{r.bytes_per_pixel:.2f}",
                  *[f"{r.cycles_per_pixel[lat]:.2f}" for lat in latencies],
-                 *[f"{100 * r.ratio(lat):.1f} %" for lat in latencies if lat != ZERO_WAIT]]
+                 *[f"{100 * r.ratio(lat):.1f} %" for lat in latencies if lat != ZERO_WAIT],
+                 *[f"{100 * r.ratio(lat, blocking=True):.1f} %" for lat in latencies if lat >= 20]]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def _worst(rows, latency, blocking=False):
+    """The least throughput against the zero-wait memory at ``latency``, as a percentage."""
+    if latency not in rows[0].cycles_per_pixel:
+        return "(not run)"
+    worst = min(rows, key=lambda r: r.ratio(latency, blocking=blocking))
+    return f"{100 * worst.ratio(latency, blocking=blocking):.1f} %"
 
 
 def _plot(rows, path):
@@ -129,10 +144,14 @@ def _plot(rows, path):
     for r in rows:
         if r.size == size and r.cache == next(iter(CACHES)):
             lats = sorted(r.cycles_per_pixel)
-            ax.plot(lats, [100 * r.ratio(lat) for lat in lats], "-o", label=f"{r.scene} {r.method}")
+            line, = ax.plot(lats, [100 * r.ratio(lat) for lat in lats], "-o",
+                            label=f"{r.scene} {r.method}")
+            ax.plot(lats, [100 * r.ratio(lat, blocking=True) for lat in lats], ":",
+                    color=line.get_color())
     ax.set_xlabel("memory latency (cycles, AR handshake to first R beat)")
     ax.set_ylabel("throughput vs zero-wait memory (%)")
-    ax.set_title(f"Texel cache {next(iter(CACHES))}, {size}² map, 1 texel/pixel")
+    ax.set_title(f"Texel cache {next(iter(CACHES))}, {size}² map, 1 texel/pixel "
+                 "(dotted: blocking)", fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
@@ -152,12 +171,18 @@ of `rtl/cache.tiled_layout` (`bumprtl emit pipeline --map-memory axi` writes it 
 `<name>_map.bin`; the sidecar's `memory_images.map` gives its base, size and layout), and
 reads it through `TextureCache`: set-associative, {d["sets"]} sets x {d["ways"]} ways of
 {d["block"]} x {d["block"]}-texel lines by default, tree pseudo-LRU (LRU for 2 ways), one
-AXI4 INCR burst of a whole line ({d["data_bits"]}-bit data by default) a miss. The scene
+AXI4 INCR burst of a whole line ({d["data_bits"]}-bit data by default) a miss. It does not
+block on a miss (prefetching behind a reorder queue, after Igehy, Eldridge & Proudfoot,
+HWWS 1998): the tags are checked as a pixel arrives, a miss issues its burst at once (up
+to {d["misses"]} outstanding), and the pixel waits in a queue of {d["queue"]} entries with
+its line's place while the pixels behind it are looked up and their misses issued; pixels
+leave in order, a miss once its line has landed. A line a queued pixel still needs is not
+evicted (a miss whose victim is still referenced waits). The scene
 keys `cache_sets`, `cache_ways`, `cache_block` and `axi_data_bits` (flags `--cache-sets`,
 `--cache-ways`, `--cache-block`, `--axi-data-bits` of `bumprtl emit pipeline`) size it;
-a cache that does not fit the device's block RAM beside the pipeline's tables is refused. A miss holds
-the pixel at the pipeline's input; the free-running chain behind the credit edge never
-stops, and its outputs are bit-exact with the golden model under any memory latency
+a cache that does not fit the device's block RAM beside the pipeline's tables is refused. A full
+queue, or a miss that has to wait, holds the pixel at the pipeline's input; the
+free-running chain behind the credit edge never stops, and its outputs are bit-exact with the golden model under any memory latency
 (tests/rtl/test_cache.py, tests/sim/tb/test_tb_pipeline_axi.py against cocotbext-axi's
 AxiRam).
 
@@ -168,30 +193,44 @@ of an AXI4 read channel (Amaranth's flattened names; `rtl/cache.axi_read_signatu
 `axi__arid` (1 bit, always 0), `axi__araddr` (32 bits), `axi__arlen` (beats - 1),
 `axi__arsize` (log2 of the data bytes), `axi__arburst` (1, INCR), `axi__arvalid`,
 `axi__arready`, `axi__rid` and `axi__rresp` (not read), `axi__rdata` (32 bits by default),
-`axi__rlast`, `axi__rvalid`, `axi__rready`. One burst is outstanding at a time: a whole line,
-aligned to its size (never across 4 KiB); ARVALID stays high with a stable payload until
-ARREADY; RREADY is high while the line fills and the fill ends with RLAST. Put
+`axi__rlast`, `axi__rvalid`, `axi__rready`. A burst is a whole line, aligned to its size
+(never across 4 KiB); up to {d["misses"]} are outstanding, all with ARID 0, so the memory
+returns them in order; ARVALID stays high with a stable payload until ARREADY; RREADY is
+high while a burst is outstanding, and each line's fill ends with RLAST. Put
 `<name>_map.bin` at byte `base` (0) of the memory the port reads; the sidecar's
 `memory_images.map` gives `file`, `base`, `bytes` and the `layout` in words. A reset clears
 the tags one set a cycle (`i.ready` low for `sets` cycles); the map must not change between
-resets. `i.ready` is the cache's: it falls in the cycle a miss is found, and it depends on
-the lookup and `o.ready` in the same cycle (never on `i.valid`).
+resets. `i.ready` is the cache's: it falls while the looked-up pixel waits (queue full, a
+miss with its victim still needed, {d["misses"]} bursts outstanding, or ARVALID waiting
+for ARREADY), and it depends on the lookup in the same cycle (never on `i.valid`). A hit
+reaches `o` {CACHE_LATENCY} cycles after it is taken.
 
 ## Hit rates and throughput
 
 Method: each demo geometry (bricks: plane, globe: sphere, cylinder) at one texel per pixel
 (a T x T frame on a T x T map, level 0), the {BAND_ROWS} frame rows at its centre in raster
 order through a cold cache in the golden cache model (the RTL's hit/miss sequence). Cycles
-per pixel: one a pixel plus `latency + beats + 2` a miss (`sim/golden/cache.stream_cycles`,
-the RTL's own count for a memory that never stalls and an output always taken); L is the
-memory's latency from the AR handshake to the first R beat, L = 1 the zero-wait memory.
+per pixel: `sim/golden/cache.stream_cycles`, the RTL's own count for a memory that never
+stalls, answers each burst L cycles after its AR handshake with one beat a clock, and an
+output always taken (tests/rtl/test_cache.py); L = 1 is the zero-wait memory. "blocking":
+a cache that holds the pixel on a miss (one pixel a cycle plus `L + beats + 2` a miss,
+`sim/golden/cache.blocking_cycles`, the first version of this cache), against its own
+zero-wait throughput.
 exact: 28-bit N' angle pairs in 4-byte slots; palette: {texel_bits("palette")}-bit indices
 in 1-byte slots (the cache with the palette's texels; the pipeline builds `map_memory =
 "axi"` for per-pixel shading only so far).
 
-The cache blocks on a miss: throughput at L = 20 is far below the 95 % of the zero-wait
-memory that prefetching (Igehy et al., HWWS 1998) reaches; a raster scan of a map wider
-than the cache refetches each line for every texel row of its block.
+With misses overlapping, the latency is hidden: at L = 20 every case keeps at least
+{_worst(rows, 20)} of its zero-wait throughput (the blocking cache: {_worst(rows, 20, True)}),
+at L = 60 at least {_worst(rows, 60)} (blocking: {_worst(rows, 60, True)}). What remains is
+the memory's bandwidth: a miss costs `beats` cycles of the R channel whatever the latency,
+so a stream that misses more than once per `beats` pixels runs at the memory's pace
+(exact 4 x 4 lines of a 1024² map in the 64 x 2 cache: 16 beats every 4th pixel, 4 cycles a
+pixel). A raster scan of a map wider than the cache refetches each line for every texel
+row of its block. The loss left at L = 60 is the queue's: a run of misses faster than the
+memory (the first texel row of each block row) fills its {d["queue"]} entries, and the
+latency shows once it is full. Fewer entries, or fewer bursts outstanding, hide less
+(Little's law: {d["queue"]} pixels, or {d["misses"]} lines, every L + beats cycles).
 
 ![throughput against latency]({plot})
 

@@ -14,15 +14,22 @@ def test_plane_scan_hit_rates_by_hand():
     """A plane at one texel per pixel is a raster scan of the map. 4 x 4 lines: a block row
     of a 256² map (64 lines) fits the default 64 x 2 cache, so each line misses once (15/16
     hit); a 1024² block row (256 lines) does not, so each texel row fetches its lines again
-    (3/4); 8 x 8 lines at 256²: 63/64."""
-    rows = memory_rows(scenes=["bricks"], sizes=[256, 1024], latencies=[20], rows=16)
+    (3/4); 8 x 8 lines at 256²: 63/64. Cycles at 1024² with misses overlapping: palette
+    lines (4 beats) serve 4 pixels, so after the first line (latency + 4 beats) the memory
+    keeps up with one pixel a clock; exact lines (16 beats for 4 pixels) keep the memory
+    busy, 4 cycles a pixel, whatever the latency."""
+    rows = memory_rows(scenes=["bricks"], sizes=[256, 1024], latencies=[20, 60], rows=16)
     assert _row(rows, 256, "64x2 4x4").hit_rate == 15 / 16
     assert _row(rows, 1024, "64x2 4x4").hit_rate == 3 / 4
     assert _row(rows, 256, "64x2 8x8").hit_rate == 63 / 64
     r = _row(rows, 1024, "64x2 4x4", "palette")          # 16-byte lines: 4 beats of 32 bits
     assert r.bytes_per_pixel == 16 * (1 / 4)              # a 16-byte line every 4th pixel
-    assert r.cycles_per_pixel[20] == 1 + (1 / 4) * (20 + 4 + 2)
-    assert r.ratio(20) == (1 + (1 / 4) * (1 + 4 + 2)) / r.cycles_per_pixel[20]
+    n = r.pixels
+    assert [round(r.cycles_per_pixel[lat] * n) for lat in (1, 20)] == [n + 1 + 4, n + 20 + 4]
+    assert r.ratio(20) == r.cycles_per_pixel[1] / r.cycles_per_pixel[20] > 0.99
+    r = _row(rows, 1024, "64x2 4x4")
+    assert [round(r.cycles_per_pixel[lat] * n) for lat in (1, 20, 60)] == [
+        4 * n + lat + 4 for lat in (1, 20, 60)]
 
 
 def test_bench_memory_writes_its_page(tmp_path, capsys):

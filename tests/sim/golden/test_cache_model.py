@@ -14,7 +14,14 @@ from bumprtl.rtl.cache import (
     tiled_image,
 )
 from bumprtl.rtl.config import BumpError
-from bumprtl.sim.golden.cache import CacheModel, random_levels, run_cache
+from bumprtl.sim.golden.cache import (
+    CacheModel,
+    blocking_cycles,
+    cache_stimulus,
+    random_levels,
+    run_cache,
+    stream_cycles,
+)
 
 
 def reference_address(u, v, level, g):
@@ -107,3 +114,22 @@ def test_scan_of_a_map_larger_than_the_cache_evicts():
     levels = random_levels(g, 5)
     assert (run_cache(g, u.ravel(), v.ravel(), np.zeros(u.size, int), levels).texel
             == levels[0][v.ravel(), u.ravel()]).all()
+
+
+def test_cycle_model_orders_and_limits():
+    """stream_cycles (the non-blocking cache's schedule): one cycle a pixel when every pixel
+    hits, never fewer cycles at a longer latency, never more than a blocking cache with the
+    same misses; with one burst outstanding and a queue of two it can overlap little, and a
+    lone miss costs what it costs the blocking cache but the re-read and the AR cycle."""
+    g = CacheGeometry(64, 3, 28, sets=8)
+    u, v, level = cache_stimulus(g, 400, 3)
+    run = run_cache(g, u, v, level)
+    cycles = [stream_cycles(run, g, lat) for lat in (1, 2, 20, 60)]
+    assert len(u) < cycles[0] and cycles == sorted(cycles)
+    assert cycles[-1] < blocking_cycles(run, g, 60) / 2
+    tight = CacheGeometry(64, 3, 28, sets=8, queue=2, misses=1)
+    assert cycles[-1] < stream_cycles(run, tight, 60) <= blocking_cycles(run, tight, 60)
+    one = run_cache(g, [0] * 5, [0] * 5, [0] * 5)              # a miss, then four hits
+    assert stream_cycles(one, g, 20) == blocking_cycles(one, g, 20) - 2 == 5 + 20 + 16
+    again = run_cache(g, [0, 1, 2, 3] * 50, [0] * 200, [0] * 200)
+    assert stream_cycles(again, g, 60) == 200 + 60 + 16
