@@ -103,7 +103,7 @@ def fpga_report(cfg, run: FpgaRun, units):
     and write ``run.out`` (markdown table + cost-against-error plot). Each placement not in
     the cache (``run.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
     ``run.jobs`` workers, or ``run.scheduler``'s."""
-    prims = [] if run.unit else [(f"{k}_alone", None, f"primitive:{k}") for k in PRIMITIVES]
+    prims = [(f"{k}_alone", None, f"primitive:{k}") for k in PRIMITIVES]   # small: always
     # placed in this order, the baselines (the largest netlists) last: a run stopped early
     # keeps what it placed (the cache), so the rows the target is about come first
     order = prims + [u for u in units if not _baseline(u)] + [u for u in units if _baseline(u)]
