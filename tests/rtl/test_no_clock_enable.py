@@ -12,7 +12,8 @@ with an enable, ``$dffe``/``$sdffe``/...), and the netlist is read cell by cell:
 * ECP5 form (what ``report fpga`` places): every DP16KD's CE/OCE and every MULT18X18D's
   CE pin is the constant 1 (a RAM's write port writes through WE alone).
 
-Every unit of every method, and every built-in scene's pipeline.
+Every unit of every method, and every built-in scene's pipeline: ``make test`` the paper's
+method and the default scene, ``make regress`` the rest.
 """
 
 import json
@@ -34,9 +35,24 @@ ENABLED_FF = {"$dffe", "$sdffe", "$adffe", "$aldffe", "$sdffce", "$dffsre", "$dl
 # (flat map, written once per polygon) and the palette's front-bank bit (flipped by swap).
 HOST_REGISTERS = ("polygon", "palette.front", "front")
 
-SCENES = sorted(BUILTIN)
+# make test reads the default scene's pipeline and the paper's method's units (with the
+# shared sincos, palette and fetch); every other scene and method runs in make regress
+# (each netlist takes Yosys 10-60 s).
+QUICK_SCENE, QUICK_METHOD = "default", "exact"
+
+
+def _regress_unless(quick):
+    return () if quick else (pytest.mark.regress,)
+
+
+SCENES = [pytest.param(s, marks=_regress_unless(s == QUICK_SCENE)) for s in sorted(BUILTIN)]
 UNITS = [("sincos", None), ("palette", None), ("fetch", None),
          *[(kind, method) for method in sorted(METHODS) for kind in ("rotation", "illumination")]]
+UNIT_PARAMS = [pytest.param(k, m, id=f"{k}-{m}" if m else k,
+                            marks=_regress_unless(m in (None, QUICK_METHOD)))
+               for k, m in UNITS]
+PLACED = [pytest.param(m, marks=_regress_unless(m == QUICK_METHOD))
+          for m in sorted(m for m in METHODS if METHODS[m].not_placed is None)]
 
 
 def netlist(design, name, work):
@@ -93,7 +109,7 @@ def _unit(kind, method, target=None):
     return build_unit(kind, cfg, target)[0]
 
 
-@pytest.mark.parametrize("kind,method", UNITS, ids=[f"{k}-{m}" if m else k for k, m in UNITS])
+@pytest.mark.parametrize("kind,method", UNIT_PARAMS)
 def test_no_unit_register_or_read_has_an_enable(kind, method, build_dir):
     module = netlist(_unit(kind, method), "unit", build_dir)
     regs, reads = datapath_offenders(module)
@@ -112,7 +128,7 @@ def test_no_pipeline_register_or_read_has_an_enable(scene, build_dir):
     assert "DP16KD" in kinds                          # the check saw the block RAMs
 
 
-@pytest.mark.parametrize("method", sorted(m for m in METHODS if METHODS[m].not_placed is None))
+@pytest.mark.parametrize("method", PLACED)
 def test_no_placed_primitive_has_an_enable(method, build_dir):
     for kind in ("rotation", "illumination"):
         module = netlist(_unit(kind, method, ECP5()), kind, build_dir / kind)
