@@ -49,8 +49,8 @@ __all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "m
            "DP16KD_MODES", "pipe_observer"]
 
 # Cycles from a pixel written into the edge's FIFO to the same pixel offered at ``o``:
-# the write (the FIFO's memory), then its output register.
-EDGE_LATENCY = 2
+# the write (the FIFO's memory), its prefetch register, then its output register.
+EDGE_LATENCY = 3
 # Cycles from a pixel taken at ``o`` to its credit free at ``i``: the credit count is a
 # register, so the credit is counted the cycle after the pixel leaves.
 CREDIT_RETURN = 1
@@ -216,11 +216,13 @@ class CreditFIFO(Elaboratable):
     ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
     guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
     of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at the read pointer (a copy per READ_SLICE bits) into the output register
-    ``r_data`` whenever that is empty or being taken and the memory holds a pixel (a
-    register of its own, ``stored``, whose next state needs no carry chain). ``level``
-    counts the memory's pixels and the output register's. Written to an empty FIFO in
-    cycle t, a pixel is offered in cycle t + 2 (EDGE_LATENCY)."""
+    read asynchronously (LUT RAM on ECP5) at the read pointer (a copy per READ_SLICE bits)
+    into a prefetch register ``pre_data``/``pre_valid`` beside the memory, which moves on
+    into the output register ``r_data``/``r_rdy``: each of the two loads when it is empty
+    or its pixel moves on, so the memory's read lands in a register of its own and the
+    output register is fed by a register (no LUT RAM read in the same cycle as the route to
+    the output). ``level`` counts the memory's pixels and both registers'. Written to an
+    empty FIFO in cycle t, a pixel is offered in cycle t + 3 (EDGE_LATENCY)."""
 
     def __init__(self, width, depth):
         self.width, self.depth = width, depth
@@ -229,9 +231,14 @@ class CreditFIFO(Elaboratable):
         self.w_data = Signal(width)
         self.r_en, self.r_rdy = Signal(), Signal(name="fifo_head_valid")
         self.r_data = Signal(width, name="fifo_head", reset_less=True)
+        self.pre_valid = Signal(name="fifo_pre_valid")
+        self.pre_data = Signal(width, name="fifo_pre", reset_less=True)
         self.level = Signal(range(depth + 1))
         self.count = Signal(self.bits + 1, name="fifo_count")      # pixels in the memory
         self.stored = Signal(name="fifo_stored")                    # count != 0
+        # Output register first, then the prefetch register: the pixels outside the memory,
+        # oldest first, as (valid, data).
+        self.heads = [(self.r_rdy, self.r_data), (self.pre_valid, self.pre_data)]
 
     def elaborate(self, platform):
         m, bits = Module(), self.bits
@@ -242,8 +249,9 @@ class CreditFIFO(Elaboratable):
         wport = storage.write_port()
         m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
                      self.w_rdy.eq(self.count != (1 << bits)),
-                     self.level.eq(self.count + self.r_rdy)]
-        load = self.stored & (~self.r_rdy | self.r_en)
+                     self.level.eq(self.count + self.pre_valid + self.r_rdy)]
+        out_load = self.pre_valid & (~self.r_rdy | self.r_en)       # prefetch -> output
+        load = self.stored & (~self.pre_valid | out_load)             # memory -> prefetch
         m.d.sync += [wp.eq(wp + self.w_en),                     # wrap: the credits leave room
                      self.count.eq(self.count + self.w_en - load)]
         # One read pointer per READ_SLICE bits of the word, each its own counter (so no
@@ -257,13 +265,19 @@ class CreditFIFO(Elaboratable):
             m.d.comb += rport.addr.eq(rp)
             m.d.sync += rp.eq(rp + load)
             with m.If(load):
-                m.d.sync += self.r_data[lo:hi].eq(rport.data[lo:hi])
+                m.d.sync += self.pre_data[lo:hi].eq(rport.data[lo:hi])
             pointers.append(rp)
+        with m.If(out_load):
+            m.d.sync += self.r_data.eq(self.pre_data)
         with m.If(self.w_en & ~load):
             m.d.sync += self.stored.eq(1)
         with m.Elif(load & ~self.w_en):
             m.d.sync += self.stored.eq(self.count != 1)
         with m.If(load):
+            m.d.sync += self.pre_valid.eq(1)
+        with m.Elif(out_load):
+            m.d.sync += self.pre_valid.eq(0)
+        with m.If(out_load):
             m.d.sync += self.r_rdy.eq(1)
         with m.Elif(self.r_en):
             m.d.sync += self.r_rdy.eq(0)
@@ -271,7 +285,9 @@ class CreditFIFO(Elaboratable):
             rp = pointers[0]
             m.d.comb += [Assert(self.stored == (self.count != 0)),
                          Assert(wp == (rp + self.count)[:bits]),
-                         Assert(self.count + self.r_rdy <= self.depth),
+                         Assert(self.count + self.pre_valid + self.r_rdy <= self.depth),
+                         # each register fills before the one behind it holds two
+                         Assert(self.pre_valid | (self.count <= 1)),
                          Assert(self.r_rdy | (self.count <= 1))]
             m.d.comb += [Assert(copy == rp) for copy in pointers[1:]]
         return m

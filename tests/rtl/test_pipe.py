@@ -315,7 +315,7 @@ UNITS = {
     "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2}).hardware),
     "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}).hardware),
     "pipeline-deep-fifo": lambda: BumpPipeline(
-        load_scene_config({"name": "t", "texture_size": 16}).hardware, fifo_depth=40),
+        load_scene_config({"name": "t", "texture_size": 16}).hardware, fifo_depth=48),
 }
 
 
