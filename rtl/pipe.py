@@ -13,7 +13,7 @@ FIFO's output register and never depend on ``o.ready``; ``i.ready`` is a registe
 credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cycle.
 """
 
-from amaranth.hdl import Assert, Const, Elaboratable, Module, Shape, Signal, Value
+from amaranth.hdl import Assert, Const, Elaboratable, Fragment, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -41,7 +41,7 @@ from bumprtl.rtl.targets import (
     read_port,
 )
 
-__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO", "add_credit_edge",
+__all__ = ["Pipe", "PipeUnit", "MemoryRecords", "unit_memory_records", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO", "add_credit_edge",
            "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
            "limb_products", "PRODUCT_LATENCY",
@@ -78,6 +78,33 @@ def check_fifo_depth(latency, depth=None):
                         f"latency {latency} (latency + {EDGE_LATENCY} FIFO stages + "
                         f"{CREDIT_RETURN} credit return), got {depth!r}")
     return depth
+
+
+class MemoryRecords:
+    """An elaboration's platform that collects what every unit's :class:`Pipe` built, so
+    that elaborating a unit changes nothing of the unit: ``Fragment.get(unit, records)``,
+    then :meth:`of` ``(unit)`` is the unit's memories (:attr:`Pipe.memories`; a unit that is
+    no PipeUnit answers with its own ``memories`` attribute, e.g. the texel cache's). Its
+    ``pipe_observer`` is None: it records, it observes nothing."""
+
+    pipe_observer = None
+
+    def __init__(self):
+        self._units = {}
+
+    def record(self, unit, memories):
+        self._units[id(unit)] = (unit, memories)
+
+    def of(self, unit):
+        """name -> {kind, depth, width, bits} of ``unit``'s memories in this elaboration."""
+        found = self._units.get(id(unit))
+        return dict(found[1]) if found is not None else dict(getattr(unit, "memories", {}))
+
+
+def unit_memory_records(component):
+    """``(fragment, records)``: ``component`` elaborated once with a :class:`MemoryRecords`."""
+    records = MemoryRecords()
+    return Fragment.get(component, records), records
 
 
 def pipe_observer(platform):
@@ -384,13 +411,13 @@ class PipeUnit(wiring.Component):
     Subclasses set ``latency`` (the pipe's depth) before calling this constructor and
     give ``build(m, pipe)``, which drives ``pipe.o.payload`` from ``self.i.payload``.
     The edge is the same for every unit, so a unit on its own and a pipeline have one port
-    contract. After elaboration ``memories`` holds the pipe's record of the memories built.
+    contract. ``elaborate`` changes nothing of the unit: the memories its pipe builds go to
+    the platform when that is a :class:`MemoryRecords` (:func:`unit_memory_records`).
     """
 
     def __init__(self, cfg, in_layout, out_layout, target=None, credit=True, fifo_depth=None,
                  ports=None):
         self.cfg, self.target, self.credit = cfg, target, credit
-        self.memories = {}
         self.fifo_depth = None
         if credit:
             try:
@@ -423,5 +450,6 @@ class PipeUnit(wiring.Component):
             m.d.comb += self.i.ready.eq(1)
         pipe = Pipe(m, valid, core, self.latency, self.target, pipe_observer(platform))
         self.build(m, pipe)
-        self.memories = pipe.memories
+        if isinstance(platform, MemoryRecords):
+            platform.record(self, pipe.memories)
         return m
