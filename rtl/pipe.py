@@ -243,8 +243,8 @@ class CreditFIFO(Elaboratable):
     ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
     guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
     of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at the read pointer (a copy per READ_SLICE bits)
-    into a prefetch register ``pre_data``/``pre_valid`` beside the memory, which moves on
+    read asynchronously (LUT RAM on ECP5) at the read pointer (the control a copy per
+    READ_SLICE bits of the word) into a prefetch register ``pre_data``/``pre_valid`` beside the memory, which moves on
     into the output register ``r_data``/``r_rdy``: each of the two loads when it is empty
     or its pixel moves on, so the memory's read lands in a register of its own and the
     output register is fed by a register (no LUT RAM read in the same cycle as the route to
@@ -277,46 +277,55 @@ class CreditFIFO(Elaboratable):
         m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
                      self.w_rdy.eq(self.count != (1 << bits)),
                      self.level.eq(self.count + self.pre_valid + self.r_rdy)]
-        out_load = self.pre_valid & (~self.r_rdy | self.r_en)       # prefetch -> output
-        load = self.stored & (~self.pre_valid | out_load)             # memory -> prefetch
-        m.d.sync += [wp.eq(wp + self.w_en),                     # wrap: the credits leave room
-                     self.count.eq(self.count + self.w_en - load)]
-        # One read pointer per READ_SLICE bits of the word, each its own counter (so no
-        # tool merges them), each addressing only its slice's LUT RAMs and output muxes: a
-        # wide pixel's read address would otherwise fan out to every bit of the word.
-        pointers = []
+        m.d.sync += wp.eq(wp + self.w_en)                       # wrap: the credits leave room
+        # Each READ_SLICE bits of the word have a control of their own: a read pointer, a
+        # count, and copies of the registers' valid bits, each its own register (so no tool
+        # merges them), whose loads reach only that slice's LUT RAMs, prefetch and output
+        # bits: one load would otherwise fan out to every bit of a wide pixel. Slice 0's
+        # copies are the FIFO's (``count``, ``stored``, ``pre_valid``, ``r_rdy``).
+        copies = []
         for k, lo in enumerate(range(0, self.width, READ_SLICE)):
             hi = min(lo + READ_SLICE, self.width)
+            if k == 0:
+                count, stored, pre_valid, r_rdy = self.count, self.stored, self.pre_valid, self.r_rdy
+            else:
+                count = Signal.like(self.count, name=f"fifo_count{k}")
+                stored = Signal(name=f"fifo_stored{k}")
+                pre_valid = Signal(name=f"fifo_pre_valid{k}")
+                r_rdy = Signal(name=f"fifo_head_valid{k}")
             rp = Signal(bits, name=f"fifo_read{k}" if k else "fifo_read")
+            out_load = pre_valid & (~r_rdy | self.r_en)               # prefetch -> output
+            load = stored & (~pre_valid | out_load)                   # memory -> prefetch
             rport = storage.read_port(domain="comb")
             m.d.comb += rport.addr.eq(rp)
-            m.d.sync += rp.eq(rp + load)
+            m.d.sync += [rp.eq(rp + load), count.eq(count + self.w_en - load)]
             with m.If(load):
                 m.d.sync += self.pre_data[lo:hi].eq(rport.data[lo:hi])
-            pointers.append(rp)
-        with m.If(out_load):
-            m.d.sync += self.r_data.eq(self.pre_data)
-        with m.If(self.w_en & ~load):
-            m.d.sync += self.stored.eq(1)
-        with m.Elif(load & ~self.w_en):
-            m.d.sync += self.stored.eq(self.count != 1)
-        with m.If(load):
-            m.d.sync += self.pre_valid.eq(1)
-        with m.Elif(out_load):
-            m.d.sync += self.pre_valid.eq(0)
-        with m.If(out_load):
-            m.d.sync += self.r_rdy.eq(1)
-        with m.Elif(self.r_en):
-            m.d.sync += self.r_rdy.eq(0)
+            with m.If(out_load):
+                m.d.sync += self.r_data[lo:hi].eq(self.pre_data[lo:hi])
+            with m.If(self.w_en & ~load):
+                m.d.sync += stored.eq(1)
+            with m.Elif(load & ~self.w_en):
+                m.d.sync += stored.eq(count != 1)
+            with m.If(load):
+                m.d.sync += pre_valid.eq(1)
+            with m.Elif(out_load):
+                m.d.sync += pre_valid.eq(0)
+            with m.If(out_load):
+                m.d.sync += r_rdy.eq(1)
+            with m.Elif(self.r_en):
+                m.d.sync += r_rdy.eq(0)
+            copies.append((rp, count, stored, pre_valid, r_rdy))
         if platform == "formal":         # as amaranth.lib.fifo states its own pointers
-            rp = pointers[0]
+            rp = copies[0][0]
             m.d.comb += [Assert(self.stored == (self.count != 0)),
                          Assert(wp == (rp + self.count)[:bits]),
                          Assert(self.count + self.pre_valid + self.r_rdy <= self.depth),
                          # each register fills before the one behind it holds two
                          Assert(self.pre_valid | (self.count <= 1)),
                          Assert(self.r_rdy | (self.count <= 1))]
-            m.d.comb += [Assert(copy == rp) for copy in pointers[1:]]
+            m.d.comb += [Assert(a == b) for copy in copies[1:]
+                         for a, b in zip(copy, copies[0], strict=True)]
         return m
 
 
