@@ -13,7 +13,7 @@ FIFO's output register and never depend on ``o.ready``; ``i.ready`` is a registe
 credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cycle.
 """
 
-from amaranth.hdl import Assert, Const, Elaboratable, Module, Shape, Signal, Value
+from amaranth.hdl import Assert, Const, Elaboratable, Fragment, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -41,7 +41,7 @@ from bumprtl.rtl.targets import (
     read_port,
 )
 
-__all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO", "add_credit_edge",
+__all__ = ["Pipe", "PipeUnit", "MemoryRecords", "unit_memory_records", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "min_fifo_depth", "check_fifo_depth", "CreditFIFO", "add_credit_edge",
            "RegisteredProduct", "WideProduct", "RegisteredROM",
            "RegisteredRAM", "read_port", "dp16kd_rom_block", "fits_dsp", "product_latency",
            "limb_products", "PRODUCT_LATENCY",
@@ -49,8 +49,8 @@ __all__ = ["Pipe", "PipeUnit", "CreditEdge", "EDGE_LATENCY", "CREDIT_RETURN", "m
            "DP16KD_MODES", "pipe_observer"]
 
 # Cycles from a pixel written into the edge's FIFO to the same pixel offered at ``o``:
-# the write (the FIFO's memory), then its output register.
-EDGE_LATENCY = 2
+# the write (the FIFO's memory), its prefetch register, then its output register.
+EDGE_LATENCY = 3
 # Cycles from a pixel taken at ``o`` to its credit free at ``i``: the credit count is a
 # register, so the credit is counted the cycle after the pixel leaves.
 CREDIT_RETURN = 1
@@ -78,6 +78,33 @@ def check_fifo_depth(latency, depth=None):
                         f"latency {latency} (latency + {EDGE_LATENCY} FIFO stages + "
                         f"{CREDIT_RETURN} credit return), got {depth!r}")
     return depth
+
+
+class MemoryRecords:
+    """An elaboration's platform that collects what every unit's :class:`Pipe` built, so
+    that elaborating a unit changes nothing of the unit: ``Fragment.get(unit, records)``,
+    then :meth:`of` ``(unit)`` is the unit's memories (:attr:`Pipe.memories`; a unit that is
+    no PipeUnit answers with its own ``memories`` attribute, e.g. the texel cache's). Its
+    ``pipe_observer`` is None: it records, it observes nothing."""
+
+    pipe_observer = None
+
+    def __init__(self):
+        self._units = {}
+
+    def record(self, unit, memories):
+        self._units[id(unit)] = (unit, memories)
+
+    def of(self, unit):
+        """name -> {kind, depth, width, bits} of ``unit``'s memories in this elaboration."""
+        found = self._units.get(id(unit))
+        return dict(found[1]) if found is not None else dict(getattr(unit, "memories", {}))
+
+
+def unit_memory_records(component):
+    """``(fragment, records)``: ``component`` elaborated once with a :class:`MemoryRecords`."""
+    records = MemoryRecords()
+    return Fragment.get(component, records), records
 
 
 def pipe_observer(platform):
@@ -216,11 +243,13 @@ class CreditFIFO(Elaboratable):
     ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
     guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
     of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at the read pointer (a copy per READ_SLICE bits) into the output register
-    ``r_data`` whenever that is empty or being taken and the memory holds a pixel (a
-    register of its own, ``stored``, whose next state needs no carry chain). ``level``
-    counts the memory's pixels and the output register's. Written to an empty FIFO in
-    cycle t, a pixel is offered in cycle t + 2 (EDGE_LATENCY)."""
+    read asynchronously (LUT RAM on ECP5) at the read pointer (the control a copy per
+    READ_SLICE bits of the word) into a prefetch register ``pre_data``/``pre_valid`` beside the memory, which moves on
+    into the output register ``r_data``/``r_rdy``: each of the two loads when it is empty
+    or its pixel moves on, so the memory's read lands in a register of its own and the
+    output register is fed by a register (no LUT RAM read in the same cycle as the route to
+    the output). ``level`` counts the memory's pixels and both registers'. Written to an
+    empty FIFO in cycle t, a pixel is offered in cycle t + 3 (EDGE_LATENCY)."""
 
     def __init__(self, width, depth):
         self.width, self.depth = width, depth
@@ -229,9 +258,14 @@ class CreditFIFO(Elaboratable):
         self.w_data = Signal(width)
         self.r_en, self.r_rdy = Signal(), Signal(name="fifo_head_valid")
         self.r_data = Signal(width, name="fifo_head", reset_less=True)
+        self.pre_valid = Signal(name="fifo_pre_valid")
+        self.pre_data = Signal(width, name="fifo_pre", reset_less=True)
         self.level = Signal(range(depth + 1))
         self.count = Signal(self.bits + 1, name="fifo_count")      # pixels in the memory
         self.stored = Signal(name="fifo_stored")                    # count != 0
+        # Output register first, then the prefetch register: the pixels outside the memory,
+        # oldest first, as (valid, data).
+        self.heads = [(self.r_rdy, self.r_data), (self.pre_valid, self.pre_data)]
 
     def elaborate(self, platform):
         m, bits = Module(), self.bits
@@ -242,38 +276,56 @@ class CreditFIFO(Elaboratable):
         wport = storage.write_port()
         m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
                      self.w_rdy.eq(self.count != (1 << bits)),
-                     self.level.eq(self.count + self.r_rdy)]
-        load = self.stored & (~self.r_rdy | self.r_en)
-        m.d.sync += [wp.eq(wp + self.w_en),                     # wrap: the credits leave room
-                     self.count.eq(self.count + self.w_en - load)]
-        # One read pointer per READ_SLICE bits of the word, each its own counter (so no
-        # tool merges them), each addressing only its slice's LUT RAMs and output muxes: a
-        # wide pixel's read address would otherwise fan out to every bit of the word.
-        pointers = []
+                     self.level.eq(self.count + self.pre_valid + self.r_rdy)]
+        m.d.sync += wp.eq(wp + self.w_en)                       # wrap: the credits leave room
+        # Each READ_SLICE bits of the word have a control of their own: a read pointer, a
+        # count, and copies of the registers' valid bits, each its own register (so no tool
+        # merges them), whose loads reach only that slice's LUT RAMs, prefetch and output
+        # bits: one load would otherwise fan out to every bit of a wide pixel. Slice 0's
+        # copies are the FIFO's (``count``, ``stored``, ``pre_valid``, ``r_rdy``).
+        copies = []
         for k, lo in enumerate(range(0, self.width, READ_SLICE)):
             hi = min(lo + READ_SLICE, self.width)
+            if k == 0:
+                count, stored, pre_valid, r_rdy = self.count, self.stored, self.pre_valid, self.r_rdy
+            else:
+                count = Signal.like(self.count, name=f"fifo_count{k}")
+                stored = Signal(name=f"fifo_stored{k}")
+                pre_valid = Signal(name=f"fifo_pre_valid{k}")
+                r_rdy = Signal(name=f"fifo_head_valid{k}")
             rp = Signal(bits, name=f"fifo_read{k}" if k else "fifo_read")
+            out_load = pre_valid & (~r_rdy | self.r_en)               # prefetch -> output
+            load = stored & (~pre_valid | out_load)                   # memory -> prefetch
             rport = storage.read_port(domain="comb")
             m.d.comb += rport.addr.eq(rp)
-            m.d.sync += rp.eq(rp + load)
+            m.d.sync += [rp.eq(rp + load), count.eq(count + self.w_en - load)]
             with m.If(load):
-                m.d.sync += self.r_data[lo:hi].eq(rport.data[lo:hi])
-            pointers.append(rp)
-        with m.If(self.w_en & ~load):
-            m.d.sync += self.stored.eq(1)
-        with m.Elif(load & ~self.w_en):
-            m.d.sync += self.stored.eq(self.count != 1)
-        with m.If(load):
-            m.d.sync += self.r_rdy.eq(1)
-        with m.Elif(self.r_en):
-            m.d.sync += self.r_rdy.eq(0)
+                m.d.sync += self.pre_data[lo:hi].eq(rport.data[lo:hi])
+            with m.If(out_load):
+                m.d.sync += self.r_data[lo:hi].eq(self.pre_data[lo:hi])
+            with m.If(self.w_en & ~load):
+                m.d.sync += stored.eq(1)
+            with m.Elif(load & ~self.w_en):
+                m.d.sync += stored.eq(count != 1)
+            with m.If(load):
+                m.d.sync += pre_valid.eq(1)
+            with m.Elif(out_load):
+                m.d.sync += pre_valid.eq(0)
+            with m.If(out_load):
+                m.d.sync += r_rdy.eq(1)
+            with m.Elif(self.r_en):
+                m.d.sync += r_rdy.eq(0)
+            copies.append((rp, count, stored, pre_valid, r_rdy))
         if platform == "formal":         # as amaranth.lib.fifo states its own pointers
-            rp = pointers[0]
+            rp = copies[0][0]
             m.d.comb += [Assert(self.stored == (self.count != 0)),
                          Assert(wp == (rp + self.count)[:bits]),
-                         Assert(self.count + self.r_rdy <= self.depth),
+                         Assert(self.count + self.pre_valid + self.r_rdy <= self.depth),
+                         # each register fills before the one behind it holds two
+                         Assert(self.pre_valid | (self.count <= 1)),
                          Assert(self.r_rdy | (self.count <= 1))]
-            m.d.comb += [Assert(copy == rp) for copy in pointers[1:]]
+            m.d.comb += [Assert(a == b) for copy in copies[1:]
+                         for a, b in zip(copy, copies[0], strict=True)]
         return m
 
 
@@ -368,13 +420,13 @@ class PipeUnit(wiring.Component):
     Subclasses set ``latency`` (the pipe's depth) before calling this constructor and
     give ``build(m, pipe)``, which drives ``pipe.o.payload`` from ``self.i.payload``.
     The edge is the same for every unit, so a unit on its own and a pipeline have one port
-    contract. After elaboration ``memories`` holds the pipe's record of the memories built.
+    contract. ``elaborate`` changes nothing of the unit: the memories its pipe builds go to
+    the platform when that is a :class:`MemoryRecords` (:func:`unit_memory_records`).
     """
 
     def __init__(self, cfg, in_layout, out_layout, target=None, credit=True, fifo_depth=None,
                  ports=None):
         self.cfg, self.target, self.credit = cfg, target, credit
-        self.memories = {}
         self.fifo_depth = None
         if credit:
             try:
@@ -407,5 +459,6 @@ class PipeUnit(wiring.Component):
             m.d.comb += self.i.ready.eq(1)
         pipe = Pipe(m, valid, core, self.latency, self.target, pipe_observer(platform))
         self.build(m, pipe)
-        self.memories = pipe.memories
+        if isinstance(platform, MemoryRecords):
+            platform.record(self, pipe.memories)
         return m

@@ -421,12 +421,6 @@ class BumpPipeline(wiring.Component):
     def port_latency(self):
         return self.latency + EDGE_LATENCY + (self.units["fetch"].latency if self._front else 0)
 
-    @property
-    def memories(self):
-        """Every unit's memories, ``unit.name`` -> {depth, width, bits} (after elaboration)."""
-        return {f"{unit}.{name}": size for unit, u in self.units.items()
-                for name, size in u.memories.items()}
-
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()

@@ -66,21 +66,24 @@ class RegisteredProduct(Elaboratable):
         return m
 
 
-# Stages of a WideProduct: a RegisteredProduct, then two more registers (the limbs' sums).
-WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 2
+# Stages of a WideProduct: a RegisteredProduct, then three more registers (the limb
+# products held, their pair sums, the total).
+WIDE_PRODUCT_LATENCY = PRODUCT_LATENCY + 3
 
 
 class WideProduct(Elaboratable):
     """``p = a * b`` WIDE_PRODUCT_LATENCY ``en`` cycles after ``a``/``b``, for operands wider
-    than one DSP input. Generic form: a :class:`RegisteredProduct`, then two registers (one
-    product in the counts of gen/flow/resources.py). ECP5 form (``target`` with a
+    than one DSP input. Generic form: a :class:`RegisteredProduct`, then three registers
+    (one product in the counts of gen/flow/resources.py). ECP5 form (``target`` with a
     MULT18X18D): each operand wider than a DSP input in 17-bit limbs (unsigned, the top limb
     of a signed operand signed), one RegisteredProduct per pair of limbs (a MULT18X18D with
-    its input and output registers), their shifted sum in the two registers, pairs first:
-    exact, since a b = sum_ij a_i b_j 2**(s_i + s_j), and no more than one 2-operand carry
-    chain follows a DSP output in a cycle. Yosys would otherwise build the product from DSP
-    blocks without their registers and a carry chain, all in one cycle. The target splits
-    the operands (:func:`limb_products`); this element only sums."""
+    its input and output registers), each limb product copied into a fabric register
+    (the DSP's output route ends in a flip-flop, nothing else in its cycle), then their
+    shifted sum in two registers, pairs first: exact, since a b = sum_ij a_i b_j
+    2**(s_i + s_j), and no more than one 2-operand carry chain in a cycle. Yosys would
+    otherwise build the product from DSP blocks without their registers and a carry chain,
+    all in one cycle. The target splits the operands (:func:`limb_products`); this element
+    only sums."""
 
     def __init__(self, a_shape, b_shape, name, target=None):
         self.target = target
@@ -91,7 +94,12 @@ class WideProduct(Elaboratable):
 
     def elaborate(self, platform):
         m = Module()
-        terms = limb_products(m, self.a, self.b, self.en, self.target)
+        terms = []
+        for n, term in enumerate(limb_products(m, self.a, self.b, self.en, self.target)):
+            held = Signal(term.shape(), name=f"limb{n}_q")
+            with m.If(self.en):
+                m.d.sync += held.eq(term)
+            terms.append(held)
         pairs = []
         for n in range(0, len(terms), 2):
             pair = Signal(self.p.shape(), name=f"pair{n // 2}")

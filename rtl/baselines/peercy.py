@@ -49,7 +49,7 @@ square root): :func:`sqrt_stages` = B + 6 stages of at most a (B + 8)-bit subtra
 r = isqrt(4 s) >= isqrt(4 a**2) = 2 |a|, so q <= 2**(B+1). Each is a submodule whose name
 ends in ``sqrt`` or ``_div``, which gen/flow/resources.py keeps as a black box and counts as
 one square root or one divider (Table 1's "SQRt" and "division units"). Latency
-:func:`rotation_latency` (43 at B = 13, 51 at B = 16); 1 pixel per clock. Every sum of three
+:func:`rotation_latency` (43 at B = 13, 52 at B = 16); 1 pixel per clock. Every sum of three
 products (the transform and the dots N'.A_n, :func:`sum3_rounded`, and |A_t|**2) is two
 registered 2-operand adders, not one 3-operand adder behind the DSP blocks' outputs.
 
@@ -258,7 +258,7 @@ class PeercyRotation(PipeUnit):
     space, N' passed through). Latency :func:`rotation_latency` (the two products' stages
     + 5 + (B + 6) + (B + 2): 2 PRODUCT_LATENCY + 5 + 15 + 11 = 35 at B = 9,
     2 PRODUCT_LATENCY + 5 + 19 + 15 = 43 at B = 13, PRODUCT_LATENCY + WIDE_PRODUCT_LATENCY
-    + 5 + 22 + 18 = 51 at B = 16); 1 pixel per clock.
+    + 5 + 22 + 18 = 52 at B = 16); 1 pixel per clock.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):

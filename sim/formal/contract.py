@@ -37,11 +37,11 @@ One wrapper checks one property (:data:`PROPERTIES`):
 k-induction needs the contract to be inductive, so the wrapper also asserts *lemmas* about
 the unit's own registers: the credit loop's invariant (above) with the pixels of the chain
 counted in runs of at most CHUNK stages (a ghost counter each, equal to its valid stages),
-the FIFO's output register full whenever it holds two or more, its pointers a queue of its
-occupancy, the pixels accepted and not delivered = valid stages + FIFO occupancy, the tags
+the FIFO's head registers (output, prefetch) each full whenever its memory holds two or
+more, its pointers a queue of its memory's occupancy, the pixels accepted and not delivered = valid stages + FIFO occupancy, the tags
 held in the valid stages and the FIFO's entries (oldest first) the ones the order says; with
-``o.ready`` held high (``latency``) stage n holds the input of n cycles ago and the FIFO at
-most the pixel written in the last cycle; units of one layer of a scene pipeline (fed one
+``o.ready`` held high (``latency``) stage n holds the input of n cycles ago, the FIFO's
+memory at most the pixel written in the last cycle and its prefetch register the one before; units of one layer of a scene pipeline (fed one
 valid) have equal valid chains; and (``bank``) the shadows are the table's watched entries,
 the bank bits in flight are what the pipeline's ``lut_w_ready`` counters count, and the
 watched pixel sits where its position says with the bank of its acceptance. The chain's
@@ -171,9 +171,10 @@ def _subfragment(fragment, name):
 class _Edge:
     """A :class:`~bumprtl.rtl.pipe.CreditEdge` found in an elaborated fragment, with its
     FIFO (``rtl/pipe.CreditFIFO``, or ``SyncFIFOBuffered``: an inner queue in a memory,
-    then the output register ``r_data``/``r_rdy``) and that memory: ``instance`` (the elaborated
-    MemoryInstance, to add read ports to) and ``storage`` (its ``lib.memory.Memory``, whose
-    ports' addresses are the FIFO's write and read pointers)."""
+    then registers outside it, ``heads``: (valid, data) oldest first, the output register
+    ``r_rdy``/``r_data`` first, CreditFIFO's prefetch register after it) and that memory:
+    ``instance`` (the elaborated MemoryInstance, to add read ports to) and ``storage`` (its
+    ``lib.memory.Memory``, whose ports' addresses are the FIFO's write and read pointers)."""
 
     def __init__(self, edge, fragment):
         self.edge = edge
@@ -185,12 +186,19 @@ class _Edge:
         self.instance = instance if ok else None
         self.storage = instance.origins[0] if ok else None
         self.inner_depth = self.storage.depth if ok else 0
+        self.heads = list(getattr(self.fifo, "heads", None) or
+                          ([(self.fifo.r_rdy, self.fifo.r_data)] if self.fifo is not None else []))
         self._slots = None
 
     @property
+    def outside(self):
+        """Pixels in the registers outside the memory (the valid ``heads``)."""
+        return sum((valid for valid, _ in self.heads[1:]), self.heads[0][0])
+
+    @property
     def inner_level(self):
-        """Entries in the inner queue (the memory): the occupancy less the output register."""
-        return (self.fifo.level - self.fifo.r_rdy)[:len(self.fifo.level)]
+        """Entries in the inner queue (the memory): the occupancy less the head registers."""
+        return (self.fifo.level - self.outside)[:len(self.fifo.level)]
 
     def slots(self, m, layout):
         """The inner queue's memory word at every address, as ``View(layout)``: one
@@ -411,8 +419,9 @@ class StreamContract(Elaboratable):
         depth = edge.depth
         chain = self._chain if chain is None else chain
         claim(m, edge.level <= depth, "credit: the FIFO holds at most its depth")
-        claim(m, fifo.r_rdy | (edge.level <= 1),
-              "credit: the FIFO's output register is full when it holds two or more")
+        for n, (valid, _) in enumerate(self.edge.heads):
+            claim(m, valid | (self.edge.inner_level <= 1),
+                  f"credit: the FIFO's head register {n} is full when the memory holds two or more")
         claim(m, edge.credits + chain + edge.level == depth,
               "credit: credits + pixels in the chain + FIFO occupancy != depth")
         claim(m, edge.i_ready == (edge.credits != 0), "credit: i.ready is not credits != 0")
@@ -454,16 +463,25 @@ class StreamContract(Elaboratable):
         return self.edge
 
     def _in_fifo(self, m, field, k):
-        """``field`` of the FIFO's ``k``-th oldest pixel: the output register's when it is
-        full and ``k`` is 0, else the inner entry ``k - r_rdy`` places behind the oldest."""
-        edge, fifo = self.edge, self.edge.fifo
+        """``field`` of the FIFO's ``k``-th oldest pixel: a head register's (oldest first,
+        each counted when full), else the inner entry ``k`` less the full heads places
+        behind the oldest."""
+        edge = self.edge
         layout = self.dut.o.payload.shape()
-        head = getattr(data.View(layout, fifo.r_data), field).as_value()
-        behind = (k - fifo.r_rdy)[:len(k)]
-        there = Const(0, len(head))
+        behind = (k - edge.outside)[:len(k)]
+        width = len(getattr(data.View(layout, edge.heads[0][1]), field).as_value())
+        there = Const(0, width)
         for a, word in enumerate(edge.slots(m, layout)):
             there = Mux(edge.offset(a) == behind, getattr(word, field).as_value(), there)
-        return Mux(fifo.r_rdy & (k == 0), head, there)
+        before = Const(0, len(k))
+        value = there
+        picks = []
+        for valid, reg in edge.heads:
+            picks.append((valid & (k == before), getattr(data.View(layout, reg), field).as_value()))
+            before = before + valid
+        for hit, head in reversed(picks):
+            value = Mux(hit, head, value)
+        return value
 
     # --- the properties ---------------------------------------------------------------------
     def _hold(self, m, i, o, take_in, take_out, stages):
@@ -523,16 +541,23 @@ class StreamContract(Elaboratable):
         edge = self._fifo(m)
         if edge is None or not stages:
             return
-        # The FIFO's output register holds n_out (the property), the oldest inner entry
-        # (at the read pointer) n_out + r_rdy, and every other entry one more than the
-        # entry at the address before it: lemmas per address, local (no offsets).
+        # The FIFO's output register holds n_out (the property), each full head register
+        # behind it the next tag, the oldest inner entry (at the read pointer) n_out + the
+        # full heads, and every other entry one more than the entry at the address before
+        # it: lemmas per address, local (no offsets).
         n = edge.inner_depth
         produce = edge.storage.write_ports[0].addr
         consume = edge.storage.read_ports[0].addr
         inner = edge.inner_level
         slots = edge.slots(m, o.payload.shape())
+        after_head = n_out + edge.heads[0][0]
+        for k, (valid, reg) in enumerate(edge.heads[1:], start=1):
+            tag = data.View(o.payload.shape(), reg).tag
+            self._lemma(m, ~valid | (tag == after_head[:bits]),
+                        f"the FIFO's head register {k} holds the tag after the ones before it")
+            after_head = after_head + valid
         head = Signal(bits, name="tag_fifo_head")
-        m.d.comb += head.eq(n_out + edge.fifo.r_rdy)
+        m.d.comb += head.eq(after_head)
         youngest = head                  # the tag after the FIFO's youngest pixel
         for a, word in enumerate(slots):
             after = (a + 1) % n
@@ -580,12 +605,18 @@ class StreamContract(Elaboratable):
             if t is not None:
                 self._lemma(m, ~v | (t == tag[n]), "stage n tag = i.tag n cycles ago")
         edge = self._fifo(m)
-        if edge is None or self.port_latency != self.latency + 2:
+        if edge is None or self.port_latency != self.latency + len(edge.heads) + 1:
             return
         # The FIFO drains every cycle: its inner queue holds at most the pixel the chain
-        # wrote in the last cycle, its output register the one before.
+        # wrote in the last cycle, the head registers the ones before (the prefetch register
+        # the one of two cycles ago, the output register's is o's).
         after = valid[self.latency + 1]
         self._lemma(m, edge.inner_level == after, "the FIFO holds the last cycle's pixel only")
+        for n, (hv, reg) in enumerate(edge.heads[1:], start=1):
+            back = self.latency + 1 + len(edge.heads) - n
+            self._lemma(m, hv == valid[back], f"the FIFO's head register {n} holds the pixel of {back} cycles ago")
+            self._lemma(m, ~hv | (data.View(o.payload.shape(), reg).tag == tag[back]),
+                        f"the FIFO's head register {n} holds the tag of {back} cycles ago")
         for a, word in enumerate(edge.slots(m, o.payload.shape())):
             consume = edge.storage.read_ports[0].addr
             self._lemma(m, ~after | (consume != a) | (word.tag == tag[self.latency + 1]),

@@ -9,11 +9,10 @@ credit edge (:class:`BrokenEdge`, one mutation each) around SinCos's free-runnin
 
 from amaranth.hdl import Module, Mux, Signal
 from amaranth.lib import stream, wiring
-from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.palette import PaletteLUT
-from bumprtl.rtl.pipe import EDGE_LATENCY, CreditEdge, min_fifo_depth
+from bumprtl.rtl.pipe import EDGE_LATENCY, CreditEdge, CreditFIFO, min_fifo_depth
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
@@ -48,8 +47,7 @@ class BrokenEdge(CreditEdge):
     def elaborate(self, platform):
         m = Module()
         mutation = self.mutation
-        m.submodules.fifo = fifo = SyncFIFOBuffered(width=len(self.core.payload.as_value()),
-                                                    depth=self.depth)
+        m.submodules.fifo = fifo = CreditFIFO(len(self.core.payload.as_value()), self.depth)
         m.d.comb += self.level.eq(fifo.level)
         free = Signal(init=1, name="credit_free")
         take = self.i_valid & self.i_ready

@@ -4,7 +4,8 @@ depth and the light table's wrap, in the Amaranth simulator.
 The buffer (docs/board.md, "The elastic buffer"): the display taking pixel n at clock t
 returns a credit; the source issues pixel n + D with it one clock later (the registered
 credit count), the pipeline gives it back L clocks after that (its ``latency``), and
-``SyncFIFOBuffered`` shows an entry FIFO_DELAY clocks after its write. The display wants
+the credit edge's FIFO (rtl/pipe.CreditFIFO: memory, prefetch register, output register)
+shows an entry FIFO_DELAY clocks after its write. The display wants
 pixel n + D at clock t + D, so on a line longer than the buffer D >= 1 + L + FIFO_DELAY is
 needed and enough: rtl/pipe.min_fifo_depth, below which the pipeline refuses the depth. The reduced mode's 32-pixel lines hide a shallow buffer (a line is over
 before the shortage shows), so the check runs a mode with lines longer than the buffer and
@@ -20,20 +21,19 @@ import dataclasses
 import numpy as np
 import pytest
 from amaranth.hdl import Module, Signal
-from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.board import board_data
 from bumprtl.rtl.board import BoardCore, PixelSource, buffer_depth, payload_field
 from bumprtl.rtl.config import BumpError
-from bumprtl.rtl.pipe import min_fifo_depth
+from bumprtl.rtl.pipe import CreditFIFO, min_fifo_depth
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import STEPS, frame_inputs, light_table
 from bumprtl.sim.scenes.config import load_scene_config
 
 SMALL = {"angle_bits": 10, "texture_size": 16}
-FIFO_DELAY = 2        # SyncFIFOBuffered: an entry written to an empty queue is read 2 clocks later
+FIFO_DELAY = 3        # CreditFIFO: an entry written to an empty queue is read 3 clocks later
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +52,7 @@ def unelaborated_pipeline(scene):
 
 
 def test_fifo_delay_is_what_the_derivation_takes():
-    fifo = SyncFIFOBuffered(width=8, depth=8)
+    fifo = CreditFIFO(8, 8)
     seen = []
 
     async def bench(ctx):
@@ -60,7 +60,7 @@ def test_fifo_delay_is_what_the_derivation_takes():
         ctx.set(fifo.w_en, 1)
         await ctx.tick()
         ctx.set(fifo.w_en, 0)
-        for _ in range(4):
+        for _ in range(5):
             seen.append(ctx.get(fifo.r_rdy))
             await ctx.tick()
 
@@ -68,7 +68,7 @@ def test_fifo_delay_is_what_the_derivation_takes():
     sim.add_clock(1e-6)
     sim.add_testbench(bench)
     sim.run()
-    assert seen.index(1) + 1 == FIFO_DELAY, seen      # written in clock 0, readable in clock 2
+    assert seen.index(1) + 1 == FIFO_DELAY, seen      # written in clock 0, readable in clock 3
 
 
 def long_line_mode(depth, latency):

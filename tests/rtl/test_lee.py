@@ -101,14 +101,14 @@ def test_latency_and_one_pixel_per_clock():
 
 
 @pytest.mark.parametrize("cfg, prop, dot, rotation, illumination", [
-    (Config(angle_bits=12, frac_bits=12), PRODUCT_LATENCY, PRODUCT_LATENCY, 33, 26),
-    (Config(frac_bits=13), PRODUCT_LATENCY, PRODUCT_LATENCY, 33, 26),
-    (Config(), PRODUCT_LATENCY, PRODUCT_LATENCY, 33, 26),
-    (Config(angle_bits=13, frac_bits=16), PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 33, 28),
-    (Config(angle_bits=16, frac_bits=24), WIDE_PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 35, 28)],
+    (Config(angle_bits=12, frac_bits=12), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
+    (Config(frac_bits=13), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
+    (Config(), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
+    (Config(angle_bits=13, frac_bits=16), PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 34, 29),
+    (Config(angle_bits=16, frac_bits=24), WIDE_PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 37, 29)],
     ids=["a12b12", "b13", "default", "a13b16", "a16b24"])
 def test_latencies_follow_the_product_widths(cfg, prop, dot, rotation, illumination):
-    """A product whose operands outgrow one 18-bit DSP input is a WideProduct, two stages
+    """A product whose operands outgrow one 18-bit DSP input is a WideProduct, three stages
     more: eq. 19's (90 - |Z|, angle_bits + 3 bits, x T_prop, B + 1 bits) from angle_bits 16
     or B = 17, eq. 24's (c- - c+, B + 3 bits, x c_phi) from B = 16."""
     cfg = cfg.replace(method="lee")

@@ -36,6 +36,7 @@ from bumprtl.rtl.pipe import (
     fits_dsp,
     min_fifo_depth,
     product_latency,
+    unit_memory_records,
 )
 from bumprtl.rtl.pipeline import BumpPipeline, LightSum
 from bumprtl.rtl.rotation import VectorRotation
@@ -315,7 +316,7 @@ UNITS = {
     "lightsum": lambda: LightSum(load_scene_config({"name": "t", "lights": 2}).hardware),
     "pipeline": lambda: BumpPipeline(load_scene_config({"name": "t", "texture_size": 16}).hardware),
     "pipeline-deep-fifo": lambda: BumpPipeline(
-        load_scene_config({"name": "t", "texture_size": 16}).hardware, fifo_depth=40),
+        load_scene_config({"name": "t", "texture_size": 16}).hardware, fifo_depth=48),
 }
 
 
@@ -433,10 +434,11 @@ def test_spread_memories_take_one_more_address_register():
     NEAR_BLOCKS like the default scene's, so the two rotations have the same stages."""
     dut = BumpPipeline(load_scene_config("full").hardware)
     narrow = BumpPipeline(load_scene_config("default").hardware)
-    Fragment.get(dut, None)                 # elaborates the units: their memories' record
-    spread = {name: mem for name, mem in dut.units["fetch"].memories.items()
+    _, records = unit_memory_records(dut)   # elaborates the units: their memories' record
+    fetch = records.of(dut.units["fetch"])
+    spread = {name: mem for name, mem in fetch.items()
               if rom_blocks(mem["depth"], mem["width"]) > SPREAD_BLOCKS}
-    assert set(spread) == {"map", "texture"}, dut.units["fetch"].memories
+    assert set(spread) == {"map", "texture"}, fetch
     assert dut.units["fetch"].latency == narrow.units["fetch"].latency + 1
     assert dut.units["rotation"].latency == narrow.units["rotation"].latency
 
