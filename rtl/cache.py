@@ -623,7 +623,8 @@ class AxiMapFetch(wiring.Component):
     Parameters
     ----------
     scene : HardwareScene
-        ``map_memory = "axi"`` scenes (a varying N' map, per-pixel shading).
+        ``map_memory = "axi"`` scenes (a varying N' map with per-pixel shading, or the
+        palette's index map: the fetched field is ``bumpfetch.fetched_field``'s).
     out_layout : data.StructLayout
         As BumpMapFetch's: the fetched field plus fields carried unchanged.
     cache : dict, optional
@@ -639,9 +640,16 @@ class AxiMapFetch(wiring.Component):
     issues its line's burst and queues the pixel, and the pixels behind it go on being
     looked up (:class:`TextureCache`); ``i.ready`` falls while the looked-up pixel has to
     wait, and depends on the lookup in the same cycle (not a register as a credit edge's).
+    At most :attr:`capacity` pixels are inside at once.
     """
 
     latency = CACHE_LATENCY
+
+    @property
+    def capacity(self):
+        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the lookup register,
+        the queue's entries, the data read and the output register."""
+        return self.geom.queue + 3
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):
         check_scene(self, scene)

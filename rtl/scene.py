@@ -57,18 +57,25 @@ def check_choice(key, value, allowed, error=BumpError):
 
 def check_map_memory(map_memory, shading, bump_map, texture, cache=None, error=BumpError):
     """``map_memory`` is one of :data:`MAP_MEMORIES`; ``axi`` (rtl/cache.py) holds a
-    varying N' map with per-pixel shading and no colour texture; the ``cache`` keys
-    (:data:`CACHE_DEFAULTS`) other than their defaults need ``axi``; else ``error`` naming
-    the key (rtl/cache.CacheGeometry checks their ranges)."""
+    per-texel map without a colour texture: a varying N' map with per-pixel shading, or
+    the palette's index map; the ``cache`` keys (:data:`CACHE_DEFAULTS`) other than their
+    defaults need ``axi``; else ``error`` naming the key (rtl/cache.CacheGeometry checks
+    their ranges)."""
     check_choice("map_memory", map_memory, MAP_MEMORIES, error)
     for key, value in (cache or {}).items():
         if map_memory != "axi" and value != CACHE_DEFAULTS[key]:
             raise error(f"{key} = {value!r} applies to map_memory = 'axi' (the texel cache), "
                         f"the scene has map_memory = {map_memory!r}", key)
-    if map_memory == "axi" and (shading, bump_map, texture) != ("per-pixel", "varying", False):
-        raise error(f"map_memory = 'axi' needs shading = 'per-pixel', bump_map = 'varying' and "
-                    f"texture = false (got {shading!r}, {bump_map!r}, {texture}); allowed "
-                    f"otherwise: map_memory = 'bram'", "map_memory")
+    if map_memory != "axi":
+        return
+    if texture:
+        raise error("map_memory = 'axi' needs texture = false (the colour texture stays in "
+                    "block RAM beside a map in block RAM): allowed otherwise map_memory = "
+                    "'bram'", "map_memory")
+    if shading == "per-pixel" and bump_map != "varying":
+        raise error("map_memory = 'axi' needs a map: bump_map = 'varying' with shading = "
+                    "'per-pixel', or shading = 'palette' (got bump_map = 'flat'); allowed "
+                    "otherwise map_memory = 'bram'", "map_memory")
 
 
 def check_map_size(texture_size, mip_levels, error=BumpError):
@@ -112,8 +119,8 @@ class HardwareScene:
     map_memory : str
         ``bram`` (the map in block RAM, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`) or
         ``axi`` (the map in the user's memory behind a texel cache with an AXI4 read port,
-        :class:`~bumprtl.rtl.cache.AxiMapFetch`; per-pixel shading of a varying map, no
-        colour texture).
+        :class:`~bumprtl.rtl.cache.AxiMapFetch`; a varying N' map with per-pixel shading
+        or the palette's index map, no colour texture).
     cache_sets, cache_ways, cache_block, axi_data_bits : int
         With ``map_memory = "axi"``: the texel cache's sets, ways a set, side of a line's
         square block of texels (powers of two) and AXI data width (32 or 64);

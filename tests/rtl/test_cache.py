@@ -171,8 +171,12 @@ def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, 
 def test_map_memory_refusals():
     with pytest.raises(BumpError, match="map_memory must be one of bram, axi"):
         load_scene_config({"map_memory": "dram"})
-    with pytest.raises(BumpError, match="map_memory = 'axi' needs shading = 'per-pixel'"):
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs texture = false"):
         load_scene_config({"map_memory": "axi", "texture": True})
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs texture = false"):
+        load_scene_config({"map_memory": "axi", "texture": True, "shading": "palette"})
+    with pytest.raises(BumpError, match="needs a map: bump_map = 'varying'"):
+        load_scene_config({"map_memory": "axi", "bump_map": "flat"})
     with pytest.raises(BumpError, match="cache_ways: ways must be a power of two"):
         load_scene_config({"map_memory": "axi", "cache_ways": 3})
     with pytest.raises(BumpError, match="cache_sets = 16 applies to map_memory = 'axi'"):
@@ -182,6 +186,14 @@ def test_map_memory_refusals():
     bram = BumpPipeline(load_scene_config({}).hardware)
     bram._MustUse__silence = True                 # built for its ports only
     assert "axi" not in bram.signature.members
+
+
+def test_cli_refuses_axi_with_a_colour_texture_in_one_line(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--scene", "textured", "--map-memory", "axi",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "texture = false" in err and len(err.strip().splitlines()) == 1 and not out.exists()
 
 
 def test_cli_refuses_a_cache_larger_than_the_block_ram(tmp_path, capsys):

@@ -1,6 +1,7 @@
 """A ``map_memory = "axi"`` scene pipeline emitted with its ``_map.bin``, under cocotb on
 Icarus and Verilator against cocotbext-axi's AxiRamRead holding that image
-(sim/tb/tb_pipeline_axi.py): outputs bit-exact with the golden pipeline and AR requests
+(sim/tb/tb_pipeline_axi.py): outputs bit-exact with the golden pipeline (per-pixel
+shading) or the colour-table model (palette: the indices in the ``.bin``), AR requests
 with the golden cache model, memory latencies 2, 20 and 60, random stalls everywhere."""
 
 import pytest
@@ -12,18 +13,28 @@ from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
-# The default scene at small widths, a 32 x 32 map of two levels, its map in AXI memory.
-SCENE = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8, "tag_bits": 6,
-                           "texture_size": 32, "mip_levels": 2, "map_memory": "axi"})
+# The default scene at small widths, a 32 x 32 map of two levels, its map in AXI memory;
+# the palette scene's 8-bit index map the same way, its colour table behind the cache.
+SCENES = {
+    "default": load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8,
+                                  "tag_bits": 6, "texture_size": 32, "mip_levels": 2,
+                                  "map_memory": "axi"}),
+    "palette": load_scene_config({**BUILTIN["palette"], "tag_bits": 6, "texture_size": 32,
+                                  "mip_levels": 2, "map_memory": "axi"})}
 
 
+@pytest.mark.parametrize("scene", SCENES)
 @pytest.mark.parametrize("sim", SIMULATORS)
-def test_pipeline_axi_cocotb_against_axi_ram(sim, build_dir):
-    images = memory_images("pipeline", SCENE, *scene_memories(SCENE))
-    v, j, files = emit_scene_unit("pipeline", SCENE, build_dir / "rtl", images)
-    assert [f.name for f in files] == ["pipeline_map.bin"]
+def test_pipeline_axi_cocotb_against_axi_ram(sim, scene, build_dir):
+    scene = SCENES[scene]
+    images = memory_images("pipeline", scene, *scene_memories(scene))
+    v, j, files = emit_scene_unit("pipeline", scene, build_dir / "rtl", images)
+    assert [f.name for f in files if f.suffix == ".bin"] == ["pipeline_map.bin"]
     meta = load_sidecar(j)
-    assert meta.memory_images["map"]["bytes"] == files[0].stat().st_size
+    record = meta.memory_images["map"]
+    assert record["bytes"] == files[0].stat().st_size
+    slot = 1 if scene.shading == "palette" else 4       # an 8-bit index, a 16-bit angle pair
+    assert record["bytes"] == slot * sum((32 >> n) ** 2 for n in range(2))
     assert lint(v) == []
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_pipeline_axi", build_dir / sim,
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 150})
