@@ -43,8 +43,8 @@ from bumprtl.rtl.scene import HardwareScene, check_scene
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
            "texel_byte_address", "tiled_image", "plru_victim", "plru_touch", "TextureCache",
-           "CACHE_DEFAULTS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry", "scene_levels",
-           "CACHE_LATENCY"]
+           "CACHE_DEFAULTS", "SCENE_KEYS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry",
+           "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
 # queue is empty: the lookup register, the queue's read, the data read, the output register.
@@ -54,10 +54,11 @@ AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
 MAX_BURST = 256                     # AXI4 INCR: ARLEN + 1 <= 256 beats
 AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
-# sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
-CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
-                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"],
-                  "queue": 256, "misses": 64}
+# CacheGeometry's parameter -> the scene key that sets it (rtl/scene.CACHE_DEFAULTS)
+SCENE_KEYS = {"sets": "cache_sets", "ways": "cache_ways", "block": "cache_block",
+              "data_bits": "axi_data_bits", "queue": "cache_queue", "misses": "cache_outstanding"}
+# sets, ways, block side, AXI data bits, queue, bursts outstanding: the scene's defaults
+CACHE_DEFAULTS = {name: SCENE_CACHE[key] for name, key in SCENE_KEYS.items()}
 
 
 def _pow2(x):
@@ -596,11 +597,11 @@ class TextureCache(wiring.Component):
 def scene_geometry(scene: HardwareScene, **cache):
     """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
     width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
-    ``axi_data_bits``), the parameters ``cache`` (sets, ways, block, data_bits, base,
-    addr_bits) overriding them."""
+    ``axi_data_bits``, ``cache_queue``, ``cache_outstanding``: :data:`SCENE_KEYS`), the
+    parameters ``cache`` (CacheGeometry's: sets, ways, block, data_bits, queue, misses,
+    base, addr_bits, stamp_bits) overriding them."""
     bits = Shape.cast(texel_shape(scene)).width
-    own = {"sets": scene.cache_sets, "ways": scene.cache_ways, "block": scene.cache_block,
-           "data_bits": scene.axi_data_bits}
+    own = {name: getattr(scene, key) for name, key in SCENE_KEYS.items()}
     return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **{**own, **cache})
 
 

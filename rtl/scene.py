@@ -26,8 +26,11 @@ TEXTURE_SIZES = (16, 4096)               # a power of two in this range
 MAP_MEMORIES = ("bram", "axi")           # the map in block RAM, or behind a cache on AXI4
 # The texel cache of map_memory = "axi" (rtl/cache.CacheGeometry): sets, ways, side of a
 # line's square block of texels, AXI data bits. 64 x 2 lines of 4 x 4 texels: 8 KiB of
-# 28-bit texels in 4-byte slots, a line one 16-beat burst on a 32-bit bus.
-CACHE_DEFAULTS = {"cache_sets": 64, "cache_ways": 2, "cache_block": 4, "axi_data_bits": 32}
+# 28-bit texels in 4-byte slots, a line one 16-beat burst on a 32-bit bus. Pixels its
+# in-order queue holds (a power of two in [2, 1024]) and AXI bursts outstanding at most (a
+# power of two in [1, 64]): what hides the memory's latency (docs/memory.md).
+CACHE_DEFAULTS = {"cache_sets": 64, "cache_ways": 2, "cache_block": 4, "axi_data_bits": 32,
+                  "cache_queue": 256, "cache_outstanding": 64}
 
 
 def derived_rotation(shading, bump_map):
@@ -125,6 +128,10 @@ class HardwareScene:
         With ``map_memory = "axi"``: the texel cache's sets, ways a set, side of a line's
         square block of texels (powers of two) and AXI data width (32 or 64);
         :data:`CACHE_DEFAULTS`.
+    cache_queue, cache_outstanding : int
+        With ``map_memory = "axi"``: pixels the cache's queue holds (a power of two in
+        [2, 1024], default 256) and AXI bursts outstanding at most (a power of two in
+        [1, 64], default 64).
     config : Config
         The datapath widths, method, lights, specular, terms and palette size.
     """
@@ -142,6 +149,8 @@ class HardwareScene:
     cache_ways: int = CACHE_DEFAULTS["cache_ways"]
     cache_block: int = CACHE_DEFAULTS["cache_block"]
     axi_data_bits: int = CACHE_DEFAULTS["axi_data_bits"]
+    cache_queue: int = CACHE_DEFAULTS["cache_queue"]
+    cache_outstanding: int = CACHE_DEFAULTS["cache_outstanding"]
     config: Config = Config()
 
     def __post_init__(self):

@@ -222,7 +222,7 @@ _FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "heig
               "resample", "texture_size", "method", "angle_bits", "frac_bits", "tag_bits",
               "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights", "specular",
               "palette_size", "map_memory", "cache_sets", "cache_ways", "cache_block",
-              "axi_data_bits")
+              "axi_data_bits", "cache_queue", "cache_outstanding")
 
 
 _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",

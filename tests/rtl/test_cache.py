@@ -201,3 +201,49 @@ def test_cli_refuses_a_cache_larger_than_the_block_ram(tmp_path, capsys):
     assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-sets", "4096",
                  "--cache-ways", "16", "--out", str(out)]) == 2
     assert "fewer sets or ways" in capsys.readouterr().err and not out.exists()
+
+
+def _pipeline_cycles(scene, latency, n=120, seed=3):
+    """(cycles, golden cycle model's prediction) of the palette pipeline of ``scene`` on
+    ``n`` random pixels, its memory never stalling, its output always taken: the reset's
+    flush, stream_cycles of the scene's own geometry, the pipeline's port latency."""
+    rng = np.random.default_rng(seed)
+    words, inputs = random_map(scene, rng), random_inputs(scene, n, rng)
+    dut = BumpPipeline(scene.hardware)
+    geom = scene_geometry(scene.hardware)
+    assert dut.units["fetch"].geom == geom
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
+                        latency=latency)
+    _, cycles = simulate_stream(dut, as_payload_list(inputs), max_cycles=50_000,
+                                processes=[mem.process])
+    run = run_scene_cache(scene.hardware, geom, inputs, words)
+    return cycles, geom.sets + stream_cycles(run, geom, latency) + dut.port_latency
+
+
+def test_queue_and_outstanding_keys_set_the_cycle_schedule():
+    """cache_queue and cache_outstanding reach the RTL and the golden model from the one
+    scene: a 4-entry queue with 2 bursts outstanding takes more cycles than the defaults on
+    a miss-heavy stream at latency 30, and each count is the cycle model's exactly."""
+    keys = {**BUILTIN["palette"], "texture_size": 64, "mip_levels": 3, "tag_bits": 8,
+            "map_memory": "axi", "cache_sets": 8}
+    small = load_scene_config({**keys, "cache_queue": 4, "cache_outstanding": 2})
+    assert scene_geometry(small.hardware).queue == 4
+    assert scene_geometry(small.hardware).misses == 2
+    got_small, want_small = _pipeline_cycles(small, 30)
+    got, want = _pipeline_cycles(load_scene_config(keys), 30)
+    assert (got_small, got) == (want_small, want)
+    assert got_small > 1.5 * got
+
+
+def test_queue_and_outstanding_refusals(tmp_path, capsys):
+    with pytest.raises(BumpError, match=r"cache_queue: queue must be a power of two in \[2, 1024\]"):
+        load_scene_config({"map_memory": "axi", "cache_queue": 3})
+    with pytest.raises(BumpError, match=r"cache_outstanding: misses must be a power of two in \[1, 64\]"):
+        load_scene_config({"map_memory": "axi", "cache_outstanding": 128})
+    with pytest.raises(BumpError, match="cache_queue = 16 applies to map_memory = 'axi'"):
+        load_scene_config({"cache_queue": 16})
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-outstanding", "0",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "cache_outstanding" in err and len(err.strip().splitlines()) == 1 and not out.exists()
