@@ -95,6 +95,11 @@ class CacheGeometry:
         two): what hides the memory's latency (docs/memory.md).
     misses : int
         Line fills (AXI bursts) outstanding at most (a power of two).
+    stamp_bits : int or None
+        Bits of the sequence numbers of queued pixels (a stamp a line), in
+        [log2(queue) + 1, 32]; None: ``max(16, log2(queue) + 2)``, wide enough that a stale
+        stamp rarely looks queued (that only delays a miss until the queue drains). A
+        narrow one wraps within a short stream (the tests' way to reach the wrap).
     """
 
     texture_size: int
@@ -108,6 +113,7 @@ class CacheGeometry:
     addr_bits: int = 32
     queue: int = CACHE_DEFAULTS["queue"]
     misses: int = CACHE_DEFAULTS["misses"]
+    stamp_bits: int | None = None
 
     def __post_init__(self):
         _check_pow2("texture_size", self.texture_size, 1, 1 << 16)
@@ -138,6 +144,13 @@ class CacheGeometry:
                             f"{self.addr_bits!r}", "addr_bits")
         _check_pow2("queue", self.queue, 2, 1024)
         _check_pow2("misses", self.misses, 1, 64)
+        least = self.queue.bit_length()          # in_seq - out_seq counts up to queue
+        if self.stamp_bits is None:
+            object.__setattr__(self, "stamp_bits", max(16, least + 1))
+        elif isinstance(self.stamp_bits, bool) or not isinstance(self.stamp_bits, int) \
+                or not least <= self.stamp_bits <= 32:
+            raise BumpError(f"stamp_bits must be an integer in [{least}, 32] for queue "
+                            f"{self.queue}, got {self.stamp_bits!r}", "stamp_bits")
         if self.base + self.image_bytes > 1 << self.addr_bits:
             raise BumpError(f"the map's image ends at byte {self.base + self.image_bytes}, "
                             f"beyond the {self.addr_bits}-bit AXI address space (addr_bits "
@@ -211,12 +224,6 @@ class CacheGeometry:
     @property
     def way_bits(self):
         return self.ways.bit_length() - 1
-
-    @property
-    def stamp_bits(self):
-        """Bits of the sequence numbers of queued pixels (a stamp a line): wide enough that
-        a stale stamp rarely looks queued (that only delays a miss until the queue drains)."""
-        return max(16, self.queue.bit_length() + 1)
 
     @property
     def cache_bits(self):

@@ -247,3 +247,43 @@ def test_queue_and_outstanding_refusals(tmp_path, capsys):
                  "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "cache_outstanding" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+def _stamp_cycles(geom, latency, n, seed):
+    """The RTL's cycles (bit-exact texels and AR stream checked) and the cycle model's for
+    ``n`` pixels of cache_stimulus, memory and sink never stalling."""
+    levels = random_levels(geom, seed)
+    u, v, level = cache_stimulus(geom, n, seed)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
+    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
+    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
+    assert [o["texel"] for o in out] == golden.texel.tolist()
+    assert mem.requests == golden.requests
+    return cycles, geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY
+
+
+def test_stamp_wrap_in_rtl_is_the_cycle_models():
+    """3-bit stamps (the least for a 4-entry queue) wrap every 8 pixels: a stale stamp then
+    reads as a queued pixel's and holds a miss until the queue has drained. The RTL's
+    texels and AR stream stay the golden model's, and its cycles are stream_cycles' with
+    the wrap modelled, which differ from the same stream's with 16-bit stamps (so the
+    wrap was reached and changed the schedule)."""
+    keys = {"texture_size": 64, "mip_levels": 3, "texel_bits": 28, "sets": 2, "queue": 4}
+    narrow = CacheGeometry(**keys, stamp_bits=3)
+    wide = CacheGeometry(**keys)
+    assert wide.stamp_bits == 16
+    got_narrow, want_narrow = _stamp_cycles(narrow, 9, 300, 11)
+    got_wide, want_wide = _stamp_cycles(wide, 9, 300, 11)
+    assert (got_narrow, got_wide) == (want_narrow, want_wide)
+    assert got_narrow > got_wide
+    with pytest.raises(BumpError, match=r"stamp_bits must be an integer in \[3, 32\]"):
+        CacheGeometry(**keys, stamp_bits=2)
+
+
+def test_stamp_wrap_bit_exact_under_stalls():
+    """Wrapping stamps under AR/R stalls, input gaps and backpressure: no line a queued pixel
+    needs is evicted (every texel the golden model's), the AR stream the golden model's."""
+    check_cache(CacheGeometry(64, 3, 28, sets=2, queue=8, stamp_bits=4), n=300, latency=20,
+                seed=4)
