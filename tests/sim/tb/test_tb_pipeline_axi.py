@@ -4,14 +4,23 @@ Icarus and Verilator against cocotbext-axi's AxiRamRead holding that image
 shading) or the colour-table model (palette: the indices in the ``.bin``), AR requests
 with the golden cache model, memory latencies 2, 20 and 60, random stalls everywhere."""
 
+import logging
+
+import numpy as np
 import pytest
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.memories import emit_scene_unit, memory_images
-from bumprtl.gen.render.rtl import scene_memories
+from bumprtl.gen.render.rtl import emit_pipeline, scene_memories, scene_stimulus
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.sidecar import load as load_sidecar
+from bumprtl.sim.golden.cache import run_scene_cache
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
+from bumprtl.sim.tb.bulk import CHUNK, TRAFFIC, run_bulk
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
+
+log = logging.getLogger(__name__)
 
 # The default scene at small widths, a 32 x 32 map of two levels, its map in AXI memory;
 # the palette scene's 8-bit index map the same way, its colour table behind the cache.
@@ -53,3 +62,73 @@ def test_megatexel_pipeline_axi_raster_on_verilator(build_dir):
     run = run_cocotb("verilator", v, "bumprtl.sim.tb.tb_pipeline_axi", build_dir / "verilator",
                      {"BUMPRTL_SIDECAR": j, "BUMPRTL_SAMPLES": 4096, "BUMPRTL_STIMULUS": "raster"})
     assert (run.tests, run.failures) == (3, 0)
+
+
+def _bulk_frame(scene, size, sim, build_dir, patterns=tuple(TRAFFIC)):
+    """``scene``'s frame at ``size`` x ``size`` (gen/render/rtl.scene_stimulus, level 0)
+    through its emitted axi pipeline on the bulk path (sim/tb/bulk.py, the wrapper's AXI
+    memory model holding the ``_map.bin``): chunk by chunk, each chunk under ``patterns``
+    one after the other, without a reset between them. Every output field bit-exact with
+    the golden pipeline, and per pattern the AR requests (count and sum of addresses) the
+    golden cache model's for the pixels in that order. Returns (BulkResult, CacheRun)."""
+    inputs, words, _, _, _ = scene_stimulus(scene, size)
+    n = len(inputs["tag"])
+    v, j = emit_pipeline(scene, words, None, build_dir, None)
+    golden = pipeline_fixed(inputs, scene, words)
+    r = run_bulk(sim, v, j, build_dir / f"bulk_{sim}", patterns, inputs=inputs,
+                 expected=golden, keep=False)
+    assert r.checked and all(r.pixels[p] == n for p in patterns)
+    order = [(p, slice(s, min(s + CHUNK, n))) for s in range(0, n, CHUNK) for p in patterns]
+    pixels = {k: np.concatenate([inputs[k][sl] for _, sl in order])
+              for k in ("u", "v", "level") if k in inputs}
+    cache = run_scene_cache(scene.hardware, scene_geometry(scene.hardware), pixels, words)
+    addrs = np.array([a for a, _ in cache.requests], np.int64)
+    want, at, miss = {p: [0, 0] for p in patterns}, 0, 0
+    for p, sl in order:
+        count = int((~cache.hit[at:at + sl.stop - sl.start]).sum())
+        want[p][0] += count
+        want[p][1] += int(addrs[miss:miss + count].sum())
+        at, miss = at + sl.stop - sl.start, miss + count
+    got = {p: [r.summary["patterns"][p]["ar"], r.summary["patterns"][p]["ar_sum"]]
+           for p in patterns}
+    assert got == want
+    return r, cache
+
+
+def test_bulk_axi_frame_on_icarus(build_dir):
+    """The bulk path with its AXI memory model, reduced: a 32 x 32 frame of the default
+    scene (small widths) on a 32² map in a 4-set cache, four traffic patterns back to back
+    (the cache warm from the pattern before)."""
+    scene = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8,
+                               "tag_bits": 6, "texture_size": 32, "map_memory": "axi",
+                               "cache_sets": 4})
+    _, cache = _bulk_frame(scene, 32, "icarus", build_dir)
+    # one texel per pixel in raster order: a block row's 8 lines fit the 4 x 2 lines, so
+    # each of the 64 lines is fetched once a pattern (the next frame's first rows evicted
+    # by the last ones)
+    assert len(cache.requests) == len(TRAFFIC) * (32 // 4) ** 2
+
+
+# (image, frame side, patterns): bumprtl render's 512² frame, every pixel 4 texels from the
+# last (every pixel misses), and the plane at one texel per pixel over the whole map (16
+# chunks: every texel read, a miss every 4th pixel and each line refetched for each of its
+# 4 texel rows).
+MEGATEXEL = [("bricks", 512, tuple(TRAFFIC)), ("globe", 512, tuple(TRAFFIC)),
+             ("bricks", 2048, ("no_stall", "both"))]
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("image,size,patterns", MEGATEXEL,
+                         ids=[f"{i}-{n}-{len(p)}patterns" for i, n, p in MEGATEXEL])
+def test_megatexel_frames_pipeline_axi_on_verilator(image, size, patterns, build_dir):
+    """A 2048² map at the default widths (a 16 MiB _map.bin), whole frames of the scene
+    through the axi pipeline on Verilator's bulk path, under traffic patterns back to back:
+    bit-exact and AR stream as the golden model's (the 16-bit stamps wrap every 65536
+    pixels)."""
+    scene = load_scene_config({**BUILTIN["default"], "image": image, "texture_size": 2048,
+                               "map_memory": "axi"})
+    r, cache = _bulk_frame(scene, size, "verilator", build_dir, patterns)
+    log.info("%s %d²: %d pixels x %d patterns, %d AR requests, cycles %s, simulated in %s s "
+             "(build %.0f s)", image, size, r.pixels[patterns[0]], len(patterns),
+             len(cache.requests), r.cycles, {p: round(t, 1) for p, t in r.sim_s.items()},
+             r.build_s)
