@@ -15,9 +15,10 @@ from bumprtl.gen.render.rtl import emit_pipeline, scene_memories, scene_stimulus
 from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.sidecar import load as load_sidecar
 from bumprtl.sim.golden.cache import run_scene_cache
+from bumprtl.sim.golden.fixed.palette_lut import palette_colors
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
-from bumprtl.sim.tb.bulk import CHUNK, TRAFFIC, run_bulk
+from bumprtl.sim.tb.bulk import CHUNK, TRAFFIC, run_bulk, setup_writes
 from bumprtl.sim.tb.runner import SIMULATORS, run_cocotb
 
 log = logging.getLogger(__name__)
@@ -67,16 +68,21 @@ def test_megatexel_pipeline_axi_raster_on_verilator(build_dir):
 def _bulk_frame(scene, size, sim, build_dir, patterns=tuple(TRAFFIC)):
     """``scene``'s frame at ``size`` x ``size`` (gen/render/rtl.scene_stimulus, level 0)
     through its emitted axi pipeline on the bulk path (sim/tb/bulk.py, the wrapper's AXI
-    memory model holding the ``_map.bin``): chunk by chunk, each chunk under ``patterns``
-    one after the other, without a reset between them. Every output field bit-exact with
-    the golden pipeline, and per pattern the AR requests (count and sum of addresses) the
-    golden cache model's for the pixels in that order. Returns (BulkResult, CacheRun)."""
-    inputs, words, _, _, _ = scene_stimulus(scene, size)
+    memory model holding the ``_map.bin``; a palette scene's colour table written and
+    swapped in first): chunk by chunk, each chunk under ``patterns`` one after the other,
+    without a reset between them. Every output field bit-exact with the golden pipeline
+    (palette: the table entry of the golden index), and per pattern the AR requests (count
+    and sum of addresses) the golden cache model's for the pixels in that order. Returns
+    (BulkResult, CacheRun)."""
+    inputs, words, _, table, _ = scene_stimulus(scene, size)
     n = len(inputs["tag"])
-    v, j = emit_pipeline(scene, words, None, build_dir, None)
-    golden = pipeline_fixed(inputs, scene, words)
+    v, j = emit_pipeline(scene, words, None, build_dir, None, table)
+    golden, setup = pipeline_fixed(inputs, scene, words), ()
+    if scene.shading == "palette":
+        golden = {**palette_colors(golden, table, scene), "oor": np.zeros(n, np.int64)}
+        setup = setup_writes(load_sidecar(j), table=table)
     r = run_bulk(sim, v, j, build_dir / f"bulk_{sim}", patterns, inputs=inputs,
-                 expected=golden, keep=False)
+                 expected=golden, setup=setup, keep=False)
     assert r.checked and all(r.pixels[p] == n for p in patterns)
     order = [(p, slice(s, min(s + CHUNK, n))) for s in range(0, n, CHUNK) for p in patterns]
     pixels = {k: np.concatenate([inputs[k][sl] for _, sl in order])
@@ -96,12 +102,12 @@ def _bulk_frame(scene, size, sim, build_dir, patterns=tuple(TRAFFIC)):
 
 
 def test_bulk_axi_frame_on_icarus(build_dir):
-    """The bulk path with its AXI memory model, reduced: a 32 x 32 frame of the default
-    scene (small widths) on a 32² map in a 4-set cache, four traffic patterns back to back
-    (the cache warm from the pattern before)."""
-    scene = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits": 8,
-                               "tag_bits": 6, "texture_size": 32, "map_memory": "axi",
-                               "cache_sets": 4})
+    """The bulk path with its AXI memory model, reduced: a 32 x 32 frame of the palette
+    scene on a 32² index map in a 4-set cache, its colour table written through the host
+    ports first, four traffic patterns back to back (the cache warm from the pattern
+    before)."""
+    scene = load_scene_config({**BUILTIN["palette"], "tag_bits": 6, "texture_size": 32,
+                               "map_memory": "axi", "cache_sets": 4})
     _, cache = _bulk_frame(scene, 32, "icarus", build_dir)
     # one texel per pixel in raster order: a block row's 8 lines fit the 4 x 2 lines, so
     # each of the 64 lines is fetched once a pattern (the next frame's first rows evicted
@@ -109,23 +115,25 @@ def test_bulk_axi_frame_on_icarus(build_dir):
     assert len(cache.requests) == len(TRAFFIC) * (32 // 4) ** 2
 
 
-# (image, frame side, patterns): bumprtl render's 512² frame, every pixel 4 texels from the
-# last (every pixel misses), and the plane at one texel per pixel over the whole map (16
-# chunks: every texel read, a miss every 4th pixel and each line refetched for each of its
-# 4 texel rows).
-MEGATEXEL = [("bricks", 512, tuple(TRAFFIC)), ("globe", 512, tuple(TRAFFIC)),
-             ("bricks", 2048, ("no_stall", "both"))]
+# (scene, image, frame side, patterns): bumprtl render's 512² frame, every pixel 4 texels
+# from the last (every pixel misses), and the plane at one texel per pixel over the whole
+# map (16 chunks: every texel read, a miss every 4th pixel and each line refetched for each
+# of its 4 texel rows); the palette's 8-bit indices (a 4 MiB _map.bin) on the sphere.
+MEGATEXEL = [("default", "bricks", 512, tuple(TRAFFIC)),
+             ("default", "globe", 512, tuple(TRAFFIC)),
+             ("default", "bricks", 2048, ("no_stall", "both")),
+             ("palette", "globe", 512, tuple(TRAFFIC))]
 
 
 @pytest.mark.regress
-@pytest.mark.parametrize("image,size,patterns", MEGATEXEL,
-                         ids=[f"{i}-{n}-{len(p)}patterns" for i, n, p in MEGATEXEL])
-def test_megatexel_frames_pipeline_axi_on_verilator(image, size, patterns, build_dir):
-    """A 2048² map at the default widths (a 16 MiB _map.bin), whole frames of the scene
-    through the axi pipeline on Verilator's bulk path, under traffic patterns back to back:
-    bit-exact and AR stream as the golden model's (the 16-bit stamps wrap every 65536
-    pixels)."""
-    scene = load_scene_config({**BUILTIN["default"], "image": image, "texture_size": 2048,
+@pytest.mark.parametrize("base,image,size,patterns", MEGATEXEL,
+                         ids=[f"{b}-{i}-{n}-{len(p)}patterns" for b, i, n, p in MEGATEXEL])
+def test_megatexel_frames_pipeline_axi_on_verilator(base, image, size, patterns, build_dir):
+    """A 2048² map at the default widths (a 16 MiB _map.bin of angle pairs, or 4 MiB of
+    palette indices), whole frames of the scene through the axi pipeline on Verilator's
+    bulk path, under traffic patterns back to back: bit-exact and AR stream as the golden
+    model's (the 16-bit stamps wrap every 65536 pixels)."""
+    scene = load_scene_config({**BUILTIN[base], "image": image, "texture_size": 2048,
                                "map_memory": "axi"})
     r, cache = _bulk_frame(scene, size, "verilator", build_dir, patterns)
     log.info("%s %d²: %d pixels x %d patterns, %d AR requests, cycles %s, simulated in %s s "
