@@ -9,6 +9,7 @@ import logging
 import numpy as np
 import pytest
 
+from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.memories import emit_scene_unit, memory_images
 from bumprtl.gen.render.rtl import emit_pipeline, scene_memories, scene_stimulus
@@ -140,3 +141,17 @@ def test_megatexel_frames_pipeline_axi_on_verilator(base, image, size, patterns,
              "(build %.0f s)", image, size, r.pixels[patterns[0]], len(patterns),
              len(cache.requests), r.cycles, {p: round(t, 1) for p, t in r.sim_s.items()},
              r.build_s)
+
+
+@pytest.mark.parametrize("flags", [["--per-cycle"], ["--load", "port"]])
+def test_render_rtl_refuses_the_per_cycle_path_and_load_with_axi(flags, tmp_path, capfd):
+    """The per-cycle cocotb driver has no memory on the AXI port (the bulk wrapper has):
+    one line, exit 2, before anything is built."""
+    scene = tmp_path / "axi.toml"
+    scene.write_text('name = "axi"\ntexture_size = 16\nmap_memory = "axi"\n')
+    out = tmp_path / "r.png"
+    assert main(["render", "--rtl", "--pipeline", str(scene), "--size", "16",
+                 "--simulator", "icarus", "--out", str(out), *flags]) == 2
+    err = capfd.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{flags[0]} applies to map_memory = 'bram'" in err[0], err
+    assert not out.exists()
