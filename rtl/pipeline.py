@@ -433,10 +433,10 @@ class BumpPipeline(wiring.Component):
 
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
-        m, s = Module(), self.scene
+        m = Module()
         if self._front:                       # the cache, then the edge and the chain
             front = self.units["fetch"]
-            if s.shading != "palette":        # the palette's fetch also takes the bank
+            if self.scene.shading != "palette":   # the palette's fetch also takes the bank
                 wiring.connect(m, wiring.flipped(self.i), front.i)
             wiring.connect(m, wiring.flipped(self.axi), front.axi)
         _, core = add_credit_edge(m, front.o if self._front else self.i, self.o, self.latency,
@@ -444,7 +444,7 @@ class BumpPipeline(wiring.Component):
         _feed(m, self.units[self._last].o, core)
         for name, unit in self.units.items():
             m.submodules[name] = unit
-        u = self.units
+        s, u = self.scene, self.units
         for prefix in ("map_", "tex_"):
             if hasattr(self, f"{prefix}w_en"):
                 f, port = u["fetch"], prefix.replace("map_", "")
