@@ -101,6 +101,22 @@ def test_cache_hits_at_one_pixel_a_clock():
     assert cycles[1] - cycles[0] == len(one)
 
 
+def _cycles(geom, latency, n, seed, levels_seed=None):
+    """``n`` pixels of cache_stimulus through the RTL, memory and sink never stalling: its
+    texels and AR stream checked against the golden model; returns (the RTL's cycles, the
+    cycle model's: the reset's flush, stream_cycles, the hit latency, golden run)."""
+    levels = random_levels(geom, seed if levels_seed is None else levels_seed)
+    u, v, level = cache_stimulus(geom, n, seed)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
+    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
+    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
+    assert [o["texel"] for o in out] == golden.texel.tolist()
+    assert mem.requests == golden.requests
+    return cycles, geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY, golden
+
+
 @pytest.mark.parametrize("latency", [1, 9])
 @pytest.mark.parametrize("geom", [CacheGeometry(64, 3, 28, sets=8),
                                   CacheGeometry(64, 3, 8, sets=4, data_bits=64),
@@ -110,14 +126,8 @@ def test_cycle_model_counts_the_rtl_cycles(geom, latency):
     """sim/golden/cache.stream_cycles (what bumprtl bench memory reports) is the RTL's count
     for a stall-free memory and sink, the reset's flush (sets cycles) and the hit latency
     aside."""
-    levels = random_levels(geom)
-    u, v, level = cache_stimulus(geom, 80, latency)
-    golden = run_cache(geom, u, v, level, levels)
-    dut = TextureCache(geom)
-    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
-    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    _, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
-    assert cycles == geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY
+    cycles, predicted, _ = _cycles(geom, latency, 80, latency, levels_seed=0)
+    assert cycles == predicted
 
 
 def test_misses_overlap():
@@ -125,17 +135,10 @@ def test_misses_overlap():
     cache takes far fewer cycles than a blocking one with the same hits and misses (one
     miss at a time: sim/golden/cache.blocking_cycles), and exactly the cycle model's."""
     geom = CacheGeometry(64, 3, 28, sets=8)
-    levels = random_levels(geom, 5)
-    u, v, level = cache_stimulus(geom, 120, 5)
-    golden = run_cache(geom, u, v, level, levels)
-    dut = TextureCache(geom)
-    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=60)
-    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
-    assert [o["texel"] for o in out] == golden.texel.tolist()
+    cycles, predicted, golden = _cycles(geom, 60, 120, 5)
     blocking = blocking_cycles(golden, geom, 60)
     assert len(golden.requests) > 20 and cycles - geom.sets - CACHE_LATENCY < blocking / 2
-    assert cycles == geom.sets + stream_cycles(golden, geom, 60) + CACHE_LATENCY
+    assert cycles == predicted
 
 
 # The default scene at small widths, two levels, wrap; the same with clamp addressing.
@@ -249,21 +252,6 @@ def test_queue_and_outstanding_refusals(tmp_path, capsys):
     assert "cache_outstanding" in err and len(err.strip().splitlines()) == 1 and not out.exists()
 
 
-def _stamp_cycles(geom, latency, n, seed):
-    """The RTL's cycles (bit-exact texels and AR stream checked) and the cycle model's for
-    ``n`` pixels of cache_stimulus, memory and sink never stalling."""
-    levels = random_levels(geom, seed)
-    u, v, level = cache_stimulus(geom, n, seed)
-    golden = run_cache(geom, u, v, level, levels)
-    dut = TextureCache(geom)
-    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
-    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
-    assert [o["texel"] for o in out] == golden.texel.tolist()
-    assert mem.requests == golden.requests
-    return cycles, geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY
-
-
 def test_stamp_wrap_in_rtl_is_the_cycle_models():
     """3-bit stamps (the least for a 4-entry queue) wrap every 8 pixels: a stale stamp then
     reads as a queued pixel's and holds a miss until the queue has drained. The RTL's
@@ -274,8 +262,8 @@ def test_stamp_wrap_in_rtl_is_the_cycle_models():
     narrow = CacheGeometry(**keys, stamp_bits=3)
     wide = CacheGeometry(**keys)
     assert wide.stamp_bits == 16
-    got_narrow, want_narrow = _stamp_cycles(narrow, 9, 300, 11)
-    got_wide, want_wide = _stamp_cycles(wide, 9, 300, 11)
+    got_narrow, want_narrow, _ = _cycles(narrow, 9, 300, 11)
+    got_wide, want_wide, _ = _cycles(wide, 9, 300, 11)
     assert (got_narrow, got_wide) == (want_narrow, want_wide)
     assert got_narrow > got_wide
     with pytest.raises(BumpError, match=r"stamp_bits must be an integer in \[3, 32\]"):
