@@ -44,7 +44,7 @@ def test_pipeline_axi_cocotb_against_axi_ram(sim, scene, build_dir):
     meta = load_sidecar(j)
     record = meta.memory_images["map"]
     assert record["bytes"] == files[0].stat().st_size
-    slot = 1 if scene.shading == "palette" else 4       # an 8-bit index, a 16-bit angle pair
+    slot = 1 if scene.shading == "palette" else 2       # an 8-bit index, a 16-bit angle pair
     assert record["bytes"] == slot * sum((32 >> n) ** 2 for n in range(2))
     assert lint(v) == []
     run = run_cocotb(sim, v, "bumprtl.sim.tb.tb_pipeline_axi", build_dir / sim,
