@@ -43,8 +43,8 @@ from bumprtl.rtl.scene import HardwareScene, check_scene
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
            "texel_byte_address", "tiled_image", "plru_victim", "plru_touch", "TextureCache",
-           "CACHE_DEFAULTS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry", "scene_levels",
-           "CACHE_LATENCY"]
+           "CACHE_DEFAULTS", "SCENE_KEYS", "ARBURST_INCR", "AxiMapFetch", "scene_geometry",
+           "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
 # queue is empty: the lookup register, the queue's read, the data read, the output register.
@@ -54,10 +54,11 @@ AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
 MAX_BURST = 256                     # AXI4 INCR: ARLEN + 1 <= 256 beats
 AXI_PAGE = 4096                     # a burst never crosses a 4 KiB boundary
-# sets, ways, block side, AXI data bits: the scene's defaults (rtl/scene.CACHE_DEFAULTS)
-CACHE_DEFAULTS = {"sets": SCENE_CACHE["cache_sets"], "ways": SCENE_CACHE["cache_ways"],
-                  "block": SCENE_CACHE["cache_block"], "data_bits": SCENE_CACHE["axi_data_bits"],
-                  "queue": 256, "misses": 64}
+# CacheGeometry's parameter -> the scene key that sets it (rtl/scene.CACHE_DEFAULTS)
+SCENE_KEYS = {"sets": "cache_sets", "ways": "cache_ways", "block": "cache_block",
+              "data_bits": "axi_data_bits", "queue": "cache_queue", "misses": "cache_outstanding"}
+# sets, ways, block side, AXI data bits, queue, bursts outstanding: the scene's defaults
+CACHE_DEFAULTS = {name: SCENE_CACHE[key] for name, key in SCENE_KEYS.items()}
 
 
 def _pow2(x):
@@ -94,6 +95,11 @@ class CacheGeometry:
         two): what hides the memory's latency (docs/memory.md).
     misses : int
         Line fills (AXI bursts) outstanding at most (a power of two).
+    stamp_bits : int or None
+        Bits of the sequence numbers of queued pixels (a stamp a line), in
+        [log2(queue) + 1, 32]; None: ``max(16, log2(queue) + 2)``, wide enough that a stale
+        stamp rarely looks queued (that only delays a miss until the queue drains). A
+        narrow one wraps within a short stream (the tests' way to reach the wrap).
     """
 
     texture_size: int
@@ -107,6 +113,7 @@ class CacheGeometry:
     addr_bits: int = 32
     queue: int = CACHE_DEFAULTS["queue"]
     misses: int = CACHE_DEFAULTS["misses"]
+    stamp_bits: int | None = None
 
     def __post_init__(self):
         _check_pow2("texture_size", self.texture_size, 1, 1 << 16)
@@ -137,6 +144,13 @@ class CacheGeometry:
                             f"{self.addr_bits!r}", "addr_bits")
         _check_pow2("queue", self.queue, 2, 1024)
         _check_pow2("misses", self.misses, 1, 64)
+        least = self.queue.bit_length()          # in_seq - out_seq counts up to queue
+        if self.stamp_bits is None:
+            object.__setattr__(self, "stamp_bits", max(16, least + 1))
+        elif isinstance(self.stamp_bits, bool) or not isinstance(self.stamp_bits, int) \
+                or not least <= self.stamp_bits <= 32:
+            raise BumpError(f"stamp_bits must be an integer in [{least}, 32] for queue "
+                            f"{self.queue}, got {self.stamp_bits!r}", "stamp_bits")
         if self.base + self.image_bytes > 1 << self.addr_bits:
             raise BumpError(f"the map's image ends at byte {self.base + self.image_bytes}, "
                             f"beyond the {self.addr_bits}-bit AXI address space (addr_bits "
@@ -210,12 +224,6 @@ class CacheGeometry:
     @property
     def way_bits(self):
         return self.ways.bit_length() - 1
-
-    @property
-    def stamp_bits(self):
-        """Bits of the sequence numbers of queued pixels (a stamp a line): wide enough that
-        a stale stamp rarely looks queued (that only delays a miss until the queue drains)."""
-        return max(16, self.queue.bit_length() + 1)
 
     @property
     def cache_bits(self):
@@ -596,11 +604,11 @@ class TextureCache(wiring.Component):
 def scene_geometry(scene: HardwareScene, **cache):
     """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
     width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
-    ``axi_data_bits``), the parameters ``cache`` (sets, ways, block, data_bits, base,
-    addr_bits) overriding them."""
+    ``axi_data_bits``, ``cache_queue``, ``cache_outstanding``: :data:`SCENE_KEYS`), the
+    parameters ``cache`` (CacheGeometry's: sets, ways, block, data_bits, queue, misses,
+    base, addr_bits, stamp_bits) overriding them."""
     bits = Shape.cast(texel_shape(scene)).width
-    own = {"sets": scene.cache_sets, "ways": scene.cache_ways, "block": scene.cache_block,
-           "data_bits": scene.axi_data_bits}
+    own = {name: getattr(scene, key) for name, key in SCENE_KEYS.items()}
     return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **{**own, **cache})
 
 
@@ -623,7 +631,8 @@ class AxiMapFetch(wiring.Component):
     Parameters
     ----------
     scene : HardwareScene
-        ``map_memory = "axi"`` scenes (a varying N' map, per-pixel shading).
+        ``map_memory = "axi"`` scenes (a varying N' map with per-pixel shading, or the
+        palette's index map: the fetched field is ``bumpfetch.fetched_field``'s).
     out_layout : data.StructLayout
         As BumpMapFetch's: the fetched field plus fields carried unchanged.
     cache : dict, optional
@@ -639,9 +648,16 @@ class AxiMapFetch(wiring.Component):
     issues its line's burst and queues the pixel, and the pixels behind it go on being
     looked up (:class:`TextureCache`); ``i.ready`` falls while the looked-up pixel has to
     wait, and depends on the lookup in the same cycle (not a register as a credit edge's).
+    At most :attr:`capacity` pixels are inside at once.
     """
 
     latency = CACHE_LATENCY
+
+    @property
+    def capacity(self):
+        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the lookup register,
+        the queue's entries, the data read and the output register."""
+        return self.geom.queue + 3
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):
         check_scene(self, scene)

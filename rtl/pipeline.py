@@ -226,7 +226,8 @@ class BumpPipeline(wiring.Component):
         valid/ready handshake: the host holds ``lut_w_en``/``addr``/``data`` until it sees
         ``lut_w_ready``. It is low while a pixel accepted before the last swap still waits
         in the fetch stages to read the back bank (at most the fetch latency after the swap
-        without backpressure); before the first pixel and between frames it is high.
+        without backpressure; with ``map_memory = "axi"`` until those pixels have left the
+        cache); before the first pixel and between frames it is high.
 
     ``latency`` is the sum of the units' latencies (the free-running chain);
     ``port_latency`` adds the edge's EDGE_LATENCY (a pixel taken at ``i`` is offered at
@@ -241,7 +242,8 @@ class BumpPipeline(wiring.Component):
 
     With ``map_memory = "axi"`` the fetch is :class:`~bumprtl.rtl.cache.AxiMapFetch` (the
     map in the user's memory behind a texel cache, port ``axi``, ``cache`` its
-    :class:`~bumprtl.rtl.cache.CacheGeometry` parameters) in front of the credit edge: when
+    :class:`~bumprtl.rtl.cache.CacheGeometry` parameters; with palette shading the index
+    map, PaletteLUT behind the edge) in front of the credit edge: when
     the cache has to wait (its queue full, a miss that cannot issue) it stalls ``i`` alone
     and the free-running chain behind the edge keeps its contract;
     ``i.ready`` is then the cache's (it depends on the lookup in the same cycle), and
@@ -313,8 +315,9 @@ class BumpPipeline(wiring.Component):
             out_layout = data.StructLayout({**fields, "texel": rgb_layout(self.cfg),
                                             "tag": out_layout["tag"].shape})
         if self._front:
+            key = "shading = 'palette'" if s.shading == "palette" else "bump_map = 'varying'"
             self._add("fetch", AxiMapFetch(s, out_layout, self.cache),
-                      f"bump_map = 'varying', map_memory = 'axi': {what} per texel from the "
+                      f"{key}, map_memory = 'axi': {what} per texel from the "
                       f"user's memory through a texel cache ({s.texture_size}^2 texels, "
                       f"{s.mip_levels} level(s), {s.addressing} addressing)")
             return
@@ -333,7 +336,8 @@ class BumpPipeline(wiring.Component):
             self.built[-1]["why"] += "; the texel is PaletteLUT's eq. 2 base colour (alpha 255)"
         self._add("palette", lut, "shading = 'palette': one colour-table lookup per pixel, "
                                   "no per-pixel rotation")
-        self._first, self._last, self._layers = "fetch", "palette", [["fetch"], ["palette"]]
+        self._layers = ([] if self._front else [["fetch"]]) + [["palette"]]
+        self._first, self._last = self._layers[0][0], "palette"
         self._rot_layer = self._ill_layer = None
 
     def _plan_shading(self, init):
@@ -426,7 +430,8 @@ class BumpPipeline(wiring.Component):
         m = Module()
         if self._front:                       # the cache, then the edge and the chain
             front = self.units["fetch"]
-            wiring.connect(m, wiring.flipped(self.i), front.i)
+            if self.scene.shading != "palette":   # the palette's fetch also takes the bank
+                wiring.connect(m, wiring.flipped(self.i), front.i)
             wiring.connect(m, wiring.flipped(self.axi), front.axi)
         _, core = add_credit_edge(m, front.o if self._front else self.i, self.o, self.latency,
                                   self.fifo_depth)
@@ -511,9 +516,14 @@ class BumpPipeline(wiring.Component):
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
 
     def _elaborate_palette(self, m):
-        """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel."""
+        """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel
+        (with ``map_memory = "axi"`` through the cache, the LUT behind the credit edge)."""
         lut, f = self.units["palette"], self.units["fetch"]
-        m.d.comb += [f.i.valid.eq(self._taken().valid), f.i.payload.bank.eq(lut.bank)]
+        if self._front:                        # i -> cache; its output, when taken -> LUT
+            m.d.comb += [f.i.valid.eq(self.i.valid), self.i.ready.eq(f.i.ready)]
+        else:
+            m.d.comb += f.i.valid.eq(self._taken().valid)
+        m.d.comb += f.i.payload.bank.eq(lut.bank)
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]
         if self.scene.texture:                 # Tarini eq. 2: the texel is the base colour
             m.d.comb += [lut.i.valid.eq(f.o.valid), lut.i.payload.index.eq(f.o.payload.index),
@@ -521,11 +531,13 @@ class BumpPipeline(wiring.Component):
                          lut.i.payload.bank.eq(f.o.payload.bank),
                          lut.i.payload.tag.eq(f.o.payload.tag)]
         else:
-            _feed(m, f.o, lut.i)
+            _feed(m, self._taken() if self._front else f.o, lut.i)
         # Pixels between the input and the LUT per bank they read: a write to the back bank
-        # waits (lut_w_ready low) while one of them still has to read it.
+        # waits (lut_w_ready low) while one of them still has to read it. The fetch holds
+        # its latency's pixels, the cache up to its capacity (its queue and registers).
         take_in, take_lut = self.i.valid & self.i.ready, lut.i.valid & lut.i.ready
-        waiting = [Signal(range(f.latency + 1), name=f"lut_bank{b}_pending") for b in (0, 1)]
+        held = f.capacity if self._front else f.latency
+        waiting = [Signal(range(held + 1), name=f"lut_bank{b}_pending") for b in (0, 1)]
         self.lut_pending = waiting                 # read by sim/formal's bank lemmas
         for b, count in enumerate(waiting):
             m.d.sync += count.eq(count + (take_in & (lut.bank == b))

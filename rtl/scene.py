@@ -26,8 +26,11 @@ TEXTURE_SIZES = (16, 4096)               # a power of two in this range
 MAP_MEMORIES = ("bram", "axi")           # the map in block RAM, or behind a cache on AXI4
 # The texel cache of map_memory = "axi" (rtl/cache.CacheGeometry): sets, ways, side of a
 # line's square block of texels, AXI data bits. 64 x 2 lines of 4 x 4 texels: 8 KiB of
-# 28-bit texels in 4-byte slots, a line one 16-beat burst on a 32-bit bus.
-CACHE_DEFAULTS = {"cache_sets": 64, "cache_ways": 2, "cache_block": 4, "axi_data_bits": 32}
+# 28-bit texels in 4-byte slots, a line one 16-beat burst on a 32-bit bus. Pixels its
+# in-order queue holds (a power of two in [2, 1024]) and AXI bursts outstanding at most (a
+# power of two in [1, 64]): what hides the memory's latency (docs/memory.md).
+CACHE_DEFAULTS = {"cache_sets": 64, "cache_ways": 2, "cache_block": 4, "axi_data_bits": 32,
+                  "cache_queue": 256, "cache_outstanding": 64}
 
 
 def derived_rotation(shading, bump_map):
@@ -57,18 +60,25 @@ def check_choice(key, value, allowed, error=BumpError):
 
 def check_map_memory(map_memory, shading, bump_map, texture, cache=None, error=BumpError):
     """``map_memory`` is one of :data:`MAP_MEMORIES`; ``axi`` (rtl/cache.py) holds a
-    varying N' map with per-pixel shading and no colour texture; the ``cache`` keys
-    (:data:`CACHE_DEFAULTS`) other than their defaults need ``axi``; else ``error`` naming
-    the key (rtl/cache.CacheGeometry checks their ranges)."""
+    per-texel map without a colour texture: a varying N' map with per-pixel shading, or
+    the palette's index map; the ``cache`` keys (:data:`CACHE_DEFAULTS`) other than their
+    defaults need ``axi``; else ``error`` naming the key (rtl/cache.CacheGeometry checks
+    their ranges)."""
     check_choice("map_memory", map_memory, MAP_MEMORIES, error)
     for key, value in (cache or {}).items():
         if map_memory != "axi" and value != CACHE_DEFAULTS[key]:
             raise error(f"{key} = {value!r} applies to map_memory = 'axi' (the texel cache), "
                         f"the scene has map_memory = {map_memory!r}", key)
-    if map_memory == "axi" and (shading, bump_map, texture) != ("per-pixel", "varying", False):
-        raise error(f"map_memory = 'axi' needs shading = 'per-pixel', bump_map = 'varying' and "
-                    f"texture = false (got {shading!r}, {bump_map!r}, {texture}); allowed "
-                    f"otherwise: map_memory = 'bram'", "map_memory")
+    if map_memory != "axi":
+        return
+    if texture:
+        raise error("map_memory = 'axi' needs texture = false (the colour texture stays in "
+                    "block RAM beside a map in block RAM): allowed otherwise map_memory = "
+                    "'bram'", "map_memory")
+    if shading == "per-pixel" and bump_map != "varying":
+        raise error("map_memory = 'axi' needs a map: bump_map = 'varying' with shading = "
+                    "'per-pixel', or shading = 'palette' (got bump_map = 'flat'); allowed "
+                    "otherwise map_memory = 'bram'", "map_memory")
 
 
 def check_map_size(texture_size, mip_levels, error=BumpError):
@@ -112,12 +122,16 @@ class HardwareScene:
     map_memory : str
         ``bram`` (the map in block RAM, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`) or
         ``axi`` (the map in the user's memory behind a texel cache with an AXI4 read port,
-        :class:`~bumprtl.rtl.cache.AxiMapFetch`; per-pixel shading of a varying map, no
-        colour texture).
+        :class:`~bumprtl.rtl.cache.AxiMapFetch`; a varying N' map with per-pixel shading
+        or the palette's index map, no colour texture).
     cache_sets, cache_ways, cache_block, axi_data_bits : int
         With ``map_memory = "axi"``: the texel cache's sets, ways a set, side of a line's
         square block of texels (powers of two) and AXI data width (32 or 64);
         :data:`CACHE_DEFAULTS`.
+    cache_queue, cache_outstanding : int
+        With ``map_memory = "axi"``: pixels the cache's queue holds (a power of two in
+        [2, 1024], default 256) and AXI bursts outstanding at most (a power of two in
+        [1, 64], default 64).
     config : Config
         The datapath widths, method, lights, specular, terms and palette size.
     """
@@ -135,6 +149,8 @@ class HardwareScene:
     cache_ways: int = CACHE_DEFAULTS["cache_ways"]
     cache_block: int = CACHE_DEFAULTS["cache_block"]
     axi_data_bits: int = CACHE_DEFAULTS["axi_data_bits"]
+    cache_queue: int = CACHE_DEFAULTS["cache_queue"]
+    cache_outstanding: int = CACHE_DEFAULTS["cache_outstanding"]
     config: Config = Config()
 
     def __post_init__(self):

@@ -179,7 +179,10 @@ its line's place while the pixels behind it are looked up and their misses issue
 leave in order, a miss once its line has landed. A line a queued pixel still needs is not
 evicted (a miss whose victim is still referenced waits). The scene
 keys `cache_sets`, `cache_ways`, `cache_block` and `axi_data_bits` (flags `--cache-sets`,
-`--cache-ways`, `--cache-block`, `--axi-data-bits` of `bumprtl emit pipeline`) size it;
+`--cache-ways`, `--cache-block`, `--axi-data-bits` of `bumprtl emit pipeline`) size it,
+`cache_queue` (`--cache-queue`, a power of two in [2, 1024], default {d["queue"]}) and
+`cache_outstanding` (`--cache-outstanding`, a power of two in [1, 64], default
+{d["misses"]}) set its queue and the bursts it keeps outstanding;
 a cache that does not fit the device's block RAM beside the pipeline's tables is refused. A full
 queue, or a miss that has to wait, holds the pixel at the pipeline's input; the
 free-running chain behind the credit edge never stops, and its outputs are bit-exact with the golden model under any memory latency
@@ -217,8 +220,8 @@ a cache that holds the pixel on a miss (one pixel a cycle plus `L + beats + 2` a
 `sim/golden/cache.blocking_cycles`, the first version of this cache), against its own
 zero-wait throughput.
 exact: 28-bit N' angle pairs in 4-byte slots; palette: {texel_bits("palette")}-bit indices
-in 1-byte slots (the cache with the palette's texels; the pipeline builds `map_memory =
-"axi"` for per-pixel shading only so far).
+in 1-byte slots (the palette scene's index map with `map_memory = "axi"`, its colour table
+behind the cache).
 
 With misses overlapping, the latency is hidden: at L = 20 every case keeps at least
 {_worst(rows, 20)} of its zero-wait throughput (the blocking cache: {_worst(rows, 20, True)}),
@@ -229,8 +232,9 @@ so a stream that misses more than once per `beats` pixels runs at the memory's p
 pixel). A raster scan of a map wider than the cache refetches each line for every texel
 row of its block. The loss left at L = 60 is the queue's: a run of misses faster than the
 memory (the first texel row of each block row) fills its {d["queue"]} entries, and the
-latency shows once it is full. Fewer entries, or fewer bursts outstanding, hide less
-(Little's law: {d["queue"]} pixels, or {d["misses"]} lines, every L + beats cycles).
+latency shows once it is full. Fewer entries, or fewer bursts outstanding (`cache_queue`,
+`cache_outstanding`), hide less (Little's law: {d["queue"]} pixels, or {d["misses"]} lines,
+every L + beats cycles).
 
 ![throughput against latency]({plot})
 

@@ -228,7 +228,11 @@ def add_parser(sub):
     for key, what in (("cache_sets", "sets of the texel cache, a power of two"),
                       ("cache_ways", "ways a set, a power of two up to 16 (tree pseudo-LRU)"),
                       ("cache_block", "side of a line's square block of texels, a power of two"),
-                      ("axi_data_bits", "AXI RDATA width, 32 or 64")):
+                      ("axi_data_bits", "AXI RDATA width, 32 or 64"),
+                      ("cache_queue", "pixels the cache's in-order queue holds while misses "
+                                      "are fetched, a power of two in [2, 1024]"),
+                      ("cache_outstanding", "AXI bursts outstanding at most, a power of two "
+                                            "in [1, 64]")):
         g.add_argument(flag_name(key), type=int, default=None, metavar="N",
                        help=f"--map-memory axi: {what} (default {CACHE_DEFAULTS[key]})")
     p.add_argument("--device", default=None, choices=sorted(DEVICE_BRAM),

@@ -178,10 +178,11 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
 
 def _axi_image(unit, scene, words, width, depth):
     """The map of a ``map_memory = "axi"`` pipeline: ``<unit>_map.bin``, the bytes the user
-    puts in memory from ``base`` on (rtl/cache.tiled_image; the cache's default geometry)."""
+    puts in memory from ``base`` on (rtl/cache.tiled_image; the scene's cache geometry): N'
+    angle pairs, or a palette scene's indices, each in a ``slot_bytes`` slot."""
     g = scene_geometry(scene.hardware)
     return {"words": words, "width": width, "depth": depth, "file": f"{unit}_map.bin",
-            "load": "axi", "base": g.base, "bytes": g.image_bytes,
+            "load": "axi", "base": g.base, "bytes": g.image_bytes, "slot_bytes": g.slot_bytes,
             "bin": tiled_image(g, scene_levels(scene, words)),
             "layout": (f"tiled (rtl/cache.tiled_layout): level l's texels in lines of "
                        f"{g.block} x {g.block} texels ({g.line_bytes} bytes, one AXI INCR burst "
@@ -221,7 +222,7 @@ _FLAG_KEYS = ("height_map", "normal_map", "normal_convention", "geometry", "heig
               "resample", "texture_size", "method", "angle_bits", "frac_bits", "tag_bits",
               "spec_exponent", "spec_index_bits", "ka", "kd", "ks", "lights", "specular",
               "palette_size", "map_memory", "cache_sets", "cache_ways", "cache_block",
-              "axi_data_bits")
+              "axi_data_bits", "cache_queue", "cache_outstanding")
 
 
 _PICTURE_FLAGS = ("height_map", "normal_map", "normal_convention", "geometry", "height_scale",

@@ -320,7 +320,12 @@ def rtl_render_png(scene, size, out, simulator="verilator", *, device=DEFAULT_DE
     x ``size`` pixels on ``simulator``; writes the RTL image to ``out``, prints one line of
     counts and one of the comparison with the golden render, and returns 0 when the two are
     the same bytes, else 1. A map that does not fit ``device``'s block RAM is refused before
-    anything is built."""
+    anything is built; so is ``per_cycle`` or ``load = "port"`` with a map in AXI memory
+    (the bulk wrapper holds that memory; the map is its ``_map.bin``)."""
+    if scene.map_memory == "axi" and (per_cycle or load != "initial"):
+        flag = "--per-cycle" if per_cycle else "--load"
+        raise BumpError(f"{flag} applies to map_memory = 'bram': a map in AXI memory is "
+                        f"rendered on the bulk path, whose wrapper holds the memory", "map_memory")
     check_scene_fits(scene, device)
     light = {"azimuth": azimuth, "light_elevation": light_elevation, "light": light}
     require_sim(simulator)

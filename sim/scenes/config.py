@@ -12,7 +12,7 @@ import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
-from bumprtl.rtl.cache import scene_geometry
+from bumprtl.rtl.cache import SCENE_KEYS, scene_geometry
 from bumprtl.rtl.config import TWO_LIGHT_WIDTHS, BumpError, Config
 from bumprtl.rtl.methods import PER_PIXEL, get
 from bumprtl.rtl.scene import (
@@ -95,6 +95,10 @@ class SceneConfig:
     cache_sets, cache_ways, cache_block, axi_data_bits : int
         ``axi``: the cache's sets, ways, line block side (powers of two) and AXI data width
         (32 or 64); defaults 64, 2, 4, 32 (rtl/scene.CACHE_DEFAULTS).
+    cache_queue, cache_outstanding : int
+        ``axi``: pixels the cache's in-order queue holds (a power of two in [2, 1024],
+        default 256) and AXI bursts outstanding at most (a power of two in [1, 64], default
+        64).
     method, angle_bits, frac_bits, tag_bits, spec_exponent, spec_index_bits, ka, kd, ks,
     palette_size :
         Passed to :class:`Config` (checked there).
@@ -116,6 +120,8 @@ class SceneConfig:
     cache_ways: int = CACHE_DEFAULTS["cache_ways"]
     cache_block: int = CACHE_DEFAULTS["cache_block"]
     axi_data_bits: int = CACHE_DEFAULTS["axi_data_bits"]
+    cache_queue: int = CACHE_DEFAULTS["cache_queue"]
+    cache_outstanding: int = CACHE_DEFAULTS["cache_outstanding"]
     # Config's fields and defaults (rtl/config.py is the one source of both)
     method: str = Config.method
     angle_bits: int = Config.angle_bits
@@ -154,8 +160,7 @@ class SceneConfig:
             try:
                 scene_geometry(self.hardware)        # the cache's keys, checked now
             except BumpError as e:
-                key = {"sets": "cache_sets", "ways": "cache_ways", "block": "cache_block",
-                       "data_bits": "axi_data_bits"}.get(e.field, e.field)
+                key = SCENE_KEYS.get(e.field, e.field)
                 raise SceneError(f"scene {self.name!r}: {key}: {e}", key) from None
         try:
             _ = self.config       # derive it now: a bad width is the scene's error

@@ -44,8 +44,10 @@ from bumprtl.sim.tb.bulk_build import (
 )
 from bumprtl.sim.tb.bulk_codec import check_stimulus, decode_words, encode_words
 from bumprtl.sim.tb.bulk_wrapper import (
+    AXI_FILE,
     DENSITY_BITS,
     PERIOD,
+    has_axi,
     host_fields,
     setup_arrays,
     setup_writes,
@@ -56,10 +58,12 @@ from bumprtl.sim.traffic import PATTERNS as TRAFFIC
 __all__ = ["CHUNK", "IDLE_LIMIT", "TRAFFIC", "SIMULATORS", "CLOCKS", "IOS", "PERIOD",
            "DEFAULTS", "SimulationTimeout", "BulkResult", "wrapper_verilog", "host_fields",
            "setup_arrays", "check_stimulus", "encode_words", "decode_words", "setup_writes",
-           "build_options", "build_args", "build", "cache_root", "run_bulk", "density"]
+           "build_options", "build_args", "build", "cache_root", "run_bulk", "density",
+           "AXI_LATENCY"]
 
 CHUNK = 1 << 18                         # stimulus memory depth: one 512 x 512 frame
 IDLE_LIMIT = 1 << 14                    # cycles without an output before the run is a deadlock
+AXI_LATENCY = 20                        # cycles from an AR handshake to its first R beat
 # TRAFFIC: sim/traffic.py's PATTERNS, name -> (probability of an input gap, probability of
 # output backpressure), the numbers of the per-cycle drivers too
 
@@ -88,7 +92,7 @@ class BulkResult:
 
 
 def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, source, keep,
-             clock, chunk, idle_limit, seed, traffic):
+             clock, chunk, idle_limit, seed, traffic, axi_latency):
     """Write the job (and the stimulus arrays), run the cocotb test, read the summary and
     the outputs: ``(summary, outputs, run seconds)``."""
     module = "bumprtl.sim.tb.tb_bulk_gen"
@@ -104,7 +108,8 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
            "traffic": {p: [density(g), density(b)] for p, (g, b) in traffic.items()},
            "setup": list(setup), "source": source, "keep": bool(keep), "clock": clock,
            "chunk": chunk, "idle_limit": idle_limit, "seed": seed,
-           "result": str(work / "bulk_result.npz"), "summary": str(summary_path)}
+           "result": str(work / "bulk_result.npz"), "summary": str(summary_path),
+           "axi_latency": axi_latency}
     (work / "bulk_job.json").write_text(json.dumps(job, indent=1))
     summary_path.unlink(missing_ok=True)
     t0 = time.perf_counter()
@@ -137,7 +142,7 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
 def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
              setup=(), source=None, widths=None, keep=True, clock=None, chunk=CHUNK,
              idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None, io=None, opt_fast=None,
-             extra=None):
+             extra=None, axi_latency=AXI_LATENCY):
     """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
     under each traffic pattern, in bulk.
 
@@ -149,9 +154,13 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
     (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
     (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
     (regressions). ``clock``, ``io``, ``opt_fast``, ``extra``: the build
-    (:func:`build_options`; None: the simulator's fastest, :data:`DEFAULTS`). Returns a
-    :class:`BulkResult`; raises :class:`SimulationTimeout` when the unit stopped producing
-    outputs and AssertionError on a mismatch.
+    (:func:`build_options`; None: the simulator's fastest, :data:`DEFAULTS`). A unit with
+    an AXI4 read port (``map_memory = "axi"``) reads its ``_map.bin`` (beside the sidecar)
+    from the wrapper's memory model, each burst ``axi_latency`` cycles after its AR
+    handshake; the summary's patterns then carry ``ar`` (AR requests) and ``ar_sum`` (the
+    sum of their addresses). Returns a :class:`BulkResult`; raises
+    :class:`SimulationTimeout` when the unit stopped producing outputs and AssertionError
+    on a mismatch.
     """
     opts = build_options(sim, clock, io, opt_fast, extra)
     meta = load_sidecar(j_path)
@@ -168,13 +177,22 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
             if name not in outs:
                 raise BumpError(f"expected field {name!r} is not an output field of "
                                 f"{meta.unit}.json (o__payload fields: {', '.join(outs)})")
+    if isinstance(axi_latency, bool) or not isinstance(axi_latency, int) \
+            or not 1 <= axi_latency < 1 << 16:
+        raise BumpError(f"axi_latency must be an integer in [1, 65535], got {axi_latency!r}",
+                        "axi_latency")
     work = Path(work_dir).resolve()
     work.mkdir(parents=True, exist_ok=True)
+    axi = has_axi(meta)
+    if axi:                              # the memory model's image: the unit's _map.bin
+        image = Path(j_path).parent / meta.memory_images["map"]["file"]
+        (work / AXI_FILE).write_bytes(image.read_bytes())
     bdir, top, build_s, cached = build(sim, v_path, meta, chunk, cache=cache, **opts)
     with locked(work / "bulk.lock"):    # one run at a time in a work directory
         summary, outputs, run_s = _run_job(sim, top, bdir, work, j_path, patterns, inputs,
                                            expected, setup, source, keep, opts["clock"], chunk,
-                                           idle_limit, seed, traffic)
+                                           idle_limit, seed, traffic,
+                                           axi_latency if axi else None)
     pats = summary["patterns"]
     per = lambda key: {p: pats[p][key] for p in patterns}
     return BulkResult(outputs, per("cycles"), per("pixels"), per("sim_s"), per("sim_cpu_s"),

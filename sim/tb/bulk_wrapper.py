@@ -12,7 +12,11 @@ played one per clock into the host ports; ``gap_seed``/``gap_density``,
 ``bp_seed``/``bp_density`` (a gap or a stall when the upper 16 bits of the next xorshift32
 state are below the density, out of 2**16); ``idle_limit``. Status: ``done`` (held until
 ``start`` falls), ``timed_out``, ``n_in``, ``n_out``, ``cycles``. Outputs go to
-``bulk_out.bin``, one ``%u`` word each.
+``bulk_out.bin``, one ``%u`` word each. A unit with an AXI4 read port (``axi__*``,
+``map_memory = "axi"``) gets the wrapper's memory model on it (``BULK_AXI``): it holds
+``bulk_axi.bin`` (:data:`AXI_FILE`, the unit's ``_map.bin``), answers each burst
+``axi_latency`` cycles after its AR handshake, and counts the requests (``ar_count``,
+``ar_sum``).
 """
 
 from importlib.resources import files
@@ -20,8 +24,8 @@ from importlib.resources import files
 import numpy as np
 
 __all__ = ["TEMPLATE", "TOP", "HOOK", "PERIOD", "DENSITY_BITS", "IN_FILE", "OUT_FILE",
-           "SETUP_FILE", "OWN_CLOCK_DEFINE", "host_fields", "setup_arrays", "setup_writes",
-           "wrapper_verilog"]
+           "SETUP_FILE", "AXI_FILE", "OWN_CLOCK_DEFINE", "AXI_DEFINE", "has_axi", "host_fields",
+           "setup_arrays", "setup_writes", "wrapper_verilog"]
 
 TEMPLATE = files("bumprtl.sim.tb").joinpath("bulk_wrapper.v")
 TOP = "bulk_wrapper"
@@ -29,21 +33,29 @@ HOOK = "/*@host_ports@*/"
 PERIOD = 10                             # the wrapper's own clock (Icarus), in ns
 DENSITY_BITS = 16                       # a gap / stall when 16 LFSR bits < density
 IN_FILE, OUT_FILE, SETUP_FILE = "bulk_in.bin", "bulk_out.bin", "bulk_setup.bin"
+AXI_FILE = "bulk_axi.bin"
 OWN_CLOCK_DEFINE = "BULK_OWN_CLOCK"
+AXI_DEFINE = "BULK_AXI"
+AXI_PREFIX = "axi__"                    # the unit's AXI4 read port (rtl/cache.py)
 STREAM_PORTS = ("clk", "rst", "i__valid", "i__payload", "i__ready", "o__valid", "o__payload",
                 "o__ready")
 
 
 def _host_ports(meta):
-    """The unit's inputs besides the two streams, clk and rst (map/LUT/polygon host ports),
-    in name order: the wrapper registers the set-up word on its way into them."""
+    """The unit's inputs besides the two streams, clk, rst and the AXI port (map/LUT/polygon
+    host ports), in name order: the wrapper registers the set-up word on its way into them."""
     return {name: p.width for name, p in sorted(meta.ports.items())
-            if p.dir == "in" and name not in STREAM_PORTS}
+            if p.dir == "in" and name not in STREAM_PORTS and not name.startswith(AXI_PREFIX)}
 
 
 def _other_outputs(meta):
     return {name: p.width for name, p in sorted(meta.ports.items())
-            if p.dir == "out" and name not in STREAM_PORTS}
+            if p.dir == "out" and name not in STREAM_PORTS and not name.startswith(AXI_PREFIX)}
+
+
+def has_axi(meta):
+    """The unit has an AXI4 read port (its map in the user's memory)."""
+    return any(name.startswith(AXI_PREFIX) for name in meta.ports)
 
 
 def host_fields(meta):
@@ -104,6 +116,8 @@ def _connections(meta):
     for port, w in _other_outputs(meta).items():
         out.append(f".{port}(unread[{lo + w - 1}:{lo}])")
         lo += w
+    out += [f".{name}(ax_{name[len(AXI_PREFIX):]})" for name in sorted(meta.ports)
+            if name.startswith(AXI_PREFIX)]
     return "".join(f",\n    {c}" for c in out)
 
 
@@ -122,5 +136,12 @@ def wrapper_verilog(meta, own_clock, chunk):
                   "OW": meta.port("o__payload").width, "DEPTH": chunk, "HW": hw,
                   "XW": sum(_other_outputs(meta).values()), "PERIOD": PERIOD}
     defines = {"BULK_UNIT": unit, **({OWN_CLOCK_DEFINE: 1} if own_clock else {})}
+    if has_axi(meta):                   # the memory model and its image's place
+        image = meta.memory_images["map"]
+        parameters.update({"AXI_DW": meta.port("axi__rdata").width,
+                           "AXI_AW": meta.port("axi__araddr").width,
+                           "AXI_BYTES": 1 << (image["bytes"] - 1).bit_length(),
+                           "AXI_BASE": image["base"]})
+        defines[AXI_DEFINE] = 1
     head = f"// bulk wrapper around `{unit}` (widths from {unit}.json): {parameters}\n"
     return TOP, head + template.replace(HOOK, _connections(meta)), parameters, defines

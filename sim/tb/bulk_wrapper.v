@@ -8,9 +8,18 @@
 // defined (Icarus) the wrapper toggles clk itself; otherwise clk is an input, toggled by
 // the Verilator build's C++ main (bulk_main.cpp).
 //
+// With BULK_AXI defined (a unit with an AXI4 read port, map_memory = "axi") the wrapper
+// also holds the memory that port reads: bulk_axi.bin (the unit's _map.bin) loaded at
+// time 0 from byte AXI_BASE on, ARREADY high while fewer than AXI_DEPTH bursts wait, each
+// burst's beats in order, one a clock, from axi_latency cycles after its AR handshake; it
+// counts the AR handshakes (ar_count) and sums their addresses (ar_sum).
+//
 // Parameters: IW, OW the unit's input and output payload widths, DEPTH the words of one
 // chunk, HW the width of the host set-up word (0: the unit has no host ports), XW the
-// width of the unit's other outputs, left unread, PERIOD the own clock's period. Macros: BULK_UNIT the unit's module name. The one text hook,
+// width of the unit's other outputs, left unread, PERIOD the own clock's period; with
+// BULK_AXI, AXI_DW and AXI_AW the port's data and address widths, AXI_BYTES the memory's
+// bytes (a power of two), AXI_BASE the image's first byte address, AXI_DEPTH the bursts
+// it holds. Macros: BULK_UNIT the unit's module name. The one text hook,
 // the host-port connections of the unit instance, is a comment below that
 // bulk_wrapper.py replaces (`.port(host_q[hi:lo])` per host port, `.port(unread[hi:lo])`
 // per other output); as it stands the file is a complete module (linted on its own by
@@ -24,8 +33,13 @@ module bulk_wrapper #(
   parameter DEPTH = 16,
   parameter HW = 0,
   parameter XW = 0,
-  /* verilator lint_off UNUSEDPARAM */  // used with BULK_OWN_CLOCK only
+  /* verilator lint_off UNUSEDPARAM */  // used with BULK_OWN_CLOCK only, BULK_AXI only
   parameter PERIOD = 10,
+  parameter AXI_DW = 32,
+  parameter AXI_AW = 32,
+  parameter AXI_BYTES = 16,
+  parameter AXI_BASE = 0,
+  parameter AXI_DEPTH = 64,
   /* verilator lint_on UNUSEDPARAM */
   localparam AW = (DEPTH > 1 ? $clog2(DEPTH) : 1) + 1,  // counts 0..DEPTH inclusive
   localparam DENSITY_BITS = 16         // a gap / stall when 16 LFSR bits < density
@@ -34,6 +48,11 @@ module bulk_wrapper #(
   output reg clk /*verilator public_flat_rw*/,
 `else
   input wire clk /*verilator public_flat_rw*/,
+`endif
+`ifdef BULK_AXI
+  input wire [15:0] axi_latency /*verilator public_flat_rw*/,
+  output reg [31:0] ar_count /*verilator public_flat_rw*/,
+  output reg [63:0] ar_sum /*verilator public_flat_rw*/,
 `endif
   input wire rst /*verilator public_flat_rw*/,
   input wire start /*verilator public_flat_rw*/,
@@ -103,6 +122,80 @@ module bulk_wrapper #(
   wire [31:0] bp_next = xorshift32(bp_rng);
   wire gap = {1'b0, gap_next[31:32 - DENSITY_BITS]} < gap_density;
   wire stall = {1'b0, bp_next[31:32 - DENSITY_BITS]} < bp_density;
+
+`ifdef BULK_AXI
+  // The memory behind the unit's AXI4 read port (one ID: bursts answered in order).
+  localparam AXB = AXI_DW / 8;                    // bytes a beat
+  localparam QW = $clog2(AXI_DEPTH);
+  localparam MW = $clog2(AXI_BYTES);
+  reg [7:0] axmem [0:AXI_BYTES-1];
+  reg [AXI_AW-1:0] ar_addr_q [0:AXI_DEPTH-1];
+  reg [7:0] ar_len_q [0:AXI_DEPTH-1];
+  reg [47:0] ar_due_q [0:AXI_DEPTH-1];
+  reg [QW:0] ax_wr, ax_rd;                        // burst queue pointers, one bit wider
+  reg [7:0] ax_beat;
+  reg [47:0] ax_clock;
+  /* verilator lint_off UNUSEDSIGNAL */           // ARID, ARSIZE, ARBURST: one ID, INCR
+  wire ax_arid;
+  wire [2:0] ax_arsize;
+  wire [1:0] ax_arburst;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire ax_arvalid, ax_rready;
+  wire [AXI_AW-1:0] ax_araddr;
+  wire [7:0] ax_arlen;
+  wire [QW-1:0] ax_head = ax_rd[QW-1:0];
+  wire ax_empty = ax_wr == ax_rd;
+  wire ax_arready = (ax_wr ^ ax_rd) != {1'b1, {QW{1'b0}}};   // not full
+  wire ax_rvalid = !ax_empty && ax_clock >= ar_due_q[ax_head];
+  wire ax_rlast = ax_beat == ar_len_q[ax_head];
+  wire ax_rid = 1'b0;
+  wire [1:0] ax_rresp = 2'b00;
+  /* verilator lint_off UNUSEDSIGNAL */           // the image is AXI_BYTES, the address wider
+  wire [AXI_AW-1:0] ax_at = ar_addr_q[ax_head] - AXI_BASE
+                            + {{(AXI_AW - 8){1'b0}}, ax_beat} * AXB;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [AXI_DW-1:0] ax_rdata;
+  genvar ab;
+  generate
+    for (ab = 0; ab < AXB; ab = ab + 1) begin : axi_byte
+      assign ax_rdata[8 * ab +: 8] = axmem[ax_at[MW-1:0] + ab];
+    end
+  endgenerate
+  integer axfd;
+  integer axread;
+  initial begin
+    axfd = $fopen("bulk_axi.bin", "rb");
+    axread = $fread(axmem, axfd);
+    $fclose(axfd);
+  end
+  always @(posedge clk) begin
+    if (unit_rst) begin
+      ax_wr <= {(QW + 1){1'b0}};
+      ax_rd <= {(QW + 1){1'b0}};
+      ax_beat <= 8'd0;
+      ax_clock <= 48'd0;
+      ar_count <= 32'd0;
+      ar_sum <= 64'd0;
+    end else begin
+      ax_clock <= ax_clock + 48'd1;
+      if (ax_arvalid && ax_arready) begin
+        ar_addr_q[ax_wr[QW-1:0]] <= ax_araddr;
+        ar_len_q[ax_wr[QW-1:0]] <= ax_arlen;
+        ar_due_q[ax_wr[QW-1:0]] <= ax_clock + {32'd0, axi_latency};
+        ax_wr <= ax_wr + 1'b1;
+        ar_count <= ar_count + 32'd1;
+        ar_sum <= ar_sum + {{(64 - AXI_AW){1'b0}}, ax_araddr};
+      end
+      if (ax_rvalid && ax_rready) begin
+        if (ax_rlast) begin
+          ax_beat <= 8'd0;
+          ax_rd <= ax_rd + 1'b1;
+        end else
+          ax_beat <= ax_beat + 8'd1;
+      end
+    end
+  end
+`endif
 
   `BULK_UNIT dut (
     .clk(clk),

@@ -64,18 +64,21 @@ async def _reset(dut):
     await RisingEdge(dut.clk)
 
 
-async def run_stream(dut, meta, inputs, model, pattern, seed=1, timeout_factor=20):
+async def run_stream(dut, meta, inputs, model, pattern, seed=1, timeout_factor=20, setup=None):
     """Drive ``inputs`` (list of field dicts) through the DUT under ``pattern``.
 
     Input monitor -> ``model`` (list of accepted input dicts -> list of expected output
     dicts) -> in-order check against the output monitor, field by field, bit for bit.
-    Returns the number of cycles spent.
+    ``setup``: an async function awaited after the reset, before the first pixel (the
+    host's writes). Returns the number of cycles spent.
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
     fin, fout = meta.input_fields, meta.output_fields
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
     await _reset(dut)
+    if setup is not None:
+        await setup()
 
     accepted, received = [], []
     pending = list(inputs)

@@ -5,7 +5,9 @@ Per chunk it writes ``bulk_in.bin``, sets the count, the traffic seeds and densi
 raises ``start`` and sleeps (a cocotb Timer) until ``done``: the clock runs inside the
 simulator meanwhile, and Python wakes up a few times per chunk, never per clock. Then it
 reads ``bulk_out.bin`` back as arrays and checks them: every tag once and in order, and
-every field bit for bit against the golden outputs when the source has them.
+every field bit for bit against the golden outputs when the source has them. With an AXI
+memory in the wrapper (a ``map_memory = "axi"`` unit) it sets the memory's latency from the
+job and counts, per pattern, the AR requests and the sum of their addresses.
 
 Environment: BUMPRTL_BULK_JOB, the job JSON that :func:`bumprtl.sim.tb.bulk.run_bulk`
 writes (sidecar, patterns, traffic, set-up cycles, source, result and summary paths). The
@@ -118,6 +120,9 @@ async def _run(dut, job, meta, summary, make_source):
     iw, ow = meta.port("i__payload").width, meta.port("o__payload").width
     patterns = job["patterns"]
     setup, chunks = make_source(meta, job["source"], job["chunk"])
+    axi = job.get("axi_latency") is not None
+    if axi:
+        dut.axi_latency.value = job["axi_latency"]
     await _reset_and_setup(dut, meta, job["setup"] + setup, job["chunk"])
     dut.idle_limit.value = job["idle_limit"]
     kept = {p: [] for p in patterns}
@@ -131,6 +136,7 @@ async def _run(dut, job, meta, summary, make_source):
             dut.gap_seed.value = _seed(job["seed"], k, j, 0)
             dut.bp_seed.value = _seed(job["seed"], k, j, 1)
             dut.count.value = n
+            ars = (int(dut.ar_count.value), int(dut.ar_sum.value)) if axi else None
             dut.start.value = 1
             t0, c0 = time.perf_counter(), time.process_time()
             if not await _wait_done(dut, n, gap, stall):
@@ -163,6 +169,9 @@ async def _run(dut, job, meta, summary, make_source):
                 summary["checked"] = True
             s["pixels"] += n
             s["cycles"] += cycles
+            if axi:
+                s["ar"] = s.get("ar", 0) + int(dut.ar_count.value) - ars[0]
+                s["ar_sum"] = s.get("ar_sum", 0) + int(dut.ar_sum.value) - ars[1]
             if job["keep"]:
                 kept[pattern].append(got)
         dut._log.info("chunk %d: %d pixels x %d patterns", k, n, len(patterns))

@@ -21,7 +21,7 @@ from tqdm import tqdm
 from bumprtl.sim.tb.stream import PATTERNS, load_sidecar, pack, unpack
 
 
-async def _host_setup(dut, meta, stim):
+async def host_setup(dut, meta, stim):
     """Host cycles of the stimulus (``setup.<port>`` arrays: e.g. the map written through
     its port), the polygon registers (flat map) and the palette colour table, before the
     first pixel."""
@@ -111,7 +111,7 @@ async def pipeline_stream(dut):
     result = {}
     for pattern in os.environ.get("BUMPRTL_PATTERNS", "no_stall").split(","):
         await _reset(dut, meta)
-        await _host_setup(dut, meta, stim)
+        await host_setup(dut, meta, stim)
         out, cycles = await _stream(dut, meta, words, pattern)
         fields = [unpack(fout, w) for w in out]
         for name in fout:

@@ -4,7 +4,10 @@ emission wrote, its AR and R channels paused at random and its bursts delayed by
 60 cycles (one cocotb test each); pixels stream in with random gaps and out under random
 backpressure. Every output field is compared bit for bit with the golden pipeline
 (sim/golden/fixed/pipeline.py, the same model as the block-RAM map's) and the AR requests
-with the golden cache model's (sim/golden/cache.run_scene_cache).
+with the golden cache model's (sim/golden/cache.run_scene_cache). A palette scene's
+``_map.bin`` holds the indices: the host writes a random colour table through ``lut_w_*``
+(held until ``lut_w_ready``) and swaps it in before the first pixel, and each pixel's
+colour is the table model's lookup of its index (sim/golden/fixed/palette_lut.py).
 
 Environment: BUMPRTL_SIDECAR (the pipeline's sidecar), BUMPRTL_SAMPLES, BUMPRTL_PATTERN,
 BUMPRTL_STIMULUS (``raster``: the pixels' texel coordinates a raster scan of a plane at one
@@ -22,11 +25,13 @@ from cocotbext.axi import AxiReadBus
 
 from bumprtl.rtl.cache import scene_geometry
 from bumprtl.sim.golden.cache import image_words, run_scene_cache
+from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel
 from bumprtl.sim.golden.fixed.pipeline import as_payload_list, pipeline_fixed, random_inputs
 from bumprtl.sim.scenes import texel_coordinates
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.stream import load_sidecar, run_stream, samples
 from bumprtl.sim.tb.tb_cache import LATENCIES, LatentAxiRamRead
+from bumprtl.sim.tb.tb_pipeline import host_setup
 
 
 def raster(size, n):
@@ -36,6 +41,18 @@ def raster(size, n):
     top = max(0, size // 2 - n // (2 * size))
     u, v = u[top:].ravel()[:n], v[top:].ravel()[:n]
     return {"u": u, "v": v, "level": np.zeros_like(u)}
+
+
+def _palette_colors(scene, index, rng):
+    """``(golden outputs, table)``: a random colour table of ``palette_size`` entries, written
+    then swapped to the front, and each pixel's lookup of its ``index`` in it."""
+    table = rng.integers(0, 1 << 32, scene.palette_size)
+    lut = PaletteLUTModel(scene.config)
+    for addr, word in enumerate(table.tolist()):
+        lut.clock((addr, word))
+    lut.clock(swap=True)
+    looked = [lut.lookup(int(i)) for i in index]
+    return {k: [d[k] for d in looked] for k in looked[0]}, table
 
 
 def _pauses(rng, p):
@@ -59,6 +76,11 @@ async def pipeline_matches_golden_against_axi_ram(dut, latency):
                        if k in inputs})
     golden = pipeline_fixed(inputs, scene, words)
     cache = run_scene_cache(scene.hardware, geom, inputs, words)
+    setup = None
+    if scene.shading == "palette":
+        golden, table = _palette_colors(scene, golden["index"], rng)
+        dut.lut_w_en.value, dut.lut_swap.value = 0, 0
+        setup = lambda: host_setup(dut, meta, {"lut": table})
 
     ram = LatentAxiRamRead(AxiReadBus.from_prefix(dut, "axi_"), dut.clk, dut.rst, latency,
                            size=1 << (record["base"] + record["bytes"] - 1).bit_length())
@@ -73,7 +95,8 @@ async def pipeline_matches_golden_against_axi_ram(dut, latency):
                  for name in meta.output_fields} for k, px in enumerate(accepted)]
 
     await run_stream(dut, meta, payloads, model, os.environ.get("BUMPRTL_PATTERN", "both"),
-                     seed=latency, timeout_factor=2 * (latency + 2 * geom.beats + 20))
+                     seed=latency, timeout_factor=2 * (latency + 2 * geom.beats + 20),
+                     setup=setup)
     assert ram.requests == cache.requests, (
         f"{len(ram.requests)} AR requests, golden {len(cache.requests)}")
     dut._log.info("%d pixels bit-exact, %d AR requests as the golden cache model (hit rate "

@@ -101,6 +101,22 @@ def test_cache_hits_at_one_pixel_a_clock():
     assert cycles[1] - cycles[0] == len(one)
 
 
+def _cycles(geom, latency, n, seed, levels_seed=None):
+    """``n`` pixels of cache_stimulus through the RTL, memory and sink never stalling: its
+    texels and AR stream checked against the golden model; returns (the RTL's cycles, the
+    cycle model's: the reset's flush, stream_cycles, the hit latency, golden run)."""
+    levels = random_levels(geom, seed if levels_seed is None else levels_seed)
+    u, v, level = cache_stimulus(geom, n, seed)
+    golden = run_cache(geom, u, v, level, levels)
+    dut = TextureCache(geom)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
+    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
+    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
+    assert [o["texel"] for o in out] == golden.texel.tolist()
+    assert mem.requests == golden.requests
+    return cycles, geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY, golden
+
+
 @pytest.mark.parametrize("latency", [1, 9])
 @pytest.mark.parametrize("geom", [CacheGeometry(64, 3, 28, sets=8),
                                   CacheGeometry(64, 3, 8, sets=4, data_bits=64),
@@ -110,14 +126,8 @@ def test_cycle_model_counts_the_rtl_cycles(geom, latency):
     """sim/golden/cache.stream_cycles (what bumprtl bench memory reports) is the RTL's count
     for a stall-free memory and sink, the reset's flush (sets cycles) and the hit latency
     aside."""
-    levels = random_levels(geom)
-    u, v, level = cache_stimulus(geom, 80, latency)
-    golden = run_cache(geom, u, v, level, levels)
-    dut = TextureCache(geom)
-    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
-    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    _, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
-    assert cycles == geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY
+    cycles, predicted, _ = _cycles(geom, latency, 80, latency, levels_seed=0)
+    assert cycles == predicted
 
 
 def test_misses_overlap():
@@ -125,17 +135,10 @@ def test_misses_overlap():
     cache takes far fewer cycles than a blocking one with the same hits and misses (one
     miss at a time: sim/golden/cache.blocking_cycles), and exactly the cycle model's."""
     geom = CacheGeometry(64, 3, 28, sets=8)
-    levels = random_levels(geom, 5)
-    u, v, level = cache_stimulus(geom, 120, 5)
-    golden = run_cache(geom, u, v, level, levels)
-    dut = TextureCache(geom)
-    mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=60)
-    pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem.process])
-    assert [o["texel"] for o in out] == golden.texel.tolist()
+    cycles, predicted, golden = _cycles(geom, 60, 120, 5)
     blocking = blocking_cycles(golden, geom, 60)
     assert len(golden.requests) > 20 and cycles - geom.sets - CACHE_LATENCY < blocking / 2
-    assert cycles == geom.sets + stream_cycles(golden, geom, 60) + CACHE_LATENCY
+    assert cycles == predicted
 
 
 # The default scene at small widths, two levels, wrap; the same with clamp addressing.
@@ -171,8 +174,12 @@ def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, 
 def test_map_memory_refusals():
     with pytest.raises(BumpError, match="map_memory must be one of bram, axi"):
         load_scene_config({"map_memory": "dram"})
-    with pytest.raises(BumpError, match="map_memory = 'axi' needs shading = 'per-pixel'"):
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs texture = false"):
         load_scene_config({"map_memory": "axi", "texture": True})
+    with pytest.raises(BumpError, match="map_memory = 'axi' needs texture = false"):
+        load_scene_config({"map_memory": "axi", "texture": True, "shading": "palette"})
+    with pytest.raises(BumpError, match="needs a map: bump_map = 'varying'"):
+        load_scene_config({"map_memory": "axi", "bump_map": "flat"})
     with pytest.raises(BumpError, match="cache_ways: ways must be a power of two"):
         load_scene_config({"map_memory": "axi", "cache_ways": 3})
     with pytest.raises(BumpError, match="cache_sets = 16 applies to map_memory = 'axi'"):
@@ -184,8 +191,87 @@ def test_map_memory_refusals():
     assert "axi" not in bram.signature.members
 
 
+def test_cli_refuses_axi_with_a_colour_texture_in_one_line(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--scene", "textured", "--map-memory", "axi",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "texture = false" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_cli_refuses_a_cache_larger_than_the_block_ram(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-sets", "4096",
                  "--cache-ways", "16", "--out", str(out)]) == 2
     assert "fewer sets or ways" in capsys.readouterr().err and not out.exists()
+
+
+def _pipeline_cycles(scene, latency, n=120, seed=3):
+    """(cycles, golden cycle model's prediction) of the palette pipeline of ``scene`` on
+    ``n`` random pixels, its memory never stalling, its output always taken: the reset's
+    flush, stream_cycles of the scene's own geometry, the pipeline's port latency."""
+    rng = np.random.default_rng(seed)
+    words, inputs = random_map(scene, rng), random_inputs(scene, n, rng)
+    dut = BumpPipeline(scene.hardware)
+    geom = scene_geometry(scene.hardware)
+    assert dut.units["fetch"].geom == geom
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
+                        latency=latency)
+    _, cycles = simulate_stream(dut, as_payload_list(inputs), max_cycles=50_000,
+                                processes=[mem.process])
+    run = run_scene_cache(scene.hardware, geom, inputs, words)
+    return cycles, geom.sets + stream_cycles(run, geom, latency) + dut.port_latency
+
+
+def test_queue_and_outstanding_keys_set_the_cycle_schedule():
+    """cache_queue and cache_outstanding reach the RTL and the golden model from the one
+    scene: a 4-entry queue with 2 bursts outstanding takes more cycles than the defaults on
+    a miss-heavy stream at latency 30, and each count is the cycle model's exactly."""
+    keys = {**BUILTIN["palette"], "texture_size": 64, "mip_levels": 3, "tag_bits": 8,
+            "map_memory": "axi", "cache_sets": 8}
+    small = load_scene_config({**keys, "cache_queue": 4, "cache_outstanding": 2})
+    assert scene_geometry(small.hardware).queue == 4
+    assert scene_geometry(small.hardware).misses == 2
+    got_small, want_small = _pipeline_cycles(small, 30)
+    got, want = _pipeline_cycles(load_scene_config(keys), 30)
+    assert (got_small, got) == (want_small, want)
+    assert got_small > 1.5 * got
+
+
+def test_queue_and_outstanding_refusals(tmp_path, capsys):
+    with pytest.raises(BumpError, match=r"cache_queue: queue must be a power of two in \[2, 1024\]"):
+        load_scene_config({"map_memory": "axi", "cache_queue": 3})
+    with pytest.raises(BumpError, match=r"cache_outstanding: misses must be a power of two in \[1, 64\]"):
+        load_scene_config({"map_memory": "axi", "cache_outstanding": 128})
+    with pytest.raises(BumpError, match="cache_queue = 16 applies to map_memory = 'axi'"):
+        load_scene_config({"cache_queue": 16})
+    out = tmp_path / "out"
+    assert main(["emit", "pipeline", "--map-memory", "axi", "--cache-outstanding", "0",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "cache_outstanding" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_stamp_wrap_in_rtl_is_the_cycle_models():
+    """3-bit stamps (the least for a 4-entry queue) wrap every 8 pixels: a stale stamp then
+    reads as a queued pixel's and holds a miss until the queue has drained. The RTL's
+    texels and AR stream stay the golden model's, and its cycles are stream_cycles' with
+    the wrap modelled, which differ from the same stream's with 16-bit stamps (so the
+    wrap was reached and changed the schedule)."""
+    keys = {"texture_size": 64, "mip_levels": 3, "texel_bits": 28, "sets": 2, "queue": 4}
+    narrow = CacheGeometry(**keys, stamp_bits=3)
+    wide = CacheGeometry(**keys)
+    assert wide.stamp_bits == 16
+    got_narrow, want_narrow, _ = _cycles(narrow, 9, 300, 11)
+    got_wide, want_wide, _ = _cycles(wide, 9, 300, 11)
+    assert (got_narrow, got_wide) == (want_narrow, want_wide)
+    assert got_narrow > got_wide
+    with pytest.raises(BumpError, match=r"stamp_bits must be an integer in \[3, 32\]"):
+        CacheGeometry(**keys, stamp_bits=2)
+
+
+def test_stamp_wrap_bit_exact_under_stalls():
+    """Wrapping stamps under AR/R stalls, input gaps and backpressure: no line a queued pixel
+    needs is evicted (every texel the golden model's), the AR stream the golden model's."""
+    check_cache(CacheGeometry(64, 3, 28, sets=2, queue=8, stamp_bits=4), n=300, latency=20,
+                seed=4)

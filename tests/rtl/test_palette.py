@@ -11,6 +11,7 @@ from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.emit import lint
 from bumprtl.gen.flow.units import build_unit, emit_unit
+from bumprtl.rtl.cache import scene_levels, tiled_image
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.palette import (
     CHANNELS,
@@ -23,6 +24,8 @@ from bumprtl.rtl.palette import (
 )
 from bumprtl.rtl.pipe import EDGE_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.axi_memory import AxiReadMemory
+from bumprtl.sim.golden.cache import run_scene_cache
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs, random_map
 from bumprtl.sim.scenes.config import load_scene_config
@@ -197,17 +200,29 @@ def test_emit_lint_and_sidecar(cfg, build_dir):
     assert f"--palette-size {cfg.palette_size}" in command
 
 
-def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15):
+def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15, cache=None,
+                         latency=20):
     """BumpPipeline(palette scene) with a racing host that obeys the ``lut_w_ready``
     handshake (a write is held until it is taken) and swaps at random; every pixel's colour
-    must be the model's lookup in the cycle the *pipeline* accepted it. Returns (received,
-    expected, writes held back by lut_w_ready)."""
+    must be the model's lookup in the cycle the *pipeline* accepted it. With ``map_memory =
+    "axi"`` the index map is in an AXI memory (sim/axi_memory.py, ``latency``, AR and R
+    stalls) behind the cache (``cache``: CacheGeometry parameters), whose AR stream must be
+    the golden cache model's. Returns (received, expected, writes held back by
+    lut_w_ready)."""
     cfg = scene.config
     nrng = np.random.default_rng(seed)
     words = random_map(scene, nrng)
     inputs = random_inputs(scene, n, nrng)
     index = pipeline_fixed(inputs, scene, words)["index"]
-    dut = BumpPipeline(scene.hardware, init=words)
+    mem = None
+    if scene.map_memory == "axi":
+        dut = BumpPipeline(scene.hardware, cache=cache)
+        geom = dut.units["fetch"].geom
+        mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)),
+                            geom.data_bits, latency=latency, ar_stall=0.3, r_stall=0.3,
+                            seed=seed)
+    else:
+        dut = BumpPipeline(scene.hardware, init=words)
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
     model = PaletteLUTModel(cfg)
@@ -224,8 +239,9 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15):
                 offered, nxt = nxt, nxt + 1
             ctx.set(dut.i.valid, offered is not None)
             if offered is not None:
-                for k in ("u", "v", "tag"):
-                    ctx.set(dut.i.payload[k], int(inputs[k][offered]))
+                for k in ("u", "v", "level", "tag"):
+                    if k in inputs:
+                        ctx.set(dut.i.payload[k], int(inputs[k][offered]))
             if write is None:                     # a new write only once the last was taken
                 write, swap = host_op(rng, cfg, write_p, swap_p)
             else:
@@ -257,7 +273,11 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15):
     sim = Simulator(dut)
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
+    if mem is not None:
+        sim.add_testbench(mem.process, background=True)
     sim.run()
+    if mem is not None:
+        assert mem.requests == run_scene_cache(scene.hardware, geom, inputs, words).requests
     return received, expected, held[0]
 
 
@@ -275,3 +295,22 @@ def test_pipeline_pixel_reads_the_bank_of_its_acceptance(pattern):
         assert got == exp, f"pixel {n} ({pattern}): RTL {got} != model {exp}"
     assert held > 0                               # lut_w_ready did hold writes back
     assert len({e["color.r"] for e in expected}) > 4      # written entries were read back
+
+
+@pytest.mark.parametrize("palette_size,mip_levels", [(16, 2), (1000, 1)])
+def test_axi_pipeline_pixel_reads_the_bank_of_its_acceptance(palette_size, mip_levels):
+    """map_memory = "axi": the palette indices (8 bits, or 10 in 2-byte slots) come from an
+    AXI memory at latency 20 through the cache; a pixel waits there far longer than in the
+    block-RAM fetch (its queue of 8 here filled by misses), and still reads the table as it
+    was when the pipeline accepted it; writes are held back the longer. Fails if the
+    per-bank counters cannot count the cache's pixels (they would wrap and let a write
+    through to a bank a queued pixel still reads)."""
+    scene = load_scene_config({"name": "p", "shading": "palette", "texture_size": 32,
+                               "mip_levels": mip_levels, "palette_size": palette_size,
+                               "tag_bits": 8, "map_memory": "axi"})
+    received, expected, held = run_palette_pipeline(scene, 200, "both", seed=palette_size,
+                                                    cache={"sets": 4, "queue": 8})
+    assert len(received) == len(expected) == 200
+    for n, (got, exp) in enumerate(zip(received, expected, strict=False)):
+        assert got == exp, f"pixel {n}: RTL {got} != model {exp}"
+    assert held > 0 and len({e["color.r"] for e in expected}) > 4

@@ -8,9 +8,11 @@ import subprocess
 import pytest
 
 from bumprtl.gen.flow.units import emit_unit
+from bumprtl.gen.render.rtl import emit_pipeline, scene_memories
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.sidecar import load as load_sidecar
+from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk_wrapper import HOOK, TEMPLATE, TOP, host_fields, wrapper_verilog
 
 BUILDS = {"own clock": ["-DBULK_OWN_CLOCK"], "cxx clock, file": [],
@@ -51,6 +53,25 @@ def test_filled_wrapper_with_host_ports_is_lint_clean(build, build_dir):
     top, text, params, defines = wrapper_verilog(meta, "BULK_OWN_CLOCK" in str(BUILDS[build]),
                                                  64)
     assert HOOK not in text and ".w_en(host_q[" in text.replace(".lut_w_en", ".w_en")
+    path = build_dir / f"{top}.v"
+    path.write_text(text)
+    defines.update({d[2:]: 1 for d in BUILDS[build]})
+    assert _lint(path, v, params, defines) == []
+
+
+@pytest.mark.parametrize("build", BUILDS)
+def test_filled_wrapper_with_an_axi_memory_is_lint_clean(build, build_dir):
+    """A map_memory = "axi" palette pipeline: the AXI port on the wrapper's memory model
+    (BULK_AXI), not on the set-up word; the LUT's host ports on the set-up word."""
+    scene = load_scene_config({"shading": "palette", "texture_size": 16, "tag_bits": 6,
+                               "map_memory": "axi"})
+    words, _, table = scene_memories(scene)
+    v, j = emit_pipeline(scene, words, None, build_dir, None, table)
+    meta = load_sidecar(j)
+    top, text, params, defines = wrapper_verilog(meta, "BULK_OWN_CLOCK" in str(BUILDS[build]),
+                                                 64)
+    assert defines["BULK_AXI"] == 1 and ".axi__rdata(ax_rdata)" in text
+    assert not any(name.startswith("axi__") for name in host_fields(meta)[0])
     path = build_dir / f"{top}.v"
     path.write_text(text)
     defines.update({d[2:]: 1 for d in BUILDS[build]})
