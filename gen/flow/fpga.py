@@ -19,7 +19,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from amaranth.back import verilog
-from amaranth.hdl import Const, Module, Signal, signed, unsigned
+from amaranth.hdl import Cat, Const, Module, Shape, Signal, signed, unsigned
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -32,6 +32,7 @@ from bumprtl.rtl.illumination import Illumination
 from bumprtl.rtl.pipe import (
     ECP5,
     EDGE_LATENCY,
+    CreditEdge,
     RegisteredProduct,
     RegisteredROM,
     add_credit_edge,
@@ -42,7 +43,7 @@ from bumprtl.sim.golden.methods import METHODS
 
 __all__ = ["DEVICES", "PACKAGE", "LPF", "FpgaError", "lpf_mhz", "place_and_route", "fpga_unit",
            "Placement", "place_text", "place_component", "placement_key", "PRIMITIVES",
-           "primitive_component"]
+           "primitive_component", "edge_component"]
 
 # Device name -> nextpnr-ecp5 flag. All three come in the CABGA381 package.
 DEVICES = {"LFE5U-25F": "--25k", "LFE5U-45F": "--45k", "LFE5U-85F": "--85k"}
@@ -201,6 +202,31 @@ def primitive_component(kind):
                 m.d.comb += [unit.a.eq(src[:18]), unit.b.eq(src[18:]), unit.en.eq(Const(1))]
                 value = unit.p
             m.d.sync += self.o.eq(value)
+            return m
+
+    return Alone()
+
+
+def edge_component(layout, latency, depth):
+    """The credit edge (``rtl.pipe.CreditEdge``: credits and its LUT-RAM FIFO) of a pipe of
+    ``latency`` stages with ``depth`` entries of ``layout``, alone between flip-flops: the
+    core stream's valid and payload, ``i.valid`` and ``o.ready`` from registers, ``o`` and
+    ``i.ready`` into registers. Its placed cost is what the edge adds to a pipeline."""
+    width = Shape.cast(layout).width
+
+    class Alone(wiring.Component):
+        def __init__(self):
+            self.target = ECP5()
+            super().__init__({"i": In(width + 3), "o": Out(width + 2)})
+
+        def elaborate(self, platform):
+            m = Module()
+            m.submodules.edge = edge = CreditEdge(layout, latency, depth)
+            src = Signal.like(self.i, name="src")
+            m.d.sync += [src.eq(self.i),
+                         self.o.eq(Cat(edge.o.payload.as_value(), edge.o.valid, edge.i_ready))]
+            m.d.comb += [edge.core.payload.eq(src[:width]), edge.core.valid.eq(src[width]),
+                         edge.i_valid.eq(src[width + 1]), edge.o.ready.eq(src[width + 2])]
             return m
 
     return Alone()

@@ -19,6 +19,7 @@ from bumprtl.gen.flow.fpga import (
     FpgaError,
     Placement,
     check_device,
+    edge_component,
     lpf_mhz,
     pipeline_component,
     place_text,
@@ -35,6 +36,9 @@ from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run"]
+
+# The scene pipeline whose credit edge is placed alone in every run (its cost on its own).
+EDGE_SCENE = "default"
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,11 @@ def _component(design, row, cfg):
     target = ECP5()
     if row.startswith("primitive:"):   # one registered primitive alone: the ceiling
         return primitive_component(row.split(":", 1)[1])
+    if row.startswith("edge:"):        # a scene pipeline's credit edge alone: its cost
+        pipeline = BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
+        for unit in (pipeline, *pipeline.units.values()):
+            unit._MustUse__silence = True          # read for its ports and latency only
+        return edge_component(pipeline.o.payload.shape(), pipeline.latency, pipeline.fifo_depth)
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
         return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
     cfg = cfg.replace(method=design)
@@ -104,12 +113,13 @@ def fpga_report(cfg, run: FpgaRun, units):
     the cache (``run.work``, by Verilog digest) is a job of gen/tools/jobs.py: a local cluster of
     ``run.jobs`` workers, or ``run.scheduler``'s."""
     prims = [(f"{k}_alone", None, f"primitive:{k}") for k in PRIMITIVES]   # small: always
+    prims.append(("credit_edge_alone", None, f"edge:{EDGE_SCENE}"))
     # placed in this order, the baselines (the largest netlists) last: a run stopped early
     # keeps what it placed (the cache), so the rows the target is about come first
     order = prims + [u for u in units if not _baseline(u)] + [u for u in units if _baseline(u)]
     placed = place_all(cfg, run, [(u, seed) for u in order for seed in _row_seeds(run, u[2])])
     ceilings = {}
-    for label, design, row in prims:
+    for label, design, row in prims[:len(PRIMITIVES)]:
         ok = [r for s in _row_seeds(run, row)
               if "error" not in (r := placed[((label, design, row), s)])]
         if ok:
@@ -126,8 +136,10 @@ def fpga_report(cfg, run: FpgaRun, units):
             rows.append({**worst, "unit": label, "design": design, "row": row,
                          "fmax_by_seed": {r["seed"]: r["fmax_mhz"] for r in ok}})
         print(f"{label}: {rows[-1]}", flush=True)
+    edge = [r for s in _row_seeds(run, prims[-1][2])
+            if "error" not in (r := placed[(prims[-1], s)])]
     acc = {d: accuracy(d, cfg, run.samples) for d in {r["design"] for r in rows}}
-    write_report(run, rows, acc, cfg, ceilings)
+    write_report(run, rows, acc, cfg, ceilings, edge)
 
 
 def _baseline(unit):
@@ -217,7 +229,27 @@ def _ceiling_lines(rows, ceilings):
     return lines
 
 
-def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None):
+def _edge_lines(edge):
+    """The section on the default scene's credit edge placed alone (its placements, one per
+    seed): what the free-running datapath's flow control costs."""
+    if not edge:
+        return []
+    worst = worst_run(edge)
+    return ["", "## The credit edge on its own", "",
+            f"The `{EDGE_SCENE}` scene pipeline's credit edge (`rtl/pipe.CreditEdge`: its "
+            "credit count and its LUT-RAM FIFO with the prefetch and output registers, at "
+            "that pipeline's payload width, latency and FIFO depth) placed alone between "
+            "flip-flops (`gen/flow/fpga.edge_component`), same flow and seeds: what the flow "
+            "control adds to a pipeline's row above.", "",
+            "| design | LUT4 | FF | DSP | BRAM | Fmax (MHz) | Fmax by seed | path |",
+            "|---|---|---|---|---|---|---|---|",
+            f"| credit_edge_alone | {worst['LUT4']} | {worst['FF']} | {worst['DSP']} | "
+            f"{worst['BRAM']} | {worst['fmax_mhz']} | "
+            + ", ".join(f"{r['seed']}: {r['fmax_mhz']}" for r in sorted(edge, key=lambda r: r["seed"]))
+            + f" | {worst['critical_path']} |"]
+
+
+def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
     out = Path(run.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot = out.parent / "img" / "cost_vs_error.png"
@@ -256,6 +288,7 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None):
               "nextpnr's worst register-to-register path of each unit (start -> end cell.port):", ""]
     lines += [f"- {r['unit']}: {r['critical_path']}" for r in rows if "error" not in r]
     lines += _ceiling_lines(rows, ceilings or {})
+    lines += _edge_lines(edge or [])
     target = [r for r in rows if r["unit"] == "exact_pipeline"]
     if target:
         r = target[0]
@@ -403,7 +436,16 @@ FPGA_NOTES = """
   174.9 MHz); the light sum and the blend register 255 D before its rounding
   (scene_textured at 188.8 MHz). Each adds a stage where it sits: the exact sine reads two
   (Lee's and Kim's one),
-  the rotation one more; the blend and light-sum latencies are unchanged.
+  the rotation one more; the blend and light-sum latencies are unchanged. Then the edge's
+  FIFO reads its LUT RAM into a prefetch register beside it, which feeds the output
+  register (`rtl/pipe.CreditFIFO`; the LUT-RAM read into the output register, 1.25 ns of
+  logic and 3.9-5.3 ns of routing, held exact_pipeline at 188.9, scene_default at 182.4,
+  scene_diffuse at 153.4 and scene_textured at 194.6 MHz: `EDGE_LATENCY` 3, the least
+  depth L + 4), each 16 bits of the pixel with a copy of the FIFO's control (the prefetch
+  register's load, fanned out to every read pointer and every bit's enable, then held
+  exact_pipeline at 193.1 MHz); and `pipe.WideProduct` holds each limb product in a
+  fabric register before the pair sums (the DSP output into the pair sum held scene_full
+  at 167.8 and scene_two_lights at 166.7 MHz: `WIDE_PRODUCT_LATENCY` one more).
 - The primitives' own ceiling above is nextpnr's timing model of one DP16KD or
   MULT18X18D between flip-flops; Lattice's datasheet figures for the primitives are not
   in that model and not quoted here.

@@ -7,7 +7,7 @@ import pytest
 from amaranth.back import verilog
 
 from bumprtl.gen.flow.fpga import PRIMITIVES, primitive_component
-from bumprtl.gen.report.fpga import _ceiling_lines
+from bumprtl.gen.report.fpga import _ceiling_lines, _edge_lines
 from bumprtl.rtl.config import BumpError
 
 
@@ -44,3 +44,29 @@ def test_each_primitive_alone_is_its_registered_ecp5_cell(kind, cell, registers)
 def test_an_unknown_primitive_is_refused_in_one_line():
     with pytest.raises(BumpError, match="primitive must be one of dp16kd, mult18x18d, got 'lut4'"):
         primitive_component("lut4")
+
+
+def test_the_credit_edge_alone_section_gives_its_cost_at_the_worst_seed():
+    def placed(seed, fmax, lut4):
+        return {**_row("credit_edge_alone", fmax, fmax >= 200), "seed": seed, "LUT4": lut4,
+                "FF": 300, "DSP": 0, "BRAM": 0}
+    text = "\n".join(_edge_lines([placed(2, 310.0, 410), placed(1, 290.5, 400)]))
+    assert "## The credit edge on its own" in text
+    assert "| credit_edge_alone | 400 | 300 | 0 | 0 | 290.5 | 1: 290.5, 2: 310.0 |" in text
+    assert _edge_lines([]) == []
+
+
+def test_the_credit_edge_alone_is_the_edge_between_registers_and_nothing_else():
+    """The default pipeline's edge: its FIFO's LUT RAM and no product or block RAM; every
+    input and output of the edge registered (no port reaches it through logic alone)."""
+    from amaranth.hdl import signed
+    from amaranth.lib import data
+
+    from bumprtl.gen.flow.fpga import edge_component
+    layout = data.StructLayout({"color": 24, "tag": signed(6)})
+    text = verilog.convert(edge_component(layout, 10, 14), name="edge_alone", emit_src=False)
+    assert "MULT18X18D" not in text and "DP16KD" not in text
+    assert "credits" in text and "fifo_pre" in text
+    assert re.search(r"reg \[32:0\] src", text) and re.search(r"output \[31:0\] o", text)
+    with pytest.raises(BumpError, match="fifo_depth must be an int >= 14.*got 13"):
+        edge_component(layout, 10, 13).elaborate(None)
