@@ -38,13 +38,14 @@ from amaranth.lib import wiring
 from amaranth.lib.cdc import ResetSynchronizer
 from amaranth.lib.memory import Memory
 
+from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
 __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "PixelSource",
-           "BoardCore", "ULX3STop", "SimTop", "pll_params"]
+           "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock"]
 
 BUFFER_MARGIN = 8
 
@@ -176,12 +177,47 @@ class BoardCore(Elaboratable):
         return m
 
 
+# ECP5 EHXPLLL limits (Lattice FPGA-TN-02200, sysCLOCK PLL): the phase detector's input
+# (reference / CLKI_DIV) at least 3.125 MHz, the VCO (CLKOP x CLKOP_DIV) 400 .. 800 MHz,
+# each output at most 400 MHz, every divider 1 .. 128.
+PFD_MIN_HZ, VCO_HZ, OUT_MAX_HZ, DIV_MAX = 3.125e6, (400e6, 800e6), 400e6, 128
+
+
+def pll_dividers(pixel_hz, ref_hz=25e6):
+    """``(clki_div, clkfb_div, clkop_div)`` of the EHXPLLL that makes the shift clock
+    (CLKOP, the feedback: ref / clki_div x clkfb_div) nearest 5 x ``pixel_hz`` within the
+    limits above, the smallest dividers among equals; CLKOS = CLKOP / 5 is the pixel clock.
+    BumpError when no setting is within 0.5 % (the CEA-861 / VESA clock tolerance)."""
+    shift = 5 * pixel_hz
+    best = None                          # ((error, clki), dividers); CLKOP_DIV 5 where it fits
+    for clki in range(1, DIV_MAX + 1):
+        if ref_hz / clki < PFD_MIN_HZ:
+            break
+        fb = max(1, min(DIV_MAX, round(shift * clki / ref_hz)))
+        got = ref_hz / clki * fb
+        ops = [d for d in range(1, DIV_MAX // 5 + 1) if VCO_HZ[0] <= got * d <= VCO_HZ[1]]
+        if got > OUT_MAX_HZ or not ops:
+            continue
+        key = (abs(got - shift), clki)
+        if best is None or key < best[0]:
+            best = (key, (clki, fb, 5 if 5 in ops else max(ops)))
+    if best is None or best[0][0] > 0.005 * shift:
+        raise BumpError(f"pixel clock {pixel_hz / 1e6:g} MHz: no EHXPLLL setting from a "
+                        f"{ref_hz / 1e6:g} MHz reference within 0.5 %", "mode")
+    return best[1]
+
+
+def pll_clock(pixel_hz, ref_hz=25e6):
+    """The pixel clock the PLL of :func:`pll_dividers` gives (Hz)."""
+    clki, fb, _ = pll_dividers(pixel_hz, ref_hz)
+    return ref_hz / clki * fb / 5
+
+
 def pll_params(pixel_hz, ref_hz=25e6):
     """EHXPLLL parameters: CLKOP = 5 x pixel (the shift clock, also the feedback), CLKOS =
-    the pixel clock, from ``ref_hz``. VCO = CLKOP x CLKOP_DIV in [400, 800] MHz."""
-    fb = round(5 * pixel_hz / ref_hz)
-    op_div = 5 if 5 * pixel_hz * 5 <= 800e6 else 4
-    return {"p_CLKI_DIV": 1, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
+    the pixel clock, from ``ref_hz`` (:func:`pll_dividers`)."""
+    clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
+    return {"p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
             "p_CLKOP_ENABLE": "ENABLED", "p_CLKOP_DIV": op_div, "p_CLKOP_CPHASE": op_div - 1,
             "p_CLKOP_FPHASE": 0, "p_CLKOS_ENABLE": "ENABLED", "p_CLKOS_DIV": 5 * op_div,
             "p_CLKOS_CPHASE": 5 * op_div - 1, "p_CLKOS_FPHASE": 0,
