@@ -21,6 +21,7 @@ policy, rows stay open until a miss in that bank or a refresh).
 from dataclasses import dataclass
 from fractions import Fraction
 from math import ceil
+from types import SimpleNamespace
 
 from amaranth.hdl import Array, Cat, Module, Mux, Signal
 from amaranth.lib import wiring
@@ -245,12 +246,24 @@ class SdramConfig:
         return self.init_refreshes if self.init_refreshes is not None else self.chip.init_refreshes
 
     @property
-    def refresh_slack(self):
-        """Most cycles from a refresh falling due to its AUTO REFRESH: the longest a bank
-        must stay open (tRAS, or a write's data and tWR, or a read's burst), then tRP (or
-        what is left of tRC), and the two register stages of the decision."""
+    def pre_wait(self):
+        """Most cycles a bank may have to stay open: tRAS, a write's data and tWR, a READ's
+        burst."""
         t, bl = self.cycles, self.burst
-        return max(t["ras"], bl - 1 + t["wr"], bl) + max(t["rp"], t["rc"]) + 3
+        return max(t["ras"], bl - 1 + t["wr"], bl)
+
+    @property
+    def act_wait(self):
+        """Most cycles an idle bank may have to wait for ACTIVE or AUTO REFRESH."""
+        t = self.cycles
+        return max(t["rp"], t["rc"], t["rfc"], t["mrd"])
+
+    @property
+    def refresh_slack(self):
+        """Most cycles from a refresh falling due to its AUTO REFRESH on the pins: every
+        open bank's wait (:attr:`pre_wait`, or a command's tRFC/tMRD), PRECHARGE ALL, the
+        idle banks' wait (:attr:`act_wait`), and the decision's register stage."""
+        return max(self.pre_wait, self.act_wait) + self.act_wait + 3
 
     @property
     def refresh_reload(self):
@@ -313,6 +326,22 @@ class SdramController(wiring.Component):
 
     def __init__(self, cfg: SdramConfig):
         self.cfg = cfg
+        nb, tw, t = cfg.chip.banks, cfg.timer_max.bit_length(), cfg.cycles
+        # The scheduler's registers, here so that the formal contract (sim/formal/sdram.py)
+        # can state its lemmas about them.
+        self.regs = SimpleNamespace(
+            cmd=Signal(4, init=CMD["nop"], name="cmd"),
+            open=Signal(nb, name="open"),
+            act_t=[Signal(tw, name=f"act_t{b}") for b in range(nb)],   # ACT/REF allowed at 0
+            rcd_t=[Signal(tw, name=f"rcd_t{b}") for b in range(nb)],   # READ/WRITE allowed at 0
+            pre_t=[Signal(tw, name=f"pre_t{b}") for b in range(nb)],   # PRECHARGE allowed at 0
+            rrd_t=Signal(tw, name="rrd_t"), rd_t=Signal(tw, name="rd_t"),
+            wr_t=Signal(tw, name="wr_t"), cmd_t=Signal(tw, name="cmd_t"),
+            ref_cnt=Signal(range(max(t["powerup"], cfg.refresh_reload) + 1),
+                           init=t["powerup"], name="ref_cnt"),
+            init_pre=Signal(init=1, name="init_pre"),
+            init_refs=Signal(range(cfg.refreshes + 1), init=cfg.refreshes, name="init_refs"),
+            run=Signal(name="run"))
         super().__init__({"rd": In(axi_read_signature(cfg.addr_bits, cfg.data_bits)),
                           "wr": In(axi_write_signature(cfg.addr_bits, cfg.data_bits)),
                           "sdram": Out(sdram_signature(cfg))})
@@ -322,12 +351,9 @@ class SdramController(wiring.Component):
         cfg, chip, t = self.cfg, self.cfg.chip, self.cfg.cycles
         bl, wpb, nb = cfg.burst, cfg.words_per_beat, chip.banks
         pins, rd, wr = self.sdram, self.rd, self.wr
-        tw = cfg.timer_max.bit_length()
+        r = self.regs
         col_bits, bank_bits, row_bits = chip.col_bits, chip.bank_bits, chip.row_bits
         word_bits = col_bits + bank_bits + row_bits
-
-        def timer(name):
-            return Signal(tw, name=name)
 
         def count_down(sig):
             m.d.sync += sig.eq(Mux(sig == 0, 0, sig - 1))
@@ -339,7 +365,7 @@ class SdramController(wiring.Component):
             m.d.sync += sig.eq(Mux(sig > v + 1, sig - 1, v))
 
         # --- registered pins ---
-        cmd = Signal(4, init=CMD["nop"])
+        cmd = r.cmd
         m.d.comb += [pins.cs_n.eq(cmd[3]), pins.ras_n.eq(cmd[2]), pins.cas_n.eq(cmd[1]),
                      pins.we_n.eq(cmd[0])]
         m.d.comb += pins.cke.eq(1)                  # no power-down, no self refresh
@@ -349,12 +375,10 @@ class SdramController(wiring.Component):
         m.d.sync += [cmd.eq(nxt_cmd), pins.ba.eq(nxt_ba), pins.a.eq(nxt_a)]
 
         # --- bank table and timers ---
-        open_ = Signal(nb)
+        open_ = r.open
         rows = Array(Signal(row_bits, name=f"row{b}") for b in range(nb))
-        act_t = Array(timer(f"act_t{b}") for b in range(nb))    # ACT/REF allowed at 0
-        rcd_t = Array(timer(f"rcd_t{b}") for b in range(nb))    # READ/WRITE allowed at 0
-        pre_t = Array(timer(f"pre_t{b}") for b in range(nb))    # PRECHARGE allowed at 0
-        rrd_t, rd_t, wr_t, cmd_t = timer("rrd_t"), timer("rd_t"), timer("wr_t"), timer("cmd_t")
+        act_t, rcd_t, pre_t = Array(r.act_t), Array(r.rcd_t), Array(r.pre_t)
+        rrd_t, rd_t, wr_t, cmd_t = r.rrd_t, r.rd_t, r.wr_t, r.cmd_t
         timers = [*act_t, *rcd_t, *pre_t, rrd_t, rd_t, wr_t, cmd_t]
 
         # --- the transaction being served ---
@@ -369,14 +393,12 @@ class SdramController(wiring.Component):
             m.d.comb += hit[b].eq(open_[b] & (rows[b] == cur_row))
 
         # --- refresh ---
-        ref_cnt = Signal(range(max(t["powerup"], cfg.refresh_reload) + 1), init=t["powerup"])
-        ref_due = Signal()
+        ref_cnt, ref_due = r.ref_cnt, Signal()
         m.d.sync += ref_cnt.eq(Mux(ref_cnt == 0, 0, ref_cnt - 1))
         m.d.comb += ref_due.eq(ref_cnt == 0)
 
         # --- initialisation: power-up wait (ref_cnt), PRECHARGE ALL, refreshes, MRS ---
-        init_pre, init_refs, run = Signal(init=1), Signal(range(cfg.refreshes + 1),
-                                                          init=cfg.refreshes), Signal()
+        init_pre, init_refs, run = r.init_pre, r.init_refs, r.run
 
         # --- write data buffer: max(burst, words a beat) words, loaded a beat at a time ---
         cap = max(bl, wpb)
