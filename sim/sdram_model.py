@@ -206,8 +206,8 @@ class SdramModel:
                 self._since(self.last["WDATA"][b], "WR", f"PRECHARGE bank {b} after write data")
                 if now < self.last["READ_END"][b]:
                     self._fail(f"PRECHARGE bank {b} truncates a READ burst")
-                if self.writes:
-                    self._fail(f"PRECHARGE bank {b} during a WRITE burst")
+                if any(w[0] == b for w in self.writes.values()):
+                    self._fail(f"PRECHARGE bank {b} during its WRITE burst")
             self.row[b] = None
             self.last["PRE"][b] = now
         if self.state == "powerup":

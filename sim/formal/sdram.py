@@ -12,10 +12,13 @@ command pair it constrains does occur. The minimums are the configuration's cycl
 (``SdramConfig.cycles``, the datasheet's ns at the clock); the power-up wait is the
 configuration's ``powerup_cycles``.
 
-:func:`prove` runs the assertions by induction (``abc pdr``: property-directed reachability,
-an inductive invariant found by the solver; the counters' long ranges make plain
-k-induction need a depth of tREFI), :func:`bmc` by bounded model checking from reset, and
-:func:`cover` the covers.
+Lemmas tie the controller's registers (``SdramController.regs``) to the monitor: each timer
+holds the rest of its command's wait, the bank table is the pins' next, the refresh
+counter plus the cycles since the last AUTO REFRESH is the reload value, and a refresh
+that is due comes within the slack the configuration reserved
+(``SdramConfig.refresh_slack``). With them the rules are 2-inductive: :func:`prove` runs
+k-induction at depth 2 (seconds; without them the refresh deadline would need a depth of
+tREFI). :func:`cover` runs the covers, :func:`bmc` bounded model checking from reset.
 """
 
 from amaranth.hdl import (
@@ -61,17 +64,19 @@ RULES = {
 FORMAL_CONFIGS = {
     "32mb_100mhz_cl2": SdramConfig("32mb", 100, 2, burst=8, powerup_cycles=2, init_refreshes=2),
     "64mb_133mhz_cl3": SdramConfig("64mb", 133, 3, burst=4, powerup_cycles=2, init_refreshes=2),
-    # slow enough that two refreshes fall within a cover's depth
+    # slow clocks, every timing one cycle: the covers' traces are short
     "32mb_10mhz_cl2": SdramConfig("32mb", 10, 2, burst=8, powerup_cycles=2, init_refreshes=2),
+    # tREFI of 7 cycles: a refresh falls due within a cover's depth
+    "32mb_1mhz_bl1": SdramConfig("32mb", 1, 2, burst=1, powerup_cycles=2, init_refreshes=2),
 }
 
 
 class SdramCommandContract(Elaboratable):
     """The controller built from ``cfg`` and the monitor of its pins (module docstring)."""
 
-    def __init__(self, cfg: SdramConfig):
+    def __init__(self, cfg: SdramConfig, dut=None):
         self.cfg = cfg
-        self.dut = SdramController(cfg)
+        self.dut = dut if dut is not None else SdramController(cfg)
         self.messages = {}
         self.covers = []
 
@@ -281,9 +286,10 @@ def _sby(top, workdir, name, mode, depth, engine="smtbmc z3", timeout=1800):
                    script=("memory_map", "opt -fast"), timeout=timeout)
 
 
-def prove(cfg, workdir, name="prove", depth=2, timeout=1800):
-    """Every rule for all time: k-induction with the lemmas."""
-    top = SdramCommandContract(cfg)
+def prove(cfg, workdir, name="prove", depth=2, timeout=1800, dut=None):
+    """Every rule for all time: k-induction with the lemmas. ``dut``: a controller built
+    otherwise (a broken one) checked against ``cfg``'s rules."""
+    top = SdramCommandContract(cfg, dut)
     return top, _sby(top, workdir, name, "prove", depth, timeout=timeout)
 
 
