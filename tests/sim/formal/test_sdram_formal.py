@@ -46,7 +46,7 @@ def test_every_rule_is_asserted():
 
 @pytest.mark.parametrize("timing,rule", [
     ("ras", "pre_t"), pytest.param("wr", "pre_t", marks=pytest.mark.formal),
-    pytest.param("rfc", "act_t", marks=pytest.mark.formal),
+    pytest.param("rfc", "cmd_t", marks=pytest.mark.formal),
     pytest.param("mrd", "cmd_t", marks=pytest.mark.formal)])
 def test_a_timing_one_cycle_short_is_not_proved(timing, rule, build_dir):
     """The controller built with one timing a cycle short, against the true rules: the
