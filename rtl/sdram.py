@@ -119,7 +119,7 @@ CMD = {"nop": 0b0111, "active": 0b0011, "read": 0b0101, "write": 0b0100,
        "precharge": 0b0010, "refresh": 0b0001, "mode": 0b0000}
 DQ_BITS = 16
 ADDR_PINS = 13                       # A0..A12 on the ULX3S
-DATA_BITS = (16, 32, 64)
+DATA_BITS = (32, 64)
 
 
 def ns_to_cycles(ns, freq_mhz):
@@ -153,7 +153,7 @@ class SdramConfig:
         Words (16 bits) a READ or WRITE moves: the mode register's burst length, 1, 2, 4 or
         8. An AXI burst must be a whole number of these, aligned to ``2 * burst`` bytes.
     data_bits : int
-        AXI data width, 16, 32 or 64.
+        AXI data width, 32 or 64 (the cache's).
     addr_bits : int
         AXI address width; addresses wrap modulo the chip's size.
     read_fifo : int
@@ -190,7 +190,7 @@ class SdramConfig:
         if not _pow2(self.burst) or self.burst > 8:
             raise BumpError(f"burst must be a power of two in [1, 8], got {self.burst!r}", "burst")
         if self.data_bits not in DATA_BITS:
-            raise BumpError(f"data_bits must be one of 16, 32, 64, got {self.data_bits!r}",
+            raise BumpError(f"data_bits must be 32 or 64, got {self.data_bits!r}",
                             "data_bits")
         need = self.chip_addr_bits
         if not isinstance(self.addr_bits, int) or not need <= self.addr_bits <= 64:
@@ -523,9 +523,14 @@ class SdramController(wiring.Component):
             m.d.sync += [cur_addr.eq(rd.araddr[1:1 + word_bits]), cur_left.eq(bursts(rd.arlen))]
 
         # --- write data: W beats into the buffer's tail; a WRITE sends its front ---
-        m.d.comb += wr.wready.eq((wcount <= cap - wpb) & ~wsend.any())
+        # ``drop`` (a register) is high the cycle after each word went to the pins: the
+        # buffer lets that word go then, so its shift enable comes from registers, not
+        # from the decision; meanwhile the next word is the buffer's second.
+        drop = Signal()
+        m.d.comb += wr.wready.eq((wcount <= cap - wpb) & ~wsend.any() & ~drop)
         take_beat = wr.wvalid & wr.wready
-        sending = issue["write"] | (wsend != 0)
+        sending = issue["write"] | wsend.any()
+        m.d.sync += drop.eq(sending)
         with m.If(take_beat):
             for k in range(cap):
                 src = k + wpb
@@ -536,15 +541,15 @@ class SdramController(wiring.Component):
                     m.d.sync += [wbuf[k].eq(wr.wdata.word_select(j, DQ_BITS)),
                                  wmask[k].eq(~wr.wstrb.word_select(j, 2))]
             m.d.sync += wcount.eq(wcount + wpb)
-        with m.Elif(sending):
+        with m.Elif(drop):
             for k in range(cap - 1):
                 m.d.sync += [wbuf[k].eq(wbuf[k + 1]), wmask[k].eq(wmask[k + 1])]
         with m.If(issue["write"]):
             m.d.sync += [wcount.eq(wcount - bl), wsend.eq(bl - 1)]
-        with m.Elif(wsend != 0):
+        with m.Elif(wsend.any()):
             m.d.sync += wsend.eq(wsend - 1)
-        m.d.sync += [pins.dq_oe.eq(sending), pins.dq_o.eq(wbuf[0]),
-                     pins.dqm.eq(Mux(sending, wmask[0], 0))]
+        m.d.sync += [pins.dq_oe.eq(sending), pins.dq_o.eq(Mux(drop, wbuf[1], wbuf[0])),
+                     pins.dqm.eq(Mux(sending, Mux(drop, wmask[1], wmask[0]), 0))]
         m.d.comb += [wr.bid.eq(0), wr.bresp.eq(0), wr.bvalid.eq(bvalid)]
         with m.If(bvalid & wr.bready):
             m.d.sync += bvalid.eq(0)

@@ -48,7 +48,7 @@ def test_every_timing_converts_from_the_table(variant):
     ("freq_mhz", 0.5, "[1, 100]"),
     ("burst", 3, "power of two in [1, 8]"),
     ("burst", 16, "power of two in [1, 8]"),
-    ("data_bits", 8, "one of 16, 32, 64"),
+    ("data_bits", 16, "32 or 64"),
     ("addr_bits", 24, "[25, 64]"),         # the 32 MB chip has 25 byte-address bits
     ("read_fifo", 12, "power of two"),
     ("init_refreshes", 1, "[2, 16]"),
@@ -74,8 +74,10 @@ def _strobes(rng, beats, nbytes, masked):
 
 
 @pytest.mark.parametrize("cfg", [FAST, replace(FAST, variant="64mb", freq_mhz=133,
-                                               cas_latency=3, burst=4, data_bits=64)],
-                         ids=["32mb_cl2_bl8_32bit", "64mb_cl3_bl4_64bit"])
+                                               cas_latency=3, burst=4, data_bits=64),
+                                 replace(FAST, burst=2, data_bits=64)],
+                         ids=["32mb_cl2_bl8_32bit", "64mb_cl3_bl4_64bit",
+                              "32mb_cl2_bl2_64bit_writes_back_to_back"])
 def test_random_traffic_reads_what_was_written(cfg):
     rng = random.Random(3)
     nbytes, unit = cfg.data_bits // 8, 2 * cfg.burst
