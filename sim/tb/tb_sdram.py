@@ -86,7 +86,7 @@ async def start(dut, cfg):
     dut.rst.value = 1
     for name in AXI_INPUTS:           # the master leaves a channel's payload undriven until used
         getattr(dut, name).value = 0
-    cocotb.start_soon(Clock(dut.clk, round(period_ns * 1000), unit="ps").start())
+    cocotb.start_soon(Clock(dut.clk, 2 * round(period_ns * 500), unit="ps").start())   # even ps
     bus = AxiBus(write=AxiWriteBus.from_prefix(dut, "wr_"), read=AxiReadBus.from_prefix(dut, "rd_"))
     axi = AxiMaster(bus, dut.clk, dut.rst)
     pins = SdramPins(dut, model_for(cfg))
