@@ -339,6 +339,7 @@ class SdramController(wiring.Component):
             wr_t=Signal(tw, name="wr_t"), cmd_t=Signal(tw, name="cmd_t"),
             ref_cnt=Signal(range(max(t["powerup"], cfg.refresh_reload) + 1),
                            init=t["powerup"], name="ref_cnt"),
+            ref_due=Signal(name="ref_due"),             # ref_cnt == 0, as a register
             init_pre=Signal(init=1, name="init_pre"),
             init_refs=Signal(range(cfg.refreshes + 1), init=cfg.refreshes, name="init_refs"),
             run=Signal(name="run"))
@@ -396,9 +397,8 @@ class SdramController(wiring.Component):
             m.d.comb += hit[b].eq(open_[b] & (rows[b] == cur_row))
 
         # --- refresh ---
-        ref_cnt, ref_due = r.ref_cnt, Signal()
-        m.d.sync += ref_cnt.eq(Mux(ref_cnt.any(), ref_cnt - 1, 0))
-        m.d.comb += ref_due.eq(~ref_cnt.any())
+        ref_cnt, ref_due = r.ref_cnt, r.ref_due
+        m.d.sync += [ref_cnt.eq(Mux(ref_cnt.any(), ref_cnt - 1, 0)), ref_due.eq(ref_cnt <= 1)]
 
         # --- initialisation: power-up wait (ref_cnt), PRECHARGE ALL, refreshes, MRS ---
         init_pre, init_refs, run = r.init_pre, r.init_refs, r.run
@@ -452,11 +452,11 @@ class SdramController(wiring.Component):
                 at_least(act_t[b], t["rp"])
         with m.If(issue["ref"]):
             m.d.comb += nxt_cmd.eq(CMD["refresh"])
-            m.d.sync += ref_cnt.eq(cfg.refresh_reload)
+            m.d.sync += [ref_cnt.eq(cfg.refresh_reload), ref_due.eq(0)]
             with m.If(~run):
                 m.d.sync += init_refs.eq(init_refs - 1)
-                with m.If(init_refs != 1):
-                    m.d.sync += ref_cnt.eq(0)          # the next one as soon as tRFC allows
+                with m.If(init_refs != 1):             # the next one as soon as tRFC allows
+                    m.d.sync += [ref_cnt.eq(0), ref_due.eq(1)]
             at_least(cmd_t, t["rfc"])
             for b in range(nb):
                 at_least(act_t[b], max(t["rfc"], t["rc"]))

@@ -231,6 +231,7 @@ class SdramCommandContract(Elaboratable):
                     ~r.init_pre | (r.ref_cnt + s_reset == t["powerup"])
                     | ((r.ref_cnt == 0) & (s_reset >= t["powerup"])))
         self._lemma(m, "the power-up wait is over", r.init_pre | (s_reset >= t["powerup"]))
+        self._lemma(m, "ref_due is ref_cnt == 0", r.ref_due == (r.ref_cnt == 0))
         reload, refi = cfg.refresh_reload, t["refi"]
         counting = refreshed & ~is_["ref"] & ~r.init_pre
         self._lemma(m, "the refresh counter counts from the last AUTO REFRESH",
