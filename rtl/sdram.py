@@ -315,7 +315,7 @@ class SdramController(wiring.Component):
         Write bursts on the same terms; WSTRB becomes DQM; one B response (BID 0, OKAY) per
         burst once its last WRITE is issued; one write burst at a time.
     sdram : Out(sdram_signature(cfg))
-        Every output is a register. A READ on the pins in cycle n returns its first word
+        Every output is a register (CKE is tied high). A READ on the pins in cycle n returns its first word
         on ``dq_i`` in cycle n + CL (sampled by the chip's clock edges), which the
         controller registers once.
 

@@ -127,6 +127,8 @@ def run(cfg: SdramConfig, ops, r_stall=0.0, seed=0, limit=200_000):
     sim.add_process(r_channel)
     sim.add_testbench(manager)
     sim.run()
+    if model.error is not None:
+        raise model.error
     model.ar_cycles = state["ar"]
     return reads, beats, model
 

@@ -68,6 +68,7 @@ class SdramModel:
         self.init_refreshes = init_refreshes
         self.mem = {}
         self.log = [] if log else None
+        self.error = None             # the first violation seen by :meth:`process`
         self.reset()
 
     def reset(self):
@@ -248,19 +249,23 @@ class SdramModel:
     # --- running it ---
     async def process(self, ctx, pins):
         """An Amaranth simulator process on ``pins`` (the controller's ``sdram`` interface):
-        the sync domain's reset resets the model too."""
+        the sync domain's reset resets the model too. The first violation is kept in
+        ``error`` (the model stops there and the simulation runs on: an exception thrown
+        out of a simulator process leaves its other coroutines half closed); the caller
+        raises it once the simulation has ended."""
         drive, value = False, 0
         while True:
             ctx.set(pins.dq_i, value if drive else 0)
             _, rst, *vals = await ctx.tick().sample(
                 pins.cs_n, pins.ras_n, pins.cas_n, pins.we_n, pins.ba, pins.a, pins.dqm,
                 pins.dq_o, pins.dq_oe, pins.cke)
+            if self.error is not None:
+                continue
             if rst:
                 self.reset()
                 drive = False
                 continue
-            drive, value = self.cycle(*vals)
-
-    def read_bytes(self, where):
-        """The two bytes of the word at ``where`` (bank, row, column), for benches."""
-        return self.mem.get(where, 0).to_bytes(2, "little")
+            try:
+                drive, value = self.cycle(*vals)
+            except SdramViolation as e:
+                self.error, drive = e, False
