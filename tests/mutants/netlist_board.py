@@ -1,6 +1,6 @@
 """The board's units as targets of tests/mutants/netlist.py (``make mutate-rtl``): the video
 timing (rtl/video.VideoTiming), one TMDS encoder lane (rtl/tmds.TMDSEncoder), the elastic
-buffer (amaranth.lib.fifo.SyncFIFOBuffered at the board's width and depth, rtl/board.py)
+buffer (the pipeline's credit FIFO, rtl/pipe.CreditFIFO, at the board's width and depth)
 and the pixel source (rtl/board.PixelSource), each emitted alone as the board builds it for
 the default scene in the reduced mode ``test`` (rtl/video.MODES).
 
@@ -13,11 +13,11 @@ compared with an oracle that is not the RTL:
   here from the VESA-style line of rtl/video.MODES (active, porches, sync, polarity);
 * ``board:tmds``: the DVI 1.0 encoding flow chart of tests/rtl/test_tmds.py (``dvi_encode``,
   written from the standard) with its control symbols, two cycles behind the inputs;
-* ``board:buffer``: a first-in first-out queue as amaranth.lib.fifo documents
-  SyncFIFOBuffered: every read returns the oldest unread word, ``level`` counts the unread
-  words, a word can be read from the second cycle after its write on (one more than
-  SyncFIFO), and ``w_rdy`` is high while the words not in the output register number
-  fewer than depth - 1;
+* ``board:buffer``: a first-in first-out queue as docs/architecture.md states the credit
+  FIFO: every read returns the oldest unread word, ``level`` counts the unread words, a
+  word can be read from the third cycle after its write on (EDGE_LATENCY, typed here as
+  3), and ``w_rdy`` is high (the writes, as the credits allow, never fill it: fewer than
+  depth words unread when one is written);
 * ``board:source``: the raster order of sim/golden/board.py's frames (texel coordinates by
   rtl/board.texel_coords, the plane's constants and a 4-step light table from
   plane_constants / light_table), one pixel a transfer, valid from the second cycle after
@@ -46,6 +46,7 @@ UNIT = {"board:timing": "video_timing", "board:tmds": "tmds_encoder",
         "board:buffer": "elastic_buffer", "board:source": "pixel_source"}
 MODE = "test"
 LIGHT_STEPS = 4            # the source's light table: small, so that the step wraps
+FIFO_DELAY = 3             # docs/architecture.md: written in cycle t, readable from t + 3
 SIM_TIMEOUT = 120          # seconds for one mutant's simulation
 
 
@@ -80,7 +81,6 @@ def _leaves(layout, base=0, prefix=""):
 def _unit(target):
     """(elaboratable, [(port signal, "in"|"out")], context for the oracle)."""
     from amaranth.hdl import Elaboratable, Module, Signal
-    from amaranth.lib.fifo import SyncFIFOBuffered
 
     from bumprtl.rtl.board import PixelSource, buffer_depth
     from bumprtl.rtl.tmds import TMDSEncoder
@@ -96,7 +96,28 @@ def _unit(target):
     scene, pipe = _default_scene()
     if target == "board:buffer":
         width, depth = 24 + pipe.cfg.tag_bits, buffer_depth(pipe.latency)
-        u = SyncFIFOBuffered(width=width, depth=depth)
+        from bumprtl.rtl.pipe import CreditFIFO
+
+        class Buffer(Elaboratable):
+            """The FIFO with its ports named as amaranth.lib.fifo names them."""
+
+            def __init__(self):
+                self.fifo = CreditFIFO(width, depth)
+                self.w_en, self.r_en = Signal(name="w_en"), Signal(name="r_en")
+                self.w_data = Signal(width, name="w_data")
+                self.w_rdy, self.r_rdy = Signal(name="w_rdy"), Signal(name="r_rdy")
+                self.r_data = Signal(width, name="r_data")
+                self.level = Signal.like(self.fifo.level, name="level")
+
+            def elaborate(self, platform):
+                m = Module()
+                m.submodules.fifo = f = self.fifo
+                m.d.comb += [f.w_en.eq(self.w_en), f.w_data.eq(self.w_data), f.r_en.eq(self.r_en),
+                             self.w_rdy.eq(f.w_rdy), self.r_rdy.eq(f.r_rdy),
+                             self.r_data.eq(f.r_data), self.level.eq(f.level)]
+                return m
+
+        u = Buffer()
         return u, [(u.w_en, "in"), (u.w_data, "in"), (u.r_en, "in"), (u.w_rdy, "out"),
                    (u.r_rdy, "out"), (u.r_data, "out"), (u.level, "out")], \
             {"width": width, "depth": depth}
@@ -235,9 +256,11 @@ def _buffer(ctx, rng):
     exp = {k: [] for k in ("w_rdy", "r_rdy", "r_data", "level")}
     care = {"r_data": []}
     for t in range(n):
-        r_rdy = int(bool(queue) and queue[0][1] <= t - 2)
+        if len(queue) >= depth:       # no credit free: the pipeline writes nothing
+            ins["w_en"][t] = 0
+        r_rdy = int(bool(queue) and queue[0][1] <= t - FIFO_DELAY)
         level = len(queue)
-        w_rdy = int(level - r_rdy < depth - 1)
+        w_rdy = 1
         exp["w_rdy"].append(w_rdy)
         exp["r_rdy"].append(r_rdy)
         exp["level"].append(level)
@@ -248,7 +271,7 @@ def _buffer(ctx, rng):
             continue
         if r_rdy and ins["r_en"][t]:
             queue.pop(0)
-        if w_rdy and ins["w_en"][t]:
+        if ins["w_en"][t]:
             queue.append((int(ins["w_data"][t]), t))
     return ins, exp, care
 
@@ -403,7 +426,7 @@ endmodule
 _ORACLE_WORDS = {
     "board:timing": "the raster counted from the mode's numbers",
     "board:tmds": "the DVI 1.0 flow chart (tests/rtl/test_tmds.py's dvi_encode)",
-    "board:buffer": "a FIFO queue with SyncFIFOBuffered's documented latency and level",
+    "board:buffer": "a FIFO queue with the credit FIFO's stated latency and level",
     "board:source": "the golden board frames' raster order and light table "
                     "(sim/golden/board.py), payload where valid",
 }
