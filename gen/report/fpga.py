@@ -376,8 +376,8 @@ FPGA_NOTES = """
   usage guides (Yosys ships DP16KD as a blackbox and no MULT18X18D model);
   `tests/sim/ecp5/` runs RegisteredROM (every word, the spill word included),
   RegisteredProduct and RegisteredRAM in their ECP5 form against the generic form under a
-  random enable, checks that Yosys' own block-RAM mapping reads back through the DP16KD
-  model (x4, x9, x2 modes), and (`make fpga`) simulates the `synth_ecp5` netlists of the
+  random enable, and (`make fpga`) checks that Yosys' own block-RAM mapping reads back
+  through the DP16KD model (x4, x9, x2 modes) and simulates the `synth_ecp5` netlists of the
   exact pipeline and of the default scene's BumpPipeline with Yosys' `cells_sim.v` and the
   two models, bit-exact against the golden model on 10^4 pixels under random
   backpressure and input gaps. Both pass under cocotb on Icarus; `make fpga

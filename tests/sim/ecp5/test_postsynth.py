@@ -83,7 +83,8 @@ def test_registered_ram_ecp5_form(depth, width, build_dir):
     assert [generic["ram_r_data"][k] for k in filled] == [want[k] for k in filled]
 
 
-@pytest.mark.parametrize("depth, width", [(4096, 4), pytest.param(2048, 9, marks=pytest.mark.fpga),
+@pytest.mark.parametrize("depth, width", [pytest.param(4096, 4, marks=pytest.mark.fpga),
+                                          pytest.param(2048, 9, marks=pytest.mark.fpga),
                                           pytest.param(8192, 2, marks=pytest.mark.fpga)])
 def test_yosys_bram_mapping_agrees_with_the_model(depth, width, build_dir):
     """A plain Verilog ROM that Yosys maps to one DP16KD in the x4 / x9 / x2 mode reads every

@@ -34,8 +34,13 @@ SCENES = {
                                   "mip_levels": 2, "map_memory": "axi"})}
 
 
-@pytest.mark.parametrize("scene", SCENES)
-@pytest.mark.parametrize("sim", SIMULATORS)
+# make test: the default scene on both simulators, the palette scene on Icarus (its
+# Verilator run in make regress)
+CASES = [pytest.param(sim, scene, marks=pytest.mark.regress if (sim, scene) == ("verilator", "palette")
+                      else ()) for scene in SCENES for sim in SIMULATORS]
+
+
+@pytest.mark.parametrize("sim,scene", CASES)
 def test_pipeline_axi_cocotb_against_axi_ram(sim, scene, build_dir):
     scene = SCENES[scene]
     images = memory_images("pipeline", scene, *scene_memories(scene))
