@@ -16,8 +16,9 @@ compared with an oracle that is not the RTL:
 * ``board:buffer``: a first-in first-out queue as docs/architecture.md states the credit
   FIFO: every read returns the oldest unread word, ``level`` counts the unread words, a
   word can be read from the third cycle after its write on (EDGE_LATENCY, typed here as
-  3), and ``w_rdy`` is high (the writes, as the credits allow, never fill it: fewer than
-  depth words unread when one is written);
+  3); the writes come as the credits allow them (fewer than depth words unread), and
+  ``w_rdy``, which the board never reads (the FIFO states it for the proofs), is not an
+  output of the target;
 * ``board:source``: the raster order of sim/golden/board.py's frames (texel coordinates by
   rtl/board.texel_coords, the plane's constants and a 4-step light table from
   plane_constants / light_table), one pixel a transfer, valid from the second cycle after
@@ -99,13 +100,15 @@ def _unit(target):
         from bumprtl.rtl.pipe import CreditFIFO
 
         class Buffer(Elaboratable):
-            """The FIFO with its ports named as amaranth.lib.fifo names them."""
+            """The FIFO with its ports named as amaranth.lib.fifo names them, those the
+            board reads (not ``w_rdy``: the credits guarantee room, the FIFO states it for
+            the proofs only)."""
 
             def __init__(self):
                 self.fifo = CreditFIFO(width, depth)
                 self.w_en, self.r_en = Signal(name="w_en"), Signal(name="r_en")
                 self.w_data = Signal(width, name="w_data")
-                self.w_rdy, self.r_rdy = Signal(name="w_rdy"), Signal(name="r_rdy")
+                self.r_rdy = Signal(name="r_rdy")
                 self.r_data = Signal(width, name="r_data")
                 self.level = Signal.like(self.fifo.level, name="level")
 
@@ -113,12 +116,12 @@ def _unit(target):
                 m = Module()
                 m.submodules.fifo = f = self.fifo
                 m.d.comb += [f.w_en.eq(self.w_en), f.w_data.eq(self.w_data), f.r_en.eq(self.r_en),
-                             self.w_rdy.eq(f.w_rdy), self.r_rdy.eq(f.r_rdy),
+                             self.r_rdy.eq(f.r_rdy),
                              self.r_data.eq(f.r_data), self.level.eq(f.level)]
                 return m
 
         u = Buffer()
-        return u, [(u.w_en, "in"), (u.w_data, "in"), (u.r_en, "in"), (u.w_rdy, "out"),
+        return u, [(u.w_en, "in"), (u.w_data, "in"), (u.r_en, "in"),
                    (u.r_rdy, "out"), (u.r_data, "out"), (u.level, "out")], \
             {"width": width, "depth": depth}
     from bumprtl.sim.golden.board import light_table, plane_constants
@@ -253,15 +256,13 @@ def _buffer(ctx, rng):
            "w_data": rng.integers(0, 1 << width, n, dtype=np.int64),
            "rst": _reset_at(rng, n)}
     queue = []                        # unread words: (word, the cycle it was written)
-    exp = {k: [] for k in ("w_rdy", "r_rdy", "r_data", "level")}
+    exp = {k: [] for k in ("r_rdy", "r_data", "level")}
     care = {"r_data": []}
     for t in range(n):
         if len(queue) >= depth:       # no credit free: the pipeline writes nothing
             ins["w_en"][t] = 0
         r_rdy = int(bool(queue) and queue[0][1] <= t - FIFO_DELAY)
         level = len(queue)
-        w_rdy = 1
-        exp["w_rdy"].append(w_rdy)
         exp["r_rdy"].append(r_rdy)
         exp["level"].append(level)
         exp["r_data"].append(queue[0][0] if r_rdy else 0)
