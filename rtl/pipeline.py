@@ -51,6 +51,7 @@ from bumprtl.rtl.pipe import (
     PipeUnit,
     add_credit_edge,
     check_fifo_depth,
+    pipe_observer,
 )
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.scene import HardwareScene, check_scene
@@ -445,7 +446,7 @@ class BumpPipeline(wiring.Component):
                 m.d.comb += [getattr(f, f"{port}w_{k}").eq(getattr(self, f"{prefix}w_{k}"))
                              for k in ("en", "addr", "data")]
         if s.shading == "palette":
-            self._elaborate_palette(m)
+            self._elaborate_palette(m, platform)
             return m
         if s.lights == 1 and s.rotation == "per-pixel" and not s.texture:  # fetch -> rotation -> illumination
             if self._front:
@@ -515,7 +516,7 @@ class BumpPipeline(wiring.Component):
             m.d.comb += total.i.payload.texel.eq(u["texel_i"].o.payload.texel)
         m.d.comb += total.i.payload.tag.eq(lead.payload.tag)
 
-    def _elaborate_palette(self, m):
+    def _elaborate_palette(self, m, platform):
         """fetch -> PaletteLUT; the front bank sampled at the input rides with the pixel
         (with ``map_memory = "axi"`` through the cache, the LUT behind the credit edge)."""
         lut, f = self.units["palette"], self.units["fetch"]
@@ -538,7 +539,9 @@ class BumpPipeline(wiring.Component):
         take_in, take_lut = self.i.valid & self.i.ready, lut.i.valid & lut.i.ready
         held = f.capacity if self._front else f.latency
         waiting = [Signal(range(held + 1), name=f"lut_bank{b}_pending") for b in (0, 1)]
-        self.lut_pending = waiting                 # read by sim/formal's bank lemmas
+        observer = pipe_observer(platform)         # sim/formal's bank lemmas read them
+        if observer is not None and hasattr(observer, "counter"):
+            observer.counter(self, "lut_pending", waiting)
         for b, count in enumerate(waiting):
             m.d.sync += count.eq(count + (take_in & (lut.bank == b))
                                  - (take_lut & (lut.i.payload.bank == b)))

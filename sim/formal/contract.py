@@ -102,6 +102,12 @@ class PipeObserver:
 
     def __init__(self, read_ports=0):
         self.read_ports, self.seen, self._rams = read_ports, {}, {}
+        self.counters = {}               # (id(unit), name) -> [Signal]: a unit's own counters
+
+    def counter(self, unit, name, signals):
+        """``unit`` built the counters ``signals`` named ``name`` (a scene pipeline's
+        per-bank counters of the pixels before its palette LUT, ``lut_pending``)."""
+        self.counters[(id(unit), name)] = list(signals)
 
     def pipe(self, pipe):
         self.seen[id(pipe.m)] = {"valid": list(pipe.valid), "o": pipe.o, "tags": {}, "banks": {},
@@ -148,10 +154,10 @@ class _Observing(str):
 
 def observe_pipes(dut, read_ports=0, formal=False):
     """Elaborate ``dut`` with a :class:`PipeObserver` (and, with ``formal``, the library's
-    own FIFO assertions): ``(fragment, seen)``."""
+    own FIFO assertions): ``(fragment, observer)``."""
     observer = PipeObserver(read_ports)
     fragment = Fragment.get(dut, _Observing(observer, formal))
-    return fragment, observer.seen
+    return fragment, observer
 
 
 def _origins(fragment, found=None):
@@ -364,7 +370,8 @@ class StreamContract(Elaboratable):
         m = Module()
         dut = self.dut
         ports = 2 if self.prop == "bank" and self.lemmas else 0   # the watched entry of both banks
-        fragment, self._pipes = observe_pipes(dut, ports, formal=self.lemmas)
+        fragment, observer = observe_pipes(dut, ports, formal=self.lemmas)
+        self._pipes, self._counters = observer.seen, observer.counters
         self._frags = _origins(fragment)
         self.edge = find_edge(fragment)
         m.submodules.dut = _Built(fragment)
@@ -739,7 +746,7 @@ class StreamContract(Elaboratable):
         fetch = self._record(dut.units["fetch"])
         valid = fetch["valid"][1:]
         banks = [fetch["banks"][n] for n in range(1, len(valid) + 1)]
-        for b, pending in enumerate(dut.lut_pending):
+        for b, pending in enumerate(self._counters[(id(dut), "lut_pending")]):
             self._lemma(m, pending == sum(v & (bank == b) for v, bank in zip(valid, banks, strict=False)),
                         "the per-bank counters count the fetch stages' bank bits")
         self._lemma(m, occ_f == sum(valid), "pixels before the LUT = valid fetch stages")

@@ -254,7 +254,7 @@ class UncarriedBankPipeline(BumpPipeline):
                 "spec_index_bits": cfg.spec_index_bits, "tag_bits": cfg.tag_bits}
         super().__init__(load_scene_config(keys).hardware)
 
-    def _elaborate_palette(self, m):
+    def _elaborate_palette(self, m, platform):
         lut, f = self.units["palette"], self.units["fetch"]
         m.d.comb += f.i.valid.eq(self.i.valid & self.i.ready)
         m.d.comb += [f.i.payload[name].eq(self.i.payload[name]) for name, _ in self.i.payload.shape()]

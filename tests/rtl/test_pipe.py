@@ -460,3 +460,20 @@ def test_a_fifo_below_the_credit_loop_is_refused_naming_both_numbers(make):
         assert "\n" not in msg and msg.endswith(f"got {bad!r}") and f">= {least}" in msg
         assert f"latency {latency}" in msg
     assert make(least).fifo_depth == least and make(least + 5).fifo_depth == least + 5
+
+
+@pytest.mark.parametrize("scene", ["default", "palette"])
+def test_elaborating_a_pipeline_sets_nothing_on_it_or_its_units(scene):
+    """elaborate has no side effects: a scene pipeline and each of its units hold the same
+    attributes (the same objects) after an elaboration as before it."""
+    dut = BumpPipeline(load_scene_config({"name": "t", "shading": "palette"} if scene == "palette"
+                                         else {"name": "t", "texture_size": 16}).hardware)
+    units = [dut, *dut.units.values()]
+    def attributes(u):                # Amaranth's own used-flag aside
+        return {k: v for k, v in vars(u).items() if not k.startswith("_MustUse")}
+    before = [attributes(u) for u in units]
+    unit_memory_records(dut)
+    for u, was in zip(units, before, strict=True):
+        now = attributes(u)
+        assert now.keys() == was.keys(), (type(u).__name__, now.keys() - was.keys())
+        assert all(now[k] is was[k] for k in was), type(u).__name__

@@ -132,7 +132,7 @@ def test_the_credit_edge_is_found_in_the_elaborated_unit(name):
     (the one around its units), with its FIFO of ``fifo_depth`` entries and that FIFO's
     memory (rtl/pipe.CreditFIFO: the next power of two words at least ``fifo_depth``)."""
     dut = TARGETS[name].unit()
-    fragment, _seen = observe_pipes(dut)
+    fragment, _observer = observe_pipes(dut)
     edge = find_edge(fragment)
     assert edge is not None and edge.edge.depth == dut.fifo_depth
     words = 1 << (dut.fifo_depth - 1).bit_length()
@@ -164,7 +164,8 @@ def test_the_observer_sees_only_its_own_elaboration():
     a, b = TARGETS["rotation_exact"].unit(), TARGETS["sincos"].unit()
     assert a.latency != b.latency
     with ThreadPoolExecutor(max_workers=2) as pool:
-        (_, seen_a), (_, seen_b) = pool.map(observe_pipes, (a, b))
+        (_, obs_a), (_, obs_b) = pool.map(observe_pipes, (a, b))
+    seen_a, seen_b = obs_a.seen, obs_b.seen
     assert not set(seen_a) & set(seen_b)
     assert [len(r["valid"]) for r in seen_a.values()] == [a.latency + 1]
     assert [len(r["valid"]) for r in seen_b.values()] == [b.latency + 1]
