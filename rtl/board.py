@@ -177,9 +177,9 @@ class BoardCore(Elaboratable):
         return m
 
 
-# ECP5 EHXPLLL limits (Lattice FPGA-TN-02200, sysCLOCK PLL): the phase detector's input
-# (reference / CLKI_DIV) at least 3.125 MHz, the VCO (CLKOP x CLKOP_DIV) 400 .. 800 MHz,
-# each output at most 400 MHz, every divider 1 .. 128.
+# ECP5 EHXPLLL limits (Lattice FPGA-TN-02200, sysCLOCK PLL), in Hz: the phase detector's
+# input (reference / CLKI_DIV) at least PFD_MIN_HZ, the VCO (CLKOP x CLKOP_DIV) within
+# VCO_HZ, each output at most OUT_MAX_HZ, every divider 1 .. DIV_MAX.
 PFD_MIN_HZ, VCO_HZ, OUT_MAX_HZ, DIV_MAX = 3.125e6, (400e6, 800e6), 400e6, 128
 
 

@@ -4,7 +4,7 @@ A :class:`VideoMode` is one line of the VESA table: active, front porch, sync an
 porch per axis, the sync polarities and the pixel clock. :data:`MODES` holds the modes
 ``bumprtl board`` accepts: ``640x480`` (VESA DMT 640 x 480 @ 60 Hz: 25.175 MHz nominal,
 run at 25 MHz, h 640/16/96/48, v 480/10/2/33, both syncs negative), ``1280x720`` (CEA-861
-720p60: 74.25 MHz nominal, run at the PLL's 74.29 MHz, h 1280/110/40/220, v 720/5/5/20,
+720p60: 74.25 MHz nominal, run at the PLL's 25 / 7 x 104 / 5 MHz, h 1280/110/40/220, v 720/5/5/20,
 both syncs positive) and ``test`` (32 x 24
 with short blanking, the reduced mode the frame check in ``make test`` simulates; not a
 monitor mode).
@@ -62,7 +62,7 @@ class VideoMode:
 MODES = {
     "640x480": VideoMode("640x480", 640, 16, 96, 48, 480, 10, 2, 33, 25e6, 25.175e6, zoom=1),
     # CEA-861 VIC 4: 74.25 MHz nominal; the ECP5 PLL from the ULX3S's 25 MHz makes the
-    # shift clock 25 / 7 x 104 = 371.43 MHz (rtl/board.pll_dividers), 0.05 % fast
+    # shift clock 25 / 7 x 104 MHz (rtl/board.pll_dividers), 0.05 % above 5 x 74.25
     "1280x720": VideoMode("1280x720", 1280, 110, 40, 220, 720, 5, 5, 20, 25e6 / 7 * 104 / 5,
                           74.25e6, h_negative=False, v_negative=False, zoom=1),
     "test": VideoMode("test", 32, 4, 8, 4, 24, 2, 2, 2, 25e6, 25e6, zoom=0),
