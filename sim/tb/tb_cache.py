@@ -52,9 +52,12 @@ class LatentAxiRamRead(AxiRamRead):
         self.ar_channel.recv = delayed
 
 
-@cocotb.test()
-@cocotb.parametrize(latency=LATENCIES)
-async def cache_matches_golden_against_axi_ram(dut, latency):
+
+def cache_case():
+    """What a cache bench streams, from its environment: ``(geom, n, pattern, seed, levels,
+    (u, v, level), golden, meta)``: the geometry (BUMPRTL_CACHE), the pixel count, traffic
+    pattern and seed, the random map levels, the stimulus, the golden cache model's run
+    and the port layouts (a TextureCache's, for its payloads only)."""
     geom = CacheGeometry(**json.loads(os.environ["BUMPRTL_CACHE"]))
     n = samples(200)
     pattern, seed = os.environ.get("BUMPRTL_PATTERN", "both"), int(os.environ.get("BUMPRTL_SEED", 1))
@@ -65,6 +68,12 @@ async def cache_matches_golden_against_axi_ram(dut, latency):
     cache._MustUse__silence = True
     meta = SimpleNamespace(input_fields=layout_fields(cache.i.payload.shape()),
                            output_fields=layout_fields(cache.o.payload.shape()))
+    return geom, n, pattern, seed, levels, (u, v, level), golden, meta
+
+@cocotb.test()
+@cocotb.parametrize(latency=LATENCIES)
+async def cache_matches_golden_against_axi_ram(dut, latency):
+    geom, n, pattern, seed, levels, (u, v, level), golden, meta = cache_case()
 
     image = tiled_image(geom, levels)
     ram = LatentAxiRamRead(AxiReadBus.from_prefix(dut, "axi_"), dut.clk, dut.rst, latency,

@@ -13,7 +13,6 @@ SdramConfig's), BUMPRTL_SAMPLES, BUMPRTL_PATTERN, BUMPRTL_SEED.
 
 import json
 import os
-from types import SimpleNamespace
 
 import cocotb
 from amaranth.hdl import Module
@@ -24,11 +23,9 @@ from cocotb.triggers import RisingEdge
 from cocotbext.axi import AxiMasterWrite, AxiWriteBus
 
 from bumprtl.rtl.cache import CacheGeometry, TextureCache, tiled_image
-from bumprtl.rtl.layouts import layout_fields
 from bumprtl.rtl.sdram import SdramConfig, SdramController, axi_write_signature, sdram_signature
-from bumprtl.sim.golden.cache import cache_stimulus, random_levels, run_cache
-from bumprtl.sim.tb.stream import run_stream, samples
-from bumprtl.sim.tb.tb_cache import TAG_BITS
+from bumprtl.sim.tb.stream import run_stream
+from bumprtl.sim.tb.tb_cache import TAG_BITS, cache_case
 from bumprtl.sim.tb.tb_sdram import AXI_INPUTS, SdramPins, model_for
 
 
@@ -81,17 +78,8 @@ async def load_image(dut, cfg, base, image):
 
 @cocotb.test(timeout_time=50, timeout_unit="ms")
 async def cache_matches_golden_on_sdram(dut):
-    geom = CacheGeometry(**json.loads(os.environ["BUMPRTL_CACHE"]))
+    geom, n, pattern, seed, levels, (u, v, level), golden, meta = cache_case()
     cfg = json.loads(os.environ["BUMPRTL_SDRAM"])
-    n = samples(200)
-    pattern, seed = os.environ.get("BUMPRTL_PATTERN", "both"), int(os.environ.get("BUMPRTL_SEED", 1))
-    levels = random_levels(geom, seed)
-    u, v, level = cache_stimulus(geom, n, seed)
-    golden = run_cache(geom, u, v, level, levels)
-    cache = TextureCache(geom, extra={"tag": TAG_BITS})       # for its payload layouts only
-    cache._MustUse__silence = True
-    meta = SimpleNamespace(input_fields=layout_fields(cache.i.payload.shape()),
-                           output_fields=layout_fields(cache.o.payload.shape()))
 
     pins = await load_image(dut, cfg, geom.base, tiled_image(geom, levels))
     inputs = [{"u": int(u[k]), "v": int(v[k]), "level": int(level[k]), "tag": k % (1 << TAG_BITS)}
