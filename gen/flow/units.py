@@ -122,9 +122,8 @@ def unit_memories(dut):
     built them in the one elaboration emission converts (``emit.memory_records``, see
     rtl/pipe.MemoryRecords); ``unit.name`` for each unit of a pipeline."""
     records = memory_records(dut)
-    units = getattr(dut, "units", None)
     if isinstance(dut, BumpPipeline):
-        found = {f"{unit}.{name}": size for unit, u in units.items()
+        found = {f"{unit}.{name}": size for unit, u in dut.units.items()
                  for name, size in records.of(u).items()}
     else:
         found = records.of(dut)
