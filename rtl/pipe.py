@@ -13,7 +13,7 @@ FIFO's output register and never depend on ``o.ready``; ``i.ready`` is a registe
 credit is free") and never depends on ``i.valid`` or ``o.ready`` in the same cycle.
 """
 
-from amaranth.hdl import Assert, Const, Elaboratable, Fragment, Module, Shape, Signal, Value
+from amaranth.hdl import Array, Assert, Const, Elaboratable, Fragment, Module, Shape, Signal, Value
 from amaranth.lib import stream, wiring
 from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
@@ -56,6 +56,10 @@ EDGE_LATENCY = 3
 CREDIT_RETURN = 1
 # Bits of the FIFO's word read at one copy of its read pointer (CreditFIFO).
 READ_SLICE = 16
+# Address bits of one bank of the FIFO's memory (CreditFIFO): 16 words, one ECP5 LUT RAM
+# (TRELLIS_DPR16X4) deep, so a bank's read reaches its prefetch register through no
+# multiplexer.
+BANK_BITS = 4
 
 
 def min_fifo_depth(latency):
@@ -241,66 +245,99 @@ class CreditFIFO(Elaboratable):
     """The credit edge's FIFO of ``depth`` pixels of ``width`` bits, with
     ``amaranth.lib.fifo``'s port names (``w_en``, ``w_data``, ``w_rdy``, ``r_en``,
     ``r_data``, ``r_rdy``, ``level``) and no full check on writes: its owner's credits
-    guarantee room (``w_rdy`` is stated for the proofs). A memory (submodule ``storage``)
-    of ``2**ceil(log2(depth))`` words, written at a write pointer that wraps by overflow,
-    read asynchronously (LUT RAM on ECP5) at the read pointer (the control a copy per
-    READ_SLICE bits of the word) into a prefetch register ``pre_data``/``pre_valid`` beside the memory, which moves on
-    into the output register ``r_data``/``r_rdy``: each of the two loads when it is empty
-    or its pixel moves on, so the memory's read lands in a register of its own and the
-    output register is fed by a register (no LUT RAM read in the same cycle as the route to
-    the output). ``level`` counts the memory's pixels and both registers'. Written to an
-    empty FIFO in cycle t, a pixel is offered in cycle t + 3 (EDGE_LATENCY)."""
+    guarantee room (``w_rdy`` is stated for the proofs).
+
+    Its inner queue is ``2**ceil(log2(depth))`` words in banks of at most
+    ``2**BANK_BITS`` (:attr:`banks`, submodules ``storage0``, ``storage1``, ...: each one
+    LUT RAM deep on ECP5), word ``a`` in bank ``a >> BANK_BITS``; it is written at
+    :attr:`write_pointer`, which wraps by overflow, and read asynchronously at
+    :attr:`read_pointer` (the control a copy per READ_SLICE bits of the word). Each bank's
+    read lands in a prefetch register of its own beside it (``pre_data`` is the one the
+    registered bank select names, ``pre_valid`` its valid bit), so no bank multiplexer sits
+    between a LUT RAM and a register; the prefetched pixel moves on into the output
+    register ``r_data``/``r_rdy``. Each of the two loads when it is empty or its pixel
+    moves on. ``level`` counts the memory's pixels and both registers'. Written to an empty
+    FIFO in cycle t, a pixel is offered in cycle t + 3 (EDGE_LATENCY)."""
 
     def __init__(self, width, depth):
         self.width, self.depth = width, depth
         self.bits = (depth - 1).bit_length()
+        self.bank_bits = min(self.bits, BANK_BITS)
+        self.banks = [Memory(shape=width, depth=1 << self.bank_bits, init=[],
+                             attrs={"ram_style": "distributed"})
+                      for _ in range(1 << (self.bits - self.bank_bits))]
         self.w_en, self.w_rdy = Signal(), Signal()
         self.w_data = Signal(width)
         self.r_en, self.r_rdy = Signal(), Signal(name="fifo_head_valid")
         self.r_data = Signal(width, name="fifo_head", reset_less=True)
         self.pre_valid = Signal(name="fifo_pre_valid")
-        self.pre_data = Signal(width, name="fifo_pre", reset_less=True)
+        self.pre_data = Signal(width, name="fifo_pre")
         self.level = Signal(range(depth + 1))
         self.count = Signal(self.bits + 1, name="fifo_count")      # pixels in the memory
         self.stored = Signal(name="fifo_stored")                    # count != 0
+        self.write_pointer = Signal(self.bits, name="fifo_write")
+        self.read_pointer = Signal(self.bits, name="fifo_read")
         # Output register first, then the prefetch register: the pixels outside the memory,
         # oldest first, as (valid, data).
         self.heads = [(self.r_rdy, self.r_data), (self.pre_valid, self.pre_data)]
 
+    def _bank_is(self, pointer, b):
+        """1 when ``pointer`` addresses bank ``b`` (always, with one bank): a bit of the
+        one-hot decode of its high bits (an equality with 0 would be Verilog's ``!`` of a
+        vector, which lint refuses)."""
+        if len(self.banks) == 1:
+            return Const(1, 1)
+        return (Const(1, len(self.banks)) << pointer[self.bank_bits:])[b]
+
     def elaborate(self, platform):
-        m, bits = Module(), self.bits
-        # LUT RAM (its read is asynchronous): a block RAM would put the load on its CE
-        m.submodules.storage = storage = Memory(shape=self.width, depth=1 << bits, init=[],
-                                                attrs={"ram_style": "distributed"})
-        wp = Signal(bits, name="fifo_write")
-        wport = storage.write_port()
-        m.d.comb += [wport.addr.eq(wp), wport.data.eq(self.w_data), wport.en.eq(self.w_en),
-                     self.w_rdy.eq(self.count != (1 << bits)),
+        m, bits, bb = Module(), self.bits, self.bank_bits
+        wp = self.write_pointer
+        m.d.comb += [self.w_rdy.eq(self.count != (1 << bits)),
                      self.level.eq(self.count + self.pre_valid + self.r_rdy)]
         m.d.sync += wp.eq(wp + self.w_en)                       # wrap: the credits leave room
+        # LUT RAM banks (their reads are asynchronous): a block RAM would put the load on
+        # its CE
+        n = len(self.banks)
+        for b, bank in enumerate(self.banks):
+            m.submodules[f"storage{b}"] = bank
+            wport = bank.write_port()
+            m.d.comb += [wport.addr.eq(wp[:bb]), wport.data.eq(self.w_data),
+                         wport.en.eq(self.w_en & self._bank_is(wp, b))]
         # Each READ_SLICE bits of the word have a control of their own: a read pointer, a
-        # count, and copies of the registers' valid bits, each its own register (so no tool
-        # merges them), whose loads reach only that slice's LUT RAMs, prefetch and output
-        # bits: one load would otherwise fan out to every bit of a wide pixel. Slice 0's
-        # copies are the FIFO's (``count``, ``stored``, ``pre_valid``, ``r_rdy``).
+        # count, a bank select and copies of the registers' valid bits, each its own
+        # register (so no tool merges them), whose loads reach only that slice's LUT RAMs,
+        # prefetch and output bits: one load would otherwise fan out to every bit of a
+        # wide pixel. Slice 0's copies are the FIFO's (``read_pointer``, ``count``, ...).
+        pres = [Signal(self.width, name=f"fifo_pre_bank{b}", reset_less=True)
+                for b in range(len(self.banks))]
         copies = []
         for k, lo in enumerate(range(0, self.width, READ_SLICE)):
             hi = min(lo + READ_SLICE, self.width)
             if k == 0:
-                count, stored, pre_valid, r_rdy = self.count, self.stored, self.pre_valid, self.r_rdy
+                rp, count, stored = self.read_pointer, self.count, self.stored
+                pre_valid, r_rdy = self.pre_valid, self.r_rdy
             else:
+                rp = Signal(bits, name=f"fifo_read{k}")
                 count = Signal.like(self.count, name=f"fifo_count{k}")
                 stored = Signal(name=f"fifo_stored{k}")
                 pre_valid = Signal(name=f"fifo_pre_valid{k}")
                 r_rdy = Signal(name=f"fifo_head_valid{k}")
-            rp = Signal(bits, name=f"fifo_read{k}" if k else "fifo_read")
+            select = Signal(bits - bb, name=f"fifo_pre_bank_select{k}" if k
+                            else "fifo_pre_bank_select") if n > 1 else None
             out_load = pre_valid & (~r_rdy | self.r_en)               # prefetch -> output
             load = stored & (~pre_valid | out_load)                   # memory -> prefetch
-            rport = storage.read_port(domain="comb")
-            m.d.comb += rport.addr.eq(rp)
+            for b, bank in enumerate(self.banks):
+                rport = bank.read_port(domain="comb")
+                m.d.comb += rport.addr.eq(rp[:bb])
+                with m.If(load & self._bank_is(rp, b)):
+                    m.d.sync += pres[b][lo:hi].eq(rport.data[lo:hi])
+            if n > 1:
+                with m.If(load):
+                    m.d.sync += select.eq(rp[bb:])
+                m.d.comb += self.pre_data[lo:hi].eq(Array(pre[lo:hi] for pre in pres)[select])
+            else:
+                m.d.comb += self.pre_data[lo:hi].eq(pres[0][lo:hi])
             m.d.sync += [rp.eq(rp + load), count.eq(count + self.w_en - load)]
-            with m.If(load):
-                m.d.sync += self.pre_data[lo:hi].eq(rport.data[lo:hi])
             with m.If(out_load):
                 m.d.sync += self.r_data[lo:hi].eq(self.pre_data[lo:hi])
             with m.If(self.w_en & ~load):
@@ -315,9 +352,9 @@ class CreditFIFO(Elaboratable):
                 m.d.sync += r_rdy.eq(1)
             with m.Elif(self.r_en):
                 m.d.sync += r_rdy.eq(0)
-            copies.append((rp, count, stored, pre_valid, r_rdy))
+            copies.append((rp, count, stored, pre_valid, r_rdy) + ((select,) if n > 1 else ()))
         if platform == "formal":         # as amaranth.lib.fifo states its own pointers
-            rp = copies[0][0]
+            rp = self.read_pointer
             m.d.comb += [Assert(self.stored == (self.count != 0)),
                          Assert(wp == (rp + self.count)[:bits]),
                          Assert(self.count + self.pre_valid + self.r_rdy <= self.depth),

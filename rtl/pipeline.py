@@ -28,7 +28,7 @@ or ``o.ready`` in the same cycle; ``o.valid``/``o.payload`` come from the FIFO's
 register and never depend on ``o.ready``.
 """
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, unsigned
+from amaranth.hdl import Assert, Cat, Const, Module, Mux, Signal, unsigned
 from amaranth.lib import data, stream, wiring
 from amaranth.lib.wiring import In, Out
 
@@ -542,10 +542,17 @@ class BumpPipeline(wiring.Component):
         observer = pipe_observer(platform)         # sim/formal's bank lemmas read them
         if observer is not None and hasattr(observer, "counter"):
             observer.counter(self, "lut_pending", waiting)
+        # busy: count != 0 as a register of its own (loaded with the next count's test), so
+        # the write enable of the table's block RAMs comes from a register through one gate
+        busy = [Signal(name=f"lut_bank{b}_busy") for b in (0, 1)]
         for b, count in enumerate(waiting):
-            m.d.sync += count.eq(count + (take_in & (lut.bank == b))
+            after = Signal.like(count, name=f"lut_bank{b}_pending_next")
+            m.d.comb += after.eq(count + (take_in & (lut.bank == b))
                                  - (take_lut & (lut.i.payload.bank == b)))
-        m.d.comb += [self.lut_w_ready.eq(~Mux(lut.bank, waiting[0], waiting[1]).any()),
+            m.d.sync += [count.eq(after), busy[b].eq(after != 0)]
+            if platform == "formal":
+                m.d.comb += Assert(busy[b] == (count != 0))
+        m.d.comb += [self.lut_w_ready.eq(~Mux(lut.bank, busy[0], busy[1])),
                      lut.w_en.eq(self.lut_w_en & self.lut_w_ready),
                      lut.w_addr.eq(self.lut_w_addr), lut.w_data.eq(self.lut_w_data),
                      lut.swap.eq(self.lut_swap), self.lut_bank.eq(lut.bank)]

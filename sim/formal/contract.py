@@ -176,25 +176,41 @@ def _subfragment(fragment, name):
 
 class _Edge:
     """A :class:`~bumprtl.rtl.pipe.CreditEdge` found in an elaborated fragment, with its
-    FIFO (``rtl/pipe.CreditFIFO``, or ``SyncFIFOBuffered``: an inner queue in a memory,
-    then registers outside it, ``heads``: (valid, data) oldest first, the output register
+    FIFO (``rtl/pipe.CreditFIFO``, or ``SyncFIFOBuffered``: an inner queue in memory, then
+    registers outside it, ``heads``: (valid, data) oldest first, the output register
     ``r_rdy``/``r_data`` first, CreditFIFO's prefetch register after it) and that memory:
-    ``instance`` (the elaborated MemoryInstance, to add read ports to) and ``storage`` (its
-    ``lib.memory.Memory``, whose ports' addresses are the FIFO's write and read pointers)."""
+    ``banks``, (elaborated MemoryInstance, to add read ports to; its ``lib.memory.Memory``;
+    the logical address of its word 0) for each bank (CreditFIFO's ``storage0``, ...;
+    SyncFIFOBuffered's one ``storage``), and ``produce``/``consume``, the queue's write and
+    read pointers (logical addresses)."""
 
     def __init__(self, edge, fragment):
         self.edge = edge
         fifo_fragment = _subfragment(fragment, "fifo")
         self.fifo = fifo_fragment.origins[0] if fifo_fragment is not None else None
-        instance = _subfragment(fifo_fragment, "storage") if fifo_fragment is not None else None
-        ok = isinstance(self.fifo, (CreditFIFO, SyncFIFOBuffered)) and \
-            isinstance(instance, MemoryInstance)
-        self.instance = instance if ok else None
-        self.storage = instance.origins[0] if ok else None
-        self.inner_depth = self.storage.depth if ok else 0
+        self.banks, self.produce, self.consume = [], None, None
+        if isinstance(self.fifo, CreditFIFO):
+            found = [_subfragment(fifo_fragment, f"storage{b}") for b in range(len(self.fifo.banks))]
+            if all(isinstance(inst, MemoryInstance) for inst in found):
+                size = 1 << self.fifo.bank_bits
+                self.banks = [(inst, inst.origins[0], b * size) for b, inst in enumerate(found)]
+                self.produce, self.consume = self.fifo.write_pointer, self.fifo.read_pointer
+        elif isinstance(self.fifo, SyncFIFOBuffered):
+            inst = _subfragment(fifo_fragment, "storage")
+            if isinstance(inst, MemoryInstance):
+                self.banks = [(inst, inst.origins[0], 0)]
+                storage = inst.origins[0]
+                self.produce = storage.write_ports[0].addr
+                self.consume = storage.read_ports[0].addr
+        self.inner_depth = sum(memory.depth for _, memory, _ in self.banks)
         self.heads = list(getattr(self.fifo, "heads", None) or
                           ([(self.fifo.r_rdy, self.fifo.r_data)] if self.fifo is not None else []))
         self._slots = None
+
+    @property
+    def has_memory(self):
+        """The inner queue's memory was found (its entries may be stated)."""
+        return bool(self.banks)
 
     @property
     def outside(self):
@@ -207,22 +223,22 @@ class _Edge:
         return (self.fifo.level - self.outside)[:len(self.fifo.level)]
 
     def slots(self, m, layout):
-        """The inner queue's memory word at every address, as ``View(layout)``: one
-        asynchronous read port at each constant address (added once)."""
+        """The inner queue's memory word at every logical address, as ``View(layout)``: one
+        asynchronous read port at each constant address of each bank (added once)."""
         if self._slots is None:
             self._slots = []
-            for a in range(self.inner_depth):
-                word = Signal(len(self.fifo.w_data), name=f"fifo_slot{a}")
-                self.instance.read_port(domain="comb", addr=Const(a, ceil_log2(self.inner_depth)),
-                                        data=word, en=Const(1), transparent_for=())
-                self._slots.append(data.View(layout, word))
+            for instance, memory, base in self.banks:
+                for a in range(memory.depth):
+                    word = Signal(len(self.fifo.w_data), name=f"fifo_slot{base + a}")
+                    instance.read_port(domain="comb", addr=Const(a, ceil_log2(memory.depth)),
+                                       data=word, en=Const(1), transparent_for=())
+                    self._slots.append(data.View(layout, word))
         return self._slots
 
     def holds(self, a):
         """Address ``a`` holds an entry: between the read and the write pointer, around the
         end of the memory when they have wrapped (comparisons only, no subtraction)."""
-        produce = self.storage.write_ports[0].addr
-        consume = self.storage.read_ports[0].addr
+        produce, consume = self.produce, self.consume
         return Mux(self.inner_level == self.inner_depth, 1,
                    Mux(consume <= produce, (consume <= a) & (a < produce),
                        (a >= consume) | (a < produce)))
@@ -230,7 +246,7 @@ class _Edge:
     def offset(self, a):
         """How many entries address ``a`` is behind the oldest one (the read pointer's),
         mod the inner depth: ``a`` holds an entry when this is below the inner occupancy."""
-        consume = self.storage.read_ports[0].addr
+        consume = self.consume
         return Mux(a >= consume, a - consume, a + self.inner_depth - consume)
 
 
@@ -454,8 +470,7 @@ class StreamContract(Elaboratable):
         """The FIFO's pointers are a queue of its inner occupancy: the write pointer is the
         read pointer + inner occupancy (mod the inner depth), both in range."""
         n = self.edge.inner_depth
-        produce = self.edge.storage.write_ports[0].addr
-        consume = self.edge.storage.read_ports[0].addr
+        produce, consume = self.edge.produce, self.edge.consume
         at = consume + self.edge.inner_level
         self._lemma(m, (produce < n) & (consume < n), "the FIFO's pointers are in range")
         self._lemma(m, produce == Mux(at >= n, at - n, at),
@@ -464,7 +479,7 @@ class StreamContract(Elaboratable):
     def _fifo(self, m):
         """The edge, with the FIFO's pointer lemmas asserted, when its entries may be
         stated (lemmas on, a FIFO with a memory); else None."""
-        if self.edge is None or self.edge.storage is None or not self.lemmas:
+        if self.edge is None or not self.edge.has_memory or not self.lemmas:
             return None
         self._fifo_lemmas(m)
         return self.edge
@@ -553,8 +568,7 @@ class StreamContract(Elaboratable):
         # full heads, and every other entry one more than the entry at the address before
         # it: lemmas per address, local (no offsets).
         n = edge.inner_depth
-        produce = edge.storage.write_ports[0].addr
-        consume = edge.storage.read_ports[0].addr
+        produce, consume = edge.produce, edge.consume
         inner = edge.inner_level
         slots = edge.slots(m, o.payload.shape())
         after_head = n_out + edge.heads[0][0]
@@ -625,7 +639,7 @@ class StreamContract(Elaboratable):
             self._lemma(m, ~hv | (data.View(o.payload.shape(), reg).tag == tag[back]),
                         f"the FIFO's head register {n} holds the tag of {back} cycles ago")
         for a, word in enumerate(edge.slots(m, o.payload.shape())):
-            consume = edge.storage.read_ports[0].addr
+            consume = edge.consume
             self._lemma(m, ~after | (consume != a) | (word.tag == tag[self.latency + 1]),
                         "the FIFO's entry is the chain's output of the last cycle")
 

@@ -137,7 +137,10 @@ def test_the_credit_edge_is_found_in_the_elaborated_unit(name):
     assert edge is not None and edge.edge.depth == dut.fifo_depth
     words = 1 << (dut.fifo_depth - 1).bit_length()
     assert edge.fifo.depth == dut.fifo_depth and edge.inner_depth == words >= dut.fifo_depth
-    assert edge.storage.depth == words
+    # in banks of 16 words (rtl/pipe.BANK_BITS), each its own LUT RAM, at logical
+    # addresses 0, 16, ...
+    assert [(memory.depth, base) for _, memory, base in edge.banks] == \
+        [(min(words, 16), b * 16) for b in range(max(1, words // 16))]
 
 
 def test_parallel_elaborations_each_observe_every_stage():
