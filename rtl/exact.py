@@ -69,10 +69,12 @@ class SineBank:
 
 def rotation_latency(cfg: Config):
     """Stages of :class:`ExactRotation` (and ``pipeline.VectorTerms``, in lock step beside
-    it): the input sums, ``SineBank.latency``, two adder levels, the output register (a
-    plain copy of the second level, which feeds every light's illumination: the adders'
-    route does not cross to them in the cycle that sums)."""
-    return 1 + registered_sine_latency(cfg) + 3
+    it): the input sums, ``SineBank.latency``, three adder levels (pairs; the pairs of
+    pairs, the doubled term copied beside them; their weighted sum: one carry chain a
+    level), the output register (a plain copy of the third level, which feeds every
+    light's illumination: the adders' route does not cross to them in the cycle that
+    sums)."""
+    return 1 + registered_sine_latency(cfg) + 4
 
 
 def vector_terms(pipe, bank, vec, n_phi, name, latency):
@@ -106,7 +108,7 @@ class ExactRotation(PipeUnit):
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
     Latency :func:`rotation_latency`: the input sums (a, b, D), SineBank.latency (read
     angle, ROM address, its near copy, ROM read, block-RAM output register, data register,
-    its copy, sign: 11 in all), two adder levels, the output register; 1 pixel per clock.
+    its copy, sign: 11 in all), three adder levels, the output register; 1 pixel per clock.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
@@ -125,13 +127,16 @@ class ExactRotation(PipeUnit):
              enumerate((a + t, a - t, b + t, b - t, t + bt, t - bt))}
         c = {f"c{n}": rom.cos(x, f"n_c{n}") for n, x in
              enumerate((b, a, a - t, a + t, b - t, b + t, bt - t, bt + t))}
-        # Two adder levels, each registered: pairs first, then the weighted sum.
+        # Three adder levels, each registered and each one carry chain: pairs, then the
+        # pairs of pairs (the doubled pair copied beside them), then the weighted sum.
         reg = pipe.register
         x = [reg(s["s0"] + s["s1"], "x4_a"), reg(s["s2"] + s["s3"], "x4_b"), reg(s["s4"] + s["s5"], "x4_c")]
         z = [reg(c["c2"] - c["c3"], "z4_a"), reg(c["c4"] - c["c5"], "z4_b"), reg(c["c6"] + c["c7"], "z4_c")]
-        sums = {"x4": x[0] + x[1] + 2 * x[2],
-                "y2": reg(c["c0"] - c["c1"], "y2_a"),
-                "z4": -(z[0] + z[1]) + 2 * z[2]}
+        x01, x2 = reg(x[0] + x[1], "x4_ab"), reg(x[2], "x4_c2")
+        z01, z2 = reg(z[0] + z[1], "z4_ab"), reg(z[2], "z4_c2")
+        sums = {"x4": x01 + 2 * x2,
+                "y2": reg(reg(c["c0"] - c["c1"], "y2_a"), "y2_a2"),
+                "z4": 2 * z2 - z01}
         for name, value in sums.items():
             m.d.comb += o.n[name].eq(reg(reg(value, f"n_{name}_sum"), f"n_{name}"))
         for v in vectors(cfg):
