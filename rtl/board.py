@@ -33,9 +33,20 @@ pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's
 k) and ``tmds_clk_p``.
 """
 
-from amaranth.hdl import Cat, ClockDomain, ClockSignal, Elaboratable, Instance, Module, Mux, Signal
+from amaranth.hdl import (
+    Cat,
+    ClockDomain,
+    ClockSignal,
+    DomainRenamer,
+    Elaboratable,
+    Instance,
+    Module,
+    Mux,
+    Signal,
+)
 from amaranth.lib import wiring
 from amaranth.lib.cdc import ResetSynchronizer
+from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.config import BumpError
@@ -45,9 +56,34 @@ from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
 __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "PixelSource",
-           "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock"]
+           "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
+           "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider"]
 
 BUFFER_MARGIN = 8
+# Synchronizer stages of the clock-crossing FIFO's pointers (amaranth.lib.fifo.AsyncFIFO's
+# default): a pointer written in one domain is seen in the other that many clocks later.
+CDC_SYNC_STAGES = 2
+
+
+def cdc_depth(pixel_hz, pipe_hz, stall_cycles=0):
+    """Entries of the asynchronous FIFO between the pipeline's clock domain (``pipe_hz``)
+    and the pixel clock (docs/board.md, The pipeline in its own clock domain): the display
+    takes one entry a pixel clock through an active line, and a slot it frees is filled
+    again, at the latest, after the round trip ``3 + CDC_SYNC_STAGES`` pixel clocks (the
+    read pointer's register and synchronizer, the entry's register) plus ``2 +
+    CDC_SYNC_STAGES + stall_cycles`` pipe clocks (the write side's synchronizer, the write,
+    and the longest the pipeline's output may pause: 0 for a map in block RAM, which never
+    pauses while credits are held), so that many entries and one more keep it fed; the
+    next power of two (AsyncFIFO's depths). BumpError when the pipeline's clock is slower
+    than the pixel clock: a line's pixels would outrun it."""
+    if not pipe_hz >= pixel_hz:
+        raise BumpError(f"pipe clock must be at least the pixel clock {pixel_hz / 1e6:g} MHz "
+                        f"(one pixel a clock through a line), got {pipe_hz / 1e6:g} MHz", "pipe_hz")
+    if not isinstance(stall_cycles, int) or stall_cycles < 0:
+        raise BumpError(f"stall_cycles must be an int >= 0, got {stall_cycles!r}", "stall_cycles")
+    pipe_side = (2 + CDC_SYNC_STAGES + stall_cycles) * pixel_hz / pipe_hz
+    need = 3 + CDC_SYNC_STAGES + int(-(-pipe_side // 1)) + 1
+    return 1 << (need - 1).bit_length()
 
 
 def texel_coords(x, y, zoom, size):
@@ -124,13 +160,19 @@ class BoardCore(Elaboratable):
     """Source, pipeline, elastic buffer, timing, TMDS encoders and serializer (module
     docstring). ``o0``, ``o1``: the serializer's bits of lanes 0-2 (blue, green, red) and 3
     (clock) each shift cycle; ``underflow``, ``order_error``: sticky status; ``frame``: the
-    source's light step."""
+    source's light step; ``pixel``: the bytes (blue, green, red) the encoders are given,
+    0 outside the active raster."""
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
-                 target=None, depth=None):
+                 target=None, depth=None, pipe_hz=None):
         """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
-        below ``min_fifo_depth`` of the latency the pipeline refuses it)."""
+        below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
+        runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
+        (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
+        :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``."""
         self.mode = mode
+        self.pipe_hz = pipe_hz
+        self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
         self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target,
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
@@ -139,12 +181,18 @@ class BoardCore(Elaboratable):
         self.underflow = Signal()
         self.order_error = Signal()
         self.o0, self.o1 = Signal(4), Signal(4)
+        self.pixel = Signal(24, name="shown_pixel")   # what the encoders get: blue, green, red
 
     def elaborate(self, platform):
         m, p = Module(), self.pipeline
         tag_bits = p.cfg.tag_bits
-        m.submodules.pipeline = p
-        m.submodules.source = src = self.source
+        src = self.source
+        if self.pipe_hz is None:
+            m.submodules.pipeline = p
+            m.submodules.source = src
+        else:
+            m.submodules.pipeline = DomainRenamer("pipe")(p)
+            m.submodules.source = DomainRenamer("pipe")(src)
         m.submodules.timing = t = VideoTiming(self.mode)
         # the pixel's colour: grey from the shade, or the colour-texture blend's RGB
         o = p.o.payload
@@ -152,17 +200,27 @@ class BoardCore(Elaboratable):
             rgb = Cat(o.color.b, o.color.g, o.color.r)
         else:
             rgb = Cat(o.color, o.color, o.color)
-        # the source offers a pixel every cycle; the pipeline's credits decide when it is taken
-        take = t.de & p.o.valid
-        m.d.comb += [src.allow.eq(1), p.o.ready.eq(t.de)]
+        m.d.comb += src.allow.eq(1)   # a pixel every cycle; the credits decide when it is taken
+        if self.pipe_hz is None:      # the pipeline's FIFO is the buffer, read at the display
+            valid, color, tag = p.o.valid, rgb, o.tag
+            m.d.comb += p.o.ready.eq(t.de)
+        else:                         # its FIFO feeds the crossing, which the display reads
+            m.submodules.cdc = cdc = AsyncFIFO(width=len(rgb) + tag_bits, depth=self.cdc_depth,
+                                               w_domain="pipe", r_domain="sync")
+            m.d.comb += [cdc.w_data.eq(Cat(rgb, o.tag)), cdc.w_en.eq(p.o.valid),
+                         p.o.ready.eq(cdc.w_rdy), cdc.r_en.eq(t.de)]
+            valid, color, tag = cdc.r_rdy, cdc.r_data[:len(rgb)], cdc.r_data[len(rgb):]
+        take = t.de & valid
         shown = Signal(tag_bits, name="shown_count")
         with m.If(take):
             m.d.sync += shown.eq(shown + 1)
-            with m.If(o.tag != shown):
+            with m.If(tag != shown):
                 m.d.sync += self.order_error.eq(1)
-        with m.If(t.de & ~p.o.valid):
+        with m.If(t.de & ~valid):
             m.d.sync += self.underflow.eq(1)
+        rgb = color
         pixel = Mux(take, rgb, 0)                     # bytes: blue, green, red
+        m.d.comb += self.pixel.eq(pixel)
         words = []
         for lane in range(3):
             enc = TMDSEncoder()
@@ -213,11 +271,32 @@ def pll_clock(pixel_hz, ref_hz=25e6):
     return ref_hz / clki * fb / 5
 
 
-def pll_params(pixel_hz, ref_hz=25e6):
-    """EHXPLLL parameters: CLKOP = 5 x pixel (the shift clock, also the feedback), CLKOS =
-    the pixel clock, from ``ref_hz`` (:func:`pll_dividers`)."""
+def pll_pipe_divider(pixel_hz, pipe_hz, ref_hz=25e6):
+    """``(clkos2_div, hz)``: the EHXPLLL's CLKOS2 divider of the VCO of
+    :func:`pll_dividers` that gives the pipeline's clock nearest ``pipe_hz`` from above (never
+    below it: :func:`cdc_depth` assumes at least that rate), and that clock. BumpError
+    when no divider gives a clock within [``pipe_hz``, OUT_MAX_HZ]."""
     clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
-    return {"p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
+    vco = ref_hz / clki * fb * op_div
+    div = int(vco // pipe_hz) if pipe_hz > 0 else 0
+    if not 1 <= div <= DIV_MAX or vco / div > OUT_MAX_HZ:
+        raise BumpError(f"pipe clock must be in [{vco / DIV_MAX / 1e6:g}, {OUT_MAX_HZ / 1e6:g}] MHz "
+                        f"(the VCO {vco / 1e6:g} MHz over a divider 1 .. {DIV_MAX}), got "
+                        f"{pipe_hz / 1e6:g} MHz", "pipe_hz")
+    return div, vco / div
+
+
+def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None):
+    """EHXPLLL parameters: CLKOP = 5 x pixel (the shift clock, also the feedback), CLKOS =
+    the pixel clock, from ``ref_hz`` (:func:`pll_dividers`); with ``pipe_hz``, CLKOS2 = the
+    pipeline's clock (:func:`pll_pipe_divider`)."""
+    clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
+    extra = {}
+    if pipe_hz is not None:
+        div, _ = pll_pipe_divider(pixel_hz, pipe_hz, ref_hz)
+        extra = {"p_CLKOS2_ENABLE": "ENABLED", "p_CLKOS2_DIV": div,
+                 "p_CLKOS2_CPHASE": div - 1, "p_CLKOS2_FPHASE": 0}
+    return {**extra,"p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
             "p_CLKOP_ENABLE": "ENABLED", "p_CLKOP_DIV": op_div, "p_CLKOP_CPHASE": op_div - 1,
             "p_CLKOP_FPHASE": 0, "p_CLKOS_ENABLE": "ENABLED", "p_CLKOS_DIV": 5 * op_div,
             "p_CLKOS_CPHASE": 5 * op_div - 1, "p_CLKOS_FPHASE": 0,
@@ -240,6 +319,15 @@ class ULX3STop(Elaboratable):
         clk25 = platform.request("clk25", 0)
         locked = Signal()
         shift_clk, pixel_clk = Signal(name="pll_clkop"), Signal(name="pll_clkos")
+        pipe_hz = self.core.pipe_hz
+        pipe = {}
+        if pipe_hz is not None:          # the pipeline's own clock on CLKOS2
+            m.domains.pipe = ClockDomain("pipe")
+            pipe_clk = Signal(name="pll_clkos2")
+            _, hz = pll_pipe_divider(self.core.mode.pixel_hz, pipe_hz)
+            pipe = {"o_CLKOS2": pipe_clk, "a_FREQUENCY_PIN_CLKOS2": f"{hz / 1e6:g}"}
+            m.d.comb += ClockSignal("pipe").eq(pipe_clk)
+            m.submodules.rst_pipe = ResetSynchronizer(~locked, domain="pipe")
         m.submodules.pll = Instance(
             "EHXPLLL", i_CLKI=clk25.i, i_CLKFB=shift_clk, i_RST=0, i_STDBY=0,
             i_PHASESEL0=0, i_PHASESEL1=0, i_PHASEDIR=0, i_PHASESTEP=0, i_PHASELOADREG=0,
@@ -247,7 +335,7 @@ class ULX3STop(Elaboratable):
             o_CLKOP=shift_clk, o_CLKOS=pixel_clk, o_LOCK=locked,
             a_FREQUENCY_PIN_CLKI="25", a_FREQUENCY_PIN_CLKOP=f"{5 * self.core.mode.pixel_hz / 1e6:g}",
             a_FREQUENCY_PIN_CLKOS=f"{self.core.mode.pixel_hz / 1e6:g}",
-            **pll_params(self.core.mode.pixel_hz))
+            **pipe, **pll_params(self.core.mode.pixel_hz, pipe_hz=pipe_hz))
         m.d.comb += [ClockSignal("sync").eq(pixel_clk), ClockSignal("shift").eq(shift_clk)]
         m.submodules.rst_sync = ResetSynchronizer(~locked, domain="sync")
         m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
