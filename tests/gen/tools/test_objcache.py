@@ -121,7 +121,11 @@ def test_a_failed_compile_returns_its_status_and_caches_nothing(tmp_path, monkey
 
 
 def test_a_header_from_the_build_directory_is_never_cached(tmp_path, monkeypatch):
+    """A relative header is the build directory's (the design's Vtop.h): another design's
+    build would find a file of that name, so the compile is never served from the cache."""
     cmd, obj, header = _lib(tmp_path, monkeypatch)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "Vtop.h").write_text("// the design's header\n")
     objcache, calls = _fake_compiler(monkeypatch, [str(header), "Vtop.h"])
     assert objcache.main(cmd) == 0 and objcache.main(cmd) == 0 and len(calls) == 2
     assert not any((tmp_path / "cache").glob("*/manifest.json"))
