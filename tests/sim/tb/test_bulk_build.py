@@ -113,3 +113,10 @@ def test_one_build_per_digest_reused_and_rebuilt_for_other_options(monkeypatch, 
     assert build("verilator", v, meta, 64, cache=tmp_path / "cache")[0] not in (bdir, other[0])
     ic = build("icarus", v, meta, 64, cache=tmp_path / "cache")
     assert _Runner.builds[-1]["main"] is None and ic[0].name.startswith("icarus-sincos-")
+
+
+def test_run_cocotb_refuses_an_unknown_simulator_before_any_build(tmp_path):
+    from bumprtl.sim.tb.runner import run_cocotb
+    with pytest.raises(ValueError, match="simulator must be one of icarus, verilator, got 'vcs'"):
+        run_cocotb("vcs", tmp_path / "x.v", "bumprtl.sim.tb.tb_datapath", tmp_path / "b")
+    assert list(tmp_path.iterdir()) == []
