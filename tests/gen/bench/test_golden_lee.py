@@ -31,7 +31,7 @@ def test_golden_rows_per_method_and_no_simulation_at_zero_samples(monkeypatch, r
     assert called == [] and "cocotb simulation" not in r.stdout
 
 
-def test_golden_simulates_every_method_unit_and_simulator(monkeypatch, capsys):
+def test_golden_simulates_every_method_unit_and_simulator(monkeypatch, run_cli):
     calls = []
 
     def fake_rate(cfg, sim, unit, samples, work):
@@ -39,10 +39,12 @@ def test_golden_simulates_every_method_unit_and_simulator(monkeypatch, capsys):
         return 12345.6, 2.25
 
     monkeypatch.setattr(golden, "unit_sim_rate", fake_rate)
-    assert golden.golden_bench(methods=["exact", "lee"], pixels=32, sim_samples=7) == 0
+    r = run_cli(["bench", "golden", "--pixels", "32", "--sim-samples", "7", "--methods",
+                 "exact", "lee"])
+    assert r.returncode == 0, r.stderr
     assert calls == [(m, u, s, 7) for m in ("exact", "lee") for u in ("rotation", "illumination")
                      for s in ("icarus", "verilator")]
-    out = capsys.readouterr().out
+    out = r.stdout
     assert "| method | unit | simulator | pixels/s | build s |" in out
     assert "| lee | illumination | verilator | 12,346 | 2.2 |" in out
 

@@ -30,7 +30,7 @@ def test_candidates_term_error(exponent):
         assert err["interpolated"] > 10 > 100 * err["interpolated, finer near 1 (kept)"]
 
 
-def test_bench_table_costs_follow_the_candidates_structure(monkeypatch, tmp_path, capsys):
+def test_bench_table_costs_follow_the_candidates_structure(monkeypatch, tmp_path, run_cli):
     """bench specular's cost columns against closed forms: a nearest table of 2^s + 1
     8-bit words (2048 a DP16KD), the interpolated tables 2^index_bits + 1 words of 8 + F
     bits (1024 a DP16KD) and one multiplier, squaring floor(log2 n) + popcount(n) - 1
@@ -50,8 +50,10 @@ def test_bench_table_costs_follow_the_candidates_structure(monkeypatch, tmp_path
         cfg, candidates=2000, keep=20, channel=channel))
     monkeypatch.setattr(specular, "count_unit",
                         lambda unit, cfg, work: counted.append((unit, cfg, work)) or Counts())
-    assert specular.specular_bench(spec_exponent=[16, 5], samples=300, work=tmp_path) == 0
-    out = capsys.readouterr().out
+    r = run_cli(["bench", "specular", "--spec-exponent", "16", "5", "--samples", "300",
+                 "--work", tmp_path])
+    assert r.returncode == 0, r.stderr
+    out = r.stdout
     assert out.splitlines()[0] == "bumprtl bench specular --samples 300 --spec-exponent 16 5"
     rows = [line.strip("| ").split(" | ") for line in out.splitlines()
             if line.startswith("| ") and line[2].isdigit()]
