@@ -33,7 +33,7 @@ def _no_build(*a, **k):
     ({"inputs": {"angle": [1]}, "source": {"kind": "sincos", "n": 1}},
      "run_bulk takes stimulus inputs or a source, not both"),
     ({"inputs": {"angle": [1, 2], "tag": [0, 1]}, "expected": {"tan": [0, 0]}},
-     "expected field 'tan' is not an output field of sincos.json (o__payload fields: sin, cos"),
+     "expected field 'tan' is not an output field of sincos.json (o__payload fields: cos, sin, tag)"),
     ({"source": {"kind": "sincos", "n": 1}, "axi_latency": 0},
      "axi_latency must be an integer in [1, 65535], got 0"),
     ({"source": {"kind": "sincos", "n": 1}, "axi_latency": True},
