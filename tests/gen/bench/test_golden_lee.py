@@ -18,7 +18,8 @@ def _table(text, first):
     return [line.split(" | ") for line in text.splitlines() if line.startswith(first)]
 
 
-def test_golden_rows_per_method_and_no_simulation_at_zero_samples(monkeypatch, run_cli):
+def test_golden_rows_per_method_and_no_simulation_at_zero_samples(monkeypatch, run_cli, tmp_path):
+    monkeypatch.chdir(tmp_path)                         # the tools' log: build/bench/golden.log
     called = []
     monkeypatch.setattr(golden, "unit_sim_rate", lambda *a: called.append(a))
     r = run_cli(["bench", "golden", "--pixels", "64", "--sim-samples", "0",
@@ -31,7 +32,8 @@ def test_golden_rows_per_method_and_no_simulation_at_zero_samples(monkeypatch, r
     assert called == [] and "cocotb simulation" not in r.stdout
 
 
-def test_golden_simulates_every_method_unit_and_simulator(monkeypatch, run_cli):
+def test_golden_simulates_every_method_unit_and_simulator(monkeypatch, run_cli, tmp_path):
+    monkeypatch.chdir(tmp_path)
     calls = []
 
     def fake_rate(cfg, sim, unit, samples, work):
@@ -89,7 +91,9 @@ def test_golden_rate_is_pixels_over_the_best_time(monkeypatch):
     assert golden._golden_rate(Config(method=PER_PIXEL[0]), 1000) == 500.0
 
 
-def test_lee_widths_rows_follow_the_widths_and_the_error_is_the_geometrys(run_cli):
+def test_lee_widths_rows_follow_the_widths_and_the_error_is_the_geometrys(run_cli, tmp_path,
+                                                                            monkeypatch):
+    monkeypatch.chdir(tmp_path)
     r = run_cli(["bench", "lee-widths", "--samples", "400", "--seed", "3"])
     assert r.returncode == 0, r.stderr
     lines = r.stdout.splitlines()

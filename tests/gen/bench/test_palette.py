@@ -93,7 +93,9 @@ def test_images_named_by_scene_lighting_size_and_dither(tmp_path, capsys):
      ["Per-frame cost"]),
 ])
 def test_the_printed_command_names_the_flags_that_shaped_the_tables(what, words, absent,
-                                                                    tmp_path, run_cli):
+                                                                    tmp_path, run_cli,
+                                                                    monkeypatch):
+    monkeypatch.chdir(tmp_path)                         # the tools' log: build/bench/palette.log
     r = run_cli(["bench", "palette", "--what", *what, "--sizes", "8", "--palettes", "4",
                  "--size", "16", "--scenes", "bumps", "--images-dir", tmp_path / "img"])
     assert r.returncode == 0, r.stderr

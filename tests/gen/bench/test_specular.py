@@ -50,6 +50,7 @@ def test_bench_table_costs_follow_the_candidates_structure(monkeypatch, tmp_path
         cfg, candidates=2000, keep=20, channel=channel))
     monkeypatch.setattr(specular, "count_unit",
                         lambda unit, cfg, work: counted.append((unit, cfg, work)) or Counts())
+    monkeypatch.chdir(tmp_path)                         # the tools' log: build/bench/
     r = run_cli(["bench", "specular", "--spec-exponent", "16", "5", "--samples", "300",
                  "--work", tmp_path])
     assert r.returncode == 0, r.stderr
