@@ -26,11 +26,22 @@ from bumprtl.gen.bench.sweep import DEFAULT_MAPS, FPGA_POINTS, MAP_SIZES, METHOD
 from bumprtl.gen.cli.quiet import quiet_commands
 from bumprtl.gen.render.rtl import require_sim
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
+from bumprtl.rtl.config import BumpError, Config
 from bumprtl.sim.golden.methods import METHODS, PER_PIXEL
 from bumprtl.sim.tb.bulk import SIMULATORS, build_options
 
 
+def at_least(low, **flags):
+    """Refuse a flag's value (or any of its values) below ``low``, before any work: one
+    line naming the flag, a BumpError (exit 2)."""
+    for name, given in flags.items():
+        for v in given if isinstance(given, (list, tuple)) else [given]:
+            if v < low:
+                raise BumpError(f"--{name.replace('_', '-')} must be >= {low}, got {v}", name)
+
+
 def run_float64(args):
+    at_least(1, samples=args.samples)
     return float64.float64_bench(samples=args.samples, seed=args.seed)
 
 
@@ -53,10 +64,13 @@ def run_sweep(args):
 
 
 def run_lee_widths(args):
+    at_least(1, samples=args.samples)
     return lee_widths.lee_widths_bench(samples=args.samples, seed=args.seed)
 
 
 def run_golden(args):
+    at_least(1, pixels=args.pixels)
+    at_least(0, sim_samples=args.sim_samples)
     if args.sim_samples:            # the simulations need [sim]'s cocotb: refuse before any work
         require_sim()
     return golden.golden_bench(methods=args.methods, pixels=args.pixels, sim_samples=args.sim_samples)
@@ -67,6 +81,9 @@ def run_stress(args):
 
 
 def run_specular(args):
+    at_least(1, samples=args.samples)
+    for n in args.spec_exponent:            # the Config's range, before the table's header
+        Config(spec_exponent=n)
     return specular.specular_bench(spec_exponent=args.spec_exponent, samples=args.samples, work=args.work)
 
 
@@ -79,6 +96,7 @@ def run_rtl_sim(args):
 
 
 def run_palette(args):
+    at_least(1, sizes=args.sizes, palettes=args.palettes)
     return palette.palette_bench(what=args.what, sizes=args.sizes, palettes=args.palettes, scenes=args.scenes, size=args.size, plot=args.plot, images_dir=args.images_dir)
 
 
@@ -196,7 +214,8 @@ def add_golden(kinds):
                                    "and of cocotb simulation under Icarus and Verilator, in one run.")
     p.add_argument("--pixels", type=int, default=1_000_000, help="golden-model batch (default: 10^6)")
     p.add_argument("--sim-samples", type=int, default=5000,
-                   help="random vectors per traffic pattern in the simulations (default: 5000)")
+                   help="random vectors per traffic pattern in the simulations (default: 5000; "
+                        "0: no simulations)")
     p.add_argument("--methods", nargs="+", default=list(PER_PIXEL), choices=PER_PIXEL)
     p.set_defaults(func=run_golden)
 

@@ -86,3 +86,33 @@ def test_each_method_golden_models_run(name):
     assert all(0 <= int(v) <= 255 for k in ("diffuse", "specular", "color") for v in out[k])
     assert isinstance(m.predicted_error_bound_lsb(cfg), int) and m.error_note
     assert m.reference(px, cfg).diffuse.shape == (50,)
+
+
+def test_the_registries_refuse_unknown_and_duplicate_methods_naming_method(monkeypatch):
+    """Both registries' lookups name ``method`` and the allowed names; a name registered
+    twice, hardware with no models' record and a hardware path outside rtl/ are refused."""
+    with pytest.raises(ConfigError) as e:
+        hardware.get("nosuch")
+    assert e.value.field == "method"
+    assert str(e.value) == f"method must be one of {', '.join(hardware.METHODS)}, got 'nosuch'"
+    with pytest.raises(ConfigError, match="method 'exact' is registered already"):
+        hardware.register(hardware.METHODS["exact"])
+    assert list(hardware.METHODS).count("exact") == 1
+    with pytest.raises(ValueError, match="'os.path:join' must name an attribute of a bumprtl.rtl"):
+        hardware._resolve("os.path:join")
+    with pytest.raises(ValueError, match="must name an attribute"):
+        hardware._resolve("bumprtl.rtl.rotation")
+    monkeypatch.setitem(hardware.METHODS, "toy-no-models", hardware.METHODS["exact"])
+    with pytest.raises(ConfigError, match="method 'toy-no-models' has hardware .* but no "
+                                          "models' record") as e:
+        methods.get("toy-no-models")
+    assert e.value.field == "method"
+    assert not hasattr(methods.get("exact"), "__nosuch__")     # dunders are not the hardware's
+
+
+def test_a_method_built_on_anothers_hardware_names_that_hardware():
+    shared = [m for m in hardware.METHODS.values() if m.hardware_of]
+    assert shared, "no method shares another's hardware"
+    for m in shared:
+        assert m.hardware == m.hardware_of != m.name and m.hardware_of in hardware.HARDWARE
+    assert hardware.METHODS["exact"].hardware == "exact"

@@ -51,6 +51,26 @@ def test_each_shape_gives_amaranths_own_bytes(k):
     assert ours == theirs
 
 
+@pytest.mark.parametrize("width", [8, 0])
+def test_a_ram_without_contents_or_of_no_width_gives_amaranths_own_bytes(width):
+    """A RAM written at run time (contents all zero) and a zero-width memory (no constant
+    at all: Amaranth's own path), same bytes."""
+    def ram():
+        m = Module()
+        m.submodules.mem = mem = Memory(shape=unsigned(width), depth=4, init=[])
+        w, r = mem.write_port(), mem.read_port()
+        return m, [w.addr, w.data, w.en, r.addr, r.data]
+    theirs, ours = _both(ram)
+    assert ours == theirs
+
+
+def test_another_amaranth_keeps_its_own_writer(monkeypatch):
+    monkeypatch.setattr(rtlil.ModuleEmitter, "emit_memory", meminit._ORIGINAL)
+    monkeypatch.setattr(meminit, "AMARANTH_VERSION", "0.6.0")
+    assert meminit.install() is False
+    assert rtlil.ModuleEmitter.emit_memory is meminit._ORIGINAL
+
+
 def test_a_design_of_several_memories_gives_amaranths_own_bytes():
     theirs, ours = _both(lambda: _design(SHAPES))
     assert ours == theirs

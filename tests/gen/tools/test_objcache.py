@@ -55,3 +55,90 @@ def test_other_sources_always_compile(tmp_path):
         _compile(cc, build / "design.cpp", "design.o", build, env)
         assert _calls(log) == n
     assert not (tmp_path / "cache").exists()
+
+
+# In-process cases (the compiler stood in by a function writing the object and its
+# dependency file): which commands are library compiles, a failed compile, a header
+# from the build directory, a torn cache entry.
+
+def _fake_compiler(monkeypatch, headers, status=0):
+    from bumprtl.gen.tools import objcache
+    calls = []
+
+    def call(cmd):
+        calls.append(cmd)
+        obj = __import__("pathlib").Path(cmd[cmd.index("-o") + 1])
+        if status == 0:
+            obj.write_bytes(b"object %d" % len(calls))
+            obj.with_suffix(".d").write_text(f"{obj.name}: {cmd[-1]} \\\n " + " ".join(headers) + "\n")
+        return status
+
+    monkeypatch.setattr(objcache.subprocess, "call", call)
+    monkeypatch.setattr(objcache.os, "execvp", lambda *a: (_ for _ in ()).throw(
+        AssertionError(f"exec {a}")))
+    return objcache, calls
+
+
+def test_only_an_explicit_object_of_a_runtime_source_is_a_library_compile(tmp_path, monkeypatch):
+    from bumprtl.gen.tools.objcache import _library_compile
+    root = tmp_path / "verilator"
+    (root / "include").mkdir(parents=True)
+    src = str(root / "include" / "verilated.cpp")
+    monkeypatch.setenv("VERILATOR_ROOT", str(root))
+    assert _library_compile(["g++", "-c", "-o", "v.o", src]) == \
+        (root / "include" / "verilated.cpp", __import__("pathlib").Path("v.o"))
+    assert _library_compile(["g++", "-o", "v.o", src]) is None             # no -c: a link
+    assert _library_compile(["g++", "-c", src, "-o"]) is None              # -o without a name
+    assert _library_compile(["g++", "-c", "-o", "v.o", "include/verilated.cpp"]) is None
+    assert _library_compile(["g++", "-c", "-o", "v.o", str(tmp_path / "design.cpp")]) is None
+    assert _library_compile(["g++", "-c", "-o", "v.o", str(root / "include" / "x.h")]) is None
+    monkeypatch.delenv("VERILATOR_ROOT")
+    assert _library_compile(["g++", "-c", "-o", "v.o", src]) is None
+
+
+def test_headers_of_a_dependency_file_with_continuations():
+    from bumprtl.gen.tools.objcache import _headers
+    assert _headers("a.o: /s/a.cpp \\\n /i/a.h \\\n /i/b.h\n") == ["/s/a.cpp", "/i/a.h", "/i/b.h"]
+
+
+def _lib(tmp_path, monkeypatch):
+    root = tmp_path / "verilator"
+    (root / "include").mkdir(parents=True)
+    src = root / "include" / "lib.cpp"
+    src.write_text("int x;\n")
+    header = root / "include" / "lib.h"
+    header.write_text("#define X 1\n")
+    monkeypatch.setenv("VERILATOR_ROOT", str(root))
+    monkeypatch.setenv("BUMPRTL_OBJCACHE", str(tmp_path / "cache"))
+    obj = tmp_path / "lib.o"
+    return ["g++", "-MMD", "-c", "-o", str(obj), str(src)], obj, header
+
+
+def test_a_failed_compile_returns_its_status_and_caches_nothing(tmp_path, monkeypatch):
+    cmd, obj, header = _lib(tmp_path, monkeypatch)
+    objcache, calls = _fake_compiler(monkeypatch, [str(header)], status=3)
+    assert objcache.main(cmd) == 3 and not (tmp_path / "cache").exists()
+
+
+def test_a_header_from_the_build_directory_is_never_cached(tmp_path, monkeypatch):
+    """A relative header is the build directory's (the design's Vtop.h): another design's
+    build would find a file of that name, so the compile is never served from the cache."""
+    cmd, obj, header = _lib(tmp_path, monkeypatch)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "Vtop.h").write_text("// the design's header\n")
+    objcache, calls = _fake_compiler(monkeypatch, [str(header), "Vtop.h"])
+    assert objcache.main(cmd) == 0 and objcache.main(cmd) == 0 and len(calls) == 2
+    assert not any((tmp_path / "cache").glob("*/manifest.json"))
+
+
+def test_a_torn_entry_is_compiled_again_and_replaced(tmp_path, monkeypatch):
+    cmd, obj, header = _lib(tmp_path, monkeypatch)
+    objcache, calls = _fake_compiler(monkeypatch, [str(header)])
+    assert objcache.main(cmd) == 0 and len(calls) == 1
+    [entry] = (tmp_path / "cache").iterdir()
+    (entry / "manifest.json").write_text("{not json")
+    obj.unlink()
+    assert objcache.main(cmd) == 0 and len(calls) == 2 and obj.read_bytes() == b"object 2"
+    obj.unlink()
+    assert objcache.main(cmd) == 0 and len(calls) == 2 and obj.read_bytes() == b"object 2"
+    assert [p.name for p in (tmp_path / "cache").iterdir()] == [entry.name]   # no .tmp- left

