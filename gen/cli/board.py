@@ -21,6 +21,7 @@ from bumprtl.gen.flow.board import (
     check_frames,
     part_costs,
 )
+from bumprtl.rtl.board import cdc_depth, pll_pipe_divider
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.scenes.imaging import save_png
@@ -34,10 +35,17 @@ def run(args):
     seeds = _seeds(args.seeds)
     if args.check_frames < 0:
         raise BumpError(f"--check-frames must be >= 0, got {args.check_frames}", "check_frames")
+    pipe_hz = None
+    if args.pipe_mhz is not None:      # refused below the pixel clock, one line
+        pipe_hz = args.pipe_mhz * 1e6
+        cdc_depth(mode.pixel_hz, pipe_hz)
+        if mode.name != "test" and not args.no_bitstream:
+            pll_pipe_divider(mode.pixel_hz, pipe_hz)
     out = Path(args.out)
-    summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name}
+    summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name,
+               "pipe_mhz": args.pipe_mhz}
     if mode.name != "test" and not args.no_bitstream:
-        rows = build_bitstream(scene, mode, out, args.board, seeds)
+        rows = build_bitstream(scene, mode, out, args.board, seeds, pipe_hz=pipe_hz)
         for r in rows:
             res = ", ".join(f"{k} {u}/{a}" for k, (u, a) in r["resources"].items())
             fmax = ", ".join(f"{d} {a:.1f} MHz (constraint {c:.1f})" for d, (a, c) in
@@ -62,7 +70,7 @@ def run(args):
     status = 0
     if args.check_frames:
         r = check_frames(scene, mode, out / f"sim_{mode.name}", args.check_frames,
-                         board_data(scene))
+                         board_data(scene), pipe_hz=pipe_hz)
         for k, same in enumerate(r["same"]):
             print(f"frame {k} (light step {k}): {'identical to the golden frame' if same else 'DIFFERS from the golden frame'}")
         for e in r["timing_errors"]:
@@ -111,4 +119,8 @@ def add_parser(sub):
     p.add_argument("--parts", action="store_true",
                    help="also synthesize the core without flattening: LUT4/FF/DSP/BRAM per part")
     p.add_argument("--no-bitstream", action="store_true", help="skip the bitstream")
+    p.add_argument("--pipe-mhz", type=float, default=None, metavar="MHZ",
+                   help="run the source and pipeline in their own clock domain at MHZ (at least "
+                        "the pixel clock; the PLL's CLKOS2 gives the nearest rate from above), "
+                        "behind an asynchronous FIFO (default: the pixel clock, one domain)")
     p.set_defaults(func=run)

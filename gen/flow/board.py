@@ -52,9 +52,12 @@ def board_data(scene):
     return words, texels, plane_constants(scene), light_table(scene)
 
 
-def board_core(scene, mode, target=None, data=None):
+def board_core(scene, mode, target=None, data=None, pipe_hz=None):
+    """The board's core (rtl/board.BoardCore) of ``scene`` in ``mode``; ``pipe_hz``: the
+    source and pipeline in their own clock domain at that rate (None: the pixel clock)."""
     words, texels, constants, table = board_data(scene) if data is None else data
-    return BoardCore(scene.hardware, mode, words, constants, table, texels, target)
+    return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
+                     pipe_hz=pipe_hz)
 
 
 def bram_budget(scene, mode, device):
@@ -109,7 +112,8 @@ def _tool_environ():
     return env
 
 
-def build_bitstream(scene, mode, out_dir, board="ulx3s", seeds=(1,), name="ulx3s_85f"):
+def build_bitstream(scene, mode, out_dir, board="ulx3s", seeds=(1,), name="ulx3s_85f",
+                    pipe_hz=None):
     """Synthesize, place (nextpnr seed ``seeds[0]``) and pack the board top into
     ``out_dir``/``name``.bit and .svf with Amaranth's ECP5 flow; place the same netlist again
     with each further seed (report ``seed<N>.report.json``). Returns one dict a seed:
@@ -117,7 +121,7 @@ def build_bitstream(scene, mode, out_dir, board="ulx3s", seeds=(1,), name="ulx3s
     constraint MHz)}, seed, seconds."""
     platform_name, device, mode = check_board(board, mode.name, scene)
     platform = _platform(platform_name)
-    top = ULX3STop(board_core(scene, mode, ECP5()))
+    top = ULX3STop(board_core(scene, mode, ECP5(), pipe_hz=pipe_hz))
     out_dir = Path(out_dir).resolve()
     t0 = time.perf_counter()
     first, *more = seeds
@@ -225,26 +229,28 @@ def part_costs(scene, mode, work_dir):
     return rows
 
 
-def emit_sim(scene, mode, out_dir, data=None):
-    """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``."""
+def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None):
+    """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``; with
+    ``pipe_hz`` it has the pipeline's clock and reset ports too (``pipe_clk``, ``pipe_rst``)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    top = SimTop(board_core(scene, mode, None, data))
+    top = SimTop(board_core(scene, mode, None, data, pipe_hz))
     path = out_dir / "board_sim.v"
     path.write_text(verilog.convert(top, name="board_sim", emit_src=False))
     return path, top
 
 
-def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
+def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_hz=None):
     """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
     under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
     golden frame. ``opt_fast``: g++'s optimisation of the model's per-cycle code (verilated.mk's
     OPT_FAST; None: Verilator's -Os), e.g. ``-O0`` for a few reduced-mode frames, whose run
-    is cocotb's and whose build it halves. Returns a dict: captured (list of arrays), golden,
+    is cocotb's and whose build it halves. ``pipe_hz``: the pipeline in its own clock domain,
+    its clock driven at that rate (its edges drift against the pixel clock's). Returns a dict: captured (list of arrays), golden,
     timing (the run lengths the testbench measured), seconds, the verdicts."""
     out_dir = Path(out_dir).resolve()
     data = board_data(scene) if data is None else data
-    v_path, top = emit_sim(scene, mode, out_dir, data)
+    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz)
     result = out_dir / "frames.npz"
     if result.exists():
         result.unlink()
@@ -254,6 +260,8 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None):
                                                      m.v_active, m.v_front, m.v_sync, m.v_back,
                                                      int(m.h_negative), int(m.v_negative))),
            "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
+    if pipe_hz is not None:       # the same ratio to the simulated pixel period, in ps (even)
+        env["BOARD_PIPE_PS"] = 2 * round(5e2 * env["BOARD_PIXEL_NS"] * m.pixel_hz / pipe_hz)
     t0 = time.perf_counter()
     build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env, opt_fast)
     res = dict(np.load(result))

@@ -98,11 +98,15 @@ async def board_frames(dut):
     htot, vtot = sum(timing[0:4]), sum(timing[4:8])
     cocotb.start_soon(Clock(dut.clk, period, unit="ns").start())
     cocotb.start_soon(Clock(dut.shift_clk, period / 5, unit="ns").start())
-    dut.rst.value = 1
-    dut.shift_rst.value = 1
+    pipe_ps = os.environ.get("BOARD_PIPE_PS")     # the pipeline in its own clock domain
+    resets = [dut.rst, dut.shift_rst] + ([dut.pipe_rst] if pipe_ps else [])
+    if pipe_ps:
+        cocotb.start_soon(Clock(dut.pipe_clk, int(pipe_ps), unit="ps").start())
+    for r in resets:
+        r.value = 1
     await ClockCycles(dut.clk, 4)
-    dut.rst.value = 0
-    dut.shift_rst.value = 0
+    for r in resets:
+        r.value = 0
     # The sink's frame parser must first see a horizontal sync pulse's end while the
     # vertical sync is inactive (it keeps the pulse it measures in a local variable made at
     # that edge, and fails on a pulse's start before it). The raster starts at x = 0 of the

@@ -33,8 +33,8 @@ def checked_once(monkeypatch):
 def _build(fmax_by_seed):
     calls = []
 
-    def build(scene, mode, out, board, seeds):
-        calls.append((scene.name, mode.name, out, board, list(seeds)))
+    def build(scene, mode, out, board, seeds, pipe_hz=None):
+        calls.append((scene.name, mode.name, out, board, list(seeds)) + ((pipe_hz,) if pipe_hz else ()))
         return [{"seed": s, "seconds": 12.0,
                  "resources": {"LUT4": (100 * s, 83640), "DSP": (4, 156)},
                  "fmax": fmax_by_seed[s]} for s in seeds]
@@ -73,8 +73,8 @@ def test_bitstream_seeds_minimum_fmax_parts_and_summary(tmp_path, monkeypatch, r
 def _frames(same, timing_errors=(), underflow=0, order_error=0):
     seen = {}
 
-    def check(scene, mode, out, frames, data):
-        seen.update(mode=mode.name, out=out, frames=frames, words=len(data[0]))
+    def check(scene, mode, out, frames, data, pipe_hz=None):
+        seen.update(mode=mode.name, out=out, frames=frames, words=len(data[0]), pipe_hz=pipe_hz)
         captured = [np.full((mode.v_active, mode.h_active, 3), 40 + k, np.uint8)
                     for k in range(frames)]
         return {"captured": captured, "same": list(same), "timing_errors": list(timing_errors),
@@ -140,3 +140,21 @@ def test_bad_seeds_or_frames_one_line_exit_2_nothing_written(flags, message, tmp
     [line] = r.stderr.strip().splitlines()
     assert line.startswith("bumprtl: error: ") and message in line
     assert not out.exists() and r.stdout == ""
+
+
+def test_pipe_mhz_reaches_the_bitstream_and_the_frames_and_is_refused_below_the_pixel_clock(
+        tmp_path, monkeypatch, run_cli):
+    build, calls = _build({1: {"sync (pixel)": (30.0, 25.2)}})
+    check, seen = _frames([True])
+    monkeypatch.setattr(cli_board, "build_bitstream", build)
+    monkeypatch.setattr(cli_board, "check_frames", check)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", *SMALL, "--out", out, "--pipe-mhz", "60", "--check-frames", "1"])
+    assert r.returncode == 0, r.stderr
+    assert calls == [("default", "640x480", out, "ulx3s", [1], 60e6)] and seen["pipe_hz"] == 60e6
+    assert json.loads((out / "summary_640x480.json").read_text())["pipe_mhz"] == 60.0
+    bad = tmp_path / "bad"
+    r = run_cli(["board", "ulx3s", *SMALL, "--out", bad, "--pipe-mhz", "20", "--no-bitstream"])
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "pipe clock must be at least the pixel clock" in r.stderr and "got 20 MHz" in r.stderr
+    assert not bad.exists()
