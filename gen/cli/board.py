@@ -10,6 +10,7 @@ beside the video logic) prints one line and exits 2 before anything is written.
 """
 
 import json
+import math
 from pathlib import Path
 
 from bumprtl.gen.cli.flags import add_map_flags, scene_from_args
@@ -36,15 +37,21 @@ def run(args):
     if args.check_frames < 0:
         raise BumpError(f"--check-frames must be >= 0, got {args.check_frames}", "check_frames")
     pipe_hz = None
+    bitstream = mode.name != "test" and not args.no_bitstream
     if args.pipe_mhz is not None:      # refused below the pixel clock, one line
         pipe_hz = args.pipe_mhz * 1e6
+        if not math.isfinite(pipe_hz):
+            raise BumpError(f"--pipe-mhz must be a finite clock rate, got {args.pipe_mhz}", "pipe_hz")
         cdc_depth(mode.pixel_hz, pipe_hz)
-        if mode.name != "test" and not args.no_bitstream:
+        if bitstream:
             pll_pipe_divider(mode.pixel_hz, pipe_hz)
+        elif not args.check_frames:
+            raise BumpError("--pipe-mhz has no effect without a bitstream or --check-frames",
+                            "pipe_hz")
     out = Path(args.out)
     summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name,
                "pipe_mhz": args.pipe_mhz}
-    if mode.name != "test" and not args.no_bitstream:
+    if bitstream:
         rows = build_bitstream(scene, mode, out, args.board, seeds, pipe_hz=pipe_hz)
         for r in rows:
             res = ", ".join(f"{k} {u}/{a}" for k, (u, a) in r["resources"].items())

@@ -158,3 +158,17 @@ def test_pipe_mhz_reaches_the_bitstream_and_the_frames_and_is_refused_below_the_
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
     assert "pipe clock must be at least the pixel clock" in r.stderr and "got 20 MHz" in r.stderr
     assert not bad.exists()
+
+
+@pytest.mark.parametrize("value, message", [
+    ("inf", "--pipe-mhz must be a finite clock rate, got inf"),
+    ("nan", "--pipe-mhz must be a finite clock rate, got nan"),
+    ("60", "--pipe-mhz has no effect without a bitstream or --check-frames"),
+])
+def test_pipe_mhz_without_meaning_is_refused(value, message, tmp_path, monkeypatch, run_cli):
+    for name in ("build_bitstream", "part_costs", "check_frames"):
+        monkeypatch.setattr(cli_board, name, _no)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", *SMALL, "--mode", "test", "--out", out, "--pipe-mhz", value])
+    assert r.returncode == 2 and r.stderr.strip().splitlines() == [f"bumprtl: error: {message}"]
+    assert not out.exists()
