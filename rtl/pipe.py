@@ -60,6 +60,11 @@ READ_SLICE = 16
 # (TRELLIS_DPR16X4) deep, so a bank's read reaches its prefetch register through no
 # multiplexer.
 BANK_BITS = 4
+# The widest FIFO word kept in banks: each bank's prefetch register multiplies the flip-flops
+# every load of the FIFO's control reaches, and past this width they spread the FIFO so far
+# that the control's routes bind instead of the multiplexer they save; a wider FIFO reads its
+# whole memory through the multiplexer into one prefetch register.
+BANKED_WIDTH_MAX = 8 * READ_SLICE
 
 
 def min_fifo_depth(latency):
@@ -249,7 +254,8 @@ class CreditFIFO(Elaboratable):
 
     Its inner queue is ``2**ceil(log2(depth))`` words in banks of at most
     ``2**BANK_BITS`` (:attr:`banks`, submodules ``storage0``, ``storage1``, ...: each one
-    LUT RAM deep on ECP5), word ``a`` in bank ``a >> BANK_BITS``; it is written at
+    LUT RAM deep on ECP5; one bank of them all when ``width`` exceeds BANKED_WIDTH_MAX),
+    word ``a`` in bank ``a >> bank_bits``; it is written at
     :attr:`write_pointer`, which wraps by overflow, and read asynchronously at
     :attr:`read_pointer` (the control a copy per READ_SLICE bits of the word). Each bank's
     read lands in a prefetch register of its own beside it (``pre_data`` is the one the
@@ -262,7 +268,7 @@ class CreditFIFO(Elaboratable):
     def __init__(self, width, depth):
         self.width, self.depth = width, depth
         self.bits = (depth - 1).bit_length()
-        self.bank_bits = min(self.bits, BANK_BITS)
+        self.bank_bits = min(self.bits, BANK_BITS) if width <= BANKED_WIDTH_MAX else self.bits
         self.banks = [Memory(shape=width, depth=1 << self.bank_bits, init=[],
                              attrs={"ram_style": "distributed"})
                       for _ in range(1 << (self.bits - self.bank_bits))]

@@ -451,7 +451,10 @@ FPGA_NOTES = """
   multiplexer moved behind those registers (the LUT-RAM read through the multiplexer of
   four banks into the one prefetch register, 1.25 ns of logic and 3.6-4.2 ns of routing,
   held exact_pipeline at 195.8, scene_default at 183.2 and the edge alone at 205.5 MHz,
-  min over seeds 1-3; latency and least depth unchanged).
+  min over seeds 1-3; latency and least depth unchanged); a FIFO wider than
+  `rtl/pipe.BANKED_WIDTH_MAX` bits keeps one prefetch register (with four banks'
+  registers the 180-bit FIFO of exact_setup spread so far that its control's fan-out held
+  it at 178.0 MHz, seed 1).
 - The primitives' own ceiling above is nextpnr's timing model of one DP16KD or
   MULT18X18D between flip-flops; Lattice's datasheet figures for the primitives are not
   in that model and not quoted here.

@@ -14,7 +14,7 @@ from amaranth.back import rtlil
 
 from bumprtl.gen.formal import run as formal_run
 from bumprtl.gen.formal.run import check, check_mutant
-from bumprtl.rtl.pipe import Pipe
+from bumprtl.rtl.pipe import CreditFIFO, Pipe
 from bumprtl.sim.formal.contract import CHUNK, StreamContract, find_edge, observe_pipes
 from bumprtl.sim.formal.mutants import EDGE_MUTATIONS, MUTANTS, Glitcher
 from bumprtl.sim.formal.targets import SMALL, TARGETS, Config, Target
@@ -141,6 +141,15 @@ def test_the_credit_edge_is_found_in_the_elaborated_unit(name):
     # addresses 0, 16, ...
     assert [(memory.depth, base) for _, memory, base in edge.banks] == \
         [(min(words, 16), b * 16) for b in range(max(1, words // 16))]
+
+
+@pytest.mark.parametrize("width, banks", [(8, [8]), (73, [16, 16, 16, 16]), (128, [16] * 4),
+                                          (129, [64]), (180, [64])])
+def test_a_wide_fifo_keeps_one_bank(width, banks):
+    """rtl/pipe.CreditFIFO: banks of 16 words up to BANKED_WIDTH_MAX (8 x READ_SLICE) bits,
+    one bank of every word above it (here 43 entries: 64 words; 8 entries: 8 words)."""
+    fifo = CreditFIFO(width, 43 if width > 8 else 8)
+    assert [bank.depth for bank in fifo.banks] == banks and fifo.bank_bits == (banks[0] - 1).bit_length()
 
 
 def test_parallel_elaborations_each_observe_every_stage():
