@@ -35,10 +35,20 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run"]
+__all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run",
+           "AXI_SCENE", "axi_scene"]
 
 # The scene pipeline whose credit edge is placed alone in every run (its cost on its own).
 EDGE_SCENE = "default"
+# The built-in scene also placed with its map in the user's memory (map_memory = "axi":
+# the texel cache and its AXI4 read port in front of the credit edge), row scene_<name>_axi.
+AXI_SCENE = "default"
+
+
+def axi_scene(name):
+    """The built-in scene ``name`` with ``map_memory = "axi"`` (the scene's cache keys at
+    their defaults)."""
+    return load_scene_config({**BUILTIN[name], "map_memory": "axi"})
 
 
 @dataclass(frozen=True)
@@ -64,14 +74,17 @@ def fpga_units(cfg):
     """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
     pipeline (setup -> illumination only: their per-unit numbers are Table 1's Yosys counts,
     and with their pipelined square roots and dividers they are the largest netlists to
-    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``). A
+    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``) and
+    the :data:`AXI_SCENE` one's with its map behind the texel cache (``scene_axi:<name>``). A
     method whose hardware is another's (Ernst's is Peercy's, rtl/methods.py) is placed once,
     under that other name (the report's notes say so)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
     placed = [d for d in TABLE1_ORDER if d not in NOT_PLACED and METHODS[d].hardware_of is None]
     return ([(f"{d}_{row}", d, row) for d in placed for row in rows(d)]
             + [(f"scene_{s.replace('-', '_')}", load_scene_config(s).method, f"scene:{s}")
-               for s in BUILTIN])
+               for s in BUILTIN]
+            + [(f"scene_{AXI_SCENE}_axi", load_scene_config(AXI_SCENE).method,
+                f"scene_axi:{AXI_SCENE}")])
 
 
 def fpga_run(cfg, run: FpgaRun):
@@ -99,6 +112,8 @@ def _component(design, row, cfg):
         for unit in (pipeline, *pipeline.units.values()):
             unit._MustUse__silence = True          # read for its ports and latency only
         return edge_component(pipeline.o.payload.shape(), pipeline.latency, pipeline.fifo_depth)
+    if row.startswith("scene_axi:"):  # the same with the map in the user's memory (AXI4)
+        return BumpPipeline(axi_scene(row.split(":", 1)[1]).hardware, target=target)
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
         return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
     cfg = cfg.replace(method=design)
@@ -201,7 +216,7 @@ def _row_seeds(run, row):
     else ``run.seeds``."""
     seeds = list(run.seeds or [1])
     scene = run.scene_seeds
-    return list(scene) if scene and row.startswith("scene:") else seeds
+    return list(scene) if scene and row.startswith(("scene:", "scene_axi:")) else seeds
 
 
 def _ceiling_lines(rows, ceilings):
@@ -313,7 +328,7 @@ def _scene_widths(rows):
     """The scene rows placed at widths of their own (the built-in scenes' TOML decides)."""
     own = []
     for r in rows:
-        if r["row"].startswith("scene:"):
+        if r["row"].startswith(("scene:", "scene_axi:")):
             sc = load_scene_config(r["row"].split(":", 1)[1])
             own.append(f"{r['unit']} at {sc.angle_bits} / {sc.frac_bits}")
     return "the scene rows at their scenes' widths: " + ", ".join(own) if own else ""
