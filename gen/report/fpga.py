@@ -305,10 +305,10 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
     lines += _ceiling_lines(rows, ceilings or {})
     lines += _edge_lines(edge or [])
     target = [r for r in rows if r["unit"] == "exact_pipeline"]
+    lines += ["", "## Notes", ""]
     if target:
         r = target[0]
-        lines += ["", "## Notes", "",
-                  f"- Target: the default exact pipeline at >= {r['target_mhz']:g} MHz "
+        lines += [f"- Target: the default exact pipeline at >= {r['target_mhz']:g} MHz "
                   f"and 1 pixel per clock: {'met' if r['met'] else 'not met'} "
                   f"({r['fmax_mhz']} MHz, speed grade 6, out of context)."]
     skipped = [d for d in NOT_PLACED if d in TABLE1_ORDER]
@@ -316,12 +316,27 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
         lines += [f"- {', '.join(skipped)}: {NOT_PLACED[skipped[0]]}."]
     lines += [f"- {d}: {METHODS[d].hardware_of}'s hardware (rtl/methods.py), placed once as "
               f"{METHODS[d].hardware_of}." for d in TABLE1_ORDER if METHODS[d].hardware_of]
+    lines += [_axi_note(r) for r in rows if r["row"].startswith("scene_axi:")]
     out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
     print(f"wrote {out}")
     data = out.parent / "data" / "fpga.json"         # read by report table1
     data.parent.mkdir(parents=True, exist_ok=True)
     data.write_text(json.dumps({"command": command, "device": run.device, "rows": rows,
                                 "accuracy": acc}, indent=1, sort_keys=True) + "\n")
+
+
+def _axi_note(row):
+    """The note line of a ``scene_axi:<name>`` row: what it places."""
+    from bumprtl.rtl.cache import scene_geometry
+    name = row["row"].split(":", 1)[1]
+    g = scene_geometry(axi_scene(name).hardware)
+    return (f"- {row['unit']}: the `{name}` scene's BumpPipeline with `map_memory = \"axi\"`: "
+            f"its bump map in the user's memory behind the texel cache (`rtl/cache.TextureCache`: "
+            f"{g.sets} sets x {g.ways} ways of {g.block} x {g.block}-texel lines, a queue of "
+            f"{g.queue} pixels, {g.misses} bursts outstanding) in front of the credit edge, "
+            f"its AXI4 read port (AR and R, {g.data_bits}-bit RDATA, one INCR burst of "
+            f"{g.beats} beats a miss) as top-level ports; the cache's tag, data, stamp and "
+            f"queue memories replace scene_{name}'s map block RAM.")
 
 
 def _scene_widths(rows):
