@@ -20,17 +20,21 @@ from bumprtl.gen.formal.doc import table, write_doc
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.tools.sby import run_sby
+from bumprtl.sim.formal import axi
 from bumprtl.sim.formal.contract import StreamContract
 from bumprtl.sim.formal.mutants import MUTANTS
-from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
+from bumprtl.sim.formal.targets import AXI, SMALL, TARGETS, Config
 
-__all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
+__all__ = ["Row", "check", "check_mutant", "check_axi", "check_axi_mutant", "formal_job", "run",
+           "table", "main", "INDUCTION_DEPTH", "AXI_MUTANT_GEOMETRY"]
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
 BMC_MARGIN = 6               # cover, BMC depth = latency + this (every pixel reaches the output)
 PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
 BANK_MARGIN = 7              # palette bank BMC fallback depth = latency + this (docs/formal.md)
 FILL = ("credit",)           # covers that fill the FIFO: depth latency + fifo_depth + BMC_MARGIN
+AXI_BMC_DEPTH = 24           # the AXI rules' BMC fallback and broken managers: from reset
+AXI_MUTANT_GEOMETRY = "2beats"   # the cache the broken AXI managers are built around
 
 
 def _fill_depth(dut):
@@ -59,8 +63,53 @@ def _job(top, workdir, name, mode, depth, script=(), timeout=3600):
     return run_sby(top, workdir, name, mode=mode, depth=depth, script=script, timeout=timeout)
 
 
+def check_axi(target, prop, root, induction_depth=INDUCTION_DEPTH):
+    """The AXI4 read rules of a texel cache (sim/formal/axi.py, ``target.config``'s
+    geometry): ``axi`` every rule by k-induction with the lemmas (BMC to AXI_BMC_DEPTH when
+    the induction does not close: *bounded*), ``axi_cover`` every rule's cover."""
+    workdir = Path(root) / target.name
+    geom = axi.geometry(target.config["geometry"])
+    t0 = time.perf_counter()
+    if prop == "axi_cover":
+        top, res = axi.cover(geom, workdir, axi.cover_depth(geom), name=prop)
+        result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
+    else:
+        top, res = axi.prove(geom, workdir, name=prop, depth=induction_depth,
+                             timeout=PROVE_TIMEOUT)
+        result = "proved" if res.passed else res.status
+        if res.status == "UNKNOWN" or (res.status == "FAIL" and not res.trace) or res.timed_out:
+            top, res = axi.bmc(geom, workdir, AXI_BMC_DEPTH, name=f"{prop}_bmc")
+            result = "bounded" if res.passed else res.status
+    return _axi_row(target.name, prop, result, res, top, t0)
+
+
+def _axi_row(unit, prop, result, res, top, t0):
+    detail = "; ".join(top.describe(f) for f in res.failed) if not res.passed else ""
+    if res.status == "ERROR" and not detail:
+        detail = res.log.strip().splitlines()[-1] if res.log.strip() else "sby error"
+    return Row(unit, prop, result, res.depth, time.perf_counter() - t0, 0, len(top.lemmas),
+               detail, str(res.trace or ""))
+
+
+def check_axi_mutant(name, root):
+    """A broken AXI manager of :data:`bumprtl.sim.formal.axi.MUTANTS` (around the cache of
+    AXI_MUTANT_GEOMETRY) against every rule, BMC to AXI_BMC_DEPTH without the lemmas: the
+    row says whether it failed (its detail names the rules that failed)."""
+    cls, _rule = axi.MUTANTS[name]
+    geom = axi.geometry(AXI_MUTANT_GEOMETRY)
+    t0 = time.perf_counter()
+    top, res = axi.bmc(geom, Path(root) / "mutants", AXI_BMC_DEPTH, name=f"axi_{name}", dut=cls(geom))
+    result = "fails as expected" if res.status == "FAIL" and res.trace else \
+        ("NOT CAUGHT" if res.passed else res.status)
+    row = _axi_row(f"mutant axi_{name}", "axi", result, res, top, t0)
+    row.detail = "; ".join(top.describe(f) for f in res.failed)
+    return row
+
+
 def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
     """One (target, property): returns a :class:`Row`."""
+    if prop in AXI:
+        return check_axi(target, prop, root, induction_depth)
     workdir = Path(root) / target.name
     t0 = time.perf_counter()
     if prop == "cover":
@@ -124,13 +173,15 @@ def check_mutant(name, root, cfg=None):
 
 
 def formal_job(kind, name, prop):
-    """One check as a job (gen/tools/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`) or
-    "mutant" (of :data:`MUTANTS`), checked in a temporary directory of the worker. Returns
+    """One check as a job (gen/tools/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`),
+    "mutant" (of :data:`MUTANTS`) or "axi_mutant" (of sim/formal/axi.MUTANTS), checked in a
+    temporary directory of the worker. Returns
     ``{"row": Row as a dict, "files": {path under the work root: text} (each sby run's
     log and the counterexample trace), "log": the sby logs}``; the client writes the files
     under its ``--out`` and points ``trace`` at its copy."""
     with tempfile.TemporaryDirectory(prefix=f"bumprtl-formal-{name}-") as tmp:
-        row = check(TARGETS[name], prop, tmp) if kind == "target" else check_mutant(name, tmp)
+        row = check(TARGETS[name], prop, tmp) if kind == "target" else \
+            check_axi_mutant(name, tmp) if kind == "axi_mutant" else check_mutant(name, tmp)
         root = Path(tmp).resolve()
         keep = [p for p in root.rglob("*") if p.is_file() and
                 (p.name == "logfile.txt" or (row.trace and p.resolve() == Path(row.trace).resolve()))]
@@ -158,6 +209,9 @@ def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=p
         for name, (_cls, prop) in MUTANTS.items():
             if props is None or prop in props:
                 jobs_list.append((f"mutant {name}", prop, ("mutant", name, prop)))
+        for name in axi.MUTANTS:
+            if props is None or "axi" in props:
+                jobs_list.append((f"mutant axi_{name}", "axi", ("axi_mutant", name, "axi")))
     root = Path(root)
     order = {job_name("formal", unit, prop): n for n, (unit, prop, _) in enumerate(jobs_list)}
     units = {job_name("formal", unit, prop): (unit, prop) for unit, prop, _ in jobs_list}
@@ -204,7 +258,7 @@ def report_failures(rows, out=None):
 def _ordered(rows):
     """Rows in table order: the targets as :data:`TARGETS` lists them, each with its
     properties in order, then the broken units as :data:`MUTANTS` lists them."""
-    units = list(TARGETS) + [f"mutant {n}" for n in MUTANTS]
+    units = list(TARGETS) + [f"mutant {n}" for n in MUTANTS] + [f"mutant axi_{n}" for n in axi.MUTANTS]
 
     def key(r):
         n = units.index(r.unit) if r.unit in units else len(units)
