@@ -29,6 +29,7 @@ from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
@@ -327,7 +328,6 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
 
 def _axi_note(row):
     """The note line of a ``scene_axi:<name>`` row: what it places."""
-    from bumprtl.rtl.cache import scene_geometry
     name = row["row"].split(":", 1)[1]
     g = scene_geometry(axi_scene(name).hardware)
     return (f"- {row['unit']}: the `{name}` scene's BumpPipeline with `map_memory = \"axi\"`: "

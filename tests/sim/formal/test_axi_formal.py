@@ -93,3 +93,30 @@ def test_the_axi_pipeline_counts_the_pixels_in_its_cache():
 def test_axi_pipeline_keeps_the_stream_contract(prop, build_dir):
     row = check(TARGETS["pipeline_default_axi"], prop, build_dir)
     assert row.result in ("proved", "covered"), row
+
+
+def test_the_axi_rows_have_a_section_of_their_own(tmp_path):
+    """write_doc puts the texel cache's rows (its AXI port, its broken managers, the cached
+    pipeline) in their own section and leaves a section it has no rows for as it was: a run
+    of the AXI checks alone does not re-render the stream table with nothing in it."""
+    from types import SimpleNamespace
+
+    from bumprtl.gen.formal.doc import write_doc
+
+    def row(unit, prop):
+        return SimpleNamespace(unit=unit, prop=prop, result="proved", depth=2, latency=0,
+                               lemmas=6, seconds=1.0)
+
+    doc = tmp_path / "formal.md"
+    write_doc(doc, [row("sincos", "order")], "-j 2 --doc docs/formal.md", seconds=10, checked=1)
+    before = doc.read_text()
+    axi_rows = [row("cache_axi_2beats", "axi"), row("mutant axi_long_burst", "axi"),
+                row("pipeline_default_axi", "hold")]
+    write_doc(doc, axi_rows, "cache_axi_2beats --prop axi --doc docs/formal.md", seconds=3,
+              checked=3)
+    text = doc.read_text()
+    main, axi_part = text.split("<!-- formal axi table:begin -->")
+    assert main.strip() == before.strip()                     # the stream table untouched
+    assert all(f"| {r.unit} | {r.prop} |" in axi_part for r in axi_rows)
+    assert "`python -m bumprtl.gen.formal.run cache_axi_2beats --prop axi --doc docs/formal.md`" \
+        in axi_part and "that run: 3 checks in 3 s" in axi_part
