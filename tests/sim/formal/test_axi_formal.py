@@ -89,7 +89,7 @@ def test_the_axi_pipeline_counts_the_pixels_in_its_cache():
 
 
 @pytest.mark.formal
-@pytest.mark.parametrize("prop", ["hold", "quiet", "credit", "cover", "credit_cover"])
+@pytest.mark.parametrize("prop", ["hold", "quiet", "credit", "cover", "hold_cover"])
 def test_axi_pipeline_keeps_the_stream_contract(prop, build_dir):
     row = check(TARGETS["pipeline_default_axi"], prop, build_dir)
     assert row.result in ("proved", "covered"), row
