@@ -18,6 +18,7 @@ golden model).
 """
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 from amaranth.hdl import (
@@ -350,6 +351,18 @@ class TextureCache(wiring.Component):
     def __init__(self, geom: CacheGeometry, extra=None):
         self.geom = geom
         self.extra = dict(extra or {})
+        K = geom.stamp_bits
+        # The control registers, here so that the formal contracts (sim/formal/axi.py, the
+        # stream contract of a map_memory = "axi" pipeline) can state lemmas about them.
+        self.regs = SimpleNamespace(
+            flushing=Signal(init=1, name="flushing"),
+            look_valid=Signal(name="look_valid"),                 # a pixel under lookup
+            in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
+            rd_valid=Signal(name="rd_valid"),                     # the data read register
+            fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
+            landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
+            f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
+            beat=Signal(range(geom.beats), name="beat"))          # the R beat of the line
         tb = geom.texture_size.bit_length() - 1
         fields = {"u": unsigned(max(1, tb)), "v": unsigned(max(1, tb))}
         if geom.mip_levels > 1:
@@ -406,10 +419,11 @@ class TextureCache(wiring.Component):
         stamp_w = smem.write_port(granularity=K)
         stamp_r = smem.read_port(transparent_for=(stamp_w,))
 
-        flushing = Signal(init=1)
+        r = self.regs
+        flushing = r.flushing
         flush_set = Signal(range(g.sets))
         # --- the pixel under lookup ---
-        look_valid = Signal()
+        look_valid = r.look_valid
         look_line = Signal(g.line_bits)
         look_slot = Signal(2 * g.block_bits)
         look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
@@ -449,7 +463,7 @@ class TextureCache(wiring.Component):
                              victim_stamp.eq(stamp_r.data.word_select(w, K))]
 
         # --- the pixel queue: pixels in[out_seq, in_seq) wait in order ---
-        in_seq, out_seq = Signal(K), Signal(K)
+        in_seq, out_seq = r.in_seq, r.out_seq
         count = Signal(K)
         m.d.comb += count.eq(in_seq - out_seq)
         qb = g.queue.bit_length() - 1
@@ -462,14 +476,13 @@ class TextureCache(wiring.Component):
         m.d.comb += locked.eq(victim_valid & ((victim_stamp - out_seq)[:K] < count))
 
         # --- the bursts outstanding: (set, way) of each, in AR order ---
-        fills = Signal(range(g.misses + 1))
-        landed = Signal(range(g.queue + 1))       # lines filled whose miss has not left
+        fills, landed = r.fills, r.landed
         m.submodules.fillq = fmem = Memory(
             shape=data.StructLayout({"set": unsigned(max(1, g.set_bits)),
                                      "way": unsigned(max(1, g.way_bits))}),
             depth=g.misses, init=[], attrs={"ram_style": "distributed"})
         f_w, f_r = fmem.write_port(), fmem.read_port(domain="comb")
-        f_in, f_out = Signal(range(g.misses)), Signal(range(g.misses))
+        f_in, f_out = r.f_in, r.f_out
 
         ar_free = ~ax.arvalid | ax.arready
         can_miss = ar_free & (fills != g.misses) & ~locked
@@ -526,7 +539,7 @@ class TextureCache(wiring.Component):
                      f_w.data.way.eq(way), f_r.addr.eq(f_out)]
 
         # --- the R beats: into the oldest outstanding burst's line ---
-        beat = Signal(range(g.beats))
+        beat = r.beat
         m.d.comb += ax.rready.eq(fills != 0)
         beat_in = ax.rready & ax.rvalid
         line_in = beat_in & ax.rlast
@@ -547,8 +560,9 @@ class TextureCache(wiring.Component):
         # --- the queue's head leaves in order: read its word, then the output register ---
         head = q_r.data
         o_free = ~self.o.valid | self.o.ready
-        rd_valid, rd_way, rd_sel = Signal(), Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
+        rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
+        r.look_extra, r.rd_extra, r.queue = look_extra, rd_extra, qmem   # for the lemmas
         rd_move = ~rd_valid | o_free
         pop = Signal()
         m.d.comb += pop.eq((count != 0) & (~head.miss | (landed != 0)) & rd_move)

@@ -199,7 +199,9 @@ of an AXI4 read channel (Amaranth's flattened names; `rtl/cache.axi_read_signatu
 `axi__rlast`, `axi__rvalid`, `axi__rready`. A burst is a whole line, aligned to its size
 (never across 4 KiB); up to {d["misses"]} are outstanding, all with ARID 0, so the memory
 returns them in order; ARVALID stays high with a stable payload until ARREADY; RREADY is
-high while a burst is outstanding, and each line's fill ends with RLAST. Put
+high while a burst is outstanding, and each line's fill ends with RLAST (these rules are
+proved by k-induction against any subordinate that keeps AXI4's: `make formal`,
+docs/formal.md, The texel cache's AXI4 port). Put
 `<name>_map.bin` at byte `base` (0) of the memory the port reads; the sidecar's
 `memory_images.map` gives `file`, `base`, `bytes` and the `layout` in words. A reset clears
 the tags one set a cycle (`i.ready` low for `sets` cycles); the map must not change between

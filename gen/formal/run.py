@@ -20,22 +20,50 @@ from bumprtl.gen.formal.doc import table, write_doc
 from bumprtl.gen.tools.jobs import Job, Runner, SchedulerError, job_name, scheduler_address
 from bumprtl.gen.tools.jobs import add_arguments as add_job_arguments
 from bumprtl.gen.tools.sby import run_sby
+from bumprtl.sim.formal import axi
 from bumprtl.sim.formal.contract import StreamContract
 from bumprtl.sim.formal.mutants import MUTANTS
-from bumprtl.sim.formal.targets import SMALL, TARGETS, Config
+from bumprtl.sim.formal.targets import AXI, SMALL, TARGETS, Config
 
-__all__ = ["Row", "check", "check_mutant", "formal_job", "run", "table", "main", "INDUCTION_DEPTH"]
+__all__ = ["Row", "check", "check_mutant", "check_axi", "check_axi_mutant", "formal_job", "run",
+           "table", "main", "INDUCTION_DEPTH", "AXI_MUTANT_GEOMETRY"]
 
 INDUCTION_DEPTH = 2          # k of k-induction (the lemmas make every property 1-inductive)
 BMC_MARGIN = 6               # cover, BMC depth = latency + this (every pixel reaches the output)
 PROVE_TIMEOUT = 600          # seconds of k-induction before falling back to BMC
 BANK_MARGIN = 7              # palette bank BMC fallback depth = latency + this (docs/formal.md)
 FILL = ("credit",)           # covers that fill the FIFO: depth latency + fifo_depth + BMC_MARGIN
+AXI_BMC_DEPTH = 24           # the AXI rules' BMC fallback and broken managers: from reset
+AXI_MUTANT_GEOMETRY = "2beats"   # the cache the broken AXI managers are built around
 
 
 def _fill_depth(dut):
     """BMC depth that spends every credit and fills the FIFO, then drains a pixel."""
-    return dut.latency + dut.fifo_depth + BMC_MARGIN
+    return dut.latency + dut.fifo_depth + BMC_MARGIN + _front(dut)
+
+
+def _front(dut):
+    """Cycles a texel cache in front of a pipeline's edge adds to a first pixel's way out
+    (0 without one): its flush after reset (a set a cycle), its hit latency, and a miss's
+    AR and line of beats landing."""
+    if not getattr(dut, "_front", False):
+        return 0
+    fetch = dut.units["fetch"]
+    return fetch.geom.sets + fetch.latency + fetch.geom.beats + 2
+
+
+def _script(prop, dut):
+    """Yosys commands after the model is flattened: the bank check reads the table's
+    contents, and a texel cache's memories (tags, stamps, lines, queue) in arrays made a
+    cover of the cached pipeline run past 9 minutes where as flip-flops it takes seconds:
+    their memories become flip-flops."""
+    return ("memory_map", "opt -fast") if prop == "bank" or _front(dut) else ()
+
+
+def _cover_depth(dut, margin=BMC_MARGIN):
+    """BMC depth of a cover: the chain's latency + ``margin`` (every pixel reaches the
+    output) + a texel cache's first miss (:func:`_front`)."""
+    return dut.latency + margin + _front(dut)
 
 
 @dataclass
@@ -59,14 +87,59 @@ def _job(top, workdir, name, mode, depth, script=(), timeout=3600):
     return run_sby(top, workdir, name, mode=mode, depth=depth, script=script, timeout=timeout)
 
 
+def check_axi(target, prop, root, induction_depth=INDUCTION_DEPTH):
+    """The AXI4 read rules of a texel cache (sim/formal/axi.py, ``target.config``'s
+    geometry): ``axi`` every rule by k-induction with the lemmas (BMC to AXI_BMC_DEPTH when
+    the induction does not close: *bounded*), ``axi_cover`` every rule's cover."""
+    workdir = Path(root) / target.name
+    geom = axi.geometry(target.config["geometry"])
+    t0 = time.perf_counter()
+    if prop == "axi_cover":
+        top, res = axi.cover(geom, workdir, axi.cover_depth(geom), name=prop)
+        result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
+    else:
+        top, res = axi.prove(geom, workdir, name=prop, depth=induction_depth,
+                             timeout=PROVE_TIMEOUT)
+        result = "proved" if res.passed else res.status
+        if res.status == "UNKNOWN" or (res.status == "FAIL" and not res.trace) or res.timed_out:
+            top, res = axi.bmc(geom, workdir, AXI_BMC_DEPTH, name=f"{prop}_bmc")
+            result = "bounded" if res.passed else res.status
+    return _axi_row(target.name, prop, result, res, top, t0)
+
+
+def _axi_row(unit, prop, result, res, top, t0):
+    detail = "; ".join(top.describe(f) for f in res.failed) if not res.passed else ""
+    if res.status == "ERROR" and not detail:
+        detail = res.log.strip().splitlines()[-1] if res.log.strip() else "sby error"
+    return Row(unit, prop, result, res.depth, time.perf_counter() - t0, 0, len(top.lemmas),
+               detail, str(res.trace or ""))
+
+
+def check_axi_mutant(name, root):
+    """A broken AXI manager of :data:`bumprtl.sim.formal.axi.MUTANTS` (around the cache of
+    AXI_MUTANT_GEOMETRY) against every rule, BMC to AXI_BMC_DEPTH without the lemmas: the
+    row says whether it failed (its detail names the rules that failed)."""
+    cls, _rule = axi.MUTANTS[name]
+    geom = axi.geometry(AXI_MUTANT_GEOMETRY)
+    t0 = time.perf_counter()
+    top, res = axi.bmc(geom, Path(root) / "mutants", AXI_BMC_DEPTH, name=f"axi_{name}", dut=cls(geom))
+    result = "fails as expected" if res.status == "FAIL" and res.trace else \
+        ("NOT CAUGHT" if res.passed else res.status)
+    row = _axi_row(f"mutant axi_{name}", "axi", result, res, top, t0)
+    row.detail = "; ".join(top.describe(f) for f in res.failed)
+    return row
+
+
 def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
     """One (target, property): returns a :class:`Row`."""
+    if prop in AXI:
+        return check_axi(target, prop, root, induction_depth)
     workdir = Path(root) / target.name
     t0 = time.perf_counter()
     if prop == "cover":
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
-        res = _job(top, workdir, prop, "cover", dut.latency + BMC_MARGIN)
+        res = _job(top, workdir, prop, "cover", _cover_depth(dut), script=_script(prop, dut))
         result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
         return _row(target, prop, result, res, top, dut, t0)
     if prop.endswith("_cover"):     # a property's own covers: it is exercised, not vacuous
@@ -75,15 +148,13 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         top = StreamContract(dut, base, lemmas=False)
         bank = base == "bank"
         depth = _fill_depth(dut) if base in FILL else \
-            dut.latency + (BANK_MARGIN + 2 if bank else BMC_MARGIN)
-        res = _job(top, workdir, prop, "cover", depth,
-                   script=("memory_map", "opt -fast") if bank else ())
+            _cover_depth(dut, BANK_MARGIN + 2 if bank else BMC_MARGIN)
+        res = _job(top, workdir, prop, "cover", depth, script=_script(base, dut))
         result = "covered" if res.passed else "NOT COVERED" if res.status == "FAIL" else res.status
         return _row(target, prop, result, res, top, dut, t0)
-    # The bank check reads the table's contents: its memories become flip-flops.
-    script = ("memory_map", "opt -fast") if prop == "bank" else ()
     margin = BANK_MARGIN if prop == "bank" else BMC_MARGIN
     dut = target.unit()
+    script = _script(prop, dut)
     top = StreamContract(dut, prop)
     res = _job(top, workdir, prop, "prove", induction_depth, script=script, timeout=PROVE_TIMEOUT)
     if res.passed:
@@ -92,7 +163,7 @@ def check(target, prop, root, induction_depth=INDUCTION_DEPTH):
         # induction did not close: fall back to BMC without the lemmas
         dut = target.unit()
         top = StreamContract(dut, prop, lemmas=False)
-        res = _job(top, workdir, f"{prop}_bmc", "bmc", dut.latency + margin, script=script)
+        res = _job(top, workdir, f"{prop}_bmc", "bmc", _cover_depth(dut, margin), script=script)
         return _row(target, prop, "bounded" if res.passed else res.status, res, top, dut, t0)
     return _row(target, prop, res.status, res, top, dut, t0)
 
@@ -124,13 +195,15 @@ def check_mutant(name, root, cfg=None):
 
 
 def formal_job(kind, name, prop):
-    """One check as a job (gen/tools/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`) or
-    "mutant" (of :data:`MUTANTS`), checked in a temporary directory of the worker. Returns
+    """One check as a job (gen/tools/jobs.py): ``kind`` "target" (``name`` of :data:`TARGETS`),
+    "mutant" (of :data:`MUTANTS`) or "axi_mutant" (of sim/formal/axi.MUTANTS), checked in a
+    temporary directory of the worker. Returns
     ``{"row": Row as a dict, "files": {path under the work root: text} (each sby run's
     log and the counterexample trace), "log": the sby logs}``; the client writes the files
     under its ``--out`` and points ``trace`` at its copy."""
     with tempfile.TemporaryDirectory(prefix=f"bumprtl-formal-{name}-") as tmp:
-        row = check(TARGETS[name], prop, tmp) if kind == "target" else check_mutant(name, tmp)
+        row = check(TARGETS[name], prop, tmp) if kind == "target" else \
+            check_axi_mutant(name, tmp) if kind == "axi_mutant" else check_mutant(name, tmp)
         root = Path(tmp).resolve()
         keep = [p for p in root.rglob("*") if p.is_file() and
                 (p.name == "logfile.txt" or (row.trace and p.resolve() == Path(row.trace).resolve()))]
@@ -158,6 +231,9 @@ def run(names=None, props=None, mutants=True, root="build/formal", jobs=1, log=p
         for name, (_cls, prop) in MUTANTS.items():
             if props is None or prop in props:
                 jobs_list.append((f"mutant {name}", prop, ("mutant", name, prop)))
+        for name in axi.MUTANTS:
+            if props is None or "axi" in props:
+                jobs_list.append((f"mutant axi_{name}", "axi", ("axi_mutant", name, "axi")))
     root = Path(root)
     order = {job_name("formal", unit, prop): n for n, (unit, prop, _) in enumerate(jobs_list)}
     units = {job_name("formal", unit, prop): (unit, prop) for unit, prop, _ in jobs_list}
@@ -204,7 +280,7 @@ def report_failures(rows, out=None):
 def _ordered(rows):
     """Rows in table order: the targets as :data:`TARGETS` lists them, each with its
     properties in order, then the broken units as :data:`MUTANTS` lists them."""
-    units = list(TARGETS) + [f"mutant {n}" for n in MUTANTS]
+    units = list(TARGETS) + [f"mutant {n}" for n in MUTANTS] + [f"mutant axi_{n}" for n in axi.MUTANTS]
 
     def key(r):
         n = units.index(r.unit) if r.unit in units else len(units)

@@ -29,16 +29,27 @@ from bumprtl.gen.flow.units import build_unit
 from bumprtl.gen.report.table1 import TABLE1_ORDER, accuracy, check_samples
 from bumprtl.gen.tools.docs import made_at
 from bumprtl.gen.tools.jobs import Job, Runner, job_name, scheduler_address
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.golden.methods import METHODS
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run"]
+__all__ = ["FpgaRun", "fpga_units", "fpga_run", "fpga_report", "place_all", "write_report", "worst_run",
+           "AXI_SCENE", "axi_scene"]
 
 # The scene pipeline whose credit edge is placed alone in every run (its cost on its own).
 EDGE_SCENE = "default"
+# The built-in scene also placed with its map in the user's memory (map_memory = "axi":
+# the texel cache and its AXI4 read port in front of the credit edge), row scene_<name>_axi.
+AXI_SCENE = "default"
+
+
+def axi_scene(name):
+    """The built-in scene ``name`` with ``map_memory = "axi"`` (the scene's cache keys at
+    their defaults)."""
+    return load_scene_config({**BUILTIN[name], "map_memory": "axi"})
 
 
 @dataclass(frozen=True)
@@ -64,14 +75,17 @@ def fpga_units(cfg):
     """What ``report fpga`` places: our designs' two units and their pipeline, the baselines'
     pipeline (setup -> illumination only: their per-unit numbers are Table 1's Yosys counts,
     and with their pipelined square roots and dividers they are the largest netlists to
-    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``). A
+    place), then the BumpPipeline of every built-in scene class (row ``scene:<name>``) and
+    the :data:`AXI_SCENE` one's with its map behind the texel cache (``scene_axi:<name>``). A
     method whose hardware is another's (Ernst's is Peercy's, rtl/methods.py) is placed once,
     under that other name (the report's notes say so)."""
     rows = lambda d: ("pipeline",) if METHODS[d].baseline else ("setup", "illumination", "pipeline")
     placed = [d for d in TABLE1_ORDER if d not in NOT_PLACED and METHODS[d].hardware_of is None]
     return ([(f"{d}_{row}", d, row) for d in placed for row in rows(d)]
             + [(f"scene_{s.replace('-', '_')}", load_scene_config(s).method, f"scene:{s}")
-               for s in BUILTIN])
+               for s in BUILTIN]
+            + [(f"scene_{AXI_SCENE}_axi", load_scene_config(AXI_SCENE).method,
+                f"scene_axi:{AXI_SCENE}")])
 
 
 def fpga_run(cfg, run: FpgaRun):
@@ -99,6 +113,8 @@ def _component(design, row, cfg):
         for unit in (pipeline, *pipeline.units.values()):
             unit._MustUse__silence = True          # read for its ports and latency only
         return edge_component(pipeline.o.payload.shape(), pipeline.latency, pipeline.fifo_depth)
+    if row.startswith("scene_axi:"):  # the same with the map in the user's memory (AXI4)
+        return BumpPipeline(axi_scene(row.split(":", 1)[1]).hardware, target=target)
     if row.startswith("scene:"):     # the drop-in BumpPipeline of a built-in scene class
         return BumpPipeline(load_scene_config(row.split(":", 1)[1]).hardware, target=target)
     cfg = cfg.replace(method=design)
@@ -201,7 +217,7 @@ def _row_seeds(run, row):
     else ``run.seeds``."""
     seeds = list(run.seeds or [1])
     scene = run.scene_seeds
-    return list(scene) if scene and row.startswith("scene:") else seeds
+    return list(scene) if scene and row.startswith(("scene:", "scene_axi:")) else seeds
 
 
 def _ceiling_lines(rows, ceilings):
@@ -290,10 +306,10 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
     lines += _ceiling_lines(rows, ceilings or {})
     lines += _edge_lines(edge or [])
     target = [r for r in rows if r["unit"] == "exact_pipeline"]
+    lines += ["", "## Notes", ""]
     if target:
         r = target[0]
-        lines += ["", "## Notes", "",
-                  f"- Target: the default exact pipeline at >= {r['target_mhz']:g} MHz "
+        lines += [f"- Target: the default exact pipeline at >= {r['target_mhz']:g} MHz "
                   f"and 1 pixel per clock: {'met' if r['met'] else 'not met'} "
                   f"({r['fmax_mhz']} MHz, speed grade 6, out of context)."]
     skipped = [d for d in NOT_PLACED if d in TABLE1_ORDER]
@@ -301,6 +317,7 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
         lines += [f"- {', '.join(skipped)}: {NOT_PLACED[skipped[0]]}."]
     lines += [f"- {d}: {METHODS[d].hardware_of}'s hardware (rtl/methods.py), placed once as "
               f"{METHODS[d].hardware_of}." for d in TABLE1_ORDER if METHODS[d].hardware_of]
+    lines += [_axi_note(r) for r in rows if r["row"].startswith("scene_axi:")]
     out.write_text("\n".join(lines) + "\n" + FPGA_NOTES)
     print(f"wrote {out}")
     data = out.parent / "data" / "fpga.json"         # read by report table1
@@ -309,11 +326,24 @@ def write_report(run: FpgaRun, rows, acc, cfg, ceilings=None, edge=None):
                                 "accuracy": acc}, indent=1, sort_keys=True) + "\n")
 
 
+def _axi_note(row):
+    """The note line of a ``scene_axi:<name>`` row: what it places."""
+    name = row["row"].split(":", 1)[1]
+    g = scene_geometry(axi_scene(name).hardware)
+    return (f"- {row['unit']}: the `{name}` scene's BumpPipeline with `map_memory = \"axi\"`: "
+            f"its bump map in the user's memory behind the texel cache (`rtl/cache.TextureCache`: "
+            f"{g.sets} sets x {g.ways} ways of {g.block} x {g.block}-texel lines, a queue of "
+            f"{g.queue} pixels, {g.misses} bursts outstanding) in front of the credit edge, "
+            f"its AXI4 read port (AR and R, {g.data_bits}-bit RDATA, one INCR burst of "
+            f"{g.beats} beats a miss) as top-level ports; the cache's tag, data, stamp and "
+            f"queue memories replace scene_{name}'s map block RAM.")
+
+
 def _scene_widths(rows):
     """The scene rows placed at widths of their own (the built-in scenes' TOML decides)."""
     own = []
     for r in rows:
-        if r["row"].startswith("scene:"):
+        if r["row"].startswith(("scene:", "scene_axi:")):
             sc = load_scene_config(r["row"].split(":", 1)[1])
             own.append(f"{r['unit']} at {sc.angle_bits} / {sc.frac_bits}")
     return "the scene rows at their scenes' widths: " + ", ".join(own) if own else ""

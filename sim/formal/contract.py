@@ -75,10 +75,11 @@ from amaranth.lib import data, wiring
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.utils import ceil_log2
 
+from bumprtl.rtl.cache import TextureCache
 from bumprtl.rtl.pipe import CreditEdge, CreditFIFO
 
 __all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers",
-           "find_edge", "CHUNK"]
+           "find_edge", "find_cache", "CHUNK"]
 
 PROPERTIES = ("hold", "ready", "order", "quiet", "latency", "credit", "cover", "bank")
 
@@ -259,6 +260,14 @@ def find_edge(fragment):
     return _Edge(*found[0]) if len(found) == 1 else None
 
 
+def find_cache(fragment):
+    """The one :class:`~bumprtl.rtl.cache.TextureCache` of an elaborated pipeline (a
+    ``map_memory = "axi"`` scene's, in front of its credit edge), or None."""
+    found = {id(f.origins[0]): f.origins[0] for f in _origins(fragment).values()
+             if f.origins and isinstance(f.origins[0], TextureCache)}
+    return next(iter(found.values())) if len(found) == 1 else None
+
+
 def pipeline_layers(dut):
     """The layers of a :class:`~bumprtl.rtl.pipeline.BumpPipeline` (units fed one valid;
     the first unit of each layer carries the tag), or ``[[dut]]`` for a single unit."""
@@ -390,6 +399,7 @@ class StreamContract(Elaboratable):
         self._pipes, self._counters = observer.seen, observer.counters
         self._frags = _origins(fragment)
         self.edge = find_edge(fragment)
+        self.cache = find_cache(fragment)
         m.submodules.dut = _Built(fragment)
         i, o = dut.i, dut.o
         take_in = i.valid & i.ready
@@ -408,7 +418,8 @@ class StreamContract(Elaboratable):
         """Wide enough for every pixel that can be accepted and not delivered (at most
         ``fifo_depth``, one per stage without an edge), even without the lemmas (BMC), where
         a wrapping counter would be a false failure."""
-        return (max(len(stages), self.port_latency, self.fifo_depth or 0) + 2).bit_length() + 1
+        front = self.dut.units["fetch"].capacity if getattr(self.dut, "_front", False) else 0
+        return (max(len(stages), self.port_latency, self.fifo_depth or 0) + front + 2).bit_length() + 1
 
     def _pixels(self, m, stages):
         """The valid stages of the chain, counted in runs of at most CHUNK stages, each run
@@ -540,13 +551,34 @@ class StreamContract(Elaboratable):
 
     def _occupancy(self, m, take_in, take_out):
         """Pixels accepted and not delivered, counted at the ports from reset; lemma: the
-        chain's valid stages + the FIFO's occupancy."""
+        chain's valid stages + the FIFO's occupancy (+ the pixels in a texel cache in front
+        of the edge)."""
         occ = Signal(self._width(), name="in_flight")
         m.d.sync += occ.eq(occ + take_in - take_out)
         if self.edge is not None and self._chain is not None:
-            self._lemma(m, occ == self._chain + self.edge.edge.level,
-                        "pixels in flight = valid stages + FIFO occupancy")
+            self._lemma(m, occ == self._in_cache(m, take_in) + self._chain + self.edge.edge.level,
+                        "pixels in flight = valid stages + FIFO occupancy" if self.cache is None
+                        else "pixels in flight = pixels in the cache + valid stages + FIFO occupancy")
         return occ
+
+    def _in_cache(self, m, take_in):
+        """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
+        front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
+        lemmas to the cache's lookup register, queue, data-read register and output
+        register (``TextureCache.regs``). Made once per contract."""
+        if self.cache is None:
+            return Const(0, 1)
+        if getattr(self, "_cache_ghost", None) is not None:
+            return self._cache_ghost
+        c, r = self.cache, self.cache.regs
+        ghost = Signal(self._width(), name="in_cache")
+        m.d.sync += ghost.eq(ghost + take_in - (c.o.valid & c.o.ready))
+        count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
+        self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
+        self._lemma(m, ghost == r.look_valid + count + r.rd_valid + c.o.valid,
+                    "pixels in the cache = its lookup, queue, read and output registers")
+        self._cache_ghost = ghost
+        return ghost
 
     def _quiet(self, m, i, o, take_in, take_out, stages):
         occ = self._occupancy(m, take_in, take_out)
@@ -602,7 +634,54 @@ class StreamContract(Elaboratable):
             nxt = Signal(bits, name=f"tag_after_stage{j + 1}")
             m.d.comb += nxt.eq(Mux(valid, tag + 1, expect))
             expect = nxt
-        self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
+        if self.cache is None:
+            self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
+            return
+        # The cache in front of the edge: the tag after the chain's youngest is the next
+        # one the cache delivers, the next input's that plus the pixels in the cache.
+        c = self.cache
+        n_edge = Signal(bits, name="tag_into_chain")
+        m.d.sync += n_edge.eq(n_edge + (c.o.valid & c.o.ready))
+        self._lemma(m, n_edge == expect, "the cache's next pixel is one past the chain's youngest")
+        self._lemma(m, n_in == (n_edge + self._in_cache(m, take_in))[:bits],
+                    "next input tag is one past the youngest in flight")
+        self._cache_order(m, n_edge, bits)
+
+    def _cache_order(self, m, n_edge, bits):
+        """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
+        its output register, its data-read register, its queue's entries from the read
+        sequence number (read through asynchronous ports added to the queue's memory, one
+        per address; the queue's registered read is the entry at that number) and its
+        lookup register."""
+        c, r, g = self.cache, self.cache.regs, self.cache.geom
+        frag = self._frags.get(id(c))
+        inst = _subfragment(frag, "queue") if frag is not None else None
+        if not isinstance(inst, MemoryInstance) or "tag" not in r.rd_extra:
+            return
+        layout = c.queue_layout(g, c.extra)
+        qb = g.queue.bit_length() - 1
+        count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
+        self._lemma(m, ~c.o.valid | (c.o.payload.tag == n_edge),
+                    "the cache's output register holds the chain's next tag")
+        at_rd = (n_edge + c.o.valid)[:bits]
+        self._lemma(m, ~r.rd_valid | (r.rd_extra["tag"] == at_rd),
+                    "the cache's read register holds the tag after its output's")
+        at_q = Signal(bits, name="tag_cache_queue_head")
+        m.d.comb += at_q.eq(at_rd + r.rd_valid)
+        head = r.queue.read_ports[0].data
+        oldest = r.out_seq[:qb] if qb else Const(0, 1)
+        for a in range(g.queue):
+            word = Signal(len(head.as_value()), name=f"cache_queue_slot{a}")
+            inst.read_port(domain="comb", addr=Const(a, max(1, qb)), data=word, en=Const(1),
+                           transparent_for=())
+            word = data.View(layout, word)
+            offset = (Const(a, max(1, qb)) - oldest)[:qb] if qb else Const(0, 1)
+            self._lemma(m, ~(offset < count) | (word.tag == (at_q + offset)[:bits]),
+                        "the cache's queue holds consecutive tags from its oldest")
+            self._lemma(m, ~((oldest == a) & (count != 0)) | (head.as_value() == word.as_value()),
+                        "the cache's queue read is its oldest entry")
+        self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == (at_q + count)[:bits]),
+                    "the cache's lookup register holds the tag after its queue's")
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""

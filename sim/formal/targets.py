@@ -18,10 +18,12 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.rtl.sincos import SinCos
 from bumprtl.rtl.texture import TextureBlend
+from bumprtl.sim.formal.axi import FORMAL_GEOMETRIES, PROVE_ONLY
 from bumprtl.sim.golden.methods import BASELINES, HARDWARE, PER_PIXEL
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
-__all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "target"]
+__all__ = ["Target", "TARGETS", "SMALL", "SMALL_SCENE", "SMALL_CACHE", "AXI_STREAM", "AXI",
+           "target"]
 
 # Small datapath widths (Config checks B >= k - 1 and the table sizes).
 SMALL = {"angle_bits": 6, "frac_bits": 6, "tag_bits": 4, "spec_index_bits": 4, "palette_size": 16}
@@ -29,6 +31,16 @@ SMALL_SCENE = {**SMALL, "texture_size": 16}
 
 STREAM = ("hold", "ready", "order", "quiet", "latency", "credit", "cover", "hold_cover",
           "ready_cover", "order_cover", "quiet_cover", "latency_cover", "credit_cover")
+# A map_memory = "axi" pipeline: the cache in front of the credit edge sets i.ready (its
+# lookup, not the credits) and a miss waits for the memory, so neither ``ready`` (i.ready =
+# fewer than fifo_depth in flight) nor ``latency`` (a fixed port_latency) is its contract.
+AXI_STREAM = tuple(p for p in STREAM if not p.startswith(("ready", "latency")))
+# The texel cache's AXI4 manager port (sim/formal/axi.py): every rule proved, every cover.
+AXI = ("axi", "axi_cover")
+# A small texel cache for the map_memory = "axi" pipeline (a flush of two cycles after
+# reset; the queue and bursts outstanding small): the scene keys of rtl/scene.CACHE_DEFAULTS.
+SMALL_CACHE = {"cache_sets": 2, "cache_ways": 2, "cache_block": 2, "cache_queue": 4,
+               "cache_outstanding": 2}
 
 
 @dataclass(frozen=True)
@@ -41,14 +53,20 @@ class Target:
     config: dict = field(default_factory=dict)
 
     def unit(self):
-        """A fresh unit with a tag wide enough for its pixels in flight."""
+        """A fresh unit with a tag wide enough for its pixels in flight (a texel cache in
+        front of the edge adds the pixels it holds)."""
         bits = SMALL["tag_bits"]
         dut = self.build(bits)
-        while (1 << bits) <= dut.fifo_depth + 1:
+        while (1 << bits) <= dut.fifo_depth + _front_capacity(dut) + 1:
             bits += 1
             _discard(dut)
             dut = self.build(bits)
         return dut
+
+
+def _front_capacity(dut):
+    """Pixels a texel cache in front of a pipeline's edge holds (0 without one)."""
+    return dut.units["fetch"].capacity if getattr(dut, "_front", False) else 0
 
 
 def _discard(dut):
@@ -83,8 +101,8 @@ def _palette(blend):
     return build
 
 
-def _scene(name, bits):
-    keys = {**BUILTIN[name], **SMALL_SCENE, "tag_bits": bits}
+def _scene(name, bits, **more):
+    keys = {**BUILTIN[name], **SMALL_SCENE, "tag_bits": bits, **more}
     return load_scene_config(keys)
 
 
@@ -96,10 +114,14 @@ def _texture_blend(bits):
     return TextureBlend(_cfg(bits), lights=2)
 
 
-def _pipeline(name):
+def _pipeline(name, **more):
     def build(bits):
-        return BumpPipeline(_scene(name, bits).hardware)
+        return BumpPipeline(_scene(name, bits, **more).hardware)
     return build
+
+
+def _no_unit(bits):
+    raise ValueError("an AXI target is checked by sim/formal/axi.py, not built as a unit")
 
 
 def _targets():
@@ -121,6 +143,13 @@ def _targets():
         out.append(Target(f"pipeline_{name}", _pipeline(name),
                           STREAM + (("bank", "bank_cover") if palette else ()), slow=True,
                           note=f"scene {name}"))
+    out.append(Target("pipeline_default_axi", _pipeline("default", map_memory="axi", **SMALL_CACHE),
+                      AXI_STREAM, slow=True, note="scene default, map_memory = 'axi'"))
+    # the cache's AXI4 port: a small cache and the default scene's own (sim/formal/axi.py)
+    for geometry in FORMAL_GEOMETRIES:
+        out.append(Target(f"cache_axi_{geometry}", _no_unit,
+                          AXI[:1] if geometry in PROVE_ONLY else AXI, note="AXI4 read rules",
+                          config={"geometry": geometry}))
     return out
 
 

@@ -230,3 +230,38 @@ def test_a_run_stopped_early_keeps_the_placements_it_finished(tmp_path, monkeypa
     rows = report.place_all(Config(), args, tasks)
     assert calls == ["first", "second"]                 # the first came from the cache
     assert {r["unit"] for r in rows.values()} == {"first", "second"}
+
+
+def test_report_fpga_places_the_default_scene_with_its_map_behind_the_cache(tmp_path, monkeypatch):
+    """The scene_default_axi row: the default scene's BumpPipeline with map_memory = "axi"
+    (the AXI4 read port as top-level ports, no map write port), placed at the scene seeds
+    like the other scene rows, with a note line saying what it places."""
+    from bumprtl.gen.flow.units import build_unit
+    from bumprtl.gen.report import fpga as report
+    from bumprtl.gen.tools import jobs
+    from bumprtl.rtl.cache import AxiMapFetch
+
+    assert ("scene_default_axi", "exact", "scene_axi:default") in report.fpga_units(Config())
+    pipeline = report._component(None, "scene_axi:default", Config())
+    members = pipeline.signature.members
+    assert "axi" in members and "map_w_en" not in members
+    assert {"araddr", "arvalid", "arready", "rdata", "rlast", "rready"} <= set(members["axi"].signature.members)
+    assert isinstance(pipeline.units["fetch"], AxiMapFetch)
+    for unit in (pipeline, *pipeline.units.values()):
+        unit._MustUse__silence = True
+
+    monkeypatch.setattr(jobs, "LOCAL_PROCESSES", False)
+    monkeypatch.setattr(jobs, "LOG_DIR", tmp_path / "job_logs")
+    calls = []
+    monkeypatch.setattr(fpga, "place_and_route", _fake_place_and_route(calls))
+    monkeypatch.setattr(report, "accuracy", lambda d, cfg, n: {"max": 1, "mean": 0.1})
+    monkeypatch.setattr(report, "_component", lambda design, row, cfg: build_unit(
+        "sincos", Config(angle_bits=6, frac_bits=5 + (row == "scene_axi:default")), ECP5())[0])
+    out = tmp_path / "report.md"
+    assert main(["report", "fpga", "--unit", "scene_default_axi", "--scene-seeds", "2,3",
+                 "--out", str(out), "--work", str(tmp_path)]) == 0
+    text = out.read_text()
+    assert "| scene_default_axi | 1 | 2 | 0 | 0 | 102.0 |" in text and "2: 102.0, 3: 103.0" in text
+    notes = text.split("## Notes")[1].splitlines()
+    note = [ln for ln in notes if ln.startswith("- scene_default_axi: ")]
+    assert len(note) == 1 and 'map_memory = "axi"' in note[0] and "AXI4 read port" in note[0]
