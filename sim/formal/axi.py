@@ -29,18 +29,15 @@ from amaranth.hdl import (
     Assert,
     Assume,
     Cat,
-    Cover,
-    Elaboratable,
     Module,
     Signal,
-    Value,
-    ValueCastable,
 )
 from amaranth.lib import wiring
 from amaranth.lib.wiring import Out
 
 from bumprtl.gen.tools.sby import run_sby
 from bumprtl.rtl.cache import ARBURST_INCR, CacheGeometry, TextureCache, scene_geometry
+from bumprtl.sim.formal.rules import RuleContract
 from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
 
 __all__ = ["RULES", "ASSUMED", "AxiReadContract", "FORMAL_GEOMETRIES", "MUTANTS", "prove", "bmc",
@@ -102,42 +99,22 @@ def cover_depth(geom):
     return geom.sets + geom.misses + 2 * geom.beats + 12
 
 
-class AxiReadContract(Elaboratable):
+class AxiReadContract(RuleContract):
     """The cache built from ``geom`` (or ``dut``, a broken one with the same ports and
     ``regs``) and the monitor of its AXI port (module docstring)."""
 
+    RULES = RULES
+
     def __init__(self, geom: CacheGeometry, dut=None, lemmas=True):
+        super().__init__(dut if dut is not None else TextureCache(geom))
         self.geom, self.lemmas_on = geom, lemmas
-        self.dut = dut if dut is not None else TextureCache(geom)
-        self.messages = {}
-        self.covers = []
         self.lemmas = []
         self.assumed = []
-
-    def free_inputs(self):
-        ports = []
-        for _path, member, value in self.dut.signature.flatten(self.dut):
-            if member.flow == wiring.In:
-                ports.append(value.as_value() if isinstance(value, ValueCastable)
-                             else Value.cast(value))
-        return ports
-
-    def describe(self, location):
-        """The rule sby reports at ``location`` (``file:line ...``)."""
-        return self.messages.get(location.split(" ")[0], location)
-
-    def _check(self, m, rule, test):
-        check = Assert(test, RULES[rule], src_loc_at=1)
-        self.messages[f"{check.src_loc[0]}:{check.src_loc[1]}"] = rule
-        m.d.comb += check
 
     def _assume(self, m, rule, test):
         self.assumed.append(rule)
         m.d.comb += Assume(test, ASSUMED[rule], src_loc_at=1)
 
-    def _cover(self, m, what, test):
-        self.covers.append(what)
-        m.d.comb += Cover(test)
 
     def _lemma(self, m, what, test):
         if not self.lemmas_on:

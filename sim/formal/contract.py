@@ -68,15 +68,14 @@ from amaranth.hdl import (
     Module,
     Mux,
     Signal,
-    Value,
-    ValueCastable,
 )
-from amaranth.lib import data, wiring
+from amaranth.lib import data
 from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.utils import ceil_log2
 
 from bumprtl.rtl.cache import TextureCache
 from bumprtl.rtl.pipe import CreditEdge, CreditFIFO
+from bumprtl.sim.formal.rules import component_inputs
 
 __all__ = ["PROPERTIES", "StreamContract", "PipeObserver", "observe_pipes", "pipeline_layers",
            "find_edge", "find_cache", "CHUNK"]
@@ -359,11 +358,7 @@ class StreamContract(Elaboratable):
     def free_inputs(self):
         """Every input of the unit (``i.valid``, ``i.payload``, ``o.ready``, host ports) and
         the clock and reset: the model's free inputs, chosen by the solver in every cycle."""
-        ports = []
-        for _path, member, value in self.dut.signature.flatten(self.dut):
-            if member.flow == wiring.In:
-                ports.append(value.as_value() if isinstance(value, ValueCastable) else Value.cast(value))
-        return ports + self._free
+        return component_inputs(self.dut) + self._free
 
     def _check(self, m, test, message, src_loc_at=1):
         """``Assert(test)``; sby names a failed one by its source line, ``messages`` maps

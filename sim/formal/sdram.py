@@ -25,18 +25,14 @@ from amaranth.hdl import (
     Assert,
     Cat,
     Const,
-    Cover,
-    Elaboratable,
     Module,
     Mux,
     Signal,
-    Value,
-    ValueCastable,
 )
-from amaranth.lib import wiring
 
 from bumprtl.gen.tools.sby import run_sby
 from bumprtl.rtl.sdram import SdramConfig, SdramController
+from bumprtl.sim.formal.rules import RuleContract
 
 __all__ = ["RULES", "SdramCommandContract", "FORMAL_CONFIGS", "prove", "bmc", "cover"]
 
@@ -71,35 +67,14 @@ FORMAL_CONFIGS = {
 }
 
 
-class SdramCommandContract(Elaboratable):
+class SdramCommandContract(RuleContract):
     """The controller built from ``cfg`` and the monitor of its pins (module docstring)."""
 
+    RULES = RULES
+
     def __init__(self, cfg: SdramConfig, dut=None):
+        super().__init__(dut if dut is not None else SdramController(cfg))
         self.cfg = cfg
-        self.dut = dut if dut is not None else SdramController(cfg)
-        self.messages = {}
-        self.covers = []
-
-    def free_inputs(self):
-        ports = []
-        for _path, member, value in self.dut.signature.flatten(self.dut):
-            if member.flow == wiring.In:
-                ports.append(value.as_value() if isinstance(value, ValueCastable)
-                             else Value.cast(value))
-        return ports
-
-    def _check(self, m, rule, test):
-        check = Assert(test, RULES[rule], src_loc_at=1)
-        self.messages[f"{check.src_loc[0]}:{check.src_loc[1]}"] = rule
-        m.d.comb += check
-
-    def _cover(self, m, what, test):
-        self.covers.append(what)
-        m.d.comb += Cover(test)
-
-    def describe(self, location):
-        """The rule sby reports at ``location`` (``file:line ...``)."""
-        return self.messages.get(location.split(" ")[0], location)
 
     def _lemma(self, m, what, test, src_loc_at=1):
         """An assertion about the controller's registers that makes the rules inductive
