@@ -16,6 +16,7 @@ from bumprtl.gen.bench.sweep import METHOD_CHOICES, SweepOptions, command_line, 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.flow.fpga import NOT_PLACED, FpgaError
 from bumprtl.rtl.config import Config
+from tests.tools.fake_jobs import fake_runner, outcome
 
 DEFAULT = (Config().angle_bits, Config().frac_bits)
 
@@ -55,27 +56,14 @@ class FakePlacement:
         return {**value["row"], "unit": self.label, "stored": True}
 
 
-class FakeRunner:
-    jobs = []
+def _placed(job):
+    key, _label = job.args
+    if key == "bad":
+        return outcome(error="x" * 400)
+    return outcome({"row": {"fmax_mhz": 50.0, "LUT4": 7}})
 
-    def __init__(self, address, workers, progress=True):
-        pass
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
-    def run(self, jobs, desc=None):
-        out = {}
-        for job in jobs:
-            FakeRunner.jobs.append(job.name)
-            key, _label = job.args
-            ok = key != "bad"
-            out[job.name] = SimpleNamespace(ok=ok, error="x" * 400 if not ok else None,
-                                            value={"row": {"fmax_mhz": 50.0, "LUT4": 7}})
-        return out
+FakeRunner = fake_runner(_placed)
 
 
 def test_points_get_their_rows_from_the_cache_one_job_per_verilog_or_their_error(monkeypatch):

@@ -47,45 +47,32 @@ def test_a_shard_runs_in_a_directory_holding_the_files_it_carries(monkeypatch):
 
 
 def test_shards_run_as_jobs_their_counts_added_and_a_failure_named(monkeypatch, tmp_path):
-    from types import SimpleNamespace
-
     from bumprtl.sim.tb import bulk_shards
+    from tests.tools.fake_jobs import fake_runner, outcome
 
-    class Runner:
-        def __init__(self, address, workers):
-            Runner.workers = workers
+    failing = {"seed": None}
 
-        def __enter__(self):
-            return self
+    def shard(job):
+        sim, files, v_name, j_name, patterns, source, kw = job.args
+        if source["seed"] == failing["seed"]:
+            return outcome(error="tb_bulk: 3 mismatches")
+        return outcome({"pixels": {p: source["n"] for p in patterns},
+                        "checked": source["seed"] != 1})
 
-        def __exit__(self, *exc):
-            return False
-
-        def run(self, jobs, desc=None):
-            out = {}
-            for job in jobs:
-                sim, files, v_name, j_name, patterns, source, kw = job.args
-                Runner.files = files
-                fail = source["seed"] == Runner.fail
-                out[job.name] = SimpleNamespace(
-                    ok=not fail, error="tb_bulk: 3 mismatches" if fail else None,
-                    value={"pixels": {p: source["n"] for p in patterns},
-                           "checked": source["seed"] != 1})
-            return out
-
+    Runner = fake_runner(shard)
     monkeypatch.setattr(bulk_shards, "Runner", Runner)
     monkeypatch.delenv("BUMPRTL_SCHEDULER", raising=False)
     (tmp_path / "u.v").write_text("module u; endmodule")
     (tmp_path / "u.json").write_text("{}")
     (tmp_path / "notes.txt").write_text("not carried")
-    Runner.fail = None
     r = bulk_shards.run_bulk_shards("icarus", tmp_path / "u.v", tmp_path / "u.json",
                                     ("no_stall", "both"), {"kind": "sincos", "n": 10, "seed": 2},
                                     shards=3)
-    assert Runner.workers == 2 and sorted(Runner.files) == ["u.json", "u.v"]
+    assert Runner.workers == 2
+    assert len(Runner.jobs) == 3 and all(sorted(job.args[1]) == ["u.json", "u.v"] for job in Runner.jobs)
     assert r["pixels"] == {"no_stall": 10, "both": 10} and r["checked"] is True
     assert [s["pixels"]["no_stall"] for s in r["shards"]] == [4, 3, 3]
-    Runner.fail = 2001
+    failing["seed"] = 2001
     with pytest.raises(AssertionError, match=r"bulk shards failed: bulk-icarus-u-sincos-shard1: "
                                              r"tb_bulk: 3 mismatches"):
         bulk_shards.run_bulk_shards("icarus", tmp_path / "u.v", tmp_path / "u.json",
