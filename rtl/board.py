@@ -33,6 +33,8 @@ pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's
 k) and ``tmds_clk_p``.
 """
 
+import math
+
 from amaranth.hdl import (
     Cat,
     ClockDomain,
@@ -81,8 +83,8 @@ def cdc_depth(pixel_hz, pipe_hz, stall_cycles=0):
                         f"(one pixel a clock through a line), got {pipe_hz / 1e6:g} MHz", "pipe_hz")
     if not isinstance(stall_cycles, int) or stall_cycles < 0:
         raise BumpError(f"stall_cycles must be an int >= 0, got {stall_cycles!r}", "stall_cycles")
-    pipe_side = (2 + CDC_SYNC_STAGES + stall_cycles) * pixel_hz / pipe_hz
-    need = 3 + CDC_SYNC_STAGES + int(-(-pipe_side // 1)) + 1
+    pipe_side = math.ceil((2 + CDC_SYNC_STAGES + stall_cycles) * pixel_hz / pipe_hz)
+    need = 3 + CDC_SYNC_STAGES + pipe_side + 1
     return 1 << (need - 1).bit_length()
 
 
@@ -218,8 +220,7 @@ class BoardCore(Elaboratable):
                 m.d.sync += self.order_error.eq(1)
         with m.If(t.de & ~valid):
             m.d.sync += self.underflow.eq(1)
-        rgb = color
-        pixel = Mux(take, rgb, 0)                     # bytes: blue, green, red
+        pixel = Mux(take, color, 0)                   # bytes: blue, green, red
         m.d.comb += self.pixel.eq(pixel)
         words = []
         for lane in range(3):
@@ -296,7 +297,7 @@ def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None):
         div, _ = pll_pipe_divider(pixel_hz, pipe_hz, ref_hz)
         extra = {"p_CLKOS2_ENABLE": "ENABLED", "p_CLKOS2_DIV": div,
                  "p_CLKOS2_CPHASE": div - 1, "p_CLKOS2_FPHASE": 0}
-    return {**extra,"p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
+    return {**extra, "p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
             "p_CLKOP_ENABLE": "ENABLED", "p_CLKOP_DIV": op_div, "p_CLKOP_CPHASE": op_div - 1,
             "p_CLKOP_FPHASE": 0, "p_CLKOS_ENABLE": "ENABLED", "p_CLKOS_DIV": 5 * op_div,
             "p_CLKOS_CPHASE": 5 * op_div - 1, "p_CLKOS_FPHASE": 0,

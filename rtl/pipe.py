@@ -314,8 +314,7 @@ class CreditFIFO(Elaboratable):
         # register (so no tool merges them), whose loads reach only that slice's LUT RAMs,
         # prefetch and output bits: one load would otherwise fan out to every bit of a
         # wide pixel. Slice 0's copies are the FIFO's (``read_pointer``, ``count``, ...).
-        pres = [Signal(self.width, name=f"fifo_pre_bank{b}", reset_less=True)
-                for b in range(len(self.banks))]
+        pres = [Signal(self.width, name=f"fifo_pre_bank{b}", reset_less=True) for b in range(n)]
         copies = []
         for k, lo in enumerate(range(0, self.width, READ_SLICE)):
             hi = min(lo + READ_SLICE, self.width)
