@@ -102,12 +102,18 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     """
     k = cfg.k
     a = angle[:cfg.angle_bits]
-    if registered and angle_stage:
-        a = pipe.register(a, f"{name}_angle")
     quadrant, index = a[k:], a[:k]
     if quarters:                                        # angle + quarters * 2**k
         quadrant = (quadrant + quarters)[:2]
-    address = Mux(quadrant[0], (1 << k) - index, index)
+    if registered and angle_stage:
+        # The angle register holds the index folded for its quadrant (i ^ q0), so that a
+        # sine and a cosine of one angle have registers of their own (a shared one spans
+        # both ROMs); the mirrored index 2**k - i = ~i + 1 is then the folded word + q0.
+        folded = pipe.register(Cat(index ^ quadrant[0].replicate(k), quadrant), f"{name}_angle")
+        quadrant = folded[k:]
+        address = folded[:k] + quadrant[0]
+    else:
+        address = Mux(quadrant[0], (1 << k) - index, index)
     if registered:             # the block RAM's address pins straight from a flip-flop
         address = pipe.register(address, f"{name}_address")
         if near:
