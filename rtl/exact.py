@@ -44,7 +44,7 @@ def rotated_layout(cfg: Config):
 class SineBank:
     """Dual-port quarter-wave ROMs, two reads each (one block RAM per pair on an FPGA);
     a value read appears ``latency`` pipe stages after its angle (angle register,
-    address register, [its near copy for a wide ROM,] read, block-RAM output register,
+    folded index, address register, [its near copy for a wide ROM,] read, block-RAM output register,
     data register, its copy, sign: sincos.registered_sine_latency)."""
 
     def __init__(self, m, pipe, cfg):
@@ -60,7 +60,7 @@ class SineBank:
         return self.pending.pop(0)
 
     def sin(self, angle, name, quarters=0):
-        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name, registered=True,
+        return sine_read(self.m, self.pipe, self._port(), angle, self.cfg, name,
                          near=self.near, line=self.line, quarters=quarters)
 
     def cos(self, angle, name):
@@ -107,8 +107,8 @@ class ExactRotation(PipeUnit):
     and per vector A: D = ph_A - ph_N, X = th_A + D, Y = th_A - D,
       2p = s(X) + s(Y), 2y = c(Y) - c(X), z = c(th_A).
     Latency :func:`rotation_latency`: the input sums (a, b, D), SineBank.latency (read
-    angle, ROM address, its near copy, ROM read, block-RAM output register, data register,
-    its copy, sign: 11 in all), three adder levels, the output register; 1 pixel per clock.
+    angle, folded index, ROM address, its near copy, ROM read, block-RAM output register,
+    data register, its copy, sign), three adder levels, the output register; 1 pixel per clock.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):

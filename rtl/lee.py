@@ -216,7 +216,7 @@ def block_rom(pipe, init, shape, name, ports):
 
 def sine_rom(pipe, cfg: Config, name, ports):
     """The quarter-wave sine ROM (tables.quarter_sine) as a :class:`BlockROM` with ``ports``
-    read ports, each read through sincos.sine_read(registered=True)."""
+    read ports, each read through sincos.sine_read."""
     return block_rom(pipe, quarter_sine(cfg).tolist(), unsigned(cfg.frac_bits + 1), name, ports)
 
 
@@ -232,17 +232,17 @@ def rom_read(pipe, name, table, width, address):
 
 # rom_read: the address register, the ROM read and its output register, the data register.
 ROM_STAGES = 2 + ROM_LATENCY
-# sine_value: sincos.sine_read(registered=True), whose data register before the sign is
+# sine_value: sincos.sine_read, whose data register before the sign is
 # rom_read's.
 SINE_STAGES = REGISTERED_SINE_LATENCY
 
 
 def sine_value(m, pipe, port, angle, cfg: Config, name):
     """``sin(angle)`` through ``port`` of a :func:`sine_rom`, SINE_STAGES pipe stages later:
-    sincos.sine_read(registered=True) (angle, mirrored address, read, output register, the
+    sincos.sine_read (angle, folded index, mirrored address, read, output register, the
     word registered once more before the sign's carry chain as :func:`rom_read` does, sign;
     bit-exact with tables.sin_lookup). ``cos(a)`` is ``sin(a + 2**k)``."""
-    return sine_read(m, pipe, port, angle, cfg, name, registered=True)
+    return sine_read(m, pipe, port, angle, cfg, name)
 
 
 S, W = SINE_STAGES, WIDE_PRODUCT_LATENCY
@@ -364,7 +364,7 @@ class LeeIllumination(IlluminationDatapath):
 
     Input :func:`rotated_layout`; output ``shade_layout(cfg)``. Each cosine table is a
     one-port :func:`sine_rom` (one DP16KD with its output register on ECP5) read
-    by sincos.sine_read (angle sum, address, read, output register, data register, its copy, sign:
+    by sincos.sine_read (angle sum, folded index, address, read, output register, data register, its copy, sign:
     REGISTERED_SINE_LATENCY stages); then c- + c+ and c- - c+ (1), the registered product
     (``pipe.product_latency`` of :func:`dot_operands`: PRODUCT_LATENCY up to B = 15, else a
     ``pipe.WideProduct``, WIDE_PRODUCT_LATENCY, on every target), the sum and its rounding
@@ -386,7 +386,7 @@ class LeeIllumination(IlluminationDatapath):
         for name, angle in angles.items():                                 # 3 cosine tables
             rom = sine_rom(pipe, cfg, f"{v}_cos_{name}_rom", ports=1)
             c[name] = sine_read(m, pipe, rom.ports[0], angle + (1 << cfg.k), cfg,
-                                f"{v}_cos_{name}", registered=True)
+                                f"{v}_cos_{name}")
         first = pipe.register(c["minus"] + c["plus"], f"{v}_first")
         diff = pipe.register(c["minus"] - c["plus"], f"{v}_diff")
         mul = pipe.multiplier(*dot_operands(cfg))

@@ -2,20 +2,19 @@
 
 from amaranth.hdl import Cat, Const, Mux, signed, unsigned
 from amaranth.lib import data
-from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipe import ROM_LATENCY, PipeUnit
 from bumprtl.rtl.tables import quarter_sine, quarter_sine_above_line
 from bumprtl.rtl.targets import NEAR_BLOCKS, is_spread, rom_blocks
 
-__all__ = ["SinCos", "quarter_wave_rom", "registered_quarter_wave_rom", "sine_read",
+__all__ = ["SinCos", "registered_quarter_wave_rom", "sine_read",
            "REGISTERED_SINE_LATENCY", "spread_sine", "near_sine", "registered_sine_latency", "sine_line",
            "sine_rom_table"]
 
-# sine_read(registered=True): angle register, address register, ROM read, block-RAM
-# output register, data register, its copy, sign.
-REGISTERED_SINE_LATENCY = 2 + ROM_LATENCY + 3
+# sine_read: angle register, folded index, address register, ROM read,
+# block-RAM output register, data register, its copy, sign.
+REGISTERED_SINE_LATENCY = 3 + ROM_LATENCY + 3
 
 
 def _width(words):
@@ -58,34 +57,28 @@ def near_sine(cfg: Config):
 
 
 def registered_sine_latency(cfg: Config):
-    """Stages of :func:`sine_read` (registered) through the quarter-wave ROM of ``cfg``:
+    """Stages of :func:`sine_read` through the quarter-wave ROM of ``cfg``:
     REGISTERED_SINE_LATENCY, one more where its reads take a near address register
     (:func:`near_sine`)."""
     return REGISTERED_SINE_LATENCY + near_sine(cfg)
 
 
-def quarter_wave_rom(cfg: Config):
-    """The quarter-wave sine ROM as an Amaranth Memory (contents: tables.quarter_sine)."""
-    return Memory(shape=unsigned(cfg.frac_bits + 1), depth=cfg.sincos_depth,
-                  init=quarter_sine(cfg).tolist())
-
-
 def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
     """The quarter-wave sine ROM (:func:`sine_rom_table`) as a :class:`pipe.RegisteredROM`
     (read, output register; DP16KD with both ports on ECP5), read by :func:`sine_read`
-    with ``registered`` and ``line=sine_line(cfg)``."""
+    with ``line=sine_line(cfg)``."""
     table, width = sine_rom_table(cfg)
     return pipe.rom(table.tolist(), unsigned(width), name, ports)
 
 
-def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_stage=True,
-              near=False, line=False, quarters=0):
-    """``sin(angle)`` through one read port of a quarter-wave ROM; the signed Q1.B value
-    appears two pipe stages later (ROM read, then sign) from a Memory read port, or
-    REGISTERED_SINE_LATENCY stages later from a :class:`pipe.RegisteredROM` port with
-    ``registered`` (the angle, the address, ROM read, block-RAM output register, a data
-    register beside the block RAM, its copy beside the adder, then sign: the angle's adder,
-    the mirrored address ``2**k - i``, the route to the block RAM's address pins, its
+def sine_read(m, pipe, port, angle, cfg: Config, name, angle_stage=True, near=False,
+              line=False, quarters=0):
+    """``sin(angle)`` through one read port of a registered quarter-wave ROM
+    (:class:`pipe.RegisteredROM`); the signed Q1.B value appears
+    REGISTERED_SINE_LATENCY (+ ``near``) stages later (the angle, its index folded for the quadrant, the address, ROM read,
+    block-RAM output register, a data register beside the block RAM, its copy beside the
+    adder, then sign: the angle's adder, the route from a register shared by the reads of
+    one angle, the mirrored address ``2**k - i``, the route to the block RAM's address pins, its
     clock-to-out and the route from its data pins, which is long where a table spans two
     blocks side by side or the ROM sits far from its reader, each get a cycle of their own;
     ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
@@ -102,31 +95,25 @@ def sine_read(m, pipe, port, angle, cfg: Config, name, registered=False, angle_s
     """
     k = cfg.k
     a = angle[:cfg.angle_bits]
+    if angle_stage:
+        a = pipe.register(a, f"{name}_angle")
     quadrant, index = a[k:], a[:k]
     if quarters:                                        # angle + quarters * 2**k
         quadrant = (quadrant + quarters)[:2]
-    if registered and angle_stage:
-        # The angle register holds the index folded for its quadrant (i ^ q0), so that a
-        # sine and a cosine of one angle have registers of their own (a shared one spans
-        # both ROMs); the mirrored index 2**k - i = ~i + 1 is then the folded word + q0.
-        folded = pipe.register(Cat(index ^ quadrant[0].replicate(k), quadrant), f"{name}_angle")
-        quadrant = folded[k:]
-        address = folded[:k] + quadrant[0]
-    else:
-        address = Mux(quadrant[0], (1 << k) - index, index)
-    if registered:             # the block RAM's address pins straight from a flip-flop
-        address = pipe.register(address, f"{name}_address")
-        if near:
-            address = pipe.register(address, f"{name}_address_near")
-        m.d.comb += port.addr.eq(address)
-        if line:
-            return _sine_above_line(pipe, port, address, quadrant[1], cfg, name, near)
-        negative = pipe.delay(quadrant[1], 3 + near + ROM_LATENCY, f"{name}_negative")
-        value = pipe.register(pipe.register(port.data, f"{name}_data"), f"{name}_word")
-    else:
-        m.d.comb += [port.addr.eq(address), port.en.eq(pipe.en)]
-        negative = pipe.register(quadrant[1], f"{name}_negative")
-        value = port.data
+    # Each read's own register: the index folded for its quadrant (i ^ q0). A sine and a
+    # cosine of one angle differ in it, so no tool merges the two (one register would reach
+    # both ROMs' address logic), and the long route to a ROM placed apart passes one LUT.
+    # The mirrored address 2**k - i = ~i + 1 is then the folded word + 1.
+    folded = pipe.register(Cat(index ^ quadrant[0].replicate(k), quadrant), f"{name}_folded")
+    quadrant, word = folded[k:], folded[:k]
+    address = pipe.register(Mux(quadrant[0], word + 1, word), f"{name}_address")  # to the pins
+    if near:
+        address = pipe.register(address, f"{name}_address_near")
+    m.d.comb += port.addr.eq(address)
+    if line:
+        return _sine_above_line(pipe, port, address, quadrant[1], cfg, name, near)
+    negative = pipe.delay(quadrant[1], 3 + near + ROM_LATENCY, f"{name}_negative")
+    value = pipe.register(pipe.register(port.data, f"{name}_data"), f"{name}_word")
     return pipe.register(Mux(negative, -value, value), name)
 
 
@@ -170,8 +157,9 @@ class SinCos(PipeUnit):
         ``sin``/``cos`` are Q1.B: ``2**B`` is 1.0. Bit-exact with
         :func:`bumprtl.rtl.tables.sin_lookup` / ``cos_lookup``.
 
-    Latency REGISTERED_SINE_LATENCY = 7 cycles (angle, address, ROM read, block-RAM
-    output register, data register, its copy, sign); throughput 1 angle per clock when not stalled.
+    Latency :func:`registered_sine_latency` (angle, folded index, address, [its near
+    copy,] ROM read, block-RAM output register, data register, its copy, sign); one angle
+    per clock.
     """
 
     def __init__(self, cfg: Config, target=None, credit=True, fifo_depth=None):
@@ -184,13 +172,13 @@ class SinCos(PipeUnit):
                          target, credit, fifo_depth)
 
     def build(self, m, pipe):
-        cfg, k = self.cfg, self.cfg.k
+        cfg = self.cfg
         rom = registered_quarter_wave_rom(pipe, cfg, "rom")
         angle = pipe.register(self.i.payload.angle, "angle")     # one angle stage for both
-        outputs = {name: sine_read(m, pipe, port, angle + offset, cfg, f"{name}_value",
-                                   registered=True, angle_stage=False, near=near_sine(cfg),
-                                   line=sine_line(cfg))
-                   for port, (name, offset) in zip(rom.ports, (("sin", 0), ("cos", 1 << k)), strict=False)}
+        outputs = {name: sine_read(m, pipe, port, angle, cfg, f"{name}_value",
+                                   angle_stage=False, near=near_sine(cfg),
+                                   line=sine_line(cfg), quarters=quarters)
+                   for port, (name, quarters) in zip(rom.ports, (("sin", 0), ("cos", 1)), strict=True)}
         m.d.comb += [
             pipe.o.payload.sin.eq(outputs["sin"]),
             pipe.o.payload.cos.eq(outputs["cos"]),

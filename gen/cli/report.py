@@ -76,7 +76,8 @@ def add_fpga(kinds):
     f.add_argument("--seeds", type=_seeds, default=[1],
                    help="nextpnr seeds, comma-separated (default 1); Fmax is their minimum")
     f.add_argument("--scene-seeds", type=_seeds, default=None,
-                   help="nextpnr seeds of the scene pipelines' rows (default: --seeds)")
+                   help="nextpnr seeds of the rows with the 200 MHz goal: the scene pipelines "
+                        "and the default method's pipeline (default: --seeds)")
     f.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="local worker processes, one placement each at a time (default: the "
                         "number of cores; ignored with --scheduler)")

@@ -287,7 +287,7 @@ class KimRotation(PipeUnit):
     Cartesian, M, back to polar. Input ``pixel_layout(cfg)``; output :func:`rotated_layout` (L', H', N' passed
     through, polar binary angles, as rtl/lee.py).
 
-    Every sin/cos read is lee.sine_value (S = SINE_STAGES: angle, address, read, output
+    Every sin/cos read is lee.sine_value (S = SINE_STAGES: angle, folded index, address, read, output
     register, data register, its copy, sign), every other table read lee.rom_read (R = ROM_STAGES:
     address register, read, output register, data register), every product a
     RegisteredProduct (P = PRODUCT_LATENCY), and at most one carry chain or half a mux chain
@@ -400,15 +400,14 @@ class KimIllumination(IlluminationDatapath):
         cfg, k = self.cfg, self.cfg.k
         b = payload.b
         rom = sine_rom(pipe, cfg, "b_sincos_rom", ports=2)
-        st_n = sine_read(m, pipe, rom.ports[0], b.theta, cfg, "b_sin_theta", registered=True)
-        ct_n = sine_read(m, pipe, rom.ports[1], b.theta + (1 << k), cfg, "b_cos_theta",
-                         registered=True)
+        st_n = sine_read(m, pipe, rom.ports[0], b.theta, cfg, "b_sin_theta")
+        ct_n = sine_read(m, pipe, rom.ports[1], b.theta + (1 << k), cfg, "b_cos_theta")
         dots = {}
         for v in vectors(cfg):
             a = payload[v]
             mul = _multiplier(pipe, f"{v}_dot")
             rom = sine_rom(pipe, cfg, f"{v}_sincos_rom", ports=3)
-            st, ct, cphi = (sine_read(m, pipe, port, angle, cfg, f"{v}_{name}", registered=True)
+            st, ct, cphi = (sine_read(m, pipe, port, angle, cfg, f"{v}_{name}")
                             for port, (angle, name) in zip(rom.ports, (
                                 (a.theta, "sin_theta"), (a.theta + (1 << k), "cos_theta"),
                                 (a.phi - b.phi + (1 << k), "cos_dphi")), strict=False))          # sin/cos

@@ -34,3 +34,19 @@ def test_timing_page_and_its_figure_state_the_latency():
     assert f"the default pipeline's latency is {p.port_latency} cycles" in (DOCS / "timing.md").read_text()
     latency = json.loads((DOCS / "timing" / "latency.json").read_text())
     assert latency["head"]["text"] == f"Latency of the default pipeline: {p.port_latency} cycles"
+
+
+def test_hand_written_latencies_are_the_rtls():
+    """The hand-written pages that quote a latency at today's default say what the RTL
+    computes: Lee's two units (docs/lee_method.md) and the default pipeline's sidecar
+    (docs/scenes.md)."""
+    from bumprtl.rtl import methods
+    from bumprtl.rtl.config import Config
+    cfg = Config(method="lee")
+    rot, ill = methods.get("lee").rotation(cfg), methods.get("lee").illumination(cfg)
+    for unit in (rot, ill):
+        unit._MustUse__silence = True
+    lee = " ".join((DOCS / "lee_method.md").read_text().split())
+    assert f"Latency {rot.latency} + {ill.latency} cycles at the default widths" in lee
+    scenes = " ".join((DOCS / "scenes.md").read_text().split())
+    assert f"{default_pipeline().port_latency} at today's default, the `latency` of" in scenes

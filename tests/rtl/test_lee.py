@@ -101,11 +101,11 @@ def test_latency_and_one_pixel_per_clock():
 
 
 @pytest.mark.parametrize("cfg, prop, dot, rotation, illumination", [
-    (Config(angle_bits=12, frac_bits=12), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
-    (Config(frac_bits=13), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
-    (Config(), PRODUCT_LATENCY, PRODUCT_LATENCY, 34, 26),
-    (Config(angle_bits=13, frac_bits=16), PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 34, 29),
-    (Config(angle_bits=16, frac_bits=24), WIDE_PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 37, 29)],
+    (Config(angle_bits=12, frac_bits=12), PRODUCT_LATENCY, PRODUCT_LATENCY, 35, 27),
+    (Config(frac_bits=13), PRODUCT_LATENCY, PRODUCT_LATENCY, 35, 27),
+    (Config(), PRODUCT_LATENCY, PRODUCT_LATENCY, 35, 27),
+    (Config(angle_bits=13, frac_bits=16), PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 35, 30),
+    (Config(angle_bits=16, frac_bits=24), WIDE_PRODUCT_LATENCY, WIDE_PRODUCT_LATENCY, 38, 30)],
     ids=["a12b12", "b13", "default", "a13b16", "a16b24"])
 def test_latencies_follow_the_product_widths(cfg, prop, dot, rotation, illumination):
     """A product whose operands outgrow one 18-bit DSP input is a WideProduct, three stages

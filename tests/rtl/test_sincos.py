@@ -65,4 +65,4 @@ def test_sine_line_where_it_saves_block_rams(angle_bits, frac_bits, line, width,
     assert rom_blocks(1 << cfg.k, width) == blocks
     assert spread_sine(cfg) == (blocks > 8)
     assert near_sine(cfg) == (blocks > NEAR_BLOCKS)
-    assert SinCos(cfg).latency == 7 + near_sine(cfg)
+    assert SinCos(cfg).latency == 8 + near_sine(cfg)
