@@ -48,8 +48,9 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
-# queue is empty: the lookup register, the queue's read, the data read, the output register.
-CACHE_LATENCY = 4
+# queue is empty: the tag read, the lookup, the queue's entry, the data read, the output
+# register.
+CACHE_LATENCY = 5
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -331,7 +332,8 @@ class TextureCache(wiring.Component):
         RREADY high while a burst is outstanding.
 
     Misses overlap (prefetching behind a reorder queue, Igehy, Eldridge & Proudfoot, HWWS
-    1998): the tags are checked the cycle after a pixel is taken, and a miss writes the new
+    1998): a pixel's set is read as it is taken (tags and sequence stamps, into a register
+    stage of their own), its tags are checked the cycle after, and a miss writes the new
     tag and issues its line's burst at once; the pixel then waits in a queue of
     ``geom.queue`` entries with its (set, way, word) while the pixels behind it are looked
     up. A pixel leaves the queue in order; a miss's pixel only once its line has landed
@@ -341,8 +343,9 @@ class TextureCache(wiring.Component):
     on it, and a miss whose pseudo-LRU victim is still referenced waits at the lookup
     (so does a miss with ``misses`` bursts outstanding, a pixel with the queue full, or a
     miss while ARVALID waits for ARREADY). The hit/miss sequence and the AR stream are the
-    blocking cache's (sim/golden/cache.py). ``i.ready`` depends on the lookup in the same
-    cycle (never on ``i.valid``). A hit leaves ``CACHE_LATENCY`` cycles after it is taken,
+    blocking cache's (sim/golden/cache.py). ``i.ready`` is high while the register of the
+    pixel read is empty or moves on into the lookup, so it depends on the lookup in the
+    same cycle (never on ``i.valid``). A hit leaves ``CACHE_LATENCY`` cycles after it is taken,
     one pixel a clock. A reset invalidates every line: the tags are cleared one set a cycle
     (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must not
     change between resets.
@@ -356,6 +359,7 @@ class TextureCache(wiring.Component):
         # stream contract of a map_memory = "axi" pipeline) can state lemmas about them.
         self.regs = SimpleNamespace(
             flushing=Signal(init=1, name="flushing"),
+            in_valid=Signal(name="in_valid"),                     # a pixel read: its set
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
             rd_valid=Signal(name="rd_valid"),                     # the data read register
@@ -422,27 +426,49 @@ class TextureCache(wiring.Component):
         r = self.regs
         flushing = r.flushing
         flush_set = Signal(range(g.sets))
-        # --- the pixel under lookup ---
-        look_valid = r.look_valid
-        look_line = Signal(g.line_bits)
-        look_slot = Signal(2 * g.block_bits)
-        look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
-        in_line, in_slot = self._locate(m, self.i.payload)
 
         def split(line, slot):
             word = Cat(slot[sel_bits:], line[:g.set_bits]) if g.beats > 1 else line[:g.set_bits]
             return line[:g.set_bits], line[g.set_bits:], word, slot[:sel_bits]
 
+        def set_of(line):
+            return line[:g.set_bits] if g.set_bits else Const(0, 1)
+
+        # --- the pixel read: its set's tags and stamps are read as it is taken (the read
+        # ports always address the input) and land on the ports the next cycle; held here
+        # while the pixel under lookup waits ---
+        in_valid = r.in_valid
+        in_line, in_slot = Signal(g.line_bits, name="in_line"), Signal(2 * g.block_bits, name="in_slot")
+        in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
+        new_line, new_slot = self._locate(m, self.i.payload)
+        fresh = Signal(name="in_fresh")          # taken last cycle: its words on the ports
+        in_tags = [Signal(g.tag_bits + 1, name=f"in_tag{w}") for w in range(g.ways)]
+        in_stamps = Signal(K * g.ways, name="in_stamps")
+        held_tags = [Signal.like(t, name=f"in_tag{w}_held") for w, t in enumerate(in_tags)]
+        held_stamps = Signal.like(in_stamps, name="in_stamps_held")
+        for (rp, _), t, h in zip(tags, in_tags, held_tags, strict=True):
+            m.d.comb += [rp.addr.eq(set_of(new_line)), t.eq(Mux(fresh, rp.data, h))]
+            m.d.sync += h.eq(t)
+        m.d.comb += [stamp_r.addr.eq(set_of(new_line)),
+                     in_stamps.eq(Mux(fresh, stamp_r.data, held_stamps))]
+        m.d.sync += held_stamps.eq(in_stamps)
+
+        # --- the pixel under lookup: its words in registers ---
+        look_valid = r.look_valid
+        look_line = Signal(g.line_bits)
+        look_slot = Signal(2 * g.block_bits)
+        look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
+        look_tags = [Signal(g.tag_bits + 1, name=f"look_tag{w}") for w in range(g.ways)]
+        look_stamps = [Signal(K, name=f"look_stamp{w}") for w in range(g.ways)]
         look_set, line_tag, look_word, look_sel = split(look_line, look_slot)
-        in_set, _, _, _ = split(in_line, in_slot)
         if g.set_bits == 0:
-            look_set, in_set = Const(0, 1), Const(0, 1)
+            look_set = Const(0, 1)
         look_tag = Signal(g.tag_bits)          # as stored (a line index may have fewer bits)
         m.d.comb += look_tag.eq(line_tag)
 
         hits = Signal(g.ways)
-        for w, (rp, _) in enumerate(tags):
-            m.d.comb += hits[w].eq(rp.data[-1] & (rp.data[:g.tag_bits] == look_tag))
+        for w, t in enumerate(look_tags):
+            m.d.comb += hits[w].eq(t[-1] & (t[:g.tag_bits] == look_tag))
         hit = hits.any()
 
         # --- replacement state: tree pseudo-LRU bits a set (LUT RAM, read in the cycle) ---
@@ -454,13 +480,9 @@ class TextureCache(wiring.Component):
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
         m.d.comb += way_hot.eq(Mux(hit, hits, victim))
         way = Signal(max(1, g.way_bits))
-        victim_valid, victim_stamp = Signal(), Signal(K)
         for w in range(g.ways):
             with m.If(way_hot[w]):
                 m.d.comb += way.eq(w)
-            with m.If(victim[w]):
-                m.d.comb += [victim_valid.eq(tags[w][0].data[-1]),
-                             victim_stamp.eq(stamp_r.data.word_select(w, K))]
 
         # --- the pixel queue: pixels in[out_seq, in_seq) wait in order ---
         in_seq, out_seq = r.in_seq, r.out_seq
@@ -468,12 +490,18 @@ class TextureCache(wiring.Component):
         m.d.comb += count.eq(in_seq - out_seq)
         qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
-        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
+        # LUT RAM read in the cycle at the oldest entry: no read address waits on a pop
+        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[],
+                                           attrs={"ram_style": "distributed"})
         q_w = qmem.write_port()
-        q_r = qmem.read_port(transparent_for=(q_w,))
-        # a victim still referenced by a queued pixel (its last pixel not yet left)
+        q_r = qmem.read_port(domain="comb")
+        # a victim still referenced by a queued pixel (its last pixel not yet left): each
+        # way's test beside the others, the victim's chosen after them
+        referenced = Signal(g.ways)
+        for w in range(g.ways):
+            m.d.comb += referenced[w].eq(look_tags[w][-1] & ((look_stamps[w] - out_seq)[:K] < count))
         locked = Signal()
-        m.d.comb += locked.eq(victim_valid & ((victim_stamp - out_seq)[:K] < count))
+        m.d.comb += locked.eq((referenced & victim).any())
 
         # --- the bursts outstanding: (set, way) of each, in AR order ---
         fills, landed = r.fills, r.landed
@@ -489,18 +517,28 @@ class TextureCache(wiring.Component):
         advance = Signal()
         m.d.comb += advance.eq(~flushing & look_valid & (count != g.queue) & (hit | can_miss))
         miss = advance & ~hit
-        m.d.comb += self.i.ready.eq(~flushing & (~look_valid | advance))
+        move = ~look_valid | advance               # the pixel read moves on to the lookup
+        m.d.comb += self.i.ready.eq(~flushing & (~in_valid | move))
         take = self.i.valid & self.i.ready
-
-        # read addresses: the pixel taken, else the pixel held (re-read every cycle)
-        for trp, _ in tags:
-            m.d.comb += trp.addr.eq(Mux(take, in_set, look_set))
-        m.d.comb += stamp_r.addr.eq(Mux(take, in_set, look_set))
+        m.d.sync += fresh.eq(take)
         with m.If(take):
-            m.d.sync += [look_valid.eq(1), look_line.eq(in_line), look_slot.eq(in_slot)]
-            m.d.sync += [look_extra[k].eq(self.i.payload[k]) for k in self.extra]
-        with m.Elif(advance):
-            m.d.sync += look_valid.eq(0)
+            m.d.sync += [in_valid.eq(1), in_line.eq(new_line), in_slot.eq(new_slot)]
+            m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
+        with m.Elif(move):
+            m.d.sync += in_valid.eq(0)
+        # Into the lookup, with what the pixel leaving it writes to the same set this cycle
+        # (its read saw every earlier write: a pixel read waits only while the lookup does,
+        # and the read ports are transparent to a write in the cycle of the read).
+        same = advance & (set_of(in_line) == look_set)
+        with m.If(move):
+            m.d.sync += [look_valid.eq(in_valid), look_line.eq(in_line), look_slot.eq(in_slot)]
+            m.d.sync += [look_extra[k].eq(in_extra[k]) for k in self.extra]
+            for w in range(g.ways):
+                m.d.sync += [
+                    look_tags[w].eq(Mux(same & ~hit & victim[w], Cat(look_tag, Const(1, 1)),
+                                        in_tags[w])),
+                    look_stamps[w].eq(Mux(same & way_hot[w], in_seq,
+                                          in_stamps.word_select(w, K)))]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         m.d.comb += [q_w.addr.eq(in_seq[:qb]), q_w.en.eq(advance),
@@ -562,11 +600,11 @@ class TextureCache(wiring.Component):
         o_free = ~self.o.valid | self.o.ready
         rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
-        r.look_extra, r.rd_extra, r.queue = look_extra, rd_extra, qmem   # for the lemmas
+        r.in_extra, r.look_extra, r.rd_extra, r.queue = in_extra, look_extra, rd_extra, qmem
         rd_move = ~rd_valid | o_free
         pop = Signal()
         m.d.comb += pop.eq((count != 0) & (~head.miss | (landed != 0)) & rd_move)
-        m.d.comb += q_r.addr.eq(Mux(pop, out_seq[:qb] + 1, out_seq[:qb]) if qb else 0)
+        m.d.comb += q_r.addr.eq(out_seq[:qb] if qb else 0)
         with m.If(pop):
             m.d.sync += out_seq.eq(out_seq + 1)
         m.d.sync += landed.eq(landed + line_in - (pop & head.miss))
@@ -669,9 +707,9 @@ class AxiMapFetch(wiring.Component):
 
     @property
     def capacity(self):
-        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the lookup register,
-        the queue's entries, the data read and the output register."""
-        return self.geom.queue + 3
+        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the tag read's and the
+        lookup's registers, the queue's entries, the data read and the output register."""
+        return self.geom.queue + 4
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):
         check_scene(self, scene)

@@ -560,7 +560,8 @@ class StreamContract(Elaboratable):
         """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
         front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
         lemmas to the cache's lookup register, queue, data-read register and output
-        register (``TextureCache.regs``). Made once per contract."""
+        register (``TextureCache.regs``; the lookup's two: the pixel read, the pixel looked
+        up). Made once per contract."""
         if self.cache is None:
             return Const(0, 1)
         if getattr(self, "_cache_ghost", None) is not None:
@@ -570,7 +571,7 @@ class StreamContract(Elaboratable):
         m.d.sync += ghost.eq(ghost + take_in - (c.o.valid & c.o.ready))
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
         self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
-        self._lemma(m, ghost == r.look_valid + count + r.rd_valid + c.o.valid,
+        self._lemma(m, ghost == r.in_valid + r.look_valid + count + r.rd_valid + c.o.valid,
                     "pixels in the cache = its lookup, queue, read and output registers")
         self._cache_ghost = ghost
         return ghost
@@ -646,8 +647,8 @@ class StreamContract(Elaboratable):
         """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
         its output register, its data-read register, its queue's entries from the read
         sequence number (read through asynchronous ports added to the queue's memory, one
-        per address; the queue's registered read is the entry at that number) and its
-        lookup register."""
+        per address; the queue's own read is the entry at that number), its lookup register
+        and the register of the pixel read before it."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
         inst = _subfragment(frag, "queue") if frag is not None else None
@@ -675,8 +676,12 @@ class StreamContract(Elaboratable):
                         "the cache's queue holds consecutive tags from its oldest")
             self._lemma(m, ~((oldest == a) & (count != 0)) | (head.as_value() == word.as_value()),
                         "the cache's queue read is its oldest entry")
-        self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == (at_q + count)[:bits]),
+        at_look = Signal(bits, name="tag_cache_lookup")
+        m.d.comb += at_look.eq(at_q + count)
+        self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == at_look),
                     "the cache's lookup register holds the tag after its queue's")
+        self._lemma(m, ~r.in_valid | (r.in_extra["tag"] == (at_look + r.look_valid)[:bits]),
+                    "the cache's read register holds the tag after its lookup's")
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""
