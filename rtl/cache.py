@@ -48,9 +48,9 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
-# queue is empty: the tag read, the lookup, the queue's entry, the data read, the output
-# register.
-CACHE_LATENCY = 5
+# queue is empty: the tag read, the lookup, the queue's entry, its head register, the data
+# read, the output register.
+CACHE_LATENCY = 6
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -362,6 +362,7 @@ class TextureCache(wiring.Component):
             in_valid=Signal(name="in_valid"),                     # a pixel read: its set
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
+            hd_valid=Signal(name="hd_valid"),                     # the queue's head, registered
             rd_valid=Signal(name="rd_valid"),                     # the data read register
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
@@ -380,12 +381,13 @@ class TextureCache(wiring.Component):
     @staticmethod
     def queue_layout(geom: CacheGeometry, extra=None):
         """One entry of the pixel queue: where its texel is (set, word, way, slot of the
-        word), whether it waits for a line fill (``miss``), and the carried fields."""
+        word) and the carried fields (whether it waits for a line fill is a LUT RAM of its
+        own beside it)."""
         sel_bits = geom.slots_per_beat.bit_length() - 1
         word_bits = geom.set_bits + (2 * geom.block_bits - sel_bits if geom.beats > 1 else 0)
         return data.StructLayout({
             "word": unsigned(max(1, word_bits)), "way": unsigned(max(1, geom.way_bits)),
-            "sel": unsigned(max(1, sel_bits)), "miss": unsigned(1), **dict(extra or {})})
+            "sel": unsigned(max(1, sel_bits)), **dict(extra or {})})
 
     def _locate(self, m, px):
         """(line, slot) of the pixel ``px`` (a Switch on its level; past the last: the last)."""
@@ -490,11 +492,14 @@ class TextureCache(wiring.Component):
         m.d.comb += count.eq(in_seq - out_seq)
         qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
-        # LUT RAM read in the cycle at the oldest entry: no read address waits on a pop
-        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[],
-                                           attrs={"ram_style": "distributed"})
+        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
         q_w = qmem.write_port()
-        q_r = qmem.read_port(domain="comb")
+        q_r = qmem.read_port(transparent_for=(q_w,))
+        # the entries' miss bits again in LUT RAM, read in the cycle at the oldest entry: the
+        # pop that chooses the block RAM's next read address waits on no block RAM
+        m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
+                                                attrs={"ram_style": "distributed"})
+        m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
         # a victim still referenced by a queued pixel (its last pixel not yet left): each
         # way's test beside the others, the victim's chosen after them
         referenced = Signal(g.ways)
@@ -543,8 +548,9 @@ class TextureCache(wiring.Component):
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         m.d.comb += [q_w.addr.eq(in_seq[:qb]), q_w.en.eq(advance),
                      q_w.data.word.eq(look_word), q_w.data.way.eq(way),
-                     q_w.data.sel.eq(look_sel), q_w.data.miss.eq(~hit)]
+                     q_w.data.sel.eq(look_sel)]
         m.d.comb += [q_w.data[k].eq(look_extra[k]) for k in self.extra]
+        m.d.comb += [m_w.addr.eq(in_seq[:qb]), m_w.en.eq(advance), m_w.data.eq(~hit)]
         m.d.comb += [stamp_w.addr.eq(look_set), stamp_w.data.eq(Cat(*[in_seq] * g.ways)),
                      stamp_w.en.eq(Mux(advance, way_hot, 0))]
         with m.If(advance):
@@ -595,24 +601,32 @@ class TextureCache(wiring.Component):
             m.d.sync += f_in.eq(f_in + 1)
         m.d.sync += fills.eq(fills + miss - line_in)
 
-        # --- the queue's head leaves in order: read its word, then the output register ---
+        # --- the queue's head leaves in order: into a register (the data read's address
+        # from a flip-flop), its word read, then the output register ---
         head = q_r.data
         o_free = ~self.o.valid | self.o.ready
+        hd_valid, hd = r.hd_valid, Signal(layout, name="hd")
         rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
         r.in_extra, r.look_extra, r.rd_extra, r.queue = in_extra, look_extra, rd_extra, qmem
+        r.hd_extra = {k: hd[k] for k in self.extra}
         rd_move = ~rd_valid | o_free
+        hd_move = ~hd_valid | rd_move
         pop = Signal()
-        m.d.comb += pop.eq((count != 0) & (~head.miss | (landed != 0)) & rd_move)
-        m.d.comb += q_r.addr.eq(out_seq[:qb] if qb else 0)
+        head_miss = m_r.data
+        m.d.comb += pop.eq((in_seq != out_seq) & (~head_miss | (landed != 0)) & hd_move)
+        m.d.comb += [m_r.addr.eq(out_seq[:qb] if qb else 0),
+                     q_r.addr.eq(Mux(pop, out_seq[:qb] + 1, out_seq[:qb]) if qb else 0)]
         with m.If(pop):
             m.d.sync += out_seq.eq(out_seq + 1)
-        m.d.sync += landed.eq(landed + line_in - (pop & head.miss))
+        m.d.sync += landed.eq(landed + line_in - (pop & head_miss))
+        with m.If(hd_move):
+            m.d.sync += [hd_valid.eq(pop), hd.eq(head)]
         for drp, _ in datas:
-            m.d.comb += [drp.addr.eq(head.word), drp.en.eq(rd_move)]
+            m.d.comb += [drp.addr.eq(hd.word), drp.en.eq(rd_move)]
         with m.If(rd_move):
-            m.d.sync += [rd_valid.eq(pop), rd_way.eq(head.way), rd_sel.eq(head.sel)]
-            m.d.sync += [rd_extra[k].eq(head[k]) for k in self.extra]
+            m.d.sync += [rd_valid.eq(hd_valid), rd_way.eq(hd.way), rd_sel.eq(hd.sel)]
+            m.d.sync += [rd_extra[k].eq(hd[k]) for k in self.extra]
         word = Signal(g.data_bits)
         rd_hot = Signal(g.ways)
         m.d.comb += rd_hot.eq(Const(1, g.ways) << rd_way)
@@ -708,8 +722,9 @@ class AxiMapFetch(wiring.Component):
     @property
     def capacity(self):
         """Pixels taken at ``i`` and not yet taken at ``o``, at most: the tag read's and the
-        lookup's registers, the queue's entries, the data read and the output register."""
-        return self.geom.queue + 4
+        lookup's registers, the queue's entries, its head register, the data read and the
+        output register."""
+        return self.geom.queue + 5
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):
         check_scene(self, scene)

@@ -559,9 +559,9 @@ class StreamContract(Elaboratable):
     def _in_cache(self, m, take_in):
         """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
         front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
-        lemmas to the cache's lookup register, queue, data-read register and output
-        register (``TextureCache.regs``; the lookup's two: the pixel read, the pixel looked
-        up). Made once per contract."""
+        lemmas to the cache's lookup registers (the pixel read, the pixel looked up), queue,
+        head and data-read registers and output register (``TextureCache.regs``). Made once
+        per contract."""
         if self.cache is None:
             return Const(0, 1)
         if getattr(self, "_cache_ghost", None) is not None:
@@ -571,7 +571,8 @@ class StreamContract(Elaboratable):
         m.d.sync += ghost.eq(ghost + take_in - (c.o.valid & c.o.ready))
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
         self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
-        self._lemma(m, ghost == r.in_valid + r.look_valid + count + r.rd_valid + c.o.valid,
+        self._lemma(m, ghost == r.in_valid + r.look_valid + count + r.hd_valid + r.rd_valid
+                    + c.o.valid,
                     "pixels in the cache = its lookup, queue, read and output registers")
         self._cache_ghost = ghost
         return ghost
@@ -645,10 +646,10 @@ class StreamContract(Elaboratable):
 
     def _cache_order(self, m, n_edge, bits):
         """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
-        its output register, its data-read register, its queue's entries from the read
-        sequence number (read through asynchronous ports added to the queue's memory, one
-        per address; the queue's own read is the entry at that number), its lookup register
-        and the register of the pixel read before it."""
+        its output register, its data-read register, its head register, its queue's entries
+        from the read sequence number (read through asynchronous ports added to the queue's
+        memory, one per address; the queue's registered read is the entry at that number),
+        its lookup register and the register of the pixel read before it."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
         inst = _subfragment(frag, "queue") if frag is not None else None
@@ -662,8 +663,12 @@ class StreamContract(Elaboratable):
         at_rd = (n_edge + c.o.valid)[:bits]
         self._lemma(m, ~r.rd_valid | (r.rd_extra["tag"] == at_rd),
                     "the cache's read register holds the tag after its output's")
+        at_hd = Signal(bits, name="tag_cache_head_register")
+        m.d.comb += at_hd.eq(at_rd + r.rd_valid)
+        self._lemma(m, ~r.hd_valid | (r.hd_extra["tag"] == at_hd),
+                    "the cache's head register holds the tag after its read register's")
         at_q = Signal(bits, name="tag_cache_queue_head")
-        m.d.comb += at_q.eq(at_rd + r.rd_valid)
+        m.d.comb += at_q.eq(at_hd + r.hd_valid)
         head = r.queue.read_ports[0].data
         oldest = r.out_seq[:qb] if qb else Const(0, 1)
         for a in range(g.queue):
