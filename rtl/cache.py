@@ -416,8 +416,11 @@ class TextureCache(wiring.Component):
         tags, datas = [], []
         for w in range(g.ways):
             m.submodules[f"tag{w}"] = tmem = Memory(shape=g.tag_bits + 1, depth=g.sets, init=[])
+            # a line is never read while it fills (a miss's pixel waits for its line, and a
+            # line a queued pixel or a later stage still reads is not evicted before its
+            # fill's first beat can land): no read-during-write logic beside the block RAM
             m.submodules[f"data{w}"] = dmem = Memory(shape=g.data_bits, depth=g.sets * g.beats,
-                                                     init=[])
+                                                     init=[], attrs={"no_rw_check": 1})
             twp = tmem.write_port()
             tags.append((tmem.read_port(transparent_for=(twp,)), twp))
             datas.append((dmem.read_port(), dmem.write_port()))
