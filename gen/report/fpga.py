@@ -388,9 +388,12 @@ def _plot(rows, acc, path):
 FPGA_NOTES = """
 - How the exact datapath was pipelined (every unit keeps 1 pixel per clock and its
   bit-exact tests; each unit's `latency` property counts the stages): the input angle sums
-  (a, b, D), every read angle and every ROM address are registered, so the angle adders,
-  the mirrored quarter-wave address `2**k - i` (`rtl/sincos.sine_read`) and the route to
-  the block RAM's address pins each have a cycle of their own; the block RAMs use their
+  (a, b, D), every read angle, each read's index folded for its quadrant (`i ^ q0`, a
+  register per read: a sine and a cosine of one angle would otherwise share the register
+  that reaches both ROMs) and every ROM address are registered, so the angle adders, the
+  route from a shared angle, the mirrored quarter-wave address `2**k - i`
+  (`rtl/sincos.sine_read`) and the route to the block RAM's address pins each have a
+  cycle of their own; the block RAMs use their
   own output registers (`rtl/pipe.RegisteredROM`: on ECP5 a DP16KD with REGMODE OUTREG,
   about 1 ns clock-to-out instead of 5.8 ns; the last word of a 2^n + 1-word table is kept
   in a flip-flop, so the specular table is one 1024 x 18 block and each quarter-wave
