@@ -447,16 +447,14 @@ class TextureCache(wiring.Component):
         in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
         new_line, new_slot = self._locate(m, self.i.payload)
         fresh = Signal(name="in_fresh")          # taken last cycle: its words on the ports
-        in_tags = [Signal(g.tag_bits + 1, name=f"in_tag{w}") for w in range(g.ways)]
-        in_stamps = Signal(K * g.ways, name="in_stamps")
-        held_tags = [Signal.like(t, name=f"in_tag{w}_held") for w, t in enumerate(in_tags)]
-        held_stamps = Signal.like(in_stamps, name="in_stamps_held")
-        for (rp, _), t, h in zip(tags, in_tags, held_tags, strict=True):
-            m.d.comb += [rp.addr.eq(set_of(new_line)), t.eq(Mux(fresh, rp.data, h))]
-            m.d.sync += h.eq(t)
-        m.d.comb += [stamp_r.addr.eq(set_of(new_line)),
-                     in_stamps.eq(Mux(fresh, stamp_r.data, held_stamps))]
-        m.d.sync += held_stamps.eq(in_stamps)
+        words = []                               # each way's tag, then the set's stamps
+        ports = [(rp, f"in_tag{w}") for w, (rp, _) in enumerate(tags)] + [(stamp_r, "in_stamps")]
+        for rp, name in ports:
+            word, held = Signal.like(rp.data, name=name), Signal.like(rp.data, name=f"{name}_held")
+            m.d.comb += [rp.addr.eq(set_of(new_line)), word.eq(Mux(fresh, rp.data, held))]
+            m.d.sync += held.eq(word)
+            words.append(word)
+        *in_tags, in_stamps = words
 
         # --- the pixel under lookup: its words in registers ---
         look_valid = r.look_valid
