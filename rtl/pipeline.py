@@ -426,6 +426,12 @@ class BumpPipeline(wiring.Component):
     def port_latency(self):
         return self.latency + EDGE_LATENCY + (self.units["fetch"].latency if self._front else 0)
 
+    @property
+    def front_capacity(self):
+        """Pixels the texel cache in front of the credit edge holds at most (its
+        ``capacity``; 0 without one): taken at ``i``, not yet counted by the credits."""
+        return self.units["fetch"].capacity if self._front else 0
+
     # --- elaboration ------------------------------------------------------------------------
     def elaborate(self, platform):
         m = Module()

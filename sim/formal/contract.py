@@ -413,7 +413,7 @@ class StreamContract(Elaboratable):
         """Wide enough for every pixel that can be accepted and not delivered (at most
         ``fifo_depth``, one per stage without an edge), even without the lemmas (BMC), where
         a wrapping counter would be a false failure."""
-        front = self.dut.units["fetch"].capacity if getattr(self.dut, "_front", False) else 0
+        front = getattr(self.dut, "front_capacity", 0)      # a unit has no cache in front
         return (max(len(stages), self.port_latency, self.fifo_depth or 0) + front + 2).bit_length() + 1
 
     def _pixels(self, m, stages):

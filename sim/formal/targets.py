@@ -57,16 +57,11 @@ class Target:
         front of the edge adds the pixels it holds)."""
         bits = SMALL["tag_bits"]
         dut = self.build(bits)
-        while (1 << bits) <= dut.fifo_depth + _front_capacity(dut) + 1:
+        while (1 << bits) <= dut.fifo_depth + getattr(dut, "front_capacity", 0) + 1:
             bits += 1
             _discard(dut)
             dut = self.build(bits)
         return dut
-
-
-def _front_capacity(dut):
-    """Pixels a texel cache in front of a pipeline's edge holds (0 without one)."""
-    return dut.units["fetch"].capacity if getattr(dut, "_front", False) else 0
 
 
 def _discard(dut):
