@@ -74,21 +74,21 @@ def registered_quarter_wave_rom(pipe, cfg: Config, name, ports=2):
 def sine_read(m, pipe, port, angle, cfg: Config, name, angle_stage=True, near=False,
               line=False, quarters=0):
     """``sin(angle)`` through one read port of a registered quarter-wave ROM
-    (:class:`pipe.RegisteredROM`); the signed Q1.B value appears
-    REGISTERED_SINE_LATENCY (+ ``near``) stages later (the angle, its index folded for the quadrant, the address, ROM read,
-    block-RAM output register, a data register beside the block RAM, its copy beside the
-    adder, then sign: the angle's adder, the route from a register shared by the reads of
-    one angle, the mirrored address ``2**k - i``, the route to the block RAM's address pins, its
-    clock-to-out and the route from its data pins, which is long where a table spans two
-    blocks side by side or the ROM sits far from its reader, each get a cycle of their own;
-    ``angle_stage=False`` when the caller registered ``angle`` itself and counts that
-    stage; ``near``: one more address register, a plain copy the placer puts beside the
+    (:class:`pipe.RegisteredROM`); the signed Q1.B value appears REGISTERED_SINE_LATENCY (+
+    ``near``) stages later (the angle, its index folded for the quadrant, the address, ROM
+    read, block-RAM output register, a data register beside the block RAM, its copy beside
+    the adder, then sign: the angle's adder, the route from a register shared by the reads
+    of one angle, the mirrored address ``2**k - i``, the route to the block RAM's address
+    pins, its clock-to-out and the route from its data pins, which is long where a table
+    spans two blocks side by side or the ROM sits far from its reader, each get a cycle of
+    their own; ``angle_stage=False`` when the caller registered ``angle`` itself and counts
+    that stage; ``near``: one more address register, a plain copy the placer puts beside the
     ROM's blocks, for a wide ROM: :func:`near_sine`; ``line``: the ROM holds the sine minus
-    the line under it, :func:`sine_line`, and the line ``(address << B) >> k``, delayed beside
-    the read and signed a stage ahead, is added in the sign's stage, one carry chain as the
-    sign alone is: :func:`_sine_above_line`). ``cos(a)`` is ``sin(a + 2**k)``: ``quarters``
-    (0 to 3) quarter turns added to ``angle`` after its register, to the two quadrant bits
-    alone (no carry chain behind the angle's adder).
+    the line under it, :func:`sine_line`, and the line ``(address << B) >> k``, delayed
+    beside the read and signed a stage ahead, is added in the sign's stage, one carry chain
+    as the sign alone is: :func:`_sine_above_line`). ``cos(a)`` is ``sin(a + 2**k)``:
+    ``quarters`` (0 to 3) quarter turns added to ``angle`` after its register, to the two
+    quadrant bits alone (no carry chain behind the angle's adder).
 
     Quadrants 1 and 3 read the ROM backwards (index ``2**k - i``; entry ``2**k`` is 1.0),
     quadrants 2 and 3 are negative. Bit-exact with :func:`tables.sin_lookup`.

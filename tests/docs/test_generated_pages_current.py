@@ -6,16 +6,23 @@ import json
 import re
 from pathlib import Path
 
+from bumprtl.rtl import methods
+from bumprtl.rtl.config import Config
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.scenes.config import load_scene_config
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 
 
+def _silenced(*units):
+    for unit in units:
+        unit._MustUse__silence = True          # read for its latency only, never elaborated
+    return units
+
+
 def default_pipeline():
     pipeline = BumpPipeline(load_scene_config("default").hardware)
-    for unit in (pipeline, *pipeline.units.values()):
-        unit._MustUse__silence = True          # read for its latency only, never elaborated
+    _silenced(pipeline, *pipeline.units.values())
     return pipeline
 
 
@@ -40,12 +47,8 @@ def test_hand_written_latencies_are_the_rtls():
     """The hand-written pages that quote a latency at today's default say what the RTL
     computes: Lee's two units (docs/lee_method.md) and the default pipeline's sidecar
     (docs/scenes.md)."""
-    from bumprtl.rtl import methods
-    from bumprtl.rtl.config import Config
     cfg = Config(method="lee")
-    rot, ill = methods.get("lee").rotation(cfg), methods.get("lee").illumination(cfg)
-    for unit in (rot, ill):
-        unit._MustUse__silence = True
+    rot, ill = _silenced(methods.get("lee").rotation(cfg), methods.get("lee").illumination(cfg))
     lee = " ".join((DOCS / "lee_method.md").read_text().split())
     assert f"Latency {rot.latency} + {ill.latency} cycles at the default widths" in lee
     scenes = " ".join((DOCS / "scenes.md").read_text().split())
