@@ -68,6 +68,10 @@ TESTS = ["tests/rtl", "tests/sim/golden", "tests/sim/scenes", "tests/sim/tb",
 PRELOAD = ["numpy", "pytest", "hypothesis", "amaranth", "amaranth.hdl", "amaranth.sim", "PIL.Image",
            "scipy.spatial", "_pytest.python", "xdist"]
 BEGIN, END = "<!-- pymut:begin -->", "<!-- pymut:end -->"
+# laid out at the top of the copy (file in tests/mutants -> its name there): the cocotb
+# benches run in a simulator's own Python, where mutmut's record sees nothing; these two
+# bring its hits back to the test that started the simulator
+SIM_RECORD = {"pymut_sim.py": "pymut_sim.py", "pymut_sitecustomize.py": "sitecustomize.py"}
 # mutmut 3's exit codes per mutant (mutmut/__main__.py status_by_exit_code)
 KILLED = {1, 3, -24, 24, 152, 255, 36, -9, 9, 37}     # test failed, timeout, killed, type check
 SURVIVED, NO_TESTS = {0, 5}, {33}
@@ -425,6 +429,9 @@ def lay_out(dest, src, files):
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(src / name, target)
     (dest / "bumprtl" / "__init__.py").write_text("")
+    # the record's hits from the simulators' processes (pymut_sim.py, pymut_sitecustomize.py)
+    for name, as_name in SIM_RECORD.items():
+        shutil.copy2(src / "tests" / "mutants" / name, dest / as_name)
     # tests/mutants is this tooling, not tests to run
     shutil.rmtree(dest / "tests" / "mutants", ignore_errors=True)
 
@@ -454,12 +461,13 @@ def configure(dest, deselect, only=None, tests=None):
     cfg += [f"    {p}" for p in (only or MUTATE)]
     cfg += ["pytest_add_cli_args_test_selection ="] + [f"    {t}" for t in selected_tests(dest, tests)]
     cfg += ["pytest_add_cli_args =", "    -p", "    no:cacheprovider", "    -p", "    no:xdist",
+            "    -p", "    pymut_sim",
             "    -m", "    not regress and not fpga and not formal",
             *[x for d in deselect for x in ("    --deselect", f"    {d}")],
             # mutmut runs the tests in mutants/, which holds the package and tests/ only:
             # tests/gen/cli/test_packaging.py::test_version reads the changelog beside them,
             # tests/gen/cli/test_flags_roundtrip.py docs/scenes.md
-            "also_copy =", "    CHANGELOG.md", "    docs",
+            "also_copy =", "    CHANGELOG.md", "    docs", *[f"    {n}" for n in SIM_RECORD.values()],
             "use_git_change_detection = false", "timeout_multiplier = 5.0",
             # each mutant's tests run in a process forked from a server that imported the
             # third-party modules only: forked from mutmut's own process (its default), a
