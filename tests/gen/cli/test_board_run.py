@@ -172,3 +172,18 @@ def test_pipe_mhz_without_meaning_is_refused(value, message, tmp_path, monkeypat
     r = run_cli(["board", "ulx3s", *SMALL, "--mode", "test", "--out", out, "--pipe-mhz", value])
     assert r.returncode == 2 and r.stderr.strip().splitlines() == [f"bumprtl: error: {message}"]
     assert not out.exists()
+
+
+def test_pipe_mhz_without_a_bitstream_reaches_the_frame_check(tmp_path, monkeypatch, run_cli):
+    """In the test mode (no bitstream) --pipe-mhz has an effect through --check-frames: the
+    frames are simulated with the pipeline at that clock, and nothing is built."""
+    check, seen = _frames([True])
+    for name in ("build_bitstream", "part_costs"):
+        monkeypatch.setattr(cli_board, name, _no)
+    monkeypatch.setattr(cli_board, "check_frames", check)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", *SMALL, "--mode", "test", "--out", out, "--pipe-mhz", "40",
+                 "--check-frames", "1"])
+    assert r.returncode == 0, r.stderr
+    assert seen["mode"] == "test" and seen["frames"] == 1 and seen["pipe_hz"] == 40e6
+    assert json.loads((out / "summary_test.json").read_text())["pipe_mhz"] == 40.0
