@@ -5,7 +5,16 @@ Two parts, each written into docs/coverage.md between its markers by this comman
 * ``--python JSON``: branch coverage of rtl/, sim/ and gen/ under make test, from the JSON
   report of pytest-cov (``make coverage`` runs make test's selection with ``--cov-branch``
   and then this): statements and branches per directory, and the files below 80 % of
-  their branches, least covered first.
+  their branches, least covered first; and every branch it left uncovered, one by one
+  (coverage.py's ``missing_branches``), grouped by file, each with the source text of its
+  line, where it jumps to and why no test of make test goes there: the reason comes from
+  :data:`coverage_reasons.REASONS` (tests/tools/coverage_reasons.py), matched on the file
+  and the stripped text of the branch's line (and of its target's when one line has two
+  reasons), never on line numbers, so a reason written once holds while the code moves. A
+  branch with no reason says "not read yet"; a reason that matches no uncovered branch is
+  reported as stale (its branch is covered now, or its line changed). ``--at COMMIT`` reads
+  the source text at that commit (the one the JSON was measured on) instead of the
+  working tree.
 * ``--verilator``: Verilator line and toggle coverage (``--coverage-line
   --coverage-toggle``) of the default scene's pipeline under make test's bulk stimulus
   (tests/sim/tb/test_bulk.py: a 16 x 16 frame of the default scene under all four traffic
@@ -19,14 +28,26 @@ Two parts, each written into docs/coverage.md between its markers by this comman
 import argparse
 import json
 import re
+import subprocess
 import sys
 import time
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import coverage_reasons  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 MARK = {"python": ("<!-- coverage:python:begin -->", "<!-- coverage:python:end -->"),
+        "branches": ("<!-- coverage:branches:begin -->", "<!-- coverage:branches:end -->"),
         "verilator": ("<!-- coverage:verilator:begin -->", "<!-- coverage:verilator:end -->")}
+NOT_READ = "not read yet"
+
+
+def _own_files(data):
+    """``{repository path: file record}`` of the JSON's files in this checkout (a copy
+    outside it, a test's unpacked archive run in a subprocess, has an absolute path)."""
+    return {name: f for name, f in data["files"].items() if not Path(name).is_absolute()}
 
 
 def python_block(path, command):
@@ -67,10 +88,102 @@ def python_block(path, command):
     low = sorted(x for x in files if x[0] < 0.8)
     lines += ["", "Files below 80 % of their branches, least covered first:", ""]
     lines += [f"* `{rel}`: {s['covered_branches']} / {s['num_branches']} branches "
-              f"({100 * frac:.0f}%), missing lines: {s['missing_lines']}" for frac, rel, s in low[:25]]
+              f"({100 * frac:.0f}%), {s['missing_lines']} statement(s) not run"
+              for frac, rel, s in low[:25]]
     if not low:
         lines.append("* none")
     return "\n".join(lines)
+
+
+# --- every uncovered branch with its reason ---------------------------------------------------
+
+def source_lines(rel, at=None, root=ROOT):
+    """The lines of repository file ``rel``: in the working tree, or at commit ``at``."""
+    if at is None:
+        path = Path(root) / rel
+        return path.read_text().splitlines() if path.is_file() else []
+    out = subprocess.run(["git", "show", f"{at}:{rel}"], cwd=root, capture_output=True,
+                         text=True)
+    return out.stdout.splitlines() if out.returncode == 0 else []
+
+
+def uncovered(data, at=None, root=ROOT):
+    """Every missing branch of the checkout's files: ``[(file, line, target, text,
+    target_text)]`` in file and line order; ``target`` < 0 is an exit from the code object
+    that starts at line ``-target`` (its text ``"exit"``)."""
+    out = []
+    for rel, f in sorted(_own_files(data).items()):
+        pairs = f.get("missing_branches") or []
+        if not pairs:
+            continue
+        src = source_lines(rel, at, root)
+        text = lambda n, src=src: src[n - 1].strip() if 0 < n <= len(src) else "?"
+        for a, b in sorted(pairs, key=lambda p: (p[0], p[1] < 0, p[1])):
+            out.append((rel, a, b, text(a), "exit" if b < 0 else text(b)))
+    return out
+
+
+def matches(entry, branch):
+    """Whether a reason of :data:`coverage_reasons.REASONS` ``(file, text, target, class,
+    why)`` is this branch's: the same file and stripped line text, and the target's text
+    when the entry names one."""
+    file, text, target = entry[:3]
+    return file == branch[0] and text == branch[3] and target in (None, branch[4])
+
+
+def reason_of(branch, reasons):
+    """``(index in reasons, class, why)`` of ``branch``, or ``(None, NOT_READ, "")``."""
+    for k, entry in enumerate(reasons):
+        if matches(entry, branch):
+            return k, entry[3], entry[4]
+    return None, NOT_READ, ""
+
+
+def _code(text, limit=90):
+    text = text if len(text) <= limit else text[:limit - 1] + "…"
+    return "`" + text.replace("`", "'") + "`"
+
+
+def branches_block(data, command, reasons=None, classes=None, at=None, root=ROOT):
+    """``(markdown, not read, stale)``: every uncovered branch grouped by file with its
+    reason, opened by the count per class; ``not read``: the branches no reason matches,
+    ``stale``: the reasons that match no uncovered branch."""
+    reasons = coverage_reasons.REASONS if reasons is None else reasons
+    classes = coverage_reasons.CLASSES if classes is None else classes
+    found = uncovered(data, at, root)
+    used, per_class, rows = set(), Counter(), []
+    for b in found:
+        k, cls, why = reason_of(b, reasons)
+        if k is not None:
+            used.add(k)
+        per_class[cls] += 1
+        rows.append((b, cls, why))
+    not_read = [b for b, cls, _ in rows if cls == NOT_READ]
+    stale = [e for k, e in enumerate(reasons) if k not in used]
+    where = f" (the source read at commit {at})" if at else ""
+    lines = [f"Generated by `{command}`{where}.", "",
+             f"{len(found)} branches uncovered, by reason:", "",
+             "| class | what it means | branches |", "|---|---|---|"]
+    meaning = {**classes, NOT_READ: "no reason in tests/tools/coverage_reasons.py yet"}
+    for key in [*classes, NOT_READ]:
+        if per_class.get(key):
+            lines.append(f"| {key} | {meaning[key]} | {per_class[key]} |")
+    for key in sorted(set(per_class) - set(meaning)):
+        lines.append(f"| {key} | a class CLASSES does not list | {per_class[key]} |")
+    if stale:
+        lines += ["", f"{len(stale)} reason(s) of tests/tools/coverage_reasons.py match no "
+                  f"uncovered branch (stale: covered now, or the line changed):", ""]
+        lines += [f"* `{e[0]}`: {_code(e[1])}" + (f" -> {_code(e[2])}" if e[2] else "")
+                  for e in stale]
+    current = None
+    for (rel, a, b, text, ttext), cls, why in rows:
+        if rel != current:
+            n = sum(1 for r in rows if r[0][0] == rel)
+            lines += ["", f"**`{rel}`** ({n}):", ""]
+            current = rel
+        to = "exit" if b < 0 else f"{b} {_code(ttext, 60)}"
+        lines.append(f"* {a} {_code(text)} -> {to}: **{cls}**" + (f": {why}" if why else ""))
+    return "\n".join(lines), not_read, stale
 
 
 # --- Verilator ------------------------------------------------------------------------------
@@ -176,6 +289,9 @@ def main(argv=None):
     p.add_argument("--dat", type=Path, default=None,
                    help="with --verilator: read this coverage.dat instead of building and running")
     p.add_argument("--doc", type=Path, default=None)
+    p.add_argument("--at", default=None, metavar="COMMIT",
+                   help="with --python: read the branches' source text at this commit (the one "
+                        "the JSON was measured on; default: the working tree)")
     a = p.parse_args(argv)
     if a.python is None and not a.verilator:
         print("error: give --python JSON and/or --verilator", file=sys.stderr)
@@ -187,8 +303,18 @@ def main(argv=None):
     if a.python is not None:
         block = python_block(a.python, command)
         print(block)
+        data = json.loads(a.python.read_text())
+        listing, not_read, stale = branches_block(data, command, at=a.at)
+        print(listing)
+        for b in not_read:
+            print(f"not read yet: {b[0]}:{b[1]} -> {b[2]}: {b[3]}", file=sys.stderr)
+        for e in stale:
+            print(f"stale reason (matches no uncovered branch): {e[0]}: {e[1]}", file=sys.stderr)
+        print(f"{len(not_read)} uncovered branch(es) not read yet, {len(stale)} stale reason(s)",
+              file=sys.stderr)
         if a.doc:
             write_doc(a.doc, "python", block)
+            write_doc(a.doc, "branches", listing)
     if a.verilator:
         if a.dat is not None:
             dat, seconds = a.dat, None
