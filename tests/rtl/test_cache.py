@@ -83,6 +83,15 @@ def test_cache_bit_exact_geometries(texel_bits, data_bits, ways, block):
     assert golden.evictions
 
 
+@pytest.mark.parametrize("ways", [1, 2])
+def test_cache_bit_exact_with_one_set(ways):
+    """sets = 1: no set bits in the address, every line competes for the one set's ways."""
+    geom = CacheGeometry(32, 2, 28, sets=1, ways=ways)
+    assert geom.set_bits == 0
+    golden, _ = check_cache(geom, n=100, seed=3)
+    assert golden.evictions
+
+
 def test_cache_hits_at_one_pixel_a_clock():
     """A scan the cache holds after its first pass: the second pass hits every pixel and
     takes one cycle a pixel (no input gaps, no backpressure)."""

@@ -92,3 +92,11 @@ def test_sdram_clock_too_slow_to_refresh_in_time_is_refused():
     with pytest.raises(BumpError, match="at 1 MHz a refresh cannot be scheduled within tREFI") as e:
         SdramConfig(freq_mhz=1)
     assert e.value.field == "freq_mhz"
+
+
+def test_a_unit_inside_a_chain_refuses_a_fifo_depth_of_its_own():
+    from bumprtl.rtl.illumination import Illumination
+
+    assert Illumination(Config(), credit=True, fifo_depth=None).fifo_depth >= 1
+    with pytest.raises(BumpError, match="fifo_depth is given but credit=False"):
+        Illumination(Config(), credit=False, fifo_depth=8)

@@ -45,3 +45,32 @@ def test_bench_memory_writes_its_page(tmp_path, capsys):
 def test_bench_memory_refuses_an_unknown_scene(capsys):
     assert main(["bench", "memory", "--scenes", "nowhere"]) == 2
     assert "scene must be one of" in capsys.readouterr().err
+
+
+def test_bench_memory_without_doc_prints_the_table_and_writes_no_page(tmp_path, monkeypatch,
+                                                                     capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["bench", "memory", "--scenes", "globe", "--sizes", "256", "--rows", "4",
+                 "--caches", "64x2 4x4", "--latencies", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "cycles/px L=5" in out and "| globe | palette | 256² | 64x2 4x4 |" in out
+    assert "wrote" not in out
+    assert [p for p in tmp_path.rglob("*") if p.is_file() and p.suffix != ".log"] == []
+
+
+def test_the_page_gives_no_number_for_a_latency_that_was_not_run():
+    """The page's summary quotes the throughput at L = 20 and 60; a run without them
+    (``--latencies 5``) has none to quote and says so instead of failing or inventing one."""
+    import re
+    from pathlib import Path
+
+    from bumprtl.gen.bench.memory import ZERO_WAIT, _page
+
+    rows = memory_rows(scenes=["globe"], sizes=[256], caches=["64x2 4x4"], latencies=[5], rows=4)
+    page = _page(rows, sorted({ZERO_WAIT, 5}), Path("img/memory.png"))
+    quoted = re.search(r"at L = 20 every case keeps at least\s+(\S+)", page).group(1)
+    assert "%" not in quoted
+    full = memory_rows(scenes=["globe"], sizes=[256], caches=["64x2 4x4"], latencies=[20, 60],
+                       rows=4)
+    page = _page(full, sorted({ZERO_WAIT, 20, 60}), Path("img/memory.png"))
+    assert re.search(r"at L = 20 every case keeps at least\s+[\d.]+ %", page)

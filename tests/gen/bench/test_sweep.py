@@ -261,3 +261,16 @@ def test_sim_rate_with_a_relative_work_dir(tmp_path, monkeypatch):
     rate, build_s = unit_sim_rate(Config(angle_bits=6, frac_bits=5), "icarus", "rotation", 5, Path("rel"))
     assert rate > 0 and build_s >= 0
     assert (tmp_path / "rel" / "rtl" / "rotation.json").is_file()
+
+
+def test_stress_rows_at_the_narrowest_widths_are_bit_exact_only_and_none_crashes():
+    """Float64 results do not depend on the widths: the narrowest configuration has a row
+    per bit-exact method and none for the float64 models; every bit-exact model runs at
+    4-bit angles and fractions without raising."""
+    from bumprtl.gen.bench.stress import stress_rows
+    from bumprtl.sim.golden.methods import METHODS
+
+    rows = stress_rows(100, 0, configs=["narrowest"], cases=["below_horizon"])
+    assert sorted(m for _, _, m, _ in rows) == sorted(f"{m} (fixed)" for m in METHODS)
+    assert not any("float64" in m for _, _, m, _ in rows)
+    assert all("crash" not in stats for *_, stats in rows), rows

@@ -227,3 +227,19 @@ def test_an_older_sweep_without_map_records_is_read_from_its_grid():
                           "texels": 4096}]}
     assert bench_sweep.unquantized_maps({**point, "palette_size": 100}, recorded) == ["moon"]
     assert bench_sweep.unquantized_maps({**point, "palette_size": 99}, recorded) == []
+
+
+def test_sweep_bench_with_docs_and_no_data_copy_writes_the_page_only(tmp_path, monkeypatch,
+                                                                      capsys):
+    """--docs without --data-copy (the command line's default): the JSON and the page, no
+    copy of the JSON anywhere else."""
+    monkeypatch.setattr(bench_sweep, "sweep", lambda grid, opts, work, progress=True: _data(grid))
+    docs = tmp_path / "docs" / "bench.md"
+    opts = SweepOptions(quick=True, maps=("moon:32",), out=tmp_path / "o" / "s.json",
+                        work=tmp_path / "w", docs=docs, no_progress=True)
+    assert opts.data_copy is None
+    assert bench_sweep.sweep_bench(opts) == 0
+    assert "## Error, cost and speed sweep" in docs.read_text()
+    jsons = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*.json"))
+    assert [str(p) for p in jsons] == [str(opts.out.relative_to(tmp_path))]
+    assert f"wrote {docs}" in capsys.readouterr().out

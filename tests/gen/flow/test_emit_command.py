@@ -88,3 +88,18 @@ def test_load_initial_emits_no_host_write_port_and_load_port_does(tmp_path, emit
     assert load == "initial" and not any(initial.values()), initial
     port, load = _host_ports(emitted / "named-port-fusesoc" / "a", "my_bump")
     assert load == "port" and all(port.values()), port
+
+
+def test_scene_command_gives_a_boolean_key_as_its_flag_or_no_flag():
+    """A boolean scene key that differs from the named scene's is ``--key`` or
+    ``--no-key``, and the emit parser reads it back to the same value."""
+    from bumprtl.gen.cli.main import build_parser
+    from bumprtl.gen.flow.memories import scene_command
+    from bumprtl.sim.scenes.config import load_scene_config
+
+    base = load_scene_config("default")
+    for key in ("specular", "resample"):
+        scene = base.replace(**{key: not getattr(base, key)})
+        command = scene_command("pipeline", scene)
+        args = build_parser().parse_args(command.split()[1:])
+        assert getattr(args, key) is (not getattr(base, key)), command

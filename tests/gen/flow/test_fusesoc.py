@@ -81,3 +81,14 @@ def test_core_alone_runs_a_named_pipeline_with_its_memory_images(tmp_path):
     shutil.copytree(alone, broken, ignore=shutil.ignore_patterns("fsbuild"))
     (broken / "bm_a.core").write_text(core.replace("      - bm_a_named.v\n", ""))
     assert _fusesoc(broken, "sim", "bm_a").returncode != 0
+
+
+def test_a_core_without_memory_files_has_the_rtl_fileset_only(tmp_path):
+    """A unit with no $readmemh and no sidecar carried: no mem fileset, and the targets do
+    not name one (FuseSoC refuses a target naming a fileset the core lacks)."""
+    from bumprtl.gen.flow.fusesoc import write_core
+    v = tmp_path / "inv.v"
+    v.write_text("module inv(input a, output y); assign y = ~a; endmodule\n")
+    text = write_core(v, "test").read_text()
+    assert "- inv.v" in text and "filesets: [rtl]" in text
+    assert "mem:" not in text and "[rtl, mem]" not in text

@@ -289,3 +289,24 @@ def test_default_bench_passes_on_verilator(tmp_path):
                        env=tool_env(), timeout=1800)
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout.splitlines()[-1] == "PASS 300", r.stdout[-2000:]
+
+
+def test_unit_vectors_from_the_frame_and_at_random_chain_rotation_into_illumination():
+    """A unit's vectors from the default frame or at random: the frame does not depend on
+    the seed, random does; illumination's inputs are rotation's expected outputs of the
+    same pixels, and every expected tag is its input's."""
+    from bumprtl.gen.flow.vectors import unit_vectors
+    from bumprtl.rtl.config import Config
+
+    cfg = Config()
+    for source in ("frame", "random"):
+        rot = unit_vectors("rotation", cfg, source, count=64, seed=1)
+        ill = unit_vectors("illumination", cfg, source, count=64, seed=1)
+        assert all(len(v) == 64 for v in rot.inputs.values())
+        assert np.array_equal(rot.expected["tag"], rot.inputs["tag"])
+        for field, values in ill.inputs.items():
+            if field != "tag":
+                assert np.array_equal(values, rot.expected[field]), (source, field)
+        other = unit_vectors("rotation", cfg, source, count=64, seed=2)
+        same = all(np.array_equal(other.inputs[k], rot.inputs[k]) for k in rot.inputs)
+        assert same == (source == "frame"), source

@@ -190,3 +190,14 @@ def test_cli_exits_2_with_one_line(tmp_path, capsys, content, message):
     assert main(["recommend", "--max-error-lsb", "0", "--sweep", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
+
+
+def test_without_a_local_or_shipped_sweep_the_command_says_how_to_make_one(tmp_path, capsys,
+                                                                           monkeypatch):
+    from bumprtl.gen.report import recommend as rec
+    monkeypatch.chdir(tmp_path)                           # no build/bench/sweep.json here
+    monkeypatch.setattr(rec, "SHIPPED_SWEEP", tmp_path / "docs" / "data" / "sweep.json")
+    assert rec.sweep_path() == (rec.LOCAL_SWEEP, None)
+    assert main(["recommend", "--max-error-lsb", "1"]) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert str(rec.LOCAL_SWEEP) in line and "bumprtl bench sweep" in line

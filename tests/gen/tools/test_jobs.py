@@ -83,3 +83,10 @@ def test_the_environment_names_the_scheduler(monkeypatch):
     monkeypatch.setenv(jobs.ENV, "10.0.0.1")
     with pytest.raises(jobs.SchedulerError, match="BUMPRTL_SCHEDULER must be tcp://HOST:PORT"):
         jobs.scheduler_address(None)
+
+
+def test_runner_says_where_its_jobs_run_without_starting_a_cluster():
+    local = jobs.Runner(None, 3)
+    assert "3 workers" in local.where and "scheduler" not in local.where
+    assert "1 worker" in jobs.Runner(None, 1).where and "workers" not in jobs.Runner(None, 1).where
+    assert "tcp://10.0.0.5:8786" in jobs.Runner("tcp://10.0.0.5:8786", 2).where

@@ -45,3 +45,21 @@ def test_broken_edge_refuses_an_unknown_mutation():
     with pytest.raises(ValueError, match="mutation must be one of .*got 'never'") as e:
         BrokenEdge(None, 3, "never")
     assert all(m in str(e.value) for m in EDGE_MUTATIONS)
+
+
+@pytest.mark.filterwarnings("ignore::amaranth.hdl.UnusedElaboratable")
+@pytest.mark.parametrize("prop, message", [
+    ("ready", "ready: the unit has no fifo_depth"),
+    ("credit", "credit: the unit has no credit edge and chain to check"),
+])
+def test_ready_and_credit_refuse_a_unit_built_without_its_credit_edge(prop, message):
+    """A unit built for inside a chain (credit=False) has neither a FIFO depth nor a credit
+    edge: the two properties about them are refused while the contract is built, not
+    handed to the solver."""
+    from amaranth.hdl import Fragment
+
+    from bumprtl.rtl.config import Config
+    from bumprtl.rtl.illumination import Illumination
+
+    with pytest.raises(ValueError, match=message):
+        Fragment.get(StreamContract(Illumination(Config(), credit=False), prop), None)

@@ -133,3 +133,11 @@ def test_cycle_model_orders_and_limits():
     assert stream_cycles(one, g, 20) == blocking_cycles(one, g, 20) - 2 == 5 + 20 + 16
     again = run_cache(g, [0, 1, 2, 3] * 50, [0] * 200, [0] * 200)
     assert stream_cycles(again, g, 60) == 200 + 60 + 16
+
+
+def test_an_empty_pixel_run_takes_no_cycles():
+    g = CacheGeometry(64, 1, 28)
+    empty = run_cache(g, [], [], [])
+    assert len(empty.hit) == 0 and stream_cycles(empty, g, 20) == 0
+    one = run_cache(g, [0], [0], [0])                 # one cold miss: at least its latency
+    assert stream_cycles(one, g, 20) >= 20

@@ -88,3 +88,20 @@ def test_a_run_that_reports_an_error_or_nothing_raises(summary, exc, message, tm
                       100, 1, {"no_stall": (0.0, 0.0)}, None)
     assert _Runner.job["source"] == {"kind": "arrays", "path": str(work / "bulk_arrays.npz")}
     assert _Runner.job["patterns"] == ["no_stall"] and _Runner.job["chunk"] == 64
+
+
+def test_check_stimulus_takes_empty_fields_and_still_checks_the_values_of_full_ones():
+    """An empty stimulus (no pixels) has no values to range-check; the same fields with one
+    value out of range are refused."""
+    import numpy as np
+
+    from bumprtl.sim.tb.bulk_codec import check_stimulus
+
+    _, meta, _ = build_unit("rotation", Config())
+    fields = meta.fields_of("i__payload")
+    check_stimulus(meta, {k: np.zeros(0, np.int64) for k in fields})
+    big = {k: np.zeros(2, np.int64) for k in fields}
+    name = next(k for k, f in fields.items() if not f.signed)
+    big[name][1] = 1 << fields[name].width
+    with pytest.raises(BumpError, match=repr(name)):
+        check_stimulus(meta, big)
