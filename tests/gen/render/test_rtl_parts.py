@@ -117,3 +117,21 @@ def test_scenes_table_one_row_per_builtin_with_its_counts(monkeypatch, tmp_path)
     assert work == [("pipeline", tmp_path / "w" / n) for n in BUILTIN]
     assert "| scene class | units built | multipliers | ROM bits | RAM bits | adders | golden " \
            "render 256² (s) | command |" in text
+
+
+def test_the_golden_render_of_a_palette_scene_shows_only_its_table_colours():
+    """The palette scene's golden image (what render --rtl compares the hardware's with):
+    every pixel is an entry of the scene's colour table, and the frame shows several."""
+    from bumprtl.gen.render.rtl import golden_render, scene_stimulus
+    from bumprtl.sim.golden.fixed.palette_lut import unpack_rgba
+    from bumprtl.sim.scenes.config import load_scene_config
+
+    scene = load_scene_config("palette")
+    assert scene.shading == "palette"
+    img = golden_render(scene, 32)
+    table = scene_stimulus(scene, 32)[3]
+    rgba = unpack_rgba(np.asarray(table), scene.config)
+    entries = set(zip(rgba["r"].tolist(), rgba["g"].tolist(), rgba["b"].tolist(), strict=True))
+    shown = {tuple(int(x) for x in c) for c in img.reshape(-1, 3)}
+    assert img.shape == (32, 32, 3) and len(shown) > 8
+    assert shown <= entries

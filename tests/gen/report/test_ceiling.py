@@ -70,3 +70,16 @@ def test_the_credit_edge_alone_is_the_edge_between_registers_and_nothing_else():
     assert re.search(r"reg \[32:0\] src", text) and re.search(r"output \[31:0\] o", text)
     with pytest.raises(BumpError, match="fifo_depth must be an int >= 14.*got 13"):
         edge_component(layout, 10, 13).elaborate(None)
+
+
+def test_no_share_of_the_ceiling_when_every_row_meets_or_no_ceiling_was_timed():
+    """The share sentence needs a row under its target and a ceiling with an Fmax: with
+    every row met there is nothing to say, and a ceiling of 0 MHz (nextpnr timed none) would
+    divide by zero."""
+    ceilings = {"dp16kd": {**_row("dp16kd_alone", 400.0, True), "fmax_by_seed": {1: 400.0}}}
+    met = [_row("scene_a", 250.0, True), _row("scene_b", 210.0, True)]
+    text = "\n".join(_ceiling_lines(met, ceilings))
+    assert "| DP16KD |" in text and "share of the lower ceiling" not in text
+    untimed = {"dp16kd": {**_row("dp16kd_alone", 0, True), "fmax_by_seed": {1: 0}}}
+    text = "\n".join(_ceiling_lines([_row("scene_a", 150.0, False)], untimed))
+    assert "| DP16KD |" in text and "share of the lower ceiling" not in text

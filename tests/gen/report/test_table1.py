@@ -202,3 +202,36 @@ def test_fpga_section_lists_each_pipeline_at_its_own_fmax(tmp_path):
     assert "999.0" not in text                           # units are not pipelines
     assert "| kim | not placed: timed out |" in text
     assert report.fpga_section(tmp_path / "absent.json") == ""
+
+
+def test_fpga_section_names_the_designs_a_run_left_out_and_only_those(tmp_path):
+    """A run that placed every design of Table 1 has no "not in that run" line; leaving one
+    out names that one alone."""
+    rows = [{"design": d, "row": "pipeline", "LUT4": 1, "FF": 1, "DSP": 0, "BRAM": 0,
+             "fmax_mhz": 100.0} for d in report.TABLE1_ORDER]
+    data = {"command": "bumprtl report fpga", "device": "LFE5U-85F", "rows": rows,
+            "accuracy": {d: {"max": 1, "mean": 0.5} for d in report.TABLE1_ORDER}}
+    path = tmp_path / "fpga.json"
+    path.write_text(json.dumps(data))
+    text = report.fpga_section(path)
+    assert all(f"| {d} | 1 | 1 | 0 | 0 | 100.0 |" in text for d in report.TABLE1_ORDER)
+    assert "Not in that run" not in text
+    left = report.TABLE1_ORDER[-1]
+    data["rows"] = rows[:-1]
+    path.write_text(json.dumps(data))
+    [line] = [ln for ln in report.fpga_section(path).splitlines() if "Not in that run" in ln]
+    assert line.rstrip(".").endswith(left)
+
+
+def test_a_count_that_failed_is_named_with_its_reason_and_nothing_is_claimed_from_it():
+    """Yosys failing on lee's setup leaves lee uncounted: the page names the design, the row
+    and the reason, and states no lee multiplier count or measured saving (no "None", no
+    percentage against lee's netlists)."""
+    acc = {"samples": 10, "designs": {d: {"max": 1, "mean": 0.5} for d in report.TABLE1_ORDER}}
+    text = report.table1_markdown(Config(), {}, acc, "bumprtl report table1",
+                                  failed=[("lee", "setup", "yosys: killed by signal 9")])
+    [line] = [ln for ln in text.splitlines() if "yosys: killed by signal 9" in ln]
+    assert "lee" in line and "setup" in line
+    assert "None" not in text
+    assert report.netlist_multiplier_savings({}) == {}
+    assert "| lee | setup |" not in text

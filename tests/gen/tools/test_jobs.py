@@ -90,3 +90,19 @@ def test_runner_says_where_its_jobs_run_without_starting_a_cluster():
     assert "3 workers" in local.where and "scheduler" not in local.where
     assert "1 worker" in jobs.Runner(None, 1).where and "workers" not in jobs.Runner(None, 1).where
     assert "tcp://10.0.0.5:8786" in jobs.Runner("tcp://10.0.0.5:8786", 2).where
+
+
+def _answer():
+    return 42
+
+
+def test_jobs_given_a_timeout_that_finish_in_time_keep_their_value_or_error(threads):
+    """A timeout that does not run out changes nothing: the value (any value, not only a
+    dict with a log) or the exception's first line comes back as without one."""
+    with jobs.Runner(None, 2, log_dir=threads / "jobs", progress=False) as r:
+        out = r.run([jobs.Job("ok", _sleeper, (0,), timeout=60.0),
+                     jobs.Job("plain", _answer, (), timeout=60.0),
+                     jobs.Job("bad", _fails, (), timeout=60.0)])
+    assert out["ok"].ok and out["ok"].value == {"slept": 0}
+    assert out["plain"].ok and out["plain"].value == 42
+    assert not out["bad"].ok and out["bad"].error == "ValueError: no such thing"
