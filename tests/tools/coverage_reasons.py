@@ -25,12 +25,15 @@ CLASSES = {
                "a page's regeneration)",
     "defensive": "cannot happen with the code as it is (a registry or a caller that never "
                  "gives it); the check guards a future change",
-    "never empty": "a loop's exit before its first iteration, or a condition that is always "
-                   "true under every input make test and the code give; the other side is "
-                   "covered",
+    "never empty": "a loop that never runs empty (or never runs out), or a condition that "
+                   "goes one way under every input make test and the code give; the other "
+                   "way is covered",
+    "not measurable": "taken under make test, but coverage.py cannot record it (the process "
+                      "is replaced by exec before it writes its data)",
     "covered since": "a test added after the measured run reaches it (named); the next "
                      "make coverage drops it from this list",
-    "no test yet": "reachable with a fast test, none written yet",
+    "no test yet": "a test could reach it, none is written yet (each says what it would "
+                   "take: most need an emission or a simulation of seconds)",
 }
 
 CLI = "tests/gen/cli/test_refusals_reached.py"
@@ -38,8 +41,14 @@ FLOW = "tests/gen/flow/test_refusals_reached.py"
 RTL = "tests/rtl/test_refusals_reached.py"
 SIM = "tests/sim/test_refusals_reached.py"
 RENDER = "tests/gen/render/test_refusals_reached.py"
-FORMAL_SUBSET = ("the quick subset make test proves (tests/sim/formal) never builds this "
-                 "contract path; the whole table of gen/formal/run.py does")
+FORMAL_SUBSET = ("make test's quick formal subset (tests/sim/formal) never builds this contract "
+                 "path; the whole table of gen/formal/run.py (the scene and AXI pipelines, the "
+                 "palette bank) is where it is built: read from the code, not confirmed by a "
+                 "coverage run of make formal")
+
+EDGE_FIFO = ("every CreditEdge of rtl/ holds a CreditFIFO whose banks elaborate to memories; "
+             "the SyncFIFOBuffered form and a FIFO without a memory are for an edge built "
+             "otherwise, which none is")
 
 
 def since(test, what):
@@ -53,26 +62,22 @@ REASONS = [
     ("gen/bench/memory.py", "if isinstance(rows, bool) or not isinstance(rows, int) or rows < 1:",
      None, *since(CLI, "`bench memory --rows 0`: one line, exit 2")),
     ("gen/bench/memory.py", "if latency not in rows[0].cycles_per_pixel:", None,
-     "no test yet", "the page's summary for `--latencies` without 20 or 60 (\"(not run)\"): "
-     "make test writes the page with the default latencies only"),
+     *since("tests/gen/bench/test_memory.py", "the page of a run without L = 20 and 60")),
     ("gen/bench/memory.py", "if r.size == size and r.cache == next(iter(CACHES)):", None,
      "by hand", "the plot of several map sizes or caches: docs/memory.md's default run; make "
      "test plots one size and one cache"),
     ("gen/bench/memory.py", "if doc is not None:", None,
-     "no test yet", "`bench memory` without --doc (the table printed only); make test runs it "
-     "with --doc"),
+     *since("tests/gen/bench/test_memory.py", "`bench memory` without --doc")),
     ("gen/bench/palette.py", "if curve:", None,
      "never empty", "a curve has a point for every palette size and the bench takes at least one"),
     ("gen/bench/stress.py", "if cname in FLOAT_CONFIGS:", None,
-     "no test yet", "the stress rows of a config without float64 rows (narrowest, widest): make "
-     "test asks the default config only; `make docs` runs them all"),
+     *since("tests/gen/bench/test_sweep.py", "the narrowest configuration's stress rows")),
     ("gen/bench/sweep.py", 'if "palette" in opts.methods:', None,
      "never empty", "every sweep make test runs includes palette (its default method list)"),
     ("gen/bench/sweep.py", "if front:", None,
      "never empty", "a Pareto front of at least one point: every plot has points"),
     ("gen/bench/sweep.py", "if opts.data_copy:", None,
-     "never empty", "make test's `bench sweep --doc` runs always copy the data (the default "
-     "data_copy); only a caller setting it to None skips the copy"),
+     *since("tests/gen/bench/test_sweep_parts.py", "--docs without --data-copy")),
     # gen/cli
     ("gen/cli/board.py", "elif not args.check_frames:", None,
      *since("tests/gen/cli/test_board_run.py",
@@ -125,8 +130,8 @@ REASONS = [
     ("gen/flow/axis.py", "if tdata_width is not None:", None,
      "no test yet", "the axis command with `--tdata-width` (see gen/cli/emit.py)"),
     ("gen/flow/board.py", "if result.exists():", None,
-     "make board", "a second frame check into the same directory; make test's runs each use a "
-     "fresh one"),
+     "make board", "a frame check into a directory that holds an earlier run's frames (a "
+     "second `make board`); make test's runs each use a fresh one"),
     ("gen/flow/board.py", "if pipe_hz is not None:       # the same ratio to the simulated pixel period, in ps (even)",
      None, "make board", "frames at the pixel clock alone; make test's reduced run "
      "(tests/board/test_board.py) sets a pipe clock"),
@@ -135,8 +140,8 @@ REASONS = [
     ("gen/flow/board.py", "if opt_fast is not None:            # a make command-line variable (see tool_env)",
      None, "make board", "as above (the same opt_fast)"),
     ("gen/flow/board.py", "if not (stamp.is_file() and stamp.read_text() == digest):", None,
-     "make board", "the Verilator build skipped when its digest matches (a second run on the "
-     "same Verilog); make test builds once"),
+     "make board", "the Verilator build skipped when its digest matches (a second `make "
+     "board` on the same Verilog); make test builds once"),
     ("gen/flow/board.py", "if tests == 0 or failures:", None,
      "simulator", "a failing cocotb run of tb_board"),
     ("gen/flow/emit.py", "if component not in _FRAGMENTS:", None,
@@ -148,8 +153,7 @@ REASONS = [
     ("gen/flow/fpga.py", 'if not isinstance(getattr(component, "target", None), ECP5):', None,
      *since(FLOW, "elaborate of a unit built without target=ECP5()")),
     ("gen/flow/fusesoc.py", "if mem_files:", None,
-     "no test yet", "a FuseSoC core of a unit without memory images (tests/gen/flow/test_fusesoc.py "
-     "writes the scene pipeline's, which has them)"),
+     *since("tests/gen/flow/test_fusesoc.py", "a core without memory files")),
     ("gen/flow/memories.py", "if set(DEVICE_BRAM) != set(DEVICES):", None,
      "defensive", "import-time check that two tables in the source list the same devices"),
     ("gen/flow/memories.py", "if device not in DEVICE_BRAM:", None,
@@ -162,7 +166,7 @@ REASONS = [
      "defensive", "a sidecar whose image names a port the unit lacks: the sidecar is written "
      "from the same unit"),
     ("gen/flow/memories.py", "if isinstance(value, bool):", None,
-     "no test yet", "a scene command with a boolean map flag that differs from the named scene's"),
+     *since("tests/gen/flow/test_emit_command.py", "a boolean scene key as --key / --no-key")),
     ("gen/flow/named.py", 'if "i__payload" not in ports or "o__payload" not in ports:', None,
      "defensive", "gen/cli/emit.py refuses `--ports named` with `--interface axis` before"),
     ("gen/flow/named.py", "if name in out:", None,
@@ -185,8 +189,8 @@ REASONS = [
      "never empty", "Yosys' `synth -run` leaves every product as $macc in the netlists make "
      "test counts"),
     ("gen/flow/resources.py", "elif kind in _DIV_TYPES:", None,
-     "never empty", "no unit divides (the Table 1 baselines' dividers are counted as such only "
-     "in their own netlists, `make docs`)"),
+     "never empty", "no netlist make test counts (Table 1's designs at 10-bit widths) has a "
+     "divider cell"),
     ("gen/flow/units.py", "if name not in UNITS:", None, *since(FLOW, "build_unit of an unknown unit")),
     ("gen/flow/vectors.py", 'if kind not in ("coord", "level", "phi", "theta"):', None,
      "defensive", "every scene pipeline's input fields are of those kinds"),
@@ -208,11 +212,9 @@ REASONS = [
     ("gen/flow/vectors.py", "if unit not in UNIT_SOURCES:", None,
      *since(FLOW, "unit_vectors of an unknown unit")),
     ("gen/flow/vectors.py", "if is_file:", None,
-     "no test yet", "a unit's vectors from `--source frame` (tests/gen/flow/test_vectors.py "
-     "takes random and a file)"),
+     *since("tests/gen/flow/test_vectors.py", "a unit's vectors from the frame and at random")),
     ("gen/flow/vectors.py", 'elif source == "frame":', None,
-     "no test yet", "as above: the rotation or illumination unit's vectors from the frame or "
-     "at random"),
+     *since("tests/gen/flow/test_vectors.py", "as above")),
     ("gen/flow/vectors.py", 'for name, (off, w, _s) in meta.fields_of("poly").items():', None,
      "no test yet", "the polygon word of a flat-map scene's vectors (tests/gen/flow/test_vectors.py "
      "writes those of varying maps; an emission of seconds)"),
@@ -265,10 +267,10 @@ REASONS = [
     ("gen/render/images.py", "if s.texture:", None,
      "no test yet", "the fixed-point palette render of a scene with a colour texture"),
     ("gen/render/rtl.py", 'if scene.shading == "palette":', None,
-     "simulator", "golden image of a palette scene: reached by the simulator tests that render "
-     "one (tests/sim/tb), not in this run"),
+     *since("tests/gen/render/test_rtl_parts.py", "the palette scene's golden image")),
     ("gen/render/rtl.py", "if table is not None:", None,
-     "simulator", "the stimulus file of a palette scene for tb_pipeline"),
+     "simulator", "the stimulus file of a palette scene for the per-cycle bench (tb_pipeline); "
+     "no test of make test renders a palette scene per cycle"),
     ("gen/render/rtl.py", "if per_cycle:", None,
      "simulator", "`render --rtl --per-cycle` (every pixel driven from cocotb)"),
     ("gen/render/rtl.py", 'if __name__ == "__main__":    # python -m bumprtl.gen.render.rtl [--doc docs/scenes.md]',
@@ -287,9 +289,9 @@ REASONS = [
      None, "make fpga", "as above"),
     ("gen/report/fpga.py", 'if row == "pipeline":', None, "make fpga", "as above"),
     ("gen/report/fpga.py", "if ok:", None,
-     "make fpga", "a primitive with no placed seed (a real placement failing)"),
+     "tool failure", "a primitive with no placed seed (nextpnr failing on every seed)"),
     ("gen/report/fpga.py", 'if under and low["fmax_mhz"]:', None,
-     "make fpga", "every row meeting its target, or a ceiling of 0 MHz"),
+     *since("tests/gen/report/test_ceiling.py", "every row met, or no ceiling timed")),
     ("gen/report/fpga.py", "if skipped:", None,
      "defensive", "NOT_PLACED is empty: no method that cannot be placed today"),
     ("gen/report/integration.py", "for pattern, text in _MEANINGS:", None,
@@ -306,50 +308,51 @@ REASONS = [
     ("gen/report/integration.py", 'if img["load"] != "port" or name == "lut":', None,
      "never empty", "the page emits with `--load port` and no palette scene"),
     ("gen/report/recommend.py", "if SHIPPED_SWEEP.is_file():", None,
-     "no test yet", "an install without docs/data/sweep.json and no local sweep"),
+     *since("tests/gen/report/test_recommend.py", "no local and no shipped sweep: one line, exit 2")),
     ("gen/report/recommend.py", 'if not f or f.get("device") != device:', None,
-     "no test yet", "a sweep point placed on another device (the shipped sweep has one device)"),
+     "defensive", "its one caller (recommend) passes only the points placed on the device"),
     ("gen/report/recommend.py", 'if "max_lsb" in s:', None,
      "never empty", "every scene row of the sweep has its error"),
     ("gen/report/table1.py", 'if "lee" not in counts:', None,
-     "make fpga", "a Table 1 count whose lee rows failed (Yosys)"),
-    ("gen/report/table1.py", "if failed:", None, "tool failure", "a count whose Yosys job failed"),
-    ("gen/report/table1.py", "if lee:", None, "tool failure", "as above: no lee rows"),
-    ("gen/report/table1.py", "if measured:", None, "tool failure", "as above"),
+     *since("tests/gen/report/test_table1.py", "the page of a run whose lee count failed")),
+    ("gen/report/table1.py", "if failed:", None, *since("tests/gen/report/test_table1.py", "as above")),
+    ("gen/report/table1.py", "if lee:", None, *since("tests/gen/report/test_table1.py", "as above")),
+    ("gen/report/table1.py", "if measured:", None, *since("tests/gen/report/test_table1.py", "as above")),
     ("gen/report/table1.py", "if scheduler is None:", None,
      "by hand", "the counts on a Dask scheduler (`--scheduler`)"),
     ("gen/report/table1.py", "if all(o.ok for o in got.values()):", None,
      "tool failure", "a count whose Yosys job failed"),
     ("gen/report/table1.py", "if missing:", None,
-     "never empty", "make test's report runs hold every method"),
+     *since("tests/gen/report/test_table1.py", "the ECP5 section of a run that placed every design")),
     ("gen/report/timing.py", "if foot:", None,
      "never empty", "every diagram of docs/timing has a footnote"),
     ("gen/report/timing.py", "if doc is not None and doc.is_file():", None,
      "no test yet", "`report timing` without its page (the page is always there in the tree)"),
     # gen/tools
     ("gen/tools/jobs.py", "if t.is_alive():", None,
-     "simulator", "a job timing out (killing its children); make test's jobs finish"),
+     *since("tests/gen/tools/test_jobs.py", "jobs with a timeout that finish in time")),
     ("gen/tools/jobs.py", 'if "error" in box:', None,
-     "simulator", "the timed job path (a job given a timeout) runs only in the formal and "
-     "placement runs"),
+     *since("tests/gen/tools/test_jobs.py", "as above: a value and an error")),
     ("gen/tools/jobs.py", 'if isinstance(value, dict) and "log" in value:', None,
-     "make formal", "the formal jobs return their log"),
+     *since("tests/gen/tools/test_jobs.py", "a job whose value is not a dict with a log")),
     ("gen/tools/jobs.py", "if not self.address:", None,
-     "no test yet", "Runner.where (printed by the long runs only)"),
+     *since("tests/gen/tools/test_jobs.py", "Runner.where, local and on a scheduler")),
     ("gen/tools/jobs.py", "if job.name in names:", None,
      "defensive", "two jobs with one name: every caller names them by job_name (unique)"),
     ("gen/tools/objcache.py", "if found is None or not cache:", None,
-     "simulator", "a compile that is not the Verilator library's, or no cache set: the "
-     "compiler runs itself (exec; tests/gen/tools/test_objcache.py checks the cached path)"),
+     "not measurable", "every Verilator build compiles the design's own C++ through "
+     "$(OBJCACHE) and takes this branch; os.execvp replaces the measured process before "
+     "coverage.py saves it"),
     ("gen/tools/sby.py", 'if status not in ("PASS", "FAIL", "UNKNOWN"):', None,
      "tool failure", "sby ending in another status"),
     ("gen/tools/toolchain.py", "if any(w[0] != name or int(w[1]) != k for k, w in enumerate(words)):",
      None, "defensive", "Yosys writes every ROM word by word in order"),
     # rtl
     ("rtl/axis.py", "if tb:", None,
-     "no test yet", "an AXI4-Stream wrapper with tag_bits = 1 (no TUSER)"),
+     *since("tests/rtl/test_axis.py", "a wrapper without tuser, simulated")),
     ("rtl/board.py", "if self.scene.texture:", None,
-     "make board", "the board top of a scene with a colour texture"),
+     "no test yet", "the board top of a scene with a colour texture: make test and make board "
+     "build the default scene (grey shade)"),
     ("rtl/board.py", "for clki in range(1, DIV_MAX + 1):", None,
      "never empty", "the loop always breaks on the PFD limit before the last divider"),
     ("rtl/board.py", "if pipe_hz is not None:          # the pipeline's own clock on CLKOS2", None,
@@ -367,7 +370,7 @@ REASONS = [
     ("rtl/cache.py", "if words.size and (words.min() < 0 or words.max() >> geom.texel_bits):",
      None, *since(RTL, "tiled_image refuses a word wider than a texel")),
     ("rtl/cache.py", "if g.set_bits == 0:", None,
-     "no test yet", "a one-set cache (sets = 1): no test builds one"),
+     *since("tests/rtl/test_cache.py", "one-set caches, bit-exact against the model")),
     ("rtl/ecp5.py", "if rom.depth > words:           # the last word: the address wrapped to word 0",
      None, "never empty", "every ROM make test builds on the ECP5 target here spills into a "
      "last block (the other side)"),
@@ -378,7 +381,7 @@ REASONS = [
     ("rtl/fixed.py", "if n < 0:", None, *since(RTL, "round_shift refuses a negative shift")),
     ("rtl/pipe.py", "if depth < 1:", None, *since(RTL, "Pipe refuses depth 0")),
     ("rtl/pipe.py", "elif fifo_depth is not None:", None,
-     "no test yet", "a PipeUnit given fifo_depth with credit=False (a unit author's error)"),
+     *since(RTL, "a unit built for a chain given a fifo_depth")),
     ("rtl/sdram.py", "if self.refresh_reload < 1:", None,
      *since(RTL, "a 1 MHz SDRAM clock, too slow to refresh within tREFI")),
     ("rtl/sdram.py", "if wpb == 1:", None,
@@ -401,16 +404,19 @@ REASONS = [
     ("sim/ecp5/__init__.py", "if \"`ifndef NO_INCLUDES\" in rest:        # common_sim.vh already includes cells_ff/cells_io",
      None, "make fpga", "the post-synthesis simulation on the Yosys cell library"),
     ("sim/ecp5/__init__.py", 'if out.returncode != 0 or "FATAL" in out.stdout:', None,
-     "make fpga", "as above (Icarus on the ECP5 cells)"),
+     "tool failure", "Icarus failing on the ECP5 cells (the run itself is make fpga's)"),
     ("sim/formal/axi.py", "if g.misses > 1:", None,
-     "make formal", "a cache with one miss outstanding"),
+     "no test yet", "the AXI4 contract of a cache with one miss outstanding: none of "
+     "FORMAL_GEOMETRIES has misses = 1, so make formal does not build it either"),
     ("sim/formal/contract.py", "if self.read_ports:", None, "make formal", FORMAL_SUBSET),
-    ("sim/formal/contract.py", "if isinstance(self.fifo, CreditFIFO):", None, "make formal", FORMAL_SUBSET),
+    ("sim/formal/contract.py", "if isinstance(self.fifo, CreditFIFO):", None,
+     "defensive", EDGE_FIFO),
     ("sim/formal/contract.py", "if all(isinstance(inst, MemoryInstance) for inst in found):", None,
-     "make formal", FORMAL_SUBSET),
+     "defensive", EDGE_FIFO),
     ("sim/formal/contract.py", "elif isinstance(self.fifo, SyncFIFOBuffered):", None,
-     "make formal", FORMAL_SUBSET),
-    ("sim/formal/contract.py", "if isinstance(inst, MemoryInstance):", None, "make formal", FORMAL_SUBSET),
+     "defensive", EDGE_FIFO),
+    ("sim/formal/contract.py", "if isinstance(inst, MemoryInstance):", None,
+     "defensive", EDGE_FIFO),
     ("sim/formal/contract.py", "if self._slots is None:", None, "make formal", FORMAL_SUBSET),
     ("sim/formal/contract.py", "if prop not in PROPERTIES:", None,
      *since("tests/sim/formal/test_refusals_reached.py", "an unknown property")),
@@ -424,11 +430,12 @@ REASONS = [
     ("sim/formal/contract.py", "if rec is not None:", None, "make formal", FORMAL_SUBSET),
     ("sim/formal/contract.py", "for lead, other in lockstep:", None, "make formal", FORMAL_SUBSET),
     ("sim/formal/contract.py", "if self.edge is None or self._chain is None:", None,
-     "no test yet", "`credit` asked of a unit without a credit edge (a contract user's error)"),
+     *since("tests/sim/formal/test_refusals_reached.py", "credit of a unit without its edge")),
     ("sim/formal/contract.py", "if depth is None:", None,
-     "no test yet", "`ready` asked of a unit without fifo_depth (a contract user's error)"),
+     *since("tests/sim/formal/test_refusals_reached.py", "ready of a unit without fifo_depth")),
     ("sim/formal/contract.py", "if self.edge is not None and self._chain is not None:", None,
-     "make formal", FORMAL_SUBSET),
+     *since("tests/sim/formal/test_refusals_reached.py",
+            "the ready contract of a unit without its edge counts its occupancy first")),
     ("sim/formal/contract.py", 'if getattr(self, "_cache_ghost", None) is not None:', None,
      "make formal", FORMAL_SUBSET),
     ("sim/formal/contract.py", "if tag is None:", None, "make formal", FORMAL_SUBSET),
@@ -452,11 +459,12 @@ REASONS = [
     ("sim/formal/targets.py", "if name not in TARGETS:", None,
      *since("tests/sim/formal/test_refusals_reached.py", "target() of a known and an unknown name")),
     ("sim/golden/board.py", "if scene.texture:", None,
-     "make board", "the golden frame of a scene with a colour texture"),
+     "no test yet", "the golden frame of a scene with a colour texture (as rtl/board.py)"),
     ("sim/golden/cache.py", "if n == 0:", None,
-     "no test yet", "the cache model's cycle count of an empty pixel run"),
+     *since("tests/sim/golden/test_cache_model.py", "an empty pixel run")),
     ("sim/golden/common.py", "for _ in range(64):", None,
-     "defensive", "64 redraws never all fall below the surface (the loop ends by its break)"),
+     "defensive", "64 redraws all below the surface: far too unlikely for any test to see (the "
+     "loop ends by its break)"),
     ("sim/golden/methods.py", "if [n for n in MODELS if n not in hardware.METHODS]:", None,
      "defensive", "import-time check of the two registries; tests/rtl/test_methods.py holds them "
      "together"),
@@ -465,7 +473,8 @@ REASONS = [
     ("sim/scenes/__init__.py", 'elif kind == "cylinder":                       # axis up the screen',
      None, *since(SIM, "texel_coordinates of an unknown geometry")),
     ("sim/scenes/heightfields.py", "if img.ndim == 3:", None,
-     "never empty", "the scikit-image pictures used are colour (RGB)"),
+     "never empty", "the scikit-image pictures make test loads are greyscale (no RGB to "
+     "average)"),
     ("sim/scenes/usermap.py", "if h.shape != (hh, w):", None,
      "defensive", "Pillow decodes the size the PNG header says"),
     ("sim/scenes/usermap.py", "if rgb.shape != (hh, w, channels):", None, "defensive", "as above"),
@@ -482,7 +491,7 @@ REASONS = [
     ("sim/tb/bulk_build.py", 'elif opts["clock"] == "cxx":', None,
      "defensive", "the clock is verilog or cxx (build_options refuses others)"),
     ("sim/tb/bulk_codec.py", "if arr.size == 0:", None,
-     "no test yet", "check_stimulus of an empty stimulus field"),
+     *since("tests/sim/tb/test_bulk_refusals.py", "check_stimulus of empty fields")),
     ("sim/tb/bulk_codec.py", "if w > 63:", None, *since(SIM, "a field over 63 bits")),
     ("sim/tb/bulk_codec.py", "if raw.size % nlimbs:", None,
      *since(SIM, "an output file that is not whole words")),
