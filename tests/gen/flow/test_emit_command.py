@@ -45,6 +45,8 @@ CASES = {
                              "--interface", "axis", "--name", "ax"],
     "rotation-named": ["rotation", "--method", "lee", "--angle-bits", "6", "--frac-bits", "8",
                        "--name", "rot", "--ports", "named"],
+    "rotation-axis-wide-tdata": ["rotation", "--method", "lee", "--angle-bits", "6",
+                                 "--frac-bits", "8", "--interface", "axis", "--tdata-width", "128"],
 }
 
 

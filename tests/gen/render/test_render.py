@@ -139,3 +139,19 @@ def test_render_bad_input_exit_2_one_line(tmp_path, argv, word, run_cli):
     assert r.returncode == 2, (argv, r.stderr)
     assert word in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_a_table1_baseline_renders_with_its_fixed_point_model(tmp_path, run_cli):
+    """``--model fixed --method kim``: a baseline's bit-exact model (no hardware pipeline of
+    its own) draws the picture: within an 8-bit step or two of its float64 model's, and not
+    that picture itself."""
+    pictures = {}
+    for model in ("fixed", "float64"):
+        out = tmp_path / f"kim_{model}.png"
+        r = run_cli(["render", "--model", model, "--method", "kim", "--size", "32", "--out", out])
+        assert r.returncode == 0, r.stderr
+        assert "kim" in r.stdout
+        pictures[model] = np.asarray(Image.open(out), dtype=np.int64)
+    assert pictures["fixed"].shape[:2] == (32, 32) == pictures["float64"].shape[:2]
+    diff = np.abs(pictures["fixed"] - pictures["float64"])
+    assert diff.max() <= 2 and diff.any(), diff.max()
