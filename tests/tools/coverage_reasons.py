@@ -101,8 +101,9 @@ REASONS = [
     ("gen/cli/emit.py", "for line in problems:", None,
      "simulator", "`emit --lint` (Verilator) printing its findings"),
     ("gen/cli/emit.py", "if args.tdata_width is not None:", None,
-     "no test yet", "the sidecar's command of `emit --interface axis --tdata-width N` (an "
-     "emission of seconds; the axis wrapper's width is tested in tests/rtl/test_axis.py)"),
+     *since("tests/gen/flow/test_emit_command.py",
+            "the recorded command of `emit rotation --interface axis --tdata-width 128` "
+            "writes the same files")),
     ("gen/cli/render.py", "if source is not None:", None,
      *since(CLI, "`render --scene a.toml --pipeline b.toml`")),
     ("gen/cli/render.py", "elif name == PALETTE:", None,
@@ -110,8 +111,7 @@ REASONS = [
     ("gen/cli/render.py", "elif rtl:", "raise BumpError(f\"--method {args.render_method} with --rtl: a scene pipeline is built for \"",
      *since(CLI, "`render --rtl --method kim`")),
     ("gen/cli/render.py", "elif rtl:", None,
-     "no test yet", "`render --model fixed --method` of a Table 1 baseline (kim, ...): a "
-     "fixed-point render of seconds; fixed_image's baseline path is tested directly"),
+     *since("tests/gen/render/test_render.py", "`render --model fixed --method kim`")),
     ("gen/cli/render.py", 'if args.model != "float64":', None,
      *since(CLI, "`render --rtl --model fixed`")),
     ("gen/cli/render.py", 'if args.pipeline is not None and args.model != "fixed":', None,
@@ -128,7 +128,7 @@ REASONS = [
      "makes them before)"),
     ("gen/flow/axis.py", "if name not in UNITS:", None, *since(FLOW, "build_axis of an unknown unit")),
     ("gen/flow/axis.py", "if tdata_width is not None:", None,
-     "no test yet", "the axis command with `--tdata-width` (see gen/cli/emit.py)"),
+     *since("tests/gen/flow/test_emit_command.py", "as gen/cli/emit.py's")),
     ("gen/flow/board.py", "if result.exists():", None,
      "make board", "a frame check into a directory that holds an earlier run's frames (a "
      "second `make board`); make test's runs each use a fresh one"),
@@ -385,8 +385,8 @@ REASONS = [
     ("rtl/sdram.py", "if self.refresh_reload < 1:", None,
      *since(RTL, "a 1 MHz SDRAM clock, too slow to refresh within tREFI")),
     ("rtl/sdram.py", "if wpb == 1:", None,
-     "no test yet", "an SDRAM controller whose AXI word is one 16-bit beat (data_bits 16 is not "
-     "offered; the 32-bit word takes two)"),
+     "defensive", "an AXI word of one 16-bit DQ beat: SdramConfig refuses data_bits other "
+     "than 32 and 64, two or four beats a word"),
     ("rtl/sidecar.py", 'if hasattr(value, "tolist"):', None,
      "never empty", "the sidecar's facts are plain Python by the time they are written"),
     ("rtl/sidecar.py", 'if hasattr(value, "to_dict"):', None, "never empty", "as above"),
@@ -496,13 +496,16 @@ REASONS = [
     ("sim/tb/bulk_codec.py", "if raw.size % nlimbs:", None,
      *since(SIM, "an output file that is not whole words")),
     ("sim/tb/bulk_frame.py", "if words is not None:", None,
-     "no test yet", "the coverage frame of a scene without a map (texture only): make test "
-     "builds the frame of three scenes (tests/sim/tb/test_bulk.py)"),
+     "no test yet", "the coverage frame of a flat-map scene with a colour texture (texels, no "
+     "map words): the frame is worth a test only streamed through a simulator, and "
+     "tests/sim/tb/test_bulk_scene_frames.py streams the built-in scenes, none of them that"),
     ("sim/tb/bulk_frame.py", "if new_words is not None:", None, "no test yet", "as above"),
     ("sim/tb/bulk_frame.py", 'if scene.addressing == "wrap":                # a map width further (either side)',
-     None, "no test yet", "the coverage frame of a clamped scene"),
+     None, "no test yet", "the coverage frame of a scene with clamped addressing (as above: "
+     "no built-in scene clamps)"),
     ("sim/tb/bulk_frame.py", "elif len(pick) and words is not None:        # palette: every index the map holds",
-     None, "no test yet", "the coverage frame of a palette scene without picked pixels"),
+     None, "no test yet", "the coverage frame of a palette scene none of whose pixels is picked "
+     "for the table (as above)"),
     ("sim/tb/bulk_wrapper.py", "if template.count(HOOK) != 1:", None,
      "defensive", "checks the shipped Verilog template holds its hook once"),
     ("sim/tb/stream.py", "if width and not lo <= v <= hi:", None,
