@@ -278,6 +278,20 @@ def _keys(d, want, where, optional=()):
                             f"schema_version {SCHEMA_VERSION}")
 
 
+def _object(d, where):
+    """``d`` if it is an object (a JSON dict), else BumpError naming the key."""
+    if not isinstance(d, dict):
+        raise BumpError(f"sidecar key {where!r} must be an object, got {type(d).__name__}")
+    return d
+
+
+def _int(v, where):
+    """``v`` if it is an integer (never a bool), else BumpError naming the key."""
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise BumpError(f"sidecar key {where!r} must be an integer, got {v!r}")
+    return v
+
+
 _TOP = [f.name for f in fields(Sidecar)]
 
 
@@ -294,29 +308,33 @@ def _from_dict(d):
                         f"{changed}; re-emit it with its command")
     _keys(d, _TOP, "")
     ports = {}
-    for n, p in d["ports"].items():
+    for n, p in _object(d["ports"], "ports").items():
         _keys(p, ("dir", "width", "fields"), f"ports.{n}")
         fs = None if p["fields"] is None else {}
-        for fn, f in (p["fields"] or {}).items():
-            _keys(f, ("offset", "width", "signed"), f"ports.{n}.fields.{fn}")
-            fs[fn] = Field(int(f["offset"]), int(f["width"]), bool(f["signed"]))
-        ports[n] = Port(p["dir"], int(p["width"]), fs)
+        for fn, f in _object(p["fields"] or {}, f"ports.{n}.fields").items():
+            w = f"ports.{n}.fields.{fn}"
+            _keys(f, ("offset", "width", "signed"), w)
+            fs[fn] = Field(_int(f["offset"], f"{w}.offset"), _int(f["width"], f"{w}.width"),
+                           bool(f["signed"]))
+        ports[n] = Port(p["dir"], _int(p["width"], f"ports.{n}.width"), fs)
     memories = {}
-    for n, m in d["memories"].items():
+    for n, m in _object(d["memories"], "memories").items():
         _keys(m, ("kind", "depth", "width", "bits"), f"memories.{n}")
         if m["kind"] not in MEMORY_KINDS:
             raise BumpError(f"sidecar memories.{n}.kind must be one of "
                             f"{', '.join(MEMORY_KINDS)}, got {m['kind']!r}")
-        memories[n] = Memory(m["kind"], int(m["depth"]), int(m["width"]), int(m["bits"]))
+        memories[n] = Memory(m["kind"], *(_int(m[k], f"memories.{n}.{k}")
+                                          for k in ("depth", "width", "bits")))
     e = d["error_bounds"]
     _keys(e, [f.name for f in fields(ErrorBounds)], "error_bounds")
     named = d["named_ports"]
     if named is not None:
         _keys(named, ("module", "command", "ports"), "named_ports")
         nports = {}
-        for n, p in named["ports"].items():
+        for n, p in _object(named["ports"], "named_ports.ports").items():
             _keys(p, ("dir", "width", "signed", "from", "bits", "field"), f"named_ports.ports.{n}")
-            nports[n] = NamedPort(p["dir"], int(p["width"]), bool(p["signed"]), p["from"],
+            nports[n] = NamedPort(p["dir"], _int(p["width"], f"named_ports.ports.{n}.width"),
+                                  bool(p["signed"]), p["from"],
                                   None if p["bits"] is None else tuple(p["bits"]), p["field"])
         named = NamedPorts(named["module"], named["command"], nports)
     return Sidecar(**{**d, "ports": ports, "memories": memories,

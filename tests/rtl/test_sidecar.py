@@ -180,3 +180,40 @@ def test_fields_are_the_verilog_bit_layout(tmp_path):
     for name, f in side.output_fields.items():           # each output field's wire width
         w = re.search(rf"wire \[(\d+):0\] \\o__payload\.{re.escape(name)} ;", text)
         assert w and int(w[1]) + 1 == f.width, name
+
+
+def _corrupt(d, path, value):
+    *keys, last = path
+    for k in keys:
+        d = d[k]
+    d[last] = value
+
+
+@pytest.mark.parametrize("path, value, key, kind", [
+    (("ports",), [], "ports", "an object"),
+    (("memories",), [1], "memories", "an object"),
+    (("ports", "i__payload", "fields"), ["x"], "ports.i__payload.fields", "an object"),
+    (("ports", "i__payload", "width"), "28", "ports.i__payload.width", "an integer"),
+    (("ports", "o__valid", "width"), True, "ports.o__valid.width", "an integer"),
+    (("ports", "i__payload", "fields", "b.phi", "offset"), 1.5,
+     "ports.i__payload.fields.b.phi.offset", "an integer"),
+    (("ports", "i__payload", "fields", "b.phi", "width"), None,
+     "ports.i__payload.fields.b.phi.width", "an integer"),
+])
+def test_a_container_or_width_of_the_wrong_type_is_refused_by_name(path, value, key, kind):
+    # hand-edited or foreign sidecars: one line naming the key, never a bare TypeError
+    _, meta, _ = build_unit("rotation", Config())
+    d = json.loads(meta.dumps())
+    assert d["ports"]["i__payload"]["fields"]["b.phi"]   # the corruptions reach real keys
+    _corrupt(d, path, value)
+    with pytest.raises(BumpError, match=rf"sidecar key '{re.escape(key)}' must be {kind}"):
+        loads(json.dumps(d))
+
+
+def test_a_memory_of_the_wrong_type_is_refused_by_name():
+    _, meta, _ = build_unit("sincos", Config())
+    d = json.loads(meta.dumps())
+    name = next(iter(d["memories"]))
+    d["memories"][name]["depth"] = "1024"
+    with pytest.raises(BumpError, match=rf"sidecar key 'memories\.{re.escape(name)}\.depth' must be an integer"):
+        loads(json.dumps(d))
