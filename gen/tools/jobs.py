@@ -227,7 +227,7 @@ class Runner:
 
     @property
     def where(self):
-        """``local (N workers)`` or the scheduler's address."""
+        """``local cluster (N workers)`` or ``scheduler ADDRESS``."""
         if not self.address:
             return f"local cluster ({self.workers} worker{'s' if self.workers != 1 else ''})"
         return f"scheduler {self.address}"

@@ -100,6 +100,8 @@ def decode_words(fields, width, data):
     each little-endian, on Icarus and Verilator alike) -> ``{field: int64 array}``, signed
     fields sign-extended."""
     nlimbs = (width + 31) // 32
+    if len(data) % 4:               # np.frombuffer's own ValueError names no file or word
+        raise AssertionError(f"output file is not whole {4 * nlimbs}-byte words ({len(data)} bytes)")
     raw = np.frombuffer(data, "<u4")
     if raw.size % nlimbs:
         raise AssertionError(f"output file is not whole {4 * nlimbs}-byte words ({len(data)} bytes)")

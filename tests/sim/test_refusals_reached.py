@@ -42,3 +42,5 @@ def test_bulk_codec_refuses_wide_fields_and_output_files_of_broken_words():
     assert decode_words(wide, 40, two)["w"].tolist() == [5 + (1 << 32), 7]
     with pytest.raises(AssertionError, match="not whole 8-byte words \\(12 bytes\\)"):
         decode_words(wide, 40, two[:12])
+    with pytest.raises(AssertionError, match="not whole 8-byte words \\(13 bytes\\)"):
+        decode_words(wide, 40, two[:13])               # a torn last limb: not numpy's error
