@@ -1,0 +1,353 @@
+"""Per-pixel geometry of a turning globe (docs/globe.md): a screen position in, the view-space
+normal in the pipeline's polar angles and the texel of an equirectangular map out.
+
+The globe is a sphere of radius R pixels seen orthographically, centred on the screen. A
+pixel at offset (x, y) from the centre, x to the right and **y up the screen**, is inside
+iff ``x**2 + y**2 < R**2`` (the rim itself, ``r**2 == R**2``, is outside). Its normal is
+(x, y, z) / R with ``z = sqrt(R**2 - r**2)`` toward the viewer (a right-handed view frame);
+in polar form ``phi = atan2(y, x)``, ``theta = atan2(r, z)`` (rtl/layouts.polar_layout).
+The map is W x H texels, W = 2H: longitude ``lambda = atan2(x, z) + rotation`` gives
+``u = floor(lambda / 2pi * W) mod W``; latitude ``beta = atan2(y, sqrt(R**2 - y**2))``
+gives ``v = floor((beta / pi + 1/2) * H)`` clamped to [0, H - 1] (v grows up the screen:
+row 0 is the south pole).
+
+Method, one register stage per step, fixed latency, one pixel a clock:
+
+* ``x**2``, ``y**2`` in registered products, their sum ``r2`` and ``R**2 - r2``;
+* ``r`` and ``z`` by two non-restoring integer square roots of ``r2`` and ``R**2 - r2``
+  shifted left by ``2 F``, one root bit a stage (``floor(sqrt(.) * 2**F)``, exact);
+* ``phi``, ``theta`` and ``lambda`` by three CORDIC vectoring chains of ``iterations``
+  stages on (x, y), (z, r) and (z, x) with ``F`` fraction bits below a pixel, their
+  angles summed in binary angles of ``angle_frac_bits`` bits from :func:`cordic_angles`
+  (the gain is irrelevant to the angle); ``phi``'s chain starts on the half plane x >= 0
+  (x < 0 turned by pi), ``lambda``'s accumulator starts at the rotation;
+* ``v`` from a ROM indexed by y (:func:`v_table`, float64 contents).
+
+Every output field but ``inside`` and ``tag`` is 0 outside the globe; ``phi`` is 0 at the
+centre (x = y = 0, as ``atan2(0, 0)``), ``u`` of a pixel with x = 0 is the rotation's own
+texel (``atan2(0, z)`` is exactly 0). The bit-exact model is sim/golden/globe.py, which
+also derives the error bound against float64.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+from amaranth.hdl import Cat, Const, Mux, signed, unsigned
+from amaranth.lib import data
+
+from bumprtl.rtl.config import Config, ConfigError
+from bumprtl.rtl.layouts import polar_layout
+from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
+
+__all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "globe_in_layout",
+           "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE", "FRAC_BITS_RANGE",
+           "GUARD_BITS_RANGE", "COORD_BITS_MAX", "sqrt_stages", "cordic_stages", "fit_signed"]
+
+RADIUS_RANGE = (1, 2047)          # R in pixels: R**2 << 2F stays inside 62 bits (the model's int64)
+MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2
+FRAC_BITS_RANGE = (4, 20)         # F: fraction bits of the roots and of the CORDIC datapath
+GUARD_BITS_RANGE = (1, 8)         # internal angle bits beyond the wider output
+COORD_BITS_MAX = 16               # signed width of the x, y offsets
+
+
+def _check_int(name, value, lo, hi, why=""):
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}", name)
+    if not lo <= value <= hi:
+        extra = f" ({why})" if why else ""
+        raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}", name)
+
+
+@dataclass(frozen=True)
+class GlobeConfig:
+    """The globe unit's geometry and widths.
+
+    Parameters
+    ----------
+    radius : int
+        R in pixels, 1 to 2047.
+    map_width, map_height : int
+        The equirectangular map, powers of two with ``map_width == 2 * map_height``; W from
+        4 to 32768.
+    pipeline : Config
+        The pipeline's Config: ``angle_bits`` (the width of n.phi, n.theta and the rotation)
+        and ``tag_bits``.
+    coord_bits : int
+        Signed width of the x and y offsets: ``radius.bit_length() + 1`` to 16.
+    frac_bits : int
+        F, fraction bits (below a pixel) of the square roots and the CORDIC datapaths, 4 to 20.
+    guard_bits : int
+        Bits of the CORDIC angle sums beyond the wider of ``angle_bits`` and ``log2 W``, 1 to 8.
+    iterations : None or int
+        CORDIC stages, 2 to ``angle_frac_bits``; None: ``angle_frac_bits - 1`` (the last
+        stage whose angle ``atan(2**-i)`` is at least half an internal step).
+    """
+
+    radius: int = 224
+    map_width: int = 2048
+    map_height: int = 1024
+    pipeline: Config = field(default_factory=Config)
+    coord_bits: int = 12
+    frac_bits: int = 18
+    guard_bits: int = 8
+    iterations: int | None = None
+
+    def __post_init__(self):
+        _check_int("radius", self.radius, *RADIUS_RANGE)
+        for name in ("map_width", "map_height"):
+            value = getattr(self, name)
+            lo, hi = (MAP_WIDTH_RANGE if name == "map_width"
+                      else (MAP_WIDTH_RANGE[0] // 2, MAP_WIDTH_RANGE[1] // 2))
+            _check_int(name, value, lo, hi, "a power of two")
+            if value & (value - 1):
+                raise ConfigError(f"{name} must be a power of two in [{lo}, {hi}], got {value}",
+                                  name)
+        if self.map_width != 2 * self.map_height:
+            raise ConfigError(f"map_height must be map_width / 2 = {self.map_width // 2} "
+                              f"(an equirectangular map), got {self.map_height}", "map_height")
+        if not isinstance(self.pipeline, Config):
+            raise ConfigError(f"pipeline must be a Config, got {self.pipeline!r}", "pipeline")
+        _check_int("coord_bits", self.coord_bits, self.int_bits + 1, COORD_BITS_MAX,
+                   f"signed offsets must hold +-(radius - 1) = +-{self.radius - 1}")
+        _check_int("frac_bits", self.frac_bits, *FRAC_BITS_RANGE)
+        _check_int("guard_bits", self.guard_bits, *GUARD_BITS_RANGE)
+        if self.iterations is not None:
+            _check_int("iterations", self.iterations, 2, self.angle_frac_bits,
+                       f"angle_frac_bits = {self.angle_frac_bits}")
+
+    # Derived facts.
+    @property
+    def int_bits(self):
+        """I: bits of the integer part of every magnitude (x, y, r, z < 2**I)."""
+        return self.radius.bit_length()
+
+    @property
+    def u_bits(self):
+        return self.map_width.bit_length() - 1
+
+    @property
+    def v_bits(self):
+        return self.map_height.bit_length() - 1
+
+    @property
+    def angle_bits(self):
+        return self.pipeline.angle_bits
+
+    @property
+    def angle_frac_bits(self):
+        """P: bits of the CORDIC angle sums (full circle = 2**P)."""
+        return max(self.angle_bits, self.u_bits) + self.guard_bits
+
+    @property
+    def cordic_iterations(self):
+        return self.angle_frac_bits - 1 if self.iterations is None else self.iterations
+
+    @property
+    def root_bits(self):
+        """Bits of a square root ``floor(sqrt(s) * 2**F)``, s < 2**(2I): I + F, one a stage."""
+        return self.int_bits + self.frac_bits
+
+    @property
+    def datapath_bits(self):
+        """Signed width of a CORDIC's X and Y: I + F + 2 (a sign, and the gain < 2)."""
+        return self.int_bits + self.frac_bits + 2
+
+    @property
+    def latency(self):
+        """Stages from ``i`` to ``o`` (no credit edge): the input register, the squares
+        (PRODUCT_LATENCY), r2, R**2 - r2, the roots, the CORDIC chains, the output register."""
+        return 1 + PRODUCT_LATENCY + 2 + self.root_bits + self.cordic_iterations + 1
+
+
+def cordic_angles(gcfg: GlobeConfig):
+    """The CORDIC's angles ``atan(2**-i)`` for i = 0 .. iterations - 1, in binary angles of
+    ``angle_frac_bits`` bits (full circle = 2**P), rounded to nearest: the constants of the
+    RTL's chains and of the model's."""
+    p = gcfg.angle_frac_bits
+    return [int(round(math.atan(2.0 ** -i) * (1 << p) / (2 * math.pi)))
+            for i in range(gcfg.cordic_iterations)]
+
+
+def v_table(gcfg: GlobeConfig):
+    """The v ROM: ``2**(I + 1)`` words indexed by y modulo ``2**(I + 1)`` (two's complement):
+    ``floor((atan2(y, sqrt(R**2 - y**2)) / pi + 1/2) * H)`` clamped to [0, H - 1] for
+    ``|y| < R`` (float64), 0 for the rest (no pixel inside has them)."""
+    r, h, bits = gcfg.radius, gcfg.map_height, gcfg.int_bits + 1
+    words = []
+    for a in range(1 << bits):
+        y = a - (1 << bits) if a >> (bits - 1) else a
+        if abs(y) >= r:
+            words.append(0)
+            continue
+        beta = math.atan2(y, math.sqrt(r * r - y * y))
+        words.append(min(max(math.floor((beta / math.pi + 0.5) * h), 0), h - 1))
+    return words
+
+
+def globe_in_layout(gcfg: GlobeConfig):
+    """``x``, ``y``: signed offsets from the centre (y up); ``rotation``: the globe's turn,
+    a binary angle of ``angle_bits``; ``tag``: carried through."""
+    return data.StructLayout({"x": signed(gcfg.coord_bits), "y": signed(gcfg.coord_bits),
+                              "rotation": unsigned(gcfg.angle_bits),
+                              "tag": unsigned(gcfg.pipeline.tag_bits)})
+
+
+def globe_out_layout(gcfg: GlobeConfig):
+    """``inside``; ``n``: the normal's phi and theta codes (rtl/layouts.polar_layout); ``u``,
+    ``v``: the texel; ``tag``."""
+    return data.StructLayout({"inside": unsigned(1), "n": polar_layout(gcfg.pipeline),
+                              "u": unsigned(gcfg.u_bits), "v": unsigned(gcfg.v_bits),
+                              "tag": unsigned(gcfg.pipeline.tag_bits)})
+
+
+def sqrt_stages(pipe, value, value_bits, frac_bits, name):
+    """``floor(sqrt(value << 2 frac_bits))`` of the unsigned ``value`` (its low ``value_bits``
+    bits, even) by a non-restoring square root, one root bit a stage: ``value_bits / 2 +
+    frac_bits`` stages, one carry chain each (the remainder's sign, registered, picks add or
+    subtract). The radicand's bits enter two a stage; past ``value`` they are the zeros of
+    the shift."""
+    n = value_bits // 2 + frac_bits
+    width = n + 4                                  # rem << 2 of a remainder |rem| <= 2 q + 1
+    rest = value[:value_bits]
+    rem = Const(0, signed(width))
+    q = Const(0, 1)
+    for j in range(n):
+        i = n - 1 - j                              # the radicand's pair 2i + 1 .. 2i
+        if i >= frac_bits:
+            pair = rest[2 * (i - frac_bits):2 * (i - frac_bits) + 2]
+        else:
+            pair = Const(0, 2)
+        negative = rem[-1]
+        # rem < 0: (rem << 2 | pair) + (q << 2 | 3); else (rem << 2 | pair) - (q << 2 | 1),
+        # the subtraction as the addition of ~(q << 2 | 1) + 1 at the remainder's width
+        trial = Cat(Mux(negative, Const(3, 2), Const(1, 2)), q, Const(0, width - 2 - len(q)))
+        shifted = Cat(pair, rem)[:width].as_signed()
+        new = (shifted + Mux(negative, trial, ~trial) + ~negative)[:width].as_signed()
+        rem = pipe.register(new, f"{name}_rem{j}")
+        q = pipe.register(Cat(~new[-1], q)[:j + 1], f"{name}_q{j}")
+        if i > frac_bits:
+            rest = pipe.register(rest[:2 * (i - frac_bits)], f"{name}_rest{j}")
+    return q
+
+
+def fit_signed(value, width):
+    """``value`` (signed, or unsigned: zero-extended) as exactly ``width`` signed bits:
+    sign-extended, or its low bits (callers only truncate bits every pixel inside leaves
+    equal to the sign)."""
+    if len(value) >= width:
+        return value[:width].as_signed()
+    top = value[-1] if value.shape().signed else Const(0, 1)
+    return Cat(value, top.replicate(width - len(value))).as_signed()
+
+
+def cordic_stages(pipe, x, y, acc, angles, width, name):
+    """CORDIC vectoring: ``len(angles)`` stages turn (x, y) toward the +x axis by
+    ``atan(2**-i)`` each, the way the sign of y says, and add the turn to ``acc`` (an
+    unsigned binary angle, wrapping): ``acc + atan2(y, x)`` to within the bound of
+    sim/golden/globe.error_bound_rad. ``x``, ``y`` signed ``width`` bits; the shifts
+    truncate (arithmetic shift right)."""
+    p = len(acc)
+    for i, a in enumerate(angles):
+        down = y[-1]                                   # y < 0: turn up, subtract the angle
+        xs, ys = x >> i, y >> i
+        # y >= 0: x + (y >> i), y - (x >> i), acc + a; y < 0: the other way
+        nx = (x + Mux(down, ~ys, ys) + down)[:width].as_signed()
+        ny = (y + Mux(down, xs, ~xs) + ~down)[:width].as_signed()
+        nacc = (acc + Mux(down, Const((-a) % (1 << p), p), Const(a, p)))[:p]
+        x = pipe.register(nx, f"{name}_x{i}")
+        y = pipe.register(ny, f"{name}_y{i}")
+        acc = pipe.register(nacc, f"{name}_acc{i}")
+    return acc
+
+
+class GlobeGeometry(PipeUnit):
+    """The globe's per-pixel geometry (module docstring).
+
+    Parameters
+    ----------
+    gcfg : GlobeConfig
+    target : None or pipe.ECP5
+        Elaboration target of the squares and the v ROM (None: the generic form).
+    credit, fifo_depth
+        As every :class:`pipe.PipeUnit`.
+
+    Members
+    -------
+    i : In(stream.Signature(globe_in_layout(gcfg)))
+        x, y (signed, y up), rotation (a binary angle), tag.
+    o : Out(stream.Signature(globe_out_layout(gcfg)))
+        inside, n.phi, n.theta (codes of ``angle_bits``), u, v, tag; bit-exact with
+        sim/golden/globe.globe_fixed.
+
+    Latency ``gcfg.latency`` (:attr:`GlobeConfig.latency`); one pixel per clock.
+    """
+
+    def __init__(self, gcfg: GlobeConfig, target=None, credit=True, fifo_depth=None):
+        self.gcfg = gcfg
+        self.latency = gcfg.latency
+        super().__init__(gcfg.pipeline, globe_in_layout(gcfg), globe_out_layout(gcfg),
+                         target, credit, fifo_depth)
+
+    def build(self, m, pipe):
+        g = self.gcfg
+        I, F, P, A = g.int_bits, g.frac_bits, g.angle_frac_bits, g.angle_bits
+        n, w = g.cordic_iterations, g.datapath_bits
+        angles = cordic_angles(g)
+        p = self.i.payload
+        # stage 1: the inputs
+        x = pipe.register(p.x, "x")
+        y = pipe.register(p.y, "y")
+        rot = pipe.register(p.rotation, "rotation")
+        # stages 2 .. 1 + PRODUCT_LATENCY: the squares; then r2, then R**2 - r2
+        xx, yy = pipe.multiply(x, x, "xx"), pipe.multiply(y, y, "yy")
+        r2 = pipe.register((xx + yy).as_unsigned()[:2 * g.coord_bits], "r2")
+        rr = g.radius * g.radius
+        inside = pipe.register(r2 < rr, "inside")
+        d = pipe.register((Const(rr, 2 * I) - r2)[:2 * I], "d")      # outside: masked below
+        r2_at = pipe.register(r2[:2 * I], "r2_at")
+        start = 1 + PRODUCT_LATENCY + 2                                 # the roots' input stage
+        z_root = sqrt_stages(pipe, d, 2 * I, F, "z")
+        r_root = sqrt_stages(pipe, r2_at, 2 * I, F, "r")
+        roots = start + g.root_bits
+        done = roots + n                                                 # the angles' stage
+
+        # theta = atan2(r, z), lambda = atan2(x, z) + rotation: stages roots + 1 .. done
+        z_w, r_w = fit_signed(z_root, w), fit_signed(r_root, w)
+        theta = cordic_stages(pipe, z_w, r_w, Const(1 << (P - A - 1), P), angles, w, "theta")
+        x_root = pipe.delay(x, roots - 1, "x_root")
+        lam0 = Cat(Const(0, P - A), pipe.delay(rot, roots - 1, "rotation_root"))
+        lam = cordic_stages(pipe, z_w, fit_signed(Cat(Const(0, F), x_root).as_signed(), w),
+                            lam0, angles, w, "lambda")
+        # phi = atan2(y, x): stage 2 turns x < 0 by pi, stages 3 .. 2 + n the chain
+        negative = x[-1]
+        fx = pipe.register(fit_signed(Cat(Const(0, F), Mux(negative, -x, x)).as_signed(), w),
+                           "phi_x")
+        fy = pipe.register(fit_signed(Cat(Const(0, F), Mux(negative, -y, y)).as_signed(), w),
+                           "phi_y")
+        half = 1 << (P - A - 1)                    # the codes round: floor(acc + half step)
+        facc = pipe.register(Mux(negative, Const((1 << (P - 1)) + half, P), Const(half, P)),
+                             "phi_acc")
+        phi = pipe.delay(cordic_stages(pipe, fx, fy, facc, angles, w, "phi"), done - (2 + n),
+                         "phi_done")
+        centre = pipe.delay(pipe.register((x == 0) & (y == 0), "centre"), done - 2, "centre")
+        x_zero = pipe.delay(pipe.register(x == 0, "x_zero"), done - 2, "x_zero")
+        inside = pipe.delay(inside, done - start, "inside")
+        rot_done = pipe.delay(rot, done - 1, "rotation_done")
+        # the v ROM: its address registered at done - 1 - ROM_LATENCY, its word at done
+        rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
+        at = done - 1 - ROM_LATENCY
+        address = pipe.register(pipe.delay(y, at - 2, "y_v")[:I + 1], "v_address")
+        m.d.comb += rom.ports[0].addr.eq(address)
+        v_word = pipe.register(rom.ports[0].data, "v_word")
+        # the output stage (done + 1): codes, texel, 0 outside
+        u_rot = (Cat(Const(0, P - A), rot_done) >> (P - g.u_bits))[:g.u_bits]
+        u_lam = lam[P - g.u_bits:]
+        o, zero = pipe.o.payload, Const(0)
+        m.d.comb += [
+            o.inside.eq(pipe.register(inside, "inside_out")),
+            o.n.phi.eq(pipe.register(Mux(inside & ~centre, phi[P - A:], zero), "phi_out")),
+            o.n.theta.eq(pipe.register(Mux(inside, theta[P - A:], zero), "theta_out")),
+            o.u.eq(pipe.register(Mux(inside, Mux(x_zero, u_rot, u_lam), zero), "u_out")),
+            o.v.eq(pipe.register(Mux(inside, v_word, zero), "v_out")),
+            o.tag.eq(pipe.delay(p.tag, self.latency, "tag")),
+        ]

@@ -1,0 +1,228 @@
+"""The globe unit's models (rtl/globe.py, docs/globe.md): the bit-exact integer model the RTL
+equals bit for bit (:func:`globe_fixed`), the float64 reference (:func:`globe_float`) and the
+derived bound between their angles (:func:`error_bound_rad`).
+
+``python -m bumprtl.sim.golden.globe`` measures the model against float64 over every pixel of
+the disc (and the rim's neighbours) at a few rotations and prints the bound beside it.
+"""
+
+import argparse
+import math
+
+import numpy as np
+
+from bumprtl.rtl.config import Config
+from bumprtl.rtl.globe import GlobeConfig, cordic_angles, v_table
+from bumprtl.sim.golden.common import cartesian_to_polar
+from bumprtl.sim.golden.fixed.common import angle_codes
+
+__all__ = ["isqrt", "cordic", "globe_fixed", "globe_float", "error_bound_rad", "check_against_float",
+           "disc_pixels", "main"]
+
+
+def isqrt(n):
+    """``floor(sqrt(n))`` of non-negative int64 ``n`` (< 2**62), exactly: the restoring
+    digit-by-digit root, one bit at a time from the top."""
+    n = np.asarray(n, np.int64)
+    root = np.zeros_like(n)
+    for bit in range(30, -1, -1):
+        trial = root | np.int64(1 << bit)
+        root = np.where(trial * trial <= n, trial, root)
+    return root
+
+
+def cordic(x, y, acc, gcfg: GlobeConfig):
+    """CORDIC vectoring on int64 (x, y) with truncating shifts; ``acc`` (binary angles of
+    ``angle_frac_bits``) plus the turn that brings (x, y) to the +x axis, modulo 2**P."""
+    x, y, acc = (np.asarray(v, np.int64).copy() for v in (x, y, acc))
+    for i, a in enumerate(cordic_angles(gcfg)):
+        up = y >= 0
+        xs, ys = x >> i, y >> i
+        x, y = np.where(up, x + ys, x - ys), np.where(up, y - xs, y + xs)
+        acc = np.where(up, acc + a, acc - a)
+    return acc & ((1 << gcfg.angle_frac_bits) - 1)
+
+
+def _inputs(x, y, rotation):
+    x, y, rotation = np.broadcast_arrays(*(np.asarray(v, np.int64) for v in (x, y, rotation)))
+    return x, y, rotation
+
+
+def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
+    """The unit's output fields (int64 arrays keyed like the flattened payload: ``inside``,
+    ``n.phi``, ``n.theta``, ``u``, ``v``) of pixels (x, y) (y up) at ``rotation`` (codes).
+    ``fine``: also ``phi_fine``, ``theta_fine``, ``lambda_fine``, the angle sums before
+    their rounding (full circle = 2**P, the rounding's half step taken back off; valid
+    inside only)."""
+    x, y, rotation = _inputs(x, y, rotation)
+    R, F, P, A = gcfg.radius, gcfg.frac_bits, gcfg.angle_frac_bits, gcfg.angle_bits
+    full, half = 1 << P, 1 << (P - A - 1)
+    r2 = x * x + y * y
+    inside = r2 < R * R
+    z = isqrt(np.where(inside, R * R - r2, 0) << (2 * F))
+    r = isqrt(np.where(inside, r2, 0) << (2 * F))
+    xi, yi = np.where(inside, x, 1), np.where(inside, y, 0)      # outside: any, masked
+    neg = xi < 0
+    phi = cordic(np.where(neg, -xi, xi) << F, np.where(neg, -yi, yi) << F,
+                 np.where(neg, full // 2, 0) + half, gcfg)
+    theta = cordic(z, r, np.full_like(x, half), gcfg)
+    lam = cordic(z, xi << F, (rotation & ((1 << A) - 1)) << (P - A), gcfg)
+    lam = np.where(xi == 0, (rotation & ((1 << A) - 1)) << (P - A), lam)
+    out = {"inside": inside.astype(np.int64),
+           "n.phi": np.where(inside & (r2 > 0), phi >> (P - A), 0),
+           "n.theta": np.where(inside, theta >> (P - A), 0),
+           "u": np.where(inside, lam >> (P - gcfg.u_bits), 0),
+           "v": np.where(inside, np.asarray(v_table(gcfg), np.int64)[y & ((2 << gcfg.int_bits) - 1)],
+                         0)}
+    if fine:
+        out.update(phi_fine=np.where(r2 > 0, phi - half, 0) % full,
+                   theta_fine=(theta - half) % full, lambda_fine=lam)
+    return out
+
+
+def globe_float(x, y, rotation, gcfg: GlobeConfig):
+    """The float64 reference: ``inside``, the codes ``n.phi``, ``n.theta`` made as the board
+    makes N's (sim/golden/common.cartesian_to_polar, sim/golden/fixed/common.angle_codes),
+    ``u``, ``v``; and the angles ``phi``, ``theta`` (radians) and ``lambda_turns`` (the
+    longitude in turns, [0, 1): the rotation added in turns, exactly)."""
+    x, y, rotation = _inputs(x, y, rotation)
+    R, W, H = float(gcfg.radius), gcfg.map_width, gcfg.map_height
+    xf, yf = x.astype(np.float64), y.astype(np.float64)
+    r2 = xf * xf + yf * yf
+    inside = r2 < R * R
+    z = np.sqrt(np.where(inside, R * R - r2, 0.0))
+    n = np.stack([xf, yf, z], -1) / R
+    phi, theta = cartesian_to_polar(n)
+    lam_turns = np.mod(np.arctan2(xf, z) / (2 * np.pi) + rotation / (1 << gcfg.angle_bits), 1.0)
+    beta = np.arctan2(yf, np.sqrt(np.maximum(R * R - yf * yf, 0.0)))
+    v = np.clip(np.floor((beta / np.pi + 0.5) * H), 0, H - 1).astype(np.int64)
+    zero = np.zeros_like(x)
+    return {"inside": inside.astype(np.int64),
+            "n.phi": np.where(inside, angle_codes(phi, gcfg.pipeline), zero),
+            "n.theta": np.where(inside, angle_codes(theta, gcfg.pipeline), zero),
+            "u": np.where(inside, np.floor(lam_turns * W).astype(np.int64) % W, zero),
+            "v": np.where(inside, v, zero),
+            "phi": np.mod(np.arctan2(yf, xf), 2 * np.pi), "theta": np.arctan2(np.sqrt(r2), z),
+            "lambda_turns": lam_turns}
+
+
+def error_bound_rad(gcfg: GlobeConfig, which):
+    """The largest ``|fine angle - float64 angle|`` (radians) of any pixel inside, for
+    ``which`` in ``phi``, ``theta``, ``lambda`` (proof in docs/globe.md, Error):
+
+    ``atan(2**-(n-1)) + n pi / 2**P + (n - 1) asin(1 / (M - n)) + e_in``
+
+    with n the iterations, P the angle bits of the sums: the residual angle of n vectoring
+    steps, the n rounded constants (half a step each), and the truncation of the shifts
+    (under one unit in each of X, Y at steps 1 .. n-1, none at step 0, on a vector never
+    shorter than sqrt(2) (M - n) units after step 0); M is the shortest input vector in
+    units of 2**-F pixel: phi 2**F (r >= 1; the centre is set to 0), theta R 2**F - sqrt 2,
+    lambda sqrt(2R - 1) 2**F - sqrt 2 (x**2 + z**2 = R**2 - y**2 >= 2R - 1 inside);
+    ``e_in`` the truncated roots (each under one unit): asin(sqrt 2 / M_true) for theta
+    and lambda, 0 for phi (exact integer inputs)."""
+    n, P, F, R = gcfg.cordic_iterations, gcfg.angle_frac_bits, gcfg.frac_bits, gcfg.radius
+    true = {"phi": 2.0 ** F, "theta": R * 2.0 ** F,
+            "lambda": math.sqrt(2 * R - 1) * 2.0 ** F}[which]
+    m = true - (0 if which == "phi" else math.sqrt(2))
+    e_in = 0.0 if which == "phi" else math.asin(min(1.0, math.sqrt(2) / true))
+    if m - n <= 1:
+        return math.pi
+    return (math.atan(2.0 ** -(n - 1)) + n * math.pi / 2 ** P
+            + (n - 1) * math.asin(1 / (m - n)) + e_in)
+
+
+def _turn_diff(a, b):
+    """Signed difference of angles in turns, in [-1/2, 1/2)."""
+    return np.mod(a - b + 0.5, 1.0) - 0.5
+
+
+def check_against_float(x, y, rotation, gcfg: GlobeConfig):
+    """The model against float64 on pixels (x, y, rotation): a dict of measured figures,
+    and ``violations``, a list of what breaks the contract: inside or v different, a fine
+    angle beyond :func:`error_bound_rad`, a code or texel off by more than one, or off by
+    one where the float64 value is further than the bound from a rounding boundary."""
+    fx, fl = globe_fixed(x, y, rotation, gcfg, fine=True), globe_float(x, y, rotation, gcfg)
+    P, A, W = gcfg.angle_frac_bits, gcfg.angle_bits, gcfg.map_width
+    inside = fl["inside"].astype(bool)
+    bad = []
+    if not np.array_equal(fx["inside"], fl["inside"]):
+        bad.append("inside differs")
+    if not np.array_equal(fx["v"], fl["v"]):
+        bad.append("v differs")
+    out = {"pixels": int(inside.sum())}
+    for name, fine, ref, code, steps in (
+            ("phi", "phi_fine", fl["phi"] / (2 * np.pi), "n.phi", 1 << A),
+            ("theta", "theta_fine", fl["theta"] / (2 * np.pi), "n.theta", 1 << A),
+            ("lambda", "lambda_fine", fl["lambda_turns"], "u", W)):
+        if name == "phi":
+            keep = inside & ((np.asarray(x) != 0) | (np.asarray(y) != 0))
+        else:
+            keep = inside
+        err = np.abs(_turn_diff(fx[fine][keep] / (1 << P), ref[keep])) * 2 * np.pi
+        bound = error_bound_rad(gcfg, name)
+        worst = float(err.max()) if err.size else 0.0
+        if worst > bound:
+            bad.append(f"{name}: fine error {worst:.3g} rad beyond the bound {bound:.3g}")
+        diff = np.mod(fx[code][keep] - fl[code][keep] + steps // 2, steps) - steps // 2
+        # distance of the float64 value to the nearest rounding (codes) or floor (u) boundary
+        scaled = ref[keep] * steps
+        frac = scaled - np.floor(scaled)
+        edge = np.abs(frac - 0.5) if name != "lambda" else np.minimum(frac, 1 - frac)
+        near = edge * 2 * np.pi / steps <= bound
+        if np.any(np.abs(diff) > 1) or np.any((diff != 0) & ~near):
+            bad.append(f"{code}: off where the float64 value is clear of a boundary "
+                       f"or by more than one")
+        out[name] = {"max_error_rad": worst, "bound_rad": bound,
+                     "max_error_steps": worst * steps / (2 * np.pi),
+                     "bound_steps": bound * steps / (2 * np.pi),
+                     "codes_differing": int(np.count_nonzero(diff)),
+                     "codes_max_diff": int(np.abs(diff).max()) if diff.size else 0}
+    out["violations"] = bad
+    return out
+
+
+def disc_pixels(radius, margin=2):
+    """Every (x, y) with |x|, |y| <= radius + margin: the disc, its rim and a ring outside."""
+    c = np.arange(-radius - margin, radius + margin + 1)
+    x, y = np.meshgrid(c, c)
+    return x.ravel(), y.ravel()
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m bumprtl.sim.golden.globe",
+                                 description="the globe model against float64 (docs/globe.md)")
+    ap.add_argument("--radius", type=int, default=GlobeConfig().radius)
+    ap.add_argument("--angle-bits", type=int, default=Config().angle_bits)
+    ap.add_argument("--frac-bits", type=int, default=GlobeConfig().frac_bits)
+    ap.add_argument("--guard-bits", type=int, default=GlobeConfig().guard_bits)
+    ap.add_argument("--map-width", type=int, default=GlobeConfig().map_width)
+    ap.add_argument("--rotations", type=int, nargs="*", default=[0, 1, 4095, 16383])
+    args = ap.parse_args(argv)
+    gcfg = GlobeConfig(radius=args.radius, map_width=args.map_width,
+                       map_height=args.map_width // 2,
+                       pipeline=Config(angle_bits=args.angle_bits),
+                       frac_bits=args.frac_bits, guard_bits=args.guard_bits)
+    x, y = disc_pixels(gcfg.radius)
+    rots = [r % (1 << gcfg.angle_bits) for r in args.rotations]
+    print(f"R = {gcfg.radius}, angle_bits = {gcfg.angle_bits}, W x H = {gcfg.map_width} x "
+          f"{gcfg.map_height}, F = {gcfg.frac_bits}, P = {gcfg.angle_frac_bits}, "
+          f"iterations = {gcfg.cordic_iterations}, latency = {gcfg.latency}, rotations {rots}")
+    ok = True
+    for rot in rots:
+        res = check_against_float(x, y, rot, gcfg)
+        print(f"rotation {rot}: {res['pixels']} pixels inside")
+        for name in ("phi", "theta", "lambda"):
+            s = res[name]
+            unit = "texels" if name == "lambda" else "codes"
+            print(f"  {name:6s} max |error| {s['max_error_rad']:.3e} rad = "
+                  f"{s['max_error_steps']:.4f} {unit} (bound {s['bound_rad']:.3e} rad = "
+                  f"{s['bound_steps']:.4f}); {s['codes_differing']} pixels off by "
+                  f"{s['codes_max_diff']} from float64")
+        for v in res["violations"]:
+            print("  VIOLATION:", v)
+        ok &= not res["violations"]
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
