@@ -207,7 +207,10 @@ def sqrt_stages(pipe, value, value_bits, frac_bits, name):
     subtract). The radicand's bits enter two a stage; past ``value`` they are the zeros of
     the shift."""
     n = value_bits // 2 + frac_bits
-    width = n + 4                                  # rem << 2 of a remainder |rem| <= 2 q + 1
+    # After stage j the remainder is D_j - q**2 >= 0 or D_j - (q | 1)**2 >= -(2 q + 1), so
+    # |rem| <= 2 q + 1 < 2**(j + 2): n + 2 signed bits hold every one; rem << 2 may wrap
+    # at that width, the sum it enters does not.
+    width = n + 2
     rest = value[:value_bits]
     rem = Const(0, signed(width))
     q = Const(0, 1)

@@ -139,8 +139,9 @@ def _turn_diff(a, b):
 def check_against_float(x, y, rotation, gcfg: GlobeConfig):
     """The model against float64 on pixels (x, y, rotation): a dict of measured figures,
     and ``violations``, a list of what breaks the contract: inside or v different, a fine
-    angle beyond :func:`error_bound_rad`, a code or texel off by more than one, or off by
-    one where the float64 value is further than the bound from a rounding boundary."""
+    angle beyond :func:`error_bound_rad`, a code or texel off where the float64 value is
+    further than the bound from a rounding boundary (or by more than one plus the bound's
+    whole steps anywhere)."""
     fx, fl = globe_fixed(x, y, rotation, gcfg, fine=True), globe_float(x, y, rotation, gcfg)
     P, A, W = gcfg.angle_frac_bits, gcfg.angle_bits, gcfg.map_width
     inside = fl["inside"].astype(bool)
@@ -169,9 +170,12 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
         frac = scaled - np.floor(scaled)
         edge = np.abs(frac - 0.5) if name != "lambda" else np.minimum(frac, 1 - frac)
         near = edge * 2 * np.pi / steps <= bound
-        if np.any(np.abs(diff) > 1) or np.any((diff != 0) & ~near):
+        # |round(t + e) - round(t)| <= floor(|e|) + 1 steps, and 0 unless t is within |e|
+        # of a boundary
+        most = math.floor(bound * steps / (2 * np.pi)) + 1
+        if np.any(np.abs(diff) > most) or np.any((diff != 0) & ~near):
             bad.append(f"{code}: off where the float64 value is clear of a boundary "
-                       f"or by more than one")
+                       f"or by more than {most}")
         out[name] = {"max_error_rad": worst, "bound_rad": bound,
                      "max_error_steps": worst * steps / (2 * np.pi),
                      "bound_steps": bound * steps / (2 * np.pi),

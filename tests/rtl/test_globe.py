@@ -1,0 +1,320 @@
+"""GlobeGeometry (rtl/globe.py) in the Amaranth simulator, bit for bit against the integer model
+(sim/golden/globe.py) on random pixels and the corners, under every traffic pattern; the
+model against float64 within its derived bound over whole discs and the rims of the widest
+ones; the points whose outputs are known exactly; the square root alone, exhaustively; the
+configuration's errors."""
+
+import math
+
+import numpy as np
+import pytest
+from amaranth.hdl import unsigned
+from amaranth.lib import data
+
+from bumprtl.rtl.config import BumpError, Config, ConfigError
+from bumprtl.rtl.globe import GlobeConfig, GlobeGeometry, sqrt_stages, v_table
+from bumprtl.rtl.pipe import ECP5, PipeUnit, unit_memory_records
+from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
+from bumprtl.sim.golden import globe as model
+from bumprtl.sim.golden.globe import (
+    check_against_float,
+    disc_pixels,
+    error_bound_rad,
+    globe_fixed,
+    isqrt,
+)
+from bumprtl.sim.traffic import PATTERNS
+from tests.rtl.test_no_clock_enable import datapath_offenders, netlist
+
+SMALL = Config(angle_bits=10, frac_bits=9, tag_bits=8)
+
+
+def rim_pixels(radius, limit=None):
+    """Pixels at the rim in every quadrant: for each |x| <= R + 1, the outermost |y| inside
+    and the next one out; and every pixel with r**2 in R**2 - 2 .. R**2 + 2 (on the rim,
+    just inside, just outside), whichever exist."""
+    rr, out = radius * radius, set()
+    cols = range(radius + 2)
+    if limit is not None and len(cols) > limit:
+        cols = sorted({*np.linspace(0, radius + 1, limit).astype(int).tolist(), radius - 1, radius})
+    for ax in cols:
+        top = math.isqrt(max(rr - 1 - ax * ax, 0)) if ax * ax < rr else -1
+        for ay in {top, top + 1}:
+            if ay >= 0:
+                out.update((sx * ax, sy * ay) for sx in (1, -1) for sy in (1, -1))
+    for ax in range(radius + 3):
+        for want in range(rr - 2, rr + 3):
+            rest = want - ax * ax
+            if rest >= 0 and math.isqrt(rest) ** 2 == rest:
+                ay = math.isqrt(rest)
+                out.update((sx * ax, sy * ay) for sx in (1, -1) for sy in (1, -1))
+                out.update((sy * ay, sx * ax) for sx in (1, -1) for sy in (1, -1))
+    return sorted(out)
+
+
+def corner_pixels(gcfg):
+    """The centre, the axis points (1, R - 1, R, R + 1 from the centre), the diagonals, the
+    rim (:func:`rim_pixels`), the widest offsets the ports hold."""
+    R, c = gcfg.radius, gcfg.coord_bits
+    pts = {(0, 0)}
+    for k in (1, R - 1, R, R + 1):
+        pts.update({(k, 0), (-k, 0), (0, k), (0, -k)})
+    k = max(1, int((R - 1) / math.sqrt(2)))
+    pts.update({(k, k), (-k, k), (-k, -k), (k, -k)})
+    lo, hi = -(1 << (c - 1)), (1 << (c - 1)) - 1
+    pts.update({(lo, lo), (hi, hi), (lo, hi), (hi, 0), (0, lo)})
+    pts.update(rim_pixels(R, limit=24))
+    return sorted(pts)
+
+
+def rtl_vs_model(gcfg, pixels, rotations, pattern, seed=0):
+    """Every pixel at every rotation through GlobeGeometry, bit for bit against globe_fixed;
+    returns (unit, cycles)."""
+    x = np.array([p[0] for p in pixels for _ in rotations], np.int64)
+    y = np.array([p[1] for p in pixels for _ in rotations], np.int64)
+    rot = np.array([r for _ in pixels for r in rotations], np.int64)
+    mask = (1 << gcfg.pipeline.tag_bits) - 1
+    inputs = [{"x": int(a), "y": int(b), "rotation": int(r), "tag": (n * 37) & mask}
+              for n, (a, b, r) in enumerate(zip(x, y, rot, strict=True))]
+    dut = GlobeGeometry(gcfg)
+    out, cycles = simulate_stream(dut, inputs, pattern, seed=seed, pipe_handshake=True)
+    assert_bit_exact(out, globe_fixed(x, y, rot, gcfg), inputs)
+    return dut, cycles
+
+
+def test_corners_bit_exact_default():
+    """The default globe (R = 224, 14-bit angles, 2048 x 1024 map): the corners at rotation
+    0, the code just below a full turn (u wraps) and one between, under input gaps and
+    backpressure."""
+    g = GlobeConfig()
+    top = g.pipeline.full_circle - 1
+    rtl_vs_model(g, corner_pixels(g), [0, top, 5000], "both")
+
+
+def test_corners_bit_exact_on_an_exact_rim():
+    """R = 17 has pixels at r**2 = R**2 - 1 (12, 12), on the rim R**2 (8, 15) and at R**2 + 1
+    (11, 13): inside, outside, outside; narrow angles and a small map."""
+    g = GlobeConfig(radius=17, map_width=64, map_height=32, pipeline=SMALL, coord_bits=7,
+                    frac_bits=12, guard_bits=3)
+    rim = rim_pixels(17)
+    assert {(12, 12), (8, 15), (11, 13)} <= set(rim)
+    rtl_vs_model(g, corner_pixels(g), [0, SMALL.full_circle - 1], "backpressure")
+
+
+@pytest.mark.parametrize("pattern", list(PATTERNS))
+def test_random_pixels_bit_exact(pattern):
+    """Random pixels over the disc and a ring outside it, random rotations."""
+    g = GlobeConfig(radius=40, map_width=256, map_height=128, pipeline=SMALL, coord_bits=8)
+    rng = np.random.default_rng(7 + len(pattern))
+    pts = list(zip(rng.integers(-44, 45, 120).tolist(), rng.integers(-44, 45, 120).tolist(),
+                   strict=True))
+    x, y = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+    rot = rng.integers(0, SMALL.full_circle, len(pts))
+    inputs = [{"x": int(a), "y": int(b), "rotation": int(r), "tag": n}
+              for n, ((a, b), r) in enumerate(zip(pts, rot, strict=True))]
+    dut = GlobeGeometry(g)
+    out, _ = simulate_stream(dut, inputs, pattern, seed=3, pipe_handshake=True)
+    assert_bit_exact(out, globe_fixed(x, y, rot, g), inputs)
+    assert any(o["inside"] for o in out) and not all(o["inside"] for o in out)
+
+
+def test_radius_one_and_widest_radius():
+    """R = 1 (the centre alone is inside) and R = 2047 (the widest, its rim)."""
+    rtl_vs_model(GlobeConfig(radius=1, map_width=4, map_height=2, pipeline=SMALL,
+                             coord_bits=3, frac_bits=8, guard_bits=2),
+                 [(a, b) for a in range(-2, 2) for b in range(-2, 2)], [0, 1023], "input_gaps")
+    g = GlobeConfig(radius=2047, pipeline=Config(angle_bits=16, frac_bits=16, tag_bits=4))
+    rtl_vs_model(g, [(0, 0), (2046, 0), (0, -2046), (-1, 2046), (1447, 1447), (1447, -1448),
+                     *rim_pixels(2047, limit=6)], [65535], "no_stall")
+
+
+def test_one_pixel_per_clock():
+    g = GlobeConfig(radius=20, map_width=64, map_height=32, pipeline=SMALL, coord_bits=7,
+                    frac_bits=8, guard_bits=2)
+    dut, cycles = rtl_vs_model(g, [(a, a // 2) for a in range(-25, 25)], [9], "no_stall")
+    assert dut.latency == g.latency
+    assert cycles == 50 + dut.port_latency
+
+
+def test_known_points():
+    """Outputs known without either model: at the centre phi = theta = 0, u is the
+    rotation's texel and v = H / 2; on the axes and diagonals phi is a multiple of an eighth
+    turn; outside every field but inside is 0; v climbs with y and is symmetric about the
+    equator as floor makes it."""
+    g = GlobeConfig()
+    A, W, H, R = g.angle_bits, g.map_width, g.map_height, g.radius
+    eighth = 1 << (A - 3)
+    pts = [(0, 0), (5, 0), (0, 5), (-5, 0), (0, -5), (7, 7), (-7, 7), (-7, -7), (7, -7),
+           (R, 0), (0, -R), (R, R)]
+    rot = 12345
+    out = globe_fixed([p[0] for p in pts], [p[1] for p in pts], rot, g)
+    assert out["inside"].tolist() == [1] * 9 + [0] * 3
+    assert out["n.phi"].tolist()[:9] == [0, 0, 2 * eighth, 4 * eighth, 6 * eighth, eighth,
+                                         3 * eighth, 5 * eighth, 7 * eighth]
+    assert out["n.theta"][0] == 0 and out["u"][0] == rot * W >> A and out["v"][0] == H // 2
+    assert out["u"][2] == out["u"][4] == rot * W >> A             # x = 0: the rotation's texel
+    for field in ("n.phi", "n.theta", "u", "v"):
+        assert out[field][9:].tolist() == [0, 0, 0]
+    table = v_table(g)
+    ys = list(range(-R + 1, R))
+    vs = [table[y % len(table)] for y in ys]
+    assert vs == sorted(vs) and vs[0] < H // 2 < vs[-1]
+    assert all(a + b in (H - 1, H) for a, b in zip(vs, reversed(vs), strict=True))
+
+
+def test_model_against_float_over_the_default_disc():
+    """Every pixel of the default disc and a ring outside, at rotation 0 and just below a
+    full turn: the fine angles within error_bound_rad, the codes and texels equal to
+    float64's except off by one next to a rounding boundary, inside and v equal; the bound
+    is below one step, so no code is ever off by more than one."""
+    g = GlobeConfig()
+    x, y = disc_pixels(g.radius)
+    for rot in (0, g.pipeline.full_circle - 1):
+        res = check_against_float(x, y, rot, g)
+        assert res["violations"] == [], res
+        assert res["pixels"] > 3 * g.radius ** 2
+        for name in ("phi", "theta", "lambda"):
+            assert res[name]["bound_steps"] < 1 and res[name]["codes_max_diff"] <= 1
+            assert res[name]["codes_differing"] < res["pixels"] // 50
+
+
+@pytest.mark.parametrize("radius,angle_bits,width,frac,guard", [
+    (1, 8, 4, 4, 1), (2, 8, 16, 8, 2), (3, 16, 32768, 20, 8), (17, 10, 64, 12, 3),
+    (100, 12, 512, 14, 4)])
+def test_model_against_float_small_discs(radius, angle_bits, width, frac, guard):
+    g = GlobeConfig(radius=radius, map_width=width, map_height=width // 2,
+                    pipeline=Config(angle_bits=angle_bits, frac_bits=max(angle_bits - 3, 4)),
+                    frac_bits=frac, guard_bits=guard)
+    x, y = disc_pixels(radius)
+    for rot in (0, 1, (1 << angle_bits) - 1):
+        assert check_against_float(x, y, rot, g)["violations"] == []
+
+
+def test_model_against_float_at_the_widest_rim():
+    """R = 2047, where the rim is steepest in pixels: the ring r**2 >= R**2 - 8R, the poles'
+    columns and the centre's neighbours, at the default widths."""
+    g = GlobeConfig(radius=2047)
+    R = 2047
+    xs, ys = [], []
+    for col in range(-R - 2, R + 3):
+        top = math.isqrt((R + 2) ** 2 - col * col) if col * col <= (R + 2) ** 2 else -1
+        low = R * R - 8 * R - col * col
+        bottom = math.isqrt(low - 1) + 1 if low > 0 else 0
+        rows = np.arange(bottom, top + 1) if abs(col) > 3 else np.arange(0, top + 1)
+        rows = np.concatenate([rows, -rows])
+        xs.append(np.full(len(rows), col)), ys.append(rows)
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    res = check_against_float(x, y, g.pipeline.full_circle - 1, g)
+    assert res["violations"] == [], res
+    assert res["pixels"] > 40000
+
+
+def test_the_float_check_can_fail(monkeypatch):
+    """A model that reads the wrong v word, or puts one texel off where float64 is clear of a
+    boundary, is reported."""
+    g = GlobeConfig(radius=30, map_width=256, map_height=128)
+    x, y = disc_pixels(30)
+    real = model.globe_fixed
+
+    def off_u(*args, **kw):
+        out = real(*args, **kw)
+        out["u"] = np.where(out["inside"] == 1, (out["u"] + 1) % g.map_width, 0)
+        return out
+
+    monkeypatch.setattr(model, "globe_fixed", off_u)
+    assert any(v.startswith("u:") for v in check_against_float(x, y, 0, g)["violations"])
+
+    def off_v(*args, **kw):
+        out = real(*args, **kw)
+        out["v"] = np.where(out["inside"] == 1, np.maximum(out["v"] - 1, 0), 0)
+        out["phi_fine"] = out["phi_fine"] + (1 << (g.angle_frac_bits - g.angle_bits))
+        return out
+
+    monkeypatch.setattr(model, "globe_fixed", off_v)
+    bad = check_against_float(x, y, 0, g)["violations"]
+    assert "v differs" in bad and any(v.startswith("phi: fine error") for v in bad)
+
+
+def test_bound_shrinks_with_the_widths():
+    """The derived bound is larger for narrower datapaths and fewer guard bits, and stays
+    below one output step at the defaults."""
+    g = GlobeConfig()
+    for name in ("phi", "theta", "lambda"):
+        b = error_bound_rad(g, name)
+        assert b < 2 * math.pi / (1 << max(g.angle_bits, g.u_bits))
+        assert error_bound_rad(GlobeConfig(frac_bits=12), name) > b
+        assert error_bound_rad(GlobeConfig(guard_bits=2), name) > b
+
+
+class _Root(PipeUnit):
+    """sqrt_stages on its own: floor(sqrt(s << 2F)) of an 8-bit s."""
+
+    def __init__(self, frac_bits):
+        self.frac_bits = frac_bits
+        self.latency = 4 + frac_bits
+        cfg = Config(tag_bits=8)
+        super().__init__(cfg, data.StructLayout({"s": unsigned(8), "tag": unsigned(8)}),
+                         data.StructLayout({"q": unsigned(4 + frac_bits), "tag": unsigned(8)}))
+
+    def build(self, m, pipe):
+        q = sqrt_stages(pipe, self.i.payload.s, 8, self.frac_bits, "root")
+        m.d.comb += pipe.o.payload.q.eq(q)
+        m.d.comb += pipe.o.payload.tag.eq(pipe.delay(self.i.payload.tag, self.latency, "tag"))
+
+
+@pytest.mark.parametrize("frac_bits", [0, 3])
+def test_square_root_exhaustive(frac_bits):
+    """Every 8-bit radicand: the non-restoring root is floor(sqrt) exactly."""
+    inputs = [{"s": s, "tag": s} for s in range(256)]
+    out, _ = simulate_stream(_Root(frac_bits), inputs, "no_stall")
+    assert [o["q"] for o in out] == [math.isqrt(s << (2 * frac_bits)) for s in range(256)]
+
+
+def test_model_square_root_is_exact():
+    rng = np.random.default_rng(5)
+    n = np.concatenate([rng.integers(0, 1 << 62, 2000), [0, 1, 2, 3, (1 << 62) - 1],
+                        np.arange(1, 3000) ** 2 - 1])
+    assert isqrt(n).tolist() == [math.isqrt(int(v)) for v in n]
+
+
+@pytest.mark.parametrize("changes,field", [
+    ({"radius": 0}, "radius"), ({"radius": 2048}, "radius"), ({"radius": 3.0}, "radius"),
+    ({"map_width": 3000, "map_height": 1500}, "map_width"),
+    ({"map_width": 2, "map_height": 1}, "map_width"),
+    ({"map_width": 2048, "map_height": 2048}, "map_height"),
+    ({"radius": 300, "coord_bits": 9}, "coord_bits"), ({"coord_bits": 17}, "coord_bits"),
+    ({"frac_bits": 3}, "frac_bits"), ({"frac_bits": 21}, "frac_bits"),
+    ({"guard_bits": 0}, "guard_bits"), ({"guard_bits": 9}, "guard_bits"),
+    ({"iterations": 1}, "iterations"), ({"iterations": 23}, "iterations"),
+    ({"pipeline": "default"}, "pipeline")])
+def test_config_errors_name_the_parameter(changes, field):
+    with pytest.raises(ConfigError) as err:
+        GlobeConfig(**changes)
+    assert err.value.field == field and field in str(err.value)
+    assert isinstance(err.value, BumpError)
+    if field not in ("pipeline", "map_height"):
+        assert "[" in str(err.value)           # the allowed range
+
+
+def test_config_accepts_the_edges():
+    GlobeConfig(radius=2047)
+    GlobeConfig(radius=1, coord_bits=2, map_width=4, map_height=2, frac_bits=4, guard_bits=1,
+                iterations=2)
+    GlobeConfig(map_width=32768, map_height=16384, frac_bits=20, guard_bits=8, iterations=23)
+
+
+def test_elaborates_for_ecp5_and_records_its_rom():
+    """The ECP5 form builds (DSP squares, a DP16KD v ROM); its one memory is the v table."""
+    g = GlobeConfig()
+    dut = GlobeGeometry(g, target=ECP5())
+    _, records = unit_memory_records(dut)
+    rom = records.of(dut)["v_rom"]
+    assert (rom["depth"], rom["width"]) == (2 << g.int_bits, g.v_bits)
+
+
+@pytest.mark.regress
+def test_no_register_or_read_has_an_enable(build_dir):
+    """As tests/rtl/test_no_clock_enable.py checks every unit: only the credit edge's
+    registers have enables."""
+    module = netlist(GlobeGeometry(GlobeConfig(radius=40, coord_bits=8)), "globe", build_dir)
+    assert datapath_offenders(module) == ([], [])
