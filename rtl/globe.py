@@ -332,8 +332,9 @@ class GlobeGeometry(PipeUnit):
                              "phi_acc")
         phi = pipe.delay(cordic_stages(pipe, fx, fy, facc, angles, w, "phi"), done - (2 + n),
                          "phi_done")
-        centre = pipe.delay(pipe.register((x == 0) & (y == 0), "centre"), done - 2, "centre")
-        x_zero = pipe.delay(pipe.register(x == 0, "x_zero"), done - 2, "x_zero")
+        # x == 0 as ~|x (an equality with 0 would be Verilog's ! of a vector, which lint refuses)
+        centre = pipe.delay(pipe.register(~(x.any() | y.any()), "centre"), done - 2, "centre")
+        x_zero = pipe.delay(pipe.register(~x.any(), "x_zero"), done - 2, "x_zero")
         inside = pipe.delay(inside, done - start, "inside")
         rot_done = pipe.delay(rot, done - 1, "rotation_done")
         # the v ROM: its address registered at done - 1 - ROM_LATENCY, its word at done
