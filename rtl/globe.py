@@ -336,7 +336,9 @@ class GlobeGeometry(PipeUnit):
         centre = pipe.delay(pipe.register(~(x.any() | y.any()), "centre"), done - 2, "centre")
         x_zero = pipe.delay(pipe.register(~x.any(), "x_zero"), done - 2, "x_zero")
         inside = pipe.delay(inside, done - start, "inside")
-        rot_done = pipe.delay(rot, done - 1, "rotation_done")
+        # u of x = 0 is the rotation's top log2 W bits (below them, zeros): only those ride on
+        low = max(A - g.u_bits, 0)
+        rot_done = pipe.delay(rot[low:], done - 1, "rotation_done")
         # the v ROM: its address registered at done - 1 - ROM_LATENCY, its word at done
         rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
         at = done - 1 - ROM_LATENCY
@@ -344,7 +346,7 @@ class GlobeGeometry(PipeUnit):
         m.d.comb += rom.ports[0].addr.eq(address)
         v_word = pipe.register(rom.ports[0].data, "v_word")
         # the output stage (done + 1): codes, texel, 0 outside
-        u_rot = (Cat(Const(0, P - A), rot_done) >> (P - g.u_bits))[:g.u_bits]
+        u_rot = (Cat(Const(0, P - A + low), rot_done) >> (P - g.u_bits))[:g.u_bits]
         u_lam = lam[P - g.u_bits:]
         o, zero = pipe.o.payload, Const(0)
         m.d.comb += [

@@ -13,6 +13,7 @@ import numpy as np
 
 from bumprtl.rtl.config import Config
 from bumprtl.rtl.globe import GlobeConfig, cordic_angles, v_table
+from bumprtl.rtl.pipe import EDGE_LATENCY, min_fifo_depth
 from bumprtl.sim.golden.common import cartesian_to_polar
 from bumprtl.sim.golden.fixed.common import angle_codes
 
@@ -210,7 +211,17 @@ def main(argv=None):
     rots = [r % (1 << gcfg.angle_bits) for r in args.rotations]
     print(f"R = {gcfg.radius}, angle_bits = {gcfg.angle_bits}, W x H = {gcfg.map_width} x "
           f"{gcfg.map_height}, F = {gcfg.frac_bits}, P = {gcfg.angle_frac_bits}, "
-          f"iterations = {gcfg.cordic_iterations}, latency = {gcfg.latency}, rotations {rots}")
+          f"iterations = {gcfg.cordic_iterations}, rotations {rots}")
+    print(f"widths: I = {gcfg.int_bits}, roots {gcfg.root_bits} bits ({gcfg.root_bits} "
+          f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed, angle sums "
+          f"{gcfg.angle_frac_bits} bits, v ROM {2 << gcfg.int_bits} x {gcfg.v_bits}; latency "
+          f"{gcfg.latency} (+{EDGE_LATENCY} with the unit's credit edge, FIFO depth "
+          f"{min_fifo_depth(gcfg.latency)})")
+    for name in ("phi", "theta", "lambda"):
+        b = error_bound_rad(gcfg, name)
+        steps = gcfg.map_width if name == "lambda" else 1 << gcfg.angle_bits
+        print(f"bound {name}: {b:.3e} rad = {b * steps / (2 * math.pi):.4f} "
+              f"{'texels' if name == 'lambda' else 'codes'}")
     ok = True
     for rot in rots:
         res = check_against_float(x, y, rot, gcfg)
