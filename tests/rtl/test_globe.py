@@ -138,17 +138,25 @@ def test_one_pixel_per_clock():
 
 
 def test_known_points():
-    """Outputs known without either model: at the centre phi = theta = 0, u is the
-    rotation's texel and v = H / 2; on the axes and diagonals phi is a multiple of an eighth
-    turn; outside every field but inside is 0; v climbs with y and is symmetric about the
-    equator as floor makes it."""
+    """Outputs known without either model, of the RTL and of the model: at the centre
+    phi = theta = 0, u is the rotation's texel and v = H / 2; on the axes and diagonals phi
+    is a multiple of an eighth turn; on x = 0 u is the rotation's texel; outside every field
+    but inside is 0."""
     g = GlobeConfig()
-    A, W, H, R = g.angle_bits, g.map_width, g.map_height, g.radius
-    eighth = 1 << (A - 3)
+    R = g.radius
     pts = [(0, 0), (5, 0), (0, 5), (-5, 0), (0, -5), (7, 7), (-7, 7), (-7, -7), (7, -7),
            (R, 0), (0, -R), (R, R)]
     rot = 12345
-    out = globe_fixed([p[0] for p in pts], [p[1] for p in pts], rot, g)
+    inputs = [{"x": a, "y": b, "rotation": rot, "tag": n} for n, (a, b) in enumerate(pts)]
+    rtl, _ = simulate_stream(GlobeGeometry(g), inputs, "no_stall")
+    rtl = {k: np.array([o[k] for o in rtl]) for k in rtl[0]}
+    for out in (rtl, globe_fixed([p[0] for p in pts], [p[1] for p in pts], rot, g)):
+        _check_known(out, g, rot)
+
+
+def _check_known(out, g, rot):
+    A, W, H = g.angle_bits, g.map_width, g.map_height
+    eighth = 1 << (A - 3)
     assert out["inside"].tolist() == [1] * 9 + [0] * 3
     assert out["n.phi"].tolist()[:9] == [0, 0, 2 * eighth, 4 * eighth, 6 * eighth, eighth,
                                          3 * eighth, 5 * eighth, 7 * eighth]
@@ -156,6 +164,16 @@ def test_known_points():
     assert out["u"][2] == out["u"][4] == rot * W >> A             # x = 0: the rotation's texel
     for field in ("n.phi", "n.theta", "u", "v"):
         assert out[field][9:].tolist() == [0, 0, 0]
+    theta = out["n.theta"].tolist()
+    assert len(set(theta[1:5])) == 1 and len(set(theta[5:9])) == 1 and 0 < theta[1] < theta[5]
+    assert out["v"][1] == out["v"][3] == H // 2                  # y = 0: the equator's row
+
+
+def test_v_table_climbs_and_is_symmetric():
+    """v climbs with y, from below the equator's row to above it, and v(y) + v(-y) is H - 1
+    (or H where the latitude falls on a row's edge), as floor makes it."""
+    g = GlobeConfig()
+    R, H = g.radius, g.map_height
     table = v_table(g)
     ys = list(range(-R + 1, R))
     vs = [table[y % len(table)] for y in ys]
