@@ -317,7 +317,7 @@ class GlobeGeometry(PipeUnit):
         # theta = atan2(r, z), lambda = atan2(x, z) + rotation: stages roots + 1 .. done
         z_w, r_w = fit_signed(z_root, w), fit_signed(r_root, w)
         theta = cordic_stages(pipe, z_w, r_w, Const(1 << (P - A - 1), P), angles, w, "theta")
-        x_root = pipe.delay(x, roots - 1, "x_root")
+        x_root = pipe.delay(x[:I + 1].as_signed(), roots - 1, "x_root")   # |x| < R inside
         lam0 = Cat(Const(0, P - A), pipe.delay(rot, roots - 1, "rotation_root"))
         lam = cordic_stages(pipe, z_w, fit_signed(Cat(Const(0, F), x_root).as_signed(), w),
                             lam0, angles, w, "lambda")
@@ -342,7 +342,7 @@ class GlobeGeometry(PipeUnit):
         # the v ROM: its address registered at done - 1 - ROM_LATENCY, its word at done
         rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
         at = done - 1 - ROM_LATENCY
-        address = pipe.register(pipe.delay(y, at - 2, "y_v")[:I + 1], "v_address")
+        address = pipe.register(pipe.delay(y[:I + 1], at - 2, "y_v"), "v_address")
         m.d.comb += rom.ports[0].addr.eq(address)
         v_word = pipe.register(rom.ports[0].data, "v_word")
         # the output stage (done + 1): codes, texel, 0 outside
