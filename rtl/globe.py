@@ -46,6 +46,10 @@ __all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "globe_in
 RADIUS_RANGE = (1, 2047)          # R in pixels: R**2 << 2F stays inside 62 bits (the model's int64)
 MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2
 FRAC_BITS_RANGE = (4, 20)         # F: fraction bits of the roots and of the CORDIC datapath
+# The signed width of the CORDIC datapaths and of the roots' remainders (I + F + 2) that the
+# default F aims at: the carry chains of the unit are this long (phi's CORDIC one more, the
+# angle sums angle_frac_bits), short enough for the 200 MHz target of constraints/ecp5.lpf.
+DATAPATH_BITS = 20
 GUARD_BITS_RANGE = (1, 8)         # internal angle bits beyond the wider output
 COORD_BITS_MAX = 16               # signed width of the x, y offsets
 
@@ -74,8 +78,10 @@ class GlobeConfig:
         and ``tag_bits``.
     coord_bits : int
         Signed width of the x and y offsets: ``radius.bit_length() + 1`` to 16.
-    frac_bits : int
-        F, fraction bits (below a pixel) of the square roots and the CORDIC datapaths, 4 to 20.
+    frac_bits : None or int
+        F, fraction bits (below a pixel) of the square roots and the CORDIC datapaths, 4 to
+        20; None: ``DATAPATH_BITS - 2 - I`` (at least 4), which keeps the datapaths
+        DATAPATH_BITS wide (:attr:`fraction_bits`).
     guard_bits : int
         Bits of the CORDIC angle sums beyond the wider of ``angle_bits`` and ``log2 W``, 1 to 8.
     iterations : None or int
@@ -88,7 +94,7 @@ class GlobeConfig:
     map_height: int = 1024
     pipeline: Config = field(default_factory=Config)
     coord_bits: int = 12
-    frac_bits: int = 18
+    frac_bits: int | None = None
     guard_bits: int = 8
     iterations: int | None = None
 
@@ -109,7 +115,8 @@ class GlobeConfig:
             raise ConfigError(f"pipeline must be a Config, got {self.pipeline!r}", "pipeline")
         _check_int("coord_bits", self.coord_bits, self.int_bits + 1, COORD_BITS_MAX,
                    f"signed offsets must hold +-(radius - 1) = +-{self.radius - 1}")
-        _check_int("frac_bits", self.frac_bits, *FRAC_BITS_RANGE)
+        if self.frac_bits is not None:
+            _check_int("frac_bits", self.frac_bits, *FRAC_BITS_RANGE)
         _check_int("guard_bits", self.guard_bits, *GUARD_BITS_RANGE)
         if self.iterations is not None:
             _check_int("iterations", self.iterations, 2, self.angle_frac_bits,
@@ -143,20 +150,33 @@ class GlobeConfig:
         return self.angle_frac_bits - 1 if self.iterations is None else self.iterations
 
     @property
+    def fraction_bits(self):
+        """F: ``frac_bits``, or by default ``DATAPATH_BITS - 2 - I`` within FRAC_BITS_RANGE."""
+        if self.frac_bits is not None:
+            return self.frac_bits
+        return min(max(DATAPATH_BITS - 2 - self.int_bits, FRAC_BITS_RANGE[0]), FRAC_BITS_RANGE[1])
+
+    @property
     def root_bits(self):
         """Bits of a square root ``floor(sqrt(s) * 2**F)``, s < 2**(2I): I + F, one a stage."""
-        return self.int_bits + self.frac_bits
+        return self.int_bits + self.fraction_bits
 
     @property
     def datapath_bits(self):
         """Signed width of a CORDIC's X and Y: I + F + 2 (a sign, and the gain < 2)."""
-        return self.int_bits + self.frac_bits + 2
+        return self.int_bits + self.fraction_bits + 2
+
+    @property
+    def cordic_latency(self):
+        """Stages of a CORDIC chain (:func:`cordic_stages`): one an iteration, and one more
+        for the angle sum, which takes each turn a stage after the turn itself."""
+        return self.cordic_iterations + 1
 
     @property
     def latency(self):
         """Stages from ``i`` to ``o`` (no credit edge): the input register, the squares
         (PRODUCT_LATENCY), r2, R**2 - r2, the roots, the CORDIC chains, the output register."""
-        return 1 + PRODUCT_LATENCY + 2 + self.root_bits + self.cordic_iterations + 1
+        return 1 + PRODUCT_LATENCY + 2 + self.root_bits + self.cordic_latency + 1
 
 
 def cordic_angles(gcfg: GlobeConfig):
@@ -207,14 +227,14 @@ def sqrt_stages(pipe, value, value_bits, frac_bits, name):
     subtract). The radicand's bits enter two a stage; past ``value`` they are the zeros of
     the shift."""
     n = value_bits // 2 + frac_bits
-    # After stage j the remainder is D_j - q**2 >= 0 or D_j - (q | 1)**2 >= -(2 q + 1), so
-    # |rem| <= 2 q + 1 < 2**(j + 2): n + 2 signed bits hold every one; rem << 2 may wrap
-    # at that width, the sum it enters does not.
-    width = n + 2
     rest = value[:value_bits]
-    rem = Const(0, signed(width))
+    rem = Const(0, signed(2))
     q = Const(0, 1)
     for j in range(n):
+        # After stage j the remainder is D_j - q**2 >= 0 or D_j - (q | 1)**2 >= -(2 q + 1)
+        # with q < 2**(j + 1), so |rem| < 2**(j + 2): j + 3 signed bits hold it (n + 2 at the
+        # last stage); rem << 2 may wrap at that width, the sum it enters does not.
+        width = j + 3
         i = n - 1 - j                              # the radicand's pair 2i + 1 .. 2i
         if i >= frac_bits:
             pair = rest[2 * (i - frac_bits):2 * (i - frac_bits) + 2]
@@ -223,7 +243,8 @@ def sqrt_stages(pipe, value, value_bits, frac_bits, name):
         negative = rem[-1]
         # rem < 0: (rem << 2 | pair) + (q << 2 | 3); else (rem << 2 | pair) - (q << 2 | 1),
         # the subtraction as the addition of ~(q << 2 | 1) + 1 at the remainder's width
-        trial = Cat(Mux(negative, Const(3, 2), Const(1, 2)), q, Const(0, width - 2 - len(q)))
+        trial = Cat(Mux(negative, Const(3, 2), Const(1, 2)), q,
+                    Const(0, width - 2 - len(q)))[:width]
         shifted = Cat(pair, rem)[:width].as_signed()
         new = (shifted + Mux(negative, trial, ~trial) + ~negative)[:width].as_signed()
         rem = pipe.register(new, f"{name}_rem{j}")
@@ -245,10 +266,12 @@ def fit_signed(value, width):
 
 def cordic_stages(pipe, x, y, acc, angles, width, name):
     """CORDIC vectoring: ``len(angles)`` stages turn (x, y) toward the +x axis by
-    ``atan(2**-i)`` each, the way the sign of y says, and add the turn to ``acc`` (an
-    unsigned binary angle, wrapping): ``acc + atan2(y, x)`` to within the bound of
-    sim/golden/globe.error_bound_rad. ``x``, ``y`` signed ``width`` bits; the shifts
-    truncate (arithmetic shift right)."""
+    ``atan(2**-i)`` each, the way the sign of y says, and the angle sum adds each turn to
+    ``acc`` (an unsigned binary angle, wrapping) a stage later, from a copy of that sign:
+    the sign of y then drives the two chains of x and y and the copy, not the sum's chain
+    too. ``len(angles) + 1`` stages give ``acc + atan2(y, x)`` to within the bound of
+    sim/golden/globe.error_bound_rad (``acc`` is taken a stage after ``x`` and ``y``).
+    ``x``, ``y`` signed ``width`` bits; the shifts truncate (arithmetic shift right)."""
     p = len(acc)
     for i, a in enumerate(angles):
         down = y[-1]                                   # y < 0: turn up, subtract the angle
@@ -256,11 +279,63 @@ def cordic_stages(pipe, x, y, acc, angles, width, name):
         # y >= 0: x + (y >> i), y - (x >> i), acc + a; y < 0: the other way
         nx = (x + Mux(down, ~ys, ys) + down)[:width].as_signed()
         ny = (y + Mux(down, xs, ~xs) + ~down)[:width].as_signed()
-        nacc = (acc + Mux(down, Const((-a) % (1 << p), p), Const(a, p)))[:p]
+        turn = pipe.register(down, f"{name}_turn{i}")
         x = pipe.register(nx, f"{name}_x{i}")
         y = pipe.register(ny, f"{name}_y{i}")
-        acc = pipe.register(nacc, f"{name}_acc{i}")
+        acc = pipe.register(acc, f"{name}_acc{i}") if i == 0 else acc
+        acc = pipe.register((acc + Mux(turn, Const((-a) % (1 << p), p), Const(a, p)))[:p],
+                            f"{name}_sum{i}")
     return acc
+
+
+def leading_zeros(m, bits):
+    """Zeros above the top set bit of the unsigned ``m`` within ``bits`` bits (``bits`` for
+    0): a priority encoder."""
+    count = Const(bits, range(bits + 1))
+    for k in range(bits):                          # the highest set bit decides last
+        count = Mux(m[k], bits - 1 - k, count)
+    return count
+
+
+def phi_stages(pipe, x, y, g: GlobeConfig, angles):
+    """``atan2(y, x)`` (x, y the registered inputs, signed) as a binary angle of
+    ``angle_frac_bits``, plus half a code step (so its top bits round): returns ``(angle,
+    stage)``, the stage counted from the inputs' (1). Stage 2 turns a vector with x < 0 by
+    pi (X = -x, Y = -y, the sum starting at half a turn); stage 3 takes the magnitude word
+    ``m = X | (Y ^ s)`` (s the sign of Y in every bit: the one's complement of a negative Y),
+    stage 4 its leading zeros ``z`` within I bits, stages 5 and 6 shift X and Y left by
+    ``z``'s low two bits, then by the rest: the larger of |X|, |Y| is then at least
+    2**(I - 1) (and -2**I <= Y, X < 2**I), so the chain's vector is at least 2**(I - 1 + F)
+    long at every pixel but the centre (set to 0 at the output). Then the CORDIC chain, one
+    bit wider than the others: the vector may be sqrt 2 2**(I + F) long, and the chain's
+    gain (< 1.65) takes it past 2**(I + F + 1)."""
+    I, F, P, A, w = g.int_bits, g.fraction_bits, g.angle_frac_bits, g.angle_bits, g.datapath_bits
+    negative = x[-1]
+    turned_x = pipe.register(Mux(negative, -x, x)[:I + 1].as_signed(), "phi_turned_x")
+    turned_y = pipe.register(Mux(negative, -y, y)[:I + 1].as_signed(), "phi_turned_y")
+    half = 1 << (P - A - 1)
+    acc = pipe.register(Mux(negative, Const((1 << (P - 1)) + half, P), Const(half, P)),
+                        "phi_acc")
+    m = pipe.register((turned_x | (turned_y ^ turned_y[-1].replicate(I + 1)))[:I], "phi_m")
+    vx = pipe.register(turned_x, "phi_x_m")
+    vy = pipe.register(turned_y, "phi_y_m")
+    acc = pipe.register(acc, "phi_acc_m")
+    zeros = pipe.register(leading_zeros(m, I), "phi_zeros")
+    vx, vy = pipe.register(vx, "phi_x_z"), pipe.register(vy, "phi_y_z")
+    acc = pipe.register(acc, "phi_acc_z")
+    wide = I + 1
+    high = zeros[2:]
+    for step, amount in enumerate((zeros[:2], None)):
+        if amount is None:
+            amount = high << 2
+        else:
+            high = pipe.register(high, "phi_zeros_high")       # beside the first shift
+        vx = pipe.register((vx << amount)[:wide].as_signed(), f"phi_x_s{step}")
+        vy = pipe.register((vy << amount)[:wide].as_signed(), f"phi_y_s{step}")
+        acc = pipe.register(acc, f"phi_acc_s{step}")
+    fx = fit_signed(Cat(Const(0, F), vx).as_signed(), w + 1)
+    fy = fit_signed(Cat(Const(0, F), vy).as_signed(), w + 1)
+    return cordic_stages(pipe, fx, fy, acc, angles, w + 1, "phi"), 6 + g.cordic_latency
 
 
 class GlobeGeometry(PipeUnit):
@@ -293,8 +368,8 @@ class GlobeGeometry(PipeUnit):
 
     def build(self, m, pipe):
         g = self.gcfg
-        I, F, P, A = g.int_bits, g.frac_bits, g.angle_frac_bits, g.angle_bits
-        n, w = g.cordic_iterations, g.datapath_bits
+        I, F, P, A = g.int_bits, g.fraction_bits, g.angle_frac_bits, g.angle_bits
+        w, chain = g.datapath_bits, g.cordic_latency
         angles = cordic_angles(g)
         p = self.i.payload
         # stage 1: the inputs
@@ -312,26 +387,20 @@ class GlobeGeometry(PipeUnit):
         z_root = sqrt_stages(pipe, d, 2 * I, F, "z")
         r_root = sqrt_stages(pipe, r2_at, 2 * I, F, "r")
         roots = start + g.root_bits
-        done = roots + n                                                 # the angles' stage
+        done = roots + chain                                             # the angles' stage
 
         # theta = atan2(r, z), lambda = atan2(x, z) + rotation: stages roots + 1 .. done
         z_w, r_w = fit_signed(z_root, w), fit_signed(r_root, w)
-        theta = cordic_stages(pipe, z_w, r_w, Const(1 << (P - A - 1), P), angles, w, "theta")
+        half = 1 << (P - A - 1)                    # the codes round: floor(acc + half step)
+        theta = cordic_stages(pipe, z_w, r_w, Const(half, P), angles, w, "theta")
         x_root = pipe.delay(x[:I + 1].as_signed(), roots - 1, "x_root")   # |x| < R inside
         lam0 = Cat(Const(0, P - A), pipe.delay(rot, roots - 1, "rotation_root"))
         lam = cordic_stages(pipe, z_w, fit_signed(Cat(Const(0, F), x_root).as_signed(), w),
                             lam0, angles, w, "lambda")
-        # phi = atan2(y, x): stage 2 turns x < 0 by pi, stages 3 .. 2 + n the chain
-        negative = x[-1]
-        fx = pipe.register(fit_signed(Cat(Const(0, F), Mux(negative, -x, x)).as_signed(), w),
-                           "phi_x")
-        fy = pipe.register(fit_signed(Cat(Const(0, F), Mux(negative, -y, y)).as_signed(), w),
-                           "phi_y")
-        half = 1 << (P - A - 1)                    # the codes round: floor(acc + half step)
-        facc = pipe.register(Mux(negative, Const((1 << (P - 1)) + half, P), Const(half, P)),
-                             "phi_acc")
-        phi = pipe.delay(cordic_stages(pipe, fx, fy, facc, angles, w, "phi"), done - (2 + n),
-                         "phi_done")
+        # phi = atan2(y, x): stage 2 turns x < 0 by pi, stages 3 .. 6 scale (x, y) up until
+        # the larger magnitude has its top bit at 2**(I - 1), then the chain
+        phi, phi_end = phi_stages(pipe, x, y, g, angles)
+        phi = pipe.delay(phi, done - phi_end, "phi_done")
         # x == 0 as ~|x (an equality with 0 would be Verilog's ! of a vector, which lint refuses)
         centre = pipe.delay(pipe.register(~(x.any() | y.any()), "centre"), done - 2, "centre")
         x_zero = pipe.delay(pipe.register(~x.any(), "x_zero"), done - 2, "x_zero")

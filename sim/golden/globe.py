@@ -56,7 +56,8 @@ def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
     their rounding (full circle = 2**P, the rounding's half step taken back off; valid
     inside only)."""
     x, y, rotation = _inputs(x, y, rotation)
-    R, F, P, A = gcfg.radius, gcfg.frac_bits, gcfg.angle_frac_bits, gcfg.angle_bits
+    R, F, P, A = gcfg.radius, gcfg.fraction_bits, gcfg.angle_frac_bits, gcfg.angle_bits
+    I = gcfg.int_bits
     full, half = 1 << P, 1 << (P - A - 1)
     r2 = x * x + y * y
     inside = r2 < R * R
@@ -64,7 +65,13 @@ def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
     r = isqrt(np.where(inside, r2, 0) << (2 * F))
     xi, yi = np.where(inside, x, 1), np.where(inside, y, 0)      # outside: any, masked
     neg = xi < 0
-    phi = cordic(np.where(neg, -xi, xi) << F, np.where(neg, -yi, yi) << F,
+    tx, ty = np.where(neg, -xi, xi), np.where(neg, -yi, yi)          # x < 0 turned by pi
+    # scaled up by the zeros above the top bit of max(|tx|, |ty|) within I bits
+    top = np.zeros_like(tx)
+    magnitude = tx | (ty ^ (ty >> 63))
+    for k in range(I):
+        top = np.where(magnitude >> k != 0, k + 1, top)
+    phi = cordic((tx << (I - top)) << F, (ty << (I - top)) << F,
                  np.where(neg, full // 2, 0) + half, gcfg)
     theta = cordic(z, r, np.full_like(x, half), gcfg)
     lam = cordic(z, xi << F, (rotation & ((1 << A) - 1)) << (P - A), gcfg)
@@ -117,12 +124,13 @@ def error_bound_rad(gcfg: GlobeConfig, which):
     steps, the n rounded constants (half a step each), and the truncation of the shifts
     (under one unit in each of X, Y at steps 1 .. n-1, none at step 0, on a vector never
     shorter than sqrt(2) (M - n) units after step 0); M is the shortest input vector in
-    units of 2**-F pixel: phi 2**F (r >= 1; the centre is set to 0), theta R 2**F - sqrt 2,
+    units of 2**-F pixel: phi 2**(I - 1 + F) (the vector scaled up until its larger
+    component is at least 2**(I - 1); the centre is set to 0), theta R 2**F - sqrt 2,
     lambda sqrt(2R - 1) 2**F - sqrt 2 (x**2 + z**2 = R**2 - y**2 >= 2R - 1 inside);
     ``e_in`` the truncated roots (each under one unit): asin(sqrt 2 / M_true) for theta
     and lambda, 0 for phi (exact integer inputs)."""
-    n, P, F, R = gcfg.cordic_iterations, gcfg.angle_frac_bits, gcfg.frac_bits, gcfg.radius
-    true = {"phi": 2.0 ** F, "theta": R * 2.0 ** F,
+    n, P, F, R = gcfg.cordic_iterations, gcfg.angle_frac_bits, gcfg.fraction_bits, gcfg.radius
+    true = {"phi": 2.0 ** (gcfg.int_bits - 1 + F), "theta": R * 2.0 ** F,
             "lambda": math.sqrt(2 * R - 1) * 2.0 ** F}[which]
     m = true - (0 if which == "phi" else math.sqrt(2))
     e_in = 0.0 if which == "phi" else math.asin(min(1.0, math.sqrt(2) / true))
@@ -198,7 +206,8 @@ def main(argv=None):
                                  description="the globe model against float64 (docs/globe.md)")
     ap.add_argument("--radius", type=int, default=GlobeConfig().radius)
     ap.add_argument("--angle-bits", type=int, default=Config().angle_bits)
-    ap.add_argument("--frac-bits", type=int, default=GlobeConfig().frac_bits)
+    ap.add_argument("--frac-bits", type=int, default=None,
+                    help="F (default: DATAPATH_BITS - 2 - I, rtl/globe.py)")
     ap.add_argument("--guard-bits", type=int, default=GlobeConfig().guard_bits)
     ap.add_argument("--map-width", type=int, default=GlobeConfig().map_width)
     ap.add_argument("--rotations", type=int, nargs="*", default=[0, 1, 4095, 16383])
@@ -210,7 +219,7 @@ def main(argv=None):
     x, y = disc_pixels(gcfg.radius)
     rots = [r % (1 << gcfg.angle_bits) for r in args.rotations]
     print(f"R = {gcfg.radius}, angle_bits = {gcfg.angle_bits}, W x H = {gcfg.map_width} x "
-          f"{gcfg.map_height}, F = {gcfg.frac_bits}, P = {gcfg.angle_frac_bits}, "
+          f"{gcfg.map_height}, F = {gcfg.fraction_bits}, P = {gcfg.angle_frac_bits}, "
           f"iterations = {gcfg.cordic_iterations}, rotations {rots}")
     print(f"widths: I = {gcfg.int_bits}, roots {gcfg.root_bits} bits ({gcfg.root_bits} "
           f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed, angle sums "

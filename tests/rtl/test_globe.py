@@ -260,8 +260,9 @@ def test_bound_shrinks_with_the_widths():
     g = GlobeConfig()
     for name in ("phi", "theta", "lambda"):
         b = error_bound_rad(g, name)
-        assert b < 2 * math.pi / (1 << max(g.angle_bits, g.u_bits))
-        assert error_bound_rad(GlobeConfig(frac_bits=12), name) > b
+        steps = g.map_width if name == "lambda" else g.pipeline.full_circle
+        assert b < 2 * math.pi / steps
+        assert error_bound_rad(GlobeConfig(frac_bits=g.fraction_bits - 2), name) > b
         assert error_bound_rad(GlobeConfig(guard_bits=2), name) > b
 
 
