@@ -175,8 +175,9 @@ class GlobeConfig:
     @property
     def latency(self):
         """Stages from ``i`` to ``o`` (no credit edge): the input register, the squares
-        (PRODUCT_LATENCY), r2, R**2 - r2, the roots, the CORDIC chains, the output register."""
-        return 1 + PRODUCT_LATENCY + 2 + self.root_bits + self.cordic_latency + 1
+        (PRODUCT_LATENCY) and their fabric copies, r2, R**2 - r2, the roots, the CORDIC
+        chains, the output register."""
+        return 1 + PRODUCT_LATENCY + 3 + self.root_bits + self.cordic_latency + 1
 
 
 def cordic_angles(gcfg: GlobeConfig):
@@ -225,11 +226,13 @@ def sqrt_stages(pipe, value, value_bits, frac_bits, name):
     bits, even) by a non-restoring square root, one root bit a stage: ``value_bits / 2 +
     frac_bits`` stages, one carry chain each (the remainder's sign, registered, picks add or
     subtract). The radicand's bits enter two a stage; past ``value`` they are the zeros of
-    the shift."""
+    the shift. A stage's root bit is the complement of its remainder's sign, read from the
+    remainder's register (the sum's top bit goes to that one flip-flop, no inverter in its
+    cycle); the bits before it ride in registers of their own."""
     n = value_bits // 2 + frac_bits
     rest = value[:value_bits]
     rem = Const(0, signed(2))
-    q = Const(0, 1)
+    q = Const(0, 1)                                # the root so far: none before stage 0
     for j in range(n):
         # After stage j the remainder is D_j - q**2 >= 0 or D_j - (q | 1)**2 >= -(2 q + 1)
         # with q < 2**(j + 1), so |rem| < 2**(j + 2): j + 3 signed bits hold it (n + 2 at the
@@ -247,8 +250,10 @@ def sqrt_stages(pipe, value, value_bits, frac_bits, name):
                     Const(0, width - 2 - len(q)))[:width]
         shifted = Cat(pair, rem)[:width].as_signed()
         new = (shifted + Mux(negative, trial, ~trial) + ~negative)[:width].as_signed()
+        if j:
+            older = pipe.register(q, f"{name}_q{j}")          # the root before this bit
         rem = pipe.register(new, f"{name}_rem{j}")
-        q = pipe.register(Cat(~new[-1], q)[:j + 1], f"{name}_q{j}")
+        q = Cat(~rem[-1], older) if j else ~rem[-1]
         if i > frac_bits:
             rest = pipe.register(rest[:2 * (i - frac_bits)], f"{name}_rest{j}")
     return q
@@ -311,8 +316,12 @@ def phi_stages(pipe, x, y, g: GlobeConfig, angles):
     gain (< 1.65) takes it past 2**(I + F + 1)."""
     I, F, P, A, w = g.int_bits, g.fraction_bits, g.angle_frac_bits, g.angle_bits, g.datapath_bits
     negative = x[-1]
-    turned_x = pipe.register(Mux(negative, -x, x)[:I + 1].as_signed(), "phi_turned_x")
-    turned_y = pipe.register(Mux(negative, -y, y)[:I + 1].as_signed(), "phi_turned_y")
+
+    def turned(v):                                 # -v = ~v + 1: the XOR ahead of the chain
+        return ((v ^ negative.replicate(len(v))).as_signed() + negative)[:I + 1].as_signed()
+
+    turned_x = pipe.register(turned(x), "phi_turned_x")
+    turned_y = pipe.register(turned(y), "phi_turned_y")
     half = 1 << (P - A - 1)
     acc = pipe.register(Mux(negative, Const((1 << (P - 1)) + half, P), Const(half, P)),
                         "phi_acc")
@@ -376,14 +385,16 @@ class GlobeGeometry(PipeUnit):
         x = pipe.register(p.x, "x")
         y = pipe.register(p.y, "y")
         rot = pipe.register(p.rotation, "rotation")
-        # stages 2 .. 1 + PRODUCT_LATENCY: the squares; then r2, then R**2 - r2
-        xx, yy = pipe.multiply(x, x, "xx"), pipe.multiply(y, y, "yy")
+        # stages 2 .. 1 + PRODUCT_LATENCY: the squares; a fabric copy of each (the route
+        # from a DSP's output ends in a flip-flop); then r2, then R**2 - r2
+        xx = pipe.register(pipe.multiply(x, x, "xx"), "xx_copy")
+        yy = pipe.register(pipe.multiply(y, y, "yy"), "yy_copy")
         r2 = pipe.register((xx + yy).as_unsigned()[:2 * g.coord_bits], "r2")
         rr = g.radius * g.radius
         inside = pipe.register(r2 < rr, "inside")
         d = pipe.register((Const(rr, 2 * I) - r2)[:2 * I], "d")      # outside: masked below
         r2_at = pipe.register(r2[:2 * I], "r2_at")
-        start = 1 + PRODUCT_LATENCY + 2                                 # the roots' input stage
+        start = 1 + PRODUCT_LATENCY + 3                                 # the roots' input stage
         z_root = sqrt_stages(pipe, d, 2 * I, F, "z")
         r_root = sqrt_stages(pipe, r2_at, 2 * I, F, "r")
         roots = start + g.root_bits
