@@ -41,7 +41,8 @@ from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
 __all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "globe_in_layout",
            "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE", "FRAC_BITS_RANGE",
-           "GUARD_BITS_RANGE", "COORD_BITS_MAX", "sqrt_stages", "cordic_stages", "fit_signed"]
+           "GUARD_BITS_RANGE", "COORD_BITS_MAX", "DATAPATH_BITS", "sqrt_stages", "cordic_stages",
+           "fit_signed", "leading_zeros", "phi_stages"]
 
 RADIUS_RANGE = (1, 2047)          # R in pixels: R**2 << 2F stays inside 62 bits (the model's int64)
 MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2
@@ -272,24 +273,32 @@ def fit_signed(value, width):
 def cordic_stages(pipe, x, y, acc, angles, width, name):
     """CORDIC vectoring: ``len(angles)`` stages turn (x, y) toward the +x axis by
     ``atan(2**-i)`` each, the way the sign of y says, and the angle sum adds each turn to
-    ``acc`` (an unsigned binary angle, wrapping) a stage later, from a copy of that sign:
-    the sign of y then drives the two chains of x and y and the copy, not the sum's chain
-    too. ``len(angles) + 1`` stages give ``acc + atan2(y, x)`` to within the bound of
-    sim/golden/globe.error_bound_rad (``acc`` is taken a stage after ``x`` and ``y``).
-    ``x``, ``y`` signed ``width`` bits; the shifts truncate (arithmetic shift right)."""
+    ``acc`` (an unsigned binary angle, wrapping) a stage later: ``len(angles) + 1`` stages
+    give ``acc + atan2(y, x)`` to within the bound of sim/golden/globe.error_bound_rad
+    (``acc`` is taken beside ``x`` and ``y``). ``x``, ``y`` signed ``width`` bits; the
+    shifts truncate (arithmetic shift right).
+
+    The sum is ``acc + sum(s_i a_i)`` with s_i = +1 (y >= 0) or -1, kept as
+    ``acc - sum(a_i) + sum(up_i 2 a_i)``: it starts at ``acc - sum(a_i)`` and each stage
+    adds ``2 a_i`` or nothing, an operand whose bits are a registered copy ``up_i`` of the
+    decision or 0, so the sum's carry chain takes the decision straight into its cells
+    (no select ahead of it), and the sign of y drives the two chains of x and y and that
+    copy only."""
     p = len(acc)
+    mask = (1 << p) - 1
+    acc = pipe.register((acc + ((-sum(angles)) & mask))[:p], f"{name}_sum_base")
     for i, a in enumerate(angles):
         down = y[-1]                                   # y < 0: turn up, subtract the angle
         xs, ys = x >> i, y >> i
         # y >= 0: x + (y >> i), y - (x >> i), acc + a; y < 0: the other way
         nx = (x + Mux(down, ~ys, ys) + down)[:width].as_signed()
         ny = (y + Mux(down, xs, ~xs) + ~down)[:width].as_signed()
-        turn = pipe.register(down, f"{name}_turn{i}")
+        up = pipe.register(~down, f"{name}_up{i}")
         x = pipe.register(nx, f"{name}_x{i}")
         y = pipe.register(ny, f"{name}_y{i}")
-        acc = pipe.register(acc, f"{name}_acc{i}") if i == 0 else acc
-        acc = pipe.register((acc + Mux(turn, Const((-a) % (1 << p), p), Const(a, p)))[:p],
-                            f"{name}_sum{i}")
+        twice = (2 * a) & mask
+        operand = Cat(*[up if twice >> b & 1 else Const(0, 1) for b in range(p)])
+        acc = pipe.register((acc + operand)[:p], f"{name}_sum{i}")
     return acc
 
 

@@ -13,7 +13,7 @@ from amaranth.lib import data
 
 from bumprtl.gen.flow.emit import flat_verilog, lint
 from bumprtl.rtl.config import BumpError, Config, ConfigError
-from bumprtl.rtl.globe import GlobeConfig, GlobeGeometry, sqrt_stages, v_table
+from bumprtl.rtl.globe import DATAPATH_BITS, GlobeConfig, GlobeGeometry, sqrt_stages, v_table
 from bumprtl.rtl.pipe import ECP5, PipeUnit, unit_memory_records
 from bumprtl.sim.amaranth_stream import assert_bit_exact, simulate_stream
 from bumprtl.sim.golden import globe as model
@@ -314,6 +314,15 @@ def test_config_errors_name_the_parameter(changes, field):
     assert isinstance(err.value, BumpError)
     if field not in ("pipeline", "map_height"):
         assert "[" in str(err.value)           # the allowed range
+
+
+def test_default_datapath_width_whatever_the_radius():
+    """The default F keeps the roots' remainders and the CORDIC datapaths DATAPATH_BITS wide
+    (the carry chains that bound the clock); an explicit F overrides it."""
+    for radius in (1, 17, 224, 2047):
+        g = GlobeConfig(radius=radius)
+        assert g.datapath_bits == DATAPATH_BITS == g.root_bits + 2
+    assert GlobeConfig(frac_bits=12).datapath_bits == 8 + 12 + 2
 
 
 def test_config_accepts_the_edges():
