@@ -20,7 +20,8 @@ Method, one register stage per step, fixed latency, one pixel a clock:
   stages on (x, y), (z, r) and (z, x) with ``F`` fraction bits below a pixel, their
   angles summed in binary angles of ``angle_frac_bits`` bits from :func:`cordic_angles`
   (the gain is irrelevant to the angle); ``phi``'s chain starts on the half plane x >= 0
-  (x < 0 turned by pi), ``lambda``'s accumulator starts at the rotation;
+  (x < 0 turned by pi) with the vector scaled up to a fixed length range
+  (:func:`phi_stages`), ``lambda``'s angle sum starts at the rotation;
 * ``v`` from a ROM indexed by y (:func:`v_table`, float64 contents).
 
 Every output field but ``inside`` and ``tag`` is 0 outside the globe; ``phi`` is 0 at the
@@ -49,7 +50,7 @@ MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2
 FRAC_BITS_RANGE = (4, 20)         # F: fraction bits of the roots and of the CORDIC datapath
 # The signed width of the CORDIC datapaths and of the roots' remainders (I + F + 2) that the
 # default F aims at: the carry chains of the unit are this long (phi's CORDIC one more, the
-# angle sums angle_frac_bits), short enough for the 200 MHz target of constraints/ecp5.lpf.
+# angle sums angle_frac_bits), and they bound its clock (docs/globe.md, On the ECP5).
 DATAPATH_BITS = 20
 GUARD_BITS_RANGE = (1, 8)         # internal angle bits beyond the wider output
 COORD_BITS_MAX = 16               # signed width of the x, y offsets
