@@ -222,7 +222,8 @@ def main(argv=None):
           f"{gcfg.map_height}, F = {gcfg.fraction_bits}, P = {gcfg.angle_frac_bits}, "
           f"iterations = {gcfg.cordic_iterations}, rotations {rots}")
     print(f"widths: I = {gcfg.int_bits}, roots {gcfg.root_bits} bits ({gcfg.root_bits} "
-          f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed, angle sums "
+          f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed (phi's "
+          f"{gcfg.datapath_bits + 1}), angle sums "
           f"{gcfg.angle_frac_bits} bits, v ROM {2 << gcfg.int_bits} x {gcfg.v_bits}; latency "
           f"{gcfg.latency} (+{EDGE_LATENCY} with the unit's credit edge, FIFO depth "
           f"{min_fifo_depth(gcfg.latency)})")
