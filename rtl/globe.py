@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from amaranth.hdl import Cat, Const, Mux, signed, unsigned
 from amaranth.lib import data
 
-from bumprtl.rtl.config import Config, ConfigError
+from bumprtl.rtl.config import Config, ConfigError, _check_int
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
@@ -54,14 +54,6 @@ FRAC_BITS_RANGE = (4, 20)         # F: fraction bits of the roots and of the COR
 DATAPATH_BITS = 20
 GUARD_BITS_RANGE = (1, 8)         # internal angle bits beyond the wider output
 COORD_BITS_MAX = 16               # signed width of the x, y offsets
-
-
-def _check_int(name, value, lo, hi, why=""):
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(f"{name} must be an integer in [{lo}, {hi}], got {value!r}", name)
-    if not lo <= value <= hi:
-        extra = f" ({why})" if why else ""
-        raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}", name)
 
 
 @dataclass(frozen=True)
