@@ -50,7 +50,7 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
 # queue is empty: the tag read, the lookup, the queue's entry, its head register, the data
 # read, the output register.
-CACHE_LATENCY = 6
+CACHE_LATENCY = 9
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -360,10 +360,13 @@ class TextureCache(wiring.Component):
         self.regs = SimpleNamespace(
             flushing=Signal(init=1, name="flushing"),
             in_valid=Signal(name="in_valid"),                     # a pixel read: its set
+            rw_valid=Signal(name="rw_valid"),                     # its words in registers
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
+            count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
             hd_valid=Signal(name="hd_valid"),                     # the queue's head, registered
-            rd_valid=Signal(name="rd_valid"),                     # the data read register
+            rd_valid=Signal(name="rd_valid"),                     # the data read
+            wd_valid=Signal(name="wd_valid"),                     # its words in registers
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
@@ -411,8 +414,11 @@ class TextureCache(wiring.Component):
         sel_bits = spb.bit_length() - 1           # slot within a data word
         K = g.stamp_bits
         ax = self.axi
+        r = self.regs
 
-        # --- memories: one tag and one data memory a way; the sequence stamps of a set ---
+        # --- memories: one tag and one data memory a way; the sequence stamps of a set. No
+        # read is transparent: the writes a read misses are forwarded by the stages below,
+        # and every block-RAM read lands in a register before any logic ---
         tags, datas = [], []
         for w in range(g.ways):
             m.submodules[f"tag{w}"] = tmem = Memory(shape=g.tag_bits + 1, depth=g.sets, init=[])
@@ -421,14 +427,17 @@ class TextureCache(wiring.Component):
             # fill's first beat can land): no read-during-write logic beside the block RAM
             m.submodules[f"data{w}"] = dmem = Memory(shape=g.data_bits, depth=g.sets * g.beats,
                                                      init=[], attrs={"no_rw_check": 1})
-            twp = tmem.write_port()
-            tags.append((tmem.read_port(transparent_for=(twp,)), twp))
+            tags.append((tmem.read_port(transparent_for=()), tmem.write_port()))
             datas.append((dmem.read_port(), dmem.write_port()))
         m.submodules.stamps = smem = Memory(shape=K * g.ways, depth=g.sets, init=[])
         stamp_w = smem.write_port(granularity=K)
-        stamp_r = smem.read_port(transparent_for=(stamp_w,))
+        stamp_r = smem.read_port(transparent_for=())
+        # tree pseudo-LRU bits a set (LUT RAM, read in the cycle at the pixel read's set)
+        plru_width = max(1, g.ways - 1)
+        m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
+                                          attrs={"ram_style": "distributed"})
+        plru_r, plru_w = plru.read_port(domain="comb"), plru.write_port()
 
-        r = self.regs
         flushing = r.flushing
         flush_set = Signal(range(g.sets))
 
@@ -439,73 +448,74 @@ class TextureCache(wiring.Component):
         def set_of(line):
             return line[:g.set_bits] if g.set_bits else Const(0, 1)
 
-        # --- the pixel read: its set's tags and stamps are read as it is taken (the read
-        # ports always address the input) and land on the ports the next cycle; held here
-        # while the pixel under lookup waits ---
-        in_valid = r.in_valid
-        in_line, in_slot = Signal(g.line_bits, name="in_line"), Signal(2 * g.block_bits, name="in_slot")
-        in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
-        new_line, new_slot = self._locate(m, self.i.payload)
-        fresh = Signal(name="in_fresh")          # taken last cycle: its words on the ports
-        words = []                               # each way's tag, then the set's stamps
-        ports = [(rp, f"in_tag{w}") for w, (rp, _) in enumerate(tags)] + [(stamp_r, "in_stamps")]
-        for rp, name in ports:
-            word, held = Signal.like(rp.data, name=name), Signal.like(rp.data, name=f"{name}_held")
-            m.d.comb += [rp.addr.eq(set_of(new_line)), word.eq(Mux(fresh, rp.data, held))]
-            m.d.sync += held.eq(word)
-            words.append(word)
-        *in_tags, in_stamps = words
+        def tag_of(line):                      # as stored (a line index may have fewer bits)
+            t = Signal(g.tag_bits)
+            m.d.comb += t.eq(line[g.set_bits:])
+            return t
 
-        # --- the pixel under lookup: its words in registers ---
-        look_valid = r.look_valid
-        look_line = Signal(g.line_bits)
-        look_slot = Signal(2 * g.block_bits)
+        def ways_of(value, width):
+            return [value[w * width:(w + 1) * width] for w in range(g.ways)]
+
+        # The stages from the input to the lookup: the pixel read (``in``: its set's words on
+        # the read ports, held there while it waits), the words read (``rw``: registers)
+        # and the pixel looked up (``look``). The pixel looked up writes its set when it
+        # advances (the tag of a miss's victim, its way's stamp, the pseudo-LRU bits): each
+        # stage behind it keeps, a way, the last word written to its set since its read
+        # (an override), and the words move on with the write of the cycle applied.
+        in_valid, rw_valid, look_valid = r.in_valid, r.rw_valid, r.look_valid
+        in_line, in_slot = Signal(g.line_bits, name="in_line"), Signal(2 * g.block_bits, name="in_slot")
+        rw_line, rw_slot = Signal(g.line_bits, name="rw_line"), Signal(2 * g.block_bits, name="rw_slot")
+        look_line, look_slot = Signal(g.line_bits, name="look_line"), Signal(2 * g.block_bits, name="look_slot")
+        in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
+        rw_extra = {k: Signal(s, name=f"rw_{k}") for k, s in self.extra.items()}
         look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
-        look_tags = [Signal(g.tag_bits + 1, name=f"look_tag{w}") for w in range(g.ways)]
+        new_line, new_slot = self._locate(m, self.i.payload)
+
+        # --- the pixel looked up: whether each way hits, each way's valid bit and stamp,
+        # the set's pseudo-LRU bits (all registers) ---
+        look_hits = Signal(g.ways, name="look_hits")
+        look_valids = Signal(g.ways, name="look_valids")
         look_stamps = [Signal(K, name=f"look_stamp{w}") for w in range(g.ways)]
-        look_set, line_tag, look_word, look_sel = split(look_line, look_slot)
+        look_plru = Signal(plru_width, name="look_plru")
+        look_set, _, look_word, look_sel = split(look_line, look_slot)
         if g.set_bits == 0:
             look_set = Const(0, 1)
-        look_tag = Signal(g.tag_bits)          # as stored (a line index may have fewer bits)
-        m.d.comb += look_tag.eq(line_tag)
-
-        hits = Signal(g.ways)
-        for w, t in enumerate(look_tags):
-            m.d.comb += hits[w].eq(t[-1] & (t[:g.tag_bits] == look_tag))
-        hit = hits.any()
-
-        # --- replacement state: tree pseudo-LRU bits a set (LUT RAM, read in the cycle) ---
-        plru_width = max(1, g.ways - 1)
-        m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
-                                          attrs={"ram_style": "distributed"})
-        plru_r, plru_w = plru.read_port(domain="comb"), plru.write_port()
-        victim = self._plru_hdl(plru_r.data, hits)[0]
+        look_tag = tag_of(look_line)
+        hit = look_hits.any()
+        victim = self._plru_hdl(look_plru, look_hits)[0]
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
-        m.d.comb += way_hot.eq(Mux(hit, hits, victim))
+        m.d.comb += way_hot.eq(Mux(hit, look_hits, victim))
         way = Signal(max(1, g.way_bits))
         for w in range(g.ways):
             with m.If(way_hot[w]):
                 m.d.comb += way.eq(w)
 
-        # --- the pixel queue: pixels in[out_seq, in_seq) wait in order ---
-        in_seq, out_seq = r.in_seq, r.out_seq
-        count = Signal(K)
-        m.d.comb += count.eq(in_seq - out_seq)
+        # --- the pixel queue: pixels in [out_seq, in_seq) wait in order ---
+        in_seq, out_seq, count = r.in_seq, r.out_seq, r.count
         qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
         m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
         q_w = qmem.write_port()
-        q_r = qmem.read_port(transparent_for=(q_w,))
+        q_r = qmem.read_port(transparent_for=())     # an entry is read the cycle after its write
         # the entries' miss bits again in LUT RAM, read in the cycle at the oldest entry: the
         # pop that chooses the block RAM's next read address waits on no block RAM
         m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
                                                 attrs={"ram_style": "distributed"})
         m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
-        # a victim still referenced by a queued pixel (its last pixel not yet left): each
-        # way's test beside the others, the victim's chosen after them
-        referenced = Signal(g.ways)
+
+        # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
+        # stamp in [out_seq, in_seq). In the lookup's first cycle a valid victim counts as
+        # referenced; after it, the test of the cycle before (a register) without the pixel
+        # that left then (in_seq holds while the pixel waits; out_seq only grows).
+        look_old = Signal(name="look_old")        # the pixel looked up was there last cycle
+        ref_was = Signal(g.ways, name="look_ref_was")
+        left_was = Signal(g.ways, name="look_left_was")
+        pop = Signal()
         for w in range(g.ways):
-            m.d.comb += referenced[w].eq(look_tags[w][-1] & ((look_stamps[w] - out_seq)[:K] < count))
+            m.d.sync += [ref_was[w].eq(look_valids[w] & ((look_stamps[w] - out_seq)[:K] < count)),
+                         left_was[w].eq(pop & (look_stamps[w][:qb] == out_seq[:qb]))]
+        referenced = Signal(g.ways)
+        m.d.comb += referenced.eq(Mux(look_old, ref_was & ~left_was, look_valids))
         locked = Signal()
         m.d.comb += locked.eq((referenced & victim).any())
 
@@ -519,32 +529,122 @@ class TextureCache(wiring.Component):
         f_in, f_out = r.f_in, r.f_out
 
         ar_free = ~ax.arvalid | ax.arready
-        can_miss = ar_free & (fills != g.misses) & ~locked
+        # fills == misses, count == queue: their top bits (both in [0, a power of two])
+        can_miss = ar_free & ~fills[-1] & ~locked
         advance = Signal()
-        m.d.comb += advance.eq(~flushing & look_valid & (count != g.queue) & (hit | can_miss))
+        m.d.comb += advance.eq(~flushing & look_valid & ~count[-1] & (hit | can_miss))
         miss = advance & ~hit
-        move = ~look_valid | advance               # the pixel read moves on to the lookup
-        m.d.comb += self.i.ready.eq(~flushing & (~in_valid | move))
+        move = ~look_valid | advance               # the words read move on to the lookup
+        rw_move = ~rw_valid | move                 # the pixel read moves on to the words read
+        m.d.comb += self.i.ready.eq(~flushing & (~in_valid | rw_move))
         take = self.i.valid & self.i.ready
+        m.d.sync += look_old.eq(~move)
+
+        # the write of the cycle (the pixel looked up advancing), a way at a time
+        tag_written = Cat(look_tag, Const(1, 1))
+        tag_hot = Signal(g.ways)
+        m.d.comb += tag_hot.eq(Mux(miss, victim, 0))
+        stamp_hot = Signal(g.ways)
+        m.d.comb += stamp_hot.eq(Mux(advance, way_hot, 0))
+        touched = self._plru_hdl(look_plru, way_hot)[1]
+        # the write of the cycle before, which a read taken in that cycle misses
+        was = SimpleNamespace(set=Signal.like(look_set, name="was_set"),
+                              tag=Signal.like(tag_written, name="was_tag"),
+                              tag_hot=Signal(g.ways, name="was_tag_hot"),
+                              seq=Signal(K, name="was_seq"),
+                              stamp_hot=Signal(g.ways, name="was_stamp_hot"))
+        m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.tag_hot.eq(tag_hot),
+                     was.seq.eq(in_seq), was.stamp_hot.eq(stamp_hot)]
+
+        def overrides(prefix):
+            """A stage's override registers: a way's tag and stamp written since its read."""
+            return SimpleNamespace(
+                tag_hot=Signal(g.ways, name=f"{prefix}_tag_ov"),
+                tags=[Signal.like(tag_written, name=f"{prefix}_tag_ov{w}") for w in range(g.ways)],
+                stamp_hot=Signal(g.ways, name=f"{prefix}_stamp_ov"),
+                stamps=[Signal(K, name=f"{prefix}_stamp_ov{w}") for w in range(g.ways)])
+
+        def assign(dst, src):
+            return [dst.tag_hot.eq(src.tag_hot), dst.stamp_hot.eq(src.stamp_hot)] + \
+                [d.eq(s) for d, s in zip(dst.tags + dst.stamps, src.tags + src.stamps, strict=True)]
+
+        def apply(ov, same, tag_hot, tag, stamp_hot, seq, name):
+            """``ov`` with a write of ``tag`` to the ways ``tag_hot`` and of ``seq`` to the
+            ways ``stamp_hot`` of the stage's set (``same``) on top."""
+            out = overrides(name)
+            th = Signal(g.ways, name=f"{name}_tag_hit")
+            sh = Signal(g.ways, name=f"{name}_stamp_hit")
+            m.d.comb += [th.eq(Mux(same, tag_hot, 0)), sh.eq(Mux(same, stamp_hot, 0)),
+                         out.tag_hot.eq(ov.tag_hot | th), out.stamp_hot.eq(ov.stamp_hot | sh)]
+            for w in range(g.ways):
+                m.d.comb += [out.tags[w].eq(Mux(th[w], tag, ov.tags[w])),
+                             out.stamps[w].eq(Mux(sh[w], seq, ov.stamps[w]))]
+            return out
+
+        # --- the pixel read: its set's tags and stamps are read as it is taken (the read
+        # ports address the input and hold while it waits); the write of that cycle is
+        # added the cycle after, once its set is in a register ---
+        fresh = Signal(name="in_fresh")          # taken last cycle
         m.d.sync += fresh.eq(take)
+        in_set = set_of(in_line)
+        for rp, _ in tags:
+            m.d.comb += [rp.addr.eq(set_of(new_line)), rp.en.eq(self.i.ready)]
+        m.d.comb += [stamp_r.addr.eq(set_of(new_line)), stamp_r.en.eq(self.i.ready)]
+        in_raw_tags = [rp.data for rp, _ in tags]
+        in_raw_stamps = stamp_r.data
+        in_held = overrides("in_held")
+        none = overrides("in_none")
+        m.d.comb += assign(none, SimpleNamespace(tag_hot=0, stamp_hot=0, tags=in_held.tags,
+                                                 stamps=in_held.stamps))
+        in_new = apply(none, was.set == in_set, was.tag_hot, was.tag, was.stamp_hot, was.seq,
+                       "in_new")
+        in_ov = overrides("in_ov")
+        with m.If(fresh):
+            m.d.comb += assign(in_ov, in_new)
+        with m.Else():
+            m.d.comb += assign(in_ov, in_held)
+        m.d.sync += assign(in_held, in_ov)        # no write while the pixel read waits
         with m.If(take):
             m.d.sync += [in_valid.eq(1), in_line.eq(new_line), in_slot.eq(new_slot)]
             m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
-        with m.Elif(move):
+        with m.Elif(rw_move):
             m.d.sync += in_valid.eq(0)
-        # Into the lookup, with what the pixel leaving it writes to the same set this cycle
-        # (its read saw every earlier write: a pixel read waits only while the lookup does,
-        # and the read ports are transparent to a write in the cycle of the read).
-        same = advance & (set_of(in_line) == look_set)
+
+        # --- the words read: the read ports' words in registers as they are, the overrides
+        # with the write of the cycle the pixel moves in ---
+        rw_set = set_of(rw_line)
+        rw_raw_tags = [Signal.like(t, name=f"rw_raw_tag{w}") for w, t in enumerate(in_raw_tags)]
+        rw_raw_stamps = Signal.like(in_raw_stamps, name="rw_raw_stamps")
+        rw_ov = overrides("rw_ov")
+        rw_plru = Signal(plru_width, name="rw_plru")
+        m.d.comb += plru_r.addr.eq(in_set)
+        in_same = advance & (in_set == look_set)
+        in_moved = apply(in_ov, in_same, tag_hot, tag_written, stamp_hot, in_seq, "in_moved")
+        with m.If(rw_move):
+            m.d.sync += [rw_valid.eq(in_valid), rw_line.eq(in_line), rw_slot.eq(in_slot),
+                         rw_raw_stamps.eq(in_raw_stamps),
+                         rw_plru.eq(Mux(in_same, touched, plru_r.data))]
+            m.d.sync += [d.eq(s) for d, s in zip(rw_raw_tags, in_raw_tags, strict=True)]
+            m.d.sync += [rw_extra[k].eq(in_extra[k]) for k in self.extra]
+            m.d.sync += assign(rw_ov, in_moved)
+
+        # --- into the lookup: each way's words (override or read), its hit computed here
+        # (the write of the cycle to the pixel's set: a miss's tag to its victim) ---
+        rw_same = advance & (rw_set == look_set)
+        rw_tag = tag_of(rw_line)
+        for w in range(g.ways):
+            t = Mux(rw_ov.tag_hot[w], rw_ov.tags[w], rw_raw_tags[w])
+            s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], ways_of(rw_raw_stamps, K)[w])
+            hit_w = t[-1] & (t[:g.tag_bits] == rw_tag)
+            written = rw_same & tag_hot[w]
+            with m.If(move):
+                m.d.sync += [look_hits[w].eq(Mux(written, rw_tag == look_tag, hit_w)),
+                             look_valids[w].eq(written | t[-1]),
+                             look_stamps[w].eq(Mux(rw_same & stamp_hot[w], in_seq, s))]
         with m.If(move):
-            m.d.sync += [look_valid.eq(in_valid), look_line.eq(in_line), look_slot.eq(in_slot)]
-            m.d.sync += [look_extra[k].eq(in_extra[k]) for k in self.extra]
-            for w in range(g.ways):
-                m.d.sync += [
-                    look_tags[w].eq(Mux(same & ~hit & victim[w], Cat(look_tag, Const(1, 1)),
-                                        in_tags[w])),
-                    look_stamps[w].eq(Mux(same & way_hot[w], in_seq,
-                                          in_stamps.word_select(w, K)))]
+            m.d.sync += [look_valid.eq(rw_valid), look_line.eq(rw_line), look_slot.eq(rw_slot),
+                         look_plru.eq(Mux(rw_same, touched, rw_plru))]
+            m.d.sync += [look_extra[k].eq(rw_extra[k]) for k in self.extra]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         m.d.comb += [q_w.addr.eq(in_seq[:qb]), q_w.en.eq(advance),
@@ -553,12 +653,12 @@ class TextureCache(wiring.Component):
         m.d.comb += [q_w.data[k].eq(look_extra[k]) for k in self.extra]
         m.d.comb += [m_w.addr.eq(in_seq[:qb]), m_w.en.eq(advance), m_w.data.eq(~hit)]
         m.d.comb += [stamp_w.addr.eq(look_set), stamp_w.data.eq(Cat(*[in_seq] * g.ways)),
-                     stamp_w.en.eq(Mux(advance, way_hot, 0))]
+                     stamp_w.en.eq(stamp_hot)]
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
-        touched = self._plru_hdl(plru_r.data, way_hot)[1]
-        m.d.comb += [plru_r.addr.eq(look_set), plru_w.addr.eq(look_set),
-                     plru_w.data.eq(touched), plru_w.en.eq(advance if g.ways > 1 else 0)]
+        m.d.sync += count.eq(count + advance - pop)
+        m.d.comb += [plru_w.addr.eq(look_set), plru_w.data.eq(touched),
+                     plru_w.en.eq(advance if g.ways > 1 else 0)]
         with m.If(flushing):                     # the flush clears the bits with the tags
             m.d.comb += [plru_w.addr.eq(flush_set), plru_w.data.eq(0), plru_w.en.eq(1)]
 
@@ -568,8 +668,8 @@ class TextureCache(wiring.Component):
             m.d.sync += flushing.eq(0)
         for w, (_, twp) in enumerate(tags):
             m.d.comb += [twp.addr.eq(Mux(flushing, flush_set, look_set)),
-                         twp.data.eq(Mux(flushing, 0, Cat(look_tag, Const(1, 1)))),
-                         twp.en.eq(flushing | (miss & victim[w]))]
+                         twp.data.eq(Mux(flushing, 0, tag_written)),
+                         twp.en.eq(flushing | tag_hot[w])]
 
         # --- a miss: the victim's new tag (above), its burst and its fill entry ---
         line_shift = g.line_bytes.bit_length() - 1
@@ -603,19 +703,29 @@ class TextureCache(wiring.Component):
         m.d.sync += fills.eq(fills + miss - line_in)
 
         # --- the queue's head leaves in order: into a register (the data read's address
-        # from a flip-flop), its word read, then the output register ---
+        # from a flip-flop), its word read, the words in registers, then the output
+        # register ---
         head = q_r.data
         o_free = ~self.o.valid | self.o.ready
         hd_valid, hd = r.hd_valid, Signal(layout, name="hd")
         rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
+        wd_valid, wd_way, wd_sel = r.wd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
-        r.in_extra, r.look_extra, r.rd_extra, r.queue = in_extra, look_extra, rd_extra, qmem
+        wd_extra = {k: Signal(s, name=f"wd_{k}") for k, s in self.extra.items()}
+        wd_words = [Signal(g.data_bits, name=f"wd_word{w}") for w in range(g.ways)]
+        r.in_extra, r.rw_extra, r.look_extra, r.queue = in_extra, rw_extra, look_extra, qmem
+        r.rd_extra, r.wd_extra = rd_extra, wd_extra
         r.hd_extra = {k: hd[k] for k in self.extra}
-        rd_move = ~rd_valid | o_free
+        wd_move = ~wd_valid | o_free
+        rd_move = ~rd_valid | wd_move
         hd_move = ~hd_valid | rd_move
-        pop = Signal()
         head_miss = m_r.data
-        m.d.comb += pop.eq((in_seq != out_seq) & (~head_miss | (landed != 0)) & hd_move)
+        # the oldest entry was read in the cycle before (its address then out_seq): not the
+        # one written then (the read does not see a write of its own cycle)
+        was_queued = Signal(name="was_queued")
+        m.d.sync += was_queued.eq(advance)
+        readable = (count != 0) & ~(was_queued & (count == 1))
+        m.d.comb += pop.eq(readable & (~head_miss | (landed != 0)) & hd_move)
         m.d.comb += [m_r.addr.eq(out_seq[:qb] if qb else 0),
                      q_r.addr.eq(Mux(pop, out_seq[:qb] + 1, out_seq[:qb]) if qb else 0)]
         with m.If(pop):
@@ -628,20 +738,24 @@ class TextureCache(wiring.Component):
         with m.If(rd_move):
             m.d.sync += [rd_valid.eq(hd_valid), rd_way.eq(hd.way), rd_sel.eq(hd.sel)]
             m.d.sync += [rd_extra[k].eq(hd[k]) for k in self.extra]
+        with m.If(wd_move):
+            m.d.sync += [wd_valid.eq(rd_valid), wd_way.eq(rd_way), wd_sel.eq(rd_sel)]
+            m.d.sync += [d.eq(drp.data) for d, (drp, _) in zip(wd_words, datas, strict=True)]
+            m.d.sync += [wd_extra[k].eq(rd_extra[k]) for k in self.extra]
         word = Signal(g.data_bits)
-        rd_hot = Signal(g.ways)
-        m.d.comb += rd_hot.eq(Const(1, g.ways) << rd_way)
-        for w, (drp, _) in enumerate(datas):
-            with m.If(rd_hot[w]):
-                m.d.comb += word.eq(drp.data)
+        wd_hot = Signal(g.ways)
+        m.d.comb += wd_hot.eq(Const(1, g.ways) << wd_way)
+        for w in range(g.ways):
+            with m.If(wd_hot[w]):
+                m.d.comb += word.eq(wd_words[w])
         texel = Signal(g.texel_bits)
-        with m.Switch(rd_sel[:sel_bits] if sel_bits else Const(0, 1)):   # the pixel's slot
+        with m.Switch(wd_sel[:sel_bits] if sel_bits else Const(0, 1)):   # the pixel's slot
             for k in range(spb):
                 with m.Case(k):
                     m.d.comb += texel.eq(word.word_select(k, g.data_bits // spb))
-        with m.If(rd_valid & o_free):
+        with m.If(wd_valid & o_free):
             m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(texel)]
-            m.d.sync += [self.o.payload[k].eq(rd_extra[k]) for k in self.extra]
+            m.d.sync += [self.o.payload[k].eq(wd_extra[k]) for k in self.extra]
         with m.Elif(self.o.ready):
             m.d.sync += self.o.valid.eq(0)
         return m
@@ -725,7 +839,7 @@ class AxiMapFetch(wiring.Component):
         """Pixels taken at ``i`` and not yet taken at ``o``, at most: the tag read's and the
         lookup's registers, the queue's entries, its head register, the data read and the
         output register."""
-        return self.geom.queue + 5
+        return self.geom.queue + 7
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):
         check_scene(self, scene)

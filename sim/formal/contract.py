@@ -559,9 +559,9 @@ class StreamContract(Elaboratable):
     def _in_cache(self, m, take_in):
         """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
         front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
-        lemmas to the cache's lookup registers (the pixel read, the pixel looked up), queue,
-        head and data-read registers and output register (``TextureCache.regs``). Made once
-        per contract."""
+        lemmas to the cache's lookup registers (the pixel read, its words read, the pixel
+        looked up), queue, head, data-read and words-read registers and output register
+        (``TextureCache.regs``) and its queue count. Made once per contract."""
         if self.cache is None:
             return Const(0, 1)
         if getattr(self, "_cache_ghost", None) is not None:
@@ -571,8 +571,9 @@ class StreamContract(Elaboratable):
         m.d.sync += ghost.eq(ghost + take_in - (c.o.valid & c.o.ready))
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
         self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
-        self._lemma(m, ghost == r.in_valid + r.look_valid + count + r.hd_valid + r.rd_valid
-                    + c.o.valid,
+        self._lemma(m, r.count == count, "the cache's queue count = its sequence numbers apart")
+        self._lemma(m, ghost == r.in_valid + r.rw_valid + r.look_valid + count + r.hd_valid
+                    + r.rd_valid + r.wd_valid + c.o.valid,
                     "pixels in the cache = its lookup, queue, read and output registers")
         self._cache_ghost = ghost
         return ghost
@@ -646,10 +647,11 @@ class StreamContract(Elaboratable):
 
     def _cache_order(self, m, n_edge, bits):
         """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
-        its output register, its data-read register, its head register, its queue's entries
-        from the read sequence number (read through asynchronous ports added to the queue's
-        memory, one per address; the queue's registered read is the entry at that number),
-        its lookup register and the register of the pixel read before it."""
+        its output register, its words-read and data-read registers, its head register, its
+        queue's entries from the read sequence number (read through asynchronous ports added
+        to the queue's memory, one per address; the queue's registered read is the entry at
+        that number), its lookup register and the registers of the words and the pixel read
+        before it."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
         inst = _subfragment(frag, "queue") if frag is not None else None
@@ -660,9 +662,13 @@ class StreamContract(Elaboratable):
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
         self._lemma(m, ~c.o.valid | (c.o.payload.tag == n_edge),
                     "the cache's output register holds the chain's next tag")
-        at_rd = (n_edge + c.o.valid)[:bits]
+        at_wd = (n_edge + c.o.valid)[:bits]
+        self._lemma(m, ~r.wd_valid | (r.wd_extra["tag"] == at_wd),
+                    "the cache's words-read register holds the tag after its output's")
+        at_rd = Signal(bits, name="tag_cache_read_register")
+        m.d.comb += at_rd.eq(at_wd + r.wd_valid)
         self._lemma(m, ~r.rd_valid | (r.rd_extra["tag"] == at_rd),
-                    "the cache's read register holds the tag after its output's")
+                    "the cache's read register holds the tag after its words-read register's")
         at_hd = Signal(bits, name="tag_cache_head_register")
         m.d.comb += at_hd.eq(at_rd + r.rd_valid)
         self._lemma(m, ~r.hd_valid | (r.hd_extra["tag"] == at_hd),
@@ -685,8 +691,12 @@ class StreamContract(Elaboratable):
         m.d.comb += at_look.eq(at_q + count)
         self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == at_look),
                     "the cache's lookup register holds the tag after its queue's")
-        self._lemma(m, ~r.in_valid | (r.in_extra["tag"] == (at_look + r.look_valid)[:bits]),
-                    "the cache's read register holds the tag after its lookup's")
+        at_rw = Signal(bits, name="tag_cache_words_read")
+        m.d.comb += at_rw.eq(at_look + r.look_valid)
+        self._lemma(m, ~r.rw_valid | (r.rw_extra["tag"] == at_rw),
+                    "the cache's words-read register holds the tag after its lookup's")
+        self._lemma(m, ~r.in_valid | (r.in_extra["tag"] == (at_rw + r.rw_valid)[:bits]),
+                    "the cache's read register holds the tag after its words-read one's")
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""

@@ -79,10 +79,11 @@ def stream_cycles(run, geom: CacheGeometry, latency):
     in order one a clock. Pixel k is looked up at cycle A_k, the earliest after A_{k-1}
     with a free queue entry (pixel k - queue left), for a miss fewer than ``misses`` bursts
     outstanding and a victim no queued pixel references (the RTL's sequence-stamp test,
-    wrap-around included); it leaves the queue at P_k = max(A_k + 1, P_{k-1} + 1, the cycle
+    wrap-around included; a victim holding a line counts as referenced in the pixel's first
+    cycle at the lookup, A_{k-1} + 1); it leaves the queue at P_k = max(A_k + 2, P_{k-1} + 1, the cycle
     after its line's last beat for a miss). A miss's AR handshake is at A_k + 1, its first
     beat at max(A_k + 1 + latency, the cycle after the previous burst's last beat). Returns
-    P_last - 1 (every pixel a hit: one cycle a pixel); the RTL takes the reset's flush
+    P_last - 2 (every pixel a hit: one cycle a pixel); the RTL takes the reset's flush
     (``sets`` cycles) and its hit latency (rtl/cache.CACHE_LATENCY) more
     (tests/rtl/test_cache.py checks the count against the RTL's)."""
     n = len(run.hit)
@@ -100,6 +101,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
             if miss >= geom.misses:
                 c = max(c, fills[miss - geom.misses] + 1)
             if run.victim_valid[k]:
+                c = max(c, look + 2)                # not in its first cycle at the lookup
                 stamp = stamps[key]
                 while True:                         # queued pixels left before cycle c
                     out = bisect.bisect_left(pops, c)
@@ -108,7 +110,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
                     else:
                         break
         stamps[key] = k % wrap
-        leave = c + 1
+        leave = c + 2                               # queued, then read
         if not run.hit[k]:
             first = c + 1 + latency
             if fills:
@@ -120,7 +122,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
             leave = max(leave, pops[-1] + 1)
         pops.append(leave)
         look = c
-    return pops[-1] - 1
+    return pops[-1] - 2
 
 
 class CacheModel:
