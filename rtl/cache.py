@@ -48,8 +48,8 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
-# queue is empty: the tag read, the lookup, the queue's entry, its head register, the data
-# read, the output register.
+# queue is empty: the tag read, its words' register, the lookup, the queue's write and read,
+# its head register, the data read, its words' register, the output register.
 CACHE_LATENCY = 9
 
 AXI_DATA_BITS = (32, 64)
@@ -332,23 +332,26 @@ class TextureCache(wiring.Component):
         RREADY high while a burst is outstanding.
 
     Misses overlap (prefetching behind a reorder queue, Igehy, Eldridge & Proudfoot, HWWS
-    1998): a pixel's set is read as it is taken (tags and sequence stamps, into a register
-    stage of their own), its tags are checked the cycle after, and a miss writes the new
-    tag and issues its line's burst at once; the pixel then waits in a queue of
-    ``geom.queue`` entries with its (set, way, word) while the pixels behind it are looked
-    up. A pixel leaves the queue in order; a miss's pixel only once its line has landed
-    (bursts land in order, so a count of lines landed suffices: a later hit to a line
-    still filling leaves after the miss that fetches it). A line a queued pixel still needs
-    is never evicted: each (set, way) keeps the sequence number of the last pixel queued
-    on it, and a miss whose pseudo-LRU victim is still referenced waits at the lookup
-    (so does a miss with ``misses`` bursts outstanding, a pixel with the queue full, or a
-    miss while ARVALID waits for ARREADY). The hit/miss sequence and the AR stream are the
-    blocking cache's (sim/golden/cache.py). ``i.ready`` is high while the register of the
-    pixel read is empty or moves on into the lookup, so it depends on the lookup in the
-    same cycle (never on ``i.valid``). A hit leaves ``CACHE_LATENCY`` cycles after it is taken,
-    one pixel a clock. A reset invalidates every line: the tags are cleared one set a cycle
-    (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must not
-    change between resets.
+    1998): a pixel's set is read as it is taken (tags and sequence stamps), the words land
+    in registers of their own the cycle after, its tags are checked as it moves on into the
+    lookup, and a miss writes the new tag and issues its line's burst at once; the pixel
+    then waits in a queue of ``geom.queue`` entries with its (set, way, word) while the
+    pixels behind it are looked up. A pixel leaves the queue in order; a miss's pixel only
+    once its line has landed (bursts land in order, so a count of lines landed suffices: a
+    later hit to a line still filling leaves after the miss that fetches it). A line a
+    queued pixel still needs is never evicted: each (set, way) keeps the sequence number of
+    the last pixel queued on it, and a miss whose pseudo-LRU victim is still referenced
+    waits at the lookup (a victim holding a line counts as referenced in the pixel's first
+    cycle there; so waits a miss with ``misses`` bursts outstanding, a pixel with the queue
+    full, or a miss while ARVALID waits for ARREADY). The hit/miss sequence and the AR
+    stream are the blocking cache's (sim/golden/cache.py). ``i.ready`` is high while the
+    register of the pixel read is empty or moves on, so it depends on the lookup in the same
+    cycle (never on ``i.valid``). Every block-RAM read lands in a register before any logic
+    reads it, and no read is transparent (the stages forward the writes their reads miss). A
+    hit leaves ``CACHE_LATENCY`` cycles after it is taken, one pixel a clock. A reset
+    invalidates every line: the tags are cleared one set a cycle (``sets`` cycles,
+    ``i.ready`` low) before the first lookup; the map in memory must not change between
+    resets.
     """
 
     def __init__(self, geom: CacheGeometry, extra=None):
@@ -369,6 +372,8 @@ class TextureCache(wiring.Component):
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
+            landed_any=Signal(name="landed_any"),                 # landed != 0
+            readable=Signal(name="readable"),                     # the queue's head was read
             f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
             beat=Signal(range(geom.beats), name="beat"))          # the R beat of the line
         tb = geom.texture_size.bit_length() - 1
@@ -497,11 +502,13 @@ class TextureCache(wiring.Component):
         m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
         q_w = qmem.write_port()
         q_r = qmem.read_port(transparent_for=())     # an entry is read the cycle after its write
-        # the entries' miss bits again in LUT RAM, read in the cycle at the oldest entry: the
-        # pop that chooses the block RAM's next read address waits on no block RAM
+        # the entries' miss bits again in LUT RAM, read in the cycle before at the oldest
+        # entry and the one after it (a register): the pop that chooses the block RAM's next
+        # read address waits on no memory
         m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
                                                 attrs={"ram_style": "distributed"})
-        m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
+        m_w = mmem.write_port()
+        m_r0, m_r1 = mmem.read_port(domain="comb"), mmem.read_port(domain="comb")
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). In the lookup's first cycle a valid victim counts as
@@ -719,15 +726,17 @@ class TextureCache(wiring.Component):
         wd_move = ~wd_valid | o_free
         rd_move = ~rd_valid | wd_move
         hd_move = ~hd_valid | rd_move
-        head_miss = m_r.data
-        # the oldest entry was read in the cycle before (its address then out_seq): not the
-        # one written then (the read does not see a write of its own cycle)
-        was_queued = Signal(name="was_queued")
-        m.d.sync += was_queued.eq(advance)
-        readable = (count != 0) & ~(was_queued & (count == 1))
-        m.d.comb += pop.eq(readable & (~head_miss | (landed != 0)) & hd_move)
-        m.d.comb += [m_r.addr.eq(out_seq[:qb] if qb else 0),
-                     q_r.addr.eq(Mux(pop, out_seq[:qb] + 1, out_seq[:qb]) if qb else 0)]
+        # The oldest entry was read in the cycle before (its address then out_seq), and it is
+        # readable unless written then (a read does not see a write of its own cycle): a
+        # register, as are its miss bit and whether a line has landed for it.
+        head_miss, readable, landed_any = Signal(name="head_miss"), r.readable, r.landed_any
+        m.d.comb += pop.eq(readable & (~head_miss | landed_any) & hd_move)
+        after = out_seq[:qb] + 1
+        m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
+                     q_r.addr.eq(Mux(pop, after, out_seq[:qb]))]
+        m.d.sync += [head_miss.eq(Mux(pop, m_r1.data, m_r0.data)),
+                     readable.eq((count > 1) | ((count == 1) & ~pop)),
+                     landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
         with m.If(pop):
             m.d.sync += out_seq.eq(out_seq + 1)
         m.d.sync += landed.eq(landed + line_in - (pop & head_miss))
@@ -836,9 +845,9 @@ class AxiMapFetch(wiring.Component):
 
     @property
     def capacity(self):
-        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the tag read's and the
-        lookup's registers, the queue's entries, its head register, the data read and the
-        output register."""
+        """Pixels taken at ``i`` and not yet taken at ``o``, at most: the pixel read's, its
+        words' and the lookup's registers, the queue's entries, its head register, the data
+        read's and its words' registers and the output register."""
         return self.geom.queue + 7
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None):

@@ -173,8 +173,9 @@ reads it through `TextureCache`: set-associative, {d["sets"]} sets x {d["ways"]}
 {d["block"]} x {d["block"]}-texel lines by default, tree pseudo-LRU (LRU for 2 ways), one
 AXI4 INCR burst of a whole line ({d["data_bits"]}-bit data by default) a miss. It does not
 block on a miss (prefetching behind a reorder queue, after Igehy, Eldridge & Proudfoot,
-HWWS 1998): a pixel's set is read as it arrives (its tags and stamps held in a register
-stage of their own) and its tags checked the cycle after, a miss issues its burst at once (up
+HWWS 1998): a pixel's set is read as it arrives (its tags and stamps land in registers of
+their own the cycle after) and its tags checked as it moves on to the lookup, a miss issues
+its burst at once (up
 to {d["misses"]} outstanding), and the pixel waits in a queue of {d["queue"]} entries with
 its line's place while the pixels behind it are looked up and their misses issued; pixels
 leave in order, a miss once its line has landed. A line a queued pixel still needs is not
