@@ -367,6 +367,7 @@ class TextureCache(wiring.Component):
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
             count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
+            out_after=Signal(geom.queue.bit_length() - 1, init=1, name="out_after"),  # out_seq + 1
             hd_valid=Signal(name="hd_valid"),                     # the queue's head, registered
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
@@ -504,11 +505,14 @@ class TextureCache(wiring.Component):
         q_r = qmem.read_port(transparent_for=())     # an entry is read the cycle after its write
         # the entries' miss bits again in LUT RAM, read in the cycle before at the oldest
         # entry and the one after it (a register): the pop that chooses the block RAM's next
-        # read address waits on no memory
-        m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
-                                                attrs={"ram_style": "distributed"})
-        m_w = mmem.write_port()
-        m_r0, m_r1 = mmem.read_port(domain="comb"), mmem.read_port(domain="comb")
+        # read address waits on no memory. Two copies, one a read address, so that no
+        # multiplexer of the two addresses comes before the reads.
+        miss_ports = []
+        for n in range(2):
+            m.submodules[f"queue_miss{n}"] = mmem = Memory(
+                shape=1, depth=g.queue, init=[], attrs={"ram_style": "distributed"})
+            miss_ports.append((mmem.write_port(), mmem.read_port(domain="comb")))
+        (m_w, m_r0), (m_w1, m_r1) = miss_ports
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). In the lookup's first cycle a valid victim counts as
@@ -658,7 +662,8 @@ class TextureCache(wiring.Component):
                      q_w.data.word.eq(look_word), q_w.data.way.eq(way),
                      q_w.data.sel.eq(look_sel)]
         m.d.comb += [q_w.data[k].eq(look_extra[k]) for k in self.extra]
-        m.d.comb += [m_w.addr.eq(in_seq[:qb]), m_w.en.eq(advance), m_w.data.eq(~hit)]
+        for mwp in (m_w, m_w1):
+            m.d.comb += [mwp.addr.eq(in_seq[:qb]), mwp.en.eq(advance), mwp.data.eq(~hit)]
         m.d.comb += [stamp_w.addr.eq(look_set), stamp_w.data.eq(Cat(*[in_seq] * g.ways)),
                      stamp_w.en.eq(stamp_hot)]
         with m.If(advance):
@@ -731,9 +736,11 @@ class TextureCache(wiring.Component):
         # register, as are its miss bit and whether a line has landed for it.
         head_miss, readable, landed_any = Signal(name="head_miss"), r.readable, r.landed_any
         m.d.comb += pop.eq(readable & (~head_miss | landed_any) & hd_move)
-        after = out_seq[:qb] + 1
+        after = r.out_after
         m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
                      q_r.addr.eq(Mux(pop, after, out_seq[:qb]))]
+        with m.If(pop):
+            m.d.sync += after.eq(after + 1)
         m.d.sync += [head_miss.eq(Mux(pop, m_r1.data, m_r0.data)),
                      readable.eq((count > 1) | ((count == 1) & ~pop)),
                      landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]

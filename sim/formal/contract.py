@@ -573,6 +573,9 @@ class StreamContract(Elaboratable):
         self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
         self._lemma(m, r.count == count, "the cache's queue count = its sequence numbers apart")
         self._lemma(m, ~r.readable | (count != 0), "the cache's queue head is readable when queued")
+        qb = len(r.out_after)
+        self._lemma(m, r.out_after == (r.out_seq[:qb] + 1)[:qb],
+                    "the cache's next queue address is one past its oldest")
         self._lemma(m, r.landed_any == (r.landed != 0), "the cache's landed flag = its count != 0")
         self._lemma(m, ghost == r.in_valid + r.rw_valid + r.look_valid + count + r.hd_valid
                     + r.rd_valid + r.wd_valid + c.o.valid,
