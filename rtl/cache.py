@@ -41,6 +41,7 @@ from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_c
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.scene import CACHE_DEFAULTS as SCENE_CACHE
 from bumprtl.rtl.scene import HardwareScene, check_scene
+from bumprtl.rtl.targets import RegisteredRAM
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
            "texel_byte_address", "tiled_image", "plru_victim", "plru_touch", "TextureCache",
@@ -318,6 +319,8 @@ class TextureCache(wiring.Component):
     geom : CacheGeometry
     extra : dict, optional
         Payload fields (name -> shape) carried from ``i`` to ``o`` unchanged.
+    target : None or rtl/targets.ECP5
+        The form of its RAMs (rtl/targets.RegisteredRAM): None, the generic one.
 
     Members
     -------
@@ -354,8 +357,8 @@ class TextureCache(wiring.Component):
     resets.
     """
 
-    def __init__(self, geom: CacheGeometry, extra=None):
-        self.geom = geom
+    def __init__(self, geom: CacheGeometry, extra=None, target=None):
+        self.geom, self.target = geom, target
         self.extra = dict(extra or {})
         K = geom.stamp_bits
         # The control registers, here so that the formal contracts (sim/formal/axi.py, the
@@ -422,22 +425,18 @@ class TextureCache(wiring.Component):
         ax = self.axi
         r = self.regs
 
-        # --- memories: one tag and one data memory a way; the sequence stamps of a set. No
-        # read is transparent: the writes a read misses are forwarded by the stages below,
-        # and every block-RAM read lands in a register before any logic ---
-        tags, datas = [], []
-        for w in range(g.ways):
-            m.submodules[f"tag{w}"] = tmem = Memory(shape=g.tag_bits + 1, depth=g.sets, init=[])
-            # a line is never read while it fills (a miss's pixel waits for its line, and a
-            # line a queued pixel or a later stage still reads is not evicted before its
-            # fill's first beat can land): no read-during-write logic beside the block RAM
-            m.submodules[f"data{w}"] = dmem = Memory(shape=g.data_bits, depth=g.sets * g.beats,
-                                                     init=[], attrs={"no_rw_check": 1})
-            tags.append((tmem.read_port(transparent_for=()), tmem.write_port()))
-            datas.append((dmem.read_port(), dmem.write_port()))
-        m.submodules.stamps = smem = Memory(shape=K * g.ways, depth=g.sets, init=[])
-        stamp_w = smem.write_port(granularity=K)
-        stamp_r = smem.read_port(transparent_for=())
+        # --- memories: a tag, a stamp and a data RAM a way, each read in two stages (the
+        # read, then its output register: rtl/targets.RegisteredRAM, a block RAM's output
+        # register on ECP5) that move on together. No read sees a write of its own cycle:
+        # the writes a read misses are forwarded by the stages below. A line is never read
+        # while it fills (a miss's pixel waits for its line, and a line a queued pixel or a
+        # later stage still reads is not evicted before its fill's first beat can land). ---
+        def ram(name, depth, shape):
+            m.submodules[name] = unit = RegisteredRAM(depth, shape, name, target=self.target)
+            return unit
+        tags = [ram(f"tag{w}", g.sets, g.tag_bits + 1) for w in range(g.ways)]
+        stamps = [ram(f"stamp{w}", g.sets, K) for w in range(g.ways)]
+        datas = [ram(f"data{w}", g.sets * g.beats, g.data_bits) for w in range(g.ways)]
         # tree pseudo-LRU bits a set (LUT RAM, read in the cycle at the pixel read's set)
         plru_width = max(1, g.ways - 1)
         m.submodules.plru = plru = Memory(shape=plru_width, depth=g.sets, init=[],
@@ -458,9 +457,6 @@ class TextureCache(wiring.Component):
             t = Signal(g.tag_bits)
             m.d.comb += t.eq(line[g.set_bits:])
             return t
-
-        def ways_of(value, width):
-            return [value[w * width:(w + 1) * width] for w in range(g.ways)]
 
         # The stages from the input to the lookup: the pixel read (``in``: its set's words on
         # the read ports, held there while it waits), the words read (``rw``: registers)
@@ -500,9 +496,8 @@ class TextureCache(wiring.Component):
         in_seq, out_seq, count = r.in_seq, r.out_seq, r.count
         qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
-        m.submodules.queue = qmem = Memory(shape=layout, depth=g.queue, init=[])
-        q_w = qmem.write_port()
-        q_r = qmem.read_port(transparent_for=())     # an entry is read the cycle after its write
+        # read into the RAM's register, then its output register (the head register)
+        qmem = ram("queue", g.queue, layout)
         # the entries' miss bits again in LUT RAM, read in the cycle before at the oldest
         # entry and the one after it (a register): the pop that chooses the block RAM's next
         # read address waits on no memory. Two copies, one a read address, so that no
@@ -547,7 +542,7 @@ class TextureCache(wiring.Component):
         miss = advance & ~hit
         move = ~look_valid | advance               # the words read move on to the lookup
         rw_move = ~rw_valid | move                 # the pixel read moves on to the words read
-        m.d.comb += self.i.ready.eq(~flushing & (~in_valid | rw_move))
+        m.d.comb += self.i.ready.eq(~flushing & rw_move)
         take = self.i.valid & self.i.ready
         m.d.sync += look_old.eq(~move)
 
@@ -592,17 +587,14 @@ class TextureCache(wiring.Component):
                              out.stamps[w].eq(Mux(sh[w], seq, ov.stamps[w]))]
             return out
 
-        # --- the pixel read: its set's tags and stamps are read as it is taken (the read
-        # ports address the input and hold while it waits); the write of that cycle is
-        # added the cycle after, once its set is in a register ---
+        # --- the pixel read: its set's tags and stamps are read as it is taken (the reads
+        # address the input and hold while it waits); the write of that cycle is added the
+        # cycle after, once its set is in a register ---
         fresh = Signal(name="in_fresh")          # taken last cycle
         m.d.sync += fresh.eq(take)
         in_set = set_of(in_line)
-        for rp, _ in tags:
-            m.d.comb += [rp.addr.eq(set_of(new_line)), rp.en.eq(self.i.ready)]
-        m.d.comb += [stamp_r.addr.eq(set_of(new_line)), stamp_r.en.eq(self.i.ready)]
-        in_raw_tags = [rp.data for rp, _ in tags]
-        in_raw_stamps = stamp_r.data
+        for rp in tags + stamps:
+            m.d.comb += [rp.r_addr.eq(set_of(new_line)), rp.en.eq(rw_move)]
         in_held = overrides("in_held")
         none = overrides("in_none")
         m.d.comb += assign(none, SimpleNamespace(tag_hot=0, stamp_hot=0, tags=in_held.tags,
@@ -615,17 +607,15 @@ class TextureCache(wiring.Component):
         with m.Else():
             m.d.comb += assign(in_ov, in_held)
         m.d.sync += assign(in_held, in_ov)        # no write while the pixel read waits
-        with m.If(take):
-            m.d.sync += [in_valid.eq(1), in_line.eq(new_line), in_slot.eq(new_slot)]
+        with m.If(rw_move):
+            m.d.sync += [in_valid.eq(take), in_line.eq(new_line), in_slot.eq(new_slot)]
             m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
-        with m.Elif(rw_move):
-            m.d.sync += in_valid.eq(0)
 
-        # --- the words read: the read ports' words in registers as they are, the overrides
-        # with the write of the cycle the pixel moves in ---
+        # --- the words read: the RAMs' output registers, the overrides with the write of
+        # the cycle the pixel moves in ---
         rw_set = set_of(rw_line)
-        rw_raw_tags = [Signal.like(t, name=f"rw_raw_tag{w}") for w, t in enumerate(in_raw_tags)]
-        rw_raw_stamps = Signal.like(in_raw_stamps, name="rw_raw_stamps")
+        rw_raw_tags = [rp.r_data for rp in tags]
+        rw_raw_stamps = [rp.r_data for rp in stamps]
         rw_ov = overrides("rw_ov")
         rw_plru = Signal(plru_width, name="rw_plru")
         m.d.comb += plru_r.addr.eq(in_set)
@@ -633,9 +623,7 @@ class TextureCache(wiring.Component):
         in_moved = apply(in_ov, in_same, tag_hot, tag_written, stamp_hot, in_seq, "in_moved")
         with m.If(rw_move):
             m.d.sync += [rw_valid.eq(in_valid), rw_line.eq(in_line), rw_slot.eq(in_slot),
-                         rw_raw_stamps.eq(in_raw_stamps),
                          rw_plru.eq(Mux(in_same, touched, plru_r.data))]
-            m.d.sync += [d.eq(s) for d, s in zip(rw_raw_tags, in_raw_tags, strict=True)]
             m.d.sync += [rw_extra[k].eq(in_extra[k]) for k in self.extra]
             m.d.sync += assign(rw_ov, in_moved)
 
@@ -645,7 +633,7 @@ class TextureCache(wiring.Component):
         rw_tag = tag_of(rw_line)
         for w in range(g.ways):
             t = Mux(rw_ov.tag_hot[w], rw_ov.tags[w], rw_raw_tags[w])
-            s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], ways_of(rw_raw_stamps, K)[w])
+            s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], rw_raw_stamps[w])
             hit_w = t[-1] & (t[:g.tag_bits] == rw_tag)
             written = rw_same & tag_hot[w]
             with m.If(move):
@@ -658,14 +646,14 @@ class TextureCache(wiring.Component):
             m.d.sync += [look_extra[k].eq(rw_extra[k]) for k in self.extra]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
-        m.d.comb += [q_w.addr.eq(in_seq[:qb]), q_w.en.eq(advance),
-                     q_w.data.word.eq(look_word), q_w.data.way.eq(way),
-                     q_w.data.sel.eq(look_sel)]
-        m.d.comb += [q_w.data[k].eq(look_extra[k]) for k in self.extra]
+        q_w = qmem.w_data
+        m.d.comb += [qmem.w_addr.eq(in_seq[:qb]), qmem.w_en.eq(advance),
+                     q_w.word.eq(look_word), q_w.way.eq(way), q_w.sel.eq(look_sel)]
+        m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
         for mwp in (m_w, m_w1):
             m.d.comb += [mwp.addr.eq(in_seq[:qb]), mwp.en.eq(advance), mwp.data.eq(~hit)]
-        m.d.comb += [stamp_w.addr.eq(look_set), stamp_w.data.eq(Cat(*[in_seq] * g.ways)),
-                     stamp_w.en.eq(stamp_hot)]
+        for w, sp in enumerate(stamps):
+            m.d.comb += [sp.w_addr.eq(look_set), sp.w_data.eq(in_seq), sp.w_en.eq(stamp_hot[w])]
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
         m.d.sync += count.eq(count + advance - pop)
@@ -678,10 +666,10 @@ class TextureCache(wiring.Component):
         m.d.sync += flush_set.eq(flush_set + 1)
         with m.If(flush_set == g.sets - 1):
             m.d.sync += flushing.eq(0)
-        for w, (_, twp) in enumerate(tags):
-            m.d.comb += [twp.addr.eq(Mux(flushing, flush_set, look_set)),
-                         twp.data.eq(Mux(flushing, 0, tag_written)),
-                         twp.en.eq(flushing | tag_hot[w])]
+        for w, tp in enumerate(tags):
+            m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, look_set)),
+                         tp.w_data.eq(Mux(flushing, 0, tag_written)),
+                         tp.w_en.eq(flushing | tag_hot[w])]
 
         # --- a miss: the victim's new tag (above), its burst and its fill entry ---
         line_shift = g.line_bytes.bit_length() - 1
@@ -703,9 +691,9 @@ class TextureCache(wiring.Component):
         fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
         fill_hot = Signal(g.ways)                  # one-hot by a shift: lint-clean Verilog
         m.d.comb += fill_hot.eq(Const(1, g.ways) << f_r.data.way[:max(1, g.way_bits)])
-        for w, (_, dwp) in enumerate(datas):
-            m.d.comb += [dwp.addr.eq(Cat(beat, fill_set) if g.beats > 1 else fill_set),
-                         dwp.data.eq(ax.rdata), dwp.en.eq(beat_in & fill_hot[w])]
+        for w, dp in enumerate(datas):
+            m.d.comb += [dp.w_addr.eq(Cat(beat, fill_set) if g.beats > 1 else fill_set),
+                         dp.w_data.eq(ax.rdata), dp.w_en.eq(beat_in & fill_hot[w])]
         with m.If(beat_in):
             m.d.sync += beat.eq(beat + 1)
         with m.If(line_in):
@@ -714,49 +702,48 @@ class TextureCache(wiring.Component):
             m.d.sync += f_in.eq(f_in + 1)
         m.d.sync += fills.eq(fills + miss - line_in)
 
-        # --- the queue's head leaves in order: into a register (the data read's address
-        # from a flip-flop), its word read, the words in registers, then the output
-        # register ---
-        head = q_r.data
+        # --- the queue's head leaves in order: read into the queue RAM's register, then its
+        # output register (the head register: the data read's address from a flip-flop),
+        # its word read into the data RAMs' registers, then their output registers (both
+        # stages of a RAM move on together), then the output register ---
         o_free = ~self.o.valid | self.o.ready
-        hd_valid, hd = r.hd_valid, Signal(layout, name="hd")
+        hd_valid, hd = r.hd_valid, qmem.r_data
         rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         wd_valid, wd_way, wd_sel = r.wd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
         wd_extra = {k: Signal(s, name=f"wd_{k}") for k, s in self.extra.items()}
-        wd_words = [Signal(g.data_bits, name=f"wd_word{w}") for w in range(g.ways)]
+        wd_words = [dp.r_data for dp in datas]
         r.in_extra, r.rw_extra, r.look_extra, r.queue = in_extra, rw_extra, look_extra, qmem
         r.rd_extra, r.wd_extra = rd_extra, wd_extra
         r.hd_extra = {k: hd[k] for k in self.extra}
-        wd_move = ~wd_valid | o_free
-        rd_move = ~rd_valid | wd_move
-        hd_move = ~hd_valid | rd_move
-        # The oldest entry was read in the cycle before (its address then out_seq), and it is
-        # readable unless written then (a read does not see a write of its own cycle): a
-        # register, as are its miss bit and whether a line has landed for it.
+        wd_move = ~wd_valid | o_free               # the data read and its words move on
+        hd_move = ~hd_valid | wd_move              # the queue read and the head move on
+        # The oldest entry is in the queue RAM's register when it was read (address out_seq)
+        # in the last cycle the queue read moved on, unless written in that cycle (a read
+        # does not see a write of its own cycle): a register, as are its miss bit and
+        # whether a line has landed for it.
         head_miss, readable, landed_any = Signal(name="head_miss"), r.readable, r.landed_any
         m.d.comb += pop.eq(readable & (~head_miss | landed_any) & hd_move)
         after = r.out_after
         m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
-                     q_r.addr.eq(Mux(pop, after, out_seq[:qb]))]
+                     qmem.r_addr.eq(Mux(pop, after, out_seq[:qb])), qmem.en.eq(hd_move)]
         with m.If(pop):
             m.d.sync += after.eq(after + 1)
         m.d.sync += [head_miss.eq(Mux(pop, m_r1.data, m_r0.data)),
-                     readable.eq((count > 1) | ((count == 1) & ~pop)),
                      landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
+        with m.If(hd_move):
+            m.d.sync += readable.eq((count > 1) | ((count == 1) & ~pop))
         with m.If(pop):
             m.d.sync += out_seq.eq(out_seq + 1)
         m.d.sync += landed.eq(landed + line_in - (pop & head_miss))
         with m.If(hd_move):
-            m.d.sync += [hd_valid.eq(pop), hd.eq(head)]
-        for drp, _ in datas:
-            m.d.comb += [drp.addr.eq(hd.word), drp.en.eq(rd_move)]
-        with m.If(rd_move):
-            m.d.sync += [rd_valid.eq(hd_valid), rd_way.eq(hd.way), rd_sel.eq(hd.sel)]
-            m.d.sync += [rd_extra[k].eq(hd[k]) for k in self.extra]
+            m.d.sync += hd_valid.eq(pop)
+        for dp in datas:
+            m.d.comb += [dp.r_addr.eq(hd.word), dp.en.eq(wd_move)]
         with m.If(wd_move):
-            m.d.sync += [wd_valid.eq(rd_valid), wd_way.eq(rd_way), wd_sel.eq(rd_sel)]
-            m.d.sync += [d.eq(drp.data) for d, (drp, _) in zip(wd_words, datas, strict=True)]
+            m.d.sync += [rd_valid.eq(hd_valid), rd_way.eq(hd.way), rd_sel.eq(hd.sel),
+                         wd_valid.eq(rd_valid), wd_way.eq(rd_way), wd_sel.eq(rd_sel)]
+            m.d.sync += [rd_extra[k].eq(hd[k]) for k in self.extra]
             m.d.sync += [wd_extra[k].eq(rd_extra[k]) for k in self.extra]
         word = Signal(g.data_bits)
         wd_hot = Signal(g.ways)
@@ -834,6 +821,8 @@ class AxiMapFetch(wiring.Component):
         As BumpMapFetch's: the fetched field plus fields carried unchanged.
     cache : dict, optional
         :class:`CacheGeometry` parameters (sets, ways, block, data_bits, base, addr_bits).
+    target : None or rtl/targets.ECP5
+        The cache's (:class:`TextureCache`).
 
     Members
     -------
@@ -857,24 +846,23 @@ class AxiMapFetch(wiring.Component):
         read's and its words' registers and the output register."""
         return self.geom.queue + 7
 
-    def __init__(self, scene: HardwareScene, out_layout, cache=None):
+    def __init__(self, scene: HardwareScene, out_layout, cache=None, target=None):
         check_scene(self, scene)
-        self.scene, self.out_layout = scene, out_layout
+        self.scene, self.out_layout, self.target = scene, out_layout, target
         self.geom = scene_geometry(scene, **(cache or {}))
         self.field = fetched_field(scene)
         g = self.geom
         self.memories = {}                   # the cache's block RAM, as a Pipe records it
         for w in range(g.ways):
             for name, depth, width in ((f"cache_data{w}", g.sets * g.beats, g.data_bits),
-                                       (f"cache_tag{w}", g.sets, g.tag_bits + 1)):
+                                       (f"cache_tag{w}", g.sets, g.tag_bits + 1),
+                                       (f"cache_stamp{w}", g.sets, g.stamp_bits)):
                 self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
                                        "bits": depth * width}
         queue = TextureCache.queue_layout(g, {name: f.shape for name, f in out_layout
                                               if name != fetched_field(scene)}).size
-        for name, depth, width in (("cache_queue", g.queue, queue),
-                                   ("cache_stamps", g.sets, g.ways * g.stamp_bits)):
-            self.memories[name] = {"kind": "ram", "depth": depth, "width": width,
-                                   "bits": depth * width}
+        self.memories["cache_queue"] = {"kind": "ram", "depth": g.queue, "width": queue,
+                                        "bits": g.queue * queue}
         fields = {"u": signed(coord_bits(scene)), "v": signed(coord_bits(scene))}
         if scene.mip_levels > 1:
             fields["level"] = unsigned(level_bits(scene))
@@ -886,7 +874,7 @@ class AxiMapFetch(wiring.Component):
 
     def elaborate(self, platform):
         m, scene = Module(), self.scene
-        m.submodules.cache = cache = TextureCache(self.geom, self.carried)
+        m.submodules.cache = cache = TextureCache(self.geom, self.carried, self.target)
         px, to = self.i.payload, cache.i.payload
         last = scene.mip_levels - 1
         if last == 0:

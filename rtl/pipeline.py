@@ -317,7 +317,7 @@ class BumpPipeline(wiring.Component):
                                             "tag": out_layout["tag"].shape})
         if self._front:
             key = "shading = 'palette'" if s.shading == "palette" else "bump_map = 'varying'"
-            self._add("fetch", AxiMapFetch(s, out_layout, self.cache),
+            self._add("fetch", AxiMapFetch(s, out_layout, self.cache, self.target),
                       f"{key}, map_memory = 'axi': {what} per texel from the "
                       f"user's memory through a texel cache ({s.texture_size}^2 texels, "
                       f"{s.mip_levels} level(s), {s.addressing} addressing)")

@@ -654,12 +654,13 @@ class StreamContract(Elaboratable):
         """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
         its output register, its words-read and data-read registers, its head register, its
         queue's entries from the read sequence number (read through asynchronous ports added
-        to the queue's memory, one per address; the queue's registered read is the entry at
-        that number), its lookup register and the registers of the words and the pixel read
+        to the queue's memory, one per address; the queue RAM's registered read is the entry
+        at that number once readable), its lookup register and the registers of the words and the pixel read
         before it."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
-        inst = _subfragment(frag, "queue") if frag is not None else None
+        ram = _subfragment(frag, "queue") if frag is not None else None
+        inst = _subfragment(ram, "mem") if ram is not None else None     # its generic form
         if not isinstance(inst, MemoryInstance) or "tag" not in r.rd_extra:
             return
         layout = c.queue_layout(g, c.extra)
@@ -680,7 +681,7 @@ class StreamContract(Elaboratable):
                     "the cache's head register holds the tag after its read register's")
         at_q = Signal(bits, name="tag_cache_queue_head")
         m.d.comb += at_q.eq(at_hd + r.hd_valid)
-        head = r.queue.read_ports[0].data
+        head = inst.origins[0].read_ports[0].data
         oldest = r.out_seq[:qb] if qb else Const(0, 1)
         for a in range(g.queue):
             word = Signal(len(head.as_value()), name=f"cache_queue_slot{a}")
@@ -690,7 +691,7 @@ class StreamContract(Elaboratable):
             offset = (Const(a, max(1, qb)) - oldest)[:qb] if qb else Const(0, 1)
             self._lemma(m, ~(offset < count) | (word.tag == (at_q + offset)[:bits]),
                         "the cache's queue holds consecutive tags from its oldest")
-            self._lemma(m, ~((oldest == a) & (count != 0)) | (head.as_value() == word.as_value()),
+            self._lemma(m, ~((oldest == a) & r.readable) | (head.as_value() == word.as_value()),
                         "the cache's queue read is its oldest entry")
         at_look = Signal(bits, name="tag_cache_lookup")
         m.d.comb += at_look.eq(at_q + count)
