@@ -368,6 +368,7 @@ class TextureCache(wiring.Component):
             in_valid=Signal(name="in_valid"),                     # a pixel read: its set
             rw_valid=Signal(name="rw_valid"),                     # its words in registers
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
+            go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
             count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
             out_after=Signal(geom.queue.bit_length() - 1, init=1, name="out_after"),  # out_seq + 1
@@ -483,7 +484,7 @@ class TextureCache(wiring.Component):
         if g.set_bits == 0:
             look_set = Const(0, 1)
         look_tag = tag_of(look_line)
-        hit = look_hits.any()
+        hit = Signal(name="look_hit")             # look_hits.any(), a register
         victim = self._plru_hdl(look_plru, look_hits)[0]
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
         m.d.comb += way_hot.eq(Mux(hit, look_hits, victim))
@@ -510,18 +511,11 @@ class TextureCache(wiring.Component):
         (m_w, m_r0), (m_w1, m_r1) = miss_ports
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
-        # stamp in [out_seq, in_seq). In the lookup's first cycle a valid victim counts as
-        # referenced; after it, the test of the cycle before (a register) without the pixel
-        # that left then (in_seq holds while the pixel waits; out_seq only grows).
-        look_old = Signal(name="look_old")        # the pixel looked up was there last cycle
-        ref_was = Signal(g.ways, name="look_ref_was")
-        left_was = Signal(g.ways, name="look_left_was")
+        # stamp in [out_seq, in_seq). A register a way: a pixel moving into the lookup takes
+        # a valid way as referenced (its first cycle there); while it waits, the test of the
+        # cycle (in_seq holds, out_seq only grows) less the pixel that leaves in it.
+        referenced = Signal(g.ways, name="look_referenced")
         pop = Signal()
-        for w in range(g.ways):
-            m.d.sync += [ref_was[w].eq(look_valids[w] & ((look_stamps[w] - out_seq)[:K] < count)),
-                         left_was[w].eq(pop & (look_stamps[w][:qb] == out_seq[:qb]))]
-        referenced = Signal(g.ways)
-        m.d.comb += referenced.eq(Mux(look_old, ref_was & ~left_was, look_valids))
         locked = Signal()
         m.d.comb += locked.eq((referenced & victim).any())
 
@@ -538,13 +532,13 @@ class TextureCache(wiring.Component):
         # fills == misses, count == queue: their top bits (both in [0, a power of two])
         can_miss = ar_free & ~fills[-1] & ~locked
         advance = Signal()
-        m.d.comb += advance.eq(~flushing & look_valid & ~count[-1] & (hit | can_miss))
+        go = r.go                                  # ~flushing & look_valid & count != queue
+        m.d.comb += advance.eq(go & (hit | can_miss))
         miss = advance & ~hit
         move = ~look_valid | advance               # the words read move on to the lookup
         rw_move = ~rw_valid | move                 # the pixel read moves on to the words read
         m.d.comb += self.i.ready.eq(~flushing & rw_move)
         take = self.i.valid & self.i.ready
-        m.d.sync += look_old.eq(~move)
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
         tag_written = Cat(look_tag, Const(1, 1))
@@ -631,18 +625,25 @@ class TextureCache(wiring.Component):
         # (the write of the cycle to the pixel's set: a miss's tag to its victim) ---
         rw_same = advance & (rw_set == look_set)
         rw_tag = tag_of(rw_line)
+        new_hits = Signal(g.ways)
         for w in range(g.ways):
             t = Mux(rw_ov.tag_hot[w], rw_ov.tags[w], rw_raw_tags[w])
             s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], rw_raw_stamps[w])
             hit_w = t[-1] & (t[:g.tag_bits] == rw_tag)
             written = rw_same & tag_hot[w]
+            m.d.comb += new_hits[w].eq(Mux(written, rw_tag == look_tag, hit_w))
             with m.If(move):
-                m.d.sync += [look_hits[w].eq(Mux(written, rw_tag == look_tag, hit_w)),
-                             look_valids[w].eq(written | t[-1]),
+                m.d.sync += [look_valids[w].eq(written | t[-1]),
+                             referenced[w].eq(written | t[-1]),
                              look_stamps[w].eq(Mux(rw_same & stamp_hot[w], in_seq, s))]
+            with m.Else():
+                m.d.sync += referenced[w].eq(
+                    look_valids[w] & ((look_stamps[w] - out_seq)[:K] < count)
+                    & ~(pop & (look_stamps[w][:qb] == out_seq[:qb])))
         with m.If(move):
             m.d.sync += [look_valid.eq(rw_valid), look_line.eq(rw_line), look_slot.eq(rw_slot),
-                         look_plru.eq(Mux(rw_same, touched, rw_plru))]
+                         look_plru.eq(Mux(rw_same, touched, rw_plru)),
+                         look_hits.eq(new_hits), hit.eq(new_hits.any())]
             m.d.sync += [look_extra[k].eq(rw_extra[k]) for k in self.extra]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
@@ -656,7 +657,9 @@ class TextureCache(wiring.Component):
             m.d.comb += [sp.w_addr.eq(look_set), sp.w_data.eq(in_seq), sp.w_en.eq(stamp_hot[w])]
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
-        m.d.sync += count.eq(count + advance - pop)
+        count_next = Signal.like(count)
+        m.d.comb += count_next.eq(count + advance - pop)
+        m.d.sync += count.eq(count_next)
         m.d.comb += [plru_w.addr.eq(look_set), plru_w.data.eq(touched),
                      plru_w.en.eq(advance if g.ways > 1 else 0)]
         with m.If(flushing):                     # the flush clears the bits with the tags
@@ -664,8 +667,9 @@ class TextureCache(wiring.Component):
 
         # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
         m.d.sync += flush_set.eq(flush_set + 1)
-        with m.If(flush_set == g.sets - 1):
-            m.d.sync += flushing.eq(0)
+        flushing_next = flushing & (flush_set != g.sets - 1)
+        m.d.sync += [flushing.eq(flushing_next),
+                     go.eq(~flushing_next & Mux(move, rw_valid, look_valid) & ~count_next[-1])]
         for w, tp in enumerate(tags):
             m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, look_set)),
                          tp.w_data.eq(Mux(flushing, 0, tag_written)),

@@ -190,6 +190,10 @@ class AxiReadContract(RuleContract):
             self._lemma(m, "the fill queue's pointers are its bursts apart",
                         (ptr == r.fills) | ((r.fills == g.misses) & (ptr == 0)))
         self._lemma(m, "no burst outstanding while flushing", ~r.flushing | (r.fills == 0))
+        self._lemma(m, "no pixel while flushing",
+                    ~r.flushing | ~(r.in_valid | r.rw_valid | r.look_valid))
+        self._lemma(m, "the lookup may go: not flushing, a pixel, a free queue entry",
+                    r.go == (~r.flushing & r.look_valid & ~r.count[-1]))
         return m
 
 
