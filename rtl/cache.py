@@ -346,15 +346,15 @@ class TextureCache(wiring.Component):
     the last pixel queued on it, and a miss whose pseudo-LRU victim is still referenced
     waits at the lookup (a victim holding a line counts as referenced in the pixel's first
     cycle there; so waits a miss with ``misses`` bursts outstanding, a pixel with the queue
-    full, or a miss while ARVALID waits for ARREADY). The hit/miss sequence and the AR
-    stream are the blocking cache's (sim/golden/cache.py). ``i.ready`` is high while the
-    register of the pixel read is empty or moves on, so it depends on the lookup in the same
-    cycle (never on ``i.valid``). Every block-RAM read lands in a register before any logic
-    reads it, and no read is transparent (the stages forward the writes their reads miss). A
-    hit leaves ``CACHE_LATENCY`` cycles after it is taken, one pixel a clock. A reset
-    invalidates every line: the tags are cleared one set a cycle (``sets`` cycles,
-    ``i.ready`` low) before the first lookup; the map in memory must not change between
-    resets.
+    full, or a miss while ARVALID is high: in the cycle of its handshake too). The hit/miss
+    sequence and the AR stream are the blocking cache's (sim/golden/cache.py). ``i.ready``
+    is high while the register of the pixel read is empty or moves on, so it depends on the
+    lookup in the same cycle (never on ``i.valid``). Every block-RAM read lands in a
+    register before any logic reads it, and no read is transparent (the stages forward the
+    writes their reads miss). A hit leaves ``CACHE_LATENCY`` cycles after it is taken, one
+    pixel a clock. A reset invalidates every line: the tags are cleared one set a cycle
+    (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must not
+    change between resets.
     """
 
     def __init__(self, geom: CacheGeometry, extra=None, target=None):
@@ -528,7 +528,7 @@ class TextureCache(wiring.Component):
         f_w, f_r = fmem.write_port(), fmem.read_port(domain="comb")
         f_in, f_out = r.f_in, r.f_out
 
-        ar_free = ~ax.arvalid | ax.arready
+        ar_free = ~ax.arvalid                      # (not ARREADY: no port in the lookup's cycle)
         # fills == misses, count == queue: their top bits (both in [0, a power of two])
         can_miss = ar_free & ~fills[-1] & ~locked
         advance = Signal()
@@ -538,7 +538,6 @@ class TextureCache(wiring.Component):
         move = ~look_valid | advance               # the words read move on to the lookup
         rw_move = ~rw_valid | move                 # the pixel read moves on to the words read
         m.d.comb += self.i.ready.eq(~flushing & rw_move)
-        take = self.i.valid & self.i.ready
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
         tag_written = Cat(look_tag, Const(1, 1))
@@ -584,8 +583,9 @@ class TextureCache(wiring.Component):
         # --- the pixel read: its set's tags and stamps are read as it is taken (the reads
         # address the input and hold while it waits); the write of that cycle is added the
         # cycle after, once its set is in a register ---
-        fresh = Signal(name="in_fresh")          # taken last cycle
-        m.d.sync += fresh.eq(take)
+        moved = Signal(name="in_moved")          # the pixel read moved on last cycle
+        m.d.sync += moved.eq(rw_move)
+        fresh = in_valid & moved                 # taken last cycle
         in_set = set_of(in_line)
         for rp in tags + stamps:
             m.d.comb += [rp.r_addr.eq(set_of(new_line)), rp.en.eq(rw_move)]
@@ -601,8 +601,9 @@ class TextureCache(wiring.Component):
         with m.Else():
             m.d.comb += assign(in_ov, in_held)
         m.d.sync += assign(in_held, in_ov)        # no write while the pixel read waits
-        with m.If(rw_move):
-            m.d.sync += [in_valid.eq(take), in_line.eq(new_line), in_slot.eq(new_slot)]
+        with m.If(rw_move):                      # (the input's terms apart from it)
+            m.d.sync += [in_valid.eq(self.i.valid & ~flushing), in_line.eq(new_line),
+                         in_slot.eq(new_slot)]
             m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
 
         # --- the words read: the RAMs' output registers, the overrides with the write of

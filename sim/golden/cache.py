@@ -73,31 +73,34 @@ def blocking_cycles(run, geom: CacheGeometry, latency):
 
 
 def stream_cycles(run, geom: CacheGeometry, latency):
-    """Cycles TextureCache (non-blocking) takes for the pixels of ``run`` (a
-    :class:`CacheRun`) offered back to back, its output always taken, the memory never
-    stalling and answering each burst ``latency`` cycles after its AR handshake, its beats
-    in order one a clock. Pixel k is looked up at cycle A_k, the earliest after A_{k-1}
-    with a free queue entry (pixel k - queue left), for a miss fewer than ``misses`` bursts
-    outstanding and a victim no queued pixel references (the RTL's sequence-stamp test,
-    wrap-around included; a victim holding a line counts as referenced in the pixel's first
-    cycle at the lookup, A_{k-1} + 1); it leaves the queue at P_k = max(A_k + 2, P_{k-1} + 1, the cycle
-    after its line's last beat for a miss). A miss's AR handshake is at A_k + 1, its first
-    beat at max(A_k + 1 + latency, the cycle after the previous burst's last beat). Returns
-    P_last - 2 (every pixel a hit: one cycle a pixel); the RTL takes the reset's flush
-    (``sets`` cycles) and its hit latency (rtl/cache.CACHE_LATENCY) more
-    (tests/rtl/test_cache.py checks the count against the RTL's)."""
+    """Cycles TextureCache (non-blocking) takes for the pixels of ``run`` (a :class:`CacheRun`)
+    offered back to back, its output always taken, the memory never stalling and
+    answering each burst ``latency`` cycles after its AR handshake, its beats in order
+    one a clock. Pixel k is looked up at cycle A_k, the earliest after A_{k-1} with a
+    free queue entry (pixel k - queue left), for a miss at least two cycles after the
+    one before (its AR handshake, at A + 1, frees the AR register), fewer than
+    ``misses`` bursts outstanding and a victim no queued pixel references (the RTL's
+    sequence-stamp test, wrap-around included; a victim holding a line counts as
+    referenced in the pixel's first cycle at the lookup, A_{k-1} + 1); it leaves the
+    queue at P_k = max(A_k + 2, P_{k-1} + 1, the cycle after its line's last beat for a
+    miss). A miss's AR handshake is at A_k + 1, its first beat at max(A_k + 1 + latency,
+    the cycle after the previous burst's last beat). Returns P_last - 2 (every pixel a
+    hit: one cycle a pixel); the RTL takes the reset's flush (``sets`` cycles) and its
+    hit latency (rtl/cache.CACHE_LATENCY) more (tests/rtl/test_cache.py checks the count
+    against the RTL's)."""
     n = len(run.hit)
     if n == 0:
         return 0
     wrap = 1 << geom.stamp_bits
     pops, fills, stamps = [], [], {}
-    look, miss = 0, 0
+    look, miss, last_miss = 0, 0, -2
     for k in range(n):
         key = (int(run.set[k]), int(run.way[k]))
         c = look + 1
         if k >= geom.queue:
             c = max(c, pops[k - geom.queue] + 1)
         if not run.hit[k]:
+            c = max(c, last_miss + 2)               # the AR register free again
             if miss >= geom.misses:
                 c = max(c, fills[miss - geom.misses] + 1)
             if run.victim_valid[k]:
@@ -118,6 +121,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
             fills.append(first + geom.beats - 1)
             leave = max(leave, fills[-1] + 1)
             miss += 1
+            last_miss = c
         if pops:
             leave = max(leave, pops[-1] + 1)
         pops.append(leave)
