@@ -474,11 +474,12 @@ class TextureCache(wiring.Component):
         look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
         new_line, new_slot = self._locate(m, self.i.payload)
 
-        # --- the pixel looked up: whether each way hits, each way's valid bit and stamp,
-        # the set's pseudo-LRU bits (all registers) ---
+        # --- the pixel looked up: whether each way hits, each way's valid bit and stamp
+        # (as its distance from out_seq, stamp - out_seq mod 2**K), the set's pseudo-LRU
+        # bits (all registers) ---
         look_hits = Signal(g.ways, name="look_hits")
         look_valids = Signal(g.ways, name="look_valids")
-        look_stamps = [Signal(K, name=f"look_stamp{w}") for w in range(g.ways)]
+        look_dists = [Signal(K, name=f"look_dist{w}") for w in range(g.ways)]
         look_plru = Signal(plru_width, name="look_plru")
         look_set, _, look_word, look_sel = split(look_line, look_slot)
         if g.set_bits == 0:
@@ -633,14 +634,19 @@ class TextureCache(wiring.Component):
             hit_w = t[-1] & (t[:g.tag_bits] == rw_tag)
             written = rw_same & tag_hot[w]
             m.d.comb += new_hits[w].eq(Mux(written, rw_tag == look_tag, hit_w))
+            # the distance after this cycle's pop (of the stamp in_seq when forwarded:
+            # count); a distance in [0, count) is a queued pixel, 0 the one leaving
+            stamped = rw_same & stamp_hot[w]
+            d = look_dists[w]
             with m.If(move):
                 m.d.sync += [look_valids[w].eq(written | t[-1]),
                              referenced[w].eq(written | t[-1]),
-                             look_stamps[w].eq(Mux(rw_same & stamp_hot[w], in_seq, s))]
+                             d.eq(Mux(stamped, Mux(pop, count - 1, count),
+                                      Mux(pop, s + ~out_seq, s - out_seq)))]
             with m.Else():
-                m.d.sync += referenced[w].eq(
-                    look_valids[w] & ((look_stamps[w] - out_seq)[:K] < count)
-                    & ~(pop & (look_stamps[w][:qb] == out_seq[:qb])))
+                m.d.sync += [referenced[w].eq(look_valids[w] & (d < count)
+                                              & ~(pop & (d[:qb] == 0))),
+                             d.eq(Mux(pop, d - 1, d))]
         with m.If(move):
             m.d.sync += [look_valid.eq(rw_valid), look_line.eq(rw_line), look_slot.eq(rw_slot),
                          look_plru.eq(Mux(rw_same, touched, rw_plru)),
