@@ -547,14 +547,20 @@ class TextureCache(wiring.Component):
         stamp_hot = Signal(g.ways)
         m.d.comb += stamp_hot.eq(Mux(advance, way_hot, 0))
         touched = self._plru_hdl(look_plru, way_hot)[1]
-        # the write of the cycle before, which a read taken in that cycle misses
-        was = SimpleNamespace(set=Signal.like(look_set, name="was_set"),
-                              tag=Signal.like(tag_written, name="was_tag"),
-                              tag_hot=Signal(g.ways, name="was_tag_hot"),
-                              seq=Signal(K, name="was_seq"),
-                              stamp_hot=Signal(g.ways, name="was_stamp_hot"))
+        # The writes of the two cycles before, registered: the tag and stamp RAMs take the
+        # one of the cycle before (a write lands the cycle after the lookup's), and a read
+        # taken in either cycle misses it.
+        def written_in(name):
+            return SimpleNamespace(set=Signal.like(look_set, name=f"{name}_set"),
+                                   tag=Signal.like(tag_written, name=f"{name}_tag"),
+                                   tag_hot=Signal(g.ways, name=f"{name}_tag_hot"),
+                                   seq=Signal(K, name=f"{name}_seq"),
+                                   stamp_hot=Signal(g.ways, name=f"{name}_stamp_hot"))
+        was, was2 = written_in("was"), written_in("was2")
         m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.tag_hot.eq(tag_hot),
                      was.seq.eq(in_seq), was.stamp_hot.eq(stamp_hot)]
+        m.d.sync += [getattr(was2, k).eq(getattr(was, k))
+                     for k in ("set", "tag", "tag_hot", "seq", "stamp_hot")]
 
         def overrides(prefix):
             """A stage's override registers: a way's tag and stamp written since its read."""
@@ -594,7 +600,9 @@ class TextureCache(wiring.Component):
         none = overrides("in_none")
         m.d.comb += assign(none, SimpleNamespace(tag_hot=0, stamp_hot=0, tags=in_held.tags,
                                                  stamps=in_held.stamps))
-        in_new = apply(none, was.set == in_set, was.tag_hot, was.tag, was.stamp_hot, was.seq,
+        in_old = apply(none, was2.set == in_set, was2.tag_hot, was2.tag, was2.stamp_hot,
+                       was2.seq, "in_old")
+        in_new = apply(in_old, was.set == in_set, was.tag_hot, was.tag, was.stamp_hot, was.seq,
                        "in_new")
         in_ov = overrides("in_ov")
         with m.If(fresh):
@@ -660,8 +668,9 @@ class TextureCache(wiring.Component):
         m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
         for mwp in (m_w, m_w1):
             m.d.comb += [mwp.addr.eq(in_seq[:qb]), mwp.en.eq(advance), mwp.data.eq(~hit)]
-        for w, sp in enumerate(stamps):
-            m.d.comb += [sp.w_addr.eq(look_set), sp.w_data.eq(in_seq), sp.w_en.eq(stamp_hot[w])]
+        for w, sp in enumerate(stamps):                 # (the cycle after: ``was``)
+            m.d.comb += [sp.w_addr.eq(was.set), sp.w_data.eq(was.seq),
+                         sp.w_en.eq(was.stamp_hot[w])]
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
         count_next = Signal.like(count)
@@ -678,9 +687,9 @@ class TextureCache(wiring.Component):
         m.d.sync += [flushing.eq(flushing_next),
                      go.eq(~flushing_next & Mux(move, rw_valid, look_valid) & ~count_next[-1])]
         for w, tp in enumerate(tags):
-            m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, look_set)),
-                         tp.w_data.eq(Mux(flushing, 0, tag_written)),
-                         tp.w_en.eq(flushing | tag_hot[w])]
+            m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, was.set)),
+                         tp.w_data.eq(Mux(flushing, 0, was.tag)),
+                         tp.w_en.eq(flushing | was.tag_hot[w])]
 
         # --- a miss: the victim's new tag (above), its burst and its fill entry ---
         line_shift = g.line_bytes.bit_length() - 1
