@@ -653,7 +653,7 @@ class TextureCache(wiring.Component):
                                       Mux(pop, s + ~out_seq, s - out_seq)))]
             with m.Else():
                 m.d.sync += [referenced[w].eq(look_valids[w] & (d < count)
-                                              & ~(pop & (d[:qb] == 0))),
+                                              & ~(pop & ~d[:qb].any())),
                              d.eq(Mux(pop, d - 1, d))]
         with m.If(move):
             m.d.sync += [look_valid.eq(rw_valid), look_line.eq(rw_line), look_slot.eq(rw_slot),
