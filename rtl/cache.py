@@ -496,6 +496,7 @@ class TextureCache(wiring.Component):
 
         # --- the pixel queue: pixels in [out_seq, in_seq) wait in order ---
         in_seq, out_seq, count = r.in_seq, r.out_seq, r.count
+        count_next = Signal.like(count, name="count_next")
         qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
         # read into the RAM's register, then its output register (the head register)
@@ -512,8 +513,8 @@ class TextureCache(wiring.Component):
         (m_w, m_r0), (m_w1, m_r1) = miss_ports
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
-        # stamp in [out_seq, in_seq). A register a way: a pixel moving into the lookup takes
-        # a valid way as referenced (its first cycle there); while it waits, the test of the
+        # stamp in [out_seq, in_seq). A register a way: the test as a pixel moves into the
+        # lookup, with the queue as it is after that cycle; while it waits, the test of the
         # cycle (in_seq holds, out_seq only grows) less the pixel that leaves in it.
         referenced = Signal(g.ways, name="look_referenced")
         pop = Signal()
@@ -645,12 +646,13 @@ class TextureCache(wiring.Component):
             # the distance after this cycle's pop (of the stamp in_seq when forwarded:
             # count); a distance in [0, count) is a queued pixel, 0 the one leaving
             stamped = rw_same & stamp_hot[w]
-            d = look_dists[w]
+            d, d_new = look_dists[w], Signal(K, name=f"new_dist{w}")
+            m.d.comb += d_new.eq(Mux(stamped, Mux(pop, count - 1, count),
+                                     Mux(pop, s + ~out_seq, s - out_seq)))
             with m.If(move):
                 m.d.sync += [look_valids[w].eq(written | t[-1]),
-                             referenced[w].eq(written | t[-1]),
-                             d.eq(Mux(stamped, Mux(pop, count - 1, count),
-                                      Mux(pop, s + ~out_seq, s - out_seq)))]
+                             referenced[w].eq((written | t[-1]) & (d_new < count_next)),
+                             d.eq(d_new)]
             with m.Else():
                 m.d.sync += [referenced[w].eq(look_valids[w] & (d < count)
                                               & ~(pop & ~d[:qb].any())),
@@ -673,7 +675,6 @@ class TextureCache(wiring.Component):
                          sp.w_en.eq(was.stamp_hot[w])]
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
-        count_next = Signal.like(count)
         m.d.comb += count_next.eq(count + advance - pop)
         m.d.sync += count.eq(count_next)
         m.d.comb += [plru_w.addr.eq(look_set), plru_w.data.eq(touched),

@@ -80,8 +80,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
     free queue entry (pixel k - queue left), for a miss at least two cycles after the
     one before (its AR handshake, at A + 1, frees the AR register), fewer than
     ``misses`` bursts outstanding and a victim no queued pixel references (the RTL's
-    sequence-stamp test, wrap-around included; a victim holding a line counts as
-    referenced in the pixel's first cycle at the lookup, A_{k-1} + 1); it leaves the
+    sequence-stamp test, wrap-around included); it leaves the
     queue at P_k = max(A_k + 2, P_{k-1} + 1, the cycle after its line's last beat for a
     miss). A miss's AR handshake is at A_k + 1, its first beat at max(A_k + 1 + latency,
     the cycle after the previous burst's last beat). Returns P_last - 2 (every pixel a
@@ -104,7 +103,6 @@ def stream_cycles(run, geom: CacheGeometry, latency):
             if miss >= geom.misses:
                 c = max(c, fills[miss - geom.misses] + 1)
             if run.victim_valid[k]:
-                c = max(c, look + 2)                # not in its first cycle at the lookup
                 stamp = stamps[key]
                 while True:                         # queued pixels left before cycle c
                     out = bisect.bisect_left(pops, c)
