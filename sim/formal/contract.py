@@ -576,7 +576,6 @@ class StreamContract(Elaboratable):
         qb = len(r.out_after)
         self._lemma(m, r.out_after == (r.out_seq[:qb] + 1)[:qb],
                     "the cache's next queue address is one past its oldest")
-        self._lemma(m, r.landed_any == (r.landed != 0), "the cache's landed flag = its count != 0")
         self._lemma(m, r.go == (~r.flushing & r.look_valid & (r.count != c.geom.queue)),
                     "the cache's lookup may go: not flushing, a pixel, a free entry")
         self._lemma(m, ghost == r.in_valid + r.rw_valid + r.look_valid + count + r.hd_valid
