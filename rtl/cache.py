@@ -344,17 +344,16 @@ class TextureCache(wiring.Component):
     later hit to a line still filling leaves after the miss that fetches it). A line a
     queued pixel still needs is never evicted: each (set, way) keeps the sequence number of
     the last pixel queued on it, and a miss whose pseudo-LRU victim is still referenced
-    waits at the lookup (a victim holding a line counts as referenced in the pixel's first
-    cycle there; so waits a miss with ``misses`` bursts outstanding, a pixel with the queue
-    full, or a miss while ARVALID is high: in the cycle of its handshake too). The hit/miss
-    sequence and the AR stream are the blocking cache's (sim/golden/cache.py). ``i.ready``
-    is high while the register of the pixel read is empty or moves on, so it depends on the
-    lookup in the same cycle (never on ``i.valid``). Every block-RAM read lands in a
-    register before any logic reads it, and no read is transparent (the stages forward the
-    writes their reads miss). A hit leaves ``CACHE_LATENCY`` cycles after it is taken, one
-    pixel a clock. A reset invalidates every line: the tags are cleared one set a cycle
-    (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must not
-    change between resets.
+    waits at the lookup (so does a miss with ``misses`` bursts outstanding, a pixel with the
+    queue full, or a miss while ARVALID is high: in the cycle of its handshake too). The
+    hit/miss sequence and the AR stream are the blocking cache's (sim/golden/cache.py).
+    ``i.ready`` is high while the register of the pixel read is empty or moves on, so it
+    depends on the lookup in the same cycle (never on ``i.valid``). Every block-RAM read
+    lands in a register before any logic reads it, and no read is transparent (the stages
+    forward the writes their reads miss). A hit leaves ``CACHE_LATENCY`` cycles after it is
+    taken, one pixel a clock. A reset invalidates every line: the tags are cleared one set a
+    cycle (``sets`` cycles, ``i.ready`` low) before the first lookup; the map in memory must
+    not change between resets.
     """
 
     def __init__(self, geom: CacheGeometry, extra=None, target=None):
