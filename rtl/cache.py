@@ -636,6 +636,17 @@ class TextureCache(wiring.Component):
         rw_same = advance & (rw_set == look_set)
         rw_tag = tag_of(rw_line)
         new_hits = Signal(g.ways)
+        # The window [out_seq, in_seq) after this cycle (its ends one further on a pop, an
+        # advance): a stamp is in it by one compare with each end, whether the window wraps
+        # deciding how they combine (no subtraction before a compare; each compare made
+        # with both places of its end, the pop and the advance choosing after).
+        in_one = Signal(K, init=1, name="in_seq_one")              # in_seq + 1
+        out_one = Signal(K, init=1, name="out_seq_one")            # out_seq + 1
+        m.d.sync += [in_one.eq(in_one + advance), out_one.eq(out_one + pop)]
+
+        unwrapped = Signal(name="window_unwrapped")
+        m.d.comb += unwrapped.eq(Mux(advance, Mux(pop, in_one >= out_one, in_one >= out_seq),
+                                     Mux(pop, in_seq >= out_one, in_seq >= out_seq)))
         for w in range(g.ways):
             t = Mux(rw_ov.tag_hot[w], rw_ov.tags[w], rw_raw_tags[w])
             s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], rw_raw_stamps[w])
@@ -645,12 +656,15 @@ class TextureCache(wiring.Component):
             # the distance after this cycle's pop (of the stamp in_seq when forwarded:
             # count); a distance in [0, count) is a queued pixel, 0 the one leaving
             stamped = rw_same & stamp_hot[w]
+            from_out = Mux(pop, s >= out_one, s >= out_seq)
+            before_in = Mux(advance, s < in_one, s < in_seq)
             d, d_new = look_dists[w], Signal(K, name=f"new_dist{w}")
             m.d.comb += d_new.eq(Mux(stamped, Mux(pop, count - 1, count),
                                      Mux(pop, s + ~out_seq, s - out_seq)))
             with m.If(move):
                 m.d.sync += [look_valids[w].eq(written | t[-1]),
-                             referenced[w].eq((written | t[-1]) & (d_new < count_next)),
+                             referenced[w].eq((written | t[-1]) & (stamped | Mux(
+                                 unwrapped, from_out & before_in, from_out | before_in))),
                              d.eq(d_new)]
             with m.Else():
                 m.d.sync += [referenced[w].eq(look_valids[w] & (d < count)
