@@ -16,7 +16,7 @@ from bumprtl.rtl.errors import BumpError, ConfigError
 from bumprtl.rtl.methods import METHODS
 
 __all__ = ["Config", "ConfigError", "BumpError", "ANGLE_BITS_RANGE", "FRAC_BITS_MAX",
-           "TWO_LIGHT_WIDTHS", "frac_bits_floor"]
+           "TWO_LIGHT_WIDTHS", "frac_bits_floor", "check_int"]
 
 ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
 FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
@@ -38,6 +38,11 @@ def _check_int(name, value, lo, hi, why=""):
     if not lo <= value <= hi:
         extra = f" ({why})" if why else ""
         raise ConfigError(f"{name} = {value} is out of range: allowed [{lo}, {hi}]{extra}", name)
+
+
+# the same check for the configurations of units outside this module (rtl/globe.GlobeConfig),
+# so every out-of-range parameter is refused in the same words
+check_int = _check_int
 
 
 def _check_unit(name, value):

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from amaranth.hdl import Cat, Const, Mux, signed, unsigned
 from amaranth.lib import data
 
-from bumprtl.rtl.config import Config, ConfigError, _check_int
+from bumprtl.rtl.config import Config, ConfigError, check_int
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
@@ -93,12 +93,12 @@ class GlobeConfig:
     iterations: int | None = None
 
     def __post_init__(self):
-        _check_int("radius", self.radius, *RADIUS_RANGE)
+        check_int("radius", self.radius, *RADIUS_RANGE)
         for name in ("map_width", "map_height"):
             value = getattr(self, name)
             lo, hi = (MAP_WIDTH_RANGE if name == "map_width"
                       else (MAP_WIDTH_RANGE[0] // 2, MAP_WIDTH_RANGE[1] // 2))
-            _check_int(name, value, lo, hi, "a power of two")
+            check_int(name, value, lo, hi, "a power of two")
             if value & (value - 1):
                 raise ConfigError(f"{name} must be a power of two in [{lo}, {hi}], got {value}",
                                   name)
@@ -107,13 +107,13 @@ class GlobeConfig:
                               f"(an equirectangular map), got {self.map_height}", "map_height")
         if not isinstance(self.pipeline, Config):
             raise ConfigError(f"pipeline must be a Config, got {self.pipeline!r}", "pipeline")
-        _check_int("coord_bits", self.coord_bits, self.int_bits + 1, COORD_BITS_MAX,
+        check_int("coord_bits", self.coord_bits, self.int_bits + 1, COORD_BITS_MAX,
                    f"signed offsets must hold +-(radius - 1) = +-{self.radius - 1}")
         if self.frac_bits is not None:
-            _check_int("frac_bits", self.frac_bits, *FRAC_BITS_RANGE)
-        _check_int("guard_bits", self.guard_bits, *GUARD_BITS_RANGE)
+            check_int("frac_bits", self.frac_bits, *FRAC_BITS_RANGE)
+        check_int("guard_bits", self.guard_bits, *GUARD_BITS_RANGE)
         if self.iterations is not None:
-            _check_int("iterations", self.iterations, 2, self.angle_frac_bits,
+            check_int("iterations", self.iterations, 2, self.angle_frac_bits,
                        f"angle_frac_bits = {self.angle_frac_bits}")
 
     # Derived facts.
