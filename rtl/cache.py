@@ -38,7 +38,7 @@ from amaranth.lib.memory import Memory
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_coords, texel_shape
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, check_pow2
 from bumprtl.rtl.scene import CACHE_DEFAULTS as SCENE_CACHE
 from bumprtl.rtl.scene import HardwareScene, check_scene
 from bumprtl.rtl.targets import RegisteredRAM
@@ -62,15 +62,6 @@ SCENE_KEYS = {"sets": "cache_sets", "ways": "cache_ways", "block": "cache_block"
               "data_bits": "axi_data_bits", "queue": "cache_queue", "misses": "cache_outstanding"}
 # sets, ways, block side, AXI data bits, queue, bursts outstanding: the scene's defaults
 CACHE_DEFAULTS = {name: SCENE_CACHE[key] for name, key in SCENE_KEYS.items()}
-
-
-def _pow2(x):
-    return isinstance(x, int) and not isinstance(x, bool) and x >= 1 and not x & (x - 1)
-
-
-def _check_pow2(name, value, lo, hi):
-    if not _pow2(value) or not lo <= value <= hi:
-        raise BumpError(f"{name} must be a power of two in [{lo}, {hi}], got {value!r}", name)
 
 
 @dataclass(frozen=True)
@@ -119,7 +110,7 @@ class CacheGeometry:
     stamp_bits: int | None = None
 
     def __post_init__(self):
-        _check_pow2("texture_size", self.texture_size, 1, 1 << 16)
+        check_pow2("texture_size", self.texture_size, 1, 1 << 16)
         top = self.texture_size.bit_length()
         if not isinstance(self.mip_levels, int) or not 1 <= self.mip_levels <= top:
             raise BumpError(f"mip_levels must be an integer in [1, {top}], got "
@@ -130,9 +121,9 @@ class CacheGeometry:
         if not isinstance(self.texel_bits, int) or not 1 <= self.texel_bits <= self.data_bits:
             raise BumpError(f"texel_bits must be an integer in [1, {self.data_bits}], got "
                             f"{self.texel_bits!r}", "texel_bits")
-        _check_pow2("sets", self.sets, 1, 1 << 14)
-        _check_pow2("ways", self.ways, 1, 16)
-        _check_pow2("block", self.block, 2, min(16, self.texture_size))
+        check_pow2("sets", self.sets, 1, 1 << 14)
+        check_pow2("ways", self.ways, 1, 16)
+        check_pow2("block", self.block, 2, min(16, self.texture_size))
         if self.line_bytes < self.data_bits // 8 or self.beats > MAX_BURST \
                 or self.line_bytes > AXI_PAGE:
             raise BumpError(f"block must make a line of {self.data_bits // 8} to "
@@ -145,8 +136,8 @@ class CacheGeometry:
         if not isinstance(self.addr_bits, int) or not 12 <= self.addr_bits <= 64:
             raise BumpError(f"addr_bits must be an integer in [12, 64], got "
                             f"{self.addr_bits!r}", "addr_bits")
-        _check_pow2("queue", self.queue, 2, 1024)
-        _check_pow2("misses", self.misses, 1, 64)
+        check_pow2("queue", self.queue, 2, 1024)
+        check_pow2("misses", self.misses, 1, 64)
         least = self.queue.bit_length()          # in_seq - out_seq counts up to queue
         if self.stamp_bits is None:
             object.__setattr__(self, "stamp_bits", max(16, least + 1))

@@ -16,7 +16,8 @@ from bumprtl.rtl.errors import BumpError, ConfigError
 from bumprtl.rtl.methods import METHODS
 
 __all__ = ["Config", "ConfigError", "BumpError", "ANGLE_BITS_RANGE", "FRAC_BITS_MAX",
-           "TWO_LIGHT_WIDTHS", "frac_bits_floor", "check_int"]
+           "TWO_LIGHT_WIDTHS", "frac_bits_floor", "check_int",
+           "check_pow2", "is_pow2"]
 
 ANGLE_BITS_RANGE = (4, 16)      # angle_bits, inclusive
 FRAC_BITS_MAX = 24              # frac_bits <= 24 keeps every product inside 64 bits
@@ -43,6 +44,17 @@ def _check_int(name, value, lo, hi, why=""):
 # the same check for the configurations of units outside this module (rtl/globe.GlobeConfig),
 # so every out-of-range parameter is refused in the same words
 check_int = _check_int
+
+
+def is_pow2(x):
+    """``x`` is an integer (never a bool) and a power of two >= 1."""
+    return isinstance(x, int) and not isinstance(x, bool) and x >= 1 and not x & (x - 1)
+
+
+def check_pow2(name, value, lo, hi):
+    """ConfigError naming ``name`` unless ``value`` is a power of two in [lo, hi]."""
+    if not is_pow2(value) or not lo <= value <= hi:
+        raise ConfigError(f"{name} must be a power of two in [{lo}, {hi}], got {value!r}", name)
 
 
 def _check_unit(name, value):

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from amaranth.hdl import Cat, Const, Mux, signed, unsigned
 from amaranth.lib import data
 
-from bumprtl.rtl.config import Config, ConfigError, check_int
+from bumprtl.rtl.config import Config, ConfigError, check_int, check_pow2
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
@@ -99,9 +99,7 @@ class GlobeConfig:
             lo, hi = (MAP_WIDTH_RANGE if name == "map_width"
                       else (MAP_WIDTH_RANGE[0] // 2, MAP_WIDTH_RANGE[1] // 2))
             check_int(name, value, lo, hi, "a power of two")
-            if value & (value - 1):
-                raise ConfigError(f"{name} must be a power of two in [{lo}, {hi}], got {value}",
-                                  name)
+            check_pow2(name, value, lo, hi)
         if self.map_width != 2 * self.map_height:
             raise ConfigError(f"map_height must be map_width / 2 = {self.map_width // 2} "
                               f"(an equirectangular map), got {self.map_height}", "map_height")

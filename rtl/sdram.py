@@ -29,7 +29,7 @@ from amaranth.lib.fifo import SyncFIFOBuffered
 from amaranth.lib.wiring import In, Out
 
 from bumprtl.rtl.cache import axi_read_signature
-from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.config import BumpError, is_pow2
 
 __all__ = ["SdramChip", "CHIPS", "SdramConfig", "ns_to_cycles", "axi_write_signature",
            "sdram_signature", "SdramController", "CMD", "mode_register"]
@@ -133,10 +133,6 @@ def mode_register(burst, cas_latency):
     return (burst.bit_length() - 1) | (cas_latency << 4)
 
 
-def _pow2(x):
-    return isinstance(x, int) and not isinstance(x, bool) and x >= 1 and not x & (x - 1)
-
-
 @dataclass(frozen=True)
 class SdramConfig:
     """The SDRAM, the clock and the controller's sizes.
@@ -187,7 +183,7 @@ class SdramConfig:
             raise BumpError(f"freq_mhz must be in [1, {float(fmax):g}] for cas_latency "
                             f"{self.cas_latency} ({self.chip.part}), got {self.freq_mhz!r}",
                             "freq_mhz")
-        if not _pow2(self.burst) or self.burst > 8:
+        if not is_pow2(self.burst) or self.burst > 8:
             raise BumpError(f"burst must be a power of two in [1, 8], got {self.burst!r}", "burst")
         if self.data_bits not in DATA_BITS:
             raise BumpError(f"data_bits must be 32 or 64, got {self.data_bits!r}",
@@ -197,7 +193,7 @@ class SdramConfig:
             raise BumpError(f"addr_bits must be an integer in [{need}, 64], got "
                             f"{self.addr_bits!r}", "addr_bits")
         least = max(2, 2 * self.burst_beats)
-        if not _pow2(self.read_fifo) or not least <= self.read_fifo <= 256:
+        if not is_pow2(self.read_fifo) or not least <= self.read_fifo <= 256:
             raise BumpError(f"read_fifo must be a power of two in [{least}, 256], got "
                             f"{self.read_fifo!r}", "read_fifo")
         if self.powerup_cycles is not None and (
