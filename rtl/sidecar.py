@@ -264,20 +264,6 @@ def _named_dict(p):
 
 
 # -- reading ---------------------------------------------------------------------------
-def _keys(d, want, where, optional=()):
-    """Refuse a missing or unknown key of the object ``d`` at ``where``."""
-    if not isinstance(d, dict):
-        raise BumpError(f"sidecar key {where!r} must be an object, got {type(d).__name__}")
-    for k in want:
-        if k not in d and k not in optional:
-            raise BumpError(f"sidecar lacks key {where + '.' if where else ''}{k} "
-                            f"(schema_version {SCHEMA_VERSION})")
-    for k in d:
-        if k not in want:
-            raise BumpError(f"sidecar key {where + '.' if where else ''}{k} is unknown to "
-                            f"schema_version {SCHEMA_VERSION}")
-
-
 def _object(d, where):
     """``d`` if it is an object (a JSON dict), else BumpError naming the key."""
     if not isinstance(d, dict):
@@ -290,6 +276,19 @@ def _int(v, where):
     if isinstance(v, bool) or not isinstance(v, int):
         raise BumpError(f"sidecar key {where!r} must be an integer, got {v!r}")
     return v
+
+
+def _keys(d, want, where, optional=()):
+    """Refuse a missing or unknown key of the object ``d`` at ``where``."""
+    _object(d, where)
+    for k in want:
+        if k not in d and k not in optional:
+            raise BumpError(f"sidecar lacks key {where + '.' if where else ''}{k} "
+                            f"(schema_version {SCHEMA_VERSION})")
+    for k in d:
+        if k not in want:
+            raise BumpError(f"sidecar key {where + '.' if where else ''}{k} is unknown to "
+                            f"schema_version {SCHEMA_VERSION}")
 
 
 _TOP = [f.name for f in fields(Sidecar)]
