@@ -55,9 +55,7 @@ def python_block(path, command):
     per = defaultdict(lambda: [0, 0, 0, 0])      # statements, covered, branches, covered
     files = []
     total = [0, 0, 0, 0]
-    for name, f in data["files"].items():
-        if Path(name).is_absolute():     # a copy outside the checkout (a test's unpacked
-            continue                     # archive, run in a subprocess): not this tree's
+    for name, f in _own_files(data).items():
         s = f["summary"]
         for n, k in enumerate(("num_statements", "covered_lines", "num_branches", "covered_branches")):
             total[n] += s.get(k, 0)
