@@ -1,56 +1,59 @@
-"""Per-pixel geometry of a turning globe (docs/globe.md): a screen position in, the view-space
-normal in the pipeline's polar angles and the texel of an equirectangular map out.
+"""Per-pixel geometry of a turning globe (docs/globe.md): a screen position in, the normal in
+the pipeline's polar angles and the texel of a latitude-longitude map out.
 
-The globe is a sphere of radius R pixels seen orthographically, centred on the screen. A
-pixel at offset (x, y) from the centre, x to the right and **y up the screen**, is inside
-iff ``x**2 + y**2 < R**2`` (the rim itself, ``r**2 == R**2``, is outside). Its normal is
-(x, y, z) / R with ``z = sqrt(R**2 - r**2)`` toward the viewer (a right-handed view frame);
-in polar form ``phi = atan2(y, x)``, ``theta = atan2(r, z)`` (rtl/layouts.polar_layout).
-The map is W x H texels, W = 2H: longitude ``lambda = atan2(x, z) + rotation`` gives
-``u = floor(lambda / 2pi * W) mod W``; latitude ``beta = atan2(y, sqrt(R**2 - y**2))``
-gives ``v = floor((beta / pi + 1/2) * H)`` clamped to [0, H - 1] (v grows up the screen:
-row 0 is the south pole).
+The globe is a sphere of radius R pixels seen orthographically, centred on the screen, its
+pole up the screen. A pixel at offset (x, y) from the centre, x to the right and **y up the
+screen**, is inside iff ``x**2 + y**2 < R**2`` (the rim itself, ``r**2 == R**2``, is
+outside); ``z = sqrt(R**2 - r**2)`` points toward the viewer. The normal is given in the
+scenes' world frame (sim/scenes: x right, y away from the viewer, z up the screen), as the
+software ``sphere`` geometry and the board's light table give theirs: ``N = (x, -z, y) / R``,
+in polar form (rtl/layouts.polar_layout) ``theta = acos(y / R)`` (the colatitude) and ``phi =
+atan2(-z, x) = lambda + 3/4 turn`` with ``lambda = atan2(x, z)`` the longitude seen from the
+viewer. The map is W x H texels (W = 2H, or W = H as the software sphere's square maps):
+``u = floor((lambda + rotation) / 2pi * W) mod W``, ``v = floor(theta / pi * H)`` clamped to
+[0, H - 1] (v grows down the screen: row 0 is the north pole). The tangent frame the
+pipeline rotates the bump vector from (T along increasing theta, B along increasing phi) is
+then the map's (v, u) directions, as on the software sphere.
 
 Method, one register stage per step, fixed latency, one pixel a clock:
 
 * ``x**2``, ``y**2`` in registered products, their sum ``r2`` and ``R**2 - r2``;
-* ``r`` and ``z`` by two non-restoring integer square roots of ``r2`` and ``R**2 - r2``
-  shifted left by ``2 F``, one root bit a stage (``floor(sqrt(.) * 2**F)``, exact);
-* ``phi``, ``theta`` and ``lambda`` by three CORDIC vectoring chains of ``iterations``
-  stages on (x, y), (z, r) and (z, x) with ``F`` fraction bits below a pixel, their
-  angles summed in binary angles of ``angle_frac_bits`` bits from :func:`cordic_angles`
-  (the gain is irrelevant to the angle); ``phi``'s chain starts on the half plane x >= 0
-  (x < 0 turned by pi) with the vector scaled up to a fixed length range
-  (:func:`phi_stages`), ``lambda``'s angle sum starts at the rotation;
-* ``v`` from a ROM indexed by y (:func:`v_table`, float64 contents).
+* ``z`` by a non-restoring integer square root of ``R**2 - r2`` shifted left by ``2 F``, one
+  root bit a stage (``floor(sqrt(.) * 2**F)``, exact);
+* ``lambda`` by a CORDIC vectoring chain of ``iterations`` stages on (z, x) with ``F``
+  fraction bits below a pixel, its angle sum in binary angles of ``angle_frac_bits`` bits
+  from :func:`cordic_angles` (the gain is irrelevant to the angle) starting at the
+  rotation; ``phi`` is that sum less the rotation plus 3/4 turn, one addition later;
+* ``theta`` and ``v`` from two ROMs indexed by y (:func:`theta_table`, :func:`v_table`,
+  float64 contents): they depend on y alone.
 
-Every output field but ``inside`` and ``tag`` is 0 outside the globe; ``phi`` is 0 at the
-centre (x = y = 0, as ``atan2(0, 0)``), ``u`` of a pixel with x = 0 is the rotation's own
-texel (``atan2(0, z)`` is exactly 0). The bit-exact model is sim/golden/globe.py, which
-also derives the error bound against float64.
+Every output field but ``inside`` and ``tag`` is 0 outside the globe; on the column x = 0
+the longitude is exactly 0 (``atan2(0, z)``), so ``phi`` is exactly 3/4 turn there and ``u``
+the rotation's own texel. The bit-exact model is sim/golden/globe.py, which also derives the
+error bound against float64.
 """
 
 import math
 from dataclasses import dataclass, field
 
-from amaranth.hdl import Cat, Const, Mux, signed, unsigned
+from amaranth.hdl import Cat, Const, Mux, Value, signed, unsigned
 from amaranth.lib import data
 
 from bumprtl.rtl.config import Config, ConfigError, check_int, check_pow2
 from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
-__all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "globe_in_layout",
-           "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE", "FRAC_BITS_RANGE",
-           "GUARD_BITS_RANGE", "COORD_BITS_MAX", "DATAPATH_BITS", "sqrt_stages", "cordic_stages",
-           "fit_signed", "leading_zeros", "phi_stages"]
+__all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "theta_table",
+           "globe_in_layout", "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE",
+           "FRAC_BITS_RANGE", "GUARD_BITS_RANGE", "COORD_BITS_MAX", "DATAPATH_BITS",
+           "sqrt_stages", "cordic_stages", "fit_signed", "phi_offset"]
 
 RADIUS_RANGE = (1, 2047)          # R in pixels: R**2 << 2F stays inside 62 bits (the model's int64)
-MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2
+MAP_WIDTH_RANGE = (4, 32768)      # W, a power of two; H = W / 2 or H = W
 FRAC_BITS_RANGE = (4, 20)         # F: fraction bits of the roots and of the CORDIC datapath
-# The signed width of the CORDIC datapaths and of the roots' remainders (I + F + 2) that the
-# default F aims at: the carry chains of the unit are this long (phi's CORDIC one more, the
-# angle sums angle_frac_bits), and they bound its clock (docs/globe.md, On the ECP5).
+# The signed width of the CORDIC datapath and of the root's remainders (I + F + 2) that the
+# default F aims at: the carry chains of the unit are this long (the angle sums
+# angle_frac_bits), and they bound its clock (docs/globe.md, On the ECP5).
 DATAPATH_BITS = 20
 GUARD_BITS_RANGE = (1, 8)         # internal angle bits beyond the wider output
 COORD_BITS_MAX = 16               # signed width of the x, y offsets
@@ -65,8 +68,9 @@ class GlobeConfig:
     radius : int
         R in pixels, 1 to 2047.
     map_width, map_height : int
-        The equirectangular map, powers of two with ``map_width == 2 * map_height``; W from
-        4 to 32768.
+        The latitude-longitude map, powers of two with ``map_width == 2 * map_height`` (square
+        texels) or ``map_width == map_height`` (the software sphere's square maps); W from 4
+        to 32768.
     pipeline : Config
         The pipeline's Config: ``angle_bits`` (the width of n.phi, n.theta and the rotation)
         and ``tag_bits``.
@@ -97,12 +101,13 @@ class GlobeConfig:
         for name in ("map_width", "map_height"):
             value = getattr(self, name)
             lo, hi = (MAP_WIDTH_RANGE if name == "map_width"
-                      else (MAP_WIDTH_RANGE[0] // 2, MAP_WIDTH_RANGE[1] // 2))
+                      else (MAP_WIDTH_RANGE[0] // 2, MAP_WIDTH_RANGE[1]))
             check_int(name, value, lo, hi, "a power of two")
             check_pow2(name, value, lo, hi)
-        if self.map_width != 2 * self.map_height:
-            raise ConfigError(f"map_height must be map_width / 2 = {self.map_width // 2} "
-                              f"(an equirectangular map), got {self.map_height}", "map_height")
+        if self.map_height not in (self.map_width // 2, self.map_width):
+            raise ConfigError(f"map_height must be map_width / 2 = {self.map_width // 2} or "
+                              f"map_width = {self.map_width} (a latitude-longitude map), got "
+                              f"{self.map_height}", "map_height")
         if not isinstance(self.pipeline, Config):
             raise ConfigError(f"pipeline must be a Config, got {self.pipeline!r}", "pipeline")
         check_int("coord_bits", self.coord_bits, self.int_bits + 1, COORD_BITS_MAX,
@@ -150,7 +155,7 @@ class GlobeConfig:
 
     @property
     def root_bits(self):
-        """Bits of a square root ``floor(sqrt(s) * 2**F)``, s < 2**(2I): I + F, one a stage."""
+        """Bits of the square root ``floor(sqrt(s) * 2**F)``, s < 2**(2I): I + F, one a stage."""
         return self.int_bits + self.fraction_bits
 
     @property
@@ -167,9 +172,9 @@ class GlobeConfig:
     @property
     def latency(self):
         """Stages from ``i`` to ``o`` (no credit edge): the input register, the squares
-        (PRODUCT_LATENCY) and their fabric copies, r2, R**2 - r2, the roots, the CORDIC
-        chains, the output register."""
-        return 1 + PRODUCT_LATENCY + 3 + self.root_bits + self.cordic_latency + 1
+        (PRODUCT_LATENCY) and their fabric copies, r2, R**2 - r2, the root, the CORDIC
+        chain, phi's addition, the output register."""
+        return 1 + PRODUCT_LATENCY + 3 + self.root_bits + self.cordic_latency + 2
 
 
 def cordic_angles(gcfg: GlobeConfig):
@@ -181,20 +186,39 @@ def cordic_angles(gcfg: GlobeConfig):
             for i in range(gcfg.cordic_iterations)]
 
 
+def _rows(gcfg: GlobeConfig, word):
+    """``2**(I + 1)`` words indexed by y modulo ``2**(I + 1)`` (two's complement): ``word(y)``
+    for ``|y| < R``, 0 for the rest (no pixel inside has them)."""
+    r, bits = gcfg.radius, gcfg.int_bits + 1
+    ys = [a - (1 << bits) if a >> (bits - 1) else a for a in range(1 << bits)]
+    return [word(y) if abs(y) < r else 0 for y in ys]
+
+
 def v_table(gcfg: GlobeConfig):
-    """The v ROM: ``2**(I + 1)`` words indexed by y modulo ``2**(I + 1)`` (two's complement):
-    ``floor((atan2(y, sqrt(R**2 - y**2)) / pi + 1/2) * H)`` clamped to [0, H - 1] for
-    ``|y| < R`` (float64), 0 for the rest (no pixel inside has them)."""
-    r, h, bits = gcfg.radius, gcfg.map_height, gcfg.int_bits + 1
-    words = []
-    for a in range(1 << bits):
-        y = a - (1 << bits) if a >> (bits - 1) else a
-        if abs(y) >= r:
-            words.append(0)
-            continue
-        beta = math.atan2(y, math.sqrt(r * r - y * y))
-        words.append(min(max(math.floor((beta / math.pi + 0.5) * h), 0), h - 1))
-    return words
+    """The v ROM (:func:`_rows`): ``floor(acos(y / R) / pi * H)``
+    clamped to [0, H - 1] (float64)."""
+    r, h = gcfg.radius, gcfg.map_height
+    return _rows(gcfg, lambda y: min(max(math.floor(math.acos(y / r) / math.pi * h), 0), h - 1))
+
+
+def theta_table(gcfg: GlobeConfig):
+    """The theta ROM (:func:`_rows`): ``acos(y / R)`` (float64) in codes
+    of ``angle_bits``, rounded to nearest, ties to even (as the pipeline's input codes are
+    made, sim/golden/fixed/common.angle_codes)."""
+    r, full = gcfg.radius, 1 << gcfg.angle_bits
+    return _rows(gcfg, lambda y: round(math.acos(y / r) * (full / (2 * math.pi))) & (full - 1))
+
+
+def phi_offset(gcfg: GlobeConfig, rotation):
+    """What phi's addition adds to the longitude sum (which starts at the rotation): 3/4 turn
+    less the rotation (a binary angle of ``angle_bits``), plus half a code step so that the
+    codes (the sum's top ``angle_bits`` bits) round to nearest; modulo 2**P. Amaranth values
+    and ints alike."""
+    P, A = gcfg.angle_frac_bits, gcfg.angle_bits
+    base = (3 << (P - 2)) + (1 << (P - A - 1))
+    if isinstance(rotation, Value):
+        return (Const(base, P) - Cat(Const(0, P - A), rotation))[:P]
+    return (base - (rotation << (P - A))) & ((1 << P) - 1)
 
 
 def globe_in_layout(gcfg: GlobeConfig):
@@ -293,60 +317,6 @@ def cordic_stages(pipe, x, y, acc, angles, width, name):
     return acc
 
 
-def leading_zeros(m, bits):
-    """Zeros above the top set bit of the unsigned ``m`` within ``bits`` bits (``bits`` for
-    0): a priority encoder."""
-    count = Const(bits, range(bits + 1))
-    for k in range(bits):                          # the highest set bit decides last
-        count = Mux(m[k], bits - 1 - k, count)
-    return count
-
-
-def phi_stages(pipe, x, y, g: GlobeConfig, angles):
-    """``atan2(y, x)`` (x, y the registered inputs, signed) as a binary angle of
-    ``angle_frac_bits``, plus half a code step (so its top bits round): returns ``(angle,
-    stage)``, the stage counted from the inputs' (1). Stage 2 turns a vector with x < 0 by
-    pi (X = -x, Y = -y, the sum starting at half a turn); stage 3 takes the magnitude word
-    ``m = X | (Y ^ s)`` (s the sign of Y in every bit: the one's complement of a negative Y),
-    stage 4 its leading zeros ``z`` within I bits, stages 5 and 6 shift X and Y left by
-    ``z``'s low two bits, then by the rest: the larger of |X|, |Y| is then at least
-    2**(I - 1) (and -2**I <= Y, X < 2**I), so the chain's vector is at least 2**(I - 1 + F)
-    long at every pixel but the centre (set to 0 at the output). Then the CORDIC chain, one
-    bit wider than the others: the vector may be sqrt 2 2**(I + F) long, and the chain's
-    gain (< 1.65) takes it past 2**(I + F + 1)."""
-    I, F, P, A, w = g.int_bits, g.fraction_bits, g.angle_frac_bits, g.angle_bits, g.datapath_bits
-    negative = x[-1]
-
-    def turned(v):                                 # -v = ~v + 1: the XOR ahead of the chain
-        return ((v ^ negative.replicate(len(v))).as_signed() + negative)[:I + 1].as_signed()
-
-    turned_x = pipe.register(turned(x), "phi_turned_x")
-    turned_y = pipe.register(turned(y), "phi_turned_y")
-    half = 1 << (P - A - 1)
-    acc = pipe.register(Mux(negative, Const((1 << (P - 1)) + half, P), Const(half, P)),
-                        "phi_acc")
-    m = pipe.register((turned_x | (turned_y ^ turned_y[-1].replicate(I + 1)))[:I], "phi_m")
-    vx = pipe.register(turned_x, "phi_x_m")
-    vy = pipe.register(turned_y, "phi_y_m")
-    acc = pipe.register(acc, "phi_acc_m")
-    zeros = pipe.register(leading_zeros(m, I), "phi_zeros")
-    vx, vy = pipe.register(vx, "phi_x_z"), pipe.register(vy, "phi_y_z")
-    acc = pipe.register(acc, "phi_acc_z")
-    wide = I + 1
-    high = zeros[2:]
-    for step, amount in enumerate((zeros[:2], None)):
-        if amount is None:
-            amount = high << 2
-        else:
-            high = pipe.register(high, "phi_zeros_high")       # beside the first shift
-        vx = pipe.register((vx << amount)[:wide].as_signed(), f"phi_x_s{step}")
-        vy = pipe.register((vy << amount)[:wide].as_signed(), f"phi_y_s{step}")
-        acc = pipe.register(acc, f"phi_acc_s{step}")
-    fx = fit_signed(Cat(Const(0, F), vx).as_signed(), w + 1)
-    fy = fit_signed(Cat(Const(0, F), vy).as_signed(), w + 1)
-    return cordic_stages(pipe, fx, fy, acc, angles, w + 1, "phi"), 6 + g.cordic_latency
-
-
 class GlobeGeometry(PipeUnit):
     """The globe's per-pixel geometry (module docstring).
 
@@ -379,7 +349,6 @@ class GlobeGeometry(PipeUnit):
         g = self.gcfg
         I, F, P, A = g.int_bits, g.fraction_bits, g.angle_frac_bits, g.angle_bits
         w, chain = g.datapath_bits, g.cordic_latency
-        angles = cordic_angles(g)
         p = self.i.payload
         # stage 1: the inputs
         x = pipe.register(p.x, "x")
@@ -393,47 +362,46 @@ class GlobeGeometry(PipeUnit):
         rr = g.radius * g.radius
         inside = pipe.register(r2 < rr, "inside")
         d = pipe.register((Const(rr, 2 * I) - r2)[:2 * I], "d")      # outside: masked below
-        r2_at = pipe.register(r2[:2 * I], "r2_at")
-        start = 1 + PRODUCT_LATENCY + 3                                 # the roots' input stage
+        start = 1 + PRODUCT_LATENCY + 3                                 # the root's input stage
         z_root = sqrt_stages(pipe, d, 2 * I, F, "z")
-        r_root = sqrt_stages(pipe, r2_at, 2 * I, F, "r")
         roots = start + g.root_bits
-        done = roots + chain                                             # the angles' stage
+        done = roots + chain                                             # the sum's stage
 
-        # theta = atan2(r, z), lambda = atan2(x, z) + rotation: stages roots + 1 .. done
-        z_w, r_w = fit_signed(z_root, w), fit_signed(r_root, w)
-        half = 1 << (P - A - 1)                    # the codes round: floor(acc + half step)
-        theta = cordic_stages(pipe, z_w, r_w, Const(half, P), angles, w, "theta")
+        # lambda = atan2(x, z) + rotation: stages roots + 1 .. done
         x_root = pipe.delay(x[:I + 1].as_signed(), roots - 1, "x_root")   # |x| < R inside
         lam0 = Cat(Const(0, P - A), pipe.delay(rot, roots - 1, "rotation_root"))
-        lam = cordic_stages(pipe, z_w, fit_signed(Cat(Const(0, F), x_root).as_signed(), w),
-                            lam0, angles, w, "lambda")
-        # phi = atan2(y, x): stage 2 turns x < 0 by pi, stages 3 .. 6 scale (x, y) up until
-        # the larger magnitude has its top bit at 2**(I - 1), then the chain
-        phi, phi_end = phi_stages(pipe, x, y, g, angles)
-        phi = pipe.delay(phi, done - phi_end, "phi_done")
+        lam = cordic_stages(pipe, fit_signed(z_root, w),
+                            fit_signed(Cat(Const(0, F), x_root).as_signed(), w),
+                            lam0, cordic_angles(g), w, "lambda")
+        # phi = lambda - rotation + 3/4 turn (+ half a code step): stage done + 1
+        offset = pipe.register(phi_offset(g, pipe.delay(rot, done - 2, "rotation_offset")),
+                               "phi_offset")
+        phi = pipe.register((lam + offset)[:P], "phi_sum")
+        lam = pipe.register(lam[P - g.u_bits:], "lambda_u")
         # x == 0 as ~|x (an equality with 0 would be Verilog's ! of a vector, which lint refuses)
-        centre = pipe.delay(pipe.register(~(x.any() | y.any()), "centre"), done - 2, "centre")
-        x_zero = pipe.delay(pipe.register(~x.any(), "x_zero"), done - 2, "x_zero")
-        inside = pipe.delay(inside, done - start, "inside")
+        x_zero = pipe.delay(pipe.register(~x.any(), "x_zero"), done - 1, "x_zero")
+        inside = pipe.delay(inside, done + 1 - start, "inside")
         # u of x = 0 is the rotation's top log2 W bits (below them, zeros): only those ride on
         low = max(A - g.u_bits, 0)
-        rot_done = pipe.delay(rot[low:], done - 1, "rotation_done")
-        # the v ROM: its address registered at done - 1 - ROM_LATENCY, its word at done
-        rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
-        at = done - 1 - ROM_LATENCY
-        address = pipe.register(pipe.delay(y[:I + 1], at - 2, "y_v"), "v_address")
-        m.d.comb += rom.ports[0].addr.eq(address)
-        v_word = pipe.register(rom.ports[0].data, "v_word")
-        # the output stage (done + 1): codes, texel, 0 outside
+        rot_done = pipe.delay(rot[low:], done, "rotation_done")
+        # the latitude ROMs (v and theta by y; two, each in a block RAM mode with its output
+        # register): their address registered at done - ROM_LATENCY, their words at done + 1
+        at = done - ROM_LATENCY
+        address = pipe.register(pipe.delay(y[:I + 1], at - 2, "y_rom"), "rom_address")
+        v_rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
+        theta_rom = pipe.rom(theta_table(g), unsigned(A), "theta_rom", ports=1)
+        m.d.comb += [v_rom.ports[0].addr.eq(address), theta_rom.ports[0].addr.eq(address)]
+        v_word = pipe.register(v_rom.ports[0].data, "v_word")
+        theta_word = pipe.register(theta_rom.ports[0].data, "theta_word")
+        # the output stage (done + 2): codes, texel, 0 outside
         u_rot = (Cat(Const(0, P - A + low), rot_done) >> (P - g.u_bits))[:g.u_bits]
-        u_lam = lam[P - g.u_bits:]
         o, zero = pipe.o.payload, Const(0)
         m.d.comb += [
             o.inside.eq(pipe.register(inside, "inside_out")),
-            o.n.phi.eq(pipe.register(Mux(inside & ~centre, phi[P - A:], zero), "phi_out")),
-            o.n.theta.eq(pipe.register(Mux(inside, theta[P - A:], zero), "theta_out")),
-            o.u.eq(pipe.register(Mux(inside, Mux(x_zero, u_rot, u_lam), zero), "u_out")),
+            o.n.phi.eq(pipe.register(Mux(inside, Mux(x_zero, Const(3 << (A - 2), A), phi[P - A:]),
+                                         zero), "phi_out")),
+            o.n.theta.eq(pipe.register(Mux(inside, theta_word, zero), "theta_out")),
+            o.u.eq(pipe.register(Mux(inside, Mux(x_zero, u_rot, lam), zero), "u_out")),
             o.v.eq(pipe.register(Mux(inside, v_word, zero), "v_out")),
             o.tag.eq(pipe.delay(p.tag, self.latency, "tag")),
         ]

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.globe import GlobeConfig, cordic_angles, v_table
+from bumprtl.rtl.globe import GlobeConfig, cordic_angles, phi_offset, theta_table, v_table
 from bumprtl.rtl.pipe import EDGE_LATENCY, min_fifo_depth
 from bumprtl.sim.golden.common import cartesian_to_polar
 from bumprtl.sim.golden.fixed.common import angle_codes
@@ -52,92 +52,79 @@ def _inputs(x, y, rotation):
 def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
     """The unit's output fields (int64 arrays keyed like the flattened payload: ``inside``,
     ``n.phi``, ``n.theta``, ``u``, ``v``) of pixels (x, y) (y up) at ``rotation`` (codes).
-    ``fine``: also ``phi_fine``, ``theta_fine``, ``lambda_fine``, the angle sums before
-    their rounding (full circle = 2**P, the rounding's half step taken back off; valid
+    ``fine``: also ``phi_fine`` and ``lambda_fine``, the angle sums before their rounding
+    (full circle = 2**P; phi's without the half code step its codes round with; valid
     inside only)."""
     x, y, rotation = _inputs(x, y, rotation)
     R, F, P, A = gcfg.radius, gcfg.fraction_bits, gcfg.angle_frac_bits, gcfg.angle_bits
-    I = gcfg.int_bits
     full, half = 1 << P, 1 << (P - A - 1)
+    rot = rotation & ((1 << A) - 1)
     r2 = x * x + y * y
     inside = r2 < R * R
     z = isqrt(np.where(inside, R * R - r2, 0) << (2 * F))
-    r = isqrt(np.where(inside, r2, 0) << (2 * F))
-    xi, yi = np.where(inside, x, 1), np.where(inside, y, 0)      # outside: any, masked
-    neg = xi < 0
-    tx, ty = np.where(neg, -xi, xi), np.where(neg, -yi, yi)          # x < 0 turned by pi
-    # scaled up by the zeros above the top bit of max(|tx|, |ty|) within I bits
-    top = np.zeros_like(tx)
-    magnitude = tx | (ty ^ (ty >> 63))
-    for k in range(I):
-        top = np.where(magnitude >> k != 0, k + 1, top)
-    phi = cordic((tx << (I - top)) << F, (ty << (I - top)) << F,
-                 np.where(neg, full // 2, 0) + half, gcfg)
-    theta = cordic(z, r, np.full_like(x, half), gcfg)
-    lam = cordic(z, xi << F, (rotation & ((1 << A) - 1)) << (P - A), gcfg)
-    lam = np.where(xi == 0, (rotation & ((1 << A) - 1)) << (P - A), lam)
+    xi = np.where(inside, x, 0)                                  # outside: any, masked
+    lam = cordic(z, xi << F, rot << (P - A), gcfg)
+    x_zero = xi == 0
+    lam = np.where(x_zero, rot << (P - A), lam)                  # atan2(0, z) = 0 exactly
+    phi = (lam + phi_offset(gcfg, rot)) % full                   # + 3/4 turn - rotation + half
+    rows = np.asarray(y, np.int64) & ((2 << gcfg.int_bits) - 1)
+    zero = np.zeros_like(x)
     out = {"inside": inside.astype(np.int64),
-           "n.phi": np.where(inside & (r2 > 0), phi >> (P - A), 0),
-           "n.theta": np.where(inside, theta >> (P - A), 0),
-           "u": np.where(inside, lam >> (P - gcfg.u_bits), 0),
-           "v": np.where(inside, np.asarray(v_table(gcfg), np.int64)[y & ((2 << gcfg.int_bits) - 1)],
-                         0)}
+           "n.phi": np.where(inside, np.where(x_zero, 3 << (A - 2), phi >> (P - A)), zero),
+           "n.theta": np.where(inside, np.asarray(theta_table(gcfg), np.int64)[rows], zero),
+           "u": np.where(inside, lam >> (P - gcfg.u_bits), zero),
+           "v": np.where(inside, np.asarray(v_table(gcfg), np.int64)[rows], zero)}
     if fine:
-        out.update(phi_fine=np.where(r2 > 0, phi - half, 0) % full,
-                   theta_fine=(theta - half) % full, lambda_fine=lam)
+        out.update(phi_fine=np.where(x_zero, 3 << (P - 2), (phi - half) % full),
+                   lambda_fine=lam)
     return out
 
 
 def globe_float(x, y, rotation, gcfg: GlobeConfig):
-    """The float64 reference: ``inside``, the codes ``n.phi``, ``n.theta`` made as the board
-    makes N's (sim/golden/common.cartesian_to_polar, sim/golden/fixed/common.angle_codes),
-    ``u``, ``v``; and the angles ``phi``, ``theta`` (radians) and ``lambda_turns`` (the
-    longitude in turns, [0, 1): the rotation added in turns, exactly)."""
+    """The float64 reference: ``inside``, the codes ``n.phi``, ``n.theta`` of the normal
+    ``(x, -z, y) / R`` in the scenes' world frame made as the board makes N's
+    (sim/golden/common.cartesian_to_polar, sim/golden/fixed/common.angle_codes), ``u``,
+    ``v``; and the angles ``phi`` (radians) and ``lambda_turns`` (the longitude in turns,
+    [0, 1): the rotation added in turns, exactly)."""
     x, y, rotation = _inputs(x, y, rotation)
     R, W, H = float(gcfg.radius), gcfg.map_width, gcfg.map_height
     xf, yf = x.astype(np.float64), y.astype(np.float64)
     r2 = xf * xf + yf * yf
     inside = r2 < R * R
     z = np.sqrt(np.where(inside, R * R - r2, 0.0))
-    n = np.stack([xf, yf, z], -1) / R
-    phi, theta = cartesian_to_polar(n)
+    phi, _ = cartesian_to_polar(np.stack([xf, -z, yf], -1))
+    # theta = acos(N.z / |N|) = acos(y / R): taken from y alone, as it is exactly
+    theta = np.arccos(np.clip(np.where(inside, yf, 0.0) / R, -1.0, 1.0))
     lam_turns = np.mod(np.arctan2(xf, z) / (2 * np.pi) + rotation / (1 << gcfg.angle_bits), 1.0)
-    beta = np.arctan2(yf, np.sqrt(np.maximum(R * R - yf * yf, 0.0)))
-    v = np.clip(np.floor((beta / np.pi + 0.5) * H), 0, H - 1).astype(np.int64)
+    v = np.clip(np.floor(theta / np.pi * H), 0, H - 1).astype(np.int64)
     zero = np.zeros_like(x)
     return {"inside": inside.astype(np.int64),
             "n.phi": np.where(inside, angle_codes(phi, gcfg.pipeline), zero),
             "n.theta": np.where(inside, angle_codes(theta, gcfg.pipeline), zero),
             "u": np.where(inside, np.floor(lam_turns * W).astype(np.int64) % W, zero),
-            "v": np.where(inside, v, zero),
-            "phi": np.mod(np.arctan2(yf, xf), 2 * np.pi), "theta": np.arctan2(np.sqrt(r2), z),
-            "lambda_turns": lam_turns}
+            "v": np.where(inside, v, zero), "phi": phi, "lambda_turns": lam_turns}
 
 
-def error_bound_rad(gcfg: GlobeConfig, which):
-    """The largest ``|fine angle - float64 angle|`` (radians) of any pixel inside, for
-    ``which`` in ``phi``, ``theta``, ``lambda`` (proof in docs/globe.md, Error):
+def error_bound_rad(gcfg: GlobeConfig):
+    """The largest ``|fine angle - float64 angle|`` (radians) of phi and of the longitude at
+    any pixel inside (one CORDIC chain gives both; proof in docs/globe.md, Error):
 
-    ``atan(2**-(n-1)) + n pi / 2**P + (n - 1) asin(1 / (M - n)) + e_in``
+    ``atan(2**-(n-1)) + n pi / 2**P + (n - 1) asin(1 / (M - n)) + asin(sqrt 2 / M_true)``
 
-    with n the iterations, P the angle bits of the sums: the residual angle of n vectoring
+    with n the iterations, P the angle bits of the sum: the residual angle of n vectoring
     steps, the n rounded constants (half a step each), and the truncation of the shifts
     (under one unit in each of X, Y at steps 1 .. n-1, none at step 0, on a vector never
-    shorter than sqrt(2) (M - n) units after step 0); M is the shortest input vector in
-    units of 2**-F pixel: phi 2**(I - 1 + F) (the vector scaled up until its larger
-    component is at least 2**(I - 1); the centre is set to 0), theta R 2**F - sqrt 2,
-    lambda sqrt(2R - 1) 2**F - sqrt 2 (x**2 + z**2 = R**2 - y**2 >= 2R - 1 inside);
-    ``e_in`` the truncated roots (each under one unit): asin(sqrt 2 / M_true) for theta
-    and lambda, 0 for phi (exact integer inputs)."""
+    shorter than sqrt(2) (M - n) units after step 0); M_true = sqrt(2R - 1) 2**F is the
+    shortest input vector in units of 2**-F pixel (x**2 + z**2 = R**2 - y**2 >= 2R - 1
+    inside), M = M_true - sqrt 2 the shortest after the root's truncation (under one unit),
+    whose own error is the last term."""
     n, P, F, R = gcfg.cordic_iterations, gcfg.angle_frac_bits, gcfg.fraction_bits, gcfg.radius
-    true = {"phi": 2.0 ** (gcfg.int_bits - 1 + F), "theta": R * 2.0 ** F,
-            "lambda": math.sqrt(2 * R - 1) * 2.0 ** F}[which]
-    m = true - (0 if which == "phi" else math.sqrt(2))
-    e_in = 0.0 if which == "phi" else math.asin(min(1.0, math.sqrt(2) / true))
+    true = math.sqrt(2 * R - 1) * 2.0 ** F
+    m = true - math.sqrt(2)
     if m - n <= 1:
         return math.pi
     return (math.atan(2.0 ** -(n - 1)) + n * math.pi / 2 ** P
-            + (n - 1) * math.asin(1 / (m - n)) + e_in)
+            + (n - 1) * math.asin(1 / (m - n)) + math.asin(min(1.0, math.sqrt(2) / true)))
 
 
 def _turn_diff(a, b):
@@ -147,35 +134,27 @@ def _turn_diff(a, b):
 
 def check_against_float(x, y, rotation, gcfg: GlobeConfig):
     """The model against float64 on pixels (x, y, rotation): a dict of measured figures,
-    and ``violations``, a list of what breaks the contract: inside or v different, a fine
-    angle beyond :func:`error_bound_rad`, a code or texel off where the float64 value is
-    further than the bound from a rounding boundary (or by more than one plus the bound's
-    whole steps anywhere)."""
+    and ``violations``, a list of what breaks the contract: inside, n.theta or v different
+    (each comes from y alone, through a ROM of float64 words), a fine angle beyond
+    :func:`error_bound_rad`, a code or texel off where the float64 value is further than the
+    bound from a rounding boundary (or by more than one plus the bound's whole steps
+    anywhere)."""
     fx, fl = globe_fixed(x, y, rotation, gcfg, fine=True), globe_float(x, y, rotation, gcfg)
     P, A, W = gcfg.angle_frac_bits, gcfg.angle_bits, gcfg.map_width
     inside = fl["inside"].astype(bool)
-    bad = []
-    if not np.array_equal(fx["inside"], fl["inside"]):
-        bad.append("inside differs")
-    if not np.array_equal(fx["v"], fl["v"]):
-        bad.append("v differs")
+    bad = [f"{k} differs" for k in ("inside", "n.theta", "v") if not np.array_equal(fx[k], fl[k])]
     out = {"pixels": int(inside.sum())}
+    bound = error_bound_rad(gcfg)
     for name, fine, ref, code, steps in (
             ("phi", "phi_fine", fl["phi"] / (2 * np.pi), "n.phi", 1 << A),
-            ("theta", "theta_fine", fl["theta"] / (2 * np.pi), "n.theta", 1 << A),
             ("lambda", "lambda_fine", fl["lambda_turns"], "u", W)):
-        if name == "phi":
-            keep = inside & ((np.asarray(x) != 0) | (np.asarray(y) != 0))
-        else:
-            keep = inside
-        err = np.abs(_turn_diff(fx[fine][keep] / (1 << P), ref[keep])) * 2 * np.pi
-        bound = error_bound_rad(gcfg, name)
+        err = np.abs(_turn_diff(fx[fine][inside] / (1 << P), ref[inside])) * 2 * np.pi
         worst = float(err.max()) if err.size else 0.0
         if worst > bound:
             bad.append(f"{name}: fine error {worst:.3g} rad beyond the bound {bound:.3g}")
-        diff = np.mod(fx[code][keep] - fl[code][keep] + steps // 2, steps) - steps // 2
+        diff = np.mod(fx[code][inside] - fl[code][inside] + steps // 2, steps) - steps // 2
         # distance of the float64 value to the nearest rounding (codes) or floor (u) boundary
-        scaled = ref[keep] * steps
+        scaled = ref[inside] * steps
         frac = scaled - np.floor(scaled)
         edge = np.abs(frac - 0.5) if name != "lambda" else np.minimum(frac, 1 - frac)
         near = edge * 2 * np.pi / steps <= bound
@@ -221,22 +200,22 @@ def main(argv=None):
     print(f"R = {gcfg.radius}, angle_bits = {gcfg.angle_bits}, W x H = {gcfg.map_width} x "
           f"{gcfg.map_height}, F = {gcfg.fraction_bits}, P = {gcfg.angle_frac_bits}, "
           f"iterations = {gcfg.cordic_iterations}, rotations {rots}")
-    print(f"widths: I = {gcfg.int_bits}, roots {gcfg.root_bits} bits ({gcfg.root_bits} "
-          f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed (phi's "
-          f"{gcfg.datapath_bits + 1}), angle sums "
-          f"{gcfg.angle_frac_bits} bits, v ROM {2 << gcfg.int_bits} x {gcfg.v_bits}; latency "
+    print(f"widths: I = {gcfg.int_bits}, root {gcfg.root_bits} bits ({gcfg.root_bits} "
+          f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed, angle sum "
+          f"{gcfg.angle_frac_bits} bits, v and theta ROMs "
+          f"{2 << gcfg.int_bits} x {gcfg.v_bits} and x {gcfg.angle_bits}; latency "
           f"{gcfg.latency} (+{EDGE_LATENCY} with the unit's credit edge, FIFO depth "
           f"{min_fifo_depth(gcfg.latency)})")
-    for name in ("phi", "theta", "lambda"):
-        b = error_bound_rad(gcfg, name)
-        steps = gcfg.map_width if name == "lambda" else 1 << gcfg.angle_bits
-        print(f"bound {name}: {b:.3e} rad = {b * steps / (2 * math.pi):.4f} "
-              f"{'texels' if name == 'lambda' else 'codes'}")
+    b = error_bound_rad(gcfg)
+    print(f"bound phi, lambda: {b:.3e} rad = {b * (1 << gcfg.angle_bits) / (2 * math.pi):.4f} "
+          f"codes = {b * gcfg.map_width / (2 * math.pi):.4f} texels")
     ok = True
     for rot in rots:
         res = check_against_float(x, y, rot, gcfg)
-        print(f"rotation {rot}: {res['pixels']} pixels inside")
-        for name in ("phi", "theta", "lambda"):
+        print(f"rotation {rot}: {res['pixels']} pixels inside; inside, n.theta and v equal "
+              f"float64's everywhere" if not any("differs" in v for v in res["violations"])
+              else f"rotation {rot}: {res['pixels']} pixels inside")
+        for name in ("phi", "lambda"):
             s = res[name]
             unit = "texels" if name == "lambda" else "codes"
             print(f"  {name:6s} max |error| {s['max_error_rad']:.3e} rad = "
