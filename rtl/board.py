@@ -1,5 +1,5 @@
-"""The board top: a scene's BumpPipeline rendering an animated, bump-mapped plane to HDMI
-(docs/board.md).
+"""The board top: a scene's BumpPipeline rendering an animated, bump-mapped plane or turning
+globe to HDMI (docs/board.md).
 
 Everything but the serializer runs in one clock domain, ``sync``, at the pixel clock;
 the serializer runs in ``shift`` at 5 x the pixel clock (two bits a cycle on DDR output
@@ -11,7 +11,10 @@ registers). Per pixel of the active raster, in order:
    constant; light j's L and H come from a table of ``steps`` entries indexed by the frame
    number (the light turns one step a frame). The table and the constants are data,
    computed outside rtl/ and passed in; so is the bump map (the pipeline's block-RAM
-   initial contents).
+   initial contents). With a globe (:class:`GlobeSource`) the screen position goes through
+   :class:`~bumprtl.rtl.globe.GlobeGeometry` instead, which gives N and (u, v) of a turning
+   sphere (:func:`globe_config`); the tag's top bit carries "inside" to the display, which
+   shows black outside.
 2. The scene's :class:`~bumprtl.rtl.pipeline.BumpPipeline` shades it.
 3. The pipeline's own credit edge is the elastic buffer: its FIFO, ``depth`` pixels deep
    (the pipeline's ``fifo_depth``), sits between its last unit and the scan-out, and the
@@ -52,16 +55,24 @@ from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.globe import GlobeConfig, GlobeGeometry
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
-__all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "PixelSource",
-           "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
+__all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "RasterSource",
+           "PixelSource",
+           "GlobeSource", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
+           "GLOBE_TURN_FRAMES",
+           "GLOBE_RADIUS", "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
            "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider"]
 
 BUFFER_MARGIN = 8
+# The globe: its radius is GLOBE_RADIUS of the screen's height (224 pixels at 480 lines, 336
+# at 720), and it turns once in about GLOBE_TURN_FRAMES frames (17 s at 60 Hz).
+GLOBE_RADIUS = (7, 15)
+GLOBE_TURN_FRAMES = 1024
 # Synchronizer stages of the clock-crossing FIFO's pointers (amaranth.lib.fifo.AsyncFIFO's
 # default): a pointer written in one domain is seen in the other that many clocks later.
 CDC_SYNC_STAGES = 2
@@ -107,54 +118,156 @@ def payload_field(view, key):
     return view
 
 
-class PixelSource(Elaboratable):
-    """The per-pixel input generator (module docstring, 1.). ``constants``: {key: code} of
-    payload fields that never change (the plane's N); ``table``: one {key: code} per light
-    step (L and H of every light); ``issue``: the source may hand over a pixel this cycle
-    (the credit); ``o``: the pipeline's input stream (valid, payload; ready from it)."""
+class RasterSource(Elaboratable):
+    """What the board's sources share: the raster counters (``px``, ``py``, the pixel count
+    ``count`` of ``count_bits``) and the light table (``table``: one {key: code} per light
+    step, L and H of every light), read a cycle ahead into the pipeline's payload, its step
+    register ``frame`` moving on after the last pixel of a frame. ``allow``: the source may
+    offer a pixel this cycle."""
 
-    def __init__(self, pipeline, mode: VideoMode, constants, table):
+    def __init__(self, pipeline, mode: VideoMode, table, count_bits):
         self.pipeline, self.mode = pipeline, mode
-        self.constants, self.table = dict(constants), [dict(t) for t in table]
+        self.table = [dict(t) for t in table]
         self.keys = sorted(self.table[0])
         self.widths = [len(payload_field(pipeline.i.payload, k)) for k in self.keys]
         self.allow = Signal()
         self.px = Signal(range(mode.h_active), name="src_x")
         self.py = Signal(range(mode.v_active), name="src_y")
         self.frame = Signal(range(len(self.table)), name="light_step")
-        self.count = Signal(pipeline.cfg.tag_bits, name="src_count")
+        self.count = Signal(count_bits, name="src_count")
+        # the table's read port answers a cycle late: no pixel in the cycle after reset
+        self.primed = Signal(name="table_primed")
 
-    def elaborate(self, platform):
-        m, md, p = Module(), self.mode, self.pipeline
+    def raster(self, m, take):
+        """Advance the raster on ``take``; returns (last column, last row)."""
+        md = self.mode
+        last_x, last_y = self.px == md.h_active - 1, self.py == md.v_active - 1
+        with m.If(take):
+            m.d.sync += [self.px.eq(Mux(last_x, 0, self.px + 1)), self.count.eq(self.count + 1)]
+            with m.If(last_x):
+                m.d.sync += self.py.eq(Mux(last_y, 0, self.py + 1))
+        return last_x, last_y
+
+    def lights(self, m, wrap):
+        """The light table into the pipeline's payload: the entry of ``frame``, or of the
+        next step in the cycle after ``wrap`` (the last pixel of a frame taken)."""
         words = [sum(int(t[k]) << sum(self.widths[:n]) for n, k in enumerate(self.keys))
                  for t in self.table]
         m.submodules.light_table = rom = Memory(shape=sum(self.widths), depth=len(words),
                                                 init=words)
         rd = rom.read_port()
-        # the table's read port answers a cycle late: no pixel in the cycle after reset
-        primed = Signal(name="table_primed")
-        m.d.sync += primed.eq(1)
-        issue = Signal()
-        m.d.comb += [p.i.valid.eq(self.allow & primed), issue.eq(p.i.valid & p.i.ready)]
-        last_x, last_y = self.px == md.h_active - 1, self.py == md.v_active - 1
-        wrap = issue & last_x & last_y
+        m.d.sync += self.primed.eq(1)
         step = Mux(self.frame == len(self.table) - 1, 0, self.frame + 1)
         m.d.comb += rd.addr.eq(Mux(wrap, step, self.frame))
-        with m.If(issue):
-            m.d.sync += [self.px.eq(Mux(last_x, 0, self.px + 1)), self.count.eq(self.count + 1)]
-            with m.If(last_x):
-                m.d.sync += self.py.eq(Mux(last_y, 0, self.py + 1))
         with m.If(wrap):
             m.d.sync += self.frame.eq(step)
+        at = 0
+        for k, w in zip(self.keys, self.widths, strict=False):
+            m.d.comb += payload_field(self.pipeline.i.payload, k).eq(rd.data[at:at + w])
+            at += w
+
+
+class PixelSource(RasterSource):
+    """The per-pixel input generator of the plane (module docstring, 1.). ``constants``:
+    {key: code} of payload fields that never change (the plane's N); ``table``: one
+    {key: code} per light step (L and H of every light); the pipeline's input stream
+    (valid, payload; ready from it) is driven."""
+
+    def __init__(self, pipeline, mode: VideoMode, constants, table):
+        super().__init__(pipeline, mode, table, pipeline.cfg.tag_bits)
+        self.constants = dict(constants)
+
+    def elaborate(self, platform):
+        m, md, p = Module(), self.mode, self.pipeline
+        issue = Signal()
+        m.d.comb += [p.i.valid.eq(self.allow & self.primed), issue.eq(p.i.valid & p.i.ready)]
+        last_x, last_y = self.raster(m, issue)
+        self.lights(m, issue & last_x & last_y)
         pay = p.i.payload
         size = p.scene.texture_size
         u, v = texel_coords(self.px, self.py, md.zoom, size)
         m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
         m.d.comb += [payload_field(pay, k).eq(c) for k, c in self.constants.items()]
-        at = 0
-        for k, w in zip(self.keys, self.widths, strict=False):
-            m.d.comb += payload_field(pay, k).eq(rd.data[at:at + w])
-            at += w
+        return m
+
+
+def globe_config(scene: HardwareScene, mode: VideoMode):
+    """The board's globe (rtl/globe.GlobeConfig) in ``mode``: radius GLOBE_RADIUS of the
+    active height, the scene's square map read as the software sphere reads it (W = H =
+    ``texture_size``: u over the longitude, v over the colatitude), offsets wide enough for
+    the whole screen, the pipeline's angle and tag widths."""
+    num, den = GLOBE_RADIUS
+    radius = max(1, mode.v_active * num // den)
+    reach = max(mode.h_active, mode.v_active) // 2
+    coord = max(reach.bit_length() + 1, radius.bit_length() + 1)
+    size = scene.texture_size
+    return GlobeConfig(radius=radius, map_width=size, map_height=size, pipeline=scene.config,
+                       coord_bits=coord)
+
+
+def globe_offsets(x, y, mode: VideoMode):
+    """Screen pixel (x, y) (y down from the top row) -> the globe's offsets from the centre
+    (x right, y up): ``(x - h_active // 2, v_active // 2 - y)``. Amaranth values and numpy
+    arrays alike."""
+    return x - mode.h_active // 2, mode.v_active // 2 - y
+
+
+def globe_turn_step(cfg):
+    """The globe's rotation added each frame, in angle codes: a full turn in about
+    GLOBE_TURN_FRAMES frames, at least one code."""
+    return max(1, cfg.full_circle // GLOBE_TURN_FRAMES)
+
+
+def globe_rotation(cfg, frame):
+    """The globe's rotation in frame ``frame`` (codes): 3/4 turn in frame 0, where u is the
+    software sphere's (u = phi / 2pi W: the map's seam at the right-hand limb), then
+    :func:`globe_turn_step` more each frame."""
+    return (3 * cfg.full_circle // 4 + frame * globe_turn_step(cfg)) % cfg.full_circle
+
+
+class GlobeSource(RasterSource):
+    """The per-pixel input generator of the globe (module docstring, 1.): the raster position
+    and the globe's rotation into ``globe`` (a :class:`~bumprtl.rtl.globe.GlobeGeometry`
+    with its own credit edge, elaborated by the caller), its output and light j's L and H
+    from the table into the pipeline.
+
+    The rotation starts at :func:`globe_rotation` of frame 0 and advances by
+    :func:`globe_turn_step` codes after the last pixel of a frame enters the globe; the
+    light step after the last pixel of a frame enters the pipeline (the globe's tag carries
+    the pixel count below a "last of the frame" bit, and the pipeline's tag the count below
+    the globe's ``inside``)."""
+
+    def __init__(self, pipeline, mode: VideoMode, globe: GlobeGeometry, table):
+        bits = pipeline.cfg.tag_bits
+        if bits < 2:
+            raise BumpError(f"tag_bits must be >= 2 for the globe (the pixel count and the "
+                            f"inside bit), got {bits}", "tag_bits")
+        super().__init__(pipeline, mode, table, bits - 1)
+        self.globe = globe
+        self.turn_step = globe_turn_step(pipeline.cfg)
+        self.rotation = Signal(globe.gcfg.angle_bits, name="globe_rotation",
+                               init=globe_rotation(pipeline.cfg, 0))
+
+    def elaborate(self, platform):
+        m, p, g = Module(), self.pipeline, self.globe
+        # the globe's side: the raster and the rotation
+        take = Signal()
+        m.d.comb += [g.i.valid.eq(self.allow), take.eq(g.i.valid & g.i.ready)]
+        last_x, last_y = self.raster(m, take)
+        with m.If(take & last_x & last_y):
+            m.d.sync += self.rotation.eq(self.rotation + self.turn_step)
+        x, y = globe_offsets(self.px, self.py, self.mode)
+        gi = g.i.payload
+        m.d.comb += [gi.x.eq(x), gi.y.eq(y), gi.rotation.eq(self.rotation),
+                     gi.tag.eq(Cat(self.count, last_x & last_y))]
+        # the pipeline's side: the globe's output and the light table
+        go, issue = g.o.payload, Signal()
+        m.d.comb += [p.i.valid.eq(g.o.valid & self.primed), g.o.ready.eq(p.i.ready & self.primed),
+                     issue.eq(p.i.valid & p.i.ready)]
+        self.lights(m, issue & go.tag[-1])
+        pay = p.i.payload
+        m.d.comb += [pay.u.eq(go.u), pay.v.eq(go.v), pay.n.phi.eq(go.n.phi),
+                     pay.n.theta.eq(go.n.theta), pay.tag.eq(Cat(go.tag[:-1], go.inside))]
         return m
 
 
@@ -166,12 +279,14 @@ class BoardCore(Elaboratable):
     0 outside the active raster."""
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
-                 target=None, depth=None, pipe_hz=None):
+                 target=None, depth=None, pipe_hz=None, globe=False):
         """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
         below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
         runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
         (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
-        :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``."""
+        :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``.
+        ``globe``: a turning globe (:class:`GlobeSource`, :func:`globe_config`) instead of
+        the plane; ``constants`` is then unused."""
         self.mode = mode
         self.pipe_hz = pipe_hz
         self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
@@ -179,7 +294,13 @@ class BoardCore(Elaboratable):
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
         self.depth = self.pipeline.fifo_depth
-        self.source = PixelSource(self.pipeline, mode, constants, table)
+        if globe:
+            self.globe = GlobeGeometry(globe_config(self.scene, mode), target)
+            self.source = GlobeSource(self.pipeline, mode, self.globe, table)
+        else:
+            self.globe = None
+            self.source = PixelSource(self.pipeline, mode, constants, table)
+        self.timing = VideoTiming(mode)
         self.underflow = Signal()
         self.order_error = Signal()
         self.o0, self.o1 = Signal(4), Signal(4)
@@ -189,19 +310,22 @@ class BoardCore(Elaboratable):
         m, p = Module(), self.pipeline
         tag_bits = p.cfg.tag_bits
         src = self.source
-        if self.pipe_hz is None:
-            m.submodules.pipeline = p
-            m.submodules.source = src
-        else:
-            m.submodules.pipeline = DomainRenamer("pipe")(p)
-            m.submodules.source = DomainRenamer("pipe")(src)
-        m.submodules.timing = t = VideoTiming(self.mode)
+        inner = {"pipeline": p, "source": src}
+        if self.globe is not None:
+            inner["globe"] = self.globe
+        for name, sub in inner.items():
+            m.submodules[name] = sub if self.pipe_hz is None else DomainRenamer("pipe")(sub)
+        m.submodules.timing = t = self.timing
         # the pixel's colour: grey from the shade, or the colour-texture blend's RGB
         o = p.o.payload
         if self.scene.texture:
             rgb = Cat(o.color.b, o.color.g, o.color.r)
         else:
             rgb = Cat(o.color, o.color, o.color)
+        count_bits = tag_bits
+        if self.globe is not None:    # the tag's top bit is the globe's inside: black outside
+            rgb = Mux(o.tag[-1], rgb, 0)
+            count_bits = tag_bits - 1
         m.d.comb += src.allow.eq(1)   # a pixel every cycle; the credits decide when it is taken
         if self.pipe_hz is None:      # the pipeline's FIFO is the buffer, read at the display
             valid, color, tag = p.o.valid, rgb, o.tag
@@ -213,10 +337,10 @@ class BoardCore(Elaboratable):
                          p.o.ready.eq(cdc.w_rdy), cdc.r_en.eq(t.de)]
             valid, color, tag = cdc.r_rdy, cdc.r_data[:len(rgb)], cdc.r_data[len(rgb):]
         take = t.de & valid
-        shown = Signal(tag_bits, name="shown_count")
+        shown = Signal(count_bits, name="shown_count")
         with m.If(take):
             m.d.sync += shown.eq(shown + 1)
-            with m.If(tag != shown):
+            with m.If(tag[:count_bits] != shown):
                 m.d.sync += self.order_error.eq(1)
         with m.If(t.de & ~valid):
             m.d.sync += self.underflow.eq(1)

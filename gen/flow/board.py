@@ -2,10 +2,11 @@
 
 * :func:`board_core` builds rtl/board.BoardCore with its data: the bump map (the
   pipeline's block-RAM initial contents, as ``bumprtl emit pipeline`` writes them), the
-  plane's normal and the light table (sim/golden/board.py);
+  plane's normal and the light table (sim/golden/board.py); a scene on a sphere is shown as
+  a turning globe (rtl/board.GlobeSource);
 * :func:`check_board` refuses what the board cannot show, before anything is written: an
-  unknown board or mode, a scene that is not a varying map shaded per pixel, block RAM
-  beyond the device's;
+  unknown board or mode, a scene that is not a varying map shaded per pixel, a surface
+  other than a plane or a sphere, block RAM beyond the device's;
 * :func:`build_bitstream` runs Amaranth's ECP5 flow (Yosys ``synth_ecp5``, nextpnr-ecp5,
   ecppack; the YoWASP builds) on ``ULX3S_85F_Platform`` and reads nextpnr's report: LUT4,
   FF, DSP, BRAM and the Fmax of each clock;
@@ -30,13 +31,12 @@ from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, u
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
-from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth
+from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth, globe_config
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.video import get_mode
-from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants
-from bumprtl.sim.scenes import SCENES
+from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants, surface
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames"]
@@ -57,18 +57,22 @@ def board_core(scene, mode, target=None, data=None, pipe_hz=None):
     source and pipeline in their own clock domain at that rate (None: the pixel clock)."""
     words, texels, constants, table = board_data(scene) if data is None else data
     return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
-                     pipe_hz=pipe_hz)
+                     pipe_hz=pipe_hz, globe=surface(scene) == "sphere")
 
 
 def bram_budget(scene, mode, device):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
     tables (as gen/flow/memories.check_fits counts them), the light table, the
-    elastic buffer; and the device's."""
+    elastic buffer, a globe's latitude ROM; and the device's."""
     p = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
     maps, tables = memory_blocks(unit_memories(p))
     need = {"map": maps, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
+    if surface(scene) == "sphere":
+        g = globe_config(scene.hardware, mode)
+        need["globe"] = bram_blocks(2 << g.int_bits, g.v_bits) + bram_blocks(2 << g.int_bits,
+                                                                           g.angle_bits)
     return need, DEVICE_BRAM[device]
 
 
@@ -82,10 +86,11 @@ def check_board(board, mode_name, scene):
         raise BumpError(f"scene {scene.name!r}: the board renders a varying bump map shaded per "
                         f"pixel (shading = 'per-pixel', bump_map = 'varying'), got shading = "
                         f"{scene.shading!r}, bump_map = {scene.bump_map!r}", "scene")
-    geometry = scene.geometry or (SCENES[scene.image][1] if scene.image else "plane")
-    if geometry != "plane":
-        raise BumpError(f"scene {scene.name!r}: the board renders a plane facing the viewer, "
-                        f"got geometry {geometry!r}", "geometry")
+    geometry = surface(scene)
+    if geometry not in ("plane", "sphere"):
+        raise BumpError(f"scene {scene.name!r}: the board renders a plane facing the viewer or "
+                        f"a turning globe (geometry 'plane' or 'sphere'), got geometry "
+                        f"{geometry!r}", "geometry")
     platform, device = BOARDS[board]
     need, have = bram_budget(scene, mode, device)
     total = sum(need.values())
@@ -175,7 +180,7 @@ def _domain(clock):
     return net
 
 
-_PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",),
+_PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",), "globe": ("globe",),
           "video (timing + source)": ("timing", "source"),
           "TMDS (encoders + serializer)": ("tmds0", "tmds1", "tmds2", "serializer")}
 _CELLS = {"LUT4": {"LUT4": 1, "CCU2C": 2, "TRELLIS_DPR16X4": 2}, "FF": {"TRELLIS_FF": 1},
@@ -220,7 +225,8 @@ def part_costs(scene, mode, work_dir):
                 if cname == n or cname.endswith("." + n) or cname.split("$")[0] == n:
                     for k, v in count(t).items():
                         row[k] += v
-        rows[part] = row
+        if part != "globe" or any(row.values()):      # a plane has no globe
+            rows[part] = row
     glue = {k: 0 for k in _CELLS}
     for cell in top["cells"].values():
         for k, table in _CELLS.items():

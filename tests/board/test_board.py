@@ -121,8 +121,9 @@ def test_check_board_names_the_block_ram_overrun():
     assert "too many" in str(e.value) and "DP16KD" in str(e.value)
 
 
-def test_check_board_refuses_a_surface_other_than_the_plane():
+def test_check_board_refuses_a_surface_other_than_the_plane_or_the_sphere():
     with pytest.raises(Exception) as e:
-        check_board("ulx3s", "640x480", load_scene_config("default", {"geometry": "sphere"}))
-    assert "geometry 'sphere'" in str(e.value)
+        check_board("ulx3s", "640x480", load_scene_config("default", {"geometry": "cylinder"}))
+    assert "geometry 'cylinder'" in str(e.value) and e.value.field == "geometry"
     check_board("ulx3s", "640x480", load_scene_config("default"))
+    check_board("ulx3s", "640x480", load_scene_config("default", {"geometry": "sphere"}))
