@@ -22,7 +22,7 @@ help:
 	@echo "make docs     opt-in: regenerate the generated pages at today's default Config (slow)"
 	@echo "make compat   opt-in: the wheel without extras, every command on each Python 3.11 / 3.12 / 3.13 found"
 	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
-	@echo "make board    ULX3S bitstream (build/board/ulx3s_85f.bit/.svf), Fmax per clock, 2 frames checked by a DVI sink"
+	@echo "make board    ULX3S bitstreams, plane and globe (build/board, build/board_globe), Fmax per clock, 2 frames each checked by a DVI sink"
 
 $(STAMP): pyproject.toml | icarus
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -100,8 +100,11 @@ formal: $(STAMP)
 # Verilator and checked by cocotbext-dvi's DVISink against the golden frames.
 BOARD_SEEDS  ?= 1,2,3
 BOARD_FRAMES ?= 2
+# The same for the turning globe (the moon relief on a sphere, a 256 x 256 map) in build/board_globe.
 board: $(STAMP)
 	$(RUN) $(VENV)/bin/bumprtl board ulx3s --out build/board --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
+	printf 'image = "globe"\ntexture_size = 256\n' > build/globe.toml
+	$(RUN) $(VENV)/bin/bumprtl board ulx3s --scene build/globe.toml --out build/board_globe --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
 
 # The generated pages, regenerated at today's default Config (each records it in a "Made at:"
 # line, tests/test_docs_made_at.py): slow (minutes), opt-in. make fpga, make formal and
