@@ -54,10 +54,13 @@ from amaranth.lib.cdc import ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.memory import Memory
 
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.flash import FlashLoader, spi_signature
 from bumprtl.rtl.globe import GlobeConfig, GlobeGeometry
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import HardwareScene
+from bumprtl.rtl.sdram import SdramController, sdram_signature
 from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
@@ -271,6 +274,27 @@ class GlobeSource(RasterSource):
         return m
 
 
+def _check_memory(scene, pipe_hz, sdram, flash):
+    """BumpError unless the map's place and the memory parts agree: a map in the SDRAM
+    (``map_memory = "axi"``) with an SdramConfig, a FlashConfig and a pipe clock, the
+    three data widths equal (the cache's AXI port, the controller's, the loader's); a map
+    in block RAM with neither."""
+    axi = scene.map_memory == "axi"
+    if not axi:
+        if sdram is not None or flash is not None:
+            raise BumpError("sdram and flash serve a map in the SDRAM: the scene's map_memory "
+                            f"must be 'axi', got {scene.map_memory!r}", "map_memory")
+        return
+    if sdram is None or flash is None or pipe_hz is None:
+        raise BumpError("map_memory = 'axi' on the board needs the SDRAM and the flash "
+                        "loader (sdram, flash) and the pipe clock (pipe_hz)", "map_memory")
+    bits = scene_geometry(scene).data_bits
+    if not sdram.data_bits == flash.data_bits == bits:
+        raise BumpError(f"data_bits: the cache's AXI port has {bits}, the SDRAM controller's "
+                        f"{sdram.data_bits}, the flash loader's {flash.data_bits}: they must "
+                        f"be equal", "data_bits")
+
+
 class BoardCore(Elaboratable):
     """Source, pipeline, elastic buffer, timing, TMDS encoders and serializer (module
     docstring). ``o0``, ``o1``: the serializer's bits of lanes 0-2 (blue, green, red) and 3
@@ -279,14 +303,23 @@ class BoardCore(Elaboratable):
     0 outside the active raster."""
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
-                 target=None, depth=None, pipe_hz=None, globe=False):
+                 target=None, depth=None, pipe_hz=None, globe=False, sdram=None, flash=None):
         """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
         below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
         runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
         (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
         :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``.
         ``globe``: a turning globe (:class:`GlobeSource`, :func:`globe_config`) instead of
-        the plane; ``constants`` is then unused."""
+        the plane; ``constants`` is then unused. ``sdram`` (an
+        :class:`~bumprtl.rtl.sdram.SdramConfig`) and ``flash`` (a
+        :class:`~bumprtl.rtl.flash.FlashConfig`): the scene's map lives in the SDRAM
+        (``map_memory = "axi"``, the pipeline's texel cache reading it through an
+        :class:`~bumprtl.rtl.sdram.SdramController`), copied there after reset from the SPI
+        flash by a :class:`~bumprtl.rtl.flash.FlashLoader`; the source starts once the copy
+        is done. Both run in ``pipe`` (``pipe_hz`` is the SDRAM's clock); the pins are
+        ``sdram_pins`` and ``spi``. The display starts showing at the first frame whose
+        first pixel is ready, black before it (``underflow`` counts from there)."""
+        _check_memory(scene, pipe_hz, sdram, flash)
         self.mode = mode
         self.pipe_hz = pipe_hz
         self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
@@ -300,7 +333,14 @@ class BoardCore(Elaboratable):
         else:
             self.globe = None
             self.source = PixelSource(self.pipeline, mode, constants, table)
+        self.sdram, self.flash = sdram, flash
+        if sdram is not None:
+            self.controller = SdramController(sdram)
+            self.loader = FlashLoader(flash)
+            self.sdram_pins = sdram_signature(sdram).flip().create(path=("sdram",))
+            self.spi = spi_signature().flip().create(path=("spi",))
         self.timing = VideoTiming(mode)
+        self.shows = Signal(name="display_shows")   # the display takes pixels (from a frame's start)
         self.underflow = Signal()
         self.order_error = Signal()
         self.o0, self.o1 = Signal(4), Signal(4)
@@ -313,6 +353,12 @@ class BoardCore(Elaboratable):
         inner = {"pipeline": p, "source": src}
         if self.globe is not None:
             inner["globe"] = self.globe
+        if self.sdram is not None:
+            inner.update(sdram=self.controller, flash_loader=self.loader)
+            wiring.connect(m, p.axi, self.controller.rd)
+            wiring.connect(m, self.loader.axi, self.controller.wr)
+            wiring.connect(m, self.controller.sdram, self.sdram_pins)
+            wiring.connect(m, self.loader.spi, self.spi)
         for name, sub in inner.items():
             m.submodules[name] = sub if self.pipe_hz is None else DomainRenamer("pipe")(sub)
         m.submodules.timing = t = self.timing
@@ -326,23 +372,31 @@ class BoardCore(Elaboratable):
         if self.globe is not None:    # the tag's top bit is the globe's inside: black outside
             rgb = Mux(o.tag[-1], rgb, 0)
             count_bits = tag_bits - 1
-        m.d.comb += src.allow.eq(1)   # a pixel every cycle; the credits decide when it is taken
+        # a pixel every cycle, once the map is in place; the credits decide when it is taken
+        m.d.comb += src.allow.eq(1 if self.sdram is None else self.loader.done)
+        # the display shows from the first frame whose first pixel is ready
+        running, shows = Signal(name="display_running"), self.shows
         if self.pipe_hz is None:      # the pipeline's FIFO is the buffer, read at the display
             valid, color, tag = p.o.valid, rgb, o.tag
-            m.d.comb += p.o.ready.eq(t.de)
+            m.d.comb += p.o.ready.eq(t.de & shows)
         else:                         # its FIFO feeds the crossing, which the display reads
             m.submodules.cdc = cdc = AsyncFIFO(width=len(rgb) + tag_bits, depth=self.cdc_depth,
                                                w_domain="pipe", r_domain="sync")
             m.d.comb += [cdc.w_data.eq(Cat(rgb, o.tag)), cdc.w_en.eq(p.o.valid),
-                         p.o.ready.eq(cdc.w_rdy), cdc.r_en.eq(t.de)]
+                         p.o.ready.eq(cdc.w_rdy), cdc.r_en.eq(t.de & shows)]
             valid, color, tag = cdc.r_rdy, cdc.r_data[:len(rgb)], cdc.r_data[len(rgb):]
-        take = t.de & valid
+        # x == 0 as ~|x: an equality with 0 would be Verilog's ! of a vector, which lint refuses
+        first = t.de & ~t.x.any() & ~t.y.any()
+        m.d.comb += shows.eq(running | (first & valid))
+        with m.If(first & valid):
+            m.d.sync += running.eq(1)
+        take = t.de & valid & shows
         shown = Signal(count_bits, name="shown_count")
         with m.If(take):
             m.d.sync += shown.eq(shown + 1)
             with m.If(tag[:count_bits] != shown):
                 m.d.sync += self.order_error.eq(1)
-        with m.If(t.de & ~valid):
+        with m.If(t.de & ~valid & shows):
             m.d.sync += self.underflow.eq(1)
         pixel = Mux(take, color, 0)                   # bytes: blue, green, red
         m.d.comb += self.pixel.eq(pixel)

@@ -5,8 +5,10 @@ The flash is read with the JEDEC READ command (0x03): CS# low, the opcode and a 
 address shifted in most significant bit first, then data bytes, most significant bit first,
 for as long as SCLK runs with CS# low (the address counts up by itself). SPI mode 0: SCLK
 idles low, the flash samples MOSI on SCLK's rising edge and shifts MISO out on its falling
-edge; the loader samples MISO as it raises SCLK (the bit has stood since the falling edge
-before). SCLK is the clock over ``2 * half_period``. The loader stops SCLK low (CS# held
+edge; the loader samples MISO as it raises SCLK, ``half_period - 1`` clocks after the
+falling edge that shifted it out: the flash's clock-to-output time and the board's delays
+must fit in that (one clock at the default 2, 10 ns at 100 MHz). SCLK is the clock over
+``2 * half_period``. The loader stops SCLK low (CS# held
 low) whenever the bytes it has read wait for the AXI write channel: a flash is a static
 design, a pause in SCLK's low phase is allowed at any bit.
 
@@ -53,7 +55,8 @@ class FlashConfig:
     burst : int
         Beats a burst, a power of two, 1 .. 256, at most 4096 bytes.
     half_period : int
-        Clock cycles of each SCLK phase, 1 .. 64 (SCLK = clock / (2 half_period)).
+        Clock cycles of each SCLK phase, 2 .. 64 (SCLK = clock / (2 half_period)); MISO is
+        sampled ``half_period - 1`` clocks after SCLK falls.
     """
 
     offset: int
@@ -70,7 +73,8 @@ class FlashConfig:
             raise ConfigError(f"data_bits must be one of {', '.join(map(str, DATA_BITS))}, got "
                               f"{self.data_bits!r}", "data_bits")
         check_pow2("burst", self.burst, 1, min(256, 4096 // self.word_bytes))
-        check_int("half_period", self.half_period, 1, 64)
+        check_int("half_period", self.half_period, 2, 64,
+                  "MISO is sampled half_period - 1 clocks after SCLK falls")
         check_int("length", self.length, self.burst_bytes, FLASH_BYTES_MAX,
                   f"a whole number of {self.burst_bytes}-byte bursts")
         if self.length % self.burst_bytes:

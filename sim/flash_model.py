@@ -18,11 +18,14 @@ READ = 0x03
 
 class SpiFlash:
     """``image``: the array's bytes; ``min_phase``: the shortest SCLK high or low phase, in
-    clocks of the stepping."""
+    clocks of the stepping; ``delay``: clocks from the step that sees SCLK fall to the one
+    whose MISO carries the next bit (a part's clock-to-output time and the board's wires;
+    until then MISO keeps the bit before)."""
 
-    def __init__(self, image, min_phase=1):
+    def __init__(self, image, min_phase=1, delay=1):
         self.image = bytes(image)
-        self.min_phase = min_phase
+        self.min_phase, self.delay = min_phase, delay
+        self._pending = None       # [clocks left, bit] of a bit on its way to MISO
         self.errors = []
         self.reads = []            # (address, bytes sent) of every READ
         self._cs_n, self._sclk = 1, 0
@@ -39,6 +42,10 @@ class SpiFlash:
     def step(self, cs_n, sclk, mosi):
         """One clock with these pin values; returns MISO for the next."""
         cs_n, sclk, mosi = int(cs_n), int(sclk), int(mosi)
+        if self._pending is not None:
+            self._pending[0] -= 1
+            if self._pending[0] <= 0:
+                self._miso, self._pending = self._pending[1], None
         if cs_n != self._cs_n:
             if self._sclk or sclk:
                 self._error(f"CS# {'rose' if cs_n else 'fell'} with SCLK high (mode 0 idles low)")
@@ -75,4 +82,8 @@ class SpiFlash:
     def _falling(self):
         k = self._bits - 32                           # data bits sent so far
         byte = self.image[(self._addr + k // 8) % len(self.image)]
-        self._miso = byte >> (7 - k % 8) & 1
+        bit = byte >> (7 - k % 8) & 1
+        if self.delay:
+            self._pending = [self.delay, bit]
+        else:
+            self._miso = bit

@@ -247,16 +247,16 @@ class SdramModel:
         self.last_mrs = now
 
     # --- running it ---
-    async def process(self, ctx, pins):
-        """An Amaranth simulator process on ``pins`` (the controller's ``sdram`` interface):
-        the sync domain's reset resets the model too. The first violation is kept in
+    async def process(self, ctx, pins, domain="sync"):
+        """An Amaranth simulator process on ``pins`` (the controller's ``sdram`` interface),
+        clocked by ``domain``, whose reset resets the model too. The first violation is kept in
         ``error`` (the model stops there and the simulation runs on: an exception thrown
         out of a simulator process leaves its other coroutines half closed); the caller
         raises it once the simulation has ended."""
         drive, value = False, 0
         while True:
             ctx.set(pins.dq_i, value if drive else 0)
-            _, rst, *vals = await ctx.tick().sample(
+            _, rst, *vals = await ctx.tick(domain).sample(
                 pins.cs_n, pins.ras_n, pins.cas_n, pins.we_n, pins.ba, pins.a, pins.dqm,
                 pins.dq_o, pins.dq_oe, pins.cke)
             if self.error is not None:

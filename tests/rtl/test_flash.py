@@ -77,12 +77,15 @@ class AxiWriteMemory:
         return {"awready": self.awready, "wready": self.wready, "bvalid": self.bvalid}
 
 
-def run(cfg, image, seed, ready_p=0.5, max_delay=6, limit=200000, aw_p=None):
+def run(cfg, image, seed, ready_p=0.5, max_delay=6, limit=200000, aw_p=None, delay=None):
     """The loader with ``image`` in the flash, AWREADY high with probability ``aw_p``
-    (None: ``ready_p``), WREADY with ``ready_p``; returns (flash, memory, clocks to done)."""
+    (None: ``ready_p``), WREADY with ``ready_p``; the flash's MISO ``delay`` clocks after
+    SCLK falls (None: ``half_period - 1``, the most the loader allows); returns (flash,
+    memory, clocks to done)."""
     rng = np.random.default_rng(seed)
     dut = FlashLoader(cfg)
-    flash = SpiFlash(image, min_phase=cfg.half_period)
+    flash = SpiFlash(image, min_phase=cfg.half_period,
+                     delay=cfg.half_period - 1 if delay is None else delay)
     mem = AxiWriteMemory(1 << cfg.addr_bits if cfg.addr_bits <= 20 else cfg.base + cfg.length,
                          cfg.data_bits, lambda: rng.random() < ready_p,
                          lambda: int(rng.integers(0, max_delay + 1)),
@@ -115,7 +118,7 @@ def run(cfg, image, seed, ready_p=0.5, max_delay=6, limit=200000, aw_p=None):
 
 
 @pytest.mark.parametrize("data_bits, burst, half_period, ready_p, seed", [
-    (16, 8, 2, 0.5, 1), (16, 1, 1, 0.2, 2), (32, 4, 3, 0.9, 3), (8, 16, 1, 0.05, 4),
+    (16, 8, 2, 0.5, 1), (16, 1, 2, 0.2, 2), (32, 4, 3, 0.9, 3), (8, 16, 2, 0.05, 4),
     (64, 2, 2, 0.5, 5)])
 def test_the_memory_ends_equal_to_the_flash(data_bits, burst, half_period, ready_p, seed):
     rng = np.random.default_rng(seed)
@@ -136,7 +139,7 @@ def test_the_memory_ends_equal_to_the_flash(data_bits, burst, half_period, ready
 def test_no_w_beat_leads_its_aw_when_awready_is_slow():
     """AWREADY rare, WREADY always: each burst's beats wait for its AW (the checker fails a W
     beat with no burst announced), and the copy still completes."""
-    cfg = FlashConfig(offset=3, length=64, addr_bits=12, data_bits=8, burst=4, half_period=1)
+    cfg = FlashConfig(offset=3, length=64, addr_bits=12, data_bits=8, burst=4, half_period=2)
     image = bytes(range(256))
     flash, mem, res = run(cfg, image, 11, ready_p=1.0, aw_p=0.01)
     assert mem.errors == [] and flash.errors == [] and "done" in res
@@ -154,8 +157,20 @@ def test_the_loader_keeps_the_flash_at_full_rate_when_the_memory_keeps_up():
     assert bytes(mem.mem[:64]) == image[16:80]
 
 
+@pytest.mark.parametrize("half_period", [2, 4])
+def test_a_flash_slower_than_half_period_minus_one_clocks_is_read_wrong(half_period):
+    """The margin is what the docstring says: MISO that takes half_period clocks after SCLK
+    falls is sampled a bit late, and the copy differs (so the tests above, run at
+    half_period - 1, are at the limit)."""
+    cfg = FlashConfig(offset=0, length=32, addr_bits=12, data_bits=16, burst=4,
+                      half_period=half_period)
+    image = bytes(range(1, 65))
+    _, mem, res = run(cfg, image, 3, ready_p=1.0, max_delay=0, delay=half_period)
+    assert "done" in res and bytes(mem.mem[:32]) != image[:32]
+
+
 def test_a_bad_response_is_sticky_in_error():
-    cfg = FlashConfig(offset=0, length=8, addr_bits=12, data_bits=16, burst=4, half_period=1)
+    cfg = FlashConfig(offset=0, length=8, addr_bits=12, data_bits=16, burst=4, half_period=2)
     dut = FlashLoader(cfg)
     seen = []
 
@@ -180,7 +195,7 @@ def test_a_bad_response_is_sticky_in_error():
     ({"offset": -1}, "offset"), ({"offset": (1 << 24) - 15}, "offset"),
     ({"length": 0}, "length"), ({"length": 17}, "length"), ({"length": 1 << 25}, "length"),
     ({"base": 8}, "base"), ({"base": 1 << 25}, "base"), ({"data_bits": 24}, "data_bits"),
-    ({"burst": 3}, "burst"), ({"burst": 512}, "burst"), ({"half_period": 0}, "half_period"),
+    ({"burst": 3}, "burst"), ({"burst": 512}, "burst"), ({"half_period": 1}, "half_period"),
     ({"addr_bits": 7}, "addr_bits")])
 def test_config_errors_name_the_parameter(changes, field):
     kw = {"offset": 0, "length": 16, "burst": 8, "data_bits": 16, **changes}

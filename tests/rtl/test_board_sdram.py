@@ -1,0 +1,121 @@
+"""The board with its map in the SDRAM (rtl/board.BoardCore with ``sdram`` and ``flash``;
+docs/board.md): after reset the FlashLoader copies the map's image from the SPI flash
+(sim/flash_model.py) into the SDRAM (sim/sdram_model.py, the datasheet model, which fails on
+any illegal command or timing) through the SdramController, then the pipeline's texel
+cache reads it from there. In the Amaranth simulator, the pipeline at 4 x the pixel clock:
+the first frames shown equal the golden frames (the map in block RAM's), nothing underflows
+or comes out of order, and neither model saw a rule broken. Opt-in (``make regress``): the
+load and two frames take about a minute of simulation."""
+
+import numpy as np
+import pytest
+from amaranth.sim import Simulator
+
+from bumprtl.gen.flow.board import board_data
+from bumprtl.rtl.board import BoardCore
+from bumprtl.rtl.cache import scene_geometry, scene_levels, tiled_image
+from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.flash import FlashConfig
+from bumprtl.rtl.sdram import SdramConfig
+from bumprtl.rtl.video import MODES
+from bumprtl.sim.flash_model import SpiFlash
+from bumprtl.sim.golden.board import golden_frame
+from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.sim.sdram_model import SdramModel
+
+PIPE_MHZ = 100
+OFFSET = 0x2000              # the map's place in the flash (the bitstream before it)
+
+
+def board_parts(scene):
+    """(SdramConfig, FlashConfig, flash bytes) of ``scene``'s map: its tiled image at
+    OFFSET of the flash, copied to the cache's base in bursts of one SDRAM burst."""
+    geom = scene_geometry(scene.hardware)
+    words, _, _, _ = board_data(scene)
+    image = tiled_image(geom, scene_levels(scene.hardware, words))
+    sdram = SdramConfig(freq_mhz=PIPE_MHZ, powerup_cycles=40, init_refreshes=2,
+                        data_bits=geom.data_bits, addr_bits=geom.addr_bits)
+    flash = FlashConfig(offset=OFFSET, length=len(image), base=geom.base,
+                        addr_bits=geom.addr_bits, data_bits=geom.data_bits, burst=4,
+                        half_period=2)
+    rng = np.random.default_rng(3)              # whatever else the flash holds
+    contents = rng.integers(0, 256, OFFSET + len(image) + 64, dtype=np.uint8).tobytes()
+    return sdram, flash, contents[:OFFSET] + image + contents[OFFSET + len(image):]
+
+
+@pytest.mark.regress
+def test_frames_from_the_map_in_sdram_equal_the_golden_frames():
+    scene = load_scene_config("default", {"angle_bits": 10, "texture_size": 16,
+                                          "map_memory": "axi"})
+    mode = MODES["test"]
+    words, texels, constants, table = board_data(scene)
+    table = table[:4]
+    sdram, flash_cfg, contents = board_parts(scene)
+    core = BoardCore(scene.hardware, mode, None, constants, table, texels,
+                     pipe_hz=PIPE_MHZ * 1e6, sdram=sdram, flash=flash_cfg)
+    model = SdramModel(sdram.variant, PIPE_MHZ, powerup_ns=40 * 1000 / PIPE_MHZ,
+                       init_refreshes=2)
+    flash = SpiFlash(contents, min_phase=flash_cfg.half_period, delay=flash_cfg.half_period - 1)
+    frames, seen, result = 2, [], {}
+
+    async def flash_pins(ctx):          # each pipe clock: the pins after the edge, MISO for it
+        spi = core.spi
+        while True:
+            await ctx.tick("pipe")
+            ctx.set(spi.miso, flash.step(ctx.get(spi.cs_n), ctx.get(spi.sclk), ctx.get(spi.mosi)))
+
+    async def display(ctx):
+        t = core.timing
+        limit = 400_000
+        for _ in range(limit):
+            if ctx.get(t.de) and ctx.get(core.shows):
+                seen.append(ctx.get(core.pixel))
+            if len(seen) >= frames * mode.pixels:
+                break
+            await ctx.tick()
+        result.update(underflow=ctx.get(core.underflow), order=ctx.get(core.order_error),
+                      done=ctx.get(core.loader.done), error=ctx.get(core.loader.error))
+
+    sim = Simulator(core)
+    sim.add_clock(1 / mode.pixel_hz)
+    sim.add_clock(1e-6 / PIPE_MHZ, domain="pipe")
+    async def sdram_pins(ctx):
+        await model.process(ctx, core.sdram_pins, "pipe")
+
+    sim.add_process(sdram_pins)
+    sim.add_testbench(flash_pins, background=True)
+    sim.add_testbench(display)
+    sim.run()
+    assert model.error is None, model.error
+    assert flash.errors == [] and flash.reads == [(OFFSET, flash_cfg.length)]
+    assert result == {"underflow": 0, "order": 0, "done": 1, "error": 0}
+    px = np.array(seen, np.int64)
+    rgb = np.stack([(px >> 16) & 255, (px >> 8) & 255, px & 255], -1)
+    got = rgb.reshape(frames, mode.v_active, mode.h_active, 3)
+    for f in range(frames):
+        want = golden_frame(scene, mode, f, table, words, texels)
+        assert np.array_equal(got[f], want), \
+            f"frame {f}: {np.count_nonzero(np.any(got[f] != want, -1))} pixels differ"
+
+
+def test_the_memory_parts_must_agree():
+    """A map in the SDRAM without the memory parts, or the parts with a map in block RAM,
+    or data widths that differ, is refused naming the parameter."""
+    axi = load_scene_config("default", {"angle_bits": 10, "texture_size": 16,
+                                        "map_memory": "axi"})
+    bram = load_scene_config("default", {"angle_bits": 10, "texture_size": 16})
+    sdram, flash, _ = board_parts(axi)
+    mode = MODES["test"]
+    words, texels, constants, table = board_data(bram)
+    with pytest.raises(BumpError) as e:
+        BoardCore(axi.hardware, mode, None, constants, table, texels, pipe_hz=1e8)
+    assert e.value.field == "map_memory"
+    with pytest.raises(BumpError) as e:
+        BoardCore(bram.hardware, mode, words, constants, table, texels, pipe_hz=1e8,
+                  sdram=sdram, flash=flash)
+    assert e.value.field == "map_memory"
+    wide = SdramConfig(freq_mhz=PIPE_MHZ, powerup_cycles=40, data_bits=64)
+    with pytest.raises(BumpError) as e:
+        BoardCore(axi.hardware, mode, None, constants, table, texels, pipe_hz=1e8,
+                  sdram=wide, flash=flash)
+    assert e.value.field == "data_bits" and "64" in str(e.value)
