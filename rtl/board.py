@@ -243,6 +243,7 @@ class GlobeSource(RasterSource):
     def __init__(self, pipeline, mode: VideoMode, globe: GlobeGeometry, table):
         bits = pipeline.cfg.tag_bits
         if bits < 2:
+            self._MustUse__silence = True          # refused: never to be elaborated
             raise BumpError(f"tag_bits must be >= 2 for the globe (the pixel count and the "
                             f"inside bit), got {bits}", "tag_bits")
         super().__init__(pipeline, mode, table, bits - 1)

@@ -119,29 +119,31 @@ def test_board_buffer_depth_keeps_long_lines_fed(scene_data):
     assert buffer_depth(latency) >= 1 + latency + FIFO_DELAY
 
 
-def source_payloads(scene, mode, table, frames, seed):
-    """The payload fields of every pixel PixelSource issues over ``frames`` frames, under
-    random credits and ready: {key: [value, ...]}, with the light step register."""
-    pipeline = unelaborated_pipeline(scene)
-    src = PixelSource(pipeline, mode, {"n.phi": 0, "n.theta": 0}, table)
-    p = pipeline.i
-    keys = ["u", "v", "tag", *table[0]]
+def collect_payloads(src, keys, need, seed, parts=(), each=None):
+    """The payload fields ``keys`` of the first ``need`` pixels the source ``src`` hands its
+    pipeline, under random ``allow`` and ``ready``: {key: [value, ...]}, with the light step
+    register (``step``); ``parts``: further elaboratables beside it; ``each(ctx, got)``: a
+    call every clock for more records."""
+    p = src.pipeline.i
     got = {k: [] for k in [*keys, "step"]}
-    need = frames * mode.pixels
     rng = np.random.default_rng(seed)
     m = Module()
     m.submodules.src = src
+    for n, part in enumerate(parts):
+        m.submodules[f"part{n}"] = part
     ready = Signal()
     m.d.comb += p.ready.eq(ready)
 
     async def bench(ctx):
-        while len(got["u"]) < need:
+        while len(got[keys[0]]) < need:
             ctx.set(src.allow, int(rng.random() < 0.8))
-            ctx.set(ready, int(rng.random() < 0.8))
+            ctx.set(ready, int(rng.random() < 0.7))
             if ctx.get(p.valid) and ctx.get(ready):
                 for k in keys:
                     got[k].append(ctx.get(payload_field(p.payload, k)))
                 got["step"].append(ctx.get(src.frame))
+            if each is not None:
+                each(ctx, got)
             await ctx.tick()
 
     sim = Simulator(m)
@@ -149,6 +151,12 @@ def source_payloads(scene, mode, table, frames, seed):
     sim.add_testbench(bench)
     sim.run()
     return got
+
+
+def source_payloads(scene, mode, table, frames, seed):
+    """The payload fields of every pixel PixelSource issues over ``frames`` frames."""
+    src = PixelSource(unelaborated_pipeline(scene), mode, {"n.phi": 0, "n.theta": 0}, table)
+    return collect_payloads(src, ["u", "v", "tag", *table[0]], frames * mode.pixels, seed)
 
 
 @pytest.mark.parametrize("steps", [5, STEPS])

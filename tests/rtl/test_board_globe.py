@@ -10,7 +10,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-from amaranth.hdl import Module, Signal
 from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.board import board_core, board_data
@@ -19,14 +18,13 @@ from bumprtl.rtl.board import (
     globe_config,
     globe_offsets,
     globe_turn_step,
-    payload_field,
 )
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.globe import GlobeGeometry
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import STEPS, frame_inputs, golden_frame, light_table
 from bumprtl.sim.scenes.config import load_scene_config
-from tests.rtl.test_board import unelaborated_pipeline
+from tests.rtl.test_board import collect_payloads, unelaborated_pipeline
 
 SMALL = {"angle_bits": 10, "texture_size": 16, "image": "globe"}
 
@@ -109,37 +107,18 @@ def test_golden_globe_is_lit_on_the_side_facing_the_light(step, quadrant):
 
 def source_payloads(scene, mode, table, frames, seed):
     """The payload fields of every pixel GlobeSource hands the pipeline over ``frames``
-    frames, under random credits at both ends: {key: [value, ...]}."""
+    frames, under random credits at both ends, and the rotation of every pixel the globe
+    takes: {key: [value, ...]}."""
     pipeline = unelaborated_pipeline(scene)
     globe = GlobeGeometry(globe_config(pipeline.scene, mode))
     src = GlobeSource(pipeline, mode, globe, table)
-    p = pipeline.i
+
+    def rotation(ctx, got):
+        if ctx.get(globe.i.valid) and ctx.get(globe.i.ready):
+            got.setdefault("rotation", []).append(ctx.get(globe.i.payload.rotation))
+
     keys = ["u", "v", "n.phi", "n.theta", "tag", *table[0]]
-    got = {k: [] for k in [*keys, "step", "rotation"]}
-    need = frames * mode.pixels
-    rng = np.random.default_rng(seed)
-    m = Module()
-    m.submodules.src, m.submodules.globe = src, globe
-    ready = Signal()
-    m.d.comb += p.ready.eq(ready)
-
-    async def bench(ctx):
-        while len(got["u"]) < need:
-            ctx.set(src.allow, int(rng.random() < 0.8))
-            ctx.set(ready, int(rng.random() < 0.7))
-            if ctx.get(p.valid) and ctx.get(ready):
-                for k in keys:
-                    got[k].append(ctx.get(payload_field(p.payload, k)))
-                got["step"].append(ctx.get(src.frame))
-            if ctx.get(globe.i.valid) and ctx.get(globe.i.ready):
-                got["rotation"].append(ctx.get(globe.i.payload.rotation))
-            await ctx.tick()
-
-    sim = Simulator(m)
-    sim.add_clock(1e-6)
-    sim.add_testbench(bench)
-    sim.run()
-    return got
+    return collect_payloads(src, keys, frames * mode.pixels, seed, [globe], rotation)
 
 
 def test_source_stream_follows_the_golden_inputs_through_the_wraps():
