@@ -369,10 +369,9 @@ class BoardCore(Elaboratable):
             rgb = Cat(o.color.b, o.color.g, o.color.r)
         else:
             rgb = Cat(o.color, o.color, o.color)
-        count_bits = tag_bits
         if self.globe is not None:    # the tag's top bit is the globe's inside: black outside
             rgb = Mux(o.tag[-1], rgb, 0)
-            count_bits = tag_bits - 1
+        count_bits = len(src.count)   # the tag's bits that count pixels, as the source counts
         # a pixel every cycle, once the map is in place; the credits decide when it is taken
         m.d.comb += src.allow.eq(1 if self.sdram is None else self.loader.done)
         # the display shows from the first frame whose first pixel is ready
