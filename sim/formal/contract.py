@@ -624,29 +624,39 @@ class StreamContract(Elaboratable):
                         (slots[after].tag == (word.tag + 1)[:bits]),
                         "the FIFO's entries hold consecutive tags")
             youngest = Mux((inner != 0) & (produce == after), (word.tag + 1)[:bits], youngest)
-        # Consecutive valid stages of the chain hold consecutive tags, the one nearest the
-        # FIFO the tag after the FIFO's youngest, and the next input gets one past the
-        # youngest: a chain of muxes from the output backwards (no counting, which SAT
-        # solvers find hard).
-        expect = Signal(bits, name="tag_after_fifo")
-        m.d.comb += expect.eq(youngest)
-        for j in reversed(range(len(stages))):
-            valid, tag = stages[j]
-            if tag is None:
-                return
-            self._lemma(m, ~valid | (tag == expect), "valid stages hold consecutive tags")
-            nxt = Signal(bits, name=f"tag_after_stage{j + 1}")
-            m.d.comb += nxt.eq(Mux(valid, tag + 1, expect))
-            expect = nxt
+        # The chain shifts every cycle, so stage k holds what entered it k cycles ago. A
+        # ghost delay line beside it carries the count of pixels that had entered by then
+        # (g_k): a valid stage holds tag g_k, g_k = g_(k+1) + valid_(k+1), the next pixel
+        # in gets one past g_1's stage, and the FIFO's youngest is the one before stage
+        # L's. Each lemma relates two neighbours (a long chain of muxes and adders from
+        # the output backwards was too deep for the solver past ~20 stages).
+        entry = Signal(bits, name="tag_into_chain")
+        m.d.sync += entry.eq(entry + self._valid_in)
+        ghosts, prev = [], entry
+        for k in range(1, len(stages) + 1):
+            g = Signal(bits, name=f"tag_entered_stage{k}")
+            m.d.sync += g.eq(prev)
+            ghosts.append(g)
+            prev = g
+        for k, (valid, tag) in enumerate(stages):
+            if tag is not None:
+                self._lemma(m, ~valid | (tag == ghosts[k]), "a valid stage holds the tag it entered with")
+            if k + 1 < len(stages):
+                self._lemma(m, ghosts[k] == (ghosts[k + 1] + stages[k + 1][0])[:bits],
+                            "the ghost tags of neighbouring stages differ by the older one's valid")
+        self._lemma(m, entry == (ghosts[0] + stages[0][0])[:bits],
+                    "the next pixel into the chain is one past stage 1's ghost tag")
+        self._lemma(m, youngest == ghosts[-1], "the FIFO's youngest is the one before stage L's")
+        expect = entry
         if self.cache is None:
             self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
             return
         # The cache in front of the edge: the tag after the chain's youngest is the next
         # one the cache delivers, the next input's that plus the pixels in the cache.
         c = self.cache
-        n_edge = Signal(bits, name="tag_into_chain")
+        n_edge = Signal(bits, name="tag_out_of_cache")
         m.d.sync += n_edge.eq(n_edge + (c.o.valid & c.o.ready))
-        self._lemma(m, n_edge == expect, "the cache's next pixel is one past the chain's youngest")
+        self._lemma(m, n_edge == expect, "the cache's next pixel is the chain's next")
         self._lemma(m, n_in == (n_edge + self._in_cache(m, take_in))[:bits],
                     "next input tag is one past the youngest in flight")
         self._cache_order(m, n_edge, bits)

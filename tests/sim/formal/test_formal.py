@@ -112,15 +112,20 @@ def test_runner_names_the_property_and_trace_and_exits_1(monkeypatch, build_dir,
 
 
 def test_lemmas_come_from_the_units_own_registers():
-    """The order lemmas cover every stage and every FIFO entry: one tag register per stage
-    of SinCos's chain, two per address of its edge's FIFO memory (rtl/pipe.CreditFIFO: the
+    """The order lemmas cover every stage and every FIFO entry: per stage of SinCos's chain
+    its tag and its ghost count (each stage's against the next one's, the last one's
+    against the FIFO's youngest), two per address of its edge's FIFO memory (rtl/pipe.CreditFIFO: the
     next power of two words at least ``fifo_depth``; the output register is the property
     itself; the oldest entry, and each entry after the one before it), plus the next input
     tag; and the credit loop's invariant is among them."""
     top = StreamContract(TARGETS["sincos"].unit(), "order")
     rtlil.convert(top, name="top", ports=top.free_inputs())
     said = Counter(top.lemma_names)
-    assert said["valid stages hold consecutive tags"] == top.dut.latency
+    assert said["a valid stage holds the tag it entered with"] == top.dut.latency
+    assert said["the ghost tags of neighbouring stages differ by the older one's valid"] == \
+        top.dut.latency - 1
+    assert said["the next pixel into the chain is one past stage 1's ghost tag"] == 1
+    assert said["the FIFO's youngest is the one before stage L's"] == 1
     words = 1 << (top.dut.fifo_depth - 1).bit_length()
     assert said["the FIFO's entries hold consecutive tags"] == words
     assert said["the FIFO's oldest entry holds the tag after the output's"] == words
