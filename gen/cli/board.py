@@ -112,7 +112,8 @@ def run(args):
             print(f"{d}: minimum Fmax over seeds {','.join(map(str, seeds))}: {a:.1f} MHz, "
                   f"constraint {c:.1f} MHz: {'met' if a >= c else 'NOT MET'}")
         if args.parts:
-            parts = part_costs(scene, mode, out / "parts")
+            parts = part_costs(scene, mode, out / "parts",
+                               **({} if memory is None else {"memory": memory}))
             summary["parts"] = parts
             for part, row in parts.items():
                 print(f"{part}: " + ", ".join(f"{k} {v}" for k, v in row.items()))

@@ -328,21 +328,29 @@ def _domain(clock):
 
 
 _PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",), "globe": ("globe",),
+          "SDRAM controller": ("sdram",), "flash loader": ("flash_loader",),
+          "clock crossing": ("cdc",),
           "video (timing + source)": ("timing", "source"),
           "TMDS (encoders + serializer)": ("tmds0", "tmds1", "tmds2", "serializer")}
+_OPTIONAL = ("globe", "SDRAM controller", "flash loader", "clock crossing")
 _CELLS = {"LUT4": {"LUT4": 1, "CCU2C": 2, "TRELLIS_DPR16X4": 2}, "FF": {"TRELLIS_FF": 1},
           "DSP": {"MULT18X18D": 1}, "BRAM": {"DP16KD": 1}}
 
 
-def part_costs(scene, mode, work_dir):
+def part_costs(scene, mode, work_dir, memory=None):
     """LUT4 (CCU2C counted as 2, as nextpnr's TRELLIS_COMB does; a 16 x 4 LUT RAM as 2), FF,
     DSP, BRAM of each part of the core, from one Yosys ``synth_ecp5 -noflatten`` of the core
-    (the ECP5 target); the parts' sum is within a few per cent of the flattened build."""
+    (the ECP5 target); the parts' sum is within a few per cent of the flattened build.
+    ``memory``: the map in the SDRAM (:func:`board_memory`), the SDRAM's and the flash's
+    pins then ports of the core too."""
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    core = board_core(scene, mode, ECP5())
-    (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=[
-        core.o0, core.o1, core.underflow, core.order_error]))
+    core = board_core(scene, mode, ECP5(), **({} if memory is None else {"memory": memory}))
+    ports = [core.o0, core.o1, core.underflow, core.order_error]
+    if memory is not None:
+        ports += [value for iface in (core.sdram_pins, core.spi)
+                  for _, _, value in iface.signature.flatten(iface)]
+    (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=ports))
     yosys.run_yosys("read_rtlil core.il; synth_ecp5 -noflatten -top core; write_json core.synth.json",
                     "core.synth.log", work_dir)
     net = json.loads((work_dir / "core.synth.json").read_text())["modules"]
@@ -372,7 +380,7 @@ def part_costs(scene, mode, work_dir):
                 if cname == n or cname.endswith("." + n) or cname.split("$")[0] == n:
                     for k, v in count(t).items():
                         row[k] += v
-        if part != "globe" or any(row.values()):      # a plane has no globe
+        if part not in _OPTIONAL or any(row.values()):      # a plane has no globe, ...
             rows[part] = row
     glue = {k: 0 for k in _CELLS}
     for cell in top["cells"].values():
