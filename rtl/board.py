@@ -524,10 +524,10 @@ class ULX3SSdramIO(Elaboratable):
     clock from a DDR output register (ODDRX1F) sending 0 then 1 each ``pipe`` cycle, so its
     rising edge is mid-way in the cycle (the ``pipe`` clock inverted); DQ captured by a
     flip-flop clocked by ``sdram_rd`` (CLKOS3: ``pipe`` half a period later) after its input
-    buffer, read by the controller's ``dq_i`` register in ``pipe``. The flash: SCLK through ``USRMCLK`` (the
-    configuration clock pin is no user I/O), CS#, MOSI, MISO through plain buffers (the
-    loader's outputs are registers; it samples MISO ``half_period - 1`` clocks after SCLK
-    falls), HOLD# and WP# high."""
+    buffer, read by the controller's ``dq_i`` register in ``pipe``. The flash: SCLK through
+    ``USRMCLK`` (the configuration clock pin is no user I/O), CS#, MOSI, MISO through plain
+    buffers (the loader's outputs are registers; it samples MISO ``half_period - 1`` clocks
+    after SCLK falls), HOLD# and WP# high."""
 
     def __init__(self, core: BoardCore):
         self.core = core

@@ -12,7 +12,7 @@
 * :func:`board_memory` makes the parts of a map in the SDRAM: the pipe clock (the PLL's at
   or below the SDRAM's limit), the SdramConfig for exactly that clock, the FlashConfig of
   the map's image, and the image itself (gen/flow/memories.memory_images, the bytes
-  ``bumprtl emit pipeline --map-memory axi`` writes as ``pipeline_map.bin``);
+  ``bumprtl emit pipeline --map-memory axi`` writes as ``bumprtl_pipeline_map.bin``);
 * :func:`build_bitstream` runs Amaranth's ECP5 flow (Yosys ``synth_ecp5``, nextpnr-ecp5,
   ecppack; the YoWASP builds) on ``ULX3S_85F_Platform`` and reads nextpnr's report: LUT4,
   FF, DSP, BRAM and the Fmax of each clock;
