@@ -5,8 +5,8 @@ netlist, a failed one named), the tools' environment, and the part costs added u
 non-flattened netlist."""
 
 import json
-import re
 import os
+import re
 from types import SimpleNamespace
 
 import pytest
