@@ -49,7 +49,7 @@ from amaranth.hdl import (
     Mux,
     Signal,
 )
-from amaranth.lib import wiring
+from amaranth.lib import io, wiring
 from amaranth.lib.cdc import ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.memory import Memory
@@ -69,7 +69,8 @@ __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "Ra
            "GlobeSource", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
            "GLOBE_TURN_FRAMES",
            "GLOBE_RADIUS", "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
-           "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider"]
+           "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider", "sdram_clock",
+           "SDRAM_PIN_CYCLES", "ULX3SSdramIO"]
 
 BUFFER_MARGIN = 8
 # The globe: its radius is GLOBE_RADIUS of the screen's height (224 pixels at 480 lines, 336
@@ -450,14 +451,19 @@ def pll_clock(pixel_hz, ref_hz=25e6):
     return ref_hz / clki * fb / 5
 
 
-def pll_pipe_divider(pixel_hz, pipe_hz, ref_hz=25e6):
+def pll_pipe_divider(pixel_hz, pipe_hz, ref_hz=25e6, at_most=False):
     """``(clkos2_div, hz)``: the EHXPLLL's CLKOS2 divider of the VCO of
     :func:`pll_dividers` that gives the pipeline's clock nearest ``pipe_hz`` from above (never
-    below it: :func:`cdc_depth` assumes at least that rate), and that clock. BumpError
-    when no divider gives a clock within [``pipe_hz``, OUT_MAX_HZ]."""
+    below it: :func:`cdc_depth` assumes at least that rate), or with ``at_most`` nearest at
+    or below it (the SDRAM's clock: never faster than the clock its timing was counted
+    for), and that clock. BumpError when no divider gives a clock within [``pipe_hz``,
+    OUT_MAX_HZ] (``at_most``: within [VCO / DIV_MAX, ``pipe_hz``])."""
     clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
     vco = ref_hz / clki * fb * op_div
-    div = int(vco // pipe_hz) if pipe_hz > 0 else 0
+    div = 0
+    if pipe_hz > 0:               # a clock the PLL gives exactly keeps its own divider
+        ratio = vco / pipe_hz
+        div = math.ceil(ratio - 1e-9) if at_most else math.floor(ratio + 1e-9)
     if not 1 <= div <= DIV_MAX or vco / div > OUT_MAX_HZ:
         raise BumpError(f"pipe clock must be in [{vco / DIV_MAX / 1e6:g}, {OUT_MAX_HZ / 1e6:g}] MHz "
                         f"(the VCO {vco / 1e6:g} MHz over a divider 1 .. {DIV_MAX}), got "
@@ -465,16 +471,37 @@ def pll_pipe_divider(pixel_hz, pipe_hz, ref_hz=25e6):
     return div, vco / div
 
 
-def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None):
+def sdram_clock(pixel_hz, sdram_max_hz, ref_hz=25e6):
+    """The pipe clock of a board whose map is in the SDRAM: the PLL's CLKOS2 nearest
+    ``sdram_max_hz`` at or below it (:func:`pll_pipe_divider` with ``at_most``), in Hz; the
+    SdramConfig is then made for exactly this clock. BumpError naming ``pipe_hz`` when it
+    would be below the pixel clock (:func:`cdc_depth`)."""
+    _, hz = pll_pipe_divider(pixel_hz, sdram_max_hz, ref_hz, at_most=True)
+    if hz < pixel_hz:
+        raise BumpError(f"pipe clock: the PLL's clock at or below {sdram_max_hz / 1e6:g} MHz is "
+                        f"{hz / 1e6:g} MHz, below the pixel clock {pixel_hz / 1e6:g} MHz; it must "
+                        f"be in [{pixel_hz / 1e6:g}, {sdram_max_hz / 1e6:g}] MHz", "pipe_hz")
+    return hz
+
+
+def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None, sdram=False):
     """EHXPLLL parameters: CLKOP = 5 x pixel (the shift clock, also the feedback), CLKOS =
     the pixel clock, from ``ref_hz`` (:func:`pll_dividers`); with ``pipe_hz``, CLKOS2 = the
-    pipeline's clock (:func:`pll_pipe_divider`)."""
+    pipeline's clock (:func:`pll_pipe_divider`, from above; with ``sdram`` at or below);
+    with ``sdram`` also CLKOS3 = the same clock half a period later (the SDRAM's read
+    capture, docs/sdram.md): the coarse phase counts VCO cycles after the divider's own
+    ``div - 1``, the fine phase eighths of one (the convention of Project Trellis' ecppll)."""
     clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
     extra = {}
     if pipe_hz is not None:
-        div, _ = pll_pipe_divider(pixel_hz, pipe_hz, ref_hz)
+        div, _ = pll_pipe_divider(pixel_hz, pipe_hz, ref_hz, at_most=sdram)
         extra = {"p_CLKOS2_ENABLE": "ENABLED", "p_CLKOS2_DIV": div,
-                 "p_CLKOS2_CPHASE": div - 1, "p_CLKOS2_FPHASE": 0}
+                 "p_CLKOS2_CPHASE": div - 1, "p_CLKOS2_FPHASE": 0,
+                 "p_OUTDIVIDER_MUXC": "DIVC"}
+        if sdram:               # half of div VCO cycles: div // 2 whole ones, 4/8 if div is odd
+            extra.update({"p_CLKOS3_ENABLE": "ENABLED", "p_CLKOS3_DIV": div,
+                          "p_CLKOS3_CPHASE": div - 1 + div // 2,
+                          "p_CLKOS3_FPHASE": 4 * (div % 2), "p_OUTDIVIDER_MUXD": "DIVD"})
     return {**extra, "p_CLKI_DIV": clki, "p_CLKFB_DIV": fb, "p_FEEDBK_PATH": "CLKOP",
             "p_CLKOP_ENABLE": "ENABLED", "p_CLKOP_DIV": op_div, "p_CLKOP_CPHASE": op_div - 1,
             "p_CLKOP_FPHASE": 0, "p_CLKOS_ENABLE": "ENABLED", "p_CLKOS_DIV": 5 * op_div,
@@ -484,12 +511,87 @@ def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None):
             "p_DPHASE_SOURCE": "DISABLED", "p_PLL_LOCK_MODE": 0}
 
 
-class ULX3STop(Elaboratable):
-    """The ULX3S top (``ULX3S_85F_Platform``): PLL, reset from its lock, the core on the
-    ``hdmi`` pins (DDR), LEDs 0/1: underflow / order error, LED 7: light step bit 4."""
+# Clock cycles the ULX3S top's SDRAM I/O adds to a READ's round trip (SdramConfig.pin_cycles):
+# the commands' output registers in the I/O cells (1) and DQ captured half a cycle late, on
+# CLKOS3, then re-registered by the controller's dq_i register a half cycle on (1).
+SDRAM_PIN_CYCLES = 2
+
+
+class ULX3SSdramIO(Elaboratable):
+    """The SDRAM's and the SPI flash's pins of the ULX3S for ``core`` (docs/sdram.md, The
+    pins on the ULX3S): every SDRAM output (CKE, CS#, RAS#, CAS#, WE#, BA, A, DQM, DQ and
+    its output enable) in an I/O-cell register clocked by ``pipe`` (FFBuffer), the SDRAM
+    clock from a DDR output register (ODDRX1F) sending 0 then 1 each ``pipe`` cycle, so its
+    rising edge is mid-way in the cycle (the ``pipe`` clock inverted); DQ captured by a
+    flip-flop clocked by ``sdram_rd`` (CLKOS3: ``pipe`` half a period later) after its input
+    buffer, read by the controller's ``dq_i`` register in ``pipe``. The flash: SCLK through
+    ``USRMCLK`` (the configuration clock pin is no user I/O), CS#, MOSI, MISO through plain
+    buffers (the loader's outputs are registers; it samples MISO ``half_period - 1`` clocks
+    after SCLK falls), HOLD# and WP# high."""
 
     def __init__(self, core: BoardCore):
         self.core = core
+
+    def elaborate(self, platform):
+        m, pins, spi = Module(), self.core.sdram_pins, self.core.spi
+        sd = platform.request("sdram", 0, dir="-")
+        m.submodules.sdram_clk = clk = io.DDRBuffer("o", sd.clk, o_domain="pipe")
+        m.d.comb += [clk.o[0].eq(0), clk.o[1].eq(1)]       # low, then high: the inverted clock
+        # the resource's cs, we, ras, cas are PinsN (active high here, inverted at the pin)
+        outs = {"clk_en": pins.cke, "cs": ~pins.cs_n, "we": ~pins.we_n, "ras": ~pins.ras_n,
+                "cas": ~pins.cas_n, "ba": pins.ba, "a": pins.a, "dqm": pins.dqm}
+        for name, value in outs.items():
+            m.submodules[f"sdram_{name}"] = buf = io.FFBuffer("o", getattr(sd, name),
+                                                                  o_domain="pipe")
+            m.d.comb += buf.o.eq(value)
+        # DQ: output and output enable in the I/O cell's registers (``pipe``), as above; an
+        # ECP5 I/O cell has one clock for all its registers (nextpnr refuses an IOLOGIC with
+        # two), so the capture on ``sdram_rd`` is the flip-flop after the input buffer
+        dq_in = Signal(len(pins.dq_i), name="sdram_dq_capture")
+        for k in range(len(pins.dq_i)):
+            q, t, i = Signal(name=f"sdram_dq_q{k}"), Signal(name=f"sdram_dq_t{k}"), \
+                Signal(name=f"sdram_dq_i{k}")
+            m.submodules[f"sdram_dq_o{k}"] = Instance(
+                "OFS1P3DX", i_SCLK=ClockSignal("pipe"), i_SP=1, i_CD=0, i_D=pins.dq_o[k], o_Q=q)
+            m.submodules[f"sdram_dq_oe{k}"] = Instance(
+                "OFS1P3DX", i_SCLK=ClockSignal("pipe"), i_SP=1, i_CD=0, i_D=~pins.dq_oe, o_Q=t)
+            m.submodules[f"sdram_dq_bb{k}"] = Instance("BB", i_I=q, i_T=t, o_O=i, io_B=sd.dq.io[k])
+            m.d.sdram_rd += dq_in[k].eq(i)
+        m.d.comb += pins.dq_i.eq(dq_in)
+
+        fl = platform.request("spi_flash", 0, dir="-")
+        m.submodules.usrmclk = Instance("USRMCLK", i_USRMCLKI=spi.sclk, i_USRMCLKTS=0,
+                                        a_keep=1)
+        for name, value in (("cs", ~spi.cs_n), ("copi", spi.mosi), ("hold", 0), ("wp", 0)):
+            m.submodules[f"flash_{name}"] = buf = io.Buffer("o", getattr(fl, name))
+            m.d.comb += buf.o.eq(value)
+        m.submodules.flash_cipo = cipo = io.Buffer("i", fl.cipo)
+        m.d.comb += spi.miso.eq(cipo.i)
+        return m
+
+
+class ULX3STop(Elaboratable):
+    """The ULX3S top (``ULX3S_85F_Platform``): PLL, reset from its lock, the core on the
+    ``hdmi`` pins (DDR), LEDs 0/1: underflow / order error, LED 7: light step bit 4. With
+    the map in the SDRAM, :class:`ULX3SSdramIO` on the ``sdram`` and ``spi_flash`` pins, the
+    PLL's CLKOS3 for the read capture (:func:`pll_params` with ``sdram``), LEDs 2/3: the
+    flash copy done / its error; the core's SdramConfig must be made for the PLL's pipe
+    clock (:func:`sdram_clock`) with ``pin_cycles`` = SDRAM_PIN_CYCLES, else BumpError."""
+
+    def __init__(self, core: BoardCore):
+        self.core = core
+        if core.sdram is not None:
+            cfg, pixel_hz = core.sdram, core.mode.pixel_hz
+            _, hz = pll_pipe_divider(pixel_hz, core.pipe_hz, at_most=True)
+            if not abs(hz - cfg.freq_mhz * 1e6) <= 1e-6 * hz:
+                self._MustUse__silence = True          # refused: never to be elaborated
+                raise BumpError(f"freq_mhz: the SdramConfig's clock must be the PLL's pipe clock "
+                                f"{hz / 1e6:.6g} MHz (its timings and refresh are counted in its "
+                                f"cycles), got {cfg.freq_mhz:.6g} MHz", "freq_mhz")
+            if cfg.pin_cycles != SDRAM_PIN_CYCLES:
+                self._MustUse__silence = True
+                raise BumpError(f"pin_cycles must be {SDRAM_PIN_CYCLES} on the ULX3S top (its "
+                                f"I/O registers), got {cfg.pin_cycles}", "pin_cycles")
 
     def elaborate(self, platform):
         m, core = Module(), self.core
@@ -498,15 +600,20 @@ class ULX3STop(Elaboratable):
         clk25 = platform.request("clk25", 0)
         locked = Signal()
         shift_clk, pixel_clk = Signal(name="pll_clkop"), Signal(name="pll_clkos")
-        pipe_hz = self.core.pipe_hz
+        pipe_hz, sdram = self.core.pipe_hz, self.core.sdram is not None
         pipe = {}
         if pipe_hz is not None:          # the pipeline's own clock on CLKOS2
             m.domains.pipe = ClockDomain("pipe")
             pipe_clk = Signal(name="pll_clkos2")
-            _, hz = pll_pipe_divider(self.core.mode.pixel_hz, pipe_hz)
+            _, hz = pll_pipe_divider(self.core.mode.pixel_hz, pipe_hz, at_most=sdram)
             pipe = {"o_CLKOS2": pipe_clk, "a_FREQUENCY_PIN_CLKOS2": f"{hz / 1e6:g}"}
             m.d.comb += ClockSignal("pipe").eq(pipe_clk)
             m.submodules.rst_pipe = ResetSynchronizer(~locked, domain="pipe")
+        if sdram:                        # the SDRAM's read capture on CLKOS3, 180 degrees on
+            m.domains.sdram_rd = ClockDomain("sdram_rd", reset_less=True)
+            rd_clk = Signal(name="pll_clkos3")
+            pipe.update({"o_CLKOS3": rd_clk, "a_FREQUENCY_PIN_CLKOS3": f"{hz / 1e6:g}"})
+            m.d.comb += ClockSignal("sdram_rd").eq(rd_clk)
         m.submodules.pll = Instance(
             "EHXPLLL", i_CLKI=clk25.i, i_CLKFB=shift_clk, i_RST=0, i_STDBY=0,
             i_PHASESEL0=0, i_PHASESEL1=0, i_PHASEDIR=0, i_PHASESTEP=0, i_PHASELOADREG=0,
@@ -514,7 +621,7 @@ class ULX3STop(Elaboratable):
             o_CLKOP=shift_clk, o_CLKOS=pixel_clk, o_LOCK=locked,
             a_FREQUENCY_PIN_CLKI="25", a_FREQUENCY_PIN_CLKOP=f"{5 * self.core.mode.pixel_hz / 1e6:g}",
             a_FREQUENCY_PIN_CLKOS=f"{self.core.mode.pixel_hz / 1e6:g}",
-            **pipe, **pll_params(self.core.mode.pixel_hz, pipe_hz=pipe_hz))
+            **pipe, **pll_params(self.core.mode.pixel_hz, pipe_hz=pipe_hz, sdram=sdram))
         m.d.comb += [ClockSignal("sync").eq(pixel_clk), ClockSignal("shift").eq(shift_clk)]
         m.submodules.rst_sync = ResetSynchronizer(~locked, domain="sync")
         m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
@@ -527,6 +634,10 @@ class ULX3STop(Elaboratable):
         leds = [platform.request("led", n) for n in (0, 1, 7)]
         m.d.comb += [leds[0].o.eq(core.underflow), leds[1].o.eq(core.order_error),
                      leds[2].o.eq(core.source.frame[4] if len(core.source.frame) > 4 else 0)]
+        if sdram:
+            m.submodules.memory_pins = ULX3SSdramIO(core)
+            done, error = platform.request("led", 2), platform.request("led", 3)
+            m.d.comb += [done.o.eq(core.loader.done), error.o.eq(core.loader.error)]
         return m
 
 

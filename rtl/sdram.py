@@ -159,6 +159,11 @@ class SdramConfig:
         For simulations and proofs only: replaces the datasheet's power-up wait.
     init_refreshes : int or None
         AUTO REFRESH commands at initialisation (None: the chip's; at least 2).
+    pin_cycles : int
+        Clock cycles the board's I/O registers add to a READ's round trip, 0 .. 4: 0 where
+        the controller's ``sdram`` port is the chip's pins (simulation); the ULX3S top
+        registers the commands once more in the I/O cells and captures DQ half a cycle
+        late, then re-registers it: 2 (rtl/board.SDRAM_PIN_CYCLES, docs/sdram.md).
     """
 
     variant: str = "32mb"
@@ -170,6 +175,7 @@ class SdramConfig:
     read_fifo: int = 16
     powerup_cycles: int | None = None
     init_refreshes: int | None = None
+    pin_cycles: int = 0
 
     def __post_init__(self):
         if self.variant not in CHIPS:
@@ -204,6 +210,10 @@ class SdramConfig:
                 not isinstance(self.init_refreshes, int) or not 2 <= self.init_refreshes <= 16):
             raise BumpError(f"init_refreshes must be None or an integer in [2, 16], got "
                             f"{self.init_refreshes!r}", "init_refreshes")
+        if isinstance(self.pin_cycles, bool) or not isinstance(self.pin_cycles, int) \
+                or not 0 <= self.pin_cycles <= 4:
+            raise BumpError(f"pin_cycles must be an integer in [0, 4], got {self.pin_cycles!r}",
+                            "pin_cycles")
         if self.refresh_reload < 1:
             raise BumpError(f"freq_mhz must be in [1, {float(fmax):g}]: at {self.freq_mhz} MHz "
                             f"a refresh cannot be scheduled within tREFI", "freq_mhz")
@@ -312,8 +322,8 @@ class SdramController(wiring.Component):
         burst once its last WRITE is issued; one write burst at a time.
     sdram : Out(sdram_signature(cfg))
         Every output is a register (CKE is tied high). A READ on the pins in cycle n returns its first word
-        on ``dq_i`` in cycle n + CL (sampled by the chip's clock edges), which the
-        controller registers once.
+        on ``dq_i`` in cycle n + CL + ``pin_cycles`` (sampled by the chip's clock edges),
+        which the controller registers once.
 
     One command a cycle at most; a burst's READs (WRITEs) follow each other every
     ``burst`` cycles while its row is open and the read FIFO has room (the write buffer
@@ -559,7 +569,8 @@ class SdramController(wiring.Component):
             m.d.sync += rsend.eq(rsend - 1)
         word_valid = issue["read"] | (rsend != 0)
         word_last = Mux(issue["read"], last_burst if bl == 1 else 0, rlast & (rsend == 1))
-        delay = cfg.cas_latency + 2      # decision -> pins -> chip -> dq_i register
+        # decision -> pins -> chip -> dq_i register, and the board's I/O registers
+        delay = cfg.cas_latency + 2 + cfg.pin_cycles
         sr_v = [Signal(name=f"rd_valid{k}") for k in range(delay)]
         sr_l = [Signal(name=f"rd_last{k}") for k in range(delay)]
         m.d.sync += [sr_v[0].eq(word_valid), sr_l[0].eq(word_last)]

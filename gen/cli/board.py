@@ -5,25 +5,39 @@
 ``--check-frames N``, simulates the top for N whole frames under Verilator, captures them
 with cocotbext-dvi's DVISink, compares each with the golden frame byte for byte and writes
 the first as ``frame0.png``. ``--mode test`` checks the reduced 32 x 24 mode only (no
-bitstream: it is no monitor mode). Bad input (board, mode, scene, a map that does not fit
-beside the video logic) prints one line and exits 2 before anything is written.
+bitstream: it is no monitor mode). With the map in the SDRAM (``--map-memory axi`` or a
+scene with ``map_memory = "axi"``) it also writes the map's flash image
+(``ulx3s_85f_map.bin``, the bytes the flash loader copies into the SDRAM) and prints the
+openFPGALoader commands that program the bitstream and the image (``--flash-offset``,
+``--sdram``). Bad input (board, mode, scene, a map that does not fit beside the video logic
+or in the SDRAM, a flash offset inside the bitstream) prints one line and exits 2 before
+anything is written.
 """
 
 import json
 import math
+import sys
 from pathlib import Path
 
 from bumprtl.gen.cli.flags import add_map_flags, scene_from_args
 from bumprtl.gen.flow.board import (
     BOARDS,
+    DEFAULT_FLASH_OFFSET,
+    DEFAULT_PIPE_MHZ,
+    DEFAULT_SDRAM,
+    MAP_FILE,
     board_data,
+    board_memory,
     build_bitstream,
     check_board,
     check_frames,
+    flash_commands,
     part_costs,
 )
 from bumprtl.rtl.board import cdc_depth, pll_pipe_divider
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.scene import MAP_MEMORIES
+from bumprtl.rtl.sdram import CHIPS
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.scenes.imaging import save_png
 
@@ -31,11 +45,22 @@ __all__ = ["add_parser", "run"]
 
 
 def run(args):
-    scene = scene_from_args(args, args.scene)
-    platform, device, mode = check_board(args.board, args.mode, scene)
+    scene = scene_from_args(args, args.scene, extra={"map_memory": args.map_memory})
+    axi = scene.map_memory == "axi"
+    offset = _flash_offset(args.flash_offset)
+    if not axi and (args.sdram is not None or args.flash_offset is not None):
+        flag = "--sdram" if args.sdram is not None else "--flash-offset"
+        raise BumpError(f"{flag} applies to a map in the SDRAM (--map-memory axi), the scene's "
+                        f"map_memory is {scene.map_memory!r}", "map_memory")
+    variant = DEFAULT_SDRAM if args.sdram is None else args.sdram
+    platform, device, mode = check_board(args.board, args.mode, scene, variant, offset)
     seeds = _seeds(args.seeds)
     if args.check_frames < 0:
         raise BumpError(f"--check-frames must be >= 0, got {args.check_frames}", "check_frames")
+    if axi and args.check_frames:
+        raise BumpError("--check-frames applies to map_memory = 'bram' (the DVI-sink bench has no "
+                        "SDRAM or flash model; tests/rtl/test_board_sdram.py checks those frames)",
+                        "check_frames")
     pipe_hz = None
     bitstream = mode.name != "test" and not args.no_bitstream
     if args.pipe_mhz is not None:      # refused below the pixel clock, one line
@@ -43,16 +68,28 @@ def run(args):
         if not math.isfinite(pipe_hz):
             raise BumpError(f"--pipe-mhz must be a finite clock rate, got {args.pipe_mhz}", "pipe_hz")
         cdc_depth(mode.pixel_hz, pipe_hz)
-        if bitstream:
-            pll_pipe_divider(mode.pixel_hz, pipe_hz)
-        elif not args.check_frames:
+        if not bitstream and not args.check_frames:
             raise BumpError("--pipe-mhz has no effect without a bitstream or --check-frames",
                             "pipe_hz")
+        if bitstream and not axi:      # with the SDRAM: board_memory, at or below it
+            pll_pipe_divider(mode.pixel_hz, pipe_hz)
+    memory = board_memory(scene, mode, variant, offset, pipe_hz) if axi else None
     out = Path(args.out)
+    status = 0
     summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name,
-               "pipe_mhz": args.pipe_mhz}
+               "pipe_mhz": args.pipe_mhz, "map_memory": scene.map_memory}
+    if memory is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        image = out / MAP_FILE.format(name="ulx3s_85f")
+        image.write_bytes(memory.image)
+        print(f"wrote {image} ({len(memory.image):,} bytes: the map's tiled image, for flash "
+              f"byte 0x{offset:x}; SDRAM {variant} at {memory.pipe_hz / 1e6:.4f} MHz, CL "
+              f"{memory.sdram.cas_latency})")
+        summary.update(sdram=variant, flash_offset=offset, map_bytes=len(memory.image),
+                       pipe_mhz=memory.pipe_hz / 1e6)
     if bitstream:
-        rows = build_bitstream(scene, mode, out, args.board, seeds, pipe_hz=pipe_hz)
+        rows = build_bitstream(scene, mode, out, args.board, seeds, pipe_hz=pipe_hz,
+                               **({} if memory is None else {"memory": memory}))
         for r in rows:
             res = ", ".join(f"{k} {u}/{a}" for k, (u, a) in r["resources"].items())
             fmax = ", ".join(f"{d} {a:.1f} MHz (constraint {c:.1f})" for d, (a, c) in
@@ -60,6 +97,11 @@ def run(args):
             print(f"seed {r['seed']}: {res}; Fmax {fmax}; {r['seconds']:.0f} s")
         print(f"wrote {out / 'ulx3s_85f.bit'}")
         print(f"wrote {out / 'ulx3s_85f.svf'}")
+        bit = out / "ulx3s_85f.bit"
+        if memory is not None and bit.is_file() and bit.stat().st_size > offset:
+            print(f"bumprtl: error: the bitstream's {bit.stat().st_size:,} bytes reach past the "
+                  f"map's flash offset 0x{offset:x}: a larger --flash-offset", file=sys.stderr)
+            status = 1
         summary["builds"] = rows
         worst = {}
         for r in rows:
@@ -70,11 +112,11 @@ def run(args):
             print(f"{d}: minimum Fmax over seeds {','.join(map(str, seeds))}: {a:.1f} MHz, "
                   f"constraint {c:.1f} MHz: {'met' if a >= c else 'NOT MET'}")
         if args.parts:
-            parts = part_costs(scene, mode, out / "parts")
+            parts = part_costs(scene, mode, out / "parts",
+                               **({} if memory is None else {"memory": memory}))
             summary["parts"] = parts
             for part, row in parts.items():
                 print(f"{part}: " + ", ".join(f"{k} {v}" for k, v in row.items()))
-    status = 0
     if args.check_frames:
         r = check_frames(scene, mode, out / f"sim_{mode.name}", args.check_frames,
                          board_data(scene), pipe_hz=pipe_hz)
@@ -92,9 +134,24 @@ def run(args):
                              "build_s": r["build_s"], "run_s": r["run_s"]}
         if not all(r["same"]) or r["timing_errors"] or r["underflow"] or r["order_error"]:
             status = 1
+    if memory is not None:
+        print("program the board's flash (the bitstream at 0, the map after it):")
+        for command in flash_commands(out, offset):
+            print(f"  {command}")
     out.mkdir(parents=True, exist_ok=True)
     (out / f"summary_{mode.name}.json").write_text(json.dumps(summary, indent=1) + "\n")
     return status
+
+
+def _flash_offset(text):
+    """--flash-offset: an integer in decimal or 0x hexadecimal (None: the default)."""
+    if text is None:
+        return DEFAULT_FLASH_OFFSET
+    try:
+        return int(str(text), 0)
+    except ValueError:
+        raise BumpError(f"--flash-offset must be an integer byte offset (decimal or 0x hex), got "
+                        f"{text!r}", "flash_offset") from None
 
 
 def _seeds(text):
@@ -129,5 +186,19 @@ def add_parser(sub):
     p.add_argument("--pipe-mhz", type=float, default=None, metavar="MHZ",
                    help="run the source and pipeline in their own clock domain at MHZ (at least "
                         "the pixel clock; the PLL's CLKOS2 gives the nearest rate from above), "
-                        "behind an asynchronous FIFO (default: the pixel clock, one domain)")
+                        "behind an asynchronous FIFO (default: the pixel clock, one domain); with "
+                        f"--map-memory axi the SDRAM's clock too: the PLL's nearest at or below "
+                        f"MHZ, at most 100 (default: {DEFAULT_PIPE_MHZ})")
+    g = p.add_argument_group("the map in the SDRAM, loaded from the SPI flash (docs/board.md)")
+    g.add_argument("--map-memory", default=None, choices=MAP_MEMORIES,
+                   help="where the map lives: bram (block RAM) or axi (the board's SDRAM "
+                        "behind the texel cache, copied there from the flash at power-up; the "
+                        "map's flash image is written beside the bitstream) (default: the "
+                        "scene's, bram for the built-in scenes)")
+    g.add_argument("--sdram", default=None, metavar="VARIANT",
+                   help=f"the board's SDRAM chip: {', '.join(f'{k} ({c.part})' for k, c in CHIPS.items())} "
+                        f"(default {DEFAULT_SDRAM})")
+    g.add_argument("--flash-offset", default=None, metavar="OFFSET",
+                   help=f"flash byte of the map's image, a 64 KiB sector after the bitstream's, "
+                        f"decimal or 0x hex (default 0x{DEFAULT_FLASH_OFFSET:x})")
     p.set_defaults(func=run)

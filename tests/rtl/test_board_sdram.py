@@ -4,15 +4,17 @@ docs/board.md): after reset the FlashLoader copies the map's image from the SPI 
 any illegal command or timing) through the SdramController, then the pipeline's texel
 cache reads it from there. In the Amaranth simulator, the pipeline at 4 x the pixel clock:
 the first frames shown equal the golden frames (the map in block RAM's), nothing underflows
-or comes out of order, and neither model saw a rule broken. Opt-in (``make regress``): the
-load and two frames take about a minute of simulation."""
+or comes out of order, and neither model saw a rule broken; once with the controller's pins
+the chip's, once with them registered as the ULX3S top's I/O does (``pin_cycles`` 2). Opt-in
+(``make regress``): the load and two frames take about a minute of simulation each."""
 
 import numpy as np
 import pytest
+from amaranth.hdl import Elaboratable, Module, Signal
 from amaranth.sim import Simulator
 
 from bumprtl.gen.flow.board import board_data
-from bumprtl.rtl.board import BoardCore
+from bumprtl.rtl.board import SDRAM_PIN_CYCLES, BoardCore
 from bumprtl.rtl.cache import scene_geometry, scene_levels, tiled_image
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.flash import FlashConfig
@@ -27,14 +29,15 @@ PIPE_MHZ = 100
 OFFSET = 0x2000              # the map's place in the flash (the bitstream before it)
 
 
-def board_parts(scene):
+def board_parts(scene, pin_cycles=0):
     """(SdramConfig, FlashConfig, flash bytes) of ``scene``'s map: its tiled image at
     OFFSET of the flash, copied to the cache's base in bursts of one SDRAM burst."""
     geom = scene_geometry(scene.hardware)
     words, _, _, _ = board_data(scene)
     image = tiled_image(geom, scene_levels(scene.hardware, words))
     sdram = SdramConfig(freq_mhz=PIPE_MHZ, powerup_cycles=40, init_refreshes=2,
-                        data_bits=geom.data_bits, addr_bits=geom.addr_bits)
+                        data_bits=geom.data_bits, addr_bits=geom.addr_bits,
+                        pin_cycles=pin_cycles)
     flash = FlashConfig(offset=OFFSET, length=len(image), base=geom.base,
                         addr_bits=geom.addr_bits, data_bits=geom.data_bits, burst=4,
                         half_period=2)
@@ -43,16 +46,42 @@ def board_parts(scene):
     return sdram, flash, contents[:OFFSET] + image + contents[OFFSET + len(image):]
 
 
+class BoardIO(Elaboratable):
+    """``core`` with its SDRAM pins as the ULX3S top's I/O makes them, in whole ``pipe``
+    cycles (tests/rtl/test_board_top.py, docs/sdram.md): every output registered once
+    more, DQ registered once more on its way back; ``pins`` is what the chip sees."""
+
+    def __init__(self, core):
+        self.core = core
+        self.pins = core.sdram_pins.signature.create(path=("chip",))
+
+    def elaborate(self, platform):
+        m, inner = Module(), self.core.sdram_pins
+        m.submodules.core = self.core
+        idle = {"cke": 1, "cs_n": 1, "ras_n": 1, "cas_n": 1, "we_n": 1}   # deselected at reset
+        for name in ("cke", "cs_n", "ras_n", "cas_n", "we_n", "ba", "a", "dqm", "dq_o", "dq_oe"):
+            reg = Signal.like(getattr(inner, name), init=idle.get(name, 0), name=f"io_{name}")
+            m.d.pipe += reg.eq(getattr(inner, name))
+            m.d.comb += getattr(self.pins, name).eq(reg)
+        m.d.pipe += inner.dq_i.eq(self.pins.dq_i)
+        return m
+
+
 @pytest.mark.regress
-def test_frames_from_the_map_in_sdram_equal_the_golden_frames():
+@pytest.mark.parametrize("pin_cycles", [0, SDRAM_PIN_CYCLES])
+def test_frames_from_the_map_in_sdram_equal_the_golden_frames(pin_cycles):
+    """``pin_cycles`` 0: the controller's pins are the chip's; SDRAM_PIN_CYCLES: the pins as
+    the ULX3S top registers them (BoardIO), the controller told so."""
     scene = load_scene_config("default", {"angle_bits": 10, "texture_size": 16,
                                           "map_memory": "axi"})
     mode = MODES["test"]
     words, texels, constants, table = board_data(scene)
     table = table[:4]
-    sdram, flash_cfg, contents = board_parts(scene)
+    sdram, flash_cfg, contents = board_parts(scene, pin_cycles)
     core = BoardCore(scene.hardware, mode, None, constants, table, texels,
                      pipe_hz=PIPE_MHZ * 1e6, sdram=sdram, flash=flash_cfg)
+    top = BoardIO(core) if pin_cycles else core
+    chip_pins = top.pins if pin_cycles else core.sdram_pins
     model = SdramModel(sdram.variant, PIPE_MHZ, powerup_ns=40 * 1000 / PIPE_MHZ,
                        init_refreshes=2)
     flash = SpiFlash(contents, min_phase=flash_cfg.half_period, delay=flash_cfg.half_period - 1)
@@ -76,11 +105,11 @@ def test_frames_from_the_map_in_sdram_equal_the_golden_frames():
         result.update(underflow=ctx.get(core.underflow), order=ctx.get(core.order_error),
                       done=ctx.get(core.loader.done), error=ctx.get(core.loader.error))
 
-    sim = Simulator(core)
+    sim = Simulator(top)
     sim.add_clock(1 / mode.pixel_hz)
     sim.add_clock(1e-6 / PIPE_MHZ, domain="pipe")
     async def sdram_pins(ctx):
-        await model.process(ctx, core.sdram_pins, "pipe")
+        await model.process(ctx, chip_pins, "pipe")
 
     sim.add_process(sdram_pins)
     sim.add_testbench(flash_pins, background=True)

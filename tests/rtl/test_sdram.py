@@ -53,6 +53,8 @@ def test_every_timing_converts_from_the_table(variant):
     ("read_fifo", 12, "power of two"),
     ("init_refreshes", 1, "[2, 16]"),
     ("powerup_cycles", 0, "[1,"),
+    ("pin_cycles", 5, "[0, 4]"),
+    ("pin_cycles", True, "[0, 4]"),
 ])
 def test_bad_parameters_are_refused_in_one_line(field, value, allowed):
     with pytest.raises(BumpError) as e:

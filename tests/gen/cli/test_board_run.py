@@ -22,10 +22,10 @@ def checked_once(monkeypatch):
     board, mode and scene: its block-RAM count builds the pipeline (half a second)."""
     real = cli_board.check_board
 
-    def once(board, mode, scene):
-        key = (board, mode, scene)
+    def once(board, mode, scene, *memory):
+        key = (board, mode, scene, *memory)
         if key not in _CHECKED:
-            _CHECKED[key] = real(board, mode, scene)
+            _CHECKED[key] = real(board, mode, scene, *memory)
         return _CHECKED[key]
     monkeypatch.setattr(cli_board, "check_board", once)
 

@@ -67,7 +67,8 @@ NOT_RUN = {   # command -> (why not run here, its flags)
     ("board",): ("bitstreams", ("board", "--mode", "--scene", "--height-map", "--normal-map",
                                 "--normal-convention", "--geometry", "--height-scale", "--resample",
                                 "--texture-size", "--out", "--seeds", "--check-frames", "--parts",
-                                "--no-bitstream", "--pipe-mhz")),
+                                "--no-bitstream", "--pipe-mhz", "--map-memory", "--sdram",
+                                "--flash-offset")),
 }
 
 # --spec-index-bits is a cap (rtl/config.py: at most frac_bits are used), so its value lies

@@ -6,6 +6,7 @@ non-flattened netlist."""
 
 import json
 import os
+import re
 from types import SimpleNamespace
 
 import pytest
@@ -199,3 +200,52 @@ def test_the_verilator_runner_swaps_public_flat_rw_for_the_top_ports_file(tmp_pa
     monkeypatch.setattr(base, "_build_command", lambda self: [["verilator", "x.v"]])
     with pytest.raises(AssertionError, match="--public-flat-rw not found"):
         runner._build_command()
+
+
+class _MemoryCore(_Core):
+    """A core with the SDRAM's and the flash's pins (BoardCore's sdram_pins and spi)."""
+
+    def __init__(self):
+        super().__init__()
+        from bumprtl.rtl.flash import spi_signature
+        from bumprtl.rtl.sdram import SdramConfig, sdram_signature
+        self.sdram_pins = sdram_signature(SdramConfig()).flip().create(path=("sdram",))
+        self.spi = spi_signature().flip().create(path=("spi",))
+
+    def elaborate(self, platform):
+        m = super().elaborate(platform)
+        m.d.comb += [self.sdram_pins.a.eq(self.sdram_pins.dq_i[:13]),
+                     self.spi.sclk.eq(self.spi.miso)]
+        return m
+
+
+def test_part_costs_with_the_map_in_sdram_keep_its_pins_and_name_its_parts(monkeypatch,
+                                                                           tmp_path):
+    """With the map in the SDRAM the pins of the SDRAM and the flash are the core's ports
+    (else synthesis would drop the controller and the loader), and the controller, the
+    loader and the clock crossing are parts of their own."""
+    netlist = {"modules": {
+        "core": {"cells": {"pipeline": {"type": "pipe"}, "sdram": {"type": "ctrl"},
+                           "flash_loader": {"type": "ldr"}, "cdc": {"type": "cdc"}}},
+        "pipe": {"cells": _cells(LUT4=1)}, "ctrl": {"cells": _cells(LUT4=4, TRELLIS_FF=2)},
+        "ldr": {"cells": _cells(TRELLIS_FF=3)}, "cdc": {"cells": _cells(TRELLIS_DPR16X4=1)}}}
+
+    def fake_yosys(script, log, work):
+        il = (work / "core.il").read_text()
+        for port in ("sdram__dq_i", "sdram__a", "spi__miso", "spi__sclk"):
+            assert re.search(rf"^  wire width \d+ (input|output) \d+ +\\{port}$", il, re.M), port
+        (work / "core.synth.json").write_text(json.dumps(netlist))
+
+    seen = {}
+
+    def core(scene, mode, target, memory=None):
+        seen["memory"] = memory
+        return _MemoryCore()
+    monkeypatch.setattr(board, "board_core", core)
+    monkeypatch.setattr(board.yosys, "run_yosys", fake_yosys)
+    rows = board.part_costs(None, None, tmp_path / "parts", memory="the memory")
+    assert seen["memory"] == "the memory"
+    assert rows["SDRAM controller"] == {"LUT4": 4, "FF": 2, "DSP": 0, "BRAM": 0}
+    assert rows["flash loader"] == {"LUT4": 0, "FF": 3, "DSP": 0, "BRAM": 0}
+    assert rows["clock crossing"] == {"LUT4": 2, "FF": 0, "DSP": 0, "BRAM": 0}
+    assert "globe" not in rows

@@ -1,0 +1,127 @@
+"""``bumprtl board ulx3s`` with the map in the SDRAM (``--map-memory axi``; gen/cli/board.py,
+gen/flow/board.board_memory), the bitstream flow stood in: the flash image it writes is the
+texel cache's tiled image of the scene's map (rtl/cache.tiled_image, computed here from the
+map's words; its size and a few texels' bytes at the documented layout's offsets), the
+FlashConfig copies exactly those bytes from the flash offset, the programming commands are
+printed, and every bad input (an unknown SDRAM variant, a map larger than the SDRAM, a
+flash offset inside the bitstream or off a sector, a pipe clock above the SDRAM's, the
+SDRAM flags on a map in block RAM, a frame check the bench cannot do) is one line, exit 2,
+nothing written."""
+
+import json
+
+import numpy as np
+import pytest
+
+from bumprtl.gen.cli import board as cli_board
+from bumprtl.gen.flow.board import BITSTREAM_BYTES, FLASH_SECTOR, board_data
+from bumprtl.rtl.cache import scene_geometry, scene_levels, tiled_image
+from bumprtl.sim.scenes.config import load_scene_config
+
+AXI = ["--texture-size", "16", "--map-memory", "axi"]
+
+
+def _no(*args, **kw):
+    raise AssertionError("not to be called here")
+
+
+def test_the_flash_image_is_the_caches_tiled_image_of_the_map(tmp_path, monkeypatch, run_cli):
+    seen = {}
+
+    def build(scene, mode, out, board, seeds, pipe_hz=None, memory=None):
+        seen.update(memory=memory, scene=scene, files=sorted(p.name for p in out.iterdir()))
+        return [{"seed": 1, "seconds": 1.0, "resources": {"LUT4": (1, 2)},
+                 "fmax": {"pipe": (90.0, 89.3)}}]
+    monkeypatch.setattr(cli_board, "build_bitstream", build)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", *AXI, "--out", out, "--flash-offset", "0x300000",
+                 "--sdram", "64mb"])
+    assert r.returncode == 0, r.stderr
+    image = (out / "ulx3s_85f_map.bin").read_bytes()
+    assert seen["files"] == ["ulx3s_85f_map.bin"]           # written before the build
+    # the same bytes, independently: the scene's map words tiled by rtl/cache.tiled_image
+    scene = load_scene_config("default", {"texture_size": 16, "map_memory": "axi"})
+    geom = scene_geometry(scene.hardware)
+    words = np.asarray(board_data(scene)[0], np.int64)
+    assert image == tiled_image(geom, scene_levels(scene.hardware, words))
+    assert len(image) == geom.image_bytes == geom.lines * geom.line_bytes
+    # a few texels of level 0 at the documented layout's byte (docs/memory.md, the sidecar):
+    # base + line * line_bytes + ((v mod B) * B + (u mod B)) * slot_bytes,
+    # line = (v div B) * (T / B) + (u div B), little-endian in the slot
+    T, B, slot = 16, geom.block, geom.slot_bytes
+    for u, v in ((0, 0), (1, 0), (0, 1), (B, 0), (0, B), (5, 11), (T - 1, T - 1)):
+        line = (v // B) * (T // B) + u // B
+        at = geom.base + line * geom.line_bytes + ((v % B) * B + u % B) * slot
+        assert int.from_bytes(image[at:at + slot], "little") == words[v * T + u], (u, v)
+    # what the flash loader copies: these bytes, from the offset, to the cache's base
+    mem = seen["memory"]
+    assert (mem.flash.offset, mem.flash.length, mem.flash.base) == (0x300000, len(image), geom.base)
+    assert mem.image == image and mem.sdram.variant == "64mb"
+    assert mem.flash.data_bits == mem.sdram.data_bits == geom.data_bits
+    assert f"openFPGALoader --board ulx3s -f -o 0x300000 {out / 'ulx3s_85f_map.bin'}" in r.stdout
+    assert f"openFPGALoader --board ulx3s -f {out / 'ulx3s_85f.bit'}" in r.stdout
+    summary = json.loads((out / "summary_640x480.json").read_text())
+    assert (summary["map_memory"], summary["sdram"], summary["flash_offset"]) == ("axi", "64mb", 0x300000)
+    assert summary["pipe_mhz"] == pytest.approx(625 / 8)          # at or below 80 MHz
+
+
+def _first_free_sector():
+    return -(-BITSTREAM_BYTES["LFE5U-85F"] // FLASH_SECTOR) * FLASH_SECTOR
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--sdram", "16mb"], "--sdram must be one of 32mb, 64mb"),
+    (["--sdram", "16mb", "--no-bitstream"], "--sdram must be one of 32mb, 64mb"),
+    (["--texture-size", "4096"], "texture_size 4096: the map's tiled image ends at byte "
+                                 "67,108,864, beyond the 32mb SDRAM's 33,554,432 bytes"),
+    (["--flash-offset", "0"], "--flash-offset must be a multiple of 0x10000"),
+    (["--flash-offset", hex(_first_free_sector() - FLASH_SECTOR)],
+     f"in [0x{_first_free_sector():x}, "),
+    (["--flash-offset", hex(_first_free_sector() + 0x1000)], "a 64 KiB sector"),
+    (["--flash-offset", "0xfff0000"], "within the 24-bit READ address"),
+    (["--flash-offset", "2M"], "--flash-offset must be an integer byte offset"),
+    (["--pipe-mhz", "120"], "pipe clock must be at most 100 MHz with the map in the SDRAM "
+                            "(CAS latency 2: tCK >= 10 ns"),
+    (["--pipe-mhz", "20"], "pipe clock must be at least the pixel clock"),
+    (["--check-frames", "1"], "--check-frames applies to map_memory = 'bram'"),
+])
+def test_bad_input_with_the_map_in_sdram_one_line_exit_2_nothing_written(flags, message, tmp_path,
+                                                                          monkeypatch, run_cli):
+    for name in ("build_bitstream", "part_costs", "check_frames"):
+        monkeypatch.setattr(cli_board, name, _no)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", *AXI, "--out", out, *flags])
+    assert r.returncode == 2, r.stdout + r.stderr
+    [line] = r.stderr.strip().splitlines()
+    assert line.startswith("bumprtl: error: ") and message in line, line
+    assert not out.exists() and r.stdout == ""
+
+
+@pytest.mark.parametrize("flag", [["--sdram", "32mb"], ["--flash-offset", "0x200000"]])
+def test_the_sdram_flags_on_a_map_in_block_ram_are_refused(flag, tmp_path, monkeypatch, run_cli):
+    for name in ("build_bitstream", "part_costs", "check_frames"):
+        monkeypatch.setattr(cli_board, name, _no)
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", "--texture-size", "16", "--out", out, *flag])
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [
+        f"bumprtl: error: {flag[0]} applies to a map in the SDRAM (--map-memory axi), the "
+        f"scene's map_memory is 'bram'"]
+    assert not out.exists()
+
+
+def test_a_bitstream_reaching_past_the_map_is_an_error_after_the_build(tmp_path, monkeypatch,
+                                                                        run_cli):
+    """The refusal before the build bounds the bitstream by the uncompressed size; the .bit
+    the flow wrote is checked against the offset too (exit 1, the error named)."""
+    def build(scene, mode, out, board, seeds, pipe_hz=None, memory=None):
+        with open(out / "ulx3s_85f.bit", "wb") as f:       # sparse: its size is what counts
+            f.truncate(size)
+        return [{"seed": 1, "seconds": 1.0, "resources": {}, "fmax": {}}]
+    monkeypatch.setattr(cli_board, "build_bitstream", build)
+    for size, status in ((0x200000, 0), (0x200001, 1)):
+        out = tmp_path / f"b{size}"
+        r = run_cli(["board", "ulx3s", *AXI, "--out", out])
+        assert r.returncode == status, r.stderr
+        assert ("the bitstream's 2,097,153 bytes reach past the map's flash offset 0x200000"
+                in r.stderr) == bool(status)
