@@ -807,10 +807,13 @@ class TextureCache(wiring.Component):
         head_miss = Signal(name="head_miss")
         m.d.comb += head_miss.eq(Mux(popped, miss_at[1], miss_at[0]))
         m.d.sync += [miss_at[0].eq(m_r0.data), miss_at[1].eq(m_r1.data), popped.eq(pop)]
-        m.d.comb += pop.eq(readable & (~head_miss | landed_any) & hd_move)
+        # the head leaves if the queue read moves on (registers alone: the queue RAM's read
+        # address, whose read is only enabled when it moves on, waits on no port)
+        pop_ok = Signal(name="pop_ok")
+        m.d.comb += [pop_ok.eq(readable & (~head_miss | landed_any)), pop.eq(pop_ok & hd_move)]
         after = r.out_after
         m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
-                     qmem.r_addr.eq(Mux(pop, after, out_seq[:qb])), qmem.en.eq(hd_move)]
+                     qmem.r_addr.eq(Mux(pop_ok, after, out_seq[:qb])), qmem.en.eq(hd_move)]
         with m.If(pop):
             m.d.sync += after.eq(after + 1)
         m.d.sync += [landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
