@@ -49,9 +49,10 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
-# queue is empty: the tag read, its words' register, the lookup, the queue's write and read,
-# its head register, the data read, its words' register, the output register.
-CACHE_LATENCY = 9
+# queue is empty: the tag read, its words' register, their settled register, the lookup, the
+# queue's write and read, its head register, the data read, its words' register, the output
+# register.
+CACHE_LATENCY = 10
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -327,8 +328,9 @@ class TextureCache(wiring.Component):
 
     Misses overlap (prefetching behind a reorder queue, Igehy, Eldridge & Proudfoot, HWWS
     1998): a pixel's set is read as it is taken (tags and sequence stamps), the words land
-    in registers of their own the cycle after, its tags are checked as it moves on into the
-    lookup, and a miss writes the new tag and issues its line's burst at once; the pixel
+    in the RAMs' output registers the cycle after and, with the writes they missed, in
+    registers of the fabric the cycle after that, its tags are checked as it moves on into
+    the lookup, and a miss writes the new tag and issues its line's burst at once; the pixel
     then waits in a queue of ``geom.queue`` entries with its (set, way, word) while the
     pixels behind it are looked up. A pixel leaves the queue in order; a miss's pixel only
     once its line has landed (bursts land in order, so a count of lines landed suffices: a
@@ -356,7 +358,8 @@ class TextureCache(wiring.Component):
         self.regs = SimpleNamespace(
             flushing=Signal(init=1, name="flushing"),
             in_valid=Signal(name="in_valid"),                     # a pixel read: its set
-            rw_valid=Signal(name="rw_valid"),                     # its words in registers
+            rw_valid=Signal(name="rw_valid"),                     # its words read
+            ws_valid=Signal(name="ws_valid"),                     # its words in registers
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
@@ -450,26 +453,30 @@ class TextureCache(wiring.Component):
             return t
 
         # The stages from the input to the lookup: the pixel read (``in``: its set's words on
-        # the read ports, held there while it waits), the words read (``rw``: registers)
+        # the read ports, held there while it waits), the words read (``rw``: the RAMs'
+        # output registers), the words settled (``ws``: fabric registers, overrides merged)
         # and the pixel looked up (``look``). The pixel looked up writes its set when it
         # advances (the tag of a miss's victim, its way's stamp, the pseudo-LRU bits): each
         # stage behind it keeps, a way, the last word written to its set since its read
         # (an override), and the words move on with the write of the cycle applied.
-        in_valid, rw_valid, look_valid = r.in_valid, r.rw_valid, r.look_valid
+        in_valid, rw_valid, ws_valid, look_valid = r.in_valid, r.rw_valid, r.ws_valid, r.look_valid
         in_line, in_slot = Signal(g.line_bits, name="in_line"), Signal(2 * g.block_bits, name="in_slot")
         rw_line, rw_slot = Signal(g.line_bits, name="rw_line"), Signal(2 * g.block_bits, name="rw_slot")
         look_line, look_slot = Signal(g.line_bits, name="look_line"), Signal(2 * g.block_bits, name="look_slot")
         in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
         rw_extra = {k: Signal(s, name=f"rw_{k}") for k, s in self.extra.items()}
+        ws_line, ws_slot = Signal(g.line_bits, name="ws_line"), Signal(2 * g.block_bits, name="ws_slot")
+        ws_extra = {k: Signal(s, name=f"ws_{k}") for k, s in self.extra.items()}
         look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
         new_line, new_slot = self._locate(m, self.i.payload)
 
-        # --- the pixel looked up: whether each way hits, each way's valid bit and stamp
-        # (as its distance from out_seq, stamp - out_seq mod 2**K), the set's pseudo-LRU
-        # bits (all registers) ---
+        # --- the pixel looked up: whether each way hits, whether a queued pixel references
+        # each way (below) and its stamp's distance from out_seq (stamp - out_seq, its low
+        # log2(queue) bits: all a referenced one needs), the set's pseudo-LRU bits (all
+        # registers) ---
         look_hits = Signal(g.ways, name="look_hits")
-        look_valids = Signal(g.ways, name="look_valids")
-        look_dists = [Signal(K, name=f"look_dist{w}") for w in range(g.ways)]
+        qb = g.queue.bit_length() - 1
+        look_dists = [Signal(qb, name=f"look_dist{w}") for w in range(g.ways)]
         look_plru = Signal(plru_width, name="look_plru")
         look_set, _, look_word, look_sel = split(look_line, look_slot)
         if g.set_bits == 0:
@@ -487,12 +494,11 @@ class TextureCache(wiring.Component):
         # --- the pixel queue: pixels in [out_seq, in_seq) wait in order ---
         in_seq, out_seq, count = r.in_seq, r.out_seq, r.count
         count_next = Signal.like(count, name="count_next")
-        qb = g.queue.bit_length() - 1
         layout = self.queue_layout(g, self.extra)
         # read into the RAM's register, then its output register (the head register)
         qmem = ram("queue", g.queue, layout)
         # the entries' miss bits again in LUT RAM, read in the cycle before at the oldest
-        # entry and the one after it (a register): the pop that chooses the block RAM's next
+        # entry and the one after it (registers): the pop that chooses the block RAM's next
         # read address waits on no memory. Two copies, one a read address, so that no
         # multiplexer of the two addresses comes before the reads.
         miss_ports = []
@@ -504,8 +510,9 @@ class TextureCache(wiring.Component):
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). A register a way: the test as a pixel moves into the
-        # lookup, with the queue as it is after that cycle; while it waits, the test of the
-        # cycle (in_seq holds, out_seq only grows) less the pixel that leaves in it.
+        # lookup, with the queue as it is after that cycle; while it waits (in_seq holds), the
+        # same less the pixel that leaves in the cycle (its distance 0: a pop takes one from
+        # both the distance and the count, so a distance below the count stays below it).
         referenced = Signal(g.ways, name="look_referenced")
         pop = Signal()
         locked = Signal()
@@ -527,8 +534,11 @@ class TextureCache(wiring.Component):
         go = r.go                                  # ~flushing & look_valid & count != queue
         m.d.comb += advance.eq(go & (hit | can_miss))
         miss = advance & ~hit
-        move = ~look_valid | advance               # the words read move on to the lookup
-        rw_move = ~rw_valid | move                 # the pixel read moves on to the words read
+        move = ~look_valid | advance               # the words settled move on to the lookup
+        ws_move = ~ws_valid | move                 # the words read move on to the settled
+        rw_move = Signal()                         # the pixel read moves on to the words read
+        # (one gate after the lookup's advance: it enables the block RAMs' reads)
+        m.d.comb += rw_move.eq(~(rw_valid & ws_valid & look_valid) | advance)
         m.d.comb += self.i.ready.eq(~flushing & rw_move)
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
@@ -579,8 +589,9 @@ class TextureCache(wiring.Component):
             return out
 
         # --- the pixel read: its set's tags and stamps are read as it is taken (the reads
-        # address the input and hold while it waits); the write of that cycle is added the
-        # cycle after, once its set is in a register ---
+        # address the input and hold while it waits); the writes of that cycle and the one
+        # before are added the cycle after, their sets compared with the pixel's as it is
+        # taken (registers) ---
         moved = Signal(name="in_moved")          # the pixel read moved on last cycle
         m.d.sync += moved.eq(rw_move)
         fresh = in_valid & moved                 # taken last cycle
@@ -591,9 +602,11 @@ class TextureCache(wiring.Component):
         none = overrides("in_none")
         m.d.comb += assign(none, SimpleNamespace(tag_hot=0, stamp_hot=0, tags=in_held.tags,
                                                  stamps=in_held.stamps))
-        in_old = apply(none, was2.set == in_set, was2.tag_hot, was2.tag, was2.stamp_hot,
-                       was2.seq, "in_old")
-        in_new = apply(in_old, was.set == in_set, was.tag_hot, was.tag, was.stamp_hot, was.seq,
+        same_was = Signal(name="in_same_was")      # was.set == in_set when fresh
+        same_was2 = Signal(name="in_same_was2")    # was2.set == in_set when fresh
+        in_old = apply(none, same_was2, was2.tag_hot, was2.tag, was2.stamp_hot, was2.seq,
+                       "in_old")
+        in_new = apply(in_old, same_was, was.tag_hot, was.tag, was.stamp_hot, was.seq,
                        "in_new")
         in_ov = overrides("in_ov")
         with m.If(fresh):
@@ -603,7 +616,8 @@ class TextureCache(wiring.Component):
         m.d.sync += assign(in_held, in_ov)        # no write while the pixel read waits
         with m.If(rw_move):                      # (the input's terms apart from it)
             m.d.sync += [in_valid.eq(self.i.valid & ~flushing), in_line.eq(new_line),
-                         in_slot.eq(new_slot)]
+                         in_slot.eq(new_slot), same_was.eq(set_of(new_line) == look_set),
+                         same_was2.eq(set_of(new_line) == was.set)]
             m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
 
         # --- the words read: the RAMs' output registers, the overrides with the write of
@@ -622,50 +636,76 @@ class TextureCache(wiring.Component):
             m.d.sync += [rw_extra[k].eq(in_extra[k]) for k in self.extra]
             m.d.sync += assign(rw_ov, in_moved)
 
-        # --- into the lookup: each way's words (override or read), its hit computed here
-        # (the write of the cycle to the pixel's set: a miss's tag to its victim) ---
+        # --- the words settled: each way's tag and stamp (its override, else the word read)
+        # with the write of the cycle the pixel moves in, in registers: no block-RAM output
+        # drives the lookup's compares ---
+        ws_set = set_of(ws_line)
+        ws_tags = [Signal.like(tag_written, name=f"ws_tag{w}") for w in range(g.ways)]
+        ws_stamps = [Signal(K, name=f"ws_stamp{w}") for w in range(g.ways)]
+        ws_plru = Signal(plru_width, name="ws_plru")
         rw_same = advance & (rw_set == look_set)
-        rw_tag = tag_of(rw_line)
+        rw_moved = apply(rw_ov, rw_same, tag_hot, tag_written, stamp_hot, in_seq, "rw_moved")
+        with m.If(ws_move):
+            m.d.sync += [ws_valid.eq(rw_valid), ws_line.eq(rw_line), ws_slot.eq(rw_slot),
+                         ws_plru.eq(Mux(rw_same, touched, rw_plru))]
+            m.d.sync += [ws_extra[k].eq(rw_extra[k]) for k in self.extra]
+            for w in range(g.ways):
+                m.d.sync += [
+                    ws_tags[w].eq(Mux(rw_moved.tag_hot[w], rw_moved.tags[w], rw_raw_tags[w])),
+                    ws_stamps[w].eq(Mux(rw_moved.stamp_hot[w], rw_moved.stamps[w],
+                                        rw_raw_stamps[w]))]
+
+        # --- into the lookup: each way's hit computed here (the write of the cycle to the
+        # pixel's set: a miss's tag to its victim) ---
+        ws_same = advance & (ws_set == look_set)
+        ws_tag = tag_of(ws_line)
         new_hits = Signal(g.ways)
         # The window [out_seq, in_seq) after this cycle (its ends one further on a pop, an
-        # advance): a stamp is in it by one compare with each end, whether the window wraps
-        # deciding how they combine (no subtraction before a compare; each compare made
+        # advance): a stamp s is in it iff (s >= its start) ^ (s >= its end) ^ (it wraps),
+        # one compare with each end (no subtraction before a compare; each compare made
         # with both places of its end, the pop and the advance choosing after).
         in_one = Signal(K, init=1, name="in_seq_one")              # in_seq + 1
         out_one = Signal(K, init=1, name="out_seq_one")            # out_seq + 1
-        m.d.sync += [in_one.eq(in_one + advance), out_one.eq(out_one + pop)]
+        out_not = Signal(K, init=(1 << K) - 1, name="out_seq_not")  # ~out_seq
+        out_neg = Signal(K, name="out_seq_neg")                     # -out_seq
+        m.d.sync += [in_one.eq(in_one + advance), out_one.eq(out_one + pop),
+                     out_not.eq(out_not - pop), out_neg.eq(out_neg - pop)]
 
-        unwrapped = Signal(name="window_unwrapped")
-        m.d.comb += unwrapped.eq(Mux(advance, Mux(pop, in_one >= out_one, in_one >= out_seq),
-                                     Mux(pop, in_seq >= out_one, in_seq >= out_seq)))
+        # The window wraps (in_seq < out_seq) when one end has passed 2**K and the other not
+        # (they are at most ``queue`` apart): a register, flipped as either end passes.
+        wrapped = Signal(name="window_wrapped")
+        m.d.sync += wrapped.eq(wrapped ^ (advance & in_seq.all()) ^ (pop & out_seq.all()))
         for w in range(g.ways):
-            t = Mux(rw_ov.tag_hot[w], rw_ov.tags[w], rw_raw_tags[w])
-            s = Mux(rw_ov.stamp_hot[w], rw_ov.stamps[w], rw_raw_stamps[w])
-            hit_w = t[-1] & (t[:g.tag_bits] == rw_tag)
-            written = rw_same & tag_hot[w]
-            m.d.comb += new_hits[w].eq(Mux(written, rw_tag == look_tag, hit_w))
+            t, s = ws_tags[w], ws_stamps[w]
+            hit_w = t[-1] & (t[:g.tag_bits] == ws_tag)
+            written = ws_same & tag_hot[w]
+            m.d.comb += new_hits[w].eq(Mux(written, ws_tag == look_tag, hit_w))
             # the distance after this cycle's pop (of the stamp in_seq when forwarded:
             # count); a distance in [0, count) is a queued pixel, 0 the one leaving
-            stamped = rw_same & stamp_hot[w]
-            from_out = Mux(pop, s >= out_one, s >= out_seq)
-            before_in = Mux(advance, s < in_one, s < in_seq)
-            d, d_new = look_dists[w], Signal(K, name=f"new_dist{w}")
-            m.d.comb += d_new.eq(Mux(stamped, Mux(pop, count - 1, count),
-                                     Mux(pop, s + ~out_seq, s - out_seq)))
+            stamped = ws_same & stamp_hot[w]
+            # the terms grouped by the late signal each depends on (an end passing 2**K
+            # flips the wrap)
+            by_pop = Signal(name=f"by_pop{w}", attrs={"keep": 1})
+            by_advance = Signal(name=f"by_advance{w}", attrs={"keep": 1})
+            m.d.comb += [by_pop.eq(Mux(pop, (s >= out_one) ^ out_seq.all(), s >= out_seq)),
+                         by_advance.eq(Mux(advance, (s >= in_one) ^ in_seq.all() ^ wrapped,
+                                           (s >= in_seq) ^ wrapped))]
+            inside = by_pop ^ by_advance
+            d, d_new = look_dists[w], Signal(qb, name=f"new_dist{w}")
+            m.d.comb += d_new.eq(Mux(stamped, Mux(pop, count - 1, count)[:qb],
+                                     Mux(pop, s[:qb] + out_not[:qb], s[:qb] + out_neg[:qb])[:qb]))
             with m.If(move):
-                m.d.sync += [look_valids[w].eq(written | t[-1]),
-                             referenced[w].eq((written | t[-1]) & (stamped | Mux(
-                                 unwrapped, from_out & before_in, from_out | before_in))),
+                # (a way written is stamped too: the miss's victim is the way it uses)
+                m.d.sync += [referenced[w].eq(written | (t[-1] & (stamped | inside))),
                              d.eq(d_new)]
             with m.Else():
-                m.d.sync += [referenced[w].eq(look_valids[w] & (d < count)
-                                              & ~(pop & ~d[:qb].any())),
-                             d.eq(Mux(pop, d - 1, d))]
+                m.d.sync += [referenced[w].eq(referenced[w] & ~(pop & ~d.any())),
+                             d.eq(d - pop)]
         with m.If(move):
-            m.d.sync += [look_valid.eq(rw_valid), look_line.eq(rw_line), look_slot.eq(rw_slot),
-                         look_plru.eq(Mux(rw_same, touched, rw_plru)),
+            m.d.sync += [look_valid.eq(ws_valid), look_line.eq(ws_line), look_slot.eq(ws_slot),
+                         look_plru.eq(Mux(ws_same, touched, ws_plru)),
                          look_hits.eq(new_hits), hit.eq(new_hits.any())]
-            m.d.sync += [look_extra[k].eq(rw_extra[k]) for k in self.extra]
+            m.d.sync += [look_extra[k].eq(ws_extra[k]) for k in self.extra]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         q_w = qmem.w_data
@@ -680,6 +720,9 @@ class TextureCache(wiring.Component):
         with m.If(advance):
             m.d.sync += in_seq.eq(in_seq + 1)
         m.d.comb += count_next.eq(count + advance - pop)
+        # count_next == queue without the sum: full and no pop, or one short and an advance
+        # without a pop (no advance when full)
+        full_next = ~pop & (count[-1] | (advance & (count == g.queue - 1)))
         m.d.sync += count.eq(count_next)
         m.d.comb += [plru_w.addr.eq(look_set), plru_w.data.eq(touched),
                      plru_w.en.eq(advance if g.ways > 1 else 0)]
@@ -690,7 +733,7 @@ class TextureCache(wiring.Component):
         m.d.sync += flush_set.eq(flush_set + 1)
         flushing_next = flushing & (flush_set != g.sets - 1)
         m.d.sync += [flushing.eq(flushing_next),
-                     go.eq(~flushing_next & Mux(move, rw_valid, look_valid) & ~count_next[-1])]
+                     go.eq(~flushing_next & Mux(move, ws_valid, look_valid) & ~full_next)]
         for w, tp in enumerate(tags):
             m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, was.set)),
                          tp.w_data.eq(Mux(flushing, 0, was.tag)),
@@ -716,9 +759,18 @@ class TextureCache(wiring.Component):
         fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
         fill_hot = Signal(g.ways)                  # one-hot by a shift: lint-clean Verilog
         m.d.comb += fill_hot.eq(Const(1, g.ways) << f_r.data.way[:max(1, g.way_bits)])
+        # A beat is written the cycle after it is taken, from registers (the fill queue's
+        # LUT-RAM read stays off the block RAMs' write pins): a miss's pixel reads its word
+        # two cycles after its line's last beat at the earliest (the pop, then the head
+        # register), once that beat is written.
+        fill_addr = Cat(beat, fill_set) if g.beats > 1 else fill_set
+        w_addr = Signal(len(fill_addr), name="fill_w_addr")
+        w_data = Signal(g.data_bits, name="fill_w_data")
+        w_hot = Signal(g.ways, name="fill_w_hot")
+        m.d.sync += [w_addr.eq(fill_addr), w_data.eq(ax.rdata),
+                     w_hot.eq(Mux(beat_in, fill_hot, 0))]
         for w, dp in enumerate(datas):
-            m.d.comb += [dp.w_addr.eq(Cat(beat, fill_set) if g.beats > 1 else fill_set),
-                         dp.w_data.eq(ax.rdata), dp.w_en.eq(beat_in & fill_hot[w])]
+            m.d.comb += [dp.w_addr.eq(w_addr), dp.w_data.eq(w_data), dp.w_en.eq(w_hot[w])]
         with m.If(beat_in):
             m.d.sync += beat.eq(beat + 1)
         with m.If(line_in):
@@ -738,24 +790,33 @@ class TextureCache(wiring.Component):
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
         wd_extra = {k: Signal(s, name=f"wd_{k}") for k, s in self.extra.items()}
         wd_words = [dp.r_data for dp in datas]
-        r.in_extra, r.rw_extra, r.look_extra, r.queue = in_extra, rw_extra, look_extra, qmem
+        r.in_extra, r.rw_extra, r.ws_extra, r.look_extra = in_extra, rw_extra, ws_extra, look_extra
+        r.queue = qmem
         r.rd_extra, r.wd_extra = rd_extra, wd_extra
         r.hd_extra = {k: hd[k] for k in self.extra}
         wd_move = ~wd_valid | o_free               # the data read and its words move on
         hd_move = ~hd_valid | wd_move              # the queue read and the head move on
         # The oldest entry is in the queue RAM's register when it was read (address out_seq)
         # in the last cycle the queue read moved on, unless written in that cycle (a read
-        # does not see a write of its own cycle): a register, as are its miss bit and
-        # whether a line has landed for it.
-        head_miss, readable, landed_any = Signal(name="head_miss"), r.readable, r.landed_any
-        m.d.comb += pop.eq(readable & (~head_miss | landed_any) & hd_move)
+        # does not see a write of its own cycle): a register, as is whether a line has
+        # landed for it. Its miss bit: the last cycle's reads of the oldest entry's and the
+        # next one's, in registers, the last cycle's pop choosing (no logic after the reads).
+        readable, landed_any = r.readable, r.landed_any
+        miss_at = [Signal(name=f"miss_at{n}") for n in range(2)]
+        popped = Signal(name="popped")
+        head_miss = Signal(name="head_miss")
+        m.d.comb += head_miss.eq(Mux(popped, miss_at[1], miss_at[0]))
+        m.d.sync += [miss_at[0].eq(m_r0.data), miss_at[1].eq(m_r1.data), popped.eq(pop)]
+        # the head leaves if the queue read moves on (registers alone: the queue RAM's read
+        # address, whose read is only enabled when it moves on, waits on no port)
+        pop_ok = Signal(name="pop_ok")
+        m.d.comb += [pop_ok.eq(readable & (~head_miss | landed_any)), pop.eq(pop_ok & hd_move)]
         after = r.out_after
         m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
-                     qmem.r_addr.eq(Mux(pop, after, out_seq[:qb])), qmem.en.eq(hd_move)]
+                     qmem.r_addr.eq(Mux(pop_ok, after, out_seq[:qb])), qmem.en.eq(hd_move)]
         with m.If(pop):
             m.d.sync += after.eq(after + 1)
-        m.d.sync += [head_miss.eq(Mux(pop, m_r1.data, m_r0.data)),
-                     landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
+        m.d.sync += [landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
         with m.If(hd_move):
             m.d.sync += readable.eq((count > 1) | ((count == 1) & ~pop))
         with m.If(pop):
@@ -867,9 +928,9 @@ class AxiMapFetch(wiring.Component):
     @property
     def capacity(self):
         """Pixels taken at ``i`` and not yet taken at ``o``, at most: the pixel read's, its
-        words' and the lookup's registers, the queue's entries, its head register, the data
-        read's and its words' registers and the output register."""
-        return self.geom.queue + 7
+        words read's, its words settled's and the lookup's registers, the queue's entries, its
+        head register, the data read's and its words' registers and the output register."""
+        return self.geom.queue + 8
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None, target=None):
         check_scene(self, scene)
