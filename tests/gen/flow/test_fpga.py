@@ -14,6 +14,8 @@ from bumprtl.sim.golden.methods import PER_PIXEL, datapath_fixed
 from bumprtl.sim.golden.vectors import TINY, as_payloads, random_codes
 
 
+# a real placement (nextpnr, ~10 s of CPU): make fpga runs it beside the other placements
+@pytest.mark.fpga
 def test_sincos_places_on_the_smallest_device(build_dir):
     # 12-bit angles: the 1025-word table is one block RAM (at 13 bits Yosys splits the
     # generic table over three blocks and adds registers of its own to select between them)

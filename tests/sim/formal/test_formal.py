@@ -159,6 +159,8 @@ def test_a_wide_fifo_keeps_one_bank(width, banks):
     assert [bank.depth for bank in fifo.banks] == banks and fifo.bank_bits == (banks[0] - 1).bit_length()
 
 
+# make formal (its runner elaborates contracts in parallel threads) runs it, not make test
+@pytest.mark.formal
 def test_parallel_elaborations_each_observe_every_stage():
     """make formal elaborates in parallel threads (-j 2): each contract's observer is passed
     to its own elaboration's pipes (no process-wide patch, no lock), so contracts built at
