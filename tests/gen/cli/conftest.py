@@ -29,3 +29,26 @@ def import_fails(monkeypatch):
             return real(name, *args)
         monkeypatch.setattr(importlib, "import_module", fake)
     return fails
+
+
+@pytest.fixture
+def board_refusal(tmp_path, monkeypatch, run_cli):
+    """``board_refusal(flags)``: runs ``bumprtl board ulx3s FLAGS --out DIR`` with the
+    bitstream, part-cost and frame steps failing if reached, checks the refusal (exit 2,
+    nothing on stdout, nothing written) and returns its one stderr line."""
+    from bumprtl.gen.cli import board as cli_board
+
+    def never(*args, **kw):
+        raise AssertionError("a refused command reached a build step")
+    for name in ("build_bitstream", "part_costs", "check_frames"):
+        monkeypatch.setattr(cli_board, name, never)
+
+    def refuse(flags):
+        out = tmp_path / "refused"
+        r = run_cli(["board", "ulx3s", *flags, "--out", out])
+        assert r.returncode == 2, r.stdout + r.stderr
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("bumprtl: error: "), lines
+        assert not out.exists() and r.stdout == ""
+        return lines[0]
+    return refuse

@@ -85,29 +85,17 @@ def _first_free_sector():
     (["--pipe-mhz", "20"], "pipe clock must be at least the pixel clock"),
     (["--check-frames", "1"], "--check-frames applies to map_memory = 'bram'"),
 ])
-def test_bad_input_with_the_map_in_sdram_one_line_exit_2_nothing_written(flags, message, tmp_path,
-                                                                          monkeypatch, run_cli):
-    for name in ("build_bitstream", "part_costs", "check_frames"):
-        monkeypatch.setattr(cli_board, name, _no)
-    out = tmp_path / "b"
-    r = run_cli(["board", "ulx3s", *AXI, "--out", out, *flags])
-    assert r.returncode == 2, r.stdout + r.stderr
-    [line] = r.stderr.strip().splitlines()
-    assert line.startswith("bumprtl: error: ") and message in line, line
-    assert not out.exists() and r.stdout == ""
+def test_bad_input_with_the_map_in_sdram_one_line_exit_2_nothing_written(flags, message,
+                                                                          board_refusal):
+    line = board_refusal([*AXI, *flags])
+    assert message in line, line
 
 
 @pytest.mark.parametrize("flag", [["--sdram", "32mb"], ["--flash-offset", "0x200000"]])
-def test_the_sdram_flags_on_a_map_in_block_ram_are_refused(flag, tmp_path, monkeypatch, run_cli):
-    for name in ("build_bitstream", "part_costs", "check_frames"):
-        monkeypatch.setattr(cli_board, name, _no)
-    out = tmp_path / "b"
-    r = run_cli(["board", "ulx3s", "--texture-size", "16", "--out", out, *flag])
-    assert r.returncode == 2
-    assert r.stderr.strip().splitlines() == [
+def test_the_sdram_flags_on_a_map_in_block_ram_are_refused(flag, board_refusal):
+    assert board_refusal(["--texture-size", "16", *flag]) == (
         f"bumprtl: error: {flag[0]} applies to a map in the SDRAM (--map-memory axi), the "
-        f"scene's map_memory is 'bram'"]
-    assert not out.exists()
+        f"scene's map_memory is 'bram'")
 
 
 def test_a_bitstream_reaching_past_the_map_is_an_error_after_the_build(tmp_path, monkeypatch,
