@@ -647,16 +647,15 @@ class StreamContract(Elaboratable):
         self._lemma(m, entry == (ghosts[0] + stages[0][0])[:bits],
                     "the next pixel into the chain is one past stage 1's ghost tag")
         self._lemma(m, youngest == ghosts[-1], "the FIFO's youngest is the one before stage L's")
-        expect = entry
         if self.cache is None:
-            self._lemma(m, n_in == expect, "next input tag is one past the youngest in flight")
+            self._lemma(m, n_in == entry, "next input tag is one past the youngest in flight")
             return
         # The cache in front of the edge: the tag after the chain's youngest is the next
         # one the cache delivers, the next input's that plus the pixels in the cache.
         c = self.cache
         n_edge = Signal(bits, name="tag_out_of_cache")
         m.d.sync += n_edge.eq(n_edge + (c.o.valid & c.o.ready))
-        self._lemma(m, n_edge == expect, "the cache's next pixel is the chain's next")
+        self._lemma(m, n_edge == entry, "the cache's next pixel is the chain's next")
         self._lemma(m, n_in == (n_edge + self._in_cache(m, take_in))[:bits],
                     "next input tag is one past the youngest in flight")
         self._cache_order(m, n_edge, bits)
