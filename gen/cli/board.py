@@ -89,7 +89,7 @@ def run(args):
                        pipe_mhz=memory.pipe_hz / 1e6)
     if bitstream:
         rows = build_bitstream(scene, mode, out, args.board, seeds, pipe_hz=pipe_hz,
-                               **({} if memory is None else {"memory": memory}))
+                               memory=memory)
         for r in rows:
             res = ", ".join(f"{k} {u}/{a}" for k, (u, a) in r["resources"].items())
             fmax = ", ".join(f"{d} {a:.1f} MHz (constraint {c:.1f})" for d, (a, c) in
@@ -112,8 +112,7 @@ def run(args):
             print(f"{d}: minimum Fmax over seeds {','.join(map(str, seeds))}: {a:.1f} MHz, "
                   f"constraint {c:.1f} MHz: {'met' if a >= c else 'NOT MET'}")
         if args.parts:
-            parts = part_costs(scene, mode, out / "parts",
-                               **({} if memory is None else {"memory": memory}))
+            parts = part_costs(scene, mode, out / "parts", memory=memory)
             summary["parts"] = parts
             for part, row in parts.items():
                 print(f"{part}: " + ", ".join(f"{k} {v}" for k, v in row.items()))

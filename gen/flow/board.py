@@ -28,6 +28,7 @@ import json
 import os
 import subprocess
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -110,13 +111,15 @@ def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None):
                      pipe_hz=pipe_hz, globe=surface(scene) == "sphere", **parts)
 
 
+@dataclass(frozen=True)
 class BoardMemory:
     """The parts of a map in the SDRAM (:func:`board_memory`): ``pipe_hz`` (the PLL's pipe
     clock, the SDRAM's), ``sdram`` (SdramConfig), ``flash`` (FlashConfig), ``image`` (the
     bytes the loader copies: the map's tiled image, from flash byte ``flash.offset``)."""
-
-    def __init__(self, pipe_hz, sdram, flash, image):
-        self.pipe_hz, self.sdram, self.flash, self.image = pipe_hz, sdram, flash, image
+    pipe_hz: float
+    sdram: SdramConfig
+    flash: FlashConfig
+    image: bytes
 
 
 def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET, pipe_hz=None,
@@ -345,7 +348,7 @@ def part_costs(scene, mode, work_dir, memory=None):
     pins then ports of the core too."""
     work_dir = Path(work_dir).resolve()
     work_dir.mkdir(parents=True, exist_ok=True)
-    core = board_core(scene, mode, ECP5(), **({} if memory is None else {"memory": memory}))
+    core = board_core(scene, mode, ECP5(), memory=memory)
     ports = [core.o0, core.o1, core.underflow, core.order_error]
     if memory is not None:
         ports += [value for iface in (core.sdram_pins, core.spi)

@@ -16,6 +16,7 @@ The pins on the ULX3S), without running the tools:
 """
 
 import re
+from dataclasses import replace
 
 import pytest
 from amaranth.hdl import Module, Signal
@@ -164,11 +165,10 @@ def test_the_at_most_divider_never_exceeds_what_was_asked():
 def test_a_core_whose_sdram_config_is_not_the_plls_clock_is_refused():
     mode = MODES["640x480"]
     scene = load_scene_config("default", {**SMALL, "map_memory": "axi"})
-    memory = board_memory(scene, mode)
-    for field, sdram in (("freq_mhz", SdramConfig(**{**_fields(memory.sdram), "freq_mhz": 100})),
-                         ("pin_cycles", SdramConfig(**{**_fields(memory.sdram), "pin_cycles": 0}))):
-        memory.sdram = sdram
-        core = board_core(scene, mode, memory=memory)
+    made = board_memory(scene, mode)
+    for field, sdram in (("freq_mhz", SdramConfig(**{**_fields(made.sdram), "freq_mhz": 100})),
+                         ("pin_cycles", SdramConfig(**{**_fields(made.sdram), "pin_cycles": 0}))):
+        core = board_core(scene, mode, memory=replace(made, sdram=sdram))
         with pytest.raises(BumpError) as e:
             ULX3STop(core)
         assert e.value.field == field and "\n" not in str(e.value)

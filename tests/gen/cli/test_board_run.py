@@ -33,7 +33,8 @@ def checked_once(monkeypatch):
 def _build(fmax_by_seed):
     calls = []
 
-    def build(scene, mode, out, board, seeds, pipe_hz=None):
+    def build(scene, mode, out, board, seeds, pipe_hz=None, memory=None):
+        assert memory is None                   # a map in block RAM has no SDRAM parts
         calls.append((scene.name, mode.name, out, board, list(seeds)) + ((pipe_hz,) if pipe_hz else ()))
         return [{"seed": s, "seconds": 12.0,
                  "resources": {"LUT4": (100 * s, 83640), "DSP": (4, 156)},
@@ -49,7 +50,7 @@ def test_bitstream_seeds_minimum_fmax_parts_and_summary(tmp_path, monkeypatch, r
     build, calls = _build({2: {"sync (pixel)": (30.0, 25.2), "shift": (130.0, 126.0)},
                            3: {"sync (pixel)": (27.5, 25.2), "shift": (120.0, 126.0)}})
     monkeypatch.setattr(cli_board, "build_bitstream", build)
-    monkeypatch.setattr(cli_board, "part_costs", lambda scene, mode, work: {
+    monkeypatch.setattr(cli_board, "part_costs", lambda scene, mode, work, memory=None: {
         "pipeline": {"LUT4": 10, "DSP": 4}, "buffer": {"LUT4": 1, "DSP": 0}})
     monkeypatch.setattr(cli_board, "check_frames", _no)
     out = tmp_path / "b"

@@ -175,7 +175,7 @@ def test_part_costs_add_each_parts_cells_through_the_hierarchy(monkeypatch, tmp_
         assert "module \\core" in (work / "core.il").read_text()
         (work / "core.synth.json").write_text(json.dumps(netlist))
 
-    monkeypatch.setattr(board, "board_core", lambda scene, mode, target: _Core())
+    monkeypatch.setattr(board, "board_core", lambda scene, mode, target, memory=None: _Core())
     monkeypatch.setattr(board.yosys, "run_yosys", fake_yosys)
     rows = board.part_costs(None, None, tmp_path / "parts")
     assert scripts[0][0] == ("read_rtlil core.il; synth_ecp5 -noflatten -top core; "
