@@ -490,7 +490,7 @@ def pll_params(pixel_hz, ref_hz=25e6, pipe_hz=None, sdram=False):
     pipeline's clock (:func:`pll_pipe_divider`, from above; with ``sdram`` at or below);
     with ``sdram`` also CLKOS3 = the same clock half a period later (the SDRAM's read
     capture, docs/sdram.md): the coarse phase counts VCO cycles after the divider's own
-    ``div - 1``, the fine phase eighths of one (the convention of Project Trellis' ecppll)."""
+    ``div - 1``, the fine phase eighths of one (docs/sdram.md, The pins on the ULX3S)."""
     clki, fb, op_div = pll_dividers(pixel_hz, ref_hz)
     extra = {}
     if pipe_hz is not None:

@@ -72,10 +72,9 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
 # The bitstream's bytes at flash byte 0, at most: the LFE5U-85F's uncompressed bitstream
 # (ecppack without --compress on the placed design of docs/board.md, The map in the SDRAM
-# on the ULX3S; its configuration frames alone are 13,294 x 1,136 bits = 1,887,748 bytes,
-# Project Trellis' devices.json; block RAM contents come on top). Amaranth's flow writes
-# the .bit compressed, smaller by a design-dependent amount; after a build the CLI checks
-# the .bit it wrote too.
+# on the ULX3S; its configuration frames and what comes on top of them: docs/flash.md).
+# Amaranth's flow writes the .bit compressed, smaller by a design-dependent amount; after a
+# build the CLI checks the .bit it wrote too.
 BITSTREAM_BYTES = {"LFE5U-85F": 2_080_713}
 # openFPGALoader erases the flash in 64 KiB sectors: the map starts on a sector of its own.
 FLASH_SECTOR = 1 << 16
