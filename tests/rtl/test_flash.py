@@ -10,7 +10,7 @@ from amaranth.sim import Simulator
 
 from bumprtl.rtl.config import BumpError, ConfigError
 from bumprtl.rtl.flash import FlashConfig, FlashLoader
-from bumprtl.sim.flash_model import SpiFlash
+from bumprtl.sim.flash_model import READ, SpiFlash
 
 
 class AxiWriteMemory:
@@ -217,3 +217,55 @@ def test_the_model_catches_what_a_flash_refuses():
     text = " | ".join(f.errors)
     assert "opcode 0x02" in text and "SCLK high" in text and "shorter than 2" in text
     assert "inside the command" in text
+
+
+def _read_pins(addr, nbytes, phase=2):
+    """The pins of one READ of ``nbytes`` from ``addr`` in mode 0, each SCLK phase
+    ``phase`` clocks: CS# high, low, opcode and address MSB first, then the data clocks."""
+    word = READ << 24 | addr
+    seq = [(1, 0, 0)] * phase + [(0, 0, 0)] * phase
+    for k in range(32 + 8 * nbytes):
+        mosi = word >> (31 - k) & 1 if k < 32 else 0
+        seq += [(0, 0, mosi)] * phase + [(0, 1, mosi)] * phase
+    return seq + [(0, 0, 0)] * phase + [(1, 0, 0)] * phase
+
+
+def _bytes_read(seq, miso, after):
+    """The bytes MISO carries ``after`` steps from each SCLK fall that sends a data bit (the
+    fall after the 32nd rise, the last address bit, sends the first)."""
+    rises, bits = 0, []
+    for i in range(1, len(seq)):
+        (cs_n, sclk, _), prev = seq[i], seq[i - 1][1]
+        rises += not cs_n and sclk and not prev
+        if not cs_n and prev and not sclk and rises >= 32 and len(bits) < 8 * 3:
+            bits.append(miso[i + after])
+    return bytes(int("".join(map(str, bits[k:k + 8])), 2) for k in range(0, len(bits), 8))
+
+
+@pytest.mark.parametrize("delay", [0, 1, 2])
+def test_the_model_sends_the_array_msb_first_after_its_delay(delay):
+    """A READ returns the array from its address on, MSB first; each bit reaches MISO
+    ``delay`` steps after the step that sees SCLK fall (0: in that step), and not before."""
+    image = bytes([0xA5, 0x3C, 0x81, 0x7E])
+    f = SpiFlash(image, min_phase=3, delay=delay)
+    seq = _read_pins(1, 3, phase=3)
+    miso = [f.step(*pins) for pins in seq]
+    assert _bytes_read(seq, miso, delay) == image[1:4]
+    if delay:
+        assert _bytes_read(seq, miso, delay - 1) != image[1:4]
+    assert f.errors == [] and f.reads == [(1, 3)]
+
+
+def test_the_model_keeps_the_first_twenty_errors():
+    """A run of broken commands records its first 20 errors, then no more (a bench that
+    went wrong prints a bounded list)."""
+    f = SpiFlash(bytes(4))
+    for _ in range(10):                            # CS# toggled with SCLK high: one error each
+        f.step(1, 1, 0)
+        f.step(0, 1, 0)
+    first = list(f.errors)
+    assert len(first) == 20 and sum("SCLK high" in e for e in first) >= 19
+    for _ in range(10):
+        f.step(1, 1, 0)
+        f.step(0, 1, 0)
+    assert f.errors == first

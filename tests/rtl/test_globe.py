@@ -17,6 +17,7 @@ from bumprtl.rtl.globe import (
     DATAPATH_BITS,
     GlobeConfig,
     GlobeGeometry,
+    fit_signed,
     sqrt_stages,
     theta_table,
     v_table,
@@ -379,3 +380,27 @@ def test_verilog_is_lint_clean(build_dir):
     path = build_dir / "globe_geometry.v"
     path.write_text(flat_verilog(GlobeGeometry(GlobeConfig()), "globe_geometry"))
     assert lint(path) == []
+
+
+@pytest.mark.parametrize("value, width, expected", [
+    ((0b1011, unsigned(4)), 3, 3),            # truncated to its low bits, read signed
+    ((0b1111, unsigned(4)), 3, -1),
+    ((-3, "signed6"), 4, -3),                 # a signed value narrowed
+    ((0b101, unsigned(3)), 5, 5),             # unsigned: zero-extended
+    ((-3, "signed3"), 6, -3)])                # signed: sign-extended
+def test_fit_signed_extends_by_signedness_and_truncates_to_the_low_bits(value, width, expected):
+    from amaranth.hdl import Const, Module, signed
+    from amaranth.sim import Simulator
+
+    v, shape = value
+    shape = signed(int(shape[6:])) if isinstance(shape, str) else shape
+    out = []
+
+    async def bench(ctx):
+        e = fit_signed(Const(v, shape), width)
+        out.append((len(e), e.shape().signed, ctx.get(e)))
+
+    sim = Simulator(Module())
+    sim.add_testbench(bench)
+    sim.run()
+    assert out == [(width, True, expected)]

@@ -100,3 +100,20 @@ def test_a_unit_inside_a_chain_refuses_a_fifo_depth_of_its_own():
     assert Illumination(Config(), credit=True, fifo_depth=None).fifo_depth >= 1
     with pytest.raises(BumpError, match="fifo_depth is given but credit=False"):
         Illumination(Config(), credit=False, fifo_depth=8)
+
+
+def test_a_pipe_clock_of_zero_or_below_the_pixel_clock_is_refused():
+    """No divider gives a clock of 0 Hz; the SDRAM's clock bound below the pixel clock
+    leaves the pipeline slower than the display: both name ``pipe_hz``."""
+    from bumprtl.rtl.board import pll_pipe_divider, sdram_clock
+    from bumprtl.rtl.video import MODES
+
+    pixel = MODES["1280x720"].pixel_hz
+    with pytest.raises(BumpError, match=r"^pipe clock must be in \[.*got 0 MHz$") as e:
+        pll_pipe_divider(pixel, 0)
+    assert e.value.field == "pipe_hz"
+    assert sdram_clock(pixel, 100e6) >= pixel
+    with pytest.raises(BumpError, match=r"below the pixel clock 74\.2\d* MHz; it must be in "
+                                        r"\[74\.2\d*, 70\] MHz$") as e:
+        sdram_clock(pixel, 70e6)
+    assert e.value.field == "pipe_hz"

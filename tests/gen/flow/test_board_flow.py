@@ -249,3 +249,28 @@ def test_part_costs_with_the_map_in_sdram_keep_its_pins_and_name_its_parts(monke
     assert rows["flash loader"] == {"LUT4": 0, "FF": 3, "DSP": 0, "BRAM": 0}
     assert rows["clock crossing"] == {"LUT4": 2, "FF": 0, "DSP": 0, "BRAM": 0}
     assert "globe" not in rows
+
+
+def test_read_report_names_the_pipe_and_sdram_read_clocks(tmp_path):
+    """The SDRAM top's two further clocks: the pipeline's (CLKOS2) and the DQ capture's
+    (CLKOS3), by their nets' names in either form nextpnr reports."""
+    _report(tmp_path / "r.json", 1, {
+        "$glbnet$pipe_clk": {"achieved": 90.04, "constraint": 78.125},
+        "$glbnet$sdram_rd_clk": {"achieved": 200.0, "constraint": 78.125}})
+    assert board.read_report(tmp_path / "r.json")["fmax"] == {"pipe": (90.0, 78.1),
+                                                               "sdram_rd": (200.0, 78.1)}
+    assert board._domain("pll_clkos2") == "pipe" and board._domain("pll_clkos3") == "sdram_rd"
+
+
+def test_board_memory_images_the_words_it_is_given():
+    """``words`` replaces the scene's map: a map of distinct words comes back once each, as
+    the little-endian 32-bit slots of the image (the default widths' 28-bit texel), in
+    whatever order the tiled layout puts them."""
+    import numpy as np
+
+    scene = load_scene_config("default", {"map_memory": "axi"})
+    mode = get_mode("640x480")
+    words = np.arange(64 * 64, dtype=np.int64) * 7919 % (1 << 28)
+    image = board.board_memory(scene, mode, words=words).image
+    assert sorted(np.frombuffer(image, "<u4").tolist()) == sorted(words.tolist())
+    assert board.board_memory(scene, mode).image != image
