@@ -407,7 +407,12 @@ class BoardCore(Elaboratable):
             rgb = Mux(o.tag[-1], rgb, 0)
         count_bits = len(src.count)   # the tag's bits that count pixels, as the source counts
         # a pixel every cycle, once the map is in place; the credits decide when it is taken
-        m.d.comb += src.allow.eq(1 if self.sdram is None else self.loader.done)
+        if self.sdram is None:
+            m.d.comb += src.allow.eq(1)
+        else:                         # the loader's done (a comparison) as a register
+            loaded = Signal(name="map_loaded")
+            m.d.pipe += loaded.eq(self.loader.done)
+            m.d.comb += src.allow.eq(loaded)
         # the display shows from the first frame whose first pixel is ready
         running, shows = Signal(name="display_running"), self.shows
         if self.pipe_hz is None:      # the pipeline's FIFO is the buffer, read at the display
