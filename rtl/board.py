@@ -49,7 +49,7 @@ from amaranth.hdl import (
     Mux,
     Signal,
 )
-from amaranth.lib import io, wiring
+from amaranth.lib import io, stream, wiring
 from amaranth.lib.cdc import ResetSynchronizer
 from amaranth.lib.fifo import AsyncFIFO
 from amaranth.lib.memory import Memory
@@ -65,6 +65,7 @@ from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
 __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "RasterSource",
+           "register_slice",
            "PixelSource",
            "GlobeSource", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
            "GLOBE_TURN_FRAMES",
@@ -127,10 +128,17 @@ class RasterSource(Elaboratable):
     ``count`` of ``count_bits``) and the light table (``table``: one {key: code} per light
     step, L and H of every light), read a cycle ahead into the pipeline's payload, its step
     register ``frame`` moving on after the last pixel of a frame. ``allow``: the source may
-    offer a pixel this cycle."""
+    offer a pixel this cycle. It drives ``port``: the pipeline's input stream, or with
+    ``register`` a stream of the same shape that :func:`register_slice` joins to it, so
+    that the source's counters and the table's address see a registered ready (the texel
+    cache's ready is combinational: with the map in the SDRAM it would chain the cache's
+    lookup into the source)."""
 
-    def __init__(self, pipeline, mode: VideoMode, table, count_bits):
+    def __init__(self, pipeline, mode: VideoMode, table, count_bits, register=False):
         self.pipeline, self.mode = pipeline, mode
+        self.register = register
+        self.port = (stream.Signature(pipeline.i.payload.shape()).create(path=("source_out",))
+                     if register else pipeline.i)
         self.table = [dict(t) for t in table]
         self.keys = sorted(self.table[0])
         self.widths = [len(payload_field(pipeline.i.payload, k)) for k in self.keys]
@@ -167,8 +175,31 @@ class RasterSource(Elaboratable):
             m.d.sync += self.frame.eq(step)
         at = 0
         for k, w in zip(self.keys, self.widths, strict=False):
-            m.d.comb += payload_field(self.pipeline.i.payload, k).eq(rd.data[at:at + w])
+            m.d.comb += payload_field(self.port.payload, k).eq(rd.data[at:at + w])
             at += w
+        if self.register:
+            register_slice(m, self.port, self.pipeline.i)
+
+
+def register_slice(m, src, dst):
+    """``src`` -> ``dst`` (streams of one payload shape) through two registers, full rate:
+    ``src.ready`` is a register (the spare register empty) and ``dst``'s ready reaches only
+    the output register's enable and the two valid flags. The spare register takes
+    ``src``'s payload whenever it is empty; a pixel ``src`` offers is taken into the output
+    register if that moves on this cycle, else into the spare one; the output register
+    takes the spare one first. Order kept, nothing dropped or doubled."""
+    shape = src.payload.shape()
+    out, spare = Signal(shape, name="slice_out"), Signal(shape, name="slice_spare")
+    out_valid, spare_valid = Signal(name="slice_out_valid"), Signal(name="slice_spare_valid")
+    move = ~out_valid | dst.ready
+    m.d.comb += [src.ready.eq(~spare_valid), dst.valid.eq(out_valid), dst.payload.eq(out)]
+    with m.If(~spare_valid):
+        m.d.sync += spare.eq(src.payload)
+    with m.If(move):
+        m.d.sync += [out.eq(Mux(spare_valid, spare, src.payload)),
+                     out_valid.eq(spare_valid | src.valid), spare_valid.eq(0)]
+    with m.Else():
+        m.d.sync += spare_valid.eq(spare_valid | src.valid)
 
 
 class PixelSource(RasterSource):
@@ -177,17 +208,17 @@ class PixelSource(RasterSource):
     {key: code} per light step (L and H of every light); the pipeline's input stream
     (valid, payload; ready from it) is driven."""
 
-    def __init__(self, pipeline, mode: VideoMode, constants, table):
-        super().__init__(pipeline, mode, table, pipeline.cfg.tag_bits)
+    def __init__(self, pipeline, mode: VideoMode, constants, table, register=False):
+        super().__init__(pipeline, mode, table, pipeline.cfg.tag_bits, register)
         self.constants = dict(constants)
 
     def elaborate(self, platform):
-        m, md, p = Module(), self.mode, self.pipeline
+        m, md, p, port = Module(), self.mode, self.pipeline, self.port
         issue = Signal()
-        m.d.comb += [p.i.valid.eq(self.allow & self.primed), issue.eq(p.i.valid & p.i.ready)]
+        m.d.comb += [port.valid.eq(self.allow & self.primed), issue.eq(port.valid & port.ready)]
         last_x, last_y = self.raster(m, issue)
         self.lights(m, issue & last_x & last_y)
-        pay = p.i.payload
+        pay = port.payload
         size = p.scene.texture_size
         u, v = texel_coords(self.px, self.py, md.zoom, size)
         m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
@@ -241,20 +272,20 @@ class GlobeSource(RasterSource):
     the pixel count below a "last of the frame" bit, and the pipeline's tag the count below
     the globe's ``inside``)."""
 
-    def __init__(self, pipeline, mode: VideoMode, globe: GlobeGeometry, table):
+    def __init__(self, pipeline, mode: VideoMode, globe: GlobeGeometry, table, register=False):
         bits = pipeline.cfg.tag_bits
         if bits < 2:
             self._MustUse__silence = True          # refused: never to be elaborated
             raise BumpError(f"tag_bits must be >= 2 for the globe (the pixel count and the "
                             f"inside bit), got {bits}", "tag_bits")
-        super().__init__(pipeline, mode, table, bits - 1)
+        super().__init__(pipeline, mode, table, bits - 1, register)
         self.globe = globe
         self.turn_step = globe_turn_step(pipeline.cfg)
         self.rotation = Signal(globe.gcfg.angle_bits, name="globe_rotation",
                                init=globe_rotation(pipeline.cfg, 0))
 
     def elaborate(self, platform):
-        m, p, g = Module(), self.pipeline, self.globe
+        m, g = Module(), self.globe
         # the globe's side: the raster and the rotation
         take = Signal()
         m.d.comb += [g.i.valid.eq(self.allow), take.eq(g.i.valid & g.i.ready)]
@@ -266,11 +297,11 @@ class GlobeSource(RasterSource):
         m.d.comb += [gi.x.eq(x), gi.y.eq(y), gi.rotation.eq(self.rotation),
                      gi.tag.eq(Cat(self.count, last_x & last_y))]
         # the pipeline's side: the globe's output and the light table
-        go, issue = g.o.payload, Signal()
-        m.d.comb += [p.i.valid.eq(g.o.valid & self.primed), g.o.ready.eq(p.i.ready & self.primed),
-                     issue.eq(p.i.valid & p.i.ready)]
+        go, issue, port = g.o.payload, Signal(), self.port
+        m.d.comb += [port.valid.eq(g.o.valid & self.primed),
+                     g.o.ready.eq(port.ready & self.primed), issue.eq(port.valid & port.ready)]
         self.lights(m, issue & go.tag[-1])
-        pay = p.i.payload
+        pay = port.payload
         m.d.comb += [pay.u.eq(go.u), pay.v.eq(go.v), pay.n.phi.eq(go.n.phi),
                      pay.n.theta.eq(go.n.theta), pay.tag.eq(Cat(go.tag[:-1], go.inside))]
         return m
@@ -329,12 +360,14 @@ class BoardCore(Elaboratable):
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
         self.depth = self.pipeline.fifo_depth
+        # the texel cache's ready depends on its lookup: a register slice after the source
+        slice_ = self.scene.map_memory == "axi"
         if globe:
             self.globe = GlobeGeometry(globe_config(self.scene, mode), target)
-            self.source = GlobeSource(self.pipeline, mode, self.globe, table)
+            self.source = GlobeSource(self.pipeline, mode, self.globe, table, slice_)
         else:
             self.globe = None
-            self.source = PixelSource(self.pipeline, mode, constants, table)
+            self.source = PixelSource(self.pipeline, mode, constants, table, slice_)
         self.sdram, self.flash = sdram, flash
         if sdram is not None:
             self.controller = SdramController(sdram)
@@ -374,7 +407,12 @@ class BoardCore(Elaboratable):
             rgb = Mux(o.tag[-1], rgb, 0)
         count_bits = len(src.count)   # the tag's bits that count pixels, as the source counts
         # a pixel every cycle, once the map is in place; the credits decide when it is taken
-        m.d.comb += src.allow.eq(1 if self.sdram is None else self.loader.done)
+        if self.sdram is None:
+            m.d.comb += src.allow.eq(1)
+        else:                         # the loader's done (a comparison) as a register
+            loaded = Signal(name="map_loaded")
+            m.d.pipe += loaded.eq(self.loader.done)
+            m.d.comb += src.allow.eq(loaded)
         # the display shows from the first frame whose first pixel is ready
         running, shows = Signal(name="display_running"), self.shows
         if self.pipe_hz is None:      # the pipeline's FIFO is the buffer, read at the display

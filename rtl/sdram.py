@@ -7,10 +7,13 @@ variant, selectable by name), the clock, the CAS latency and the burst length. E
 timing in cycles comes from :func:`ns_to_cycles` (``ceil(ns * f)``) through
 :meth:`SdramConfig.cycles`; nothing else in the controller is a timing.
 
-The controller is one command scheduler. Each cycle it decides at most one command from
-registers only (the bank table, the per-bank and global timers, the transaction being
-served, the refresh counter) and registers it onto the pins with its address and data,
-so the pins change on the clock edge and the decision's logic is a few LUTs deep.
+The controller is one command scheduler. Each cycle it decides at most one command
+(:func:`decide`) from registers only (the bank table, the per-bank and global timers, the
+transaction being served, the refresh counter) and registers it onto the pins with its
+address and data, so the pins change on the clock edge. The decision itself (the row
+comparison, the timers' zero tests, the refresh's, the read credit's) is made a cycle
+ahead for a cycle without a command and registered (``go``): a command comes from
+registers through one gate, and at least one cycle without a command follows each.
 Priorities: the initialisation sequence; a refresh that is due (precharge every open bank,
 then AUTO REFRESH); then the transaction taken from AR or AW (round robin), served in
 bursts of ``burst`` words, each one READ or WRITE once its bank has its row open
@@ -32,7 +35,8 @@ from bumprtl.rtl.cache import axi_read_signature
 from bumprtl.rtl.config import BumpError, is_pow2
 
 __all__ = ["SdramChip", "CHIPS", "SdramConfig", "ns_to_cycles", "axi_write_signature",
-           "sdram_signature", "SdramController", "CMD", "mode_register"]
+           "sdram_signature", "SdramController", "CMD", "mode_register", "DECISIONS",
+           "decide"]
 
 
 @dataclass(frozen=True)
@@ -303,6 +307,59 @@ def sdram_signature(cfg: SdramConfig):
         "dq_o": Out(DQ_BITS), "dq_oe": Out(1), "dq_i": In(DQ_BITS)})
 
 
+# The commands the scheduler decides, in priority order (at most one is true).
+DECISIONS = ("pre_all", "ref", "mode", "read", "write", "pre", "act")
+SERVED = ("read", "write", "pre", "act")           # the transaction's: they read cur_addr
+
+
+def decide(cfg: SdramConfig, r, quiet=False, flow=True):
+    """Which command the scheduler may issue (docs/sdram.md, The scheduler): a dict of
+    DECISIONS to expressions over the controller's registers ``r``
+    (:attr:`SdramController.regs`), true for at most one. With ``quiet`` the decision of the
+    *next* cycle if this one issues no command and takes no transaction: a timer at 0 then
+    is one at most 1 now, the refresh is due then if ``ref_cnt`` is at most 1 now, and
+    the read credit and the write buffer only grow. The controller registers the quiet
+    decision (``go``) and issues from it; the formal contract states it equals the decision
+    of the registers themselves (``quiet=False``) whenever ``fresh``. Without ``flow`` READ
+    and WRITE leave out the read credit and the write buffer's count (the data's gates, no
+    timing's: what the contract checks the command stream's rules with)."""
+    nb, bl = cfg.chip.banks, cfg.burst
+    col_bits, bank_bits = cfg.chip.col_bits, cfg.chip.bank_bits
+
+    def zero(timer):
+        return (timer <= 1) if quiet else (timer == 0)
+
+    cur_bank = r.cur_addr[col_bits:col_bits + bank_bits]
+    cur_row = r.cur_addr[col_bits + bank_bits:]
+    bank_is = Const(1, nb) << cur_bank              # one-hot by a shift: lint-clean Verilog
+    hit = Cat(*[r.open[b] & (r.rows[b] == cur_row) for b in range(nb)])
+    ref_due = (r.ref_cnt <= 1) if quiet else r.ref_due
+    idle = zero(r.cmd_t)
+    all_act = Cat(*[zero(t) for t in r.act_t]).all()
+    all_pre = Cat(*[~r.open[b] | zero(r.pre_t[b]) for b in range(nb)]).all()
+    bank_hit = (hit & bank_is).any()                # and-or selects: no case statements
+    bank_open = (r.open & bank_is).any()
+
+    def bank_ready(timers):
+        return (Cat(*[zero(t) for t in timers]) & bank_is).any()
+
+    col_ready = idle & bank_ready(r.rcd_t) & Mux(
+        r.cur_write, zero(r.wr_t) & ((r.wcount >= bl) if flow else 1),
+        zero(r.rd_t) & ((r.credit >= bl) if flow else 1))
+    init_go = ~r.run & idle & all_act
+    served = r.run & ~ref_due & r.cur_valid
+    return {
+        "pre_all": (init_go & r.init_pre & ref_due)
+        | (r.run & ref_due & r.open.any() & idle & all_pre),
+        "ref": (init_go & ~r.init_pre & r.init_refs.any())
+        | (r.run & ref_due & ~r.open.any() & idle & all_act),
+        "mode": init_go & ~r.init_pre & ~r.init_refs.any(),
+        "read": served & bank_hit & col_ready & ~r.cur_write,
+        "write": served & bank_hit & col_ready & r.cur_write,
+        "pre": served & ~bank_hit & bank_open & idle & bank_ready(r.pre_t),
+        "act": served & ~bank_open & idle & bank_ready(r.act_t) & zero(r.rrd_t)}
+
+
 class SdramController(wiring.Component):
     """AXI4 reads and writes served from an SDR SDRAM.
 
@@ -325,8 +382,8 @@ class SdramController(wiring.Component):
         on ``dq_i`` in cycle n + CL + ``pin_cycles`` (sampled by the chip's clock edges),
         which the controller registers once.
 
-    One command a cycle at most; a burst's READs (WRITEs) follow each other every
-    ``burst`` cycles while its row is open and the read FIFO has room (the write buffer
+    One command every other cycle at most; a burst's READs (WRITEs) follow each other every
+    ``max(burst, 2)`` cycles while its row is open and the read FIFO has room (the write buffer
     holds the burst's data). Initialisation, timers and refresh: docs/sdram.md.
     """
 
@@ -348,7 +405,22 @@ class SdramController(wiring.Component):
             ref_due=Signal(name="ref_due"),             # ref_cnt == 0, as a register
             init_pre=Signal(init=1, name="init_pre"),
             init_refs=Signal(range(cfg.refreshes + 1), init=cfg.refreshes, name="init_refs"),
-            run=Signal(name="run"))
+            run=Signal(name="run"),
+            rows=[Signal(cfg.chip.row_bits, name=f"row{b}") for b in range(nb)],
+            cur_valid=Signal(name="cur_valid"), cur_write=Signal(name="cur_write"),
+            # the word address of the transaction's next SDRAM burst
+            cur_addr=Signal(cfg.chip.col_bits + cfg.chip.bank_bits + cfg.chip.row_bits,
+                            name="cur_addr"),
+            # words the read FIFO can still take; words in the write buffer
+            credit=Signal(range(cfg.read_fifo * cfg.words_per_beat + 1),
+                          init=cfg.read_fifo * cfg.words_per_beat, name="credit"),
+            wcount=Signal(range(max(cfg.burst, cfg.words_per_beat) + 1), name="wcount"),
+            # the decision, a cycle ahead: go[k] is decide(regs, quiet=True)[k] of the
+            # cycle before; fresh: that cycle issued no command, took: it took a
+            # transaction; so go[k] is decide(regs)[k] of this one while fresh (and not
+            # took, for the transaction's commands; READ and WRITE: or more cautious)
+            go={k: Signal(name=f"go_{k}") for k in DECISIONS},
+            fresh=Signal(name="fresh"), took=Signal(name="took"))
         super().__init__({"rd": In(axi_read_signature(cfg.addr_bits, cfg.data_bits)),
                           "wr": In(axi_write_signature(cfg.addr_bits, cfg.data_bits)),
                           "sdram": Out(sdram_signature(cfg))})
@@ -378,19 +450,18 @@ class SdramController(wiring.Component):
         m.d.comb += pins.cke.eq(1)                  # no power-down, no self refresh
         nxt_cmd = Signal(4)
         nxt_ba, nxt_a = Signal(bank_bits), Signal(ADDR_PINS)
-        m.d.comb += nxt_cmd.eq(CMD["nop"])
         m.d.sync += [cmd.eq(nxt_cmd), pins.ba.eq(nxt_ba), pins.a.eq(nxt_a)]
 
         # --- bank table and timers ---
         open_ = r.open
-        rows = [Signal(row_bits, name=f"row{b}") for b in range(nb)]
+        rows = r.rows
         act_t, rcd_t, pre_t = r.act_t, r.rcd_t, r.pre_t
         rrd_t, rd_t, wr_t, cmd_t = r.rrd_t, r.rd_t, r.wr_t, r.cmd_t
         timers = [*act_t, *rcd_t, *pre_t, rrd_t, rd_t, wr_t, cmd_t]
 
         # --- the transaction being served ---
-        cur_valid, cur_write = Signal(), Signal()
-        cur_addr = Signal(word_bits)                 # word address of the next SDRAM burst
+        cur_valid, cur_write = r.cur_valid, r.cur_write
+        cur_addr = r.cur_addr                        # word address of the next SDRAM burst
         cur_left = Signal(range(256 * 4 // bl + 1))  # SDRAM bursts left after this one
         cur_col = cur_addr[:col_bits]
         cur_bank = cur_addr[col_bits:col_bits + bank_bits]
@@ -398,9 +469,6 @@ class SdramController(wiring.Component):
         last_burst = ~cur_left.any()
         bank_is = Signal(nb)                         # one-hot by a shift: lint-clean Verilog
         m.d.comb += bank_is.eq(Const(1, nb) << cur_bank)
-        hit = Signal(nb)
-        for b in range(nb):
-            m.d.comb += hit[b].eq(open_[b] & (rows[b] == cur_row))
 
         # --- refresh ---
         ref_cnt, ref_due = r.ref_cnt, r.ref_due
@@ -413,51 +481,44 @@ class SdramController(wiring.Component):
         cap = max(bl, wpb)
         wbuf = [Signal(DQ_BITS, name=f"wbuf{k}") for k in range(cap)]
         wmask = [Signal(2, name=f"wmask{k}") for k in range(cap)]
-        wcount = Signal(range(cap + 1))
+        wcount = r.wcount
         wsend = Signal(range(bl))                    # words of the WRITE still to send
         bvalid = Signal()
 
         # --- read path credit (words the read FIFO can still take) ---
-        credit = Signal(range(cfg.read_fifo * wpb + 1), init=cfg.read_fifo * wpb)
+        credit = r.credit
 
-        issue = {k: Signal(name=f"issue_{k}") for k in
-                 ("act", "read", "write", "pre", "pre_all", "ref", "mode")}
-        idle = ~cmd_t.any()
-        all_act = ~Cat(*act_t).any()
-        all_pre = ~Cat(*[pre_t[b].any() & open_[b] for b in range(nb)]).any()
-        bank_hit = (hit & bank_is).any()        # and-or selects: no case statements
-        bank_open = (open_ & bank_is).any()
-        rcd_ok = ~(Cat(*[t.any() for t in r.rcd_t]) & bank_is).any()
-        col_ready = idle & rcd_ok & Mux(
-            cur_write, ~wr_t.any() & (wcount >= bl), ~rd_t.any() & (credit >= bl))
-
-        # The decision as plain expressions (continuous assignments in the Verilog): who
-        # may issue what this cycle, in priority order.
-        init_go = ~run & idle & all_act
-        served = run & ~ref_due & cur_valid
-        pre_ok = ~(Cat(*[t.any() for t in pre_t]) & bank_is).any()
-        act_ok = ~(Cat(*[t.any() for t in act_t]) & bank_is).any() & ~rrd_t.any()
+        # The decision, a cycle ahead: each cycle registers what the next may issue if
+        # this one issues nothing and takes no transaction (decide's ``quiet``); ``fresh``
+        # says it issued nothing, ``took`` that it took a transaction (which only the
+        # transaction's commands read). So a command comes from three registers through
+        # one gate, and a cycle without a command follows each command.
+        go, fresh, took = r.go, r.fresh, r.took
+        issue = {k: Signal(name=f"issue_{k}") for k in DECISIONS}
+        m.d.sync += [go[k].eq(v) for k, v in decide(cfg, r, quiet=True).items()]
+        m.d.comb += [issue[k].eq(fresh & go[k] & (~took if k in SERVED else 1))
+                     for k in DECISIONS]
+        m.d.sync += fresh.eq(~Cat(*issue.values()).any())
+        # the command, its bank and address: one expression each (a continuous assignment
+        # in the Verilog, defined from time 0 in every simulator)
+        a10 = 1 << 10
+        column = issue["read"] | issue["write"]
         m.d.comb += [
-            issue["pre_all"].eq((init_go & init_pre & ref_due)
-                                | (run & ref_due & open_.any() & idle & all_pre)),
-            issue["ref"].eq((init_go & ~init_pre & init_refs.any())
-                            | (run & ref_due & ~open_.any() & idle & all_act)),
-            issue["mode"].eq(init_go & ~init_pre & ~init_refs.any()),
-            issue["read"].eq(served & bank_hit & col_ready & ~cur_write),
-            issue["write"].eq(served & bank_hit & col_ready & cur_write),
-            issue["pre"].eq(served & ~bank_hit & bank_open & idle & pre_ok),
-            issue["act"].eq(served & ~bank_open & idle & act_ok)]
+            nxt_cmd.eq(Mux(issue["pre_all"] | issue["pre"], CMD["precharge"],
+                           Mux(issue["ref"], CMD["refresh"], Mux(issue["mode"], CMD["mode"],
+                           Mux(issue["act"], CMD["active"], Mux(issue["read"], CMD["read"],
+                           Mux(issue["write"], CMD["write"], CMD["nop"]))))))),
+            nxt_ba.eq(Mux(issue["act"] | issue["pre"] | column, cur_bank, 0)),
+            nxt_a.eq(Mux(issue["pre_all"], a10, Mux(issue["mode"], mode_register(bl, cfg.cas_latency),
+                     Mux(issue["act"], cur_row, Mux(column, cur_col, 0)))))]
 
         for sig in timers:
             count_down(sig)
-        a10 = 1 << 10
         with m.If(issue["pre_all"]):
-            m.d.comb += [nxt_cmd.eq(CMD["precharge"]), nxt_a.eq(a10)]
             m.d.sync += [open_.eq(0), init_pre.eq(0)]
             for b in range(nb):
                 at_least(act_t[b], t["rp"])
         with m.If(issue["ref"]):
-            m.d.comb += nxt_cmd.eq(CMD["refresh"])
             m.d.sync += [ref_cnt.eq(cfg.refresh_reload), ref_due.eq(0)]
             with m.If(~run):
                 m.d.sync += init_refs.eq(init_refs - 1)
@@ -467,12 +528,9 @@ class SdramController(wiring.Component):
             for b in range(nb):
                 at_least(act_t[b], max(t["rfc"], t["rc"]))
         with m.If(issue["mode"]):
-            m.d.comb += [nxt_cmd.eq(CMD["mode"]),
-                         nxt_a.eq(mode_register(bl, cfg.cas_latency))]
             m.d.sync += run.eq(1)
             at_least(cmd_t, t["mrd"])
         with m.If(issue["act"]):
-            m.d.comb += [nxt_cmd.eq(CMD["active"]), nxt_ba.eq(cur_bank), nxt_a.eq(cur_row)]
             at_least(rrd_t, t["rrd"])
             for b in range(nb):
                 with m.If(bank_is[b]):
@@ -481,25 +539,21 @@ class SdramController(wiring.Component):
                     at_least(rcd_t[b], t["rcd"])
                     at_least(pre_t[b], t["ras"])
         with m.If(issue["pre"]):
-            m.d.comb += [nxt_cmd.eq(CMD["precharge"]), nxt_ba.eq(cur_bank)]
             for b in range(nb):
                 with m.If(bank_is[b]):
                     m.d.sync += open_[b].eq(0)
                     at_least(act_t[b], t["rp"])
         with m.If(issue["read"] | issue["write"]):
-            m.d.comb += [nxt_ba.eq(cur_bank), nxt_a.eq(cur_col)]
             m.d.sync += [cur_addr.eq(cur_addr + bl), cur_left.eq(cur_left - 1)]
             with m.If(last_burst):
                 m.d.sync += cur_valid.eq(0)
         with m.If(issue["read"]):
-            m.d.comb += nxt_cmd.eq(CMD["read"])
             at_least(rd_t, bl)
             at_least(wr_t, cfg.cas_latency + bl + 1)     # the read data off the bus first
             for b in range(nb):
                 with m.If(bank_is[b]):
                     at_least(pre_t[b], bl)
         with m.If(issue["write"]):
-            m.d.comb += nxt_cmd.eq(CMD["write"])
             at_least(rd_t, bl)
             at_least(wr_t, bl)
             with m.If(last_burst):
@@ -523,6 +577,7 @@ class SdramController(wiring.Component):
 
         with m.If(take_w | take_r):
             m.d.sync += [cur_valid.eq(1), cur_write.eq(take_w), prefer_w.eq(take_r)]
+        m.d.sync += took.eq(take_w | take_r)
         with m.If(take_w):
             m.d.sync += [cur_addr.eq(wr.awaddr[1:1 + word_bits]), cur_left.eq(bursts(wr.awlen))]
         with m.If(take_r):

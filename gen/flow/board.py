@@ -82,8 +82,8 @@ DEFAULT_FLASH_OFFSET = 0x200000            # 2 MiB: the first sector after the b
 DEFAULT_SDRAM = "32mb"
 SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/sdram.CHIPS)
 # The pipe clock's default bound with the map in the SDRAM (the PLL's clock at or below
-# it), under the SDRAM's own limit: why, with the placements, in docs/board.md.
-DEFAULT_PIPE_MHZ = 80
+# it): the SDRAM's own limit at CAS latency 2, where the pipe domain places (docs/board.md).
+DEFAULT_PIPE_MHZ = 100
 # SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
 FLASH_HALF_PERIOD = 4
 MAP_FILE = "{name}_map.bin"

@@ -31,7 +31,7 @@ from amaranth.hdl import (
 )
 
 from bumprtl.gen.tools.sby import run_sby
-from bumprtl.rtl.sdram import SdramConfig, SdramController
+from bumprtl.rtl.sdram import DECISIONS, SERVED, SdramConfig, SdramController, decide
 from bumprtl.sim.formal.rules import RuleContract
 
 __all__ = ["RULES", "SdramCommandContract", "FORMAL_CONFIGS", "prove", "bmc", "cover"]
@@ -62,8 +62,12 @@ FORMAL_CONFIGS = {
     "64mb_133mhz_cl3": SdramConfig("64mb", 133, 3, burst=4, powerup_cycles=2, init_refreshes=2),
     # slow clocks, every timing one cycle: the covers' traces are short
     "32mb_10mhz_cl2": SdramConfig("32mb", 10, 2, burst=8, powerup_cycles=2, init_refreshes=2),
-    # tREFI of 7 cycles: a refresh falls due within a cover's depth
+    # tREFI of 7 cycles: refreshes back to back, the deadline's tightest case
     "32mb_1mhz_bl1": SdramConfig("32mb", 1, 2, burst=1, powerup_cycles=2, init_refreshes=2),
+    # tREFI of 15 cycles: a refresh falls due within a cover's depth, and between two
+    # refreshes there is room for a transaction (at 1 MHz a READ never comes: the next
+    # refresh falls due before the cycle after its ACTIVE's gap)
+    "32mb_2mhz_bl1": SdramConfig("32mb", 2, 2, burst=1, powerup_cycles=2, init_refreshes=2),
 }
 
 
@@ -226,20 +230,39 @@ class SdramCommandContract(RuleContract):
         m_act = biggest([*r.act_t, r.cmd_t])
         m_pre = biggest([Mux(r.open[b], r.pre_t[b], 0) for b in range(banks)] + [r.cmd_t])
         m_idle = biggest([*r.act_t, Const(max(0, t["rp"] - 1), len(r.act_t[0]))])
+        # a cycle after a command or a transaction taken issues nothing (not ``fresh``)
+        stale = ~r.fresh
         self._lemma(m, "initialisation's refreshes follow each other",
-                    ~initialising | (s_ref + m_act <= cfg.act_wait))
+                    ~initialising | (s_ref + m_act + stale <= cfg.act_wait + 1))
         self._lemma(m, "no refresh before the initialisation's",
                     (r.init_refs != cfg.refreshes) | ~refreshed)
         self._lemma(m, "init_refs within its range",
                     (r.init_refs <= cfg.refreshes) & (~r.run | (r.init_refs == 0)))
         due = counting & (r.ref_cnt == 0)
         self._lemma(m, "a due refresh with every bank idle comes in time",
-                    ~due | (r.open != 0) | (s_ref + m_act <= refi - 1))
+                    ~due | (r.open != 0) | (s_ref + m_act + stale <= refi - 1))
         self._lemma(m, "a due refresh with a bank open comes in time",
-                    ~due | (r.open == 0) | (s_ref + m_pre + m_idle + 1 <= refi - 1))
+                    ~due | (r.open == 0) | (s_ref + m_pre + m_idle + 2 + stale <= refi - 1))
+        # the decision registered a cycle ahead is the registers' own while fresh; READ
+        # and WRITE imply it without the read credit and the write buffer's count (they
+        # only grow meanwhile, and gate the data, not the command stream's rules)
+        now, timing = decide(cfg, r), decide(cfg, r, flow=False)
+        for k in DECISIONS:
+            if k in ("read", "write"):
+                self._lemma(m, "go_read or go_write implies the decision of the registers",
+                            ~r.fresh | r.took | ~r.go[k] | timing[k])
+            elif k in SERVED:
+                self._lemma(m, "go_pre or go_act is the decision of the registers",
+                            ~r.fresh | r.took | (r.go[k] == now[k]))
+            else:
+                self._lemma(m, "go of the initialisation or refresh is the registers'",
+                            ~r.fresh | (r.go[k] == now[k]))
 
         # --- covers: each rule's command pair occurs (in bank 0, where traffic starts) ---
-        near_ = near
+        # within the rules' longest spacing, plus the registered decision's gaps: the cycle
+        # after a command and the one after a transaction is taken issue nothing, so at
+        # one-cycle timings ACTIVE, READ, (AR taken), PRECHARGE, ACTIVE spans 7 cycles
+        near_ = near + 3
         self._cover(m, "rcd: READ after ACTIVE", is_["read"] & here[0] & (s_act[0] < near_))
         self._cover(m, "rcd: WRITE after ACTIVE", is_["write"] & here[0] & (s_act[0] < near_))
         self._cover(m, "rp/rc: ACTIVE after PRECHARGE of an open row",
