@@ -373,6 +373,7 @@ class TextureCache(wiring.Component):
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
+            miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             landed_any=Signal(name="landed_any"),                 # landed != 0
             readable=Signal(name="readable"),                     # the queue's head was read
@@ -531,16 +532,21 @@ class TextureCache(wiring.Component):
         f_w, f_r = fmem.write_port(), fmem.read_port(domain="comb")
         f_in, f_out = r.f_in, r.f_out
 
-        ar_free = ~ax.arvalid                      # (not ARREADY: no port in the lookup's cycle)
-        # fills == misses, count == queue: their top bits (both in [0, a power of two])
-        can_miss = ar_free & ~fills[-1] & ~locked
+        # (not ARREADY: no port in the lookup's cycle)
+        miss_ok = r.miss_ok                        # ~ARVALID & fills != misses, a register
+        can_miss = miss_ok & ~locked
         advance = Signal()
         go = r.go                                  # ~flushing & look_valid & count != queue
         m.d.comb += advance.eq(go & (hit | can_miss))
         miss = advance & ~hit
-        move = ~look_valid | advance               # the distances move on to the lookup
-        ds_move = ~r.ds_valid | move               # the words settled move on to the distances
-        ws_move = ~ws_valid | ds_move              # the words read move on to the settled
+        # each stage from the lookup back moves on when it or one after it is empty, or the
+        # lookup advances (the valid bits combined apart from the advance)
+        full1, full2, full3 = (Signal(name=f"lookup_full{n}", attrs={"keep": 1}) for n in (1, 2, 3))
+        m.d.comb += [full1.eq(look_valid), full2.eq(look_valid & r.ds_valid),
+                     full3.eq(look_valid & r.ds_valid & ws_valid)]
+        move = ~full1 | advance                    # the distances move on to the lookup
+        ds_move = ~full2 | advance                 # the words settled move on to the distances
+        ws_move = ~full3 | advance                 # the words read move on to the settled
         sk_valid = r.sk_valid
         rw_move = Signal()                         # the pixel read moves on to the words read
         # (registers alone: it enables the block RAMs' reads; the words read go to the skid
@@ -670,11 +676,10 @@ class TextureCache(wiring.Component):
         sk_stamps = [Signal(K, name=f"sk_stamp{w}") for w in range(g.ways)]
         sk_plru = Signal(plru_width, name="sk_plru")
         sk_same = advance & (set_of(sk_line) == look_set)
-        with m.If(ws_move):
-            m.d.sync += sk_valid.eq(0)
-        with m.Elif(~sk_valid):
-            m.d.sync += [sk_valid.eq(rw_valid), sk_line.eq(rw_line), sk_slot.eq(rw_slot),
-                         sk_plru.eq(rw_plru_now)]
+        # (its words taken whenever it is empty: only its valid bit waits on the advance)
+        m.d.sync += sk_valid.eq(~ws_move & (sk_valid | rw_valid))
+        with m.If(~sk_valid):
+            m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot), sk_plru.eq(rw_plru_now)]
             m.d.sync += [sk_extra[k].eq(rw_extra[k]) for k in self.extra]
             m.d.sync += [d.eq(v) for d, v in zip(sk_tags + sk_stamps, rw_tags + rw_stamps,
                                                  strict=True)]
@@ -754,22 +759,29 @@ class TextureCache(wiring.Component):
         def below_count(e):                        # e < count - pop (no sum before a compare)
             return (e < count) & ~(pop & (e == count_less))
 
+        # Each register as a choice by the advance (the latest signal here) between its
+        # next value with and without it, both from registers and the pop.
+        same_set = Signal(name="ds_same_set")    # ds_set == look_set
+        m.d.comb += same_set.eq(ds_set == look_set)
         for w in range(g.ways):
-            t, e, far = ds_tags[w], ds_dists[w], ds_fars[w]
+            t, e, far, top = ds_tags[w], ds_dists[w], ds_fars[w], ds_tops[w]
             hit_w = t[-1] & (t[:g.tag_bits] == ds_tag)
             written = ds_same & tag_hot[w]
             m.d.comb += new_hits[w].eq(Mux(written, ds_tag == look_tag, hit_w))
-            stamped = ds_same & stamp_hot[w]
-            wraps = advance & ds_tops[w]
-            inside = (~far & below_count(e)) | wraps
+            queued = Signal(name=f"ds_queued{w}")       # e < count - pop
+            m.d.comb += queued.eq(~far & below_count(e))
+            # with the advance: the lookup's pixel queued, on this way if it uses it (a miss
+            # writes its victim's tag: that way is stamped too), and e + 1 (wrapping at
+            # 2**K - 1 to 0: referenced)
+            stamped = same_set & way_hot[w]
+            ref_on = (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
             d = look_dists[w]                   # e after this cycle, at most queue
-            with m.If(move):
-                # (a way written is stamped too: the miss's victim is the way it uses)
-                m.d.sync += [referenced[w].eq(written | (t[-1] & (stamped | inside))),
-                             d.eq(Mux(stamped | wraps, 0,
-                                      Mux(far, g.queue, Mux(advance, e + 1, e))))]
-            with m.Else():                       # no advance while the lookup waits
-                m.d.sync += referenced[w].eq(referenced[w] & below_count(d))
+            d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
+            # without: the lookup's pixel waits (no write), or the distances move in
+            ref_off = Mux(look_valid, referenced[w] & below_count(d), t[-1] & queued)
+            d_off = Mux(look_valid, d, Mux(far, g.queue, e))
+            m.d.sync += [referenced[w].eq(Mux(advance, ref_on, ref_off)),
+                         d.eq(Mux(advance, d_on, d_off))]
         with m.If(move):
             m.d.sync += [look_valid.eq(ds_valid), look_line.eq(ds_line), look_slot.eq(ds_slot),
                          look_plru.eq(Mux(ds_same, touched, ds_plru)),
@@ -858,6 +870,9 @@ class TextureCache(wiring.Component):
         with m.If(miss):
             m.d.sync += f_in.eq(f_in + 1)
         m.d.sync += fills.eq(fills + miss - line_in)
+        # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
+        # outstanding (fills == misses: its top bit, fills in [0, a power of two])
+        m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))
 
         # --- the queue's head leaves in order: read into the queue RAM's register, then its
         # output register (the head register: the data read's address from a flip-flop),
