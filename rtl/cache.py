@@ -49,10 +49,10 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
            "scene_levels", "CACHE_LATENCY"]
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
-# queue is empty: the tag read, its words' register, their settled register, the lookup, the
-# queue's write and read, its head register, the data read, its words' register, the output
-# register.
-CACHE_LATENCY = 10
+# queue is empty: the tag read, its words' register, their settled register, their stamps'
+# distances, the lookup, the queue's write and read, its head register, the data read, its
+# words' register, the output register.
+CACHE_LATENCY = 11
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -329,8 +329,10 @@ class TextureCache(wiring.Component):
     Misses overlap (prefetching behind a reorder queue, Igehy, Eldridge & Proudfoot, HWWS
     1998): a pixel's set is read as it is taken (tags and sequence stamps), the words land
     in the RAMs' output registers the cycle after and, with the writes they missed, in
-    registers of the fabric the cycle after that, its tags are checked as it moves on into
-    the lookup, and a miss writes the new tag and issues its line's burst at once; the pixel
+    registers of the fabric the cycle after that (through a skid register when those wait,
+    so that the RAMs' read enables come from registers), each stamp becomes its distance
+    from the youngest queued pixel the cycle after that, its tags are checked as it moves
+    on into the lookup, and a miss writes the new tag and issues its line's burst at once; the pixel
     then waits in a queue of ``geom.queue`` entries with its (set, way, word) while the
     pixels behind it are looked up. A pixel leaves the queue in order; a miss's pixel only
     once its line has landed (bursts land in order, so a count of lines landed suffices: a
@@ -340,8 +342,8 @@ class TextureCache(wiring.Component):
     waits at the lookup (so does a miss with ``misses`` bursts outstanding, a pixel with the
     queue full, or a miss while ARVALID is high: in the cycle of its handshake too). The
     hit/miss sequence and the AR stream are the blocking cache's (sim/golden/cache.py).
-    ``i.ready`` is high while the register of the pixel read is empty or moves on, so it
-    depends on the lookup in the same cycle (never on ``i.valid``). Every block-RAM read
+    ``i.ready`` is high while the skid register is empty or the words read are, a function of
+    registers alone (never of ``i.valid``). Every block-RAM read
     lands in a register before any logic reads it, and no read is transparent (the stages
     forward the writes their reads miss). A hit leaves ``CACHE_LATENCY`` cycles after it is
     taken, one pixel a clock. A reset invalidates every line: the tags are cleared one set a
@@ -359,7 +361,9 @@ class TextureCache(wiring.Component):
             flushing=Signal(init=1, name="flushing"),
             in_valid=Signal(name="in_valid"),                     # a pixel read: its set
             rw_valid=Signal(name="rw_valid"),                     # its words read
+            sk_valid=Signal(name="sk_valid"),                     # their skid register
             ws_valid=Signal(name="ws_valid"),                     # its words in registers
+            ds_valid=Signal(name="ds_valid"),                     # their stamps' distances
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
@@ -369,6 +373,7 @@ class TextureCache(wiring.Component):
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
+            miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             landed_any=Signal(name="landed_any"),                 # landed != 0
             readable=Signal(name="readable"),                     # the queue's head was read
@@ -471,12 +476,12 @@ class TextureCache(wiring.Component):
         new_line, new_slot = self._locate(m, self.i.payload)
 
         # --- the pixel looked up: whether each way hits, whether a queued pixel references
-        # each way (below) and its stamp's distance from out_seq (stamp - out_seq, its low
-        # log2(queue) bits: all a referenced one needs), the set's pseudo-LRU bits (all
+        # each way (below) and its stamp's distance from in_seq (the pixels queued since, at
+        # most ``queue``: all a referenced one needs), the set's pseudo-LRU bits (all
         # registers) ---
         look_hits = Signal(g.ways, name="look_hits")
         qb = g.queue.bit_length() - 1
-        look_dists = [Signal(qb, name=f"look_dist{w}") for w in range(g.ways)]
+        look_dists = [Signal(qb + 1, name=f"look_dist{w}") for w in range(g.ways)]
         look_plru = Signal(plru_width, name="look_plru")
         look_set, _, look_word, look_sel = split(look_line, look_slot)
         if g.set_bits == 0:
@@ -527,18 +532,26 @@ class TextureCache(wiring.Component):
         f_w, f_r = fmem.write_port(), fmem.read_port(domain="comb")
         f_in, f_out = r.f_in, r.f_out
 
-        ar_free = ~ax.arvalid                      # (not ARREADY: no port in the lookup's cycle)
-        # fills == misses, count == queue: their top bits (both in [0, a power of two])
-        can_miss = ar_free & ~fills[-1] & ~locked
+        # (not ARREADY: no port in the lookup's cycle)
+        miss_ok = r.miss_ok                        # ~ARVALID & fills != misses, a register
+        can_miss = miss_ok & ~locked
         advance = Signal()
         go = r.go                                  # ~flushing & look_valid & count != queue
         m.d.comb += advance.eq(go & (hit | can_miss))
         miss = advance & ~hit
-        move = ~look_valid | advance               # the words settled move on to the lookup
-        ws_move = ~ws_valid | move                 # the words read move on to the settled
+        # each stage from the lookup back moves on when it or one after it is empty, or the
+        # lookup advances (the valid bits combined apart from the advance)
+        full1, full2, full3 = (Signal(name=f"lookup_full{n}", attrs={"keep": 1}) for n in (1, 2, 3))
+        m.d.comb += [full1.eq(look_valid), full2.eq(look_valid & r.ds_valid),
+                     full3.eq(look_valid & r.ds_valid & ws_valid)]
+        move = ~full1 | advance                    # the distances move on to the lookup
+        ds_move = ~full2 | advance                 # the words settled move on to the distances
+        ws_move = ~full3 | advance                 # the words read move on to the settled
+        sk_valid = r.sk_valid
         rw_move = Signal()                         # the pixel read moves on to the words read
-        # (one gate after the lookup's advance: it enables the block RAMs' reads)
-        m.d.comb += rw_move.eq(~(rw_valid & ws_valid & look_valid) | advance)
+        # (registers alone: it enables the block RAMs' reads; the words read go to the skid
+        # register when the settled ones wait, and wait there while it is full)
+        m.d.comb += rw_move.eq(~sk_valid | ~rw_valid)
         m.d.comb += self.i.ready.eq(~flushing & rw_move)
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
@@ -613,7 +626,9 @@ class TextureCache(wiring.Component):
             m.d.comb += assign(in_ov, in_new)
         with m.Else():
             m.d.comb += assign(in_ov, in_held)
-        m.d.sync += assign(in_held, in_ov)        # no write while the pixel read waits
+        in_same = advance & (in_set == look_set)
+        in_moved = apply(in_ov, in_same, tag_hot, tag_written, stamp_hot, in_seq, "in_moved")
+        m.d.sync += assign(in_held, in_moved)     # with the write of each cycle it waits
         with m.If(rw_move):                      # (the input's terms apart from it)
             m.d.sync += [in_valid.eq(self.i.valid & ~flushing), in_line.eq(new_line),
                          in_slot.eq(new_slot), same_was.eq(set_of(new_line) == look_set),
@@ -621,99 +636,170 @@ class TextureCache(wiring.Component):
             m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
 
         # --- the words read: the RAMs' output registers, the overrides with the write of
-        # the cycle the pixel moves in ---
+        # the cycle the pixel moves in, and of each cycle it waits ---
         rw_set = set_of(rw_line)
         rw_raw_tags = [rp.r_data for rp in tags]
         rw_raw_stamps = [rp.r_data for rp in stamps]
         rw_ov = overrides("rw_ov")
         rw_plru = Signal(plru_width, name="rw_plru")
         m.d.comb += plru_r.addr.eq(in_set)
-        in_same = advance & (in_set == look_set)
-        in_moved = apply(in_ov, in_same, tag_hot, tag_written, stamp_hot, in_seq, "in_moved")
+        # the pseudo-LRU bits are written the cycle after the lookup's (from registers: the
+        # advance does not reach the LUT RAM's write enables), that write forwarded here
+        pl_addr, pl_data = Signal.like(plru_w.addr, name="plru_w_addr"), Signal(plru_width, name="plru_w_data")
+        pl_en = Signal(name="plru_w_en")
+        plru_now = Signal(plru_width, name="plru_now")
+        m.d.comb += plru_now.eq(Mux(pl_en & (in_set == pl_addr), pl_data, plru_r.data))
+        rw_same = advance & (rw_set == look_set)
+        rw_moved = apply(rw_ov, rw_same, tag_hot, tag_written, stamp_hot, in_seq, "rw_moved")
         with m.If(rw_move):
             m.d.sync += [rw_valid.eq(in_valid), rw_line.eq(in_line), rw_slot.eq(in_slot),
-                         rw_plru.eq(Mux(in_same, touched, plru_r.data))]
+                         rw_plru.eq(Mux(in_same, touched, plru_now))]
             m.d.sync += [rw_extra[k].eq(in_extra[k]) for k in self.extra]
             m.d.sync += assign(rw_ov, in_moved)
+        with m.Else():
+            m.d.sync += [rw_plru.eq(Mux(rw_same, touched, rw_plru))]
+            m.d.sync += assign(rw_ov, rw_moved)
+        # each way's tag and stamp (its override, else the word read) and the pseudo-LRU
+        # bits with the write of the cycle
+        rw_tags = [Mux(rw_moved.tag_hot[w], rw_moved.tags[w], rw_raw_tags[w])
+                   for w in range(g.ways)]
+        rw_stamps = [Mux(rw_moved.stamp_hot[w], rw_moved.stamps[w], rw_raw_stamps[w])
+                     for w in range(g.ways)]
+        rw_plru_now = Mux(rw_same, touched, rw_plru)
 
-        # --- the words settled: each way's tag and stamp (its override, else the word read)
-        # with the write of the cycle the pixel moves in, in registers: no block-RAM output
-        # drives the lookup's compares ---
+        # --- the skid register: the words read that moved on while the settled ones waited
+        # (no write while it is full and they wait: the lookup does not advance) ---
+        sk_line, sk_slot = Signal(g.line_bits, name="sk_line"), Signal(2 * g.block_bits, name="sk_slot")
+        sk_extra = {k: Signal(s, name=f"sk_{k}") for k, s in self.extra.items()}
+        r.sk_extra = sk_extra
+        sk_tags = [Signal.like(tag_written, name=f"sk_tag{w}") for w in range(g.ways)]
+        sk_stamps = [Signal(K, name=f"sk_stamp{w}") for w in range(g.ways)]
+        sk_plru = Signal(plru_width, name="sk_plru")
+        sk_same = advance & (set_of(sk_line) == look_set)
+        # (its words taken whenever it is empty: only its valid bit waits on the advance)
+        m.d.sync += sk_valid.eq(~ws_move & (sk_valid | rw_valid))
+        with m.If(~sk_valid):
+            m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot), sk_plru.eq(rw_plru_now)]
+            m.d.sync += [sk_extra[k].eq(rw_extra[k]) for k in self.extra]
+            m.d.sync += [d.eq(v) for d, v in zip(sk_tags + sk_stamps, rw_tags + rw_stamps,
+                                                 strict=True)]
+
+        # --- the words settled: from the skid register when it is full, else the words
+        # read, with the write of the cycle the pixel moves in, in registers: no block-RAM
+        # output drives the lookup's compares ---
         ws_set = set_of(ws_line)
         ws_tags = [Signal.like(tag_written, name=f"ws_tag{w}") for w in range(g.ways)]
         ws_stamps = [Signal(K, name=f"ws_stamp{w}") for w in range(g.ways)]
         ws_plru = Signal(plru_width, name="ws_plru")
-        rw_same = advance & (rw_set == look_set)
-        rw_moved = apply(rw_ov, rw_same, tag_hot, tag_written, stamp_hot, in_seq, "rw_moved")
-        with m.If(ws_move):
-            m.d.sync += [ws_valid.eq(rw_valid), ws_line.eq(rw_line), ws_slot.eq(rw_slot),
-                         ws_plru.eq(Mux(rw_same, touched, rw_plru))]
-            m.d.sync += [ws_extra[k].eq(rw_extra[k]) for k in self.extra]
+        with m.If(ws_move & sk_valid):
+            m.d.sync += [ws_valid.eq(1), ws_line.eq(sk_line), ws_slot.eq(sk_slot),
+                         ws_plru.eq(Mux(sk_same, touched, sk_plru))]
+            m.d.sync += [ws_extra[k].eq(sk_extra[k]) for k in self.extra]
             for w in range(g.ways):
                 m.d.sync += [
-                    ws_tags[w].eq(Mux(rw_moved.tag_hot[w], rw_moved.tags[w], rw_raw_tags[w])),
-                    ws_stamps[w].eq(Mux(rw_moved.stamp_hot[w], rw_moved.stamps[w],
-                                        rw_raw_stamps[w]))]
+                    ws_tags[w].eq(Mux(sk_same & tag_hot[w], tag_written, sk_tags[w])),
+                    ws_stamps[w].eq(Mux(sk_same & stamp_hot[w], in_seq, sk_stamps[w]))]
+        with m.Elif(ws_move):
+            m.d.sync += [ws_valid.eq(rw_valid), ws_line.eq(rw_line), ws_slot.eq(rw_slot),
+                         ws_plru.eq(rw_plru_now)]
+            m.d.sync += [ws_extra[k].eq(rw_extra[k]) for k in self.extra]
+            m.d.sync += [d.eq(v) for d, v in zip(ws_tags + ws_stamps, rw_tags + rw_stamps,
+                                                 strict=True)]
+
+        # --- the stamps' distances: each way's stamp s as e = in_seq - 1 - s (mod 2**K),
+        # the pixels queued since its own; it is queued iff e < count. A pixel waits in this
+        # stage and the ones before it only while the lookup does not advance, so in_seq
+        # holds and e with it: e is taken here, with this cycle's advance and write, as its
+        # low log2(queue) bits and whether it is at least ``queue`` (no queued pixel that
+        # far), with whether it is 2**K - 1 (an advance makes it 0: a stale stamp equal to
+        # in_seq then looks queued, as in the model). in_seq's own copies here (in_seq - 1,
+        # ~in_seq, in_seq + 1), so that its other loads do not pull it away ---
+        ws_same = advance & (ws_set == look_set)
+        in_less = Signal(K, init=(1 << K) - 1, name="in_seq_less")   # in_seq - 1
+        in_not = Signal(K, init=(1 << K) - 1, name="in_seq_not")     # ~in_seq
+        in_one = Signal(K, init=1, name="in_seq_one")                # in_seq + 1
+        m.d.sync += [in_less.eq(in_less + advance), in_not.eq(in_not - advance),
+                     in_one.eq(in_one + advance)]
+        ds_valid = r.ds_valid
+        ds_line, ds_slot = Signal(g.line_bits, name="ds_line"), Signal(2 * g.block_bits, name="ds_slot")
+        ds_extra = {k: Signal(s, name=f"ds_{k}") for k, s in self.extra.items()}
+        r.ds_extra = ds_extra
+        ds_tags = [Signal.like(tag_written, name=f"ds_tag{w}") for w in range(g.ways)]
+        ds_dists = [Signal(qb, name=f"ds_dist{w}") for w in range(g.ways)]   # e mod queue
+        ds_fars = [Signal(name=f"ds_far{w}") for w in range(g.ways)]          # e >= queue
+        ds_tops = [Signal(name=f"ds_top{w}") for w in range(g.ways)]
+        ds_plru = Signal(plru_width, name="ds_plru")
+        with m.If(ds_move):
+            m.d.sync += [ds_valid.eq(ws_valid), ds_line.eq(ws_line), ds_slot.eq(ws_slot),
+                         ds_plru.eq(Mux(ws_same, touched, ws_plru))]
+            m.d.sync += [ds_extra[k].eq(ws_extra[k]) for k in self.extra]
+            for w in range(g.ways):
+                s_w = ws_stamps[w]
+                stamped = ws_same & stamp_hot[w]   # s = in_seq now: e = 0 after the advance
+                stay = (in_less - s_w)[:K]         # e without an advance
+                go_on = ~(in_not + s_w)[:K]        # e after one (in_seq - s)
+                m.d.sync += [
+                    ds_tags[w].eq(Mux(ws_same & tag_hot[w], tag_written, ws_tags[w])),
+                    ds_dists[w].eq(Mux(stamped, 0, Mux(advance, go_on[:qb], stay[:qb]))),
+                    ds_fars[w].eq(~stamped & Mux(advance, go_on[qb:].any(), stay[qb:].any())),
+                    ds_tops[w].eq(~stamped & Mux(advance, s_w == in_one, (s_w ^ in_not).all()))]
 
         # --- into the lookup: each way's hit computed here (the write of the cycle to the
-        # pixel's set: a miss's tag to its victim) ---
-        ws_same = advance & (ws_set == look_set)
-        ws_tag = tag_of(ws_line)
+        # pixel's set: a miss's tag to its victim), and whether a queued pixel references it
+        # after this cycle: e + advance < count + advance - pop (an e of 2**K - 1 wraps to 0
+        # on an advance: referenced) ---
+        ds_set = set_of(ds_line)
+        ds_same = advance & (ds_set == look_set)
+        ds_tag = tag_of(ds_line)
         new_hits = Signal(g.ways)
-        # The window [out_seq, in_seq) after this cycle (its ends one further on a pop, an
-        # advance): a stamp s is in it iff (s >= its start) ^ (s >= its end) ^ (it wraps),
-        # one compare with each end (no subtraction before a compare; each compare made
-        # with both places of its end, the pop and the advance choosing after).
-        in_one = Signal(K, init=1, name="in_seq_one")              # in_seq + 1
-        out_one = Signal(K, init=1, name="out_seq_one")            # out_seq + 1
-        out_not = Signal(K, init=(1 << K) - 1, name="out_seq_not")  # ~out_seq
-        out_neg = Signal(K, name="out_seq_neg")                     # -out_seq
-        m.d.sync += [in_one.eq(in_one + advance), out_one.eq(out_one + pop),
-                     out_not.eq(out_not - pop), out_neg.eq(out_neg - pop)]
 
-        # The window wraps (in_seq < out_seq) when one end has passed 2**K and the other not
-        # (they are at most ``queue`` apart): a register, flipped as either end passes.
-        wrapped = Signal(name="window_wrapped")
-        m.d.sync += wrapped.eq(wrapped ^ (advance & in_seq.all()) ^ (pop & out_seq.all()))
+        count_less = Signal(len(count), init=(1 << len(count)) - 1, name="count_less")
+        m.d.sync += count_less.eq(count_less + advance - pop)     # count - 1
+
+        def below_count(e):                        # e < count - pop (no sum before a compare)
+            return (e < count) & ~(pop & (e == count_less))
+
+        # Each register as a choice by the advance (the latest signal here) between its
+        # next value with and without it, both from registers and the pop.
+        same_set = Signal(name="ds_same_set")    # ds_set == look_set
+        m.d.comb += same_set.eq(ds_set == look_set)
         for w in range(g.ways):
-            t, s = ws_tags[w], ws_stamps[w]
-            hit_w = t[-1] & (t[:g.tag_bits] == ws_tag)
-            written = ws_same & tag_hot[w]
-            m.d.comb += new_hits[w].eq(Mux(written, ws_tag == look_tag, hit_w))
-            # the distance after this cycle's pop (of the stamp in_seq when forwarded:
-            # count); a distance in [0, count) is a queued pixel, 0 the one leaving
-            stamped = ws_same & stamp_hot[w]
-            # the terms grouped by the late signal each depends on (an end passing 2**K
-            # flips the wrap)
-            by_pop = Signal(name=f"by_pop{w}", attrs={"keep": 1})
-            by_advance = Signal(name=f"by_advance{w}", attrs={"keep": 1})
-            m.d.comb += [by_pop.eq(Mux(pop, (s >= out_one) ^ out_seq.all(), s >= out_seq)),
-                         by_advance.eq(Mux(advance, (s >= in_one) ^ in_seq.all() ^ wrapped,
-                                           (s >= in_seq) ^ wrapped))]
-            inside = by_pop ^ by_advance
-            d, d_new = look_dists[w], Signal(qb, name=f"new_dist{w}")
-            m.d.comb += d_new.eq(Mux(stamped, Mux(pop, count - 1, count)[:qb],
-                                     Mux(pop, s[:qb] + out_not[:qb], s[:qb] + out_neg[:qb])[:qb]))
-            with m.If(move):
-                # (a way written is stamped too: the miss's victim is the way it uses)
-                m.d.sync += [referenced[w].eq(written | (t[-1] & (stamped | inside))),
-                             d.eq(d_new)]
-            with m.Else():
-                m.d.sync += [referenced[w].eq(referenced[w] & ~(pop & ~d.any())),
-                             d.eq(d - pop)]
+            t, e, far, top = ds_tags[w], ds_dists[w], ds_fars[w], ds_tops[w]
+            hit_w = t[-1] & (t[:g.tag_bits] == ds_tag)
+            written = ds_same & tag_hot[w]
+            m.d.comb += new_hits[w].eq(Mux(written, ds_tag == look_tag, hit_w))
+            queued = Signal(name=f"ds_queued{w}")       # e < count - pop
+            m.d.comb += queued.eq(~far & below_count(e))
+            # with the advance: the lookup's pixel queued, on this way if it uses it (a miss
+            # writes its victim's tag: that way is stamped too), and e + 1 (wrapping at
+            # 2**K - 1 to 0: referenced)
+            stamped = same_set & way_hot[w]
+            ref_on = (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
+            d = look_dists[w]                   # e after this cycle, at most queue
+            d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
+            # without: the lookup's pixel waits (no write), or the distances move in
+            ref_off = Mux(look_valid, referenced[w] & below_count(d), t[-1] & queued)
+            d_off = Mux(look_valid, d, Mux(far, g.queue, e))
+            m.d.sync += [referenced[w].eq(Mux(advance, ref_on, ref_off)),
+                         d.eq(Mux(advance, d_on, d_off))]
         with m.If(move):
-            m.d.sync += [look_valid.eq(ws_valid), look_line.eq(ws_line), look_slot.eq(ws_slot),
-                         look_plru.eq(Mux(ws_same, touched, ws_plru)),
+            m.d.sync += [look_valid.eq(ds_valid), look_line.eq(ds_line), look_slot.eq(ds_slot),
+                         look_plru.eq(Mux(ds_same, touched, ds_plru)),
                          look_hits.eq(new_hits), hit.eq(new_hits.any())]
-            m.d.sync += [look_extra[k].eq(ws_extra[k]) for k in self.extra]
+            m.d.sync += [look_extra[k].eq(ds_extra[k]) for k in self.extra]
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         q_w = qmem.w_data
         m.d.comb += [qmem.w_addr.eq(in_seq[:qb]), qmem.w_en.eq(advance),
                      q_w.word.eq(look_word), q_w.way.eq(way), q_w.sel.eq(look_sel)]
         m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
+        # the miss bits are written the cycle after (from registers), that write forwarded
+        # to the reads of its cycle (below)
+        mq_addr, mq_data, mq_en = Signal(qb, name="miss_w_addr"), Signal(name="miss_w_data"), \
+            Signal(name="miss_w_en")
+        m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance)]
         for mwp in (m_w, m_w1):
-            m.d.comb += [mwp.addr.eq(in_seq[:qb]), mwp.en.eq(advance), mwp.data.eq(~hit)]
+            m.d.comb += [mwp.addr.eq(mq_addr), mwp.en.eq(mq_en), mwp.data.eq(mq_data)]
         for w, sp in enumerate(stamps):                 # (the cycle after: ``was``)
             m.d.comb += [sp.w_addr.eq(was.set), sp.w_data.eq(was.seq),
                          sp.w_en.eq(was.stamp_hot[w])]
@@ -724,16 +810,17 @@ class TextureCache(wiring.Component):
         # without a pop (no advance when full)
         full_next = ~pop & (count[-1] | (advance & (count == g.queue - 1)))
         m.d.sync += count.eq(count_next)
-        m.d.comb += [plru_w.addr.eq(look_set), plru_w.data.eq(touched),
-                     plru_w.en.eq(advance if g.ways > 1 else 0)]
+        m.d.sync += [pl_addr.eq(look_set), pl_data.eq(touched),
+                     pl_en.eq(advance if g.ways > 1 else 0)]
         with m.If(flushing):                     # the flush clears the bits with the tags
-            m.d.comb += [plru_w.addr.eq(flush_set), plru_w.data.eq(0), plru_w.en.eq(1)]
+            m.d.sync += [pl_addr.eq(flush_set), pl_data.eq(0), pl_en.eq(1)]
+        m.d.comb += [plru_w.addr.eq(pl_addr), plru_w.data.eq(pl_data), plru_w.en.eq(pl_en)]
 
         # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
         m.d.sync += flush_set.eq(flush_set + 1)
         flushing_next = flushing & (flush_set != g.sets - 1)
         m.d.sync += [flushing.eq(flushing_next),
-                     go.eq(~flushing_next & Mux(move, ws_valid, look_valid) & ~full_next)]
+                     go.eq(~flushing_next & Mux(move, r.ds_valid, look_valid) & ~full_next)]
         for w, tp in enumerate(tags):
             m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, was.set)),
                          tp.w_data.eq(Mux(flushing, 0, was.tag)),
@@ -748,8 +835,13 @@ class TextureCache(wiring.Component):
                          ax.araddr.eq(g.base + Cat(Const(0, line_shift), look_line))]
         with m.Elif(ax.arready):
             m.d.sync += ax.arvalid.eq(0)
-        m.d.comb += [f_w.addr.eq(f_in), f_w.en.eq(miss), f_w.data.set.eq(look_set),
-                     f_w.data.way.eq(way), f_r.addr.eq(f_out)]
+        # (written the cycle after, from registers: its burst's first beat comes two cycles
+        # after the miss at the earliest, the AR handshake then RVALID)
+        fq_addr, fq_en = Signal.like(f_in, name="fill_q_addr"), Signal(name="fill_q_en")
+        fq_set, fq_way = Signal.like(f_w.data.set, name="fill_q_set"), Signal.like(way, name="fill_q_way")
+        m.d.sync += [fq_addr.eq(f_in), fq_en.eq(miss), fq_set.eq(look_set), fq_way.eq(way)]
+        m.d.comb += [f_w.addr.eq(fq_addr), f_w.en.eq(fq_en), f_w.data.set.eq(fq_set),
+                     f_w.data.way.eq(fq_way), f_r.addr.eq(f_out)]
 
         # --- the R beats: into the oldest outstanding burst's line ---
         beat = r.beat
@@ -778,6 +870,9 @@ class TextureCache(wiring.Component):
         with m.If(miss):
             m.d.sync += f_in.eq(f_in + 1)
         m.d.sync += fills.eq(fills + miss - line_in)
+        # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
+        # outstanding (fills == misses: its top bit, fills in [0, a power of two])
+        m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))
 
         # --- the queue's head leaves in order: read into the queue RAM's register, then its
         # output register (the head register: the data read's address from a flip-flop),
@@ -806,7 +901,9 @@ class TextureCache(wiring.Component):
         popped = Signal(name="popped")
         head_miss = Signal(name="head_miss")
         m.d.comb += head_miss.eq(Mux(popped, miss_at[1], miss_at[0]))
-        m.d.sync += [miss_at[0].eq(m_r0.data), miss_at[1].eq(m_r1.data), popped.eq(pop)]
+        m.d.sync += [miss_at[0].eq(Mux(mq_en & (mq_addr == out_seq[:qb]), mq_data, m_r0.data)),
+                     miss_at[1].eq(Mux(mq_en & (mq_addr == r.out_after), mq_data, m_r1.data)),
+                     popped.eq(pop)]
         # the head leaves if the queue read moves on (registers alone: the queue RAM's read
         # address, whose read is only enabled when it moves on, waits on no port)
         pop_ok = Signal(name="pop_ok")
@@ -918,8 +1015,8 @@ class AxiMapFetch(wiring.Component):
 
     Latency :data:`CACHE_LATENCY` on a hit, one pixel a clock while pixels hit; a miss
     issues its line's burst and queues the pixel, and the pixels behind it go on being
-    looked up (:class:`TextureCache`); ``i.ready`` falls while the looked-up pixel has to
-    wait, and depends on the lookup in the same cycle (not a register as a credit edge's).
+    looked up (:class:`TextureCache`); ``i.ready`` falls the cycle after the looked-up
+    pixel has to wait and the stages behind it are full (a function of registers alone).
     At most :attr:`capacity` pixels are inside at once.
     """
 
@@ -928,9 +1025,10 @@ class AxiMapFetch(wiring.Component):
     @property
     def capacity(self):
         """Pixels taken at ``i`` and not yet taken at ``o``, at most: the pixel read's, its
-        words read's, its words settled's and the lookup's registers, the queue's entries, its
-        head register, the data read's and its words' registers and the output register."""
-        return self.geom.queue + 8
+        words read's, their skid register's, its words settled's, their distances' and the
+        lookup's registers, the queue's entries, its head register, the data read's and its
+        words' registers and the output register."""
+        return self.geom.queue + 10
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None, target=None):
         check_scene(self, scene)

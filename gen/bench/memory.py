@@ -207,10 +207,10 @@ docs/formal.md, The texel cache's AXI4 port). Put
 `<name>_map.bin` at byte `base` (0) of the memory the port reads; the sidecar's
 `memory_images.map` gives `file`, `base`, `bytes` and the `layout` in words. A reset clears
 the tags one set a cycle (`i.ready` low for `sets` cycles); the map must not change between
-resets. `i.ready` is the cache's: it falls while the looked-up pixel waits (queue full, a
-miss with its victim still needed, {d["misses"]} bursts outstanding, or ARVALID waiting
-for ARREADY), and it depends on the lookup in the same cycle (never on `i.valid`). A hit
-reaches `o` {CACHE_LATENCY} cycles after it is taken.
+resets. `i.ready` is the cache's: it falls the cycle after the looked-up pixel waits (queue
+full, a miss with its victim still needed, {d["misses"]} bursts outstanding, or ARVALID
+waiting for ARREADY) with the stages behind it full, a function of registers alone (never
+of `i.valid`). A hit reaches `o` {CACHE_LATENCY} cycles after it is taken.
 
 ## Hit rates and throughput
 

@@ -190,8 +190,11 @@ class AxiReadContract(RuleContract):
             self._lemma(m, "the fill queue's pointers are its bursts apart",
                         (ptr == r.fills) | ((r.fills == g.misses) & (ptr == 0)))
         self._lemma(m, "no burst outstanding while flushing", ~r.flushing | (r.fills == 0))
+        self._lemma(m, "a miss may go: ARVALID low, fewer bursts than the most",
+                    r.miss_ok == (~ax.arvalid & (r.fills != g.misses)))
         self._lemma(m, "no pixel while flushing",
-                    ~r.flushing | ~(r.in_valid | r.rw_valid | r.ws_valid | r.look_valid))
+                    ~r.flushing | ~(r.in_valid | r.rw_valid | r.sk_valid | r.ws_valid
+                                    | r.ds_valid | r.look_valid))
         self._lemma(m, "the lookup may go: not flushing, a pixel, a free queue entry",
                     r.go == (~r.flushing & r.look_valid & ~r.count[-1]))
         self._lemma(m, "the queue holds at most its entries", r.count <= g.queue)

@@ -559,8 +559,8 @@ class StreamContract(Elaboratable):
     def _in_cache(self, m, take_in):
         """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
         front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
-        lemmas to the cache's lookup registers (the pixel read, its words read, its words
-        settled, the pixel looked up), queue, head, data-read and words-read registers and output register
+        lemmas to the cache's lookup registers (the pixel read, its words read, their skid
+        register, its words settled, their distances, the pixel looked up), queue, head, data-read and words-read registers and output register
         (``TextureCache.regs``) and its queue count. Made once per contract."""
         if self.cache is None:
             return Const(0, 1)
@@ -578,8 +578,10 @@ class StreamContract(Elaboratable):
                     "the cache's next queue address is one past its oldest")
         self._lemma(m, r.go == (~r.flushing & r.look_valid & (r.count != c.geom.queue)),
                     "the cache's lookup may go: not flushing, a pixel, a free entry")
-        self._lemma(m, ghost == r.in_valid + r.rw_valid + r.ws_valid + r.look_valid + count + r.hd_valid
-                    + r.rd_valid + r.wd_valid + c.o.valid,
+        self._lemma(m, ~r.sk_valid | r.ws_valid,
+                    "the cache's skid register is full only behind its words settled")
+        self._lemma(m, ghost == r.in_valid + r.rw_valid + r.sk_valid + r.ws_valid + r.ds_valid
+                    + r.look_valid + count + r.hd_valid + r.rd_valid + r.wd_valid + c.o.valid,
                     "pixels in the cache = its lookup, queue, read and output registers")
         self._cache_ghost = ghost
         return ghost
@@ -665,8 +667,8 @@ class StreamContract(Elaboratable):
         its output register, its words-read and data-read registers, its head register, its
         queue's entries from the read sequence number (read through asynchronous ports added
         to the queue's memory, one per address; the queue RAM's registered read is the entry
-        at that number once readable), its lookup register and the registers of the words
-        settled, the words read and the pixel read before it."""
+        at that number once readable), its lookup register and the registers of the
+        distances, the words settled, the skid, the words read and the pixel read before it."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
         ram = _subfragment(frag, "queue") if frag is not None else None
@@ -707,14 +709,22 @@ class StreamContract(Elaboratable):
         m.d.comb += at_look.eq(at_q + count)
         self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == at_look),
                     "the cache's lookup register holds the tag after its queue's")
+        at_ds = Signal(bits, name="tag_cache_distances")
+        m.d.comb += at_ds.eq(at_look + r.look_valid)
+        self._lemma(m, ~r.ds_valid | (r.ds_extra["tag"] == at_ds),
+                    "the cache's distances register holds the tag after its lookup's")
         at_ws = Signal(bits, name="tag_cache_words_settled")
-        m.d.comb += at_ws.eq(at_look + r.look_valid)
+        m.d.comb += at_ws.eq(at_ds + r.ds_valid)
         self._lemma(m, ~r.ws_valid | (r.ws_extra["tag"] == at_ws),
-                    "the cache's words-settled register holds the tag after its lookup's")
+                    "the cache's words-settled register holds the tag after its distances'")
+        at_sk = Signal(bits, name="tag_cache_skid")
+        m.d.comb += at_sk.eq(at_ws + r.ws_valid)
+        self._lemma(m, ~r.sk_valid | (r.sk_extra["tag"] == at_sk),
+                    "the cache's skid register holds the tag after its settled one's")
         at_rw = Signal(bits, name="tag_cache_words_read")
-        m.d.comb += at_rw.eq(at_ws + r.ws_valid)
+        m.d.comb += at_rw.eq(at_sk + r.sk_valid)
         self._lemma(m, ~r.rw_valid | (r.rw_extra["tag"] == at_rw),
-                    "the cache's words-read register holds the tag after its settled one's")
+                    "the cache's words-read register holds the tag after its skid one's")
         self._lemma(m, ~r.in_valid | (r.in_extra["tag"] == (at_rw + r.rw_valid)[:bits]),
                     "the cache's read register holds the tag after its words-read one's")
 
