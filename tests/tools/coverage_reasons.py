@@ -369,29 +369,12 @@ REASONS = [
     ("sim/tb/tb_pipeline_axi.py", 'if os.environ.get("BUMPRTL_STIMULUS") == "raster":', None,
      "make regress", "the raster stimulus of the AXI pipeline bench"),
     ("sim/tb/tb_sdram.py", "if unknown:", None, "simulator", "X or Z on an SDRAM pin"),
-    # read after the run of docs/coverage.md
-    ("gen/flow/board.py", "if words is None:", None,
-     *since("tests/gen/flow/test_board_flow.py", "board_memory images the words it is given")),
-    ("gen/flow/board.py", 'if net.endswith(("pipe_clk", "pll_clkos2")):', None,
-     *since("tests/gen/flow/test_board_flow.py", "the pipe and SDRAM read clocks' nets")),
-    ("gen/flow/board.py", 'if net.endswith(("sdram_rd_clk", "pll_clkos3")):', None,
-     *since("tests/gen/flow/test_board_flow.py", "the pipe and SDRAM read clocks' nets")),
     ("gen/flow/board.py", "if memory is not None:", None,
      "make board", "the bitstream of the top with its map in the SDRAM (Yosys, nextpnr, "
      "ecppack): `bumprtl board ulx3s --map-memory axi`"),
     ("gen/flow/fpga.py", "if out.returncode != 0:", None,
      "make fpga", "a placement nextpnr finishes; make test runs this function only with a "
      "nextpnr that fails (tests/gen/flow/test_fpga.py)"),
-    ("rtl/board.py", "if pipe_hz > 0:               # a clock the PLL gives exactly keeps its own divider",
-     None, *since(RTL, "a pipe clock of 0 Hz is refused")),
-    ("rtl/board.py", "if hz < pixel_hz:", None,
-     *since(RTL, "an SDRAM clock bound below the pixel clock is refused")),
-    ("rtl/globe.py", "if len(value) >= width:", None,
-     *since("tests/rtl/test_globe.py", "fit_signed truncating to the low bits")),
-    ("sim/flash_model.py", "if len(self.errors) < 20:", None,
-     *since("tests/rtl/test_flash.py", "the model keeps the first twenty errors")),
-    ("sim/flash_model.py", "if self.delay:", None,
-     *since("tests/rtl/test_flash.py", "a READ with delay 0")),
     ("sim/formal/contract.py", "if tag is not None:", None,
      "never empty", "every stage of the units make test's formal subset builds records its "
      "tag register (the Pipe carries the tag stage by stage); a stage without one would be "
