@@ -168,6 +168,12 @@ def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
                         f"--texture-size, or --sdram 64mb)", "texture_size")
     first = -(-BITSTREAM_BYTES[device] // FLASH_SECTOR) * FLASH_SECTOR
     last = FLASH_BYTES_MAX - geom.image_bytes
+    if last < first:                    # no offset at all: the map is too large for the flash
+        raise BumpError(f"texture_size {scene.texture_size}: the map's tiled image is "
+                        f"{geom.image_bytes:,} bytes, more than the {FLASH_BYTES_MAX - first:,} "
+                        f"bytes of flash from 0x{first:x} (after the {device} bitstream's "
+                        f"sectors) to the 24-bit READ address's end (a smaller --texture-size)",
+                        "texture_size")
     if isinstance(offset, bool) or not isinstance(offset, int) or not first <= offset <= last \
             or offset % FLASH_SECTOR:
         raise BumpError(f"--flash-offset must be a multiple of 0x{FLASH_SECTOR:x} (a 64 KiB "
