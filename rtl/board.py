@@ -126,8 +126,9 @@ def payload_field(view, key):
 class RasterSource(Elaboratable):
     """What the board's sources share: the raster counters (``px``, ``py``, the pixel count
     ``count`` of ``count_bits``) and the light table (``table``: one {key: code} per light
-    step, L and H of every light), read a cycle ahead into the pipeline's payload, its step
-    register ``frame`` moving on after the last pixel of a frame. ``allow``: the source may
+    step, L and H of every light), the next step's entry read ahead into a register the
+    pipeline's payload comes from, its step register ``frame`` moving on after the last
+    pixel of a frame. ``allow``: the source may
     offer a pixel this cycle. It drives ``port``: the pipeline's input stream, or with
     ``register`` a stream of the same shape that :func:`register_slice` joins to it, so
     that the source's counters and the table's address see a registered ready (the texel
@@ -161,8 +162,13 @@ class RasterSource(Elaboratable):
         return last_x, last_y
 
     def lights(self, m, wrap):
-        """The light table into the pipeline's payload: the entry of ``frame``, or of the
-        next step in the cycle after ``wrap`` (the last pixel of a frame taken)."""
+        """The light table into the pipeline's payload: the entry of ``frame`` from a
+        register (``light_entry``, the table's entry 0 after reset), which takes the next
+        step's entry in the cycle after ``wrap`` (the last pixel of a frame taken). The
+        table's read port is always at the next step, so its answer has waited at least a
+        cycle when it is taken (a frame of 2 pixels or more): the block RAM's output
+        (about 6 ns from its clock on the ECP5 without its output register) reaches one
+        flip-flop's data input, not the payload's registers beyond it."""
         words = [sum(int(t[k]) << sum(self.widths[:n]) for n, k in enumerate(self.keys))
                  for t in self.table]
         m.submodules.light_table = rom = Memory(shape=sum(self.widths), depth=len(words),
@@ -170,12 +176,13 @@ class RasterSource(Elaboratable):
         rd = rom.read_port()
         m.d.sync += self.primed.eq(1)
         step = Mux(self.frame == len(self.table) - 1, 0, self.frame + 1)
-        m.d.comb += rd.addr.eq(Mux(wrap, step, self.frame))
+        entry = Signal(sum(self.widths), init=words[0], name="light_entry")
+        m.d.comb += rd.addr.eq(step)
         with m.If(wrap):
-            m.d.sync += self.frame.eq(step)
+            m.d.sync += [self.frame.eq(step), entry.eq(rd.data)]
         at = 0
         for k, w in zip(self.keys, self.widths, strict=False):
-            m.d.comb += payload_field(self.port.payload, k).eq(rd.data[at:at + w])
+            m.d.comb += payload_field(self.port.payload, k).eq(entry[at:at + w])
             at += w
         if self.register:
             register_slice(m, self.port, self.pipeline.i)
@@ -439,13 +446,21 @@ class BoardCore(Elaboratable):
             m.d.sync += self.underflow.eq(1)
         pixel = Mux(take, color, 0)                   # bytes: blue, green, red
         m.d.comb += self.pixel.eq(pixel)
+        # the encoders' inputs registered, syncs and DE with the pixel: the display's
+        # decisions (the raster's position, the buffer's valid) and the encoders' first
+        # stage are a pixel clock each (at 720p, 13.5 ns)
+        enc_pixel, enc_de = Signal(24, name="enc_pixel"), Signal(name="enc_de")
+        enc_hsync = Signal(init=int(self.mode.h_negative), name="enc_hsync")
+        enc_vsync = Signal(init=int(self.mode.v_negative), name="enc_vsync")
+        m.d.sync += [enc_pixel.eq(pixel), enc_de.eq(t.de), enc_hsync.eq(t.hsync),
+                     enc_vsync.eq(t.vsync)]
         words = []
         for lane in range(3):
             enc = TMDSEncoder()
             m.submodules[f"tmds{lane}"] = enc
-            m.d.comb += [enc.data.eq(pixel[8 * lane:8 * lane + 8]), enc.de.eq(t.de)]
+            m.d.comb += [enc.data.eq(enc_pixel[8 * lane:8 * lane + 8]), enc.de.eq(enc_de)]
             if lane == 0:
-                m.d.comb += [enc.c0.eq(t.hsync), enc.c1.eq(t.vsync)]
+                m.d.comb += [enc.c0.eq(enc_hsync), enc.c1.eq(enc_vsync)]
             words.append(enc.q)
         clock_word = Signal(10, init=CLOCK_WORD, name="clock_word")
         m.submodules.serializer = ser = Serializer([*words, clock_word])
