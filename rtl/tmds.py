@@ -95,23 +95,27 @@ class Serializer(Elaboratable):
     shift-domain path is one flip-flop, one LUT, one flip-flop with a fan-out of ten (the
     chains differ in their own feedback, so synthesis cannot merge them). The load comes
     two or three shift cycles after the pixel edge that changed the words, of the five
-    the words stay."""
+    the words stay. No shift-domain register has a reset (their initial values hold until
+    the first load): at 371 MHz a synchronous reset is a route from the reset synchronizer
+    to every register's LSR input as long as the period, and nothing needs it, the loads
+    following the toggles within three shift cycles."""
 
     def __init__(self, words):
         self.words = list(words)
-        self.o0 = Signal(len(self.words))
-        self.o1 = Signal(len(self.words))
+        self.o0 = Signal(len(self.words), reset_less=True)
+        self.o1 = Signal(len(self.words), reset_less=True)
 
     def elaborate(self, platform):
         m = Module()
         for k, word in enumerate(self.words):
             toggle = Signal(name=f"pixel_toggle{k}")
             m.d.sync += toggle.eq(~toggle)
-            t1, t2 = Signal(name=f"toggle{k}_s1"), Signal(name=f"toggle{k}_s2")
-            load = Signal(name=f"load{k}")
+            t1 = Signal(name=f"toggle{k}_s1", reset_less=True)
+            t2 = Signal(name=f"toggle{k}_s2", reset_less=True)
+            load = Signal(name=f"load{k}", reset_less=True)
             m.d.shift += [t1.eq(toggle), t2.eq(t1), load.eq(t1 ^ t2)]
             init = int(word.init) if hasattr(word, "init") else 0
-            sr = Signal(8, init=init >> 2, name=f"shift{k}")
+            sr = Signal(8, init=init >> 2, name=f"shift{k}", reset_less=True)
             with m.If(load):
                 m.d.shift += [sr.eq(word[2:]), self.o0[k].eq(word[0]), self.o1[k].eq(word[1])]
             with m.Else():
