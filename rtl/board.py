@@ -696,13 +696,21 @@ class ULX3STop(Elaboratable):
 
 class SimTop(wiring.Component):
     """The core for simulation: ``clk``/``rst`` (pixel) and ``shift_clk``/``shift_rst`` are
-    ports; the DDR registers become ``shift_clk ? o0 : o1``."""
+    ports; the DDR registers become ``shift_clk ? o0 : o1``. With the map in the SDRAM also
+    ``pipe_clk``/``pipe_rst``, the SDRAM's pins ``sdram__*`` registered in ``pipe`` as the
+    ULX3S top's I/O cells register them (every output once, DQ's input once more: the
+    core's SdramConfig counts SDRAM_PIN_CYCLES), the flash's ``spi__*`` and
+    ``display_shows`` (the display has started, at a frame's first pixel)."""
 
     def __init__(self, core: BoardCore):
         self.core = core
-        super().__init__({"tmds_clk_p": wiring.Out(1), "tmds_data_p": wiring.Out(3),
-                          "underflow": wiring.Out(1), "order_error": wiring.Out(1),
-                          "light_step": wiring.Out(len(core.source.frame))})
+        ports = {"tmds_clk_p": wiring.Out(1), "tmds_data_p": wiring.Out(3),
+                 "underflow": wiring.Out(1), "order_error": wiring.Out(1),
+                 "light_step": wiring.Out(len(core.source.frame))}
+        if core.sdram is not None:
+            ports.update(sdram=wiring.Out(sdram_signature(core.sdram)),
+                         spi=wiring.Out(spi_signature()), display_shows=wiring.Out(1))
+        super().__init__(ports)
 
     def elaborate(self, platform):
         m, core = Module(), self.core
@@ -712,4 +720,17 @@ class SimTop(wiring.Component):
                      self.tmds_clk_p.eq(Mux(hi, core.o0[3], core.o1[3])),
                      self.underflow.eq(core.underflow), self.order_error.eq(core.order_error),
                      self.light_step.eq(core.source.frame)]
+        if core.sdram is not None:
+            inner, pins, spi = core.sdram_pins, self.sdram, self.spi
+            idle = {"cke": 1, "cs_n": 1, "ras_n": 1, "cas_n": 1, "we_n": 1}
+            for name in ("cke", "cs_n", "ras_n", "cas_n", "we_n", "ba", "a", "dqm", "dq_o",
+                         "dq_oe"):
+                reg = Signal.like(getattr(inner, name), init=idle.get(name, 0),
+                                  name=f"io_{name}")
+                m.d.pipe += reg.eq(getattr(inner, name))
+                m.d.comb += getattr(pins, name).eq(reg)
+            m.d.pipe += inner.dq_i.eq(pins.dq_i)
+            m.d.comb += [spi.sclk.eq(core.spi.sclk), spi.cs_n.eq(core.spi.cs_n),
+                         spi.mosi.eq(core.spi.mosi), core.spi.miso.eq(spi.miso),
+                         self.display_shows.eq(core.shows)]
         return m

@@ -85,7 +85,6 @@ def _first_free_sector():
     (["--pipe-mhz", "120"], "pipe clock must be at most 100 MHz with the map in the SDRAM "
                             "(CAS latency 2: tCK >= 10 ns"),
     (["--pipe-mhz", "20"], "pipe clock must be at least the pixel clock"),
-    (["--check-frames", "1"], "--check-frames applies to map_memory = 'bram'"),
 ])
 def test_bad_input_with_the_map_in_sdram_one_line_exit_2_nothing_written(flags, message,
                                                                           board_refusal):
