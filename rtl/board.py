@@ -29,8 +29,7 @@ registers). Per pixel of the active raster, in order:
    lanes (blue carries hsync, vsync) and the :class:`~bumprtl.rtl.tmds.Serializer`.
 
 :class:`BoardCore` is all of that; :class:`ULX3STop` adds the ECP5 PLL (EHXPLLL, 25 MHz ->
-pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's ODDRX1F,
-``xdr=2``); :class:`SimTop` replaces both by ports: the testbench drives ``clk`` and
+pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (an ODDRX1F a pin); :class:`SimTop` replaces both by ports: the testbench drives ``clk`` and
 ``shift_clk`` at the same ratio and the DDR registers become the multiplexer they are
 (``o0`` while the shift clock is high, ``o1`` while low), on ``tmds_data_p`` (lane k on bit
 k) and ``tmds_clk_p``.
@@ -680,10 +679,17 @@ class ULX3STop(Elaboratable):
         m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
         # nextpnr derives both clocks' constraints from clk25's through the PLL
         m.submodules.core = core
-        hdmi = platform.request("hdmi", 0, xdr={"clk": 2, "d": 2})
-        m.d.comb += [hdmi.clk.o_clk.eq(ClockSignal("shift")), hdmi.d.o_clk.eq(ClockSignal("shift")),
-                     hdmi.d.o0.eq(core.o0[:3]), hdmi.d.o1.eq(core.o1[:3]),
-                     hdmi.clk.o0.eq(core.o0[3]), hdmi.clk.o1.eq(core.o1[3])]
+        # the lanes' DDR registers: an ODDRX1F a pin before a plain output buffer, not the
+        # platform's DDR buffer (xdr=2), whose output enable of an output-only pin comes
+        # from two fabric flip-flops in the shift domain (Amaranth's ECP5 DDRBuffer), a
+        # route to the I/O cell as long as 720p's shift period
+        hdmi = platform.request("hdmi", 0, dir="-")
+        for name, port, bits in (("d", hdmi.d, range(3)), ("clk", hdmi.clk, [3])):
+            m.submodules[f"hdmi_{name}"] = buf = io.Buffer("o", port)
+            for k, lane in enumerate(bits):
+                m.submodules[f"hdmi_{name}_ddr{k}"] = Instance(
+                    "ODDRX1F", i_SCLK=ClockSignal("shift"), i_RST=0, i_D0=core.o0[lane],
+                    i_D1=core.o1[lane], o_Q=buf.o[k])
         leds = [platform.request("led", n) for n in (0, 1, 7)]
         m.d.comb += [leds[0].o.eq(core.underflow), leds[1].o.eq(core.order_error),
                      leds[2].o.eq(core.source.frame[4] if len(core.source.frame) > 4 else 0)]
