@@ -29,8 +29,7 @@ registers). Per pixel of the active raster, in order:
    lanes (blue carries hsync, vsync) and the :class:`~bumprtl.rtl.tmds.Serializer`.
 
 :class:`BoardCore` is all of that; :class:`ULX3STop` adds the ECP5 PLL (EHXPLLL, 25 MHz ->
-pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (the platform's ODDRX1F,
-``xdr=2``); :class:`SimTop` replaces both by ports: the testbench drives ``clk`` and
+pixel and 5 x pixel clocks) and the ``hdmi`` pins' DDR registers (an ODDRX1F a pin); :class:`SimTop` replaces both by ports: the testbench drives ``clk`` and
 ``shift_clk`` at the same ratio and the DDR registers become the multiplexer they are
 (``o0`` while the shift clock is high, ``o1`` while low), on ``tmds_data_p`` (lane k on bit
 k) and ``tmds_clk_p``.
@@ -126,8 +125,9 @@ def payload_field(view, key):
 class RasterSource(Elaboratable):
     """What the board's sources share: the raster counters (``px``, ``py``, the pixel count
     ``count`` of ``count_bits``) and the light table (``table``: one {key: code} per light
-    step, L and H of every light), read a cycle ahead into the pipeline's payload, its step
-    register ``frame`` moving on after the last pixel of a frame. ``allow``: the source may
+    step, L and H of every light), the next step's entry read ahead into a register the
+    pipeline's payload comes from, its step register ``frame`` moving on after the last
+    pixel of a frame. ``allow``: the source may
     offer a pixel this cycle. It drives ``port``: the pipeline's input stream, or with
     ``register`` a stream of the same shape that :func:`register_slice` joins to it, so
     that the source's counters and the table's address see a registered ready (the texel
@@ -161,8 +161,13 @@ class RasterSource(Elaboratable):
         return last_x, last_y
 
     def lights(self, m, wrap):
-        """The light table into the pipeline's payload: the entry of ``frame``, or of the
-        next step in the cycle after ``wrap`` (the last pixel of a frame taken)."""
+        """The light table into the pipeline's payload: the entry of ``frame`` from a
+        register (``light_entry``, the table's entry 0 after reset), which takes the next
+        step's entry in the cycle after ``wrap`` (the last pixel of a frame taken). The
+        table's read port is always at the next step, so its answer has waited at least a
+        cycle when it is taken (a frame of 2 pixels or more): the block RAM's output
+        (about 6 ns from its clock on the ECP5 without its output register) reaches one
+        flip-flop's data input, not the payload's registers beyond it."""
         words = [sum(int(t[k]) << sum(self.widths[:n]) for n, k in enumerate(self.keys))
                  for t in self.table]
         m.submodules.light_table = rom = Memory(shape=sum(self.widths), depth=len(words),
@@ -170,12 +175,13 @@ class RasterSource(Elaboratable):
         rd = rom.read_port()
         m.d.sync += self.primed.eq(1)
         step = Mux(self.frame == len(self.table) - 1, 0, self.frame + 1)
-        m.d.comb += rd.addr.eq(Mux(wrap, step, self.frame))
+        entry = Signal(sum(self.widths), init=words[0], name="light_entry")
+        m.d.comb += rd.addr.eq(step)
         with m.If(wrap):
-            m.d.sync += self.frame.eq(step)
+            m.d.sync += [self.frame.eq(step), entry.eq(rd.data)]
         at = 0
         for k, w in zip(self.keys, self.widths, strict=False):
-            m.d.comb += payload_field(self.port.payload, k).eq(rd.data[at:at + w])
+            m.d.comb += payload_field(self.port.payload, k).eq(entry[at:at + w])
             at += w
         if self.register:
             register_slice(m, self.port, self.pipeline.i)
@@ -439,13 +445,21 @@ class BoardCore(Elaboratable):
             m.d.sync += self.underflow.eq(1)
         pixel = Mux(take, color, 0)                   # bytes: blue, green, red
         m.d.comb += self.pixel.eq(pixel)
+        # the encoders' inputs registered, syncs and DE with the pixel: the display's
+        # decisions (the raster's position, the buffer's valid) and the encoders' first
+        # stage are a pixel clock each (at 720p, 13.5 ns)
+        enc_pixel, enc_de = Signal(24, name="enc_pixel"), Signal(name="enc_de")
+        enc_hsync = Signal(init=int(self.mode.h_negative), name="enc_hsync")
+        enc_vsync = Signal(init=int(self.mode.v_negative), name="enc_vsync")
+        m.d.sync += [enc_pixel.eq(pixel), enc_de.eq(t.de), enc_hsync.eq(t.hsync),
+                     enc_vsync.eq(t.vsync)]
         words = []
         for lane in range(3):
             enc = TMDSEncoder()
             m.submodules[f"tmds{lane}"] = enc
-            m.d.comb += [enc.data.eq(pixel[8 * lane:8 * lane + 8]), enc.de.eq(t.de)]
+            m.d.comb += [enc.data.eq(enc_pixel[8 * lane:8 * lane + 8]), enc.de.eq(enc_de)]
             if lane == 0:
-                m.d.comb += [enc.c0.eq(t.hsync), enc.c1.eq(t.vsync)]
+                m.d.comb += [enc.c0.eq(enc_hsync), enc.c1.eq(enc_vsync)]
             words.append(enc.q)
         clock_word = Signal(10, init=CLOCK_WORD, name="clock_word")
         m.submodules.serializer = ser = Serializer([*words, clock_word])
@@ -665,10 +679,17 @@ class ULX3STop(Elaboratable):
         m.submodules.rst_shift = ResetSynchronizer(~locked, domain="shift")
         # nextpnr derives both clocks' constraints from clk25's through the PLL
         m.submodules.core = core
-        hdmi = platform.request("hdmi", 0, xdr={"clk": 2, "d": 2})
-        m.d.comb += [hdmi.clk.o_clk.eq(ClockSignal("shift")), hdmi.d.o_clk.eq(ClockSignal("shift")),
-                     hdmi.d.o0.eq(core.o0[:3]), hdmi.d.o1.eq(core.o1[:3]),
-                     hdmi.clk.o0.eq(core.o0[3]), hdmi.clk.o1.eq(core.o1[3])]
+        # the lanes' DDR registers: an ODDRX1F a pin before a plain output buffer, not the
+        # platform's DDR buffer (xdr=2), whose output enable of an output-only pin comes
+        # from two fabric flip-flops in the shift domain (Amaranth's ECP5 DDRBuffer), a
+        # route to the I/O cell as long as 720p's shift period
+        hdmi = platform.request("hdmi", 0, dir="-")
+        for name, port, bits in (("d", hdmi.d, range(3)), ("clk", hdmi.clk, [3])):
+            m.submodules[f"hdmi_{name}"] = buf = io.Buffer("o", port)
+            for k, lane in enumerate(bits):
+                m.submodules[f"hdmi_{name}_ddr{k}"] = Instance(
+                    "ODDRX1F", i_SCLK=ClockSignal("shift"), i_RST=0, i_D0=core.o0[lane],
+                    i_D1=core.o1[lane], o_Q=buf.o[k])
         leds = [platform.request("led", n) for n in (0, 1, 7)]
         m.d.comb += [leds[0].o.eq(core.underflow), leds[1].o.eq(core.order_error),
                      leds[2].o.eq(core.source.frame[4] if len(core.source.frame) > 4 else 0)]
@@ -681,13 +702,21 @@ class ULX3STop(Elaboratable):
 
 class SimTop(wiring.Component):
     """The core for simulation: ``clk``/``rst`` (pixel) and ``shift_clk``/``shift_rst`` are
-    ports; the DDR registers become ``shift_clk ? o0 : o1``."""
+    ports; the DDR registers become ``shift_clk ? o0 : o1``. With the map in the SDRAM also
+    ``pipe_clk``/``pipe_rst``, the SDRAM's pins ``sdram__*`` registered in ``pipe`` as the
+    ULX3S top's I/O cells register them (every output once, DQ's input once more: the
+    core's SdramConfig counts SDRAM_PIN_CYCLES), the flash's ``spi__*`` and
+    ``display_shows`` (the display has started, at a frame's first pixel)."""
 
     def __init__(self, core: BoardCore):
         self.core = core
-        super().__init__({"tmds_clk_p": wiring.Out(1), "tmds_data_p": wiring.Out(3),
-                          "underflow": wiring.Out(1), "order_error": wiring.Out(1),
-                          "light_step": wiring.Out(len(core.source.frame))})
+        ports = {"tmds_clk_p": wiring.Out(1), "tmds_data_p": wiring.Out(3),
+                 "underflow": wiring.Out(1), "order_error": wiring.Out(1),
+                 "light_step": wiring.Out(len(core.source.frame))}
+        if core.sdram is not None:
+            ports.update(sdram=wiring.Out(sdram_signature(core.sdram)),
+                         spi=wiring.Out(spi_signature()), display_shows=wiring.Out(1))
+        super().__init__(ports)
 
     def elaborate(self, platform):
         m, core = Module(), self.core
@@ -697,4 +726,17 @@ class SimTop(wiring.Component):
                      self.tmds_clk_p.eq(Mux(hi, core.o0[3], core.o1[3])),
                      self.underflow.eq(core.underflow), self.order_error.eq(core.order_error),
                      self.light_step.eq(core.source.frame)]
+        if core.sdram is not None:
+            inner, pins, spi = core.sdram_pins, self.sdram, self.spi
+            idle = {"cke": 1, "cs_n": 1, "ras_n": 1, "cas_n": 1, "we_n": 1}
+            for name in ("cke", "cs_n", "ras_n", "cas_n", "we_n", "ba", "a", "dqm", "dq_o",
+                         "dq_oe"):
+                reg = Signal.like(getattr(inner, name), init=idle.get(name, 0),
+                                  name=f"io_{name}")
+                m.d.pipe += reg.eq(getattr(inner, name))
+                m.d.comb += getattr(pins, name).eq(reg)
+            m.d.pipe += inner.dq_i.eq(pins.dq_i)
+            m.d.comb += [spi.sclk.eq(core.spi.sclk), spi.cs_n.eq(core.spi.cs_n),
+                         spi.mosi.eq(core.spi.mosi), core.spi.miso.eq(spi.miso),
+                         self.display_shows.eq(core.shows)]
         return m

@@ -11,9 +11,10 @@ pixel-clock stages; the word is sent bit 0 first.
 :class:`Serializer` turns the pixel-domain words of every lane into two bits per cycle of
 the ``shift`` domain (5 x the pixel clock), for DDR output registers (ECP5 ODDRX1F: ``o0``
 goes out while the shift clock is high, ``o1`` while it is low). The pixel domain toggles a
-bit every pixel; the shift domain loads the next words one or two shift cycles after the
-toggle arrives (two flip-flops), when the words have been stable for a whole shift cycle:
-no assumption on the phase of the two clocks beyond their 1:5 ratio.
+bit every pixel; the shift domain loads the next words two or three shift cycles after the
+toggle arrives (two synchronizer flip-flops and a registered load), when the words have
+been stable for at least a whole shift cycle and stay so for at least one more: no
+assumption on the phase of the two clocks beyond their 1:5 ratio.
 """
 
 from amaranth.hdl import Cat, Const, Elaboratable, Module, Mux, Signal, signed
@@ -86,23 +87,35 @@ class TMDSEncoder(Elaboratable):
 
 class Serializer(Elaboratable):
     """``words``: pixel-domain 10-bit signals (one per lane) -> ``o0[k]``, ``o1[k]``: lane
-    k's two bits of each ``shift`` cycle (registered), bit 0 of a word first."""
+    k's two bits of each ``shift`` cycle (registered), bit 0 of a word first.
+
+    Each lane has its own toggle (pixel domain), its own two synchronizer flip-flops and
+    its own registered load (shift domain): the load of lane k is ``t1 ^ t2`` of its chain
+    a shift cycle late, a flip-flop driving only that lane's ten multiplexers, so every
+    shift-domain path is one flip-flop, one LUT, one flip-flop with a fan-out of ten (the
+    chains differ in their own feedback, so synthesis cannot merge them). The load comes
+    two or three shift cycles after the pixel edge that changed the words, of the five
+    the words stay. No shift-domain register has a reset (their initial values hold until
+    the first load): at 371 MHz a synchronous reset is a route from the reset synchronizer
+    to every register's LSR input as long as the period, and nothing needs it, the loads
+    following the toggles within three shift cycles."""
 
     def __init__(self, words):
         self.words = list(words)
-        self.o0 = Signal(len(self.words))
-        self.o1 = Signal(len(self.words))
+        self.o0 = Signal(len(self.words), reset_less=True)
+        self.o1 = Signal(len(self.words), reset_less=True)
 
     def elaborate(self, platform):
         m = Module()
-        toggle = Signal(name="pixel_toggle")
-        m.d.sync += toggle.eq(~toggle)
-        t1, t2 = Signal(name="toggle_s1"), Signal(name="toggle_s2")
-        m.d.shift += [t1.eq(toggle), t2.eq(t1)]
-        load = t1 ^ t2
         for k, word in enumerate(self.words):
+            toggle = Signal(name=f"pixel_toggle{k}")
+            m.d.sync += toggle.eq(~toggle)
+            t1 = Signal(name=f"toggle{k}_s1", reset_less=True)
+            t2 = Signal(name=f"toggle{k}_s2", reset_less=True)
+            load = Signal(name=f"load{k}", reset_less=True)
+            m.d.shift += [t1.eq(toggle), t2.eq(t1), load.eq(t1 ^ t2)]
             init = int(word.init) if hasattr(word, "init") else 0
-            sr = Signal(8, init=init >> 2, name=f"shift{k}")
+            sr = Signal(8, init=init >> 2, name=f"shift{k}", reset_less=True)
             with m.If(load):
                 m.d.shift += [sr.eq(word[2:]), self.o0[k].eq(word[0]), self.o1[k].eq(word[1])]
             with m.Else():

@@ -4,7 +4,8 @@
 ``.svf``), prints the resources and each clock domain's Fmax from nextpnr, and, with
 ``--check-frames N``, simulates the top for N whole frames under Verilator, captures them
 with cocotbext-dvi's DVISink, compares each with the golden frame byte for byte and writes
-the first as ``frame0.png``. ``--mode test`` checks the reduced 32 x 24 mode only (no
+the first as ``frame0.png`` (with the map in the SDRAM the testbench runs the SDRAM's and
+the flash's models, and the frames start at the display's second). ``--mode test`` checks the reduced 32 x 24 mode only (no
 bitstream: it is no monitor mode). With the map in the SDRAM (``--map-memory axi`` or a
 scene with ``map_memory = "axi"``) it also writes the map's flash image
 (``ulx3s_85f_map.bin``, the bytes the flash loader copies into the SDRAM) and prints the
@@ -57,10 +58,6 @@ def run(args):
     seeds = _seeds(args.seeds)
     if args.check_frames < 0:
         raise BumpError(f"--check-frames must be >= 0, got {args.check_frames}", "check_frames")
-    if axi and args.check_frames:
-        raise BumpError("--check-frames applies to map_memory = 'bram' (the DVI-sink bench has no "
-                        "SDRAM or flash model; tests/rtl/test_board_sdram.py checks those frames)",
-                        "check_frames")
     pipe_hz = None
     bitstream = mode.name != "test" and not args.no_bitstream
     if args.pipe_mhz is not None:      # refused below the pixel clock, one line
@@ -118,9 +115,10 @@ def run(args):
                 print(f"{part}: " + ", ".join(f"{k} {v}" for k, v in row.items()))
     if args.check_frames:
         r = check_frames(scene, mode, out / f"sim_{mode.name}", args.check_frames,
-                         board_data(scene), pipe_hz=pipe_hz)
+                         board_data(scene), pipe_hz=pipe_hz, memory=memory)
         for k, same in enumerate(r["same"]):
-            print(f"frame {k} (light step {k}): {'identical to the golden frame' if same else 'DIFFERS from the golden frame'}")
+            step = r["first"] + k
+            print(f"frame {step} (light step {step}): {'identical to the golden frame' if same else 'DIFFERS from the golden frame'}")
         for e in r["timing_errors"]:
             print(f"timing: {e}")
         print(f"sync/blanking: {'as the VESA table' if not r['timing_errors'] else 'WRONG'}"

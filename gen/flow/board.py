@@ -168,6 +168,12 @@ def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
                         f"--texture-size, or --sdram 64mb)", "texture_size")
     first = -(-BITSTREAM_BYTES[device] // FLASH_SECTOR) * FLASH_SECTOR
     last = FLASH_BYTES_MAX - geom.image_bytes
+    if last < first:                    # no offset at all: the map is too large for the flash
+        raise BumpError(f"texture_size {scene.texture_size}: the map's tiled image is "
+                        f"{geom.image_bytes:,} bytes, more than the {FLASH_BYTES_MAX - first:,} "
+                        f"bytes of flash from 0x{first:x} (after the {device} bitstream's "
+                        f"sectors) to the 24-bit READ address's end (a smaller --texture-size)",
+                        "texture_size")
     if isinstance(offset, bool) or not isinstance(offset, int) or not first <= offset <= last \
             or offset % FLASH_SECTOR:
         raise BumpError(f"--flash-offset must be a multiple of 0x{FLASH_SECTOR:x} (a 64 KiB "
@@ -392,28 +398,38 @@ def part_costs(scene, mode, work_dir, memory=None):
     return rows
 
 
-def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None):
+def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None, memory=None):
     """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``; with
-    ``pipe_hz`` it has the pipeline's clock and reset ports too (``pipe_clk``, ``pipe_rst``)."""
+    ``pipe_hz`` it has the pipeline's clock and reset ports too (``pipe_clk``, ``pipe_rst``);
+    with ``memory`` (:func:`board_memory`) the SDRAM's and the flash's pins as well."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    top = SimTop(board_core(scene, mode, None, data, pipe_hz))
+    top = SimTop(board_core(scene, mode, None, data, pipe_hz, memory))
     path = out_dir / "board_sim.v"
     path.write_text(verilog.convert(top, name="board_sim", emit_src=False))
     return path, top
 
 
-def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_hz=None):
+def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_hz=None,
+                 memory=None):
     """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
     under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
     golden frame. ``opt_fast``: g++'s optimisation of the model's per-cycle code (verilated.mk's
     OPT_FAST; None: Verilator's -Os), e.g. ``-O0`` for a few reduced-mode frames, whose run
     is cocotb's and whose build it halves. ``pipe_hz``: the pipeline in its own clock domain,
-    its clock driven at that rate (its edges drift against the pixel clock's). Returns a dict: captured (list of arrays), golden,
-    timing (the run lengths the testbench measured), seconds, the verdicts."""
+    its clock driven at that rate (its edges drift against the pixel clock's). ``memory``
+    (:func:`board_memory`): the map in the SDRAM, the testbench running the datasheet model
+    (sim/sdram_model.py) on the SDRAM's pins and the flash model (sim/flash_model.py, the
+    image at its offset) on the flash's, at the BoardMemory's pipe clock; the sink starts
+    in the frame after the display's first, so the frames compared are golden frames 1 ..
+    ``frames``. Returns a dict: captured (list of arrays), golden, timing (the run lengths
+    the testbench measured), seconds, the verdicts, ``first`` (the golden frame of the
+    first captured one)."""
     out_dir = Path(out_dir).resolve()
     data = board_data(scene) if data is None else data
-    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz)
+    if memory is not None:
+        pipe_hz = memory.pipe_hz
+    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz, memory)
     result = out_dir / "frames.npz"
     if result.exists():
         result.unlink()
@@ -425,14 +441,25 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
            "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
     if pipe_hz is not None:       # the same ratio to the simulated pixel period, in ps (even)
         env["BOARD_PIPE_PS"] = 2 * round(5e2 * env["BOARD_PIXEL_NS"] * m.pixel_hz / pipe_hz)
+    if memory is not None:        # the flash's array: the image at its offset
+        flash = out_dir / "flash.bin"
+        flash.write_bytes(bytes(memory.flash.offset) + memory.image)
+        # the model's clock is the simulated pipe clock (ps), the controller's timings the
+        # SdramConfig's: the simulated period is the configured one rounded to even ps
+        env.update(BOARD_SDRAM=memory.sdram.variant, BOARD_FLASH=flash,
+                   BOARD_FLASH_PHASE=memory.flash.half_period)
     t0 = time.perf_counter()
-    build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env, opt_fast)
+    # the flash loader's FSM and its "== 0" tests: incomplete cases and a vector's "!" in
+    # Amaranth's Verilog, which Verilator's lint flags (the board's other units do not)
+    waivers = ("CASEINCOMPLETE", "WIDTHTRUNC") if memory is not None else ()
+    build_s, run_s = _run_verilator(v_path, out_dir / "verilator", env, opt_fast, waivers)
     res = dict(np.load(result))
     captured = [res[f"frame{k}"] for k in range(frames)]
     words, texels, _, table = data
-    golden = [golden_frame(scene, mode, k, table, words, texels) for k in range(frames)]
+    first = int(res.get("first", 0))
+    golden = [golden_frame(scene, mode, first + k, table, words, texels) for k in range(frames)]
     same = [c.shape == g.shape and np.array_equal(c, g) for c, g in zip(captured, golden, strict=False)]
-    return {"captured": captured, "golden": golden, "same": same,
+    return {"captured": captured, "golden": golden, "same": same, "first": first,
             "timing_errors": [str(e) for e in res["timing_errors"]],
             "underflow": int(res["underflow"]), "order_error": int(res["order_error"]),
             "run_s": run_s, "build_s": build_s, "seconds": time.perf_counter() - t0}
@@ -466,13 +493,14 @@ def _top_ports_vlt(build_dir, top):
     return path
 
 
-def _run_verilator(v_path, build_dir, env, opt_fast=None):
+def _run_verilator(v_path, build_dir, env, opt_fast=None, waivers=()):
     """Build ``v_path`` with Verilator once per digest of its text and ``opt_fast`` (the
     build directory keeps a ``digest`` file; the board's sine ROMs make a build of minutes
     on a busy machine) and run tb_board on it. Returns (build seconds, 0 when cached; run
     seconds)."""
     build_dir = Path(build_dir).resolve()
     digest = hashlib.sha256(Path(v_path).read_bytes()).hexdigest() + " top ports public"
+    digest += "".join(f" -Wno-{w}" for w in waivers)
     if opt_fast is not None:
         digest += f" OPT_FAST={opt_fast}"
     stamp = build_dir / "digest"
@@ -489,7 +517,7 @@ def _run_verilator(v_path, build_dir, env, opt_fast=None):
         if not (stamp.is_file() and stamp.read_text() == digest):
             runner.build(sources=[Path(v_path).resolve()], hdl_toplevel=top,
                          build_dir=build_dir, timescale=("1ns", "1ps"), always=True,
-                         build_args=[f"-Wno-{w}" for w in VERILATOR_WAIVERS])
+                         build_args=[f"-Wno-{w}" for w in (*VERILATOR_WAIVERS, *waivers)])
             stamp.write_text(digest)
         t1 = time.perf_counter()
         results = runner.test(hdl_toplevel=top, hdl_toplevel_lang="verilog",

@@ -14,18 +14,39 @@ Once a word, on the clock lane's rising edge, the testbench records the sink's d
 v negative); the disagreements go to ``timing_errors``.
 
 Environment: BOARD_RESULT (npz path), BOARD_FRAMES (frames to capture), BOARD_TIMING,
-BOARD_PIXEL_NS (pixel clock period, ns).
+BOARD_PIXEL_NS (pixel clock period, ns); BOARD_PIPE_PS (the pipe clock's period, ps, when
+the pipeline has its own domain).
+
+With the map in the SDRAM (BOARD_SDRAM: the chip's variant; BOARD_FLASH: the flash array's
+file; BOARD_FLASH_PHASE: the loader's SCLK half period in pipe clocks) the testbench runs
+the datasheet model (sim/sdram_model.SdramModel, told the simulated pipe period exactly) on
+the ``sdram__*`` pins and the flash model (sim/flash_model.SpiFlash) on the ``spi__*``
+pins, both on ``pipe_clk``: the model's pins read after each rising edge, its DQ driven
+after the next (as tb_sdram's), MISO driven at the falling edge between (so it is there
+``delay`` = half period - 1 pipe clocks after the step that saw SCLK fall, the most the
+loader allows). The display starts at a frame's first pixel once the map is loaded
+(``display_shows``); the sink starts in the next frame's vertical front porch, so the
+captured frames are golden frames 1, 2, ... (``first`` = 1 in the result). A model
+violation, a flash rule broken or a READ other than the one copy fails the test.
 """
 
 import os
+from fractions import Fraction
+from pathlib import Path
 
 import cocotb
 import numpy as np
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 from cocotbext.dvi import DVIBus, DVISink
 
+from bumprtl.sim.flash_model import SpiFlash
+from bumprtl.sim.sdram_model import SdramModel
+
 __all__ = ["runs", "timing_errors"]
+
+# the SDRAM's pins the model samples (sim/tb/tb_sdram.py's)
+PINS = ("cs_n", "ras_n", "cas_n", "we_n", "ba", "a", "dqm", "dq_o", "dq_oe", "cke")
 
 
 def runs(seq):
@@ -89,6 +110,51 @@ def timing_errors(de, hs, vs, t):
     return errors
 
 
+class Memories:
+    """The SDRAM model on ``sdram__*`` and the flash model on ``spi__*``, on ``pipe_clk``
+    (module docstring); ``errors`` collects what either reports."""
+
+    def __init__(self, dut, pipe_ps):
+        self.dut = dut
+        self.sdram = SdramModel(os.environ["BOARD_SDRAM"], Fraction(10**6, pipe_ps))
+        phase = int(os.environ["BOARD_FLASH_PHASE"])
+        self.flash = SpiFlash(Path(os.environ["BOARD_FLASH"]).read_bytes(), min_phase=phase,
+                              delay=phase - 1)
+        self.errors = []
+
+    async def sdram_pins(self):
+        dut, model = self.dut, self.sdram
+        drive, value = False, 0
+        pins = {name: getattr(dut, "sdram__" + name) for name in PINS}
+        while True:
+            await RisingEdge(dut.pipe_clk)
+            dut.sdram__dq_i.value = value if drive else 0
+            await ReadOnly()
+            if str(dut.pipe_rst.value) != "0":
+                model.reset()
+                drive = False
+                continue
+            raw = {name: v.value for name, v in pins.items()}
+            if any(not set(str(v)) <= {"0", "1"} for v in raw.values()):
+                self.errors.append(f"SDRAM cycle {model.n}: X or Z on the pins")
+                return
+            try:
+                drive, value = model.cycle(**{k: int(v) for k, v in raw.items()})
+            except AssertionError as e:           # the model's SdramViolation
+                self.errors.append(f"SDRAM: {e}")
+                return
+
+    async def flash_pins(self):
+        dut, flash = self.dut, self.flash
+        while True:
+            await RisingEdge(dut.pipe_clk)
+            await ReadOnly()
+            miso = flash.step(int(dut.spi__cs_n.value), int(dut.spi__sclk.value),
+                              int(dut.spi__mosi.value))
+            await FallingEdge(dut.pipe_clk)
+            dut.spi__miso.value = miso
+
+
 @cocotb.test()
 async def board_frames(dut):
     timing = [int(x) for x in os.environ["BOARD_TIMING"].split(",")]
@@ -102,16 +168,36 @@ async def board_frames(dut):
     resets = [dut.rst, dut.shift_rst] + ([dut.pipe_rst] if pipe_ps else [])
     if pipe_ps:
         cocotb.start_soon(Clock(dut.pipe_clk, int(pipe_ps), unit="ps").start())
+    memories = Memories(dut, int(pipe_ps)) if os.environ.get("BOARD_SDRAM") else None
+    if memories is not None:
+        dut.spi__miso.value = 0
+        dut.sdram__dq_i.value = 0
+        cocotb.start_soon(memories.sdram_pins())
+        cocotb.start_soon(memories.flash_pins())
     for r in resets:
         r.value = 1
     await ClockCycles(dut.clk, 4)
     for r in resets:
         r.value = 0
+    first = 0
+    if memories is not None:    # the display's first frame: wait for it (the copy, then a frame)
+        waited, limit = 0, int(os.environ.get("BOARD_START_LIMIT", 2_000_000))
+        while True:
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            if str(dut.display_shows.value) == "1" or memories.errors or waited > limit:
+                break
+            waited += 1
+        assert not memories.errors, memories.errors
+        assert waited <= limit, f"the display did not start in {limit} pixel clocks"
+        # at its first pixel (x = 0 of line 0): on to the first front-porch line, below
+        await ClockCycles(dut.clk, va * htot)
+        first = 1
     # The sink's frame parser must first see a horizontal sync pulse's end while the
     # vertical sync is inactive (it keeps the pulse it measures in a local variable made at
     # that edge, and fails on a pulse's start before it). The raster starts at x = 0 of the
     # first front-porch line, so the sink starts in the middle of that line's hsync pulse
-    # (the wire lags the raster by the encoder's 2 stages and the serializer's few cycles).
+    # (the wire lags the raster by the encoder's 3 stages and the serializer's few cycles).
     await ClockCycles(dut.clk, timing[0] + timing[1] + timing[2] // 2)
     sink = DVISink(dut, DVIBus.from_prefix(dut, "tmds"), height=va, width=ha)
     sink.verification = False                 # the pixels are compared by the caller
@@ -143,6 +229,11 @@ async def board_frames(dut):
             rgb = rgb.reshape(va, ha, 3)
         arrays[f"frame{k}"] = rgb
     errors = timing_errors(rec["de"], rec["hs"], rec["vs"], timing)
+    if memories is not None:
+        errors += memories.errors + [f"flash: {e}" for e in memories.flash.errors]
+        reads = memories.flash.reads
+        if len(reads) != 1:
+            errors.append(f"flash: {len(reads)} READ commands, expected the one copy: {reads}")
     np.savez(os.environ["BOARD_RESULT"], **arrays, timing_errors=np.array(errors, dtype=str),
              underflow=int(dut.underflow.value), order_error=int(dut.order_error.value),
-             samples=len(rec["de"]))
+             samples=len(rec["de"]), first=first)

@@ -8,14 +8,16 @@ words whose Verilator build takes minutes); ``make board`` checks whole 640 x 48
 the default scene.
 """
 
+import dataclasses
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 from cocotbext.dvi.tmds import TMDS
 
-from bumprtl.gen.flow.board import board_data, check_board, check_frames
+from bumprtl.gen.flow.board import board_data, board_memory, check_board, check_frames
 from bumprtl.rtl.tmds import CONTROL
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import golden_frame, light_table
@@ -83,6 +85,38 @@ def test_reduced_mode_frames_match_the_golden_frames_through_the_dvi_sink(build_
         assert np.array_equal(c, g), f"frame {k}: {np.count_nonzero(np.any(c != g, -1))} pixels differ"
     # the light turns: consecutive frames differ, so the comparison sees the light step
     assert not np.array_equal(r["golden"][0], r["golden"][1])
+
+
+@pytest.mark.regress
+@pytest.mark.parametrize("scene_name", ["default", "globe"])
+def test_reduced_mode_frames_with_the_map_in_sdram_through_the_dvi_sink(scene_name, build_dir,
+                                                                        tmp_path):
+    """The map in the SDRAM (``map_memory = "axi"``): the testbench runs the SDRAM's
+    datasheet model and the flash model, the loader copies the map's image from the flash
+    offset into the SDRAM, the texel cache reads it; the frames from the display's second
+    on equal the golden frames 1, 2. The same top with one texel's bytes changed in the
+    flash shows a different frame (so the frames come from the SDRAM's copy). About 100 s
+    of CPU a scene (Verilator build, then the run; the second run reuses the build)."""
+    if scene_name == "globe":
+        (tmp_path / "globe.toml").write_text('image = "globe"\n')
+        scene_name = str(tmp_path / "globe.toml")
+    scene = load_scene_config(scene_name, {**SMALL, "map_memory": "axi"})
+    mode = MODES["test"]
+    memory = board_memory(scene, mode)
+    out = build_dir / f"board_axi_{Path(scene_name).stem}"
+    r = check_frames(scene, mode, out, frames=2, memory=memory)
+    assert r["first"] == 1 and r["timing_errors"] == []
+    assert r["underflow"] == 0 and r["order_error"] == 0
+    for k, (c, g) in enumerate(zip(r["captured"], r["golden"], strict=True)):
+        assert c.shape == g.shape == (mode.v_active, mode.h_active, 3), k
+        assert np.array_equal(c, g), f"frame {k}: {np.count_nonzero(np.any(c != g, -1))} pixels differ"
+    image = bytearray(memory.image)
+    for at in range(0, len(image), 4):          # every texel's first byte
+        image[at] ^= 0x5A
+    bad = check_frames(scene, mode, out, frames=2,
+                       memory=dataclasses.replace(memory, image=bytes(image)))
+    assert bad["build_s"] < 1.0                 # the same Verilog: the build was reused
+    assert not all(bad["same"])
 
 
 def test_golden_frames_follow_the_light_table():

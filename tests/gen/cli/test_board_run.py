@@ -74,12 +74,14 @@ def test_bitstream_seeds_minimum_fmax_parts_and_summary(tmp_path, monkeypatch, r
 def _frames(same, timing_errors=(), underflow=0, order_error=0):
     seen = {}
 
-    def check(scene, mode, out, frames, data, pipe_hz=None):
-        seen.update(mode=mode.name, out=out, frames=frames, words=len(data[0]), pipe_hz=pipe_hz)
+    def check(scene, mode, out, frames, data, pipe_hz=None, memory=None):
+        seen.update(mode=mode.name, out=out, frames=frames, words=len(data[0]), pipe_hz=pipe_hz,
+                    memory=memory)
         captured = [np.full((mode.v_active, mode.h_active, 3), 40 + k, np.uint8)
                     for k in range(frames)]
         return {"captured": captured, "same": list(same), "timing_errors": list(timing_errors),
-                "underflow": underflow, "order_error": order_error, "build_s": 1.0, "run_s": 2.0}
+                "underflow": underflow, "order_error": order_error, "build_s": 1.0, "run_s": 2.0,
+                "first": 0 if memory is None else 1}
     return check, seen
 
 

@@ -74,6 +74,8 @@ def _first_free_sector():
     (["--sdram", "16mb", "--no-bitstream"], "--sdram must be one of 32mb, 64mb"),
     (["--texture-size", "4096"], "texture_size 4096: the map's tiled image ends at byte "
                                  "67,108,864, beyond the 32mb SDRAM's 33,554,432 bytes"),
+    (["--texture-size", "2048"], "texture_size 2048: the map's tiled image is 16,777,216 bytes, "
+                                 "more than the 14,680,064 bytes of flash from 0x200000"),
     (["--flash-offset", "0"], "--flash-offset must be a multiple of 0x10000"),
     (["--flash-offset", hex(_first_free_sector() - FLASH_SECTOR)],
      f"in [0x{_first_free_sector():x}, "),
@@ -83,7 +85,6 @@ def _first_free_sector():
     (["--pipe-mhz", "120"], "pipe clock must be at most 100 MHz with the map in the SDRAM "
                             "(CAS latency 2: tCK >= 10 ns"),
     (["--pipe-mhz", "20"], "pipe clock must be at least the pixel clock"),
-    (["--check-frames", "1"], "--check-frames applies to map_memory = 'bram'"),
 ])
 def test_bad_input_with_the_map_in_sdram_one_line_exit_2_nothing_written(flags, message,
                                                                           board_refusal):
