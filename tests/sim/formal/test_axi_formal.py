@@ -80,9 +80,10 @@ def test_the_axi_pipeline_counts_the_pixels_in_its_cache():
     the pixels the cache holds besides the credits."""
     target = TARGETS["pipeline_default_axi"]
     dut = target.unit()
-    # besides its queue: the registers of the pixel read and looked up, the queue's head,
-    # the data read and the output
-    assert dut.front_capacity == dut.units["fetch"].capacity == dut.units["fetch"].geom.queue + 8
+    # besides its queue: the registers of the pixel read, its words read and their skid
+    # register, its words settled and their stamp distances, the pixel looked up, the
+    # queue's head, the data read and its words, and the output
+    assert dut.front_capacity == dut.units["fetch"].capacity == dut.units["fetch"].geom.queue + 10
     assert (1 << len(dut.i.payload.tag)) > dut.fifo_depth + dut.units["fetch"].capacity + 1
     top = StreamContract(dut, "quiet")
     rtlil.convert(top, name="top", ports=top.free_inputs())
