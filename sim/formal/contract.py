@@ -678,21 +678,29 @@ class StreamContract(Elaboratable):
         layout = c.queue_layout(g, c.extra)
         qb = g.queue.bit_length() - 1
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
-        self._lemma(m, ~c.o.valid | (c.o.payload.tag == n_edge),
-                    "the cache's output register holds the chain's next tag")
-        at_wd = (n_edge + c.o.valid)[:bits]
-        self._lemma(m, ~r.wd_valid | (r.wd_extra["tag"] == at_wd),
-                    "the cache's words-read register holds the tag after its output's")
-        at_rd = Signal(bits, name="tag_cache_read_register")
-        m.d.comb += at_rd.eq(at_wd + r.wd_valid)
-        self._lemma(m, ~r.rd_valid | (r.rd_extra["tag"] == at_rd),
-                    "the cache's read register holds the tag after its words-read register's")
-        at_hd = Signal(bits, name="tag_cache_head_register")
-        m.d.comb += at_hd.eq(at_rd + r.rd_valid)
-        self._lemma(m, ~r.hd_valid | (r.hd_extra["tag"] == at_hd),
-                    "the cache's head register holds the tag after its read register's")
+        def consecutive(at, regs):
+            """Each register ``(valid, tag, name of its expected tag or None, lemma)`` in
+            turn holds the tag ``at``, then one past it for each valid one; returns the tag
+            after the last."""
+            for valid, tag, name, text in regs:
+                if name is not None:
+                    named = Signal(bits, name=name)
+                    m.d.comb += named.eq(at)
+                    at = named
+                self._lemma(m, ~valid | (tag == at[:bits]), text)
+                at = at + valid
+            return at
+
+        after_hd = consecutive(n_edge, [
+            (c.o.valid, c.o.payload.tag, None, "the cache's output register holds the chain's next tag"),
+            (r.wd_valid, r.wd_extra["tag"], None,
+             "the cache's words-read register holds the tag after its output's"),
+            (r.rd_valid, r.rd_extra["tag"], "tag_cache_read_register",
+             "the cache's read register holds the tag after its words-read register's"),
+            (r.hd_valid, r.hd_extra["tag"], "tag_cache_head_register",
+             "the cache's head register holds the tag after its read register's")])
         at_q = Signal(bits, name="tag_cache_queue_head")
-        m.d.comb += at_q.eq(at_hd + r.hd_valid)
+        m.d.comb += at_q.eq(after_hd)
         head = inst.origins[0].read_ports[0].data
         oldest = r.out_seq[:qb] if qb else Const(0, 1)
         for a in range(g.queue):
@@ -705,28 +713,19 @@ class StreamContract(Elaboratable):
                         "the cache's queue holds consecutive tags from its oldest")
             self._lemma(m, ~((oldest == a) & r.readable) | (head.as_value() == word.as_value()),
                         "the cache's queue read is its oldest entry")
-        at_look = Signal(bits, name="tag_cache_lookup")
-        m.d.comb += at_look.eq(at_q + count)
-        self._lemma(m, ~r.look_valid | (r.look_extra["tag"] == at_look),
-                    "the cache's lookup register holds the tag after its queue's")
-        at_ds = Signal(bits, name="tag_cache_distances")
-        m.d.comb += at_ds.eq(at_look + r.look_valid)
-        self._lemma(m, ~r.ds_valid | (r.ds_extra["tag"] == at_ds),
-                    "the cache's distances register holds the tag after its lookup's")
-        at_ws = Signal(bits, name="tag_cache_words_settled")
-        m.d.comb += at_ws.eq(at_ds + r.ds_valid)
-        self._lemma(m, ~r.ws_valid | (r.ws_extra["tag"] == at_ws),
-                    "the cache's words-settled register holds the tag after its distances'")
-        at_sk = Signal(bits, name="tag_cache_skid")
-        m.d.comb += at_sk.eq(at_ws + r.ws_valid)
-        self._lemma(m, ~r.sk_valid | (r.sk_extra["tag"] == at_sk),
-                    "the cache's skid register holds the tag after its settled one's")
-        at_rw = Signal(bits, name="tag_cache_words_read")
-        m.d.comb += at_rw.eq(at_sk + r.sk_valid)
-        self._lemma(m, ~r.rw_valid | (r.rw_extra["tag"] == at_rw),
-                    "the cache's words-read register holds the tag after its skid one's")
-        self._lemma(m, ~r.in_valid | (r.in_extra["tag"] == (at_rw + r.rw_valid)[:bits]),
-                    "the cache's read register holds the tag after its words-read one's")
+        consecutive(at_q + count, [
+            (r.look_valid, r.look_extra["tag"], "tag_cache_lookup",
+             "the cache's lookup register holds the tag after its queue's"),
+            (r.ds_valid, r.ds_extra["tag"], "tag_cache_distances",
+             "the cache's distances register holds the tag after its lookup's"),
+            (r.ws_valid, r.ws_extra["tag"], "tag_cache_words_settled",
+             "the cache's words-settled register holds the tag after its distances'"),
+            (r.sk_valid, r.sk_extra["tag"], "tag_cache_skid",
+             "the cache's skid register holds the tag after its settled one's"),
+            (r.rw_valid, r.rw_extra["tag"], "tag_cache_words_read",
+             "the cache's words-read register holds the tag after its skid one's"),
+            (r.in_valid, r.in_extra["tag"], None,
+             "the cache's read register holds the tag after its words-read one's")])
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""
