@@ -24,6 +24,13 @@ help:
 	@echo "make fpga     opt-in ECP5 synthesis + place-and-route reports"
 	@echo "make board    ULX3S bitstreams, plane and globe (build/board, build/board_globe), Fmax per clock, 2 frames each checked by a DVI sink"
 
+# Python writes the bytecode of what it imports (into .venv and the sources' __pycache__,
+# git-ignored), whatever the shell says: under PYTHONDONTWRITEBYTECODE every Python process
+# the suite starts (cocotb runs, the CLI, the tool wrappers) compiles numpy, Amaranth and
+# cocotb from source again, and nothing installed comes precompiled (uv, unlike pip, writes
+# no bytecode at install).
+unexport PYTHONDONTWRITEBYTECODE
+
 # The installer: uv (from PyPI, pinned here) resolves and installs the same pins as pip in
 # a fifth of the time, which counts in make test's budget on a fresh clone; where no uv
 # wheel installs, pip does the same install.
