@@ -10,6 +10,8 @@ data width, no burst crossing 4 KiB, RREADY never needed for RVALID.
 
 import random
 
+from amaranth.hdl import Cat
+
 __all__ = ["AxiReadMemory"]
 
 
@@ -40,15 +42,17 @@ class AxiReadMemory:
     async def process(self, ctx):
         p = self.port
         cycle, beats, held_ar, presenting = 0, [], None, None
+        # ARREADY, RVALID, RDATA and RLAST in one assignment a cycle (each ctx.set settles
+        # the design again); RDATA and RLAST hold the last beat's while none is presented
+        drive = Cat(p.arready, p.rvalid, p.rlast, p.rdata)
+        beat = 0
         while True:
-            ctx.set(p.arready, self.rng.random() >= self.ar_stall)
+            arready = self.rng.random() >= self.ar_stall
             if presenting is None and beats and beats[0][0] <= cycle \
                     and self.rng.random() >= self.r_stall:
                 presenting = beats.pop(0)
-            ctx.set(p.rvalid, presenting is not None)
-            if presenting is not None:
-                ctx.set(p.rdata, presenting[1])
-                ctx.set(p.rlast, presenting[2])
+                beat = (bool(presenting[2]) << 2) | (presenting[1] << 3)
+            ctx.set(drive, arready | ((presenting is not None) << 1) | beat)
             (_, _, arvalid, arready, araddr, arlen, arsize, arburst, rvalid,
              rready) = await ctx.tick().sample(p.arvalid, p.arready, p.araddr, p.arlen,
                                                p.arsize, p.arburst, p.rvalid, p.rready)

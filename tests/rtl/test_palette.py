@@ -24,6 +24,7 @@ from bumprtl.rtl.palette import (
 )
 from bumprtl.rtl.pipe import EDGE_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
+from bumprtl.sim.amaranth_stream import Drive
 from bumprtl.sim.axi_memory import AxiReadMemory
 from bumprtl.sim.golden.cache import run_scene_cache
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
@@ -58,6 +59,13 @@ def run_lut(cfg, inputs, pattern, seed=1):
     out_sigs = {**{f"color.{c}": getattr(dut.o.payload.color, c) for c in CHANNELS},
                 "oor": dut.o.payload.oor, "tag": dut.o.payload.tag}
 
+    drive = Drive({"valid": dut.i.valid, "index": dut.i.payload.index, "tag": dut.i.payload.tag,
+                   **({f"base.{c}": getattr(dut.i.payload.base, c) for c in CHANNELS}
+                      if cfg.palette_blend else {}),
+                   "w_en": dut.w_en, "w_addr": dut.w_addr,
+                   **{f"w_data.{c}": getattr(dut.w_data, c) for c in CHANNELS},
+                   "swap": dut.swap, "ready": dut.o.ready})
+
     async def testbench(ctx):
         pending, offered = list(inputs), None
         for _ in range(30 * len(inputs)):
@@ -65,20 +73,21 @@ def run_lut(cfg, inputs, pattern, seed=1):
                 return
             if offered is None and pending and rng.random() >= gap_p:
                 offered = pending.pop(0)
-            ctx.set(dut.i.valid, offered is not None)
+            drive["valid"] = offered is not None
             if offered is not None:
-                ctx.set(dut.i.payload.index, offered["index"])
-                ctx.set(dut.i.payload.tag, offered["tag"])
+                drive["index"] = offered["index"]
+                drive["tag"] = offered["tag"]
                 for c, v in offered.get("base", {}).items():
-                    ctx.set(getattr(dut.i.payload.base, c), v)
+                    drive[f"base.{c}"] = v
             write, swap = host_op(rng, cfg)
-            ctx.set(dut.w_en, write is not None)
+            drive["w_en"] = write is not None
             if write is not None:
-                ctx.set(dut.w_addr, write[0])
+                drive["w_addr"] = write[0]
                 for c, v in unpack_rgba(write[1], cfg).items():
-                    ctx.set(getattr(dut.w_data, c), int(v))
-            ctx.set(dut.swap, swap)
-            ctx.set(dut.o.ready, rng.random() >= bp_p)
+                    drive[f"w_data.{c}"] = int(v)
+            drive["swap"] = swap
+            drive["ready"] = rng.random() >= bp_p
+            drive.set(ctx)
             _, _, i_ready, o_valid, o_ready, *vals = await ctx.tick().sample(
                 dut.i.ready, dut.o.valid, dut.o.ready, *out_sigs.values())
             if offered is not None and i_ready:
@@ -230,6 +239,12 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15, ca
     out_sigs = {**{f"color.{c}": getattr(dut.o.payload.color, c) for c in CHANNELS},
                 "oor": dut.o.payload.oor, "tag": dut.o.payload.tag}
 
+    fields = [k for k in ("u", "v", "level", "tag") if k in inputs]
+    drive = Drive({"valid": dut.i.valid, **{k: dut.i.payload[k] for k in fields},
+                   "w_en": dut.lut_w_en, "w_addr": dut.lut_w_addr,
+                   **{f"w_data.{c}": getattr(dut.lut_w_data, c) for c in CHANNELS},
+                   "swap": dut.lut_swap, "ready": dut.o.ready})
+
     async def testbench(ctx):
         nxt, offered, write = 0, None, None
         for _ in range(40 * n):
@@ -237,22 +252,22 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15, ca
                 return
             if offered is None and nxt < n and rng.random() >= gap_p:
                 offered, nxt = nxt, nxt + 1
-            ctx.set(dut.i.valid, offered is not None)
+            drive["valid"] = offered is not None
             if offered is not None:
-                for k in ("u", "v", "level", "tag"):
-                    if k in inputs:
-                        ctx.set(dut.i.payload[k], int(inputs[k][offered]))
+                for k in fields:
+                    drive[k] = int(inputs[k][offered])
             if write is None:                     # a new write only once the last was taken
                 write, swap = host_op(rng, cfg, write_p, swap_p)
             else:
                 swap = rng.random() < swap_p
-            ctx.set(dut.lut_w_en, write is not None)
+            drive["w_en"] = write is not None
             if write is not None:
-                ctx.set(dut.lut_w_addr, write[0])
+                drive["w_addr"] = write[0]
                 for c, v in unpack_rgba(write[1], cfg).items():
-                    ctx.set(getattr(dut.lut_w_data, c), int(v))
-            ctx.set(dut.lut_swap, swap)
-            ctx.set(dut.o.ready, rng.random() >= bp_p)
+                    drive[f"w_data.{c}"] = int(v)
+            drive["swap"] = swap
+            drive["ready"] = rng.random() >= bp_p
+            drive.set(ctx)
             _, _, i_ready, w_ready, bank, o_valid, o_ready, *vals = await ctx.tick().sample(
                 dut.i.ready, dut.lut_w_ready, dut.lut_bank, dut.o.valid, dut.o.ready,
                 *out_sigs.values())

@@ -50,6 +50,7 @@ from bumprtl.rtl.sincos import (
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.texture import TextureBlend
+from bumprtl.sim.amaranth_stream import Drive
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.traffic import PATTERNS
@@ -329,14 +330,17 @@ def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
     rng = np.random.default_rng(seed)
     samples = []
 
+    drive = Drive({"valid": dut.i.valid, "tag": dut.i.payload.tag, "ready": dut.o.ready})
+
     async def bench(ctx):
         pending, taken, offered = n, 0, False
         for _ in range(max_cycles):
             if not offered and pending and rng.random() >= gap_p:
                 offered = True
-            ctx.set(dut.i.valid, offered)
-            ctx.set(dut.i.payload.tag, n - pending)
-            ctx.set(dut.o.ready, bool(rng.random() >= bp_p))
+            drive["valid"] = offered
+            drive["tag"] = n - pending
+            drive["ready"] = bool(rng.random() >= bp_p)
+            drive.set(ctx)
             _, _, i_valid, i_ready, o_valid, o_ready, tag = await ctx.tick().sample(
                 dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, dut.o.payload.tag)
             samples.append((bool(i_valid), bool(i_ready), bool(o_valid), bool(o_ready), int(tag)))
