@@ -50,9 +50,10 @@ __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout
 
 # Cycles from a pixel taken at TextureCache.i to its texel offered at o when it hits and the
 # queue is empty: the tag read, its words' register, their settled register, their stamps'
-# distances, the lookup, the queue's write and read, its head register, the data read, its
-# words' register, the output register.
-CACHE_LATENCY = 11
+# distances, the lookup, the queue's write, its read, its output register (where the pixel
+# is the queue's head and leaves), the head register, the data read, its words' register,
+# the output register.
+CACHE_LATENCY = 12
 
 AXI_DATA_BITS = (32, 64)
 ARBURST_INCR = 1
@@ -342,6 +343,12 @@ class TextureCache(wiring.Component):
     waits at the lookup (so does a miss with ``misses`` bursts outstanding, a pixel with the
     queue full, or a miss while ARVALID is high: in the cycle of its handshake too). The
     hit/miss sequence and the AR stream are the blocking cache's (sim/golden/cache.py).
+    The queue RAM is read ahead of the pops, in order, at an address and with an enable that
+    are registers, into two fabric registers behind its output register (the head is the
+    oldest of them); the pixel's carried fields wait in a LUT-RAM FIFO from its taking to
+    its lookup; a skid register in front of the output register keeps ``o.ready`` off the
+    pop and the data RAMs' enables. Each register the lookup's advance reaches takes it as
+    the last choice before its flip-flop.
     ``i.ready`` is high while the skid register is empty or the words read are, a function of
     registers alone (never of ``i.valid``). Every block-RAM read
     lands in a register before any logic reads it, and no read is transparent (the stages
@@ -367,16 +374,30 @@ class TextureCache(wiring.Component):
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
+            x_in=Signal(3, name="extras_in"), x_out=Signal(3, name="extras_out"),  # their FIFO
             count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
-            out_after=Signal(geom.queue.bit_length() - 1, init=1, name="out_after"),  # out_seq + 1
+            # the queue's reads, ahead of its pops: the next address read, the entries
+            # written and not yet read (and whether any is), the read enable (a register),
+            # the entries in the RAM's register and its output register, and in the two
+            # fabric registers after them (oldest first: f0, f1, the output register, the
+            # RAM's register)
+            q_read=Signal(geom.queue.bit_length() - 1, name="q_read"),
+            q_unread=Signal(range(geom.queue + 1), name="q_unread"),
+            q_avail=Signal(name="q_avail"),                       # q_unread != 0
+            q_en=Signal(init=1, name="q_en"),                     # ~(f1 & q_v2)
+            q_v1=Signal(name="q_v1"), q_v2=Signal(name="q_v2"),
+            q_f0=Signal(name="q_f0"), q_f1=Signal(name="q_f1"),
+            q_rd=Signal(name="q_ring_rd"), q_wr=Signal(name="q_ring_wr"),   # the ring's slots
             hd_valid=Signal(name="hd_valid"),                     # the queue's head, registered
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
+            o_skid=Signal(name="o_skid"),                         # the output's skid register
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
             miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             landed_any=Signal(name="landed_any"),                 # landed != 0
-            readable=Signal(name="readable"),                     # the queue's head was read
+            head_ok=Signal(name="head_ok"),                       # the queue's head may leave
+            pop_ok=Signal(name="pop_ok"),         # the same from this cycle's registers (comb)
             f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
             beat=Signal(range(geom.beats), name="beat"))          # the R beat of the line
         tb = geom.texture_size.bit_length() - 1
@@ -468,11 +489,18 @@ class TextureCache(wiring.Component):
         in_line, in_slot = Signal(g.line_bits, name="in_line"), Signal(2 * g.block_bits, name="in_slot")
         rw_line, rw_slot = Signal(g.line_bits, name="rw_line"), Signal(2 * g.block_bits, name="rw_slot")
         look_line, look_slot = Signal(g.line_bits, name="look_line"), Signal(2 * g.block_bits, name="look_slot")
-        in_extra = {k: Signal(s, name=f"in_{k}") for k, s in self.extra.items()}
-        rw_extra = {k: Signal(s, name=f"rw_{k}") for k, s in self.extra.items()}
         ws_line, ws_slot = Signal(g.line_bits, name="ws_line"), Signal(2 * g.block_bits, name="ws_slot")
-        ws_extra = {k: Signal(s, name=f"ws_{k}") for k, s in self.extra.items()}
-        look_extra = {k: Signal(s, name=f"look_{k}") for k, s in self.extra.items()}
+        # The carried fields do not move through these stages: they wait, in order, in a
+        # LUT-RAM FIFO from the pixel's taking to its lookup's advance (the stages hold
+        # six pixels at most), so that the stages' enables reach few registers.
+        x_in, x_out = r.x_in, r.x_out
+        r.extras = None
+        if self.extra:
+            m.submodules.extras = xmem = Memory(shape=data.StructLayout(self.extra), depth=8,
+                                                init=[], attrs={"ram_style": "distributed"})
+            x_w, x_r = xmem.write_port(), xmem.read_port(domain="comb")
+            r.extras = xmem
+        look_extra = {k: x_r.data[k] for k in self.extra}
         new_line, new_slot = self._locate(m, self.i.payload)
 
         # --- the pixel looked up: whether each way hits, whether a queued pixel references
@@ -498,20 +526,16 @@ class TextureCache(wiring.Component):
 
         # --- the pixel queue: pixels in [out_seq, in_seq) wait in order ---
         in_seq, out_seq, count = r.in_seq, r.out_seq, r.count
-        count_next = Signal.like(count, name="count_next")
         layout = self.queue_layout(g, self.extra)
-        # read into the RAM's register, then its output register (the head register)
+        # read ahead of the pops into the RAM's register, then its output register, then
+        # two fabric registers (below)
         qmem = ram("queue", g.queue, layout)
-        # the entries' miss bits again in LUT RAM, read in the cycle before at the oldest
-        # entry and the one after it (registers): the pop that chooses the block RAM's next
-        # read address waits on no memory. Two copies, one a read address, so that no
-        # multiplexer of the two addresses comes before the reads.
-        miss_ports = []
-        for n in range(2):
-            m.submodules[f"queue_miss{n}"] = mmem = Memory(
-                shape=1, depth=g.queue, init=[], attrs={"ram_style": "distributed"})
-            miss_ports.append((mmem.write_port(), mmem.read_port(domain="comb")))
-        (m_w, m_r0), (m_w1, m_r1) = miss_ports
+        # the entries' miss bits in LUT RAM beside it, read at the same address into
+        # registers of the fabric that move on with the RAM's two (no logic reads a block
+        # RAM's output to decide the pop)
+        m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
+                                                attrs={"ram_style": "distributed"})
+        m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). A register a way: the test as a pixel moves into the
@@ -561,6 +585,26 @@ class TextureCache(wiring.Component):
         stamp_hot = Signal(g.ways)
         m.d.comb += stamp_hot.eq(Mux(advance, way_hot, 0))
         touched = self._plru_hdl(look_plru, way_hot)[1]
+        # The advance is the lookup's latest signal: each register the write of the cycle
+        # reaches takes a choice by the advance between its next value with the advance
+        # (a = 1) and without it (a = 0), each from registers alone, so that the advance
+        # comes last before the flip-flops.
+        def tag_hot_if(a):                 # tag_hot when the advance is a
+            return Mux(hit, 0, victim) if a else Const(0, g.ways)
+
+        def stamp_hot_if(a):               # stamp_hot when the advance is a
+            return way_hot if a else Const(0, g.ways)
+
+        def late(reg, f):
+            m.d.sync += reg.eq(Mux(advance, f(1), f(0)))
+
+        def up_down(reg, up, down):
+            """``reg`` + ``up`` - ``down`` (1-bit each): the sums from the register alone,
+            the late signals only choosing and enabling."""
+            with m.If(up & ~down):
+                m.d.sync += reg.eq(reg + 1)
+            with m.Elif(down & ~up):
+                m.d.sync += reg.eq(reg - 1)
         # The writes of the two cycles before, registered: the tag and stamp RAMs take the
         # one of the cycle before (a write lands the cycle after the lookup's), and a read
         # taken in either cycle misses it.
@@ -587,6 +631,16 @@ class TextureCache(wiring.Component):
         def assign(dst, src):
             return [dst.tag_hot.eq(src.tag_hot), dst.stamp_hot.eq(src.stamp_hot)] + \
                 [d.eq(s) for d, s in zip(dst.tags + dst.stamps, src.tags + src.stamps, strict=True)]
+
+        def fields(ov):
+            return [ov.tag_hot, ov.stamp_hot] + ov.tags + ov.stamps
+
+        def by_advance(ovs, name):
+            """The overrides ``ovs[1]`` if the advance, else ``ovs[0]``."""
+            out = overrides(name)
+            m.d.comb += [d.eq(Mux(advance, s1, s0))
+                         for d, s0, s1 in zip(fields(out), fields(ovs[0]), fields(ovs[1]), strict=True)]
+            return out
 
         def apply(ov, same, tag_hot, tag, stamp_hot, seq, name):
             """``ov`` with a write of ``tag`` to the ways ``tag_hot`` and of ``seq`` to the
@@ -626,14 +680,21 @@ class TextureCache(wiring.Component):
             m.d.comb += assign(in_ov, in_new)
         with m.Else():
             m.d.comb += assign(in_ov, in_held)
-        in_same = advance & (in_set == look_set)
-        in_moved = apply(in_ov, in_same, tag_hot, tag_written, stamp_hot, in_seq, "in_moved")
+        in_same_set = Signal(name="in_same_set")   # in_set == look_set (a register, below)
+        in_moved_if = [apply(in_ov, in_same_set & a, tag_hot_if(a), tag_written, stamp_hot_if(a),
+                             in_seq, f"in_moved{a}") for a in (0, 1)]
+        in_moved = by_advance(in_moved_if, "in_moved")
         m.d.sync += assign(in_held, in_moved)     # with the write of each cycle it waits
         with m.If(rw_move):                      # (the input's terms apart from it)
             m.d.sync += [in_valid.eq(self.i.valid & ~flushing), in_line.eq(new_line),
                          in_slot.eq(new_slot), same_was.eq(set_of(new_line) == look_set),
                          same_was2.eq(set_of(new_line) == was.set)]
-            m.d.sync += [in_extra[k].eq(self.i.payload[k]) for k in self.extra]
+        px_taken = rw_move & self.i.valid & ~flushing
+        if self.extra:
+            m.d.comb += [x_w.addr.eq(x_in), x_w.en.eq(px_taken), x_r.addr.eq(x_out)]
+            m.d.comb += [x_w.data[k].eq(self.i.payload[k]) for k in self.extra]
+        with m.If(px_taken):
+            m.d.sync += x_in.eq(x_in + 1)
 
         # --- the words read: the RAMs' output registers, the overrides with the write of
         # the cycle the pixel moves in, and of each cycle it waits ---
@@ -649,40 +710,39 @@ class TextureCache(wiring.Component):
         pl_en = Signal(name="plru_w_en")
         plru_now = Signal(plru_width, name="plru_now")
         m.d.comb += plru_now.eq(Mux(pl_en & (in_set == pl_addr), pl_data, plru_r.data))
-        rw_same = advance & (rw_set == look_set)
-        rw_moved = apply(rw_ov, rw_same, tag_hot, tag_written, stamp_hot, in_seq, "rw_moved")
+        rw_same_set = Signal(name="rw_same_set")   # rw_set == look_set (a register, below)
+        rw_moved_if = [apply(rw_ov, rw_same_set & a, tag_hot_if(a), tag_written, stamp_hot_if(a),
+                             in_seq, f"rw_moved{a}") for a in (0, 1)]
         with m.If(rw_move):
-            m.d.sync += [rw_valid.eq(in_valid), rw_line.eq(in_line), rw_slot.eq(in_slot),
-                         rw_plru.eq(Mux(in_same, touched, plru_now))]
-            m.d.sync += [rw_extra[k].eq(in_extra[k]) for k in self.extra]
-            m.d.sync += assign(rw_ov, in_moved)
-        with m.Else():
-            m.d.sync += [rw_plru.eq(Mux(rw_same, touched, rw_plru))]
-            m.d.sync += assign(rw_ov, rw_moved)
+            m.d.sync += [rw_valid.eq(in_valid), rw_line.eq(in_line), rw_slot.eq(in_slot)]
+        late(rw_plru, lambda a: Mux(rw_move, Mux(in_same_set & a, touched, plru_now),
+                                    Mux(rw_same_set & a, touched, rw_plru)))
+        for d, *src in zip(fields(rw_ov), *(fields(o) for o in in_moved_if + rw_moved_if),
+                           strict=True):
+            late(d, lambda a, src=src: Mux(rw_move, src[a], src[2 + a]))
         # each way's tag and stamp (its override, else the word read) and the pseudo-LRU
-        # bits with the write of the cycle
-        rw_tags = [Mux(rw_moved.tag_hot[w], rw_moved.tags[w], rw_raw_tags[w])
-                   for w in range(g.ways)]
-        rw_stamps = [Mux(rw_moved.stamp_hot[w], rw_moved.stamps[w], rw_raw_stamps[w])
-                     for w in range(g.ways)]
-        rw_plru_now = Mux(rw_same, touched, rw_plru)
+        # bits with the write of the cycle, with the advance a
+        rw_tags_if = [[Mux(o.tag_hot[w], o.tags[w], rw_raw_tags[w]) for w in range(g.ways)]
+                      for o in rw_moved_if]
+        rw_stamps_if = [[Mux(o.stamp_hot[w], o.stamps[w], rw_raw_stamps[w]) for w in range(g.ways)]
+                        for o in rw_moved_if]
+        rw_plru_if = [Mux(rw_same_set & a, touched, rw_plru) for a in (0, 1)]
 
         # --- the skid register: the words read that moved on while the settled ones waited
         # (no write while it is full and they wait: the lookup does not advance) ---
         sk_line, sk_slot = Signal(g.line_bits, name="sk_line"), Signal(2 * g.block_bits, name="sk_slot")
-        sk_extra = {k: Signal(s, name=f"sk_{k}") for k, s in self.extra.items()}
-        r.sk_extra = sk_extra
         sk_tags = [Signal.like(tag_written, name=f"sk_tag{w}") for w in range(g.ways)]
         sk_stamps = [Signal(K, name=f"sk_stamp{w}") for w in range(g.ways)]
         sk_plru = Signal(plru_width, name="sk_plru")
-        sk_same = advance & (set_of(sk_line) == look_set)
+        sk_same_set = Signal(name="sk_same_set")   # sk_set == look_set (a register, below)
         # (its words taken whenever it is empty: only its valid bit waits on the advance)
         m.d.sync += sk_valid.eq(~ws_move & (sk_valid | rw_valid))
         with m.If(~sk_valid):
-            m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot), sk_plru.eq(rw_plru_now)]
-            m.d.sync += [sk_extra[k].eq(rw_extra[k]) for k in self.extra]
-            m.d.sync += [d.eq(v) for d, v in zip(sk_tags + sk_stamps, rw_tags + rw_stamps,
-                                                 strict=True)]
+            m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot),
+                         sk_plru.eq(Mux(advance, rw_plru_if[1], rw_plru_if[0]))]
+            for w in range(g.ways):
+                m.d.sync += [sk_tags[w].eq(Mux(advance, rw_tags_if[1][w], rw_tags_if[0][w])),
+                             sk_stamps[w].eq(Mux(advance, rw_stamps_if[1][w], rw_stamps_if[0][w]))]
 
         # --- the words settled: from the skid register when it is full, else the words
         # read, with the write of the cycle the pixel moves in, in registers: no block-RAM
@@ -691,20 +751,21 @@ class TextureCache(wiring.Component):
         ws_tags = [Signal.like(tag_written, name=f"ws_tag{w}") for w in range(g.ways)]
         ws_stamps = [Signal(K, name=f"ws_stamp{w}") for w in range(g.ways)]
         ws_plru = Signal(plru_width, name="ws_plru")
-        with m.If(ws_move & sk_valid):
-            m.d.sync += [ws_valid.eq(1), ws_line.eq(sk_line), ws_slot.eq(sk_slot),
-                         ws_plru.eq(Mux(sk_same, touched, sk_plru))]
-            m.d.sync += [ws_extra[k].eq(sk_extra[k]) for k in self.extra]
-            for w in range(g.ways):
-                m.d.sync += [
-                    ws_tags[w].eq(Mux(sk_same & tag_hot[w], tag_written, sk_tags[w])),
-                    ws_stamps[w].eq(Mux(sk_same & stamp_hot[w], in_seq, sk_stamps[w]))]
-        with m.Elif(ws_move):
-            m.d.sync += [ws_valid.eq(rw_valid), ws_line.eq(rw_line), ws_slot.eq(rw_slot),
-                         ws_plru.eq(rw_plru_now)]
-            m.d.sync += [ws_extra[k].eq(rw_extra[k]) for k in self.extra]
-            m.d.sync += [d.eq(v) for d, v in zip(ws_tags + ws_stamps, rw_tags + rw_stamps,
-                                                 strict=True)]
+        with m.If(ws_move):
+            m.d.sync += [ws_valid.eq(sk_valid | rw_valid), ws_line.eq(Mux(sk_valid, sk_line, rw_line)),
+                         ws_slot.eq(Mux(sk_valid, sk_slot, rw_slot))]
+
+        def ws_next(a, held, from_sk, from_rw):    # the words settled's next, advance a
+            return Mux(~full3 | a, Mux(sk_valid, from_sk, from_rw), held)
+        late(ws_plru, lambda a: ws_next(a, ws_plru, Mux(sk_same_set & a, touched, sk_plru),
+                                        rw_plru_if[a]))
+        for w in range(g.ways):
+            late(ws_tags[w], lambda a, w=w: ws_next(
+                a, ws_tags[w], Mux(sk_same_set & tag_hot_if(a)[w], tag_written, sk_tags[w]),
+                rw_tags_if[a][w]))
+            late(ws_stamps[w], lambda a, w=w: ws_next(
+                a, ws_stamps[w], Mux(sk_same_set & stamp_hot_if(a)[w], in_seq, sk_stamps[w]),
+                rw_stamps_if[a][w]))
 
         # --- the stamps' distances: each way's stamp s as e = in_seq - 1 - s (mod 2**K),
         # the pixels queued since its own; it is queued iff e < count. A pixel waits in this
@@ -714,60 +775,64 @@ class TextureCache(wiring.Component):
         # far), with whether it is 2**K - 1 (an advance makes it 0: a stale stamp equal to
         # in_seq then looks queued, as in the model). in_seq's own copies here (in_seq - 1,
         # ~in_seq, in_seq + 1), so that its other loads do not pull it away ---
-        ws_same = advance & (ws_set == look_set)
+        ws_same_set = Signal(name="ws_same_set")   # ws_set == look_set (a register, below)
         in_less = Signal(K, init=(1 << K) - 1, name="in_seq_less")   # in_seq - 1
         in_not = Signal(K, init=(1 << K) - 1, name="in_seq_not")     # ~in_seq
         in_one = Signal(K, init=1, name="in_seq_one")                # in_seq + 1
-        m.d.sync += [in_less.eq(in_less + advance), in_not.eq(in_not - advance),
-                     in_one.eq(in_one + advance)]
+        with m.If(advance):
+            m.d.sync += [in_less.eq(in_less + 1), in_not.eq(in_not - 1), in_one.eq(in_one + 1)]
         ds_valid = r.ds_valid
         ds_line, ds_slot = Signal(g.line_bits, name="ds_line"), Signal(2 * g.block_bits, name="ds_slot")
-        ds_extra = {k: Signal(s, name=f"ds_{k}") for k, s in self.extra.items()}
-        r.ds_extra = ds_extra
         ds_tags = [Signal.like(tag_written, name=f"ds_tag{w}") for w in range(g.ways)]
         ds_dists = [Signal(qb, name=f"ds_dist{w}") for w in range(g.ways)]   # e mod queue
         ds_fars = [Signal(name=f"ds_far{w}") for w in range(g.ways)]          # e >= queue
         ds_tops = [Signal(name=f"ds_top{w}") for w in range(g.ways)]
         ds_plru = Signal(plru_width, name="ds_plru")
         with m.If(ds_move):
-            m.d.sync += [ds_valid.eq(ws_valid), ds_line.eq(ws_line), ds_slot.eq(ws_slot),
-                         ds_plru.eq(Mux(ws_same, touched, ws_plru))]
-            m.d.sync += [ds_extra[k].eq(ws_extra[k]) for k in self.extra]
-            for w in range(g.ways):
-                s_w = ws_stamps[w]
-                stamped = ws_same & stamp_hot[w]   # s = in_seq now: e = 0 after the advance
-                stay = (in_less - s_w)[:K]         # e without an advance
-                go_on = ~(in_not + s_w)[:K]        # e after one (in_seq - s)
-                m.d.sync += [
-                    ds_tags[w].eq(Mux(ws_same & tag_hot[w], tag_written, ws_tags[w])),
-                    ds_dists[w].eq(Mux(stamped, 0, Mux(advance, go_on[:qb], stay[:qb]))),
-                    ds_fars[w].eq(~stamped & Mux(advance, go_on[qb:].any(), stay[qb:].any())),
-                    ds_tops[w].eq(~stamped & Mux(advance, s_w == in_one, (s_w ^ in_not).all()))]
+            m.d.sync += [ds_valid.eq(ws_valid), ds_line.eq(ws_line), ds_slot.eq(ws_slot)]
+
+        def ds_next(a, held, moved):                # the distances' next, advance a
+            return Mux(~full2 | a, moved, held)
+        late(ds_plru, lambda a: ds_next(a, ds_plru, Mux(ws_same_set & a, touched, ws_plru)))
+        for w in range(g.ways):
+            s_w = ws_stamps[w]
+            stay = (in_less - s_w)[:K]             # e without an advance
+            go_on = ~(in_not + s_w)[:K]            # e after one (in_seq - s)
+            e_if = [stay, go_on]
+            top_if = [(s_w ^ in_not).all(), s_w == in_one]
+            for a in (0, 1):
+                stamped = ws_same_set & stamp_hot_if(a)[w]   # s = in_seq now: e = 0 after the advance
+                e_if[a] = (Mux(stamped, 0, e_if[a][:qb]), ~stamped & e_if[a][qb:].any(),
+                           ~stamped & top_if[a])
+            late(ds_tags[w], lambda a, w=w: ds_next(
+                a, ds_tags[w], Mux(ws_same_set & tag_hot_if(a)[w], tag_written, ws_tags[w])))
+            late(ds_dists[w], lambda a, w=w, e_if=e_if: ds_next(a, ds_dists[w], e_if[a][0]))
+            late(ds_fars[w], lambda a, w=w, e_if=e_if: ds_next(a, ds_fars[w], e_if[a][1]))
+            late(ds_tops[w], lambda a, w=w, e_if=e_if: ds_next(a, ds_tops[w], e_if[a][2]))
 
         # --- into the lookup: each way's hit computed here (the write of the cycle to the
         # pixel's set: a miss's tag to its victim), and whether a queued pixel references it
         # after this cycle: e + advance < count + advance - pop (an e of 2**K - 1 wraps to 0
         # on an advance: referenced) ---
         ds_set = set_of(ds_line)
-        ds_same = advance & (ds_set == look_set)
         ds_tag = tag_of(ds_line)
-        new_hits = Signal(g.ways)
+        new_hits_if = [Signal(g.ways, name=f"new_hits{a}") for a in (0, 1)]
 
         count_less = Signal(len(count), init=(1 << len(count)) - 1, name="count_less")
-        m.d.sync += count_less.eq(count_less + advance - pop)     # count - 1
+        up_down(count_less, advance, pop)                         # count - 1
 
         def below_count(e):                        # e < count - pop (no sum before a compare)
             return (e < count) & ~(pop & (e == count_less))
 
         # Each register as a choice by the advance (the latest signal here) between its
         # next value with and without it, both from registers and the pop.
-        same_set = Signal(name="ds_same_set")    # ds_set == look_set
-        m.d.comb += same_set.eq(ds_set == look_set)
+        same_set = Signal(name="ds_same_set")    # ds_set == look_set (a register, below)
         for w in range(g.ways):
             t, e, far, top = ds_tags[w], ds_dists[w], ds_fars[w], ds_tops[w]
             hit_w = t[-1] & (t[:g.tag_bits] == ds_tag)
-            written = ds_same & tag_hot[w]
-            m.d.comb += new_hits[w].eq(Mux(written, ds_tag == look_tag, hit_w))
+            for a in (0, 1):
+                written = same_set & tag_hot_if(a)[w]
+                m.d.comb += new_hits_if[a][w].eq(Mux(written, ds_tag == look_tag, hit_w))
             queued = Signal(name=f"ds_queued{w}")       # e < count - pop
             m.d.comb += queued.eq(~far & below_count(e))
             # with the advance: the lookup's pixel queued, on this way if it uses it (a miss
@@ -778,15 +843,33 @@ class TextureCache(wiring.Component):
             d = look_dists[w]                   # e after this cycle, at most queue
             d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
             # without: the lookup's pixel waits (no write), or the distances move in
-            ref_off = Mux(look_valid, referenced[w] & below_count(d), t[-1] & queued)
+            # (a way referenced has d < count: only the pop of its last pixel ends it)
+            ref_off = Mux(look_valid, referenced[w] & ~(pop & (d == count_less)), t[-1] & queued)
             d_off = Mux(look_valid, d, Mux(far, g.queue, e))
             m.d.sync += [referenced[w].eq(Mux(advance, ref_on, ref_off)),
                          d.eq(Mux(advance, d_on, d_off))]
+        # Each stage's set against the lookup's, in registers: compared a cycle ahead, the
+        # sets each will hold, the moves (the advance last) choosing
+        sk_set = set_of(sk_line)
+
+        def look_set_if(a):
+            return Mux(~full1 | a, ds_set, look_set)
+        late(in_same_set, lambda a: Mux(rw_move, set_of(new_line), in_set) == look_set_if(a))
+        late(rw_same_set, lambda a: Mux(rw_move, in_set, rw_set) == look_set_if(a))
+        late(sk_same_set, lambda a: Mux(sk_valid, sk_set, rw_set) == look_set_if(a))
+
+        def ws_set_if(a):
+            return Mux(~full3 | a, Mux(sk_valid, sk_set, rw_set), ws_set)
+        late(ws_same_set, lambda a: ws_set_if(a) == look_set_if(a))
+        late(same_set, lambda a: Mux(~full2 | a, ws_set, ds_set) == look_set_if(a))
         with m.If(move):
-            m.d.sync += [look_valid.eq(ds_valid), look_line.eq(ds_line), look_slot.eq(ds_slot),
-                         look_plru.eq(Mux(ds_same, touched, ds_plru)),
-                         look_hits.eq(new_hits), hit.eq(new_hits.any())]
-            m.d.sync += [look_extra[k].eq(ds_extra[k]) for k in self.extra]
+            m.d.sync += [look_valid.eq(ds_valid), look_line.eq(ds_line), look_slot.eq(ds_slot)]
+
+        def look_next(a, held, moved):              # the lookup's next, advance a
+            return Mux(~full1 | a, moved, held)
+        late(look_plru, lambda a: look_next(a, look_plru, Mux(same_set & a, touched, ds_plru)))
+        late(look_hits, lambda a: look_next(a, look_hits, new_hits_if[a]))
+        late(hit, lambda a: look_next(a, hit, new_hits_if[a].any()))
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         q_w = qmem.w_data
@@ -794,22 +877,20 @@ class TextureCache(wiring.Component):
                      q_w.word.eq(look_word), q_w.way.eq(way), q_w.sel.eq(look_sel)]
         m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
         # the miss bits are written the cycle after (from registers), that write forwarded
-        # to the reads of its cycle (below)
+        # to the read of its cycle (below)
         mq_addr, mq_data, mq_en = Signal(qb, name="miss_w_addr"), Signal(name="miss_w_data"), \
             Signal(name="miss_w_en")
         m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance)]
-        for mwp in (m_w, m_w1):
-            m.d.comb += [mwp.addr.eq(mq_addr), mwp.en.eq(mq_en), mwp.data.eq(mq_data)]
+        m.d.comb += [m_w.addr.eq(mq_addr), m_w.en.eq(mq_en), m_w.data.eq(mq_data)]
         for w, sp in enumerate(stamps):                 # (the cycle after: ``was``)
             m.d.comb += [sp.w_addr.eq(was.set), sp.w_data.eq(was.seq),
                          sp.w_en.eq(was.stamp_hot[w])]
         with m.If(advance):
-            m.d.sync += in_seq.eq(in_seq + 1)
-        m.d.comb += count_next.eq(count + advance - pop)
-        # count_next == queue without the sum: full and no pop, or one short and an advance
-        # without a pop (no advance when full)
+            m.d.sync += [in_seq.eq(in_seq + 1), x_out.eq(x_out + 1)]
+        # count + advance - pop == queue without the sum: full and no pop, or one short and
+        # an advance without a pop (no advance when full)
         full_next = ~pop & (count[-1] | (advance & (count == g.queue - 1)))
-        m.d.sync += count.eq(count_next)
+        up_down(count, advance, pop)
         m.d.sync += [pl_addr.eq(look_set), pl_data.eq(touched),
                      pl_en.eq(advance if g.ways > 1 else 0)]
         with m.If(flushing):                     # the flush clears the bits with the tags
@@ -869,58 +950,118 @@ class TextureCache(wiring.Component):
             m.d.sync += f_out.eq(f_out + 1)
         with m.If(miss):
             m.d.sync += f_in.eq(f_in + 1)
-        m.d.sync += fills.eq(fills + miss - line_in)
+        up_down(fills, miss, line_in)
         # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
         # outstanding (fills == misses: its top bit, fills in [0, a power of two])
         m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))
 
-        # --- the queue's head leaves in order: read into the queue RAM's register, then its
-        # output register (the head register: the data read's address from a flip-flop),
-        # its word read into the data RAMs' registers, then their output registers (both
-        # stages of a RAM move on together), then the output register ---
+        # --- the queue's head leaves in order. The queue RAM is read ahead of the pops, in
+        # order, at an address and with an enable that are registers (no pop reaches its
+        # pins): into its register, then its output register, then two fabric registers
+        # (f0, f1), oldest first. The head is f0 when full, else the output register; it
+        # leaves (the pop) into the head register (the data read's address from a
+        # flip-flop), its word read into the data RAMs' registers, then their output
+        # registers (both stages of a RAM move on together), then the output register
+        # (through a skid register when it waits) ---
         o_free = ~self.o.valid | self.o.ready
-        hd_valid, hd = r.hd_valid, qmem.r_data
+        hd_valid = r.hd_valid
+        hd = Signal(layout, name="hd")
         rd_valid, rd_way, rd_sel = r.rd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         wd_valid, wd_way, wd_sel = r.wd_valid, Signal(max(1, g.way_bits)), Signal(max(1, sel_bits))
         rd_extra = {k: Signal(s, name=f"rd_{k}") for k, s in self.extra.items()}
         wd_extra = {k: Signal(s, name=f"wd_{k}") for k, s in self.extra.items()}
         wd_words = [dp.r_data for dp in datas]
-        r.in_extra, r.rw_extra, r.ws_extra, r.look_extra = in_extra, rw_extra, ws_extra, look_extra
         r.queue = qmem
         r.rd_extra, r.wd_extra = rd_extra, wd_extra
         r.hd_extra = {k: hd[k] for k in self.extra}
-        wd_move = ~wd_valid | o_free               # the data read and its words move on
-        hd_move = ~hd_valid | wd_move              # the queue read and the head move on
-        # The oldest entry is in the queue RAM's register when it was read (address out_seq)
-        # in the last cycle the queue read moved on, unless written in that cycle (a read
-        # does not see a write of its own cycle): a register, as is whether a line has
-        # landed for it. Its miss bit: the last cycle's reads of the oldest entry's and the
-        # next one's, in registers, the last cycle's pop choosing (no logic after the reads).
-        readable, landed_any = r.readable, r.landed_any
-        miss_at = [Signal(name=f"miss_at{n}") for n in range(2)]
-        popped = Signal(name="popped")
+        # the data read and its words move on unless the output's skid register is full
+        # behind a full words-read register (registers alone: it enables the data RAMs'
+        # reads and, through the head register, the pop); the words that move on while
+        # the output register waits go to the skid register
+        o_skid = r.o_skid
+        wd_move = ~wd_valid | ~o_skid
+        hd_move = ~hd_valid | wd_move              # the head register moves on
+        # The reads: an entry is read once written (a read does not see a write of its own
+        # cycle: q_unread counts the writes of the cycles before), whenever the enable is
+        # high; the enable is low only while both fabric registers and the output register
+        # are full (it is known a cycle ahead: the output register's entry, when the head
+        # does not leave, has a fabric register to go to). The fabric registers are a ring
+        # of two, written at q_wr whenever the output register's entry moves on (then at
+        # most one is full: a free one), from registers alone; the pop moves only the
+        # ring's pointers and valid bits.
+        landed_any = r.landed_any
+        q_read, q_unread, q_avail, q_en = r.q_read, r.q_unread, r.q_avail, r.q_en
+        q_v1, q_v2, q_f0, q_f1 = r.q_v1, r.q_v2, r.q_f0, r.q_f1
+        fab = r.q_fab = [Signal(layout, name=f"q_fab{n}") for n in range(2)]
+        fab_miss = [Signal(name=f"q_fab_miss{n}") for n in range(2)]
+        q_rd, q_wr = r.q_rd, r.q_wr
+        q_m1, q_m2 = Signal(name="q_miss1"), Signal(name="q_miss2")       # beside v1, v2
+        q_out = qmem.r_data
+        issue = Signal(name="q_issue")           # a read of an entry this cycle
+        # the miss bits' read: its own copy of the address, and whether the entry read was
+        # written in the cycle before (the write landing now: forwarded), from registers
+        q_read_m = Signal.like(q_read, name="q_read_miss")
+        m_fwd = Signal(name="q_miss_fwd")         # mq_en & (q_unread == 1)
+        m.d.comb += [issue.eq(q_en & q_avail), qmem.r_addr.eq(q_read), qmem.en.eq(q_en),
+                     m_r.addr.eq(q_read_m)]
+        head = Signal(layout, name="q_head")
         head_miss = Signal(name="head_miss")
-        m.d.comb += head_miss.eq(Mux(popped, miss_at[1], miss_at[0]))
-        m.d.sync += [miss_at[0].eq(Mux(mq_en & (mq_addr == out_seq[:qb]), mq_data, m_r0.data)),
-                     miss_at[1].eq(Mux(mq_en & (mq_addr == r.out_after), mq_data, m_r1.data)),
-                     popped.eq(pop)]
-        # the head leaves if the queue read moves on (registers alone: the queue RAM's read
-        # address, whose read is only enabled when it moves on, waits on no port)
-        pop_ok = Signal(name="pop_ok")
-        m.d.comb += [pop_ok.eq(readable & (~head_miss | landed_any)), pop.eq(pop_ok & hd_move)]
-        after = r.out_after
-        m.d.comb += [m_r0.addr.eq(out_seq[:qb]), m_r1.addr.eq(after),
-                     qmem.r_addr.eq(Mux(pop_ok, after, out_seq[:qb])), qmem.en.eq(hd_move)]
-        with m.If(pop):
-            m.d.sync += after.eq(after + 1)
-        m.d.sync += [landed_any.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))]
-        with m.If(hd_move):
-            m.d.sync += readable.eq((count > 1) | ((count == 1) & ~pop))
+        m.d.comb += [head.eq(Mux(q_f0, Mux(q_rd, fab[1], fab[0]), q_out)),
+                     head_miss.eq(Mux(q_f0, Mux(q_rd, fab_miss[1], fab_miss[0]), q_m2))]
+        # the head may leave: it is read and its line has landed if it missed (a register:
+        # head_ok, computed a cycle ahead; pop_ok, the same from this cycle's registers, for
+        # the formal contract's lemma)
+        pop_ok = r.pop_ok
+        head_ok = r.head_ok
+        m.d.comb += [pop_ok.eq((q_f0 | q_v2) & (~head_miss | landed_any)),
+                     pop.eq(head_ok & hd_move)]
+        up_down(q_unread, advance, issue)
+        m.d.sync += [q_read.eq(q_read + issue), q_read_m.eq(q_read_m + issue),
+                     q_avail.eq(advance | (q_unread > 1) | ((q_unread == 1) & ~issue)),
+                     m_fwd.eq(advance & (~q_avail | ((q_unread == 1) & issue)))]
+        with m.If(q_en):
+            m.d.sync += [q_v1.eq(q_avail), q_m2.eq(q_m1),
+                         q_m1.eq(Mux(m_fwd, mq_data, m_r.data))]
+        # the output register's entry goes on into the ring unless it leaves as the head
+        moving = q_en & q_v2
+        into = Signal(name="q_into")
+        m.d.comb += into.eq(moving & ~(pop & ~q_f0))
+        taken = pop & q_f0                         # the ring's oldest leaves
+        f0_next, f1_next = Signal(name="q_f0_next"), Signal(name="q_f1_next")
+        v2_next = Signal(name="q_v2_next")
+        m.d.comb += [f0_next.eq(Mux(taken, q_f1 | into, q_f0 | into)),
+                     f1_next.eq(Mux(taken, q_f1 & into, q_f1 | (q_f0 & into))),
+                     v2_next.eq(Mux(q_en, q_v1, q_v2 & ~(pop & ~q_f0)))]
+        m.d.sync += [q_f0.eq(f0_next), q_f1.eq(f1_next), q_v2.eq(v2_next),
+                     q_en.eq(~(f1_next & v2_next)), q_rd.eq(q_rd ^ taken), q_wr.eq(q_wr ^ into)]
+        for n in range(2):
+            with m.If(moving & (q_wr == n)):
+                m.d.sync += [fab[n].eq(q_out), fab_miss[n].eq(q_m2)]
+        landed_any_next = Signal(name="landed_any_next")
+        m.d.comb += landed_any_next.eq(line_in | (landed > 1) | ((landed == 1) & ~(pop & head_miss)))
+        m.d.sync += landed_any.eq(landed_any_next)
+        # the next head's miss bit and whether it may leave, with the pop (p = 1) and
+        # without it (p = 0), each from registers alone: the pop chooses last
+        oldest = Mux(q_rd, fab_miss[1], fab_miss[0])      # the ring's oldest
+        second = Mux(q_rd, fab_miss[0], fab_miss[1])      # the one after it
+        s2_next = Mux(q_en, q_m1, q_m2)                   # the output register's next
+
+        def head_ok_if(p):
+            taken_p, into_p = p & q_f0, moving & ~(p & ~q_f0)
+            f0_p = Mux(taken_p, q_f1 | into_p, q_f0 | into_p)
+            v2_p = Mux(q_en, q_v1, q_v2 & ~(p & ~q_f0))
+            if p:
+                miss_p = Mux(q_f1, second, Mux(q_f0 & moving, q_m2, s2_next))
+            else:
+                miss_p = Mux(q_f0, oldest, Mux(moving, q_m2, s2_next))
+            landed_p = line_in | (landed > 1) | ((landed == 1) & ~(p & head_miss))
+            return (f0_p | v2_p) & (~miss_p | landed_p)
+        m.d.sync += head_ok.eq(Mux(pop, head_ok_if(1), head_ok_if(0)))
         with m.If(pop):
             m.d.sync += out_seq.eq(out_seq + 1)
-        m.d.sync += landed.eq(landed + line_in - (pop & head_miss))
+        up_down(landed, line_in, pop & head_miss)
         with m.If(hd_move):
-            m.d.sync += hd_valid.eq(pop)
+            m.d.sync += [hd_valid.eq(pop), hd.eq(head)]
         for dp in datas:
             m.d.comb += [dp.r_addr.eq(hd.word), dp.en.eq(wd_move)]
         with m.If(wd_move):
@@ -939,7 +1080,18 @@ class TextureCache(wiring.Component):
             for k in range(spb):
                 with m.Case(k):
                     m.d.comb += texel.eq(word.word_select(k, g.data_bits // spb))
-        with m.If(wd_valid & o_free):
+        # the output's skid register: the words read's texel when the output register waits
+        # (taken whenever it is empty: only its valid bit waits on o.ready)
+        sk_texel = Signal(g.texel_bits, name="o_skid_texel")
+        o_sk_extra = r.o_skid_extra = {k: Signal(s, name=f"o_skid_{k}") for k, s in self.extra.items()}
+        m.d.sync += o_skid.eq(~o_free & (o_skid | wd_valid))
+        with m.If(~o_skid):
+            m.d.sync += sk_texel.eq(texel)
+            m.d.sync += [o_sk_extra[k].eq(wd_extra[k]) for k in self.extra]
+        with m.If(o_skid & o_free):
+            m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(sk_texel)]
+            m.d.sync += [self.o.payload[k].eq(o_sk_extra[k]) for k in self.extra]
+        with m.Elif(wd_valid & o_free):
             m.d.sync += [self.o.valid.eq(1), self.o.payload.texel.eq(texel)]
             m.d.sync += [self.o.payload[k].eq(wd_extra[k]) for k in self.extra]
         with m.Elif(self.o.ready):
@@ -1026,9 +1178,10 @@ class AxiMapFetch(wiring.Component):
     def capacity(self):
         """Pixels taken at ``i`` and not yet taken at ``o``, at most: the pixel read's, its
         words read's, their skid register's, its words settled's, their distances' and the
-        lookup's registers, the queue's entries, its head register, the data read's and its
-        words' registers and the output register."""
-        return self.geom.queue + 10
+        lookup's registers, the queue's entries (those read ahead of their pops among them),
+        its head register, the data read's and its words' registers, the output's skid
+        register and the output register."""
+        return self.geom.queue + 11
 
     def __init__(self, scene: HardwareScene, out_layout, cache=None, target=None):
         check_scene(self, scene)

@@ -198,8 +198,15 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the lookup may go: not flushing, a pixel, a free queue entry",
                     r.go == (~r.flushing & r.look_valid & ~r.count[-1]))
         self._lemma(m, "the queue holds at most its entries", r.count <= g.queue)
-        self._lemma(m, "the queue's head is readable only when queued",
-                    ~r.readable | (r.count != 0))
+        read = r.q_f0 + r.q_f1 + r.q_v2 + r.q_v1
+        self._lemma(m, "the queue's head may leave as its registers say", r.head_ok == r.pop_ok)
+        self._lemma(m, "the queue's entries read and the ones unread are its queued ones",
+                    read + r.q_unread == r.count)
+        self._lemma(m, "the queue has an entry to read", r.q_avail == (r.q_unread != 0))
+        self._lemma(m, "the queue's read is enabled", r.q_en == ~(r.q_f1 & r.q_v2))
+        self._lemma(m, "the queue's fabric registers fill in order", ~r.q_f1 | r.q_f0)
+        self._lemma(m, "the queue's ring writes past its entries",
+                    r.q_wr == r.q_rd ^ (r.q_f0 & ~r.q_f1))
         return m
 
 

@@ -68,6 +68,7 @@ from amaranth.hdl import (
     Module,
     Mux,
     Signal,
+    Value,
 )
 from amaranth.lib import data
 from amaranth.lib.fifo import SyncFIFOBuffered
@@ -560,7 +561,7 @@ class StreamContract(Elaboratable):
         """Pixels taken at ``i`` and not yet into the chain: 0, or with a texel cache in
         front of the edge (a ``map_memory = "axi"`` pipeline) a ghost counter, tied by
         lemmas to the cache's lookup registers (the pixel read, its words read, their skid
-        register, its words settled, their distances, the pixel looked up), queue, head, data-read and words-read registers and output register
+        register, its words settled, their distances, the pixel looked up), queue, head, data-read and words-read registers, output skid and output register
         (``TextureCache.regs``) and its queue count. Made once per contract."""
         if self.cache is None:
             return Const(0, 1)
@@ -572,16 +573,26 @@ class StreamContract(Elaboratable):
         count = (r.in_seq - r.out_seq)[:len(r.in_seq)]
         self._lemma(m, count <= c.geom.queue, "the cache's queue holds at most its entries")
         self._lemma(m, r.count == count, "the cache's queue count = its sequence numbers apart")
-        self._lemma(m, ~r.readable | (count != 0), "the cache's queue head is readable when queued")
-        qb = len(r.out_after)
-        self._lemma(m, r.out_after == (r.out_seq[:qb] + 1)[:qb],
-                    "the cache's next queue address is one past its oldest")
+        read = r.q_f0 + r.q_f1 + r.q_v2 + r.q_v1
+        self._lemma(m, read + r.q_unread == count,
+                    "the cache's queue entries read and unread are its queued ones")
+        qb = len(r.q_read)
+        if qb:
+            self._lemma(m, r.q_read == (r.out_seq[:qb] + read)[:qb],
+                        "the cache's next queue read is past the entries read")
+        self._lemma(m, r.q_avail == (r.q_unread != 0), "the cache's queue has an entry to read")
+        self._lemma(m, r.q_en == ~(r.q_f1 & r.q_v2), "the cache's queue read is enabled")
+        self._lemma(m, r.head_ok == r.pop_ok, "the cache's queue head may leave as its registers say")
+        self._lemma(m, ~r.q_f1 | r.q_f0, "the cache's queue fabric registers fill in order")
+        self._lemma(m, r.q_wr == r.q_rd ^ (r.q_f0 & ~r.q_f1),
+                    "the cache's queue ring writes past its entries")
         self._lemma(m, r.go == (~r.flushing & r.look_valid & (r.count != c.geom.queue)),
                     "the cache's lookup may go: not flushing, a pixel, a free entry")
         self._lemma(m, ~r.sk_valid | r.ws_valid,
                     "the cache's skid register is full only behind its words settled")
         self._lemma(m, ghost == r.in_valid + r.rw_valid + r.sk_valid + r.ws_valid + r.ds_valid
-                    + r.look_valid + count + r.hd_valid + r.rd_valid + r.wd_valid + c.o.valid,
+                    + r.look_valid + count + r.hd_valid + r.rd_valid + r.wd_valid + r.o_skid
+                    + c.o.valid,
                     "pixels in the cache = its lookup, queue, read and output registers")
         self._cache_ghost = ghost
         return ghost
@@ -666,9 +677,11 @@ class StreamContract(Elaboratable):
         """The tags in the cache, oldest first from ``n_edge`` (the next one it delivers):
         its output register, its words-read and data-read registers, its head register, its
         queue's entries from the read sequence number (read through asynchronous ports added
-        to the queue's memory, one per address; the queue RAM's registered read is the entry
-        at that number once readable), its lookup register and the registers of the
-        distances, the words settled, the skid, the words read and the pixel read before it."""
+        to the queue's memory, one per address; the entries read ahead of the pops, in its
+        two fabric registers, its output register and its RAM's register, are the entries
+        from that number on), then the pixels of its lookup and the stages before it (the
+        lookup, the distances, the words settled, the skid, the words read and the pixel
+        read), whose carried fields wait in order in a FIFO of their own."""
         c, r, g = self.cache, self.cache.regs, self.cache.geom
         frag = self._frags.get(id(c))
         ram = _subfragment(frag, "queue") if frag is not None else None
@@ -693,8 +706,10 @@ class StreamContract(Elaboratable):
 
         after_hd = consecutive(n_edge, [
             (c.o.valid, c.o.payload.tag, None, "the cache's output register holds the chain's next tag"),
+            (r.o_skid, r.o_skid_extra["tag"], None,
+             "the cache's output skid register holds the tag after its output's"),
             (r.wd_valid, r.wd_extra["tag"], None,
-             "the cache's words-read register holds the tag after its output's"),
+             "the cache's words-read register holds the tag after its output skid's"),
             (r.rd_valid, r.rd_extra["tag"], "tag_cache_read_register",
              "the cache's read register holds the tag after its words-read register's"),
             (r.hd_valid, r.hd_extra["tag"], "tag_cache_head_register",
@@ -711,21 +726,33 @@ class StreamContract(Elaboratable):
             offset = (Const(a, max(1, qb)) - oldest)[:qb] if qb else Const(0, 1)
             self._lemma(m, ~(offset < count) | (word.tag == (at_q + offset)[:bits]),
                         "the cache's queue holds consecutive tags from its oldest")
-            self._lemma(m, ~((oldest == a) & r.readable) | (head.as_value() == word.as_value()),
-                        "the cache's queue read is its oldest entry")
-        consecutive(at_q + count, [
-            (r.look_valid, r.look_extra["tag"], "tag_cache_lookup",
-             "the cache's lookup register holds the tag after its queue's"),
-            (r.ds_valid, r.ds_extra["tag"], "tag_cache_distances",
-             "the cache's distances register holds the tag after its lookup's"),
-            (r.ws_valid, r.ws_extra["tag"], "tag_cache_words_settled",
-             "the cache's words-settled register holds the tag after its distances'"),
-            (r.sk_valid, r.sk_extra["tag"], "tag_cache_skid",
-             "the cache's skid register holds the tag after its settled one's"),
-            (r.rw_valid, r.rw_extra["tag"], "tag_cache_words_read",
-             "the cache's words-read register holds the tag after its skid one's"),
-            (r.in_valid, r.in_extra["tag"], None,
-             "the cache's read register holds the tag after its words-read one's")])
+            at = oldest
+            ring = [Value.cast(f) for f in r.q_fab]
+            for valid, held in ((r.q_f0, Mux(r.q_rd, ring[1], ring[0])),
+                                (r.q_f1, Mux(r.q_rd, ring[0], ring[1])),
+                                (r.q_v2, r.queue.r_data), (r.q_v1, head)):
+                self._lemma(m, ~((at == a) & valid) | (Value.cast(held) == word.as_value()),
+                            "the cache's queue reads hold its entries in order from its oldest")
+                at = (at + valid)[:qb] if qb else at
+        # the pixels of the lookup and the stages before it, whose carried fields wait in
+        # a FIFO of their own (read through asynchronous ports added to its memory)
+        staged = r.look_valid + r.ds_valid + r.ws_valid + r.sk_valid + r.rw_valid + r.in_valid
+        self._lemma(m, (r.x_in - r.x_out)[:len(r.x_in)] == staged,
+                    "the cache's carried-field FIFO holds the pixels of its lookup stages")
+        xinst = _subfragment(frag, "extras")
+        if not isinstance(xinst, MemoryInstance):
+            return
+        first = Signal(bits, name="tag_cache_lookup")
+        m.d.comb += first.eq(at_q + count)
+        xlayout = data.StructLayout(c.extra)
+        for a in range(1 << len(r.x_in)):
+            word = Signal(xlayout.size, name=f"cache_extras_slot{a}")
+            xinst.read_port(domain="comb", addr=Const(a, len(r.x_in)), data=word, en=Const(1),
+                            transparent_for=())
+            word = data.View(xlayout, word)
+            offset = (Const(a, len(r.x_in)) - r.x_out)[:len(r.x_in)]
+            self._lemma(m, ~(offset < staged) | (word.tag == (first + offset)[:bits]),
+                        "the cache's carried-field FIFO holds consecutive tags from its lookup's")
 
     def _latency(self, m, i, o, take_in, take_out, stages):
         """o.ready held high: the valid chain and the tags are a plain delay line."""

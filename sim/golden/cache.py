@@ -81,9 +81,9 @@ def stream_cycles(run, geom: CacheGeometry, latency):
     one before (its AR handshake, at A + 1, frees the AR register), fewer than
     ``misses`` bursts outstanding and a victim no queued pixel references (the RTL's
     sequence-stamp test, wrap-around included); it leaves the
-    queue at P_k = max(A_k + 2, P_{k-1} + 1, the cycle after its line's last beat for a
+    queue at P_k = max(A_k + 3, P_{k-1} + 1, the cycle after its line's last beat for a
     miss). A miss's AR handshake is at A_k + 1, its first beat at max(A_k + 1 + latency,
-    the cycle after the previous burst's last beat). Returns P_last - 2 (every pixel a
+    the cycle after the previous burst's last beat). Returns P_last - 3 (every pixel a
     hit: one cycle a pixel); the RTL takes the reset's flush (``sets`` cycles) and its
     hit latency (rtl/cache.CACHE_LATENCY) more (tests/rtl/test_cache.py checks the count
     against the RTL's)."""
@@ -111,7 +111,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
                     else:
                         break
         stamps[key] = k % wrap
-        leave = c + 2                               # queued, then read
+        leave = c + 3                               # queued, read, in the output register
         if not run.hit[k]:
             first = c + 1 + latency
             if fills:
@@ -124,7 +124,7 @@ def stream_cycles(run, geom: CacheGeometry, latency):
             leave = max(leave, pops[-1] + 1)
         pops.append(leave)
         look = c
-    return pops[-1] - 2
+    return pops[-1] - 3
 
 
 class CacheModel:

@@ -82,8 +82,8 @@ def test_the_axi_pipeline_counts_the_pixels_in_its_cache():
     dut = target.unit()
     # besides its queue: the registers of the pixel read, its words read and their skid
     # register, its words settled and their stamp distances, the pixel looked up, the
-    # queue's head, the data read and its words, and the output
-    assert dut.front_capacity == dut.units["fetch"].capacity == dut.units["fetch"].geom.queue + 10
+    # queue's head, the data read and its words, the output's skid and the output
+    assert dut.front_capacity == dut.units["fetch"].capacity == dut.units["fetch"].geom.queue + 11
     assert (1 << len(dut.i.payload.tag)) > dut.fifo_depth + dut.units["fetch"].capacity + 1
     top = StreamContract(dut, "quiet")
     rtlil.convert(top, name="top", ports=top.free_inputs())
