@@ -30,7 +30,8 @@ from bumprtl.rtl.ecp5 import (
 )
 
 __all__ = ["Generic", "ECP5", "GENERIC", "form", "RegisteredProduct", "WideProduct",
-           "RegisteredROM", "RegisteredRAM", "rom_data", "read_port", "dp16kd_rom_block", "dp16kd_initvals",
+           "RegisteredROM", "RegisteredRAM", "rom_data", "read_port", "dp16kd_rom_block",
+           "dp16kd_initvals",
            "fits_dsp", "product_latency", "limb_products", "DP16KD_MODES", "ROM_MAX_BLOCKS",
            "SPREAD_BLOCKS", "NEAR_BLOCKS", "rom_blocks", "is_spread",
            "DSP_WIDTH", "PRODUCT_LATENCY", "WIDE_PRODUCT_LATENCY", "ROM_LATENCY", "RAM_LATENCY"]
@@ -45,19 +46,13 @@ RAM_LATENCY = 2
 
 
 @functools.lru_cache(maxsize=512)
-def _rom_data(shape, init):
+def rom_data(shape, init):
+    """The MemoryData of a read-only table (``shape`` a Shape, ``init`` a tuple of its rows):
+    one per (shape, contents), made once however many designs elaborate the table (Amaranth
+    checks each row as it is set). Shared only because nothing writes it: a simulator keeps
+    one state per MemoryData, and a netlist one memory per Memory all the same."""
     return MemoryData(shape=shape, depth=len(init), init=init)
 
-
-def rom_data(shape, init):
-    """The MemoryData of a read-only table: one per (shape, contents), made once however many
-    designs elaborate the table (Amaranth checks each row as it is set, the larger part of
-    elaborating a unit). Shared only because nothing writes it: a simulator keeps one state
-    per MemoryData, and a netlist one memory per Memory all the same."""
-    try:
-        return _rom_data(shape, tuple(init))
-    except TypeError:                   # an unhashable shape: not shared
-        return MemoryData(shape=shape, depth=len(init), init=init)
 
 class RegisteredProduct(Elaboratable):
     """``p = a * b`` two ``en`` cycles after ``a``/``b`` (operand registers, product
@@ -267,7 +262,7 @@ class Generic:
     def rom(self, m, rom):
         """:class:`RegisteredROM` ``rom``: an Amaranth Memory with a synchronous read port
         per port and an output register."""
-        m.submodules.mem = mem = Memory(data=rom_data(rom.shape, rom.init))
+        m.submodules.mem = mem = Memory(data=rom_data(rom.shape, tuple(rom.init)))
         for port in rom.ports:
             read = mem.read_port(domain="sync")
             m.d.comb += [read.en.eq(rom.en), read.addr.eq(port.addr)]

@@ -10,7 +10,7 @@ data width, no burst crossing 4 KiB, RREADY never needed for RVALID.
 
 import random
 
-from amaranth.hdl import Cat
+from bumprtl.sim.amaranth_stream import Drive
 
 __all__ = ["AxiReadMemory"]
 
@@ -42,17 +42,18 @@ class AxiReadMemory:
     async def process(self, ctx):
         p = self.port
         cycle, beats, held_ar, presenting = 0, [], None, None
-        # ARREADY, RVALID, RDATA and RLAST in one assignment a cycle (each ctx.set settles
-        # the design again); RDATA and RLAST hold the last beat's while none is presented
-        drive = Cat(p.arready, p.rvalid, p.rlast, p.rdata)
-        beat = 0
+        # ARREADY, RVALID, RDATA and RLAST in one ctx.set a cycle; RDATA and RLAST hold the
+        # last beat's while none is presented
+        drive = Drive({"arready": p.arready, "rvalid": p.rvalid, "rdata": p.rdata,
+                       "rlast": p.rlast})
         while True:
-            arready = self.rng.random() >= self.ar_stall
+            drive["arready"] = self.rng.random() >= self.ar_stall
             if presenting is None and beats and beats[0][0] <= cycle \
                     and self.rng.random() >= self.r_stall:
                 presenting = beats.pop(0)
-                beat = (bool(presenting[2]) << 2) | (presenting[1] << 3)
-            ctx.set(drive, arready | ((presenting is not None) << 1) | beat)
+                drive["rdata"], drive["rlast"] = presenting[1], presenting[2]
+            drive["rvalid"] = presenting is not None
+            drive.set(ctx)
             (_, _, arvalid, arready, araddr, arlen, arsize, arburst, rvalid,
              rready) = await ctx.tick().sample(p.arvalid, p.arready, p.araddr, p.arlen,
                                                p.arsize, p.arburst, p.rvalid, p.rready)
