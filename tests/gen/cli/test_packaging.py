@@ -33,6 +33,29 @@ def test_every_pin_is_exact_and_dev_holds_every_extra():
     assert PROJECT["dynamic"] == ["version"]
 
 
+def test_the_wheel_declares_every_package_and_data_file_of_the_tree():
+    """A package missing from [tool.setuptools] packages is missing from the wheel: the
+    editable install this suite runs in imports it from the tree all the same, the installed
+    wheel fails at start-up. The declared packages are the directories holding an
+    ``__init__.py`` under each mapped directory, and every other file there is package data."""
+    setup = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    declared = set(setup["packages"])
+    found, data = set(), []
+    for package, directory in setup["package-dir"].items():
+        for init in (ROOT / directory).rglob("__init__.py"):
+            rel = init.parent.relative_to(ROOT / directory)
+            found.add(".".join([package, *rel.parts]))
+        data += [f for f in (ROOT / directory).rglob("*") if f.is_file()
+                 and f.suffix not in (".py", ".pyc") and "__pycache__" not in f.parts]
+    assert declared == found, (sorted(found - declared), sorted(declared - found))
+    for f in data:
+        package = next(p for p, d in setup["package-dir"].items()
+                       if f.is_relative_to(ROOT / d))
+        rel = f.parent.relative_to(ROOT / setup["package-dir"][package])
+        owner = ".".join([package, *rel.parts])
+        assert any(f.match(pattern) for pattern in setup["package-data"].get(owner, [])), f
+
+
 def test_version(capsys):
     assert re.fullmatch(r"\d+\.\d+\.\d+", __version__)
     try:
