@@ -8,8 +8,9 @@ dicts (with nested layouts flattened to dotted names).
 """
 
 import random
+from collections import deque
 
-from amaranth.hdl import Cat, Value
+from amaranth.hdl import Cat, Module, Shape, Signal, Value
 from amaranth.lib import data
 from amaranth.sim import Simulator
 
@@ -38,9 +39,14 @@ def flatten_payload(value, prefix=""):
 class Drive:
     """Inputs a testbench drives, set together once a cycle: ``drive[name] = value`` records a
     value (held until changed, as a signal holds it) and ``drive.set(ctx)`` assigns every one
-    in one ``ctx.set`` of their concatenation (each ``ctx.set`` settles the whole design
-    again, so a set per input would settle it once an input). ``signals``: {name: Value or
-    View}; a value is taken modulo its signal's width (two's complement)."""
+    at once (each ``ctx.set`` settles the whole design again, so a set per input would settle
+    it once an input). ``signals``: {name: Value or View}; a value is taken modulo its
+    signal's width (two's complement).
+
+    Wired into the simulated top (:func:`driven`), the set is of one signal of its own, which
+    drives the inputs through a combinational assignment the simulator compiles; unwired, it
+    is of the inputs' concatenation (the same values, the concatenation evaluated by the
+    simulator's interpreter each time)."""
 
     def __init__(self, signals):
         self.values = [Value.cast(v) for v in signals.values()]
@@ -49,7 +55,9 @@ class Drive:
         for name, v in zip(signals, self.values, strict=True):
             self.slots[name] = (offset, len(v))
             offset += len(v)
-        self.bits = 0
+        self.bits = 0                   # every input 0 until set, wired or not
+        self.bus = Signal(len(self.cat), name="drive")
+        self.wired = False
 
     def __setitem__(self, name, value):
         offset, width = self.slots[name]
@@ -57,7 +65,45 @@ class Drive:
         self.bits = (self.bits & ~mask) | ((int(value) << offset) & mask)
 
     def set(self, ctx):
-        ctx.set(self.cat, self.bits)
+        ctx.set(self.bus if self.wired else self.cat, self.bits)
+
+
+def driven(dut, *drives):
+    """A top for the simulator: ``dut`` with each :class:`Drive`'s signal assigned to its
+    inputs (every Drive given must be set through it from then on)."""
+    m = Module()
+    m.submodules.dut = dut
+    for d in drives:
+        m.d.comb += d.cat.eq(d.bus)
+        d.wired = True
+    return m
+
+
+class Sample:
+    """The fields of a payload View read from one sampled value: ``fields(bits)`` ->
+    {dotted name: int} (signed fields sign-extended), as :func:`flatten_payload`'s values
+    read one by one would give them."""
+
+    def __init__(self, view):
+        self.value = Value.cast(view)
+        self.slots = list(_slots(view.shape(), 0, ""))
+
+    def fields(self, bits):
+        bits, out = int(bits), {}
+        for name, offset, width, signed in self.slots:
+            x = (bits >> offset) & ((1 << width) - 1)
+            out[name] = x - (1 << width) if signed and x >> (width - 1) else x
+        return out
+
+
+def _slots(layout, base, prefix):
+    for name, field in layout:
+        shape = field.shape
+        if isinstance(shape, data.Layout):
+            yield from _slots(shape, base + field.offset, f"{prefix}{name}.")
+        else:
+            s = Shape.cast(shape)
+            yield f"{prefix}{name}", base + field.offset, s.width, s.signed
 
 
 def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None,
@@ -72,7 +118,9 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     before this cycle and not taken at ``o`` before it), and an output offered and not taken
     is offered again the next cycle (a ready that waits on ``o.ready``, or a credit lost or
     made, is bit-exact and fails only this check). ``processes``: more testbenches run beside
-    the stream's (a memory model on another port, sim/axi_memory.py).
+    the stream's: an async function, or a bench model with a ``process`` of its own and the
+    :class:`Drive` of its inputs as ``drive`` (a memory model on another port,
+    sim/axi_memory.py), whose Drive is wired into the top.
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
@@ -85,20 +133,21 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     drive = Drive({**flatten_payload(dut.i.payload), "i.valid": dut.i.valid,
                    "o.ready": dut.o.ready})
 
+    out = Sample(dut.o.payload)      # the output's payload read as one value a cycle
+
     async def testbench(ctx):
-        out_fields = flatten_payload(dut.o.payload)
-        pending = list(inputs)
+        pending = deque(inputs)
         offered = None
         while len(outputs) < len(inputs):
             if offered is None and pending and rng.random() >= gap_p:
-                offered = pending.pop(0)
+                offered = pending.popleft()
                 for name, value in offered.items():
                     drive[name] = value
             drive["i.valid"] = offered is not None
             drive["o.ready"] = rng.random() >= bp_p
             drive.set(ctx)
-            _, _, i_valid, i_ready, o_valid, o_ready, *o_vals = await ctx.tick().sample(
-                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, *out_fields.values())
+            _, _, i_valid, i_ready, o_valid, o_ready, o_bits = await ctx.tick().sample(
+                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, out.value)
             if pipe_handshake:
                 inside = state["inside"]
                 assert bool(i_ready) == (inside < dut.fifo_depth), (
@@ -111,15 +160,16 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
             if offered is not None and i_ready:
                 offered = None
             if o_valid and o_ready:
-                outputs.append(dict(zip(out_fields, (int(v) for v in o_vals), strict=False)))
+                outputs.append(out.fields(o_bits))
             state["cycles"] += 1
             assert state["cycles"] < limit, f"timeout after {limit} cycles ({len(outputs)} outputs)"
 
-    sim = Simulator(dut)
+    models = [p for p in processes if hasattr(p, "process")]
+    sim = Simulator(driven(dut, drive, *(p.drive for p in models)))
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
     for process in processes:
-        sim.add_testbench(process, background=True)
+        sim.add_testbench(getattr(process, "process", process), background=True)
     if vcd:
         with sim.write_vcd(vcd):
             sim.run()

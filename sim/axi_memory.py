@@ -28,6 +28,11 @@ class AxiReadMemory:
         self.latency, self.ar_stall, self.r_stall = latency, ar_stall, r_stall
         self.rng = random.Random(seed)
         self.requests = []
+        # ARREADY, RVALID, RDATA and RLAST in one set a cycle (wired into the top by
+        # simulate_stream when this model is passed as a process); RDATA and RLAST hold the
+        # last beat's while none is presented
+        self.drive = Drive({"arready": port.arready, "rvalid": port.rvalid,
+                            "rdata": port.rdata, "rlast": port.rlast})
 
     def _beats(self, addr, arlen, ready_at):
         off = addr - self.base
@@ -42,10 +47,7 @@ class AxiReadMemory:
     async def process(self, ctx):
         p = self.port
         cycle, beats, held_ar, presenting = 0, [], None, None
-        # ARREADY, RVALID, RDATA and RLAST in one ctx.set a cycle; RDATA and RLAST hold the
-        # last beat's while none is presented
-        drive = Drive({"arready": p.arready, "rvalid": p.rvalid, "rdata": p.rdata,
-                       "rlast": p.rlast})
+        drive = self.drive
         while True:
             drive["arready"] = self.rng.random() >= self.ar_stall
             if presenting is None and beats and beats[0][0] <= cycle \

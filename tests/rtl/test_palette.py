@@ -24,7 +24,7 @@ from bumprtl.rtl.palette import (
 )
 from bumprtl.rtl.pipe import EDGE_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
-from bumprtl.sim.amaranth_stream import Drive
+from bumprtl.sim.amaranth_stream import Drive, driven
 from bumprtl.sim.axi_memory import AxiReadMemory
 from bumprtl.sim.golden.cache import run_scene_cache
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
@@ -99,7 +99,7 @@ def run_lut(cfg, inputs, pattern, seed=1):
             model.clock(write, swap)
         raise AssertionError(f"timeout: {len(received)} of {len(inputs)} outputs")
 
-    sim = Simulator(dut)
+    sim = Simulator(driven(dut, drive))
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
     sim.run()
@@ -285,7 +285,7 @@ def run_palette_pipeline(scene, n, pattern, seed=1, write_p=0.6, swap_p=0.15, ca
                 write = None
         raise AssertionError(f"timeout: {len(received)} of {n} outputs")
 
-    sim = Simulator(dut)
+    sim = Simulator(driven(dut, drive, *([mem.drive] if mem is not None else [])))
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
     if mem is not None:

@@ -50,7 +50,7 @@ from bumprtl.rtl.sincos import (
 from bumprtl.rtl.tables import quarter_sine, specular_table
 from bumprtl.rtl.targets import NEAR_BLOCKS, ROM_MAX_BLOCKS, SPREAD_BLOCKS, rom_blocks
 from bumprtl.rtl.texture import TextureBlend
-from bumprtl.sim.amaranth_stream import Drive
+from bumprtl.sim.amaranth_stream import Drive, driven
 from bumprtl.sim.ecp5 import ecp5_lockstep, enabled_delay
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.traffic import PATTERNS
@@ -351,7 +351,7 @@ def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
                 if taken == n:
                     return
 
-    sim = Simulator(dut)
+    sim = Simulator(driven(dut, drive))
     sim.add_clock(1e-6)
     sim.add_testbench(bench)
     sim.run()
