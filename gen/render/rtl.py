@@ -68,15 +68,16 @@ class RtlRender:
 
 def sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
     """The sim scene (bumprtl.sim.scenes.Scene) of ``scene`` at ``size`` x ``size`` pixels:
-    its procedural image or its user map, on its geometry, at its texture size."""
+    its procedural image or its user map, on its geometry, at its map's width and height."""
     bump = None
     if scene.map_file is not None:
         key, path = scene.map_file
         bump = load_bump_map(path, "height" if key == "height_map" else "normal",
                              scene.normal_convention, scene.height_scale, scene.texture_size,
-                             scene.resample)
+                             scene.resample, scene.map_height)
     return load_scene(scene.image, size=size, texture_size=scene.texture_size,
-                      light_azimuth=azimuth, bump=bump, geometry=scene.geometry, **light)
+                      texture_height=scene.map_height, light_azimuth=azimuth, bump=bump,
+                      geometry=scene.geometry, **light)
 
 
 def _levels(level0, scene):

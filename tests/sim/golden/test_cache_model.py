@@ -43,7 +43,7 @@ def test_layout_round_trip(texel_bits, block, levels):
     assert len(image) == g.image_bytes
     seen = set()
     for lv in range(levels):
-        side = g.level_side(lv)
+        side = g.level_width(lv)
         v, u = np.mgrid[0:side, 0:side]
         addr = texel_byte_address(u, v, lv, g)
         for uu, vv, a in zip(u.ravel(), v.ravel(), addr.ravel(), strict=True):
@@ -52,7 +52,7 @@ def test_layout_round_trip(texel_bits, block, levels):
             got = int.from_bytes(image[off:off + g.slot_bytes], "little")
             assert got == words[lv][vv, uu], (lv, uu, vv)
             seen.add(off)
-    assert len(seen) == sum(g.level_side(lv) ** 2 for lv in range(levels))   # a bijection
+    assert len(seen) == sum(g.level_width(lv) ** 2 for lv in range(levels))   # a bijection
 
 
 def test_geometry_refusals():
