@@ -104,9 +104,8 @@ def level_coords(u, v, level, scene):
     clamp (to [0, W_l - 1], [0, H_l - 1]), W_l x H_l the level's size."""
     coords = []
     for c, bits in ((u, scene.texture_bits - level), (v, scene.height_bits - level)):
-        c = c >> level                                     # arithmetic: floor for negatives
-        coords.append(_wrap(c, bits) if scene.addressing == "wrap"
-                      else saturate(c, Q(bits, 0, signed=False)))
+        c, edge = c >> level, Q(bits, 0, signed=False)     # arithmetic: floor for negatives
+        coords.append(_wrap(c, bits) if scene.addressing == "wrap" else saturate(c, edge))
     return tuple(coords)
 
 

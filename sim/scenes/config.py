@@ -22,9 +22,9 @@ from bumprtl.rtl.scene import (
     ROTATIONS,
     SHADINGS,
     HardwareScene,
+    MapSize,
     check_choice,
     check_map_memory,
-    MapSize,
     check_map_size,
     derived_rotation,
 )
