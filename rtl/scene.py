@@ -126,6 +126,11 @@ class MapSize:
     def square(self):
         return self.map_height == self.texture_size
 
+    @property
+    def map_label(self):
+        """The map's size as messages write it: ``T^2``, or ``W x H``."""
+        return f"{self.texture_size}^2" if self.square else f"{self.texture_size} x {self.map_height}"
+
     def level_size(self, level):
         """``(width, height)`` of mip ``level``: (W >> l, H >> l)."""
         return self.texture_size >> level, self.map_height >> level

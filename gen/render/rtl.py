@@ -345,7 +345,7 @@ def rtl_render_png(scene, size, out, simulator="verilator", *, device=DEFAULT_DE
     stream = "" if r.stream_seconds is None else \
         f"; streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:,.0f} pix/s"
     print(f"rtl ({simulator}, {path}, map load {load}): {size}x{size} "
-          f"{scene.picture} ({scene.texture_size}^2 map) with pipeline {scene.name}: {r.cycles} "
+          f"{scene.picture} ({scene.map_label} map) with pipeline {scene.name}: {r.cycles} "
           f"cycles; {build}; simulation {r.seconds:.2f} s = {n / r.seconds:,.0f} pix/s{stream}; "
           f"total {time.perf_counter() - t0:.1f} s -> {out}")
     print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")
