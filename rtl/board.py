@@ -103,10 +103,13 @@ def cdc_depth(pixel_hz, pipe_hz, stall_cycles=0):
     return 1 << (need - 1).bit_length()
 
 
-def texel_coords(x, y, zoom, size):
-    """Screen pixel (x, y) -> texel (u, v) of a ``size`` x ``size`` map tiled over the
-    screen, ``2**zoom`` pixels a texel. Amaranth values and numpy integer arrays alike."""
-    return (x >> zoom) & (size - 1), (y >> zoom) & (size - 1)
+def texel_coords(x, y, zoom, size, height=None):
+    """Screen pixel (x, y) -> texel (u, v) of a ``size`` x ``height`` map (width x height,
+    powers of two; ``height`` None: ``size``) tiled over the screen, ``2**zoom`` pixels a
+    texel: u wraps by the width, v by the height. Amaranth values and numpy integer arrays
+    alike."""
+    height = size if height is None else height
+    return (x >> zoom) & (size - 1), (y >> zoom) & (height - 1)
 
 
 def buffer_depth(latency):
@@ -225,8 +228,7 @@ class PixelSource(RasterSource):
         last_x, last_y = self.raster(m, issue)
         self.lights(m, issue & last_x & last_y)
         pay = port.payload
-        size = p.scene.texture_size
-        u, v = texel_coords(self.px, self.py, md.zoom, size)
+        u, v = texel_coords(self.px, self.py, md.zoom, p.scene.texture_size, p.scene.map_height)
         m.d.comb += [pay.u.eq(u), pay.v.eq(v), pay.tag.eq(self.count)]
         m.d.comb += [payload_field(pay, k).eq(c) for k, c in self.constants.items()]
         return m
@@ -234,16 +236,16 @@ class PixelSource(RasterSource):
 
 def globe_config(scene: HardwareScene, mode: VideoMode):
     """The board's globe (rtl/globe.GlobeConfig) in ``mode``: radius GLOBE_RADIUS of the
-    active height, the scene's square map read as the software sphere reads it (W = H =
-    ``texture_size``: u over the longitude, v over the colatitude), offsets wide enough for
-    the whole screen, the pipeline's angle and tag widths."""
+    active height, the scene's map read as the software sphere reads it (u over the
+    longitude and the width W = ``texture_size``, v over the colatitude and the height H =
+    ``texture_height``: W = H, a square map, or W = 2H, an equirectangular one), offsets
+    wide enough for the whole screen, the pipeline's angle and tag widths."""
     num, den = GLOBE_RADIUS
     radius = max(1, mode.v_active * num // den)
     reach = max(mode.h_active, mode.v_active) // 2
     coord = max(reach.bit_length() + 1, radius.bit_length() + 1)
-    size = scene.texture_size
-    return GlobeConfig(radius=radius, map_width=size, map_height=size, pipeline=scene.config,
-                       coord_bits=coord)
+    return GlobeConfig(radius=radius, map_width=scene.texture_size, map_height=scene.map_height,
+                       pipeline=scene.config, coord_bits=coord)
 
 
 def globe_offsets(x, y, mode: VideoMode):

@@ -31,8 +31,9 @@ TEXEL_BITS = 24               # one colour texel: r, g, b 8 bits each (Config.co
 
 
 def coord_bits(scene):
-    """Signed texel coordinates of level 0: [-2T, 2T), so two map widths either side of the
-    map reach the wrap/clamp logic instead of wrapping silently in the port."""
+    """Signed texel coordinates of level 0: [-2W, 2W) (W the map's width, at least its
+    height), so two map widths either side of the map reach the wrap/clamp logic instead of
+    wrapping silently in the port."""
     return scene.texture_bits + 2
 
 
@@ -40,14 +41,19 @@ def level_bits(scene):
     return (scene.mip_levels - 1).bit_length()
 
 
+def _level_texels(scene):
+    return [(scene.texture_size >> n) * (scene.map_height >> n) for n in range(scene.mip_levels)]
+
+
 def level_bases(scene):
-    """Word offset of each mip level: level l (T >> l squared texels) follows level l-1."""
-    sizes = [(scene.texture_size >> n) ** 2 for n in range(scene.mip_levels)]
+    """Word offset of each mip level: level l ((W >> l) x (H >> l) texels, row-major)
+    follows level l-1."""
+    sizes = _level_texels(scene)
     return [int(x) for x in np.concatenate([[0], np.cumsum(sizes)[:-1]])]
 
 
 def memory_depth(scene):
-    return sum((scene.texture_size >> n) ** 2 for n in range(scene.mip_levels))
+    return sum(_level_texels(scene))
 
 
 def fetched_field(scene):
@@ -94,24 +100,24 @@ def _wrap(x, bits):
 
 def level_coords(u, v, level, scene):
     """``(u_l, v_l)``, texel (u, v) (level-0 coordinates, signed) in constant mip ``level``:
-    u_l = floor(u / 2**l), then wrap (modulo T_l) or clamp (to [0, T_l - 1])."""
-    bits = scene.texture_bits - level
-    edge = Q(bits, 0, signed=False)
+    u_l = floor(u / 2**l), v_l = floor(v / 2**l), then wrap (u modulo W_l, v modulo H_l) or
+    clamp (to [0, W_l - 1], [0, H_l - 1]), W_l x H_l the level's size."""
     coords = []
-    for c in (u, v):
-        c = c >> level                                     # arithmetic: floor for negatives
+    for c, bits in ((u, scene.texture_bits - level), (v, scene.height_bits - level)):
+        c, edge = c >> level, Q(bits, 0, signed=False)     # arithmetic: floor for negatives
         coords.append(_wrap(c, bits) if scene.addressing == "wrap" else saturate(c, edge))
     return tuple(coords)
 
 
 def texel_address(u, v, level, scene):
     """Word address of texel (u, v) (level-0 coordinates, signed) at constant mip ``level``:
-    (u_l, v_l) of :func:`level_coords`, then base_l + v_l T_l + u_l."""
-    bits = scene.texture_bits - level
+    (u_l, v_l) of :func:`level_coords`, then base_l + v_l W_l + u_l (W_l the level's width,
+    a power of two: v_l's bits above u_l's)."""
+    bits, v_bits = scene.texture_bits - level, scene.height_bits - level
     u_l, v_l = level_coords(u, v, level, scene)
     base = level_bases(scene)[level]
     if _is_hdl(u_l):
-        return Cat(u_l[:bits], v_l[:bits]) + base if bits else Value.cast(base)
+        return Cat(u_l[:bits], v_l[:v_bits]) + base if bits else Value.cast(base)
     return base + (v_l << bits) + u_l
 
 

@@ -2,7 +2,8 @@
 (docs/memory.md).
 
 The map lives in the user's memory in a tiled layout (:func:`tiled_layout`): each mip
-level is cut into square blocks of ``block`` x ``block`` texels, a block is one cache line
+level (W >> l by H >> l texels; W = H for a square map) is cut into square blocks of
+``block`` x ``block`` texels, a block is one cache line
 (``block**2`` texel slots, row-major inside the block), the blocks of a level row-major,
 the levels one after the other from ``base``. A texel slot is the smallest power of two
 of bytes that holds a texel (a 28-bit N' angle pair: 4 bytes; an 8-bit palette index: 1
@@ -73,9 +74,9 @@ class CacheGeometry:
     Parameters
     ----------
     texture_size : int
-        T, the side of mip level 0 (a power of two).
+        W, the width of mip level 0 (a power of two; the side T of a square map).
     mip_levels : int
-        Levels stored, level l of side T >> l.
+        Levels stored, level l of W >> l by H >> l texels, 1 to log2(H) + 1.
     texel_bits : int
         Bits of one stored texel (N' angle pair or palette index), <= ``data_bits``.
     sets, ways, block : int
@@ -96,6 +97,8 @@ class CacheGeometry:
         [log2(queue) + 1, 32]; None: ``max(16, log2(queue) + 2)``, wide enough that a stale
         stamp rarely looks queued (that only delays a miss until the queue drains). A
         narrow one wraps within a short stream (the tests' way to reach the wrap).
+    texture_height : int or None
+        H, the height of mip level 0, a power of two at most W; None: W (a square map).
     """
 
     texture_size: int
@@ -110,10 +113,13 @@ class CacheGeometry:
     queue: int = CACHE_DEFAULTS["queue"]
     misses: int = CACHE_DEFAULTS["misses"]
     stamp_bits: int | None = None
+    texture_height: int | None = None
 
     def __post_init__(self):
         check_pow2("texture_size", self.texture_size, 1, 1 << 16)
-        top = self.texture_size.bit_length()
+        if self.texture_height is not None:
+            check_pow2("texture_height", self.texture_height, 1, self.texture_size)
+        top = self.height.bit_length()
         if not isinstance(self.mip_levels, int) or not 1 <= self.mip_levels <= top:
             raise BumpError(f"mip_levels must be an integer in [1, {top}], got "
                             f"{self.mip_levels!r}", "mip_levels")
@@ -125,7 +131,7 @@ class CacheGeometry:
                             f"{self.texel_bits!r}", "texel_bits")
         check_pow2("sets", self.sets, 1, 1 << 14)
         check_pow2("ways", self.ways, 1, 16)
-        check_pow2("block", self.block, 2, min(16, self.texture_size))
+        check_pow2("block", self.block, 2, min(16, self.height))
         if self.line_bytes < self.data_bits // 8 or self.beats > MAX_BURST \
                 or self.line_bytes > AXI_PAGE:
             raise BumpError(f"block must make a line of {self.data_bits // 8} to "
@@ -155,6 +161,11 @@ class CacheGeometry:
 
     # --- the layout in memory ---
     @property
+    def height(self):
+        """H, the height of level 0: ``texture_height``, or W (a square map)."""
+        return self.texture_size if self.texture_height is None else self.texture_height
+
+    @property
     def slot_bytes(self):
         """Bytes of one texel slot: the least power of two >= texel_bits / 8."""
         return 1 << max(0, (self.texel_bits - 1).bit_length() - 3)
@@ -180,11 +191,21 @@ class CacheGeometry:
     def slots_per_beat(self):
         return self.data_bits // (8 * self.slot_bytes)
 
-    def level_side(self, level):
+    def level_width(self, level):
         return self.texture_size >> level
 
+    def level_height(self, level):
+        return self.height >> level
+
     def blocks_per_row(self, level):
-        return max(1, self.level_side(level) >> self.block_bits)
+        return max(1, self.level_width(level) >> self.block_bits)
+
+    def blocks_per_column(self, level):
+        return max(1, self.level_height(level) >> self.block_bits)
+
+    def level_blocks(self, level):
+        """Lines of ``level``: its blocks a row times its blocks a column."""
+        return self.blocks_per_row(level) * self.blocks_per_column(level)
 
     @property
     def level_lines(self):
@@ -192,12 +213,12 @@ class CacheGeometry:
         out, n = [], 0
         for level in range(self.mip_levels):
             out.append(n)
-            n += self.blocks_per_row(level) ** 2
+            n += self.level_blocks(level)
         return out
 
     @property
     def lines(self):
-        return self.level_lines[-1] + self.blocks_per_row(self.mip_levels - 1) ** 2
+        return self.level_lines[-1] + self.level_blocks(self.mip_levels - 1)
 
     @property
     def image_bytes(self):
@@ -232,16 +253,18 @@ def _is_hdl(x):
 
 
 def tiled_layout(u, v, level, geom: CacheGeometry):
-    """``(line, slot)`` of texel (u, v) of constant mip ``level`` (level coordinates, in
-    [0, T >> level)): line = first line of the level + (v >> b) * blocks a row + (u >> b),
-    slot = (v mod B) * B + (u mod B) for blocks of B = 2**b. Amaranth values or int arrays."""
+    """``(line, slot)`` of texel (u, v) of constant mip ``level`` (level coordinates, u in
+    [0, W >> level), v in [0, H >> level)): line = first line of the level + (v >> b) *
+    blocks a row + (u >> b), slot = (v mod B) * B + (u mod B) for blocks of B = 2**b.
+    Amaranth values or int arrays."""
     b, mask = geom.block_bits, geom.block - 1
     row_bits = geom.blocks_per_row(level).bit_length() - 1
     first = geom.level_lines[level]
     if _is_hdl(u):
         u, v = Value.cast(u), Value.cast(v)
-        side = geom.level_side(level).bit_length() - 1
-        inner = Cat(u[b:max(b, side)], v[b:max(b, side)]) if row_bits else Const(0, 1)
+        side = geom.level_width(level).bit_length() - 1
+        tall = geom.level_height(level).bit_length() - 1
+        inner = Cat(u[b:max(b, side)], v[b:max(b, tall)]) if row_bits else Const(0, 1)
         return inner + first, Cat(u[:b], v[:b])
     u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
     return first + ((v >> b) << row_bits) + (u >> b), ((v & mask) << b) | (u & mask)
@@ -255,19 +278,19 @@ def texel_byte_address(u, v, level, geom: CacheGeometry):
 
 def tiled_image(geom: CacheGeometry, levels):
     """The map's memory image (``bytes``, from ``base``: the image's first byte is at
-    ``base``): ``levels[l]`` is level l's texel words, a (T >> l) x (T >> l) array indexed
+    ``base``): ``levels[l]`` is level l's texel words, a (H >> l) x (W >> l) array indexed
     [v, u]; each word little-endian in its slot, unused slots zero."""
     image = np.zeros(geom.lines * geom.line_texels, np.uint64)
     for level in range(geom.mip_levels):
-        side = geom.level_side(level)
+        side, tall = geom.level_width(level), geom.level_height(level)
         words = np.asarray(levels[level], np.int64)
-        if words.shape != (side, side):
-            raise BumpError(f"level {level} must be {side} x {side} texels, got "
-                            f"{words.shape}", "levels")
+        if words.shape != (tall, side):
+            raise BumpError(f"level {level} must be {side} x {tall} texels (width x height, "
+                            f"an array of {tall} rows), got {words.shape}", "levels")
         if words.size and (words.min() < 0 or words.max() >> geom.texel_bits):
             raise BumpError(f"level {level} has words outside [0, 2**{geom.texel_bits})",
                             "levels")
-        v, u = np.mgrid[0:side, 0:side]
+        v, u = np.mgrid[0:tall, 0:side]
         line, slot = tiled_layout(u, v, level, geom)
         image[line * geom.line_texels + slot] = words
     dtype = {1: "<u1", 2: "<u2", 4: "<u4", 8: "<u8"}[geom.slot_bytes]
@@ -317,8 +340,10 @@ class TextureCache(wiring.Component):
 
     Members
     -------
-    i : In(stream.Signature({u, v: unsigned(log2 T), level: unsigned (mip_levels > 1), extra}))
-        Coordinates of the level (already wrapped or clamped, in [0, T >> level)).
+    i : In(stream.Signature({u: unsigned(log2 W), v: unsigned(log2 H), level: unsigned
+    (mip_levels > 1), extra}))
+        Coordinates of the level (already wrapped or clamped, in [0, W >> level) and
+        [0, H >> level)).
     o : Out(stream.Signature({texel: unsigned(texel_bits), extra}))
         Pixels in input order; ``o.valid``/``o.payload`` are a register.
     axi : Out(axi_read_signature(addr_bits, data_bits))
@@ -400,8 +425,8 @@ class TextureCache(wiring.Component):
             pop_ok=Signal(name="pop_ok"),         # the same from this cycle's registers (comb)
             f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
             beat=Signal(range(geom.beats), name="beat"))          # the R beat of the line
-        tb = geom.texture_size.bit_length() - 1
-        fields = {"u": unsigned(max(1, tb)), "v": unsigned(max(1, tb))}
+        tb, hb = geom.texture_size.bit_length() - 1, geom.height.bit_length() - 1
+        fields = {"u": unsigned(max(1, tb)), "v": unsigned(max(1, hb))}
         if geom.mip_levels > 1:
             fields["level"] = unsigned((geom.mip_levels - 1).bit_length())
         super().__init__({
@@ -1121,14 +1146,16 @@ class TextureCache(wiring.Component):
 
 
 def scene_geometry(scene: HardwareScene, **cache):
-    """The :class:`CacheGeometry` of ``scene``'s map (its side, levels and stored texel
-    width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
+    """The :class:`CacheGeometry` of ``scene``'s map (its width, height, levels and stored
+    texel width) and cache (its ``cache_sets``, ``cache_ways``, ``cache_block``,
     ``axi_data_bits``, ``cache_queue``, ``cache_outstanding``: :data:`SCENE_KEYS`), the
     parameters ``cache`` (CacheGeometry's: sets, ways, block, data_bits, queue, misses,
     base, addr_bits, stamp_bits) overriding them."""
     bits = Shape.cast(texel_shape(scene)).width
     own = {name: getattr(scene, key) for name, key in SCENE_KEYS.items()}
-    return CacheGeometry(scene.texture_size, scene.mip_levels, bits, **{**own, **cache})
+    height = None if scene.map_height == scene.texture_size else scene.map_height
+    return CacheGeometry(scene.texture_size, scene.mip_levels, bits,
+                         **{**own, "texture_height": height, **cache})
 
 
 def scene_levels(scene: HardwareScene, words):
@@ -1136,16 +1163,16 @@ def scene_levels(scene: HardwareScene, words):
     array a level, what :func:`tiled_image` takes."""
     words, out, base = np.asarray(words, np.int64), [], 0
     for level in range(scene.mip_levels):
-        side = scene.texture_size >> level
-        out.append(words[base:base + side * side].reshape(side, side))
-        base += side * side
+        side, tall = scene.level_size(level)
+        out.append(words[base:base + side * tall].reshape(tall, side))
+        base += side * tall
     return out
 
 
 class AxiMapFetch(wiring.Component):
     """BumpMapFetch's ports and function with the map in the user's memory: texel
     coordinates are wrapped or clamped into their level (``bumpfetch.level_coords``, the
-    block-RAM fetch's own arithmetic) and looked up in a :class:`TextureCache`.
+    block-RAM fetch's own arithmetic: u by the level's width, v by its height) and looked up in a :class:`TextureCache`.
 
     Parameters
     ----------

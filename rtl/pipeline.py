@@ -311,6 +311,7 @@ class BumpPipeline(wiring.Component):
 
     def _fetch(self, out_layout, init, what):
         s = self.scene
+        texels = s.map_label
         if s.texture:                          # the RGB texel from the parallel texture RAM
             fields = {f: out_layout[f].shape for f, _ in out_layout if f not in ("tag", "base")}
             out_layout = data.StructLayout({**fields, "texel": rgb_layout(self.cfg),
@@ -319,7 +320,7 @@ class BumpPipeline(wiring.Component):
             key = "shading = 'palette'" if s.shading == "palette" else "bump_map = 'varying'"
             self._add("fetch", AxiMapFetch(s, out_layout, self.cache, self.target),
                       f"{key}, map_memory = 'axi': {what} per texel from the "
-                      f"user's memory through a texel cache ({s.texture_size}^2 texels, "
+                      f"user's memory through a texel cache ({texels} texels, "
                       f"{s.mip_levels} level(s), {s.addressing} addressing)")
             return
         maps = ([f"bump_map = 'varying': {what}"] if has_map(s) else []) + \
@@ -327,7 +328,7 @@ class BumpPipeline(wiring.Component):
         self._add("fetch", BumpMapFetch(s, out_layout, init, self._texture, self.target,
                                         credit=False,
                                         write_port=self.write_port),
-                  f"{' and '.join(maps)} per texel in block RAM ({s.texture_size}^2 texels, "
+                  f"{' and '.join(maps)} per texel in block RAM ({texels} texels, "
                   f"{s.mip_levels} level(s), {s.addressing} addressing)")
 
     def _plan_palette(self, init):

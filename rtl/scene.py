@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from bumprtl.rtl.config import BumpError, Config
 
-__all__ = ["HardwareScene", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
+__all__ = ["HardwareScene", "MapSize", "ADDRESSING", "BUMP_MAPS", "SHADINGS", "ROTATIONS",
            "TEXTURE_SIZES", "MAP_MEMORIES", "CACHE_DEFAULTS", "check_map_memory", "derived_rotation", "check_scene", "check_choice",
            "check_map_size"]
 
@@ -81,22 +81,63 @@ def check_map_memory(map_memory, shading, bump_map, texture, cache=None, error=B
                     "otherwise map_memory = 'bram'", "map_memory")
 
 
-def check_map_size(texture_size, mip_levels, error=BumpError):
-    """The map side T is a power of two in :data:`TEXTURE_SIZES` and ``mip_levels`` in
-    [1, log2(T) + 1]; else ``error`` (a BumpError class) naming the key and its range."""
+def check_map_size(texture_size, mip_levels, error=BumpError, texture_height=None):
+    """The map's width T is a power of two in :data:`TEXTURE_SIZES`, its height
+    ``texture_height`` (None: T, a square map) a power of two in [16, T], and ``mip_levels``
+    in [1, log2(min(W, H)) + 1] (every level at least one texel on its shorter side); else
+    ``error`` (a BumpError class) naming the key and its range."""
     t, (lo, hi) = texture_size, TEXTURE_SIZES
     if isinstance(t, bool) or not isinstance(t, int) or not lo <= t <= hi or t & (t - 1):
         raise error(f"texture_size must be a power of two in [{lo}, {hi}] (texel "
                     f"addressing by bit slicing), got {t!r}", "texture_size")
-    top = t.bit_length()                   # log2(T) + 1 levels down to 1 x 1
+    h = t if texture_height is None else texture_height
+    if isinstance(h, bool) or not isinstance(h, int) or not lo <= h <= t or h & (h - 1):
+        raise error(f"texture_height must be a power of two in [{lo}, {t}] (the map's height, "
+                    f"at most its width texture_size = {t}), got {h!r}", "texture_height")
+    top = h.bit_length()                   # log2(H) + 1 levels down to 1 texel high
     if isinstance(mip_levels, bool) or not isinstance(mip_levels, int) \
             or not 1 <= mip_levels <= top:
-        raise error(f"mip_levels must be an integer in [1, {top}] for texture_size "
-                    f"{t}, got {mip_levels!r}", "mip_levels")
+        size = f"texture_size {t}" if h == t else f"a {t} x {h} map"
+        raise error(f"mip_levels must be an integer in [1, {top}] for {size}, got "
+                    f"{mip_levels!r}", "mip_levels")
+
+
+class MapSize:
+    """The map's size from a scene's ``texture_size`` (the width W) and ``texture_height``
+    (the height H, None for a square map): the one place HardwareScene and
+    sim/scenes/config.SceneConfig derive it, for the RTL, the golden models and the benches."""
+
+    @property
+    def texture_bits(self):
+        """log2 of ``texture_size``, the map's width."""
+        return self.texture_size.bit_length() - 1
+
+    @property
+    def map_height(self):
+        """The map's height H: ``texture_height``, or ``texture_size`` (a square map)."""
+        return self.texture_size if self.texture_height is None else self.texture_height
+
+    @property
+    def height_bits(self):
+        """log2 of :attr:`map_height`."""
+        return self.map_height.bit_length() - 1
+
+    @property
+    def square(self):
+        return self.map_height == self.texture_size
+
+    @property
+    def map_label(self):
+        """The map's size as messages write it: ``T^2``, or ``W x H``."""
+        return f"{self.texture_size}^2" if self.square else f"{self.texture_size} x {self.map_height}"
+
+    def level_size(self, level):
+        """``(width, height)`` of mip ``level``: (W >> l, H >> l)."""
+        return self.texture_size >> level, self.map_height >> level
 
 
 @dataclass(frozen=True)
-class HardwareScene:
+class HardwareScene(MapSize):
     """What the hardware of one scene builds.
 
     Parameters
@@ -114,11 +155,15 @@ class HardwareScene:
     texture : bool
         Build the colour texture memory and its blend.
     texture_size : int
-        Map side T, a power of two in :data:`TEXTURE_SIZES` (texel addressing by bit slicing).
+        Map width W (the side T of a square map), a power of two in :data:`TEXTURE_SIZES`
+        (texel addressing by bit slicing); u runs over it.
+    texture_height : int or None
+        Map height H, a power of two in [16, W]; v runs over it. None: W (a square map);
+        :attr:`map_height` is the height either way.
     addressing : str
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
-        Levels of the map in block RAM, 1 to log2(T) + 1.
+        Levels of the map, 1 to log2(H) + 1; level l is (W >> l) x (H >> l) texels.
     map_memory : str
         ``bram`` (the map in block RAM, :class:`~bumprtl.rtl.bumpfetch.BumpMapFetch`) or
         ``axi`` (the map in the user's memory behind a texel cache with an AXI4 read port,
@@ -142,6 +187,7 @@ class HardwareScene:
     rotation: str | None = None
     texture: bool = False
     texture_size: int = 64
+    texture_height: int | None = None
     addressing: str = "wrap"
     mip_levels: int = 1
     map_memory: str = "bram"
@@ -161,7 +207,7 @@ class HardwareScene:
             check_choice(key, getattr(self, key), allowed)
         if not isinstance(self.texture, bool):
             raise BumpError(f"texture must be true or false, got {self.texture!r}", "texture")
-        check_map_size(self.texture_size, self.mip_levels)
+        check_map_size(self.texture_size, self.mip_levels, texture_height=self.texture_height)
         check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture,
                          {k: getattr(self, k) for k in CACHE_DEFAULTS})
         derived = derived_rotation(self.shading, self.bump_map)
@@ -182,10 +228,6 @@ class HardwareScene:
         keys = {k: getattr(self, k) for k in self.__dataclass_fields__}
         return HardwareScene(**{**keys, "rotation": None, **own, "config": config})
 
-    @property
-    def texture_bits(self):
-        """log2 of ``texture_size``."""
-        return self.texture_size.bit_length() - 1
 
     @property
     def lights(self):

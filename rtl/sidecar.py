@@ -71,8 +71,9 @@ SCHEMA = {
                                       "width, signed, from, bits: [lsb, msb] or null, field}}"),
     "axis": ("object or null", "--interface axis: tdata/tuser/tlast packing and reset"),
     "memory_images": ("object or null", "pipeline and fetch: image -> {file, load, depth, "
-                                        "width, layout[, port]}; a map_memory = axi map: "
-                                        "load axi, base, bytes, slot_bytes"),
+                                        "width, layout[, port]}; the map and texture also "
+                                        "map_width, map_height (texels of level 0); a "
+                                        "map_memory = axi map: load axi, base, bytes, slot_bytes"),
     "block_ram": ("object or null", "pipeline and fetch: DP16KD blocks needed and available"),
     "pipeline": ("object or null", "pipeline: {built: units with class, latency, why; "
                                    "skipped: units with why}"),

@@ -46,8 +46,8 @@ def _stimulus(scene, size, flat_like=None):
     inputs, words, polygon, _, base = scene_stimulus(scene, size)
     texels = scene_texels(scene, base)
     if flat_like is not None:
-        sizes = [scene.texture_size >> n for n in range(scene.mip_levels)]
-        zeros = [np.zeros((t, t), np.int64) for t in sizes]  # N' = +z, as polygon_fixed(.., 0, 0)
+        sizes = [scene.level_size(n) for n in range(scene.mip_levels)]
+        zeros = [np.zeros((h, w), np.int64) for w, h in sizes]  # N' = +z, as polygon_fixed(.., 0, 0)
         words = map_words([pack_texels(scene, z, z) for z in zeros], scene)
     return inputs, words, polygon, texels
 

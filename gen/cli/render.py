@@ -112,7 +112,7 @@ def run(args):
     elapsed = time.perf_counter() - t0
     out = save_png(args.out, img)
     print(f"{args.render_method} ({args.model}): {args.size}x{args.size} {scene.picture} (map "
-          f"{scene.texture_size}^2, {base.geometry}) in {elapsed:.2f} s "
+          f"{scene.map_label}, {base.geometry}) in {elapsed:.2f} s "
           f"({args.size ** 2 / elapsed / 1e6:.2f} Mpix/s) -> {out}")
     if args.render_method == PALETTE and (note := palette_note(base, scene.config)):
         print(note)

@@ -163,16 +163,17 @@ def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
     chip = CHIPS[variant]
     end = geom.base + geom.image_bytes
     if end > chip.bytes:
-        raise BumpError(f"texture_size {scene.texture_size}: the map's tiled image ends at byte "
+        raise BumpError(f"{_map_named(scene)}: the map's tiled image ends at byte "
                         f"{end:,}, beyond the {variant} SDRAM's {chip.bytes:,} bytes (a smaller "
                         f"--texture-size, or --sdram 64mb)", "texture_size")
     first = -(-BITSTREAM_BYTES[device] // FLASH_SECTOR) * FLASH_SECTOR
     last = FLASH_BYTES_MAX - geom.image_bytes
     if last < first:                    # no offset at all: the map is too large for the flash
-        raise BumpError(f"texture_size {scene.texture_size}: the map's tiled image is "
+        raise BumpError(f"{_map_named(scene)}: the map's tiled image is "
                         f"{geom.image_bytes:,} bytes, more than the {FLASH_BYTES_MAX - first:,} "
                         f"bytes of flash from 0x{first:x} (after the {device} bitstream's "
-                        f"sectors) to the 24-bit READ address's end (a smaller --texture-size)",
+                        f"sectors) to the 24-bit READ address's end (a smaller --texture-size"
+                        f"{'' if scene.square else ' or texture_height'})",
                         "texture_size")
     if isinstance(offset, bool) or not isinstance(offset, int) or not first <= offset <= last \
             or offset % FLASH_SECTOR:
@@ -180,6 +181,13 @@ def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
                         f"sector) in [0x{first:x}, 0x{last:x}] (after the {device} bitstream's "
                         f"{BITSTREAM_BYTES[device]:,} bytes, the {geom.image_bytes:,}-byte map "
                         f"within the 24-bit READ address), got {_hex(offset)}", "flash_offset")
+
+
+def _map_named(scene):
+    """The map's size as a refusal names it: ``texture_size T``, or W x H."""
+    if scene.square:
+        return f"texture_size {scene.texture_size}"
+    return f"texture_size x texture_height {scene.texture_size} x {scene.map_height}"
 
 
 def _hex(value):
@@ -235,6 +243,12 @@ def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAU
         raise BumpError(f"scene {scene.name!r}: the board renders a plane facing the viewer or "
                         f"a turning globe (geometry 'plane' or 'sphere'), got geometry "
                         f"{geometry!r}", "geometry")
+    if geometry == "sphere" and scene.map_height not in (scene.texture_size,
+                                                         scene.texture_size // 2):
+        raise BumpError(f"scene {scene.name!r}: the globe reads a latitude-longitude map, "
+                        f"texture_height = texture_size / 2 = {scene.texture_size // 2} "
+                        f"(equirectangular) or none (square), got {scene.map_height}",
+                        "texture_height")
     platform, device = BOARDS[board]
     if scene.map_memory == "axi":
         _check_memory_flags(scene, sdram, flash_offset, device)

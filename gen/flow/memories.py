@@ -127,10 +127,17 @@ def hex_text(words, width):
     return "".join(f"{int(w):0{digits}x}\n" for w in np.asarray(words, np.int64).tolist())
 
 
+def _width_name(scene):
+    """What the layouts call the map's width: T (a square map) or W (W x H)."""
+    return "T" if scene.square else "W"
+
+
 def _layout(name, scene):
-    a, lv = scene.angle_bits, level_bases(scene)
-    where = (f"texel (u, v) of mip level l at word level_bases[l] + v * (T >> l) + u, "
-             f"T = {scene.texture_size}, level_bases = {lv}")
+    a, lv, t = scene.angle_bits, level_bases(scene), _width_name(scene)
+    size = (f"T = {scene.texture_size}" if scene.square else
+            f"W = {scene.texture_size}, H = {scene.map_height} (v in [0, H >> l))")
+    where = (f"texel (u, v) of mip level l at word level_bases[l] + v * ({t} >> l) + u, "
+             f"{size}, level_bases = {lv}")
     if name == "map" and scene.shading == "palette":
         return f"palette index of the texel's quantized normal (Tarini Sec. 4), {index_bits(scene.config)} bits; {where}"
     if name == "map":
@@ -169,6 +176,7 @@ def memory_images(unit, scene, words, texels=None, table=None, load="initial"):
             images[name] = _axi_image(unit, scene, w, width, depth)
             continue
         images[name] = {"words": w, "width": width, "depth": depth,
+                        **(_map_size(scene) if name != "lut" else {}),
                         "file": f"{unit}_{name}.hex", "layout": _layout(name, scene),
                         "port": [f"{p}w_en", f"{p}w_addr", f"{p}w_data"] +
                                 (["lut_w_ready", "lut_swap"] if name == "lut" else []),
@@ -181,7 +189,8 @@ def _axi_image(unit, scene, words, width, depth):
     puts in memory from ``base`` on (rtl/cache.tiled_image; the scene's cache geometry): N'
     angle pairs, or a palette scene's indices, each in a ``slot_bytes`` slot."""
     g = scene_geometry(scene.hardware)
-    return {"words": words, "width": width, "depth": depth, "file": f"{unit}_map.bin",
+    return {"words": words, "width": width, "depth": depth, **_map_size(scene),
+            "file": f"{unit}_map.bin",
             "load": "axi", "base": g.base, "bytes": g.image_bytes, "slot_bytes": g.slot_bytes,
             "bin": tiled_image(g, scene_levels(scene, words)),
             "layout": (f"tiled (rtl/cache.tiled_layout): level l's texels in lines of "
@@ -190,9 +199,15 @@ def _axi_image(unit, scene, words, width, depth):
                        f"the other (first lines {g.level_lines}); texel (u, v) of level l at "
                        f"byte base + line * {g.line_bytes} + ((v mod {g.block}) * {g.block} + "
                        f"(u mod {g.block})) * {g.slot_bytes}, line = first line of l + "
-                       f"(v div {g.block}) * max(1, (T >> l) / {g.block}) + (u div {g.block}); "
+                       f"(v div {g.block}) * max(1, ({_width_name(scene)} >> l) / {g.block}) + "
+                       f"(u div {g.block}); "
                        f"each texel little-endian in its {g.slot_bytes}-byte slot, as in "
                        f"block RAM: {_layout('map', scene).split('; texel (u, v)')[0]}")}
+
+
+def _map_size(scene):
+    """The sidecar's record of the map's size: texels of level 0, width and height."""
+    return {"map_width": scene.texture_size, "map_height": scene.map_height}
 
 
 def image_records(images, write_port):

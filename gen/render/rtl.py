@@ -68,15 +68,16 @@ class RtlRender:
 
 def sim_scene(scene: SceneConfig, size, azimuth=30.0, **light):
     """The sim scene (bumprtl.sim.scenes.Scene) of ``scene`` at ``size`` x ``size`` pixels:
-    its procedural image or its user map, on its geometry, at its texture size."""
+    its procedural image or its user map, on its geometry, at its map's width and height."""
     bump = None
     if scene.map_file is not None:
         key, path = scene.map_file
         bump = load_bump_map(path, "height" if key == "height_map" else "normal",
                              scene.normal_convention, scene.height_scale, scene.texture_size,
-                             scene.resample)
+                             scene.resample, scene.map_height)
     return load_scene(scene.image, size=size, texture_size=scene.texture_size,
-                      light_azimuth=azimuth, bump=bump, geometry=scene.geometry, **light)
+                      texture_height=scene.map_height, light_azimuth=azimuth, bump=bump,
+                      geometry=scene.geometry, **light)
 
 
 def _levels(level0, scene):
@@ -344,7 +345,7 @@ def rtl_render_png(scene, size, out, simulator="verilator", *, device=DEFAULT_DE
     stream = "" if r.stream_seconds is None else \
         f"; streaming {r.stream_seconds:.2f} s = {n / r.stream_seconds:,.0f} pix/s"
     print(f"rtl ({simulator}, {path}, map load {load}): {size}x{size} "
-          f"{scene.picture} ({scene.texture_size}^2 map) with pipeline {scene.name}: {r.cycles} "
+          f"{scene.picture} ({scene.map_label} map) with pipeline {scene.name}: {r.cycles} "
           f"cycles; {build}; simulation {r.seconds:.2f} s = {n / r.seconds:,.0f} pix/s{stream}; "
           f"total {time.perf_counter() - t0:.1f} s -> {out}")
     print(f"vs fixed-point golden render: {'identical bytes' if same else 'DIFFERENT'}")

@@ -90,7 +90,7 @@ def frame_inputs(scene, mode, frame, table):
         low = scene.tag_bits - 1
         inputs["tag"] = (count & ((1 << low) - 1)) | (g["inside"] << low)
     else:
-        u, v = texel_coords(x, y, mode.zoom, scene.texture_size)
+        u, v = texel_coords(x, y, mode.zoom, scene.texture_size, scene.map_height)
         inputs = {"u": u, "v": v}
         inputs.update({k: np.full(n, c, np.int64) for k, c in plane_constants(scene).items()})
         inputs["tag"] = count & ((1 << scene.tag_bits) - 1)

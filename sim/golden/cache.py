@@ -198,7 +198,7 @@ def run_cache(geom: CacheGeometry, u, v, level, levels=None):
 def random_levels(geom: CacheGeometry, seed=0):
     """Random texel words for every level of ``geom`` (``[v, u]`` arrays)."""
     rng = np.random.default_rng(seed)
-    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_side(lv), geom.level_side(lv)))
+    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_height(lv), geom.level_width(lv)))
             for lv in range(geom.mip_levels)]
 
 
@@ -209,8 +209,8 @@ def cache_stimulus(geom: CacheGeometry, n, seed):
     u, v, level = [], [], []
     while len(u) < n:
         lv = int(rng.integers(0, geom.mip_levels))
-        side = geom.level_side(lv)
-        u0, v0, run = int(rng.integers(0, side)), int(rng.integers(0, side)), int(rng.integers(1, 12))
+        side, tall = geom.level_width(lv), geom.level_height(lv)
+        u0, v0, run = int(rng.integers(0, side)), int(rng.integers(0, tall)), int(rng.integers(1, 12))
         for k in range(run):
             u.append((u0 + k) % side)
             v.append(v0)
@@ -239,8 +239,8 @@ def image_words(scene, geom: CacheGeometry, image):
     buf = np.frombuffer(image, np.uint8)
     out = []
     for level in range(scene.mip_levels):
-        side = scene.texture_size >> level
-        v, u = np.mgrid[0:side, 0:side]
+        side, tall = scene.level_size(level)
+        v, u = np.mgrid[0:tall, 0:side]
         at = texel_byte_address(u.ravel(), v.ravel(), level, geom) - geom.base
         word = sum(buf[at + k].astype(np.int64) << (8 * k) for k in range(geom.slot_bytes))
         out.append(word & ((1 << geom.texel_bits) - 1))

@@ -214,15 +214,16 @@ def stress_codes(n, cfg: Config, seed=0):
 
 def pipeline_stimulus(scene, n, seed=0):
     """Stress vectors for BumpPipeline(scene) (varying map, per-pixel shading): ``(inputs,
-    words)``. Pixel i reads texel i mod T^2, and the map holds the N' of the first T^2
-    stress pixels, so every case's N' reaches the datapath through the fetch unit."""
-    t = scene.texture_size
-    codes = stress_codes(max(n, t * t), scene.config, seed)
-    texel = np.arange(n) % (t * t)
+    words)``. Pixel i reads texel i mod W H (W x H the map, W = H = T square), and the map
+    holds the N' of the first W H stress pixels, so every case's N' reaches the datapath
+    through the fetch unit."""
+    t, h = scene.texture_size, scene.map_height
+    codes = stress_codes(max(n, t * h), scene.config, seed)
+    texel = np.arange(n) % (t * h)
     inputs = {"u": texel % t, "v": texel // t}
     inputs.update({k: codes[k][:n] for k in ("n.phi", "n.theta", "l.phi", "l.theta")})
     if scene.specular:
         inputs.update({k: codes[k][:n] for k in ("h.phi", "h.theta")})
     inputs["tag"] = np.arange(n) & ((1 << scene.tag_bits) - 1)
-    level0 = pack_texels(scene, codes["b.phi"][:t * t].reshape(t, t), codes["b.theta"][:t * t].reshape(t, t))
+    level0 = pack_texels(scene, codes["b.phi"][:t * h].reshape(h, t), codes["b.theta"][:t * h].reshape(h, t))
     return {k: np.asarray(v, np.int64) for k, v in inputs.items()}, map_words([level0], scene)

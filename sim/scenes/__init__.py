@@ -14,7 +14,7 @@ import numpy as np
 
 from bumprtl.rtl.config import BumpError
 from bumprtl.sim.golden.common import PixelInputs, cartesian_to_polar
-from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS, height_to_normals
+from bumprtl.sim.scenes.heightfields import HEIGHTFIELDS, height_to_normals, resize_field
 
 __all__ = ["SCENES", "GEOMETRIES", "REFERENCE_TEXTURE_SIZE", "Scene", "load_scene",
            "light_direction", "bump_strength", "texel_coordinates"]
@@ -63,6 +63,12 @@ class Scene:
 
     @property
     def texture_size(self):
+        """The map's width W (u runs over it)."""
+        return self.b_phi_map.shape[1]
+
+    @property
+    def texture_height(self):
+        """The map's height H (v runs over it; W for a square map)."""
         return self.b_phi_map.shape[0]
 
 
@@ -80,8 +86,11 @@ def light_direction(elevation_deg, azimuth_deg):
     return np.cos(el) * np.cos(az) * right + np.cos(el) * np.sin(az) * up + np.sin(el) * toward_viewer
 
 
-def _geometry(kind, size, tex):
-    """Per-pixel surface points P, normals N, texel coordinates (u, v) and coverage mask."""
+def _geometry(kind, size, tex, tall=None):
+    """Per-pixel surface points P, normals N, texel coordinates (u, v) and coverage mask, on a
+    map ``tex`` texels wide (u) and ``tall`` (None: ``tex``) high (v): each geometry spans
+    the same part of the map whatever its size, u and v wrapping by their own sides."""
+    tall = tex if tall is None else tall
     c = (np.arange(size) + 0.5) / size * 2 - 1
     sx, sz = np.meshgrid(c, -c)                    # screen right, screen up
     if kind == "plane":                            # facing the viewer: N = -y
@@ -89,7 +98,7 @@ def _geometry(kind, size, tex):
         p = np.stack([sx, np.zeros_like(sx), sz], -1)
         n = np.broadcast_to(np.array([0, -1.0, 0]), p.shape).copy()
         u = (sx + 1) / 2 * tex
-        v = (1 - sz) / 2 * tex                     # v grows down the screen = along T
+        v = (1 - sz) / 2 * tall                    # v grows down the screen = along T
     elif kind == "sphere":                         # pole up the screen: phi = longitude
         r2 = sx ** 2 + sz ** 2
         mask = r2 < 1
@@ -97,7 +106,7 @@ def _geometry(kind, size, tex):
         n = p.copy()
         phi, theta = cartesian_to_polar(np.where(mask[..., None], n, [0, -1.0, 0]))
         u = phi / (2 * np.pi) * tex
-        v = theta / np.pi * tex
+        v = theta / np.pi * tall
     elif kind == "cylinder":                       # axis up the screen
         mask = np.abs(sx) < 1
         y = -np.sqrt(np.clip(1 - sx ** 2, 0, 1))
@@ -105,19 +114,19 @@ def _geometry(kind, size, tex):
         n = np.stack([sx, y, np.zeros_like(sx)], -1)
         phi, _ = cartesian_to_polar(np.where(mask[..., None], n, [0, -1.0, 0]))
         u = phi / (2 * np.pi) * 2 * tex
-        v = (1 - sz) / 2 * tex
+        v = (1 - sz) / 2 * tall
     else:
         raise BumpError(f"geometry must be one of {', '.join(GEOMETRIES)}, got {kind!r}")
     n = np.where(mask[..., None], n, [0, -1.0, 0])
-    to_texel = lambda t: np.mod(np.floor(t).astype(np.int64), tex)
-    return p, n, to_texel(u), to_texel(v), mask
+    to_texel = lambda t, side: np.mod(np.floor(t).astype(np.int64), side)
+    return p, n, to_texel(u, tex), to_texel(v, tall), mask
 
 
-def texel_coordinates(geometry, size, texture_size):
-    """``(u, v, mask)`` of a ``size`` x ``size`` frame of ``geometry`` on a map of side
-    ``texture_size``: the texel each pixel reads (row-major, screen rows top first) and the
-    pixels the surface covers."""
-    _, _, u, v, mask = _geometry(geometry, size, texture_size)
+def texel_coordinates(geometry, size, texture_size, texture_height=None):
+    """``(u, v, mask)`` of a ``size`` x ``size`` frame of ``geometry`` on a map of width
+    ``texture_size`` and height ``texture_height`` (None: square): the texel each pixel
+    reads (row-major, screen rows top first) and the pixels the surface covers."""
+    _, _, u, v, mask = _geometry(geometry, size, texture_size, texture_height)
     return u, v, mask
 
 
@@ -133,12 +142,17 @@ def bump_strength(name, texture_size):
 
 
 def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
-               light="directional", texture_size=None, bump=None, geometry=None):
+               light="directional", texture_size=None, bump=None, geometry=None,
+               texture_height=None):
     """Build scene ``name`` at ``size`` x ``size`` pixels (see :data:`SCENES`).
 
     ``bump``: a user's bump map (:class:`bumprtl.sim.scenes.usermap.BumpMap`) instead of the
     scene's height field (``name`` is then ignored; no colour texture); ``geometry``
-    overrides the scene's (a user map defaults to ``plane``)."""
+    overrides the scene's (a user map defaults to ``plane``). ``texture_size`` is the map's
+    width W, ``texture_height`` its height H (a power of two in [16, W]; None: W, or the
+    user map's own): a procedural height field is drawn at W x W and resampled to W x H
+    (:func:`~bumprtl.sim.scenes.heightfields.resize_field`), the same picture over the
+    same part of the surface."""
     if bump is None and name not in SCENES:
         raise BumpError(f"scene must be one of {', '.join(SCENES)}, got {name!r}")
     if geometry is not None and geometry not in GEOMETRIES:
@@ -146,8 +160,20 @@ def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
     _power_of_two("size", size, 16, 4096)
     tex = (size if bump is None else bump.size) if texture_size is None else texture_size
     _power_of_two("texture_size", tex, 16, 4096)
-    if bump is not None and tex != bump.size:
-        raise BumpError(f"texture_size = {tex} but the map {bump.label} has {bump.size}x{bump.size} texels")
+    if texture_height is None:
+        tall = bump.texture_height if bump is not None and tex == bump.size else tex
+    else:
+        tall = texture_height
+    if isinstance(tall, bool) or not isinstance(tall, (int, np.integer)) or not 16 <= tall <= tex \
+            or tall & (tall - 1):
+        raise BumpError(f"texture_height must be a power of two in [16, {tex}] (at most the "
+                        f"width texture_size), got {tall!r}")
+    if bump is not None and (tex, tall) != (bump.size, bump.texture_height):
+        if bump.size == bump.texture_height and tall == tex:
+            raise BumpError(f"texture_size = {tex} but the map {bump.label} has "
+                            f"{bump.size}x{bump.size} texels")
+        raise BumpError(f"texture_size = {tex}, texture_height = {tall} but the map "
+                        f"{bump.label} has {bump.size}x{bump.texture_height} texels")
     for pname, val, lo, hi in (("light_elevation", light_elevation, -90, 90),
                                ("light_azimuth", light_azimuth, -360, 360)):
         if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)) \
@@ -158,13 +184,13 @@ def load_scene(name, size=512, light_elevation=45.0, light_azimuth=30.0,
 
     if bump is None:
         field, own_geometry, _, _ = SCENES[name]
-        height = HEIGHTFIELDS[field](tex)
+        height = resize_field(HEIGHTFIELDS[field](tex), tex, tall)
         b_phi_map, b_theta_map = height_to_normals(height, bump_strength(name, tex))
     else:
         field, own_geometry, name = None, "plane", bump.label
         height, b_phi_map, b_theta_map = bump.height, bump.b_phi_map, bump.b_theta_map
     geometry = geometry or own_geometry
-    p, n, u, v, mask = _geometry(geometry, size, tex)
+    p, n, u, v, mask = _geometry(geometry, size, tex, tall)
 
     ldir = light_direction(light_elevation, light_azimuth)
     if light == "directional":

@@ -22,6 +22,7 @@ from bumprtl.rtl.scene import (
     ROTATIONS,
     SHADINGS,
     HardwareScene,
+    MapSize,
     check_choice,
     check_map_memory,
     check_map_size,
@@ -43,7 +44,7 @@ class SceneError(BumpError):
 
 
 @dataclass(frozen=True)
-class SceneConfig:
+class SceneConfig(MapSize):
     """The switches of one scene class: the hardware's (:attr:`hardware`, an
     ``rtl/scene.HardwareScene``) with the map's source and the geometry.
 
@@ -58,7 +59,8 @@ class SceneConfig:
         A user's map file instead of ``image`` (at most one; sim/scenes/usermap.py): an 8- or
         16-bit greyscale PNG or a ``.npy`` of heights, or an 8-bit RGB tangent-space normal
         map PNG. In a TOML file a relative path is relative to the TOML file. The map's
-        side becomes ``texture_size`` (a power of two in [16, 4096]).
+        width becomes ``texture_size`` (a power of two in [16, 4096]) and a non-square
+        map's height ``texture_height``.
     normal_convention : str
         ``opengl`` (green = +Y up the image, the default) or ``directx`` (green = +Y down).
     geometry : str or None
@@ -84,11 +86,15 @@ class SceneConfig:
     texture : bool
         The scene has a colour texture: build the colour-texture blend.
     texture_size : int
-        Bump map (and colour texture) size T, a power of two in [16, 4096].
+        Bump map (and colour texture) width W (the side T of a square map), a power of two in
+        [16, 4096]; u runs over it.
+    texture_height : int or None
+        The map's height H, a power of two in [16, W]; v runs over it (a sphere: the
+        colatitude, so W = 2H is an equirectangular map). None: W, a square map.
     addressing : str
         ``wrap`` or ``clamp`` for texel coordinates outside the map.
     mip_levels : int
-        Levels of the bump map in block RAM, 1 (no mipmaps) to log2(T) + 1.
+        Levels of the bump map, 1 (no mipmaps) to log2(H) + 1.
     map_memory : str
         ``bram`` (the map in block RAM, the default) or ``axi`` (the map in the user's
         memory, read through a texel cache with an AXI4 port: docs/memory.md).
@@ -113,6 +119,7 @@ class SceneConfig:
     rotation: str | None = None
     texture: bool = False
     texture_size: int = 64
+    texture_height: int | None = None
     addressing: str = "wrap"
     mip_levels: int = 1
     map_memory: str = "bram"
@@ -153,7 +160,13 @@ class SceneConfig:
         if isinstance(self.lights, int) and not isinstance(self.lights, bool) and self.lights < 1:
             raise SceneError(f"lights = {self.lights}: a scene needs at least one light (allowed [1, 8])",
                              "lights")
-        check_map_size(self.texture_size, self.mip_levels, SceneError)
+        check_map_size(self.texture_size, self.mip_levels, SceneError, self.texture_height)
+        if not self.square and self.shading == "palette":
+            raise SceneError(f"texture_height = {self.texture_height} (a {self.texture_size} x "
+                             f"{self.texture_height} map) needs shading = 'per-pixel': the "
+                             f"palette's normal quantizer and index mipmaps (Tarini Sec. 4-5) "
+                             f"take square maps; allowed texture_height = {self.texture_size} "
+                             f"or none", "texture_height")
         check_map_memory(self.map_memory, self.shading, self.bump_map, self.texture,
                          {k: getattr(self, k) for k in CACHE_DEFAULTS}, SceneError)
         if self.map_memory == "axi":
@@ -247,14 +260,11 @@ class SceneConfig:
         and BoardCore are built from; the map's source and the geometry stay here."""
         return HardwareScene(name=self.name, shading=self.shading, bump_map=self.bump_map,
                              rotation=self.rotation, texture=self.texture,
-                             texture_size=self.texture_size, addressing=self.addressing,
+                             texture_size=self.texture_size,
+                             texture_height=self.texture_height, addressing=self.addressing,
                              mip_levels=self.mip_levels, map_memory=self.map_memory,
                              **{k: getattr(self, k) for k in CACHE_DEFAULTS},
                              config=self.config)
-
-    @property
-    def texture_bits(self):
-        return self.texture_size.bit_length() - 1
 
     @property
     def scene(self):
@@ -377,5 +387,5 @@ def load_scene_config(source, overrides=None, flags=None, defaults=None) -> Scen
         if len(maps) == 1 and isinstance(keys[maps[0]], str):
             resample = keys.get("resample", False) is True
             keys["texture_size"] = map_size(keys[maps[0]], resample, keys.get("texture_size"),
-                                            maps[0].split("_")[0])
+                                            maps[0].split("_")[0], keys.get("texture_height"))
     return SceneConfig(**keys)

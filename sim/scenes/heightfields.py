@@ -1,4 +1,5 @@
-"""Height fields (T x T, values in [0, 1]) and displacement -> tangent-space normals."""
+"""Height fields (T x T, values in [0, 1]; :func:`resize_field` to W x H) and displacement ->
+tangent-space normals."""
 
 import numpy as np
 import skimage.data
@@ -6,7 +7,8 @@ from PIL import Image, ImageDraw, ImageFilter, ImageFont
 
 from bumprtl.rtl.config import BumpError
 
-__all__ = ["HEIGHTFIELDS", "craters", "height_to_normals", "normals_from_gradient", "smooth_noise"]
+__all__ = ["HEIGHTFIELDS", "craters", "height_to_normals", "normals_from_gradient", "resize_field",
+           "smooth_noise"]
 
 
 def _grid(t):
@@ -147,6 +149,16 @@ HEIGHTFIELDS = {"bricks": bricks, "wood": wood, "bumps": bumps, "text": text,
                 "brick": _skimage("brick"), "gravel": _skimage("gravel"), "moon": _skimage("moon")}
 
 
+def resize_field(height, width, tall):
+    """A ``width`` x ``width`` height field resampled to ``width`` x ``tall`` (rows ``tall``;
+    Lanczos, as a user's map is resampled): the picture of a square field on a non-square
+    map. ``tall == width``: the field itself, untouched."""
+    if tall == width:
+        return height
+    img = Image.fromarray(np.asarray(height, np.float32), "F")
+    return np.asarray(img.resize((width, tall), Image.Resampling.LANCZOS), np.float64)
+
+
 def normals_from_gradient(dh_dv, dh_du):
     """Tangent-space normals (phi, theta) of a surface with the given height slopes.
 
@@ -169,8 +181,8 @@ def height_to_normals(height, strength=1.0):
     h = np.asarray(height)
     if h.dtype.kind not in "fiu":
         raise BumpError(f"height map must be a real-valued array, got dtype {h.dtype}")
-    if h.ndim != 2 or h.shape[0] != h.shape[1] or h.size == 0:
-        raise BumpError(f"height map must be a non-empty square 2-D array, got shape {h.shape}")
+    if h.ndim != 2 or h.size == 0:
+        raise BumpError(f"height map must be a non-empty 2-D array, got shape {h.shape}")
     if isinstance(strength, bool) or not isinstance(strength, (int, float)) or \
             not 0 < strength < np.inf:
         raise BumpError(f"strength must be a positive finite number, got {strength!r}")

@@ -18,8 +18,10 @@ image), tangent y along columns u (to the right). So an OpenGL normal (r, g, b) 
 N' = (-g, r, b) and a DirectX one N' = (g, r, b).
 
 A map must be square with a power-of-two side in [16, 4096] (texel addressing by bit
-slicing, rtl/bumpfetch.py). Any other size is refused with the nearest allowed size named,
-or resampled to it on request (``resample``); a map is never cropped. Every problem raises a
+slicing, rtl/bumpfetch.py), or W x H with ``texture_size`` W and ``texture_height`` H given
+(powers of two, 16 <= H <= W <= 4096). Any other size is refused with the nearest allowed
+size named, or resampled to it on request (``resample``: to W x H, each axis on its own);
+a map is never cropped. Every problem raises a
 :class:`BumpError` whose one line names the file.
 """
 
@@ -68,6 +70,12 @@ class BumpMap:
 
     @property
     def size(self):
+        """The map's width W (u runs over it)."""
+        return self.b_phi_map.shape[1]
+
+    @property
+    def texture_height(self):
+        """The map's height H (v runs over it; W for a square map)."""
         return self.b_phi_map.shape[0]
 
 
@@ -151,19 +159,31 @@ def _check_shape(path, shape):
             f"{nearest_allowed_size(w, h)}x{nearest_allowed_size(w, h)}")
 
 
-def _resize(channels, size):
-    """Resample float maps ``(H, W[, C])`` to ``size`` x ``size`` (Lanczos, per channel)."""
+def _resize(channels, size, height=None):
+    """Resample float maps ``(H, W[, C])`` to ``size`` x ``height`` texels (width x height;
+    ``height`` None: ``size``; Lanczos, per channel)."""
     arr = np.asarray(channels, np.float64)
     planes = arr[..., None] if arr.ndim == 2 else arr
+    tall = size if height is None else height
     out = np.stack([np.asarray(Image.fromarray(planes[..., c].astype(np.float32), "F")
-                               .resize((size, size), Image.Resampling.LANCZOS), np.float64)
+                               .resize((size, tall), Image.Resampling.LANCZOS), np.float64)
                     for c in range(planes.shape[-1])], -1)
     return out[..., 0] if arr.ndim == 2 else out
 
 
-def _sized(path, arr, size, resample):
-    """``arr`` at ``size`` (given) or at its own size; otherwise refused or resampled."""
+def _wanted(size, height):
+    """How a message names the size asked for: ``texture_size = T``, or W x H."""
+    if height is None or height == size:
+        return f"texture_size = {size}"
+    return f"texture_size x texture_height = {size} x {height}"
+
+
+def _sized(path, arr, size, resample, height=None):
+    """``arr`` at ``size`` x ``height`` (given; ``height`` None: square) or at its own size;
+    otherwise refused or resampled."""
     problem = _check_shape(path, arr.shape)
+    if size is None and height is not None and _allowed(arr.shape[1]):
+        size = arr.shape[1]              # a non-square map keeps its own width
     if size is None:
         if problem is None:
             return arr
@@ -173,13 +193,14 @@ def _sized(path, arr, size, resample):
     if not _allowed(size):
         raise MapError(f"{path}: texture_size must be a power of two in [{MIN_SIZE}, "
                        f"{MAX_SIZE}], got {size!r}")
-    if arr.shape[:2] == (size, size):
+    tall = size if height is None else height
+    if arr.shape[:2] == (tall, size):
         return arr
     if not resample:
         h, w = arr.shape[:2]
-        raise MapError(f"{path}: {w}x{h} texels but texture_size = {size} (pass --resample / "
+        raise MapError(f"{path}: {w}x{h} texels but {_wanted(size, height)} (pass --resample / "
                        f"resample = true to resample it, or drop texture_size)")
-    return _resize(arr, size)
+    return _resize(arr, size, height)
 
 
 def _check_png(path, kind, depth, ctype):
@@ -202,10 +223,12 @@ def _check_png(path, kind, depth, ctype):
                            f"channel (save it as 8-bit RGB)")
 
 
-def map_size(path, resample=False, texture_size=None, kind=None):
-    """The side the map at ``path`` will have (reading only the header when it can):
-    its own, ``texture_size`` when given, or the nearest allowed size with ``resample``.
-    With ``kind`` (height or normal) a PNG's channels and bit depth are checked too."""
+def map_size(path, resample=False, texture_size=None, kind=None, texture_height=None):
+    """The width the map at ``path`` will have (reading only the header when it can): its
+    own, ``texture_size`` when given, or the nearest allowed size with ``resample``; its
+    height is ``texture_height`` when given (the width given or its own: a W x H file with
+    ``texture_height`` H needs no ``texture_size``), else the width. With ``kind`` (height or
+    normal) a PNG's channels and bit depth are checked too."""
     suffix = _suffix(path)
     raw = _read_bytes(path)
     if suffix == ".png":
@@ -218,10 +241,14 @@ def map_size(path, resample=False, texture_size=None, kind=None):
             raise MapError(f"{path}: a map must be a 2-D array (or (T, T, 3) vectors), got "
                            f"shape {shape}")
         h, w = shape[:2]
+    if texture_size is None and texture_height is not None and _allowed(w):
+        texture_size = w                  # a non-square map keeps its own width
     if texture_size is not None:
-        if (w, h) != (texture_size, texture_size) and not resample:
-            raise MapError(f"{path}: {w}x{h} texels but texture_size = {texture_size} (pass "
-                           f"--resample / resample = true to resample it, or drop texture_size)")
+        tall = texture_size if texture_height is None else texture_height
+        if (w, h) != (texture_size, tall) and not resample:
+            raise MapError(f"{path}: {w}x{h} texels but {_wanted(texture_size, texture_height)} "
+                           f"(pass --resample / resample = true to resample it, or drop "
+                           f"texture_size)")
         return texture_size
     problem = _check_shape(path, (h, w))
     if problem is None:
@@ -231,9 +258,10 @@ def map_size(path, resample=False, texture_size=None, kind=None):
     return nearest_allowed_size(w, h)
 
 
-def read_height(path, size=None, resample=False):
+def read_height(path, size=None, resample=False, height=None):
     """Heights of a greyscale PNG (8-bit: /255, 16-bit: /65535) or a 2-D ``.npy``, at
-    ``size`` (or the file's own size), float64."""
+    ``size`` x ``height`` (width x height; ``height`` None: square; or the file's own size),
+    float64."""
     suffix, raw = _suffix(path), _read_bytes(path)
     if suffix == ".npy":
         h = _load_npy(path, raw)
@@ -253,12 +281,13 @@ def read_height(path, size=None, resample=False):
         raise MapError(f"{path}: every texel has the same height ({h.flat[0]:g}): an all-flat "
                        f"map has no bumps (a scene with one normal per polygon is "
                        f"bump_map = 'flat')")
-    return _sized(path, h, size, resample)
+    return _sized(path, h, size, resample, height)
 
 
-def read_normals(path, convention="opengl", size=None, resample=False):
-    """Unit tangent-space normals ``(T, T, 3)`` in the bump map's frame (tangent x along
-    rows, y along columns, z out) of an 8-bit RGB PNG or a ``(T, T, 3)`` ``.npy``."""
+def read_normals(path, convention="opengl", size=None, resample=False, height=None):
+    """Unit tangent-space normals ``(H, W, 3)`` in the bump map's frame (tangent x along
+    rows, y along columns, z out) of an 8-bit RGB PNG or a ``(H, W, 3)`` ``.npy``, at
+    ``size`` x ``height`` as :func:`read_height`."""
     if convention not in CONVENTIONS:
         raise MapError(f"normal_convention must be one of {', '.join(CONVENTIONS)}, "
                        f"got {convention!r}")
@@ -296,17 +325,17 @@ def read_normals(path, convention="opengl", size=None, resample=False):
     if np.ptp(n.reshape(-1, 3), axis=0).max() == 0:
         raise MapError(f"{path}: every texel has the same normal: an all-flat map has no bumps "
                        f"(a scene with one normal per polygon is bump_map = 'flat')")
-    n = _sized(path, n, size, resample)
+    n = _sized(path, n, size, resample, height)
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
 @functools.lru_cache(maxsize=8)
-def _cached(path, stamp, kind, convention, height_scale, size, resample):
+def _cached(path, stamp, kind, convention, height_scale, size, resample, height):
     if kind == "height":
-        h = read_height(path, size, resample)
+        h = read_height(path, size, resample, height)
         n = displacement_to_normals(h, height_scale)        # Tarini Sec. 4.1
     else:
-        h, n = None, read_normals(path, convention, size, resample)
+        h, n = None, read_normals(path, convention, size, resample, height)
     phi, theta = cartesian_to_polar(n)
     for a in (phi, theta, h):
         if a is not None:
@@ -315,16 +344,18 @@ def _cached(path, stamp, kind, convention, height_scale, size, resample):
 
 
 def load_bump_map(path, kind, convention="opengl", height_scale=DEFAULT_HEIGHT_SCALE,
-                  size=None, resample=False) -> BumpMap:
+                  size=None, resample=False, height=None) -> BumpMap:
     """The bump vector map of a height map (``kind = "height"``) or a normal map
-    (``"normal"``) file, at ``size`` x ``size`` texels (default: the file's own size).
-    Cached by path, modification time and arguments."""
+    (``"normal"``) file, at ``size`` x ``height`` texels (width x height; ``height`` None:
+    ``size``; default: the file's own size). Cached by path, modification time and
+    arguments."""
     if kind not in KINDS:
         raise MapError(f"map kind must be one of {', '.join(KINDS)}, got {kind!r}")
     check_height_scale(height_scale)
     p = Path(path)
     stamp = p.stat().st_mtime_ns if p.is_file() else None
-    return _cached(str(path), stamp, kind, convention, float(height_scale), size, bool(resample))
+    return _cached(str(path), stamp, kind, convention, float(height_scale), size, bool(resample),
+                   height)
 
 
 def check_height_scale(value):

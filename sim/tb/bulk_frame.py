@@ -214,15 +214,14 @@ def _address_coords(scene, addr, rng):
     """Level-0 texel coordinates (u, v) and the level that read word ``addr``."""
     bases = level_bases(scene)
     level = np.searchsorted(bases, addr, side="right") - 1
-    size = scene.texture_size >> level
+    size = scene.texture_size >> level                # the level's width: rows of it
     local = addr - np.asarray(bases)[level]
     u, v = (local % size) << level, (local // size) << level
     u = u + rng.integers(0, 1 << level)           # the dropped low bits of floor(u / 2**l)
     v = v + rng.integers(0, 1 << level)
-    if scene.addressing == "wrap":                # a map width further (either side)
-        t = scene.texture_size
-        u = u + t * rng.integers(-2, 2, len(u))
-        v = v + t * rng.integers(-2, 2, len(v))
+    if scene.addressing == "wrap":                # a map width (height) further, either side
+        u = u + scene.texture_size * rng.integers(-2, 2, len(u))
+        v = v + scene.map_height * rng.integers(-2, 2, len(v))
     return u, v, level
 
 
@@ -239,14 +238,14 @@ def _texel_inputs(scene, n, rng, words, addr):
     out["u"][pick], out["v"][pick], level[pick] = wu, wv, wl
     pick = np.nonzero(kind == 2)[0]
     if len(pick) and words is not None and scene.shading != "palette":
-        t = scene.texture_size
-        theta = (np.asarray(words[:t * t], np.int64) >> scene.angle_bits)
+        t, n0 = scene.texture_size, scene.texture_size * scene.map_height     # level 0
+        theta = (np.asarray(words[:n0], np.int64) >> scene.angle_bits)
         order = np.argsort(theta, kind="stable")
         ends = np.concatenate([order[::-1][:(len(pick) + 1) // 2], order[:len(pick) // 2]])
         out["u"][pick], out["v"][pick], level[pick] = ends % t, ends // t, 0
     elif len(pick) and words is not None:        # palette: every index the map holds
-        t = scene.texture_size
-        first = np.unique(np.asarray(words[:t * t]), return_index=True)[1]
+        t, n0 = scene.texture_size, scene.texture_size * scene.map_height
+        first = np.unique(np.asarray(words[:n0]), return_index=True)[1]
         texel = rng.choice(first, len(pick), replace=len(first) < len(pick))
         out["u"][pick], out["v"][pick], level[pick] = texel % t, texel // t, 0
     if lb:

@@ -181,9 +181,9 @@ def pipeline_map(scene, seed):
     texel of every level N' = N (theta_A = 0), where the corners of the first chunk
     (sim/golden/fixed/pipeline.corner_inputs) read. Emit the pipeline with these words as
     its map (``BumpPipeline(scene, init=...)``)."""
-    t = scene.texture_size
-    codes = stress_codes(t * t, scene.config, seed)
-    level0 = pack_texels(scene, codes["b.phi"].reshape(t, t), codes["b.theta"].reshape(t, t))
+    t, h = scene.texture_size, scene.map_height
+    codes = stress_codes(t * h, scene.config, seed)
+    level0 = pack_texels(scene, codes["b.phi"].reshape(h, t), codes["b.theta"].reshape(h, t))
     words = map_words([level0[::1 << n, ::1 << n] for n in range(scene.mip_levels)], scene)
     words[corner_texels(scene)] &= (1 << scene.angle_bits) - 1          # theta_A = 0
     return words
@@ -206,7 +206,7 @@ def _pipeline(meta, spec, chunk):
         for k, n in enumerate(_counts(int(spec["n"]), chunk)):
             rng = np.random.default_rng(seed * 1000 + k)
             codes = stress_codes(n, scene.config, seed * 1000 + k) if k % 2 == 0 else {}
-            texel = (np.arange(start, start + n)) % (t * t)
+            texel = (np.arange(start, start + n)) % (t * scene.map_height)
             inputs = {"u": texel % t, "v": texel // t, "level": rng.integers(0, scene.mip_levels, n),
                       "tag": None, **codes}
             if any(c not in inputs for c in keys):      # more lights than the stress cases

@@ -34,10 +34,11 @@ from bumprtl.sim.tb.tb_cache import LATENCIES, LatentAxiRamRead
 from bumprtl.sim.tb.tb_pipeline import host_setup
 
 
-def raster(size, n):
+def raster(size, n, height=None):
     """``{u, v, level}`` of ``n`` pixels of a plane at one texel per pixel (a ``size`` x
-    ``size`` frame on the map) in raster order from the frame's centre row on."""
-    u, v, _ = texel_coordinates("plane", size, size)
+    ``size`` frame on a ``size`` x ``height`` map: u over the width, v over the height; None:
+    square) in raster order from the frame's centre row on."""
+    u, v, _ = texel_coordinates("plane", size, size, height)
     top = max(0, size // 2 - n // (2 * size))
     u, v = u[top:].ravel()[:n], v[top:].ravel()[:n]
     return {"u": u, "v": v, "level": np.zeros_like(u)}
@@ -72,7 +73,8 @@ async def pipeline_matches_golden_against_axi_ram(dut, latency):
     rng = np.random.default_rng(latency)
     inputs = random_inputs(scene, samples(150), rng)
     if os.environ.get("BUMPRTL_STIMULUS") == "raster":
-        inputs.update({k: c for k, c in raster(scene.texture_size, len(inputs["u"])).items()
+        inputs.update({k: c for k, c in raster(scene.texture_size, len(inputs["u"]),
+                                                         scene.map_height).items()
                        if k in inputs})
     golden = pipeline_fixed(inputs, scene, words)
     cache = run_scene_cache(scene.hardware, geom, inputs, words)

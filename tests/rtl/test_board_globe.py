@@ -105,6 +105,32 @@ def test_golden_globe_is_lit_on_the_side_facing_the_light(step, quadrant):
     assert min(abs(cx), abs(cy)) > 2
 
 
+def test_golden_globe_of_a_2_to_1_map_reads_v_over_the_height():
+    """A 32 x 16 map (texture_height 16, W = 2H: equirectangular) on the globe: v runs over
+    the colatitude in H rows, u over the longitude in W columns. floor(x H) is
+    floor(floor(x 2H) / 2) exactly, so the frame equals the square 32 x 32 map's frame with
+    each of the 2:1 map's rows written twice (row v' of the square map = row v' >> 1); v
+    spans the rows from near the north pole to near the south pole, never past the last."""
+    keys = {**SMALL, "texture_size": 32}
+    wide = load_scene_config("default", {**keys, "texture_height": 16})
+    square = load_scene_config("default", keys)
+    mode = dataclasses.replace(MODES["test"], h_active=48, v_active=40)
+    assert (globe_config(wide.hardware, mode).map_width,
+            globe_config(wide.hardware, mode).map_height) == (32, 16)
+    words, texels, _, table = board_data(wide)
+    assert len(words) == 32 * 16
+    doubled = np.repeat(np.asarray(words).reshape(16, 32), 2, axis=0).ravel()
+    for frame in (0, 3):
+        got = golden_frame(wide, mode, frame, table, words, texels)
+        assert np.array_equal(got, golden_frame(square, mode, frame, table, doubled, texels))
+        assert got.any()
+    inputs = frame_inputs(wide, mode, 0, table)
+    inside = (inputs["tag"] >> (wide.tag_bits - 1) & 1) == 1
+    assert inputs["v"][inside].min() <= 1 and inputs["v"][inside].max() >= 14
+    assert inputs["u"].max() < 32 and inputs["v"].max() < 16
+    assert len(np.unique(inputs["u"][inside])) == 16       # the visible half of the longitudes
+
+
 def source_payloads(scene, mode, table, frames, seed):
     """The payload fields of every pixel GlobeSource hands the pipeline over ``frames``
     frames, under random credits at both ends, and the rotation of every pixel the globe

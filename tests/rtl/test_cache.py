@@ -83,6 +83,19 @@ def test_cache_bit_exact_geometries(texel_bits, data_bits, ways, block):
     assert golden.evictions
 
 
+def test_cache_bit_exact_nonsquare_map():
+    """A 64 x 32 map (texture_height 32) of three levels (64 x 32, 32 x 16, 16 x 8): lines
+    of 4 x 4 blocks, 16 a row and 8 a column at level 0; the u and v ports of their own
+    widths (6 and 5 bits)."""
+    geom = CacheGeometry(64, 3, 28, sets=8, texture_height=32)
+    assert geom.lines == 128 + 32 + 8
+    dut = TextureCache(geom)
+    dut._MustUse__silence = True                  # its ports only: check_cache builds its own
+    assert (dut.i.payload.u.shape().width, dut.i.payload.v.shape().width) == (6, 5)
+    golden, _ = check_cache(geom, n=120, seed=11)
+    assert golden.evictions
+
+
 @pytest.mark.parametrize("ways", [1, 2])
 def test_cache_bit_exact_with_one_set(ways):
     """sets = 1: no set bits in the address, every line competes for the one set's ways."""
@@ -178,6 +191,31 @@ def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, 
     assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
     golden = run_scene_cache(scene.hardware, geom, inputs, words)
     assert mem.requests == golden.requests and golden.evictions
+
+
+@pytest.mark.parametrize("addressing", ["wrap", "clamp"])
+def test_pipeline_axi_nonsquare_map_bit_exact(addressing):
+    """A 32 x 16 map of two levels (texture_height 16) in AXI memory: u wraps or clamps by
+    each level's width, v by its height (random coordinates over the whole signed port
+    range); the outputs bit-exact with the golden pipeline, the AR stream the golden cache
+    model's."""
+    scene = load_scene_config({**BUILTIN["default"], **AXI_SCENE, "texture_size": 32,
+                               "texture_height": 16, "addressing": addressing})
+    rng = np.random.default_rng(5)
+    words = random_map(scene, rng)
+    assert len(words) == 32 * 16 + 16 * 8
+    inputs = random_inputs(scene, 80, rng)
+    dut = BumpPipeline(scene.hardware, cache={"sets": 4})
+    geom = dut.units["fetch"].geom
+    assert (geom.texture_size, geom.height) == (32, 16)
+    mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
+                        latency=7, ar_stall=0.3, r_stall=0.3, seed=5)
+    payloads = as_payload_list(inputs)
+    out, _ = simulate_stream(dut, payloads, "both", seed=5, max_cycles=40_000,
+                             processes=[mem.process])
+    assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
+    golden = run_scene_cache(scene.hardware, geom, inputs, words)
+    assert mem.requests == golden.requests
 
 
 def test_map_memory_refusals():

@@ -16,6 +16,11 @@ from bumprtl.rtl.scene import HardwareScene
     ({"texture_size": True}, "texture_size"),
     ({"texture_size": 16, "mip_levels": 6}, "mip_levels"),
     ({"mip_levels": 0}, "mip_levels"),
+    ({"texture_size": 64, "texture_height": 128}, "texture_height"),
+    ({"texture_size": 64, "texture_height": 48}, "texture_height"),
+    ({"texture_size": 64, "texture_height": 8}, "texture_height"),
+    ({"texture_size": 64, "texture_height": True}, "texture_height"),
+    ({"texture_size": 64, "texture_height": 16, "mip_levels": 6}, "mip_levels"),
     ({"shading": "gouraud"}, "shading"),
     ({"bump_map": "bumpy"}, "bump_map"),
     ({"addressing": "mirror"}, "addressing"),
@@ -29,6 +34,25 @@ def test_a_bad_switch_names_its_field(keys, field):
         HardwareScene(**keys)
     assert e.value.field == field
     assert field in str(e.value) and "\n" not in str(e.value)
+
+
+def test_texture_height_range_and_the_map_size_it_gives():
+    """texture_height: a power of two in [16, texture_size] (the message names both ends);
+    mip levels stop at the height's last (log2 H + 1); None is the square map."""
+    with pytest.raises(BumpError) as e:
+        HardwareScene(texture_size=64, texture_height=128)
+    assert str(e.value) == ("texture_height must be a power of two in [16, 64] (the map's "
+                            "height, at most its width texture_size = 64), got 128")
+    with pytest.raises(BumpError, match=r"mip_levels must be an integer in \[1, 5\] for a "
+                                        r"64 x 16 map, got 6"):
+        HardwareScene(texture_size=64, texture_height=16, mip_levels=6)
+    s = HardwareScene(texture_size=64, texture_height=16, mip_levels=5)
+    assert (s.map_height, s.height_bits, s.texture_bits, s.square) == (16, 4, 6, False)
+    assert [s.level_size(n) for n in range(5)] == [(64, 16), (32, 8), (16, 4), (8, 2), (4, 1)]
+    square = HardwareScene(texture_size=32)
+    assert (square.texture_height, square.map_height, square.height_bits, square.square) == \
+        (None, 32, 5, True)
+    assert s.replace(texture_height=None).map_height == 64
 
 
 def test_the_top_mip_level_is_allowed_and_rotation_is_derived():

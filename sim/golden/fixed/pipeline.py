@@ -77,7 +77,7 @@ def unpack_texels(words, scene: SceneConfig):
 
 
 def map_words(levels, scene: SceneConfig):
-    """The memory image: per-level (T_l, T_l) word maps, row v, column u, one after the
+    """The memory image: per-level (H_l, W_l) word maps, row v, column u, one after the
     other at :func:`level_bases`."""
     if len(levels) != scene.mip_levels:
         raise ValueError(f"{len(levels)} levels given, the scene has {scene.mip_levels}")
@@ -160,7 +160,8 @@ def corner_texels(scene):
     :func:`corner_inputs` read (their coordinates wrap or clamp to one of the two)."""
     ends = []
     for base, n in zip(level_bases(scene), range(scene.mip_levels), strict=True):
-        ends += [base, base + (scene.texture_size >> n) ** 2 - 1]
+        width, height = scene.level_size(n)
+        ends += [base, base + width * height - 1]
     return np.array(ends, np.int64)
 
 
@@ -191,7 +192,7 @@ def corner_inputs(scene: SceneConfig):
     """The extreme corners of the pipeline's inputs (dict of arrays, no tag), the rows of
     :func:`~bumprtl.sim.golden.vectors.corner_codes` with every light given the same row
     (so m lights are head-on, or behind, at once: the light sum at its maximum), each row
-    at one of the texel coordinates 0, the map's last texel (T - 1) and both ends of the
+    at one of the texel coordinates 0, the map's last texel (W - 1, H - 1) and both ends of the
     signed port range, in turn, and at level 0 or the last level code, in turn. Palette
     shading: the coordinate corners alone. Widths from ``scene``."""
     cfg = scene.config
@@ -199,9 +200,9 @@ def corner_inputs(scene: SceneConfig):
     rows = len(next(iter(codes.values()))) if codes else 8
     out = {}
     if has_map(scene) or scene.texture:
-        half, last = 1 << (coord_bits(scene) - 1), scene.texture_size - 1
-        coords = np.resize([0, last, -half, half - 1], rows)
-        out["u"], out["v"] = coords, coords
+        half = 1 << (coord_bits(scene) - 1)
+        out["u"], out["v"] = (np.resize([0, last, -half, half - 1], rows)
+                              for last in (scene.texture_size - 1, scene.map_height - 1))
         if scene.mip_levels > 1:
             out["level"] = np.resize([0, 0, 0, 0, (1 << level_bits(scene)) - 1], rows)
     if codes:

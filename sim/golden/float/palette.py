@@ -49,10 +49,11 @@ def displacement_to_normals(height, scale=1.0, offsets=CROSS):
     """Sec. 4.1: per texel, the plane ``a . (x, y, 1) = z`` fitted by least squares to the
     (scaled) displacements of the texel and its neighbours ``offsets`` (row, col; wrapping);
     the normal is ``normalize(-a0, -a1, 1)``. x runs along rows (tangent x = d/dv) and y
-    along columns, the convention of :mod:`bumprtl.sim.scenes`. Returns ``(T, T, 3)``."""
+    along columns, the convention of :mod:`bumprtl.sim.scenes`. Returns ``(H, W, 3)`` for
+    an ``(H, W)`` map (square or not: the fit wraps each axis by its own length)."""
     h = np.asarray(height, dtype=np.float64)
-    if h.ndim != 2 or h.shape[0] != h.shape[1] or h.size == 0:
-        raise BumpError(f"height must be a non-empty square 2-D map, got shape {h.shape}")
+    if h.ndim != 2 or h.size == 0:
+        raise BumpError(f"height must be a non-empty 2-D map, got shape {h.shape}")
     if not np.all(np.isfinite(h)):
         raise BumpError("height contains NaN or infinity")
     x = np.array([[dr, dc, 1.0] for dr, dc in offsets])

@@ -114,3 +114,44 @@ def test_a_bitstream_reaching_past_the_map_is_an_error_after_the_build(tmp_path,
         assert r.returncode == status, r.stderr
         assert ("the bitstream's 2,097,153 bytes reach past the map's flash offset 0x200000"
                 in r.stderr) == bool(status)
+
+
+def test_a_2_to_1_map_image_is_tiled_by_its_width_and_height(tmp_path, run_cli):
+    """A 32 x 16 globe map (texture_height 16, W = 2H: equirectangular) in the SDRAM: the
+    board run without a bitstream writes its tiled image, (32 x 16) / (4 x 4) lines of 64
+    bytes; texels of level 0 sit at the documented layout's byte with a line W / B blocks
+    long (computed here), each the scene's word at row v, column u of the W x H map."""
+    scene_file = tmp_path / "globe.toml"
+    scene_file.write_text('image = "globe"\ntexture_size = 32\ntexture_height = 16\n'
+                          'map_memory = "axi"\n')
+    out = tmp_path / "b"
+    r = run_cli(["board", "ulx3s", "--scene", scene_file, "--out", out, "--no-bitstream"])
+    assert r.returncode == 0, r.stderr
+    image = (out / "ulx3s_85f_map.bin").read_bytes()
+    W, H, B, slot = 32, 16, 4, 4
+    assert len(image) == (W // B) * (H // B) * B * B * slot == 2048
+    scene = load_scene_config(str(scene_file))
+    words = np.asarray(board_data(scene)[0], np.int64)
+    assert len(words) == W * H
+    for u, v in ((0, 0), (1, 0), (0, 1), (B, 0), (0, B), (29, 13), (W - 1, H - 1), (W - 1, 0)):
+        at = ((v // B) * (W // B) + u // B) * B * B * slot + ((v % B) * B + u % B) * slot
+        assert int.from_bytes(image[at:at + slot], "little") == words[v * W + u], (u, v)
+
+
+def test_the_2048_by_1024_globe_map_fits_the_flash_and_2048_square_does_not():
+    """The ULX3S globe at 1280 x 720 with a 2048 x 1024 map in the SDRAM passes the board's
+    checks (its tiled image 2048 x 1024 texels of 4 bytes: 8,388,608 bytes, within the
+    14,680,064 bytes of flash after the bitstream); texture_height = 512 is refused for the
+    globe (a latitude-longitude map is W = 2H or square), naming texture_height."""
+    from bumprtl.gen.flow.board import check_board
+    from bumprtl.rtl.config import BumpError
+    keys = {"image": "globe", "texture_size": 2048, "texture_height": 1024, "map_memory": "axi"}
+    scene = load_scene_config(keys)
+    assert check_board("ulx3s", "1280x720", scene)[1] == "LFE5U-85F"
+    assert scene_geometry(scene.hardware).image_bytes == 2048 * 1024 * 4 == 8_388_608
+    with pytest.raises(BumpError, match="16,777,216 bytes, more than the 14,680,064") as e:
+        check_board("ulx3s", "1280x720", load_scene_config({**keys, "texture_height": None}))
+    assert e.value.field == "texture_size"
+    with pytest.raises(BumpError, match="texture_height = texture_size / 2 = 1024") as e:
+        check_board("ulx3s", "1280x720", load_scene_config({**keys, "texture_height": 512}))
+    assert e.value.field == "texture_height"

@@ -120,6 +120,25 @@ def test_a_bad_value_is_one_error_line_naming_the_parameter(capsys):
     assert err.startswith("bumprtl: error: ") and "angle_bits" in err
 
 
+@pytest.mark.parametrize("keys, words", [
+    ("texture_size = 64\ntexture_height = 128\n", "texture_height must be a power of two in [16, 64]"),
+    ("texture_size = 64\ntexture_height = 24\n", "texture_height must be a power of two in [16, 64]"),
+    ("texture_size = 64\ntexture_height = 16\nmip_levels = 6\n", "mip_levels must be an integer in [1, 5]"),
+    ('shading = "palette"\ntexture_size = 64\ntexture_height = 32\n', "texture_height = 32"),
+])
+def test_a_bad_texture_height_is_one_line_exit_2_and_nothing_written(tmp_path, capsys, keys, words):
+    """A scene file with a bad texture_height (out of range, not a power of two, too many
+    mip levels for the height, a palette scene's non-square map): exit 2, one line naming
+    the key, no file written."""
+    path = tmp_path / "s.toml"
+    path.write_text(keys)
+    out_dir = tmp_path / "out"
+    assert cli_main.main(["emit", "pipeline", "--scene", str(path), "--out", str(out_dir)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and words in err, err
+    assert not out_dir.exists()
+
+
 def test_interrupt_exits_130(monkeypatch, capsys):
     def interrupted():
         raise KeyboardInterrupt

@@ -61,17 +61,22 @@ def test_plane_normal_faces_the_viewer():
         assert plane_constants(scene) == {"n.phi": 3 << (bits - 2), "n.theta": 1 << (bits - 2)}
 
 
-@pytest.mark.parametrize("zoom, frame", [(0, 0), (1, 5)])
-def test_frame_inputs_are_the_screen_texels_the_constants_and_the_frames_light(zoom, frame):
-    scene = load_scene_config("default", SMALL)
+@pytest.mark.parametrize("zoom, frame, width, height", [(0, 0, 16, 16), (1, 5, 16, 16),
+                                                         (0, 2, 32, 16)])
+def test_frame_inputs_are_the_screen_texels_the_constants_and_the_frames_light(zoom, frame,
+                                                                                width, height):
+    """The plane tiles the map over the screen: u wraps by the map's width, v by its height
+    (a 32 x 16 map: texture_height 16)."""
+    scene = load_scene_config("default", {**SMALL, "texture_size": width,
+                                          "texture_height": height})
     mode = dataclasses.replace(MODES["test"], zoom=zoom)
     table = light_table(scene, 4)
     got = frame_inputs(scene, mode, frame, table)
     n = mode.h_active * mode.v_active
     y, x = np.divmod(np.arange(n), mode.h_active)          # raster order
-    t = scene.texture_size
-    assert np.array_equal(got["u"], (x // 2 ** zoom) % t)
-    assert np.array_equal(got["v"], (y // 2 ** zoom) % t)
+    assert mode.v_active > height                           # v wraps within the frame
+    assert np.array_equal(got["u"], (x // 2 ** zoom) % width)
+    assert np.array_equal(got["v"], (y // 2 ** zoom) % height)
     light = table[frame % 4]
     assert set(got) == {"u", "v", "tag", "n.phi", "n.theta", *light}
     for k, c in {**plane_constants(scene), **light}.items():

@@ -43,7 +43,7 @@ def test_layout_round_trip(texel_bits, block, levels):
     assert len(image) == g.image_bytes
     seen = set()
     for lv in range(levels):
-        side = g.level_side(lv)
+        side = g.level_width(lv)
         v, u = np.mgrid[0:side, 0:side]
         addr = texel_byte_address(u, v, lv, g)
         for uu, vv, a in zip(u.ravel(), v.ravel(), addr.ravel(), strict=True):
@@ -52,7 +52,65 @@ def test_layout_round_trip(texel_bits, block, levels):
             got = int.from_bytes(image[off:off + g.slot_bytes], "little")
             assert got == words[lv][vv, uu], (lv, uu, vv)
             seen.add(off)
-    assert len(seen) == sum(g.level_side(lv) ** 2 for lv in range(levels))   # a bijection
+    assert len(seen) == sum(g.level_width(lv) ** 2 for lv in range(levels))   # a bijection
+
+
+def _nonsquare_image(width, height, levels, block, slot, texel_bits, seed):
+    """Written here, without rtl/cache: the tiled image of a ``width`` x ``height`` map.
+    Level l is (width >> l) x (height >> l) texels; it is cut into block x block tiles,
+    ceil((width >> l) / block) a row and ceil((height >> l) / block) a column (a level
+    smaller than a block takes one whole tile); the tiles follow each other row by row,
+    level after level, each one a line of block * block slots of ``slot`` bytes, the
+    texels row-major inside their tile, little-endian. Returns (image bytes, the levels'
+    [v][u] words, line count)."""
+    rng = np.random.default_rng(seed)
+    tiles, words = [], []
+    for lv in range(levels):
+        w, h = width >> lv, height >> lv
+        level = rng.integers(0, 1 << texel_bits, (h, w))
+        words.append(level)
+        across, down = -(-w // block), -(-h // block)
+        for ty in range(down):
+            for tx in range(across):
+                tile = bytearray(block * block * slot)
+                for r in range(block):
+                    for c in range(block):
+                        u, v = tx * block + c, ty * block + r
+                        if u < w and v < h:
+                            at = (r * block + c) * slot
+                            tile[at:at + slot] = int(level[v, u]).to_bytes(slot, "little")
+                tiles.append(bytes(tile))
+    return b"".join(tiles), words, len(tiles)
+
+
+@pytest.mark.parametrize("width,height,levels,block,texel_bits", [
+    (64, 32, 2, 4, 28), (32, 16, 5, 4, 8), (64, 16, 3, 8, 16), (16, 16, 3, 4, 28)])
+def test_nonsquare_tiled_image_is_the_independent_one(width, height, levels, block, texel_bits):
+    """A W x H map (texture_height < texture_size) in the tiled layout: tiled_image's bytes,
+    the line count and image size equal the image built here tile by tile; every texel's
+    byte address (texel_byte_address, what the RTL and the golden cache read) holds its
+    word."""
+    g = CacheGeometry(width, levels, texel_bits, block=block,
+                      texture_height=None if height == width else height)
+    want, words, lines = _nonsquare_image(width, height, levels, block, g.slot_bytes,
+                                          texel_bits, width + levels)
+    assert g.height == height and g.lines == lines and g.image_bytes == len(want)
+    assert [g.blocks_per_row(lv) * g.blocks_per_column(lv) for lv in range(levels)] == \
+        [max(1, (width >> lv) // block) * max(1, (height >> lv) // block) for lv in range(levels)]
+    assert [w.shape for w in random_levels(g)] == [(height >> lv, width >> lv) for lv in range(levels)]
+    assert tiled_image(g, words) == want
+    for lv in range(levels):
+        v, u = np.mgrid[0:height >> lv, 0:width >> lv]
+        at = texel_byte_address(u.ravel(), v.ravel(), lv, g)
+        got = [int.from_bytes(want[a:a + g.slot_bytes], "little") for a in at.tolist()]
+        assert got == words[lv].ravel().tolist()
+
+
+def test_nonsquare_levels_of_the_wrong_shape_are_refused():
+    """tiled_image takes level l as an (H >> l, W >> l) array: the transposed one is refused."""
+    g = CacheGeometry(32, 1, 8, texture_height=16)
+    with pytest.raises(BumpError, match=r"level 0 must be 32 x 16 texels"):
+        tiled_image(g, [np.zeros((32, 16), np.int64)])
 
 
 def test_geometry_refusals():
@@ -64,6 +122,10 @@ def test_geometry_refusals():
         CacheGeometry(4096, 1, 28, addr_bits=20)
     with pytest.raises(BumpError, match="block must make a line"):
         CacheGeometry(64, 1, 8, block=2, data_bits=64)        # 4 bytes < one 8-byte beat
+    with pytest.raises(BumpError, match=r"texture_height must be a power of two in \[1, 64\]"):
+        CacheGeometry(64, 1, 28, texture_height=128)           # taller than wide
+    with pytest.raises(BumpError, match=r"mip_levels must be an integer in \[1, 5\]"):
+        CacheGeometry(64, 6, 28, texture_height=16)            # levels stop at H's last
 
 
 def test_plru_is_lru_for_two_ways_and_tree_for_four():

@@ -94,6 +94,8 @@ SCENE_RANGES = [
     ("texture_size", 16, 4096, [15, 4097, 8, 8192], {}),
     ("mip_levels", 1, 7, [0, 8], {"texture_size": 64}),
     ("mip_levels", 1, 5, [0, 6], {"texture_size": 16}),
+    ("texture_height", 16, 64, [15, 65, 8, 128, 48], {"texture_size": 64}),
+    ("mip_levels", 1, 5, [0, 6], {"texture_size": 64, "texture_height": 16}),
     ("angle_bits", 4, 16, [3, 17], {}),
     ("spec_index_bits", 4, 16, [3, 17], {}),
     ("spec_exponent", 1, 1024, [0, 1025], {}),
@@ -141,6 +143,9 @@ SCENE_ENDS = [
       for k in ("ka", "kd", "ks")],
     *[("mip_levels", 1, t.bit_length(), [0, t.bit_length() + 1], {"texture_size": t})
       for t in (16, 32, 64, 128, 256, 512, 1024, 2048, 4096)],
+    *[("texture_height", 16, t, [8, 2 * t], {"texture_size": t}) for t in (16, 4096)],
+    *[("mip_levels", 1, h.bit_length(), [0, h.bit_length() + 1],
+       {"texture_size": 4096, "texture_height": h}) for h in (16, 1024)],
 ]
 
 

@@ -199,8 +199,8 @@ def test_height_to_normals_is_a_wrapping_central_difference():
 
 @pytest.mark.parametrize("height, strength, words", [
     (np.zeros((4, 4), bool), 1.0, "real-valued array, got dtype bool"),
-    (np.zeros((4, 4, 1)), 1.0, "non-empty square 2-D array, got shape (4, 4, 1)"),
-    (np.zeros((0, 0)), 1.0, "non-empty square 2-D array, got shape (0, 0)"),
+    (np.zeros((4, 4, 1)), 1.0, "non-empty 2-D array, got shape (4, 4, 1)"),
+    (np.zeros((0, 0)), 1.0, "non-empty 2-D array, got shape (0, 0)"),
     (np.zeros((4, 4)), True, "strength must be a positive finite number, got True"),
     (np.zeros((4, 4)), 0.0, "strength must be a positive finite number, got 0.0"),
     (np.zeros((4, 4)), float("inf"), "got inf"),

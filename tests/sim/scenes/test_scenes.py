@@ -103,8 +103,9 @@ def test_light_angles_accepted_at_both_ends_and_refused_past_them(pname, lo, hi)
 
 
 def test_bad_height_map():
-    with pytest.raises(BumpError, match="square"):
-        height_to_normals(np.zeros((4, 5)))
+    with pytest.raises(BumpError, match="non-empty 2-D array"):
+        height_to_normals(np.zeros((4, 5, 1)))
+    assert height_to_normals(np.zeros((4, 8)))[0].shape == (4, 8)   # a W x H map: H rows
     with pytest.raises(BumpError, match="NaN"):
         height_to_normals(np.full((4, 4), np.nan))
 

@@ -390,3 +390,67 @@ def test_map_size_of_a_bad_npy_names_the_file(tmp_path):
         with pytest.raises(BumpError) as e:
             map_size(tmp_path / name)
         assert str(e.value).startswith(str(tmp_path / name) + ": ") and words in str(e.value)
+
+
+def _lanczos_matrix(n_in, n_out):
+    """Written here: the (n_out, n_in) weights of a Lanczos-3 resampling of one axis, as an
+    image resize computes it (output texel i centred at (i + 0.5) n_in / n_out input texels,
+    the kernel sinc(x) sinc(x / 3) on |x| < 3 stretched by the scale when shrinking, its
+    window cut at the edges and the weights normalised to sum 1)."""
+    scale = n_in / n_out
+    stretch = max(scale, 1.0)
+    support = 3.0 * stretch
+    m = np.zeros((n_out, n_in))
+    for i in range(n_out):
+        centre = (i + 0.5) * scale
+        lo, hi = max(int(centre - support + 0.5), 0), min(int(centre + support + 0.5), n_in)
+        x = (np.arange(lo, hi) - centre + 0.5) / stretch
+        w = np.where(np.abs(x) < 3, np.sinc(x) * np.sinc(x / 3), 0.0)
+        m[i, lo:hi] = w / w.sum()
+    return m
+
+
+@pytest.mark.parametrize("shape, size, height", [((96, 80), 64, 32), ((40, 24), 32, 16),
+                                                 ((16, 48), 64, 16)])
+def test_a_non_square_resampled_map_is_the_independent_resampling(tmp_path, shape, size, height):
+    """A height map resampled to texture_size x texture_height (W x H): each axis on its
+    own, the rows to H and the columns to W (a transposed or squared resampling differs);
+    the heights equal a separable Lanczos-3 resampling written here, and the scene's bump
+    map is the plane fit of those heights."""
+    rng = np.random.default_rng(shape[0])
+    h = rng.random(shape)
+    path = tmp_path / "h.npy"
+    np.save(path, h)
+    want = _lanczos_matrix(shape[0], height) @ h @ _lanczos_matrix(shape[1], size).T
+    got = read_height(path, size, resample=True, height=height)
+    assert got.shape == (height, size)
+    assert np.allclose(got, want, rtol=0, atol=2e-5), np.abs(got - want).max()
+    from bumprtl.gen.render.rtl import sim_scene
+    from bumprtl.sim.scenes.config import load_scene_config
+    scene = load_scene_config({"height_map": str(path), "texture_size": size,
+                               "texture_height": height, "resample": True})
+    assert (scene.texture_size, scene.map_height) == (size, height)
+    base = sim_scene(scene, 16)
+    assert base.b_phi_map.shape == (height, size)
+    assert np.allclose(polar_to_cartesian(base.b_phi_map, base.b_theta_map),
+                       displacement_to_normals(want, scene.height_scale), rtol=0, atol=1e-4)
+
+
+def test_a_w_by_h_map_is_its_own_size_with_texture_height(tmp_path):
+    """A 64 x 32 PNG with texture_height = 32 is read as it is (its width the texture_size),
+    no resampling; without texture_height it is refused (not square), and with a height
+    that is not its own it needs resample, the message naming both sides."""
+    from bumprtl.sim.scenes.config import load_scene_config
+    from bumprtl.sim.scenes.usermap import MapError
+    h = hex_tiles(64)[:32]
+    path = _grey_png(tmp_path / "wide.png", h)
+    assert map_size(path, texture_height=32) == 64
+    scene = load_scene_config({"height_map": str(path), "texture_height": 32})
+    assert (scene.texture_size, scene.texture_height) == (64, 32)
+    bm = load_bump_map(path, "height", size=64, height=32)
+    assert (bm.size, bm.texture_height) == (64, 32)
+    assert np.allclose(read_height(path, 64, height=32), np.rint(h * 255) / 255)
+    with pytest.raises(MapError, match="64x32 texels; a map must be square"):
+        load_scene_config({"height_map": str(path)})
+    with pytest.raises(MapError, match="64x32 texels but texture_size x texture_height = 64 x 16"):
+        load_scene_config({"height_map": str(path), "texture_height": 16})

@@ -74,12 +74,27 @@ def test_a_constant_height_and_a_periodic_ramp_along_columns():
 @pytest.mark.parametrize("height, words", [
     (np.zeros((4, 4, 1)), "got shape (4, 4, 1)"),
     (np.zeros(4), "got shape (4,)"),
-    (np.zeros((3, 4)), "got shape (3, 4)"),
+    (np.zeros((0, 4)), "got shape (0, 4)"),
 ])
-def test_height_maps_that_are_not_square_2d_are_refused_by_shape(height, words):
+def test_height_maps_that_are_not_2d_are_refused_by_shape(height, words):
     with pytest.raises(BumpError) as e:
         displacement_to_normals(height)
-    assert str(e.value) == f"height must be a non-empty square 2-D map, {words}"
+    assert str(e.value) == f"height must be a non-empty 2-D map, {words}"
+
+
+def test_a_non_square_height_map_is_fitted_wrapping_each_axis_by_its_own_length():
+    """An (H, W) map (a non-square map, texture_height < texture_size): the fit of a
+    column-only ramp of period W is the square map's, row by row; each axis wraps by its own
+    length (a roll by H along rows, by W along columns leaves the normals unchanged)."""
+    rng = np.random.default_rng(3)
+    h = rng.random((8, 16))
+    n = displacement_to_normals(h, 2.0)
+    assert n.shape == (8, 16, 3)
+    assert np.allclose(displacement_to_normals(np.roll(h, (3, 5), (0, 1)), 2.0),
+                       np.roll(n, (3, 5), (0, 1)), atol=1e-12)
+    ramp = np.sin(2 * np.pi * np.arange(16) / 16)
+    square = displacement_to_normals(np.tile(ramp, (16, 1)), 2.0)
+    assert np.allclose(displacement_to_normals(np.tile(ramp, (8, 1)), 2.0), square[:8], atol=1e-12)
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
