@@ -120,7 +120,7 @@ board: $(STAMP)
 	$(RUN) $(VENV)/bin/bumprtl board ulx3s --out build/board --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
 	printf 'image = "globe"\ntexture_size = 256\n' > build/globe.toml
 	$(RUN) $(VENV)/bin/bumprtl board ulx3s --scene build/globe.toml --out build/board_globe --seeds $(BOARD_SEEDS) --parts --check-frames $(BOARD_FRAMES)
-	printf 'image = "globe"\ntexture_size = 1024\nmap_memory = "axi"\n' > build/globe_axi.toml
+	printf 'image = "globe"\ntexture_size = 2048\ntexture_height = 1024\nmap_memory = "axi"\n' > build/globe_axi.toml
 	$(RUN) $(VENV)/bin/bumprtl board ulx3s --mode 1280x720 --scene build/globe_axi.toml --out build/board_globe720 --seeds $(BOARD_SEEDS) --parts
 
 # The generated pages, regenerated at today's default Config (each records it in a "Made at:"
