@@ -530,12 +530,17 @@ class TextureCache(wiring.Component):
         # read ahead of the pops into the RAM's register, then its output register, then
         # two fabric registers (below)
         qmem = ram("queue", g.queue, layout)
-        # the entries' miss bits in LUT RAM beside it, read at the same address into
-        # registers of the fabric that move on with the RAM's two (no logic reads a block
-        # RAM's output to decide the pop)
-        m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
-                                                attrs={"ram_style": "distributed"})
-        m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
+        # the entries' miss bits in LUT RAM beside it, the even entries' and the odd ones'
+        # apart: read a cycle ahead of the queue's read, both entries it may read next (its
+        # address's and the one after, one in each half) straight into registers, then
+        # into registers of the fabric that move on with the RAM's two (no logic reads a
+        # block RAM's output to decide the pop, and none comes between a LUT RAM's read and
+        # its register)
+        m_ports = []
+        for p in range(2):
+            m.submodules[f"queue_miss{p}"] = mmem = Memory(
+                shape=1, depth=g.queue // 2, init=[], attrs={"ram_style": "distributed"})
+            m_ports.append((mmem.write_port(), mmem.read_port(domain="comb")))
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). A register a way: the test as a pixel moves into the
@@ -876,12 +881,17 @@ class TextureCache(wiring.Component):
         m.d.comb += [qmem.w_addr.eq(in_seq[:qb]), qmem.w_en.eq(advance),
                      q_w.word.eq(look_word), q_w.way.eq(way), q_w.sel.eq(look_sel)]
         m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
-        # the miss bits are written the cycle after (from registers), that write forwarded
-        # to the read of its cycle (below)
+        # the miss bits are written the cycle after (from registers), each into its entry's
+        # half; that write and the one of the cycle before are forwarded to the reads that
+        # miss them (below)
         mq_addr, mq_data, mq_en = Signal(qb, name="miss_w_addr"), Signal(name="miss_w_data"), \
             Signal(name="miss_w_en")
-        m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance)]
-        m.d.comb += [m_w.addr.eq(mq_addr), m_w.en.eq(mq_en), m_w.data.eq(mq_data)]
+        mq_data2 = Signal(name="miss_w_data2")           # mq_data of the cycle before
+        m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance),
+                     mq_data2.eq(mq_data)]
+        for p, (m_w, _) in enumerate(m_ports):
+            m.d.comb += [m_w.addr.eq(mq_addr[1:]), m_w.en.eq(mq_en & (mq_addr[0] == p)),
+                         m_w.data.eq(mq_data)]
         for w, sp in enumerate(stamps):                 # (the cycle after: ``was``)
             m.d.comb += [sp.w_addr.eq(was.set), sp.w_data.eq(was.seq),
                          sp.w_en.eq(was.stamp_hot[w])]
@@ -998,12 +1008,25 @@ class TextureCache(wiring.Component):
         q_m1, q_m2 = Signal(name="q_miss1"), Signal(name="q_miss2")       # beside v1, v2
         q_out = qmem.r_data
         issue = Signal(name="q_issue")           # a read of an entry this cycle
-        # the miss bits' read: its own copy of the address, and whether the entry read was
-        # written in the cycle before (the write landing now: forwarded), from registers
-        q_read_m = Signal.like(q_read, name="q_read_miss")
-        m_fwd = Signal(name="q_miss_fwd")         # mq_en & (q_unread == 1)
-        m.d.comb += [issue.eq(q_en & q_avail), qmem.r_addr.eq(q_read), qmem.en.eq(q_en),
-                     m_r.addr.eq(q_read_m)]
+        # The miss bits' read, a cycle ahead: from q_read's own copy (its parity and each
+        # half's address, (q_read + 1) / 2 and q_read / 2), the halves read the entries
+        # q_read and q_read + 1, one each, into a register each (m_got), every cycle: the
+        # next cycle's q_read is one of the two, its parity (a register then) chooses. The
+        # read misses the writes of its cycle and of the next, forwarded: whether the entry
+        # then read was written in the cycle before (m_fwd: the write landing then) or two
+        # before (m_fwd2: the one landing as the halves were read), from registers.
+        m_par = Signal(name="q_read_miss_parity")              # q_read[0]
+        m_addr = [Signal(qb - 1, name=f"q_read_miss{p}") for p in range(2)]
+        m_got = [Signal(name=f"q_miss_got{p}") for p in range(2)]
+        m_fwd = Signal(name="q_miss_fwd")         # the entry read written the cycle before
+        m_fwd2 = Signal(name="q_miss_fwd2")       # ... two cycles before
+        m.d.comb += [issue.eq(q_en & q_avail), qmem.r_addr.eq(q_read), qmem.en.eq(q_en)]
+        for p, (_, m_r) in enumerate(m_ports):
+            m.d.comb += m_r.addr.eq(m_addr[p])
+            m.d.sync += m_got[p].eq(m_r.data)
+        with m.If(issue):
+            m.d.sync += [m_par.eq(~m_par), m_addr[0].eq(m_addr[0] + ~m_par),
+                         m_addr[1].eq(m_addr[1] + m_par)]
         head = Signal(layout, name="q_head")
         head_miss = Signal(name="head_miss")
         m.d.comb += [head.eq(Mux(q_f0, Mux(q_rd, fab[1], fab[0]), q_out)),
@@ -1016,12 +1039,14 @@ class TextureCache(wiring.Component):
         m.d.comb += [pop_ok.eq((q_f0 | q_v2) & (~head_miss | landed_any)),
                      pop.eq(head_ok & hd_move)]
         up_down(q_unread, advance, issue)
-        m.d.sync += [q_read.eq(q_read + issue), q_read_m.eq(q_read_m + issue),
+        m.d.sync += [q_read.eq(q_read + issue),
                      q_avail.eq(advance | (q_unread > 1) | ((q_unread == 1) & ~issue)),
-                     m_fwd.eq(advance & (~q_avail | ((q_unread == 1) & issue)))]
+                     m_fwd.eq(advance & (~q_avail | ((q_unread == 1) & issue))),
+                     m_fwd2.eq(mq_en & Mux(issue, q_unread == 2, q_unread == 1))]
         with m.If(q_en):
             m.d.sync += [q_v1.eq(q_avail), q_m2.eq(q_m1),
-                         q_m1.eq(Mux(m_fwd, mq_data, m_r.data))]
+                         q_m1.eq(Mux(m_fwd, mq_data, Mux(m_fwd2, mq_data2,
+                                                         Mux(m_par, m_got[1], m_got[0]))))]
         # the output register's entry goes on into the ring unless it leaves as the head
         moving = q_en & q_v2
         into = Signal(name="q_into")
