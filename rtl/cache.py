@@ -392,6 +392,7 @@ class TextureCache(wiring.Component):
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
             o_skid=Signal(name="o_skid"),                         # the output's skid register
+            hd_stall=Signal(name="hd_stall"),                     # hd_valid & wd_valid & o_skid
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
             miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
@@ -826,11 +827,13 @@ class TextureCache(wiring.Component):
         count_less = Signal(len(count), init=(1 << len(count)) - 1, name="count_less")
         up_down(count_less, advance, pop)                         # count - 1
 
-        def below_count(e):                        # e < count - pop (no sum before a compare)
-            return (e < count) & ~(pop & (e == count_less))
+        def below_count(e, p):                     # e < count - p (no sum before a compare)
+            return (e < count) & ~(p & (e == count_less))
 
         # Each register as a choice by the advance (the latest signal here) between its
-        # next value with and without it, both from registers and the pop.
+        # next value with and without it, both from registers and the pop (referenced: each
+        # of those a choice by the pop between its value with and without it, from
+        # registers alone).
         same_set = Signal(name="ds_same_set")    # ds_set == look_set (a register, below)
         for w in range(g.ways):
             t, e, far, top = ds_tags[w], ds_dists[w], ds_fars[w], ds_tops[w]
@@ -838,20 +841,24 @@ class TextureCache(wiring.Component):
             for a in (0, 1):
                 written = same_set & tag_hot_if(a)[w]
                 m.d.comb += new_hits_if[a][w].eq(Mux(written, ds_tag == look_tag, hit_w))
-            queued = Signal(name=f"ds_queued{w}")       # e < count - pop
-            m.d.comb += queued.eq(~far & below_count(e))
-            # with the advance: the lookup's pixel queued, on this way if it uses it (a miss
-            # writes its victim's tag: that way is stamped too), and e + 1 (wrapping at
-            # 2**K - 1 to 0: referenced)
             stamped = same_set & way_hot[w]
-            ref_on = (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
             d = look_dists[w]                   # e after this cycle, at most queue
+
+            def ref_if(a, p, w=w, t=t, e=e, far=far, top=top, stamped=stamped, d=d):
+                """referenced[w]'s next with the advance a and the pop p."""
+                queued = ~far & below_count(e, p)          # e < count - p
+                if a:
+                    # the lookup's pixel queued, on this way if it uses it (a miss writes
+                    # its victim's tag: that way is stamped too), and e + 1 (wrapping at
+                    # 2**K - 1 to 0: referenced)
+                    return (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
+                # the lookup's pixel waits (no write), or the distances move in (a way
+                # referenced has d < count: only the pop of its last pixel ends it)
+                return Mux(look_valid, referenced[w] & ~(p & (d == count_less)), t[-1] & queued)
             d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
-            # without: the lookup's pixel waits (no write), or the distances move in
-            # (a way referenced has d < count: only the pop of its last pixel ends it)
-            ref_off = Mux(look_valid, referenced[w] & ~(pop & (d == count_less)), t[-1] & queued)
             d_off = Mux(look_valid, d, Mux(far, g.queue, e))
-            m.d.sync += [referenced[w].eq(Mux(advance, ref_on, ref_off)),
+            m.d.sync += [referenced[w].eq(Mux(advance, Mux(pop, ref_if(1, 1), ref_if(1, 0)),
+                                              Mux(pop, ref_if(0, 1), ref_if(0, 0)))),
                          d.eq(Mux(advance, d_on, d_off))]
         # Each stage's set against the lookup's, in registers: compared a cycle ahead, the
         # sets each will hold, the moves (the advance last) choosing
@@ -990,7 +997,10 @@ class TextureCache(wiring.Component):
         # the output register waits go to the skid register
         o_skid = r.o_skid
         wd_move = ~wd_valid | ~o_skid
-        hd_move = ~hd_valid | wd_move              # the head register moves on
+        # the head register moves on unless it waits behind them: hd_stall, a register (the
+        # pop, the head register's enable: one register each, no logic before them)
+        hd_stall = r.hd_stall
+        hd_move = ~hd_stall
         # The reads: an entry is read once written (a read does not see a write of its own
         # cycle: q_unread counts the writes of the cycles before), whenever the enable is
         # high; the enable is low only while both fabric registers and the output register
@@ -1109,7 +1119,10 @@ class TextureCache(wiring.Component):
         # (taken whenever it is empty: only its valid bit waits on o.ready)
         sk_texel = Signal(g.texel_bits, name="o_skid_texel")
         o_sk_extra = r.o_skid_extra = {k: Signal(s, name=f"o_skid_{k}") for k, s in self.extra.items()}
-        m.d.sync += o_skid.eq(~o_free & (o_skid | wd_valid))
+        o_skid_next = ~o_free & (o_skid | wd_valid)
+        m.d.sync += [o_skid.eq(o_skid_next),
+                     hd_stall.eq(Mux(hd_move, pop, hd_valid) & Mux(wd_move, rd_valid, wd_valid)
+                                 & o_skid_next)]
         with m.If(~o_skid):
             m.d.sync += sk_texel.eq(texel)
             m.d.sync += [o_sk_extra[k].eq(wd_extra[k]) for k in self.extra]

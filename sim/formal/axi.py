@@ -200,6 +200,8 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the queue holds at most its entries", r.count <= g.queue)
         read = r.q_f0 + r.q_f1 + r.q_v2 + r.q_v1
         self._lemma(m, "the queue's head may leave as its registers say", r.head_ok == r.pop_ok)
+        self._lemma(m, "the head register waits behind its full read and skid registers",
+                    r.hd_stall == (r.hd_valid & r.wd_valid & r.o_skid))
         self._lemma(m, "the queue's entries read and the ones unread are its queued ones",
                     read + r.q_unread == r.count)
         self._lemma(m, "the queue has an entry to read", r.q_avail == (r.q_unread != 0))
