@@ -394,6 +394,7 @@ class TextureCache(wiring.Component):
             o_skid=Signal(name="o_skid"),                         # the output's skid register
             hd_stall=Signal(name="hd_stall"),                     # hd_valid & wd_valid & o_skid
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
+            fills_any=Signal(name="fills_any"),                   # fills != 0: RREADY
             miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             landed_any=Signal(name="landed_any"),                 # landed != 0
@@ -727,12 +728,19 @@ class TextureCache(wiring.Component):
                            strict=True):
             late(d, lambda a, src=src: Mux(rw_move, src[a], src[2 + a]))
         # each way's tag and stamp (its override, else the word read) and the pseudo-LRU
-        # bits with the write of the cycle, with the advance a
-        rw_tags_if = [[Mux(o.tag_hot[w], o.tags[w], rw_raw_tags[w]) for w in range(g.ways)]
-                      for o in rw_moved_if]
-        rw_stamps_if = [[Mux(o.stamp_hot[w], o.stamps[w], rw_raw_stamps[w]) for w in range(g.ways)]
+        # bits with the write of the cycle, with the advance a: a word read as (whether it
+        # is the word read, its override), so that each register it reaches chooses it
+        # right before the advance (a LUT and the advance's mux from a block RAM's output
+        # register to a flip-flop)
+        rw_tags_if = [[(~o.tag_hot[w], o.tags[w]) for w in range(g.ways)] for o in rw_moved_if]
+        rw_stamps_if = [[(~o.stamp_hot[w], o.stamps[w]) for w in range(g.ways)]
                         for o in rw_moved_if]
         rw_plru_if = [Mux(rw_same_set & a, touched, rw_plru) for a in (0, 1)]
+
+        def raw_last(reg, raw, f):
+            """``reg``'s next with the advance chosen: f(a) = (whether it is the word read
+            ``raw``, else its value) with the advance a."""
+            late(reg, lambda a: Mux(f(a)[0], raw, f(a)[1]))
 
         # --- the skid register: the words read that moved on while the settled ones waited
         # (no write while it is full and they wait: the lookup does not advance) ---
@@ -747,8 +755,8 @@ class TextureCache(wiring.Component):
             m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot),
                          sk_plru.eq(Mux(advance, rw_plru_if[1], rw_plru_if[0]))]
             for w in range(g.ways):
-                m.d.sync += [sk_tags[w].eq(Mux(advance, rw_tags_if[1][w], rw_tags_if[0][w])),
-                             sk_stamps[w].eq(Mux(advance, rw_stamps_if[1][w], rw_stamps_if[0][w]))]
+                raw_last(sk_tags[w], rw_raw_tags[w], lambda a, w=w: rw_tags_if[a][w])
+                raw_last(sk_stamps[w], rw_raw_stamps[w], lambda a, w=w: rw_stamps_if[a][w])
 
         # --- the words settled: from the skid register when it is full, else the words
         # read, with the write of the cycle the pixel moves in, in registers: no block-RAM
@@ -763,13 +771,17 @@ class TextureCache(wiring.Component):
 
         def ws_next(a, held, from_sk, from_rw):    # the words settled's next, advance a
             return Mux(~full3 | a, Mux(sk_valid, from_sk, from_rw), held)
+
+        def ws_next_raw(a, held, from_sk, from_rw):   # the same, from_rw a word read's pair
+            return ((~full3 | a) & ~sk_valid & from_rw[0],
+                    Mux(~full3 | a, Mux(sk_valid, from_sk, from_rw[1]), held))
         late(ws_plru, lambda a: ws_next(a, ws_plru, Mux(sk_same_set & a, touched, sk_plru),
                                         rw_plru_if[a]))
         for w in range(g.ways):
-            late(ws_tags[w], lambda a, w=w: ws_next(
+            raw_last(ws_tags[w], rw_raw_tags[w], lambda a, w=w: ws_next_raw(
                 a, ws_tags[w], Mux(sk_same_set & tag_hot_if(a)[w], tag_written, sk_tags[w]),
                 rw_tags_if[a][w]))
-            late(ws_stamps[w], lambda a, w=w: ws_next(
+            raw_last(ws_stamps[w], rw_raw_stamps[w], lambda a, w=w: ws_next_raw(
                 a, ws_stamps[w], Mux(sk_same_set & stamp_hot_if(a)[w], in_seq, sk_stamps[w]),
                 rw_stamps_if[a][w]))
 
@@ -780,13 +792,27 @@ class TextureCache(wiring.Component):
         # low log2(queue) bits and whether it is at least ``queue`` (no queued pixel that
         # far), with whether it is 2**K - 1 (an advance makes it 0: a stale stamp equal to
         # in_seq then looks queued, as in the model). in_seq's own copies here (in_seq - 1,
-        # ~in_seq, in_seq + 1), so that its other loads do not pull it away ---
+        # in_seq, in_seq + 1, and the bits above the queue's of in_seq - 1 - queue and of
+        # in_seq - queue), so that its other loads do not pull it away ---
         ws_same_set = Signal(name="ws_same_set")   # ws_set == look_set (a register, below)
         in_less = Signal(K, init=(1 << K) - 1, name="in_seq_less")   # in_seq - 1
-        in_not = Signal(K, init=(1 << K) - 1, name="in_seq_not")     # ~in_seq
+        in_cur = Signal(K, name="in_seq_cur")                         # in_seq
         in_one = Signal(K, init=1, name="in_seq_one")                # in_seq + 1
+        hb = K - qb
+        in_less_hi = Signal(hb, init=(1 << hb) - 2, name="in_seq_less_hi")  # (in_seq-1-queue)[qb:]
+        in_cur_hi = Signal(hb, init=(1 << hb) - 1, name="in_seq_cur_hi")    # (in_seq-queue)[qb:]
         with m.If(advance):
-            m.d.sync += [in_less.eq(in_less + 1), in_not.eq(in_not - 1), in_one.eq(in_one + 1)]
+            m.d.sync += [in_less.eq(in_less + 1), in_cur.eq(in_cur + 1), in_one.eq(in_one + 1),
+                         in_less_hi.eq(in_less_hi + in_less[:qb].all()),
+                         in_cur_hi.eq(in_cur_hi + in_cur[:qb].all())]
+
+        def distance(b, b_hi_less, s):
+            """e = b - s (mod 2**K) as (e mod queue, e >= queue): the low bits' difference,
+            whose borrow chooses the test of the high bits, an equality (e < queue iff s's
+            high bits are b's, or after a borrow b's less one): no K-bit carry chain."""
+            diff = b[:qb] - s[:qb]                 # (signed: its top bit the borrow)
+            near = Mux(diff[qb], s[qb:] == b_hi_less, s[qb:] == b[qb:])
+            return diff[:qb], ~near
         ds_valid = r.ds_valid
         ds_line, ds_slot = Signal(g.line_bits, name="ds_line"), Signal(2 * g.block_bits, name="ds_slot")
         ds_tags = [Signal.like(tag_written, name=f"ds_tag{w}") for w in range(g.ways)]
@@ -802,13 +828,12 @@ class TextureCache(wiring.Component):
         late(ds_plru, lambda a: ds_next(a, ds_plru, Mux(ws_same_set & a, touched, ws_plru)))
         for w in range(g.ways):
             s_w = ws_stamps[w]
-            stay = (in_less - s_w)[:K]             # e without an advance
-            go_on = ~(in_not + s_w)[:K]            # e after one (in_seq - s)
-            e_if = [stay, go_on]
-            top_if = [(s_w ^ in_not).all(), s_w == in_one]
+            # e without an advance (in_seq - 1 - s), after one (in_seq - s)
+            e_if = [distance(in_less, in_less_hi, s_w), distance(in_cur, in_cur_hi, s_w)]
+            top_if = [s_w == in_cur, s_w == in_one]
             for a in (0, 1):
                 stamped = ws_same_set & stamp_hot_if(a)[w]   # s = in_seq now: e = 0 after the advance
-                e_if[a] = (Mux(stamped, 0, e_if[a][:qb]), ~stamped & e_if[a][qb:].any(),
+                e_if[a] = (Mux(stamped, 0, e_if[a][0]), ~stamped & e_if[a][1],
                            ~stamped & top_if[a])
             late(ds_tags[w], lambda a, w=w: ds_next(
                 a, ds_tags[w], Mux(ws_same_set & tag_hot_if(a)[w], tag_written, ws_tags[w])))
@@ -943,7 +968,9 @@ class TextureCache(wiring.Component):
 
         # --- the R beats: into the oldest outstanding burst's line ---
         beat = r.beat
-        m.d.comb += ax.rready.eq(fills != 0)
+        # RREADY while a burst is outstanding: a register (fills_any), no logic before the
+        # beats' and lines' counts
+        m.d.comb += ax.rready.eq(r.fills_any)
         beat_in = ax.rready & ax.rvalid
         line_in = beat_in & ax.rlast
         fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
@@ -968,6 +995,7 @@ class TextureCache(wiring.Component):
         with m.If(miss):
             m.d.sync += f_in.eq(f_in + 1)
         up_down(fills, miss, line_in)
+        m.d.sync += r.fills_any.eq(miss | (fills > 1) | ((fills == 1) & ~line_in))
         # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
         # outstanding (fills == misses: its top bit, fills in [0, a power of two])
         m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))

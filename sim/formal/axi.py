@@ -183,6 +183,7 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the cache's bursts outstanding = accepted + the AR held",
                     r.fills == issued)
         self._lemma(m, "the cache's beat counter = the monitor's", r.beat == mbeat)
+        self._lemma(m, "RREADY while a burst is outstanding", r.fills_any == (r.fills != 0))
         self._lemma(m, "a burst in progress is accepted", (mbeat == 0) | (accepted != 0))
         self._lemma(m, "the beats of a burst are fewer than a line's", mbeat < g.beats)
         if g.misses > 1:
