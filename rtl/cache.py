@@ -587,10 +587,6 @@ class TextureCache(wiring.Component):
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
         tag_written = Cat(look_tag, Const(1, 1))
-        tag_hot = Signal(g.ways)
-        m.d.comb += tag_hot.eq(Mux(miss, victim, 0))
-        stamp_hot = Signal(g.ways)
-        m.d.comb += stamp_hot.eq(Mux(advance, way_hot, 0))
         touched = self._plru_hdl(look_plru, way_hot)[1]
         # The advance is the lookup's latest signal: each register the write of the cycle
         # reaches takes a choice by the advance between its next value with the advance
@@ -622,8 +618,16 @@ class TextureCache(wiring.Component):
                                    seq=Signal(K, name=f"{name}_seq"),
                                    stamp_hot=Signal(g.ways, name=f"{name}_stamp_hot"))
         was, was2 = written_in("was"), written_in("was2")
-        m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.tag_hot.eq(tag_hot),
-                     was.seq.eq(in_seq), was.stamp_hot.eq(stamp_hot)]
+        # (the ways written, one-hot, from registers of their parts: the miss and the victim,
+        # the advance and the way used, so that the lookup's signals reach flip-flops' data
+        # inputs, no synchronous reset of the ways)
+        was_miss, was_adv = Signal(name="was_miss"), Signal(name="was_advance")
+        was_victim, was_way = Signal(g.ways, name="was_victim"), Signal(g.ways, name="was_way")
+        m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.seq.eq(in_seq),
+                     was_miss.eq(miss), was_victim.eq(victim), was_adv.eq(advance),
+                     was_way.eq(way_hot)]
+        m.d.comb += [was.tag_hot.eq(Mux(was_miss, was_victim, 0)),
+                     was.stamp_hot.eq(Mux(was_adv, was_way, 0))]
         m.d.sync += [getattr(was2, k).eq(getattr(was, k))
                      for k in ("set", "tag", "tag_hot", "seq", "stamp_hot")]
 
