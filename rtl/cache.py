@@ -857,7 +857,9 @@ class TextureCache(wiring.Component):
         up_down(count_less, advance, pop)                         # count - 1
 
         def below_count(e, p):                     # e < count - p (no sum before a compare)
-            return (e < count) & ~(p & (e == count_less))
+            # (count - 1 on the queue's bits: its top bit is set only at count = 0, where
+            # e < count is not)
+            return (e < count) & ~(p & (e == count_less[:qb]))
 
         # Each register as a choice by the advance (the latest signal here) between its
         # next value with and without it, both from registers and the pop (referenced: each
@@ -882,8 +884,10 @@ class TextureCache(wiring.Component):
                     # 2**K - 1 to 0: referenced)
                     return (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
                 # the lookup's pixel waits (no write), or the distances move in (a way
-                # referenced has d < count: only the pop of its last pixel ends it)
-                return Mux(look_valid, referenced[w] & ~(p & (d == count_less)), t[-1] & queued)
+                # referenced has d < count, so d and count - 1 below ``queue``, compared on
+                # the queue's bits: only the pop of its last pixel ends it)
+                return Mux(look_valid, referenced[w] & ~(p & (d[:qb] == count_less[:qb])),
+                           t[-1] & queued)
             d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
             d_off = Mux(look_valid, d, Mux(far, g.queue, e))
             m.d.sync += [referenced[w].eq(Mux(advance, Mux(pop, ref_if(1, 1), ref_if(1, 0)),
