@@ -899,8 +899,10 @@ class TextureCache(wiring.Component):
 
         def look_set_if(a):
             return Mux(~full1 | a, ds_set, look_set)
-        late(in_same_set, lambda a: Mux(rw_move, set_of(new_line), in_set) == look_set_if(a))
-        late(rw_same_set, lambda a: Mux(rw_move, in_set, rw_set) == look_set_if(a))
+        # (the pixel read's move chooses between the compares, not the sets compared)
+        late(in_same_set, lambda a: Mux(rw_move, set_of(new_line) == look_set_if(a),
+                                        in_set == look_set_if(a)))
+        late(rw_same_set, lambda a: Mux(rw_move, in_set == look_set_if(a), rw_set == look_set_if(a)))
         late(sk_same_set, lambda a: Mux(sk_valid, sk_set, rw_set) == look_set_if(a))
 
         def ws_set_if(a):
