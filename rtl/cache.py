@@ -373,6 +373,9 @@ class TextureCache(wiring.Component):
             ds_valid=Signal(name="ds_valid"),                     # their stamps' distances
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
+            look_hit=Signal(name="look_hit"),     # the pixel looked up hits
+            go_hit=Signal(name="look_go_hit"),    # go & look_hit
+            go_miss=Signal(name="look_go_miss"),  # go & miss_ok
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
             x_in=Signal(3, name="extras_in"), x_out=Signal(3, name="extras_out"),  # their FIFO
             count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
@@ -517,7 +520,7 @@ class TextureCache(wiring.Component):
         if g.set_bits == 0:
             look_set = Const(0, 1)
         look_tag = tag_of(look_line)
-        hit = Signal(name="look_hit")             # look_hits.any(), a register
+        hit = r.look_hit                          # look_hits.any(), a register
         victim = self._plru_hdl(look_plru, look_hits)[0]
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
         m.d.comb += way_hot.eq(Mux(hit, look_hits, victim))
@@ -565,10 +568,13 @@ class TextureCache(wiring.Component):
 
         # (not ARREADY: no port in the lookup's cycle)
         miss_ok = r.miss_ok                        # ~ARVALID & fills != misses, a register
-        can_miss = miss_ok & ~locked
         advance = Signal()
         go = r.go                                  # ~flushing & look_valid & count != queue
-        m.d.comb += advance.eq(go & (hit | can_miss))
+        # go & (hit | miss_ok & ~locked), with go & hit and go & miss_ok registers of their
+        # own (go_hit, go_miss): the advance, the lookup's latest signal, one LUT and a
+        # PFUMX from its registers, the lock's among them
+        go_hit, go_miss = r.go_hit, r.go_miss
+        m.d.comb += advance.eq(go_hit | (go_miss & ~locked))
         miss = advance & ~hit
         # each stage from the lookup back moves on when it or one after it is empty, or the
         # lookup advances (the valid bits combined apart from the advance)
@@ -916,7 +922,10 @@ class TextureCache(wiring.Component):
             return Mux(~full1 | a, moved, held)
         late(look_plru, lambda a: look_next(a, look_plru, Mux(same_set & a, touched, ds_plru)))
         late(look_hits, lambda a: look_next(a, look_hits, new_hits_if[a]))
-        late(hit, lambda a: look_next(a, hit, new_hits_if[a].any()))
+        hit_next = Signal(name="look_hit_next")
+        m.d.comb += hit_next.eq(Mux(advance, look_next(1, hit, new_hits_if[1].any()),
+                                    look_next(0, hit, new_hits_if[0].any())))
+        m.d.sync += hit.eq(hit_next)
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         q_w = qmem.w_data
@@ -952,8 +961,10 @@ class TextureCache(wiring.Component):
         # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
         m.d.sync += flush_set.eq(flush_set + 1)
         flushing_next = flushing & (flush_set != g.sets - 1)
+        go_next = Signal(name="look_go_next")
+        m.d.comb += go_next.eq(~flushing_next & Mux(move, r.ds_valid, look_valid) & ~full_next)
         m.d.sync += [flushing.eq(flushing_next),
-                     go.eq(~flushing_next & Mux(move, r.ds_valid, look_valid) & ~full_next)]
+                     go.eq(go_next)]
         for w, tp in enumerate(tags):
             m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, was.set)),
                          tp.w_data.eq(Mux(flushing, 0, was.tag)),
@@ -1008,7 +1019,9 @@ class TextureCache(wiring.Component):
         m.d.sync += r.fills_any.eq(miss | (fills > 1) | ((fills == 1) & ~line_in))
         # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
         # outstanding (fills == misses: its top bit, fills in [0, a power of two])
-        m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))
+        miss_ok_next = ~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in)
+        m.d.sync += [miss_ok.eq(miss_ok_next), go_hit.eq(go_next & hit_next),
+                     go_miss.eq(go_next & miss_ok_next)]
 
         # --- the queue's head leaves in order. The queue RAM is read ahead of the pops, in
         # order, at an address and with an enable that are registers (no pop reaches its

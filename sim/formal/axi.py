@@ -199,6 +199,8 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the lookup may go: not flushing, a pixel, a free queue entry",
                     r.go == (~r.flushing & r.look_valid & ~r.count[-1]))
         self._lemma(m, "the queue holds at most its entries", r.count <= g.queue)
+        self._lemma(m, "the lookup's go and hit, go and miss_ok in registers of their own",
+                    (r.go_hit == (r.go & r.look_hit)) & (r.go_miss == (r.go & r.miss_ok)))
         read = r.q_f0 + r.q_f1 + r.q_v2 + r.q_v1
         self._lemma(m, "the queue's head may leave as its registers say", r.head_ok == r.pop_ok)
         self._lemma(m, "the head register waits behind its full read and skid registers",

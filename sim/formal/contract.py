@@ -590,6 +590,8 @@ class StreamContract(Elaboratable):
                     "the cache's queue ring writes past its entries")
         self._lemma(m, r.go == (~r.flushing & r.look_valid & (r.count != c.geom.queue)),
                     "the cache's lookup may go: not flushing, a pixel, a free entry")
+        self._lemma(m, (r.go_hit == (r.go & r.look_hit)) & (r.go_miss == (r.go & r.miss_ok)),
+                    "the cache's lookup's go and hit, go and miss_ok in registers of their own")
         self._lemma(m, ~r.sk_valid | r.ws_valid,
                     "the cache's skid register is full only behind its words settled")
         self._lemma(m, ghost == r.in_valid + r.rw_valid + r.sk_valid + r.ws_valid + r.ds_valid
