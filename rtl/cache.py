@@ -398,6 +398,9 @@ class TextureCache(wiring.Component):
             ds_valid=Signal(name="ds_valid"),                     # their stamps' distances
             look_valid=Signal(name="look_valid"),                 # a pixel under lookup
             go=Signal(name="look_go"),            # ~flushing & look_valid & count != queue
+            look_hit=Signal(name="look_hit"),     # the pixel looked up hits
+            go_hit=Signal(name="look_go_hit"),    # go & look_hit
+            go_miss=Signal(name="look_go_miss"),  # go & miss_ok
             in_seq=Signal(K, name="in_seq"), out_seq=Signal(K, name="out_seq"),  # the queue
             x_in=Signal(3, name="extras_in"), x_out=Signal(3, name="extras_out"),  # their FIFO
             count=Signal(range(geom.queue + 1), name="count"),    # in_seq - out_seq
@@ -417,7 +420,9 @@ class TextureCache(wiring.Component):
             rd_valid=Signal(name="rd_valid"),                     # the data read
             wd_valid=Signal(name="wd_valid"),                     # its words in registers
             o_skid=Signal(name="o_skid"),                         # the output's skid register
+            hd_stall=Signal(name="hd_stall"),                     # hd_valid & wd_valid & o_skid
             fills=Signal(range(geom.misses + 1), name="fills"),   # bursts issued, not landed
+            fills_any=Signal(name="fills_any"),                   # fills != 0: RREADY
             miss_ok=Signal(init=1, name="miss_ok"),               # ~arvalid & fills != misses
             landed=Signal(range(geom.queue + 1), name="landed"),  # lines landed, miss queued
             landed_any=Signal(name="landed_any"),                 # landed != 0
@@ -540,7 +545,7 @@ class TextureCache(wiring.Component):
         if g.set_bits == 0:
             look_set = Const(0, 1)
         look_tag = tag_of(look_line)
-        hit = Signal(name="look_hit")             # look_hits.any(), a register
+        hit = r.look_hit                          # look_hits.any(), a register
         victim = self._plru_hdl(look_plru, look_hits)[0]
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
         m.d.comb += way_hot.eq(Mux(hit, look_hits, victim))
@@ -555,12 +560,17 @@ class TextureCache(wiring.Component):
         # read ahead of the pops into the RAM's register, then its output register, then
         # two fabric registers (below)
         qmem = ram("queue", g.queue, layout)
-        # the entries' miss bits in LUT RAM beside it, read at the same address into
-        # registers of the fabric that move on with the RAM's two (no logic reads a block
-        # RAM's output to decide the pop)
-        m.submodules.queue_miss = mmem = Memory(shape=1, depth=g.queue, init=[],
-                                                attrs={"ram_style": "distributed"})
-        m_w, m_r = mmem.write_port(), mmem.read_port(domain="comb")
+        # the entries' miss bits in LUT RAM beside it, the even entries' and the odd ones'
+        # apart: read a cycle ahead of the queue's read, both entries it may read next (its
+        # address's and the one after, one in each half) straight into registers, then
+        # into registers of the fabric that move on with the RAM's two (no logic reads a
+        # block RAM's output to decide the pop, and none comes between a LUT RAM's read and
+        # its register)
+        m_ports = []
+        for p in range(2):
+            m.submodules[f"queue_miss{p}"] = mmem = Memory(
+                shape=1, depth=g.queue // 2, init=[], attrs={"ram_style": "distributed"})
+            m_ports.append((mmem.write_port(), mmem.read_port(domain="comb")))
 
         # A victim still referenced by a queued pixel (its last pixel not yet left): a way's
         # stamp in [out_seq, in_seq). A register a way: the test as a pixel moves into the
@@ -583,10 +593,13 @@ class TextureCache(wiring.Component):
 
         # (not ARREADY: no port in the lookup's cycle)
         miss_ok = r.miss_ok                        # ~ARVALID & fills != misses, a register
-        can_miss = miss_ok & ~locked
         advance = Signal()
         go = r.go                                  # ~flushing & look_valid & count != queue
-        m.d.comb += advance.eq(go & (hit | can_miss))
+        # go & (hit | miss_ok & ~locked), with go & hit and go & miss_ok registers of their
+        # own (go_hit, go_miss): the advance, the lookup's latest signal, one LUT and a
+        # PFUMX from its registers, the lock's among them
+        go_hit, go_miss = r.go_hit, r.go_miss
+        m.d.comb += advance.eq(go_hit | (go_miss & ~locked))
         miss = advance & ~hit
         # each stage from the lookup back moves on when it or one after it is empty, or the
         # lookup advances (the valid bits combined apart from the advance)
@@ -605,10 +618,6 @@ class TextureCache(wiring.Component):
 
         # the write of the cycle (the pixel looked up advancing), a way at a time
         tag_written = Cat(look_tag, Const(1, 1))
-        tag_hot = Signal(g.ways)
-        m.d.comb += tag_hot.eq(Mux(miss, victim, 0))
-        stamp_hot = Signal(g.ways)
-        m.d.comb += stamp_hot.eq(Mux(advance, way_hot, 0))
         touched = self._plru_hdl(look_plru, way_hot)[1]
         # The advance is the lookup's latest signal: each register the write of the cycle
         # reaches takes a choice by the advance between its next value with the advance
@@ -640,8 +649,16 @@ class TextureCache(wiring.Component):
                                    seq=Signal(K, name=f"{name}_seq"),
                                    stamp_hot=Signal(g.ways, name=f"{name}_stamp_hot"))
         was, was2 = written_in("was"), written_in("was2")
-        m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.tag_hot.eq(tag_hot),
-                     was.seq.eq(in_seq), was.stamp_hot.eq(stamp_hot)]
+        # (the ways written, one-hot, from registers of their parts: the miss and the victim,
+        # the advance and the way used, so that the lookup's signals reach flip-flops' data
+        # inputs, no synchronous reset of the ways)
+        was_miss, was_adv = Signal(name="was_miss"), Signal(name="was_advance")
+        was_victim, was_way = Signal(g.ways, name="was_victim"), Signal(g.ways, name="was_way")
+        m.d.sync += [was.set.eq(look_set), was.tag.eq(tag_written), was.seq.eq(in_seq),
+                     was_miss.eq(miss), was_victim.eq(victim), was_adv.eq(advance),
+                     was_way.eq(way_hot)]
+        m.d.comb += [was.tag_hot.eq(Mux(was_miss, was_victim, 0)),
+                     was.stamp_hot.eq(Mux(was_adv, was_way, 0))]
         m.d.sync += [getattr(was2, k).eq(getattr(was, k))
                      for k in ("set", "tag", "tag_hot", "seq", "stamp_hot")]
 
@@ -746,12 +763,19 @@ class TextureCache(wiring.Component):
                            strict=True):
             late(d, lambda a, src=src: Mux(rw_move, src[a], src[2 + a]))
         # each way's tag and stamp (its override, else the word read) and the pseudo-LRU
-        # bits with the write of the cycle, with the advance a
-        rw_tags_if = [[Mux(o.tag_hot[w], o.tags[w], rw_raw_tags[w]) for w in range(g.ways)]
-                      for o in rw_moved_if]
-        rw_stamps_if = [[Mux(o.stamp_hot[w], o.stamps[w], rw_raw_stamps[w]) for w in range(g.ways)]
+        # bits with the write of the cycle, with the advance a: a word read as (whether it
+        # is the word read, its override), so that each register it reaches chooses it
+        # right before the advance (a LUT and the advance's mux from a block RAM's output
+        # register to a flip-flop)
+        rw_tags_if = [[(~o.tag_hot[w], o.tags[w]) for w in range(g.ways)] for o in rw_moved_if]
+        rw_stamps_if = [[(~o.stamp_hot[w], o.stamps[w]) for w in range(g.ways)]
                         for o in rw_moved_if]
         rw_plru_if = [Mux(rw_same_set & a, touched, rw_plru) for a in (0, 1)]
+
+        def raw_last(reg, raw, f):
+            """``reg``'s next with the advance chosen: f(a) = (whether it is the word read
+            ``raw``, else its value) with the advance a."""
+            late(reg, lambda a: Mux(f(a)[0], raw, f(a)[1]))
 
         # --- the skid register: the words read that moved on while the settled ones waited
         # (no write while it is full and they wait: the lookup does not advance) ---
@@ -766,8 +790,8 @@ class TextureCache(wiring.Component):
             m.d.sync += [sk_line.eq(rw_line), sk_slot.eq(rw_slot),
                          sk_plru.eq(Mux(advance, rw_plru_if[1], rw_plru_if[0]))]
             for w in range(g.ways):
-                m.d.sync += [sk_tags[w].eq(Mux(advance, rw_tags_if[1][w], rw_tags_if[0][w])),
-                             sk_stamps[w].eq(Mux(advance, rw_stamps_if[1][w], rw_stamps_if[0][w]))]
+                raw_last(sk_tags[w], rw_raw_tags[w], lambda a, w=w: rw_tags_if[a][w])
+                raw_last(sk_stamps[w], rw_raw_stamps[w], lambda a, w=w: rw_stamps_if[a][w])
 
         # --- the words settled: from the skid register when it is full, else the words
         # read, with the write of the cycle the pixel moves in, in registers: no block-RAM
@@ -782,13 +806,17 @@ class TextureCache(wiring.Component):
 
         def ws_next(a, held, from_sk, from_rw):    # the words settled's next, advance a
             return Mux(~full3 | a, Mux(sk_valid, from_sk, from_rw), held)
+
+        def ws_next_raw(a, held, from_sk, from_rw):   # the same, from_rw a word read's pair
+            return ((~full3 | a) & ~sk_valid & from_rw[0],
+                    Mux(~full3 | a, Mux(sk_valid, from_sk, from_rw[1]), held))
         late(ws_plru, lambda a: ws_next(a, ws_plru, Mux(sk_same_set & a, touched, sk_plru),
                                         rw_plru_if[a]))
         for w in range(g.ways):
-            late(ws_tags[w], lambda a, w=w: ws_next(
+            raw_last(ws_tags[w], rw_raw_tags[w], lambda a, w=w: ws_next_raw(
                 a, ws_tags[w], Mux(sk_same_set & tag_hot_if(a)[w], tag_written, sk_tags[w]),
                 rw_tags_if[a][w]))
-            late(ws_stamps[w], lambda a, w=w: ws_next(
+            raw_last(ws_stamps[w], rw_raw_stamps[w], lambda a, w=w: ws_next_raw(
                 a, ws_stamps[w], Mux(sk_same_set & stamp_hot_if(a)[w], in_seq, sk_stamps[w]),
                 rw_stamps_if[a][w]))
 
@@ -799,13 +827,27 @@ class TextureCache(wiring.Component):
         # low log2(queue) bits and whether it is at least ``queue`` (no queued pixel that
         # far), with whether it is 2**K - 1 (an advance makes it 0: a stale stamp equal to
         # in_seq then looks queued, as in the model). in_seq's own copies here (in_seq - 1,
-        # ~in_seq, in_seq + 1), so that its other loads do not pull it away ---
+        # in_seq, in_seq + 1, and the bits above the queue's of in_seq - 1 - queue and of
+        # in_seq - queue), so that its other loads do not pull it away ---
         ws_same_set = Signal(name="ws_same_set")   # ws_set == look_set (a register, below)
         in_less = Signal(K, init=(1 << K) - 1, name="in_seq_less")   # in_seq - 1
-        in_not = Signal(K, init=(1 << K) - 1, name="in_seq_not")     # ~in_seq
+        in_cur = Signal(K, name="in_seq_cur")                         # in_seq
         in_one = Signal(K, init=1, name="in_seq_one")                # in_seq + 1
+        hb = K - qb
+        in_less_hi = Signal(hb, init=(1 << hb) - 2, name="in_seq_less_hi")  # (in_seq-1-queue)[qb:]
+        in_cur_hi = Signal(hb, init=(1 << hb) - 1, name="in_seq_cur_hi")    # (in_seq-queue)[qb:]
         with m.If(advance):
-            m.d.sync += [in_less.eq(in_less + 1), in_not.eq(in_not - 1), in_one.eq(in_one + 1)]
+            m.d.sync += [in_less.eq(in_less + 1), in_cur.eq(in_cur + 1), in_one.eq(in_one + 1),
+                         in_less_hi.eq(in_less_hi + in_less[:qb].all()),
+                         in_cur_hi.eq(in_cur_hi + in_cur[:qb].all())]
+
+        def distance(b, b_hi_less, s):
+            """e = b - s (mod 2**K) as (e mod queue, e >= queue): the low bits' difference,
+            whose borrow chooses the test of the high bits, an equality (e < queue iff s's
+            high bits are b's, or after a borrow b's less one): no K-bit carry chain."""
+            diff = b[:qb] - s[:qb]                 # (signed: its top bit the borrow)
+            near = Mux(diff[qb], s[qb:] == b_hi_less, s[qb:] == b[qb:])
+            return diff[:qb], ~near
         ds_valid = r.ds_valid
         ds_line, ds_slot = Signal(g.line_bits, name="ds_line"), Signal(2 * g.block_bits, name="ds_slot")
         ds_tags = [Signal.like(tag_written, name=f"ds_tag{w}") for w in range(g.ways)]
@@ -821,13 +863,12 @@ class TextureCache(wiring.Component):
         late(ds_plru, lambda a: ds_next(a, ds_plru, Mux(ws_same_set & a, touched, ws_plru)))
         for w in range(g.ways):
             s_w = ws_stamps[w]
-            stay = (in_less - s_w)[:K]             # e without an advance
-            go_on = ~(in_not + s_w)[:K]            # e after one (in_seq - s)
-            e_if = [stay, go_on]
-            top_if = [(s_w ^ in_not).all(), s_w == in_one]
+            # e without an advance (in_seq - 1 - s), after one (in_seq - s)
+            e_if = [distance(in_less, in_less_hi, s_w), distance(in_cur, in_cur_hi, s_w)]
+            top_if = [s_w == in_cur, s_w == in_one]
             for a in (0, 1):
                 stamped = ws_same_set & stamp_hot_if(a)[w]   # s = in_seq now: e = 0 after the advance
-                e_if[a] = (Mux(stamped, 0, e_if[a][:qb]), ~stamped & e_if[a][qb:].any(),
+                e_if[a] = (Mux(stamped, 0, e_if[a][0]), ~stamped & e_if[a][1],
                            ~stamped & top_if[a])
             late(ds_tags[w], lambda a, w=w: ds_next(
                 a, ds_tags[w], Mux(ws_same_set & tag_hot_if(a)[w], tag_written, ws_tags[w])))
@@ -846,11 +887,15 @@ class TextureCache(wiring.Component):
         count_less = Signal(len(count), init=(1 << len(count)) - 1, name="count_less")
         up_down(count_less, advance, pop)                         # count - 1
 
-        def below_count(e):                        # e < count - pop (no sum before a compare)
-            return (e < count) & ~(pop & (e == count_less))
+        def below_count(e, p):                     # e < count - p (no sum before a compare)
+            # (count - 1 on the queue's bits: its top bit is set only at count = 0, where
+            # e < count is not)
+            return (e < count) & ~(p & (e == count_less[:qb]))
 
         # Each register as a choice by the advance (the latest signal here) between its
-        # next value with and without it, both from registers and the pop.
+        # next value with and without it, both from registers and the pop (referenced: each
+        # of those a choice by the pop between its value with and without it, from
+        # registers alone).
         same_set = Signal(name="ds_same_set")    # ds_set == look_set (a register, below)
         for w in range(g.ways):
             t, e, far, top = ds_tags[w], ds_dists[w], ds_fars[w], ds_tops[w]
@@ -858,20 +903,26 @@ class TextureCache(wiring.Component):
             for a in (0, 1):
                 written = same_set & tag_hot_if(a)[w]
                 m.d.comb += new_hits_if[a][w].eq(Mux(written, ds_tag == look_tag, hit_w))
-            queued = Signal(name=f"ds_queued{w}")       # e < count - pop
-            m.d.comb += queued.eq(~far & below_count(e))
-            # with the advance: the lookup's pixel queued, on this way if it uses it (a miss
-            # writes its victim's tag: that way is stamped too), and e + 1 (wrapping at
-            # 2**K - 1 to 0: referenced)
             stamped = same_set & way_hot[w]
-            ref_on = (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
             d = look_dists[w]                   # e after this cycle, at most queue
+
+            def ref_if(a, p, w=w, t=t, e=e, far=far, top=top, stamped=stamped, d=d):
+                """referenced[w]'s next with the advance a and the pop p."""
+                queued = ~far & below_count(e, p)          # e < count - p
+                if a:
+                    # the lookup's pixel queued, on this way if it uses it (a miss writes
+                    # its victim's tag: that way is stamped too), and e + 1 (wrapping at
+                    # 2**K - 1 to 0: referenced)
+                    return (same_set & ~hit & victim[w]) | (t[-1] & (stamped | queued | top))
+                # the lookup's pixel waits (no write), or the distances move in (a way
+                # referenced has d < count, so d and count - 1 below ``queue``, compared on
+                # the queue's bits: only the pop of its last pixel ends it)
+                return Mux(look_valid, referenced[w] & ~(p & (d[:qb] == count_less[:qb])),
+                           t[-1] & queued)
             d_on = Mux(stamped | top, 0, Mux(far, g.queue, e + 1))
-            # without: the lookup's pixel waits (no write), or the distances move in
-            # (a way referenced has d < count: only the pop of its last pixel ends it)
-            ref_off = Mux(look_valid, referenced[w] & ~(pop & (d == count_less)), t[-1] & queued)
             d_off = Mux(look_valid, d, Mux(far, g.queue, e))
-            m.d.sync += [referenced[w].eq(Mux(advance, ref_on, ref_off)),
+            m.d.sync += [referenced[w].eq(Mux(advance, Mux(pop, ref_if(1, 1), ref_if(1, 0)),
+                                              Mux(pop, ref_if(0, 1), ref_if(0, 0)))),
                          d.eq(Mux(advance, d_on, d_off))]
         # Each stage's set against the lookup's, in registers: compared a cycle ahead, the
         # sets each will hold, the moves (the advance last) choosing
@@ -879,8 +930,10 @@ class TextureCache(wiring.Component):
 
         def look_set_if(a):
             return Mux(~full1 | a, ds_set, look_set)
-        late(in_same_set, lambda a: Mux(rw_move, set_of(new_line), in_set) == look_set_if(a))
-        late(rw_same_set, lambda a: Mux(rw_move, in_set, rw_set) == look_set_if(a))
+        # (the pixel read's move chooses between the compares, not the sets compared)
+        late(in_same_set, lambda a: Mux(rw_move, set_of(new_line) == look_set_if(a),
+                                        in_set == look_set_if(a)))
+        late(rw_same_set, lambda a: Mux(rw_move, in_set == look_set_if(a), rw_set == look_set_if(a)))
         late(sk_same_set, lambda a: Mux(sk_valid, sk_set, rw_set) == look_set_if(a))
 
         def ws_set_if(a):
@@ -894,19 +947,27 @@ class TextureCache(wiring.Component):
             return Mux(~full1 | a, moved, held)
         late(look_plru, lambda a: look_next(a, look_plru, Mux(same_set & a, touched, ds_plru)))
         late(look_hits, lambda a: look_next(a, look_hits, new_hits_if[a]))
-        late(hit, lambda a: look_next(a, hit, new_hits_if[a].any()))
+        hit_next = Signal(name="look_hit_next")
+        m.d.comb += hit_next.eq(Mux(advance, look_next(1, hit, new_hits_if[1].any()),
+                                    look_next(0, hit, new_hits_if[0].any())))
+        m.d.sync += hit.eq(hit_next)
 
         # the pixel advances: queued, its way's stamp and pseudo-LRU bits written
         q_w = qmem.w_data
         m.d.comb += [qmem.w_addr.eq(in_seq[:qb]), qmem.w_en.eq(advance),
                      q_w.word.eq(look_word), q_w.way.eq(way), q_w.sel.eq(look_sel)]
         m.d.comb += [q_w[k].eq(look_extra[k]) for k in self.extra]
-        # the miss bits are written the cycle after (from registers), that write forwarded
-        # to the read of its cycle (below)
+        # the miss bits are written the cycle after (from registers), each into its entry's
+        # half; that write and the one of the cycle before are forwarded to the reads that
+        # miss them (below)
         mq_addr, mq_data, mq_en = Signal(qb, name="miss_w_addr"), Signal(name="miss_w_data"), \
             Signal(name="miss_w_en")
-        m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance)]
-        m.d.comb += [m_w.addr.eq(mq_addr), m_w.en.eq(mq_en), m_w.data.eq(mq_data)]
+        mq_data2 = Signal(name="miss_w_data2")           # mq_data of the cycle before
+        m.d.sync += [mq_addr.eq(in_seq[:qb]), mq_data.eq(~hit), mq_en.eq(advance),
+                     mq_data2.eq(mq_data)]
+        for p, (m_w, _) in enumerate(m_ports):
+            m.d.comb += [m_w.addr.eq(mq_addr[1:]), m_w.en.eq(mq_en & (mq_addr[0] == p)),
+                         m_w.data.eq(mq_data)]
         for w, sp in enumerate(stamps):                 # (the cycle after: ``was``)
             m.d.comb += [sp.w_addr.eq(was.set), sp.w_data.eq(was.seq),
                          sp.w_en.eq(was.stamp_hot[w])]
@@ -925,8 +986,10 @@ class TextureCache(wiring.Component):
         # after a reset, every set's tags are cleared (one set a cycle) before the first lookup
         m.d.sync += flush_set.eq(flush_set + 1)
         flushing_next = flushing & (flush_set != g.sets - 1)
+        go_next = Signal(name="look_go_next")
+        m.d.comb += go_next.eq(~flushing_next & Mux(move, r.ds_valid, look_valid) & ~full_next)
         m.d.sync += [flushing.eq(flushing_next),
-                     go.eq(~flushing_next & Mux(move, r.ds_valid, look_valid) & ~full_next)]
+                     go.eq(go_next)]
         for w, tp in enumerate(tags):
             m.d.comb += [tp.w_addr.eq(Mux(flushing, flush_set, was.set)),
                          tp.w_data.eq(Mux(flushing, 0, was.tag)),
@@ -951,7 +1014,9 @@ class TextureCache(wiring.Component):
 
         # --- the R beats: into the oldest outstanding burst's line ---
         beat = r.beat
-        m.d.comb += ax.rready.eq(fills != 0)
+        # RREADY while a burst is outstanding: a register (fills_any), no logic before the
+        # beats' and lines' counts
+        m.d.comb += ax.rready.eq(r.fills_any)
         beat_in = ax.rready & ax.rvalid
         line_in = beat_in & ax.rlast
         fill_set = f_r.data.set[:g.set_bits] if g.set_bits else Const(0, 1)
@@ -976,9 +1041,12 @@ class TextureCache(wiring.Component):
         with m.If(miss):
             m.d.sync += f_in.eq(f_in + 1)
         up_down(fills, miss, line_in)
+        m.d.sync += r.fills_any.eq(miss | (fills > 1) | ((fills == 1) & ~line_in))
         # a miss may go next cycle: ARVALID low then and fewer than ``misses`` bursts
         # outstanding (fills == misses: its top bit, fills in [0, a power of two])
-        m.d.sync += miss_ok.eq(~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in))
+        miss_ok_next = ~miss & ~(ax.arvalid & ~ax.arready) & ~(fills[-1] & ~line_in)
+        m.d.sync += [miss_ok.eq(miss_ok_next), go_hit.eq(go_next & hit_next),
+                     go_miss.eq(go_next & miss_ok_next)]
 
         # --- the queue's head leaves in order. The queue RAM is read ahead of the pops, in
         # order, at an address and with an enable that are registers (no pop reaches its
@@ -1005,7 +1073,10 @@ class TextureCache(wiring.Component):
         # the output register waits go to the skid register
         o_skid = r.o_skid
         wd_move = ~wd_valid | ~o_skid
-        hd_move = ~hd_valid | wd_move              # the head register moves on
+        # the head register moves on unless it waits behind them: hd_stall, a register (the
+        # pop, the head register's enable: one register each, no logic before them)
+        hd_stall = r.hd_stall
+        hd_move = ~hd_stall
         # The reads: an entry is read once written (a read does not see a write of its own
         # cycle: q_unread counts the writes of the cycles before), whenever the enable is
         # high; the enable is low only while both fabric registers and the output register
@@ -1023,12 +1094,25 @@ class TextureCache(wiring.Component):
         q_m1, q_m2 = Signal(name="q_miss1"), Signal(name="q_miss2")       # beside v1, v2
         q_out = qmem.r_data
         issue = Signal(name="q_issue")           # a read of an entry this cycle
-        # the miss bits' read: its own copy of the address, and whether the entry read was
-        # written in the cycle before (the write landing now: forwarded), from registers
-        q_read_m = Signal.like(q_read, name="q_read_miss")
-        m_fwd = Signal(name="q_miss_fwd")         # mq_en & (q_unread == 1)
-        m.d.comb += [issue.eq(q_en & q_avail), qmem.r_addr.eq(q_read), qmem.en.eq(q_en),
-                     m_r.addr.eq(q_read_m)]
+        # The miss bits' read, a cycle ahead: from q_read's own copy (its parity and each
+        # half's address, (q_read + 1) / 2 and q_read / 2), the halves read the entries
+        # q_read and q_read + 1, one each, into a register each (m_got), every cycle: the
+        # next cycle's q_read is one of the two, its parity (a register then) chooses. The
+        # read misses the writes of its cycle and of the next, forwarded: whether the entry
+        # then read was written in the cycle before (m_fwd: the write landing then) or two
+        # before (m_fwd2: the one landing as the halves were read), from registers.
+        m_par = Signal(name="q_read_miss_parity")              # q_read[0]
+        m_addr = [Signal(qb - 1, name=f"q_read_miss{p}") for p in range(2)]
+        m_got = [Signal(name=f"q_miss_got{p}") for p in range(2)]
+        m_fwd = Signal(name="q_miss_fwd")         # the entry read written the cycle before
+        m_fwd2 = Signal(name="q_miss_fwd2")       # ... two cycles before
+        m.d.comb += [issue.eq(q_en & q_avail), qmem.r_addr.eq(q_read), qmem.en.eq(q_en)]
+        for p, (_, m_r) in enumerate(m_ports):
+            m.d.comb += m_r.addr.eq(m_addr[p])
+            m.d.sync += m_got[p].eq(m_r.data)
+        with m.If(issue):
+            m.d.sync += [m_par.eq(~m_par), m_addr[0].eq(m_addr[0] + ~m_par),
+                         m_addr[1].eq(m_addr[1] + m_par)]
         head = Signal(layout, name="q_head")
         head_miss = Signal(name="head_miss")
         m.d.comb += [head.eq(Mux(q_f0, Mux(q_rd, fab[1], fab[0]), q_out)),
@@ -1041,12 +1125,14 @@ class TextureCache(wiring.Component):
         m.d.comb += [pop_ok.eq((q_f0 | q_v2) & (~head_miss | landed_any)),
                      pop.eq(head_ok & hd_move)]
         up_down(q_unread, advance, issue)
-        m.d.sync += [q_read.eq(q_read + issue), q_read_m.eq(q_read_m + issue),
+        m.d.sync += [q_read.eq(q_read + issue),
                      q_avail.eq(advance | (q_unread > 1) | ((q_unread == 1) & ~issue)),
-                     m_fwd.eq(advance & (~q_avail | ((q_unread == 1) & issue)))]
+                     m_fwd.eq(advance & (~q_avail | ((q_unread == 1) & issue))),
+                     m_fwd2.eq(mq_en & Mux(issue, q_unread == 2, q_unread == 1))]
         with m.If(q_en):
             m.d.sync += [q_v1.eq(q_avail), q_m2.eq(q_m1),
-                         q_m1.eq(Mux(m_fwd, mq_data, m_r.data))]
+                         q_m1.eq(Mux(m_fwd, mq_data, Mux(m_fwd2, mq_data2,
+                                                         Mux(m_par, m_got[1], m_got[0]))))]
         # the output register's entry goes on into the ring unless it leaves as the head
         moving = q_en & q_v2
         into = Signal(name="q_into")
@@ -1109,7 +1195,10 @@ class TextureCache(wiring.Component):
         # (taken whenever it is empty: only its valid bit waits on o.ready)
         sk_texel = Signal(g.texel_bits, name="o_skid_texel")
         o_sk_extra = r.o_skid_extra = {k: Signal(s, name=f"o_skid_{k}") for k, s in self.extra.items()}
-        m.d.sync += o_skid.eq(~o_free & (o_skid | wd_valid))
+        o_skid_next = ~o_free & (o_skid | wd_valid)
+        m.d.sync += [o_skid.eq(o_skid_next),
+                     hd_stall.eq(Mux(hd_move, pop, hd_valid) & Mux(wd_move, rd_valid, wd_valid)
+                                 & o_skid_next)]
         with m.If(~o_skid):
             m.d.sync += sk_texel.eq(texel)
             m.d.sync += [o_sk_extra[k].eq(wd_extra[k]) for k in self.extra]

@@ -183,6 +183,7 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the cache's bursts outstanding = accepted + the AR held",
                     r.fills == issued)
         self._lemma(m, "the cache's beat counter = the monitor's", r.beat == mbeat)
+        self._lemma(m, "RREADY while a burst is outstanding", r.fills_any == (r.fills != 0))
         self._lemma(m, "a burst in progress is accepted", (mbeat == 0) | (accepted != 0))
         self._lemma(m, "the beats of a burst are fewer than a line's", mbeat < g.beats)
         if g.misses > 1:
@@ -198,8 +199,12 @@ class AxiReadContract(RuleContract):
         self._lemma(m, "the lookup may go: not flushing, a pixel, a free queue entry",
                     r.go == (~r.flushing & r.look_valid & ~r.count[-1]))
         self._lemma(m, "the queue holds at most its entries", r.count <= g.queue)
+        self._lemma(m, "the lookup's go and hit, go and miss_ok in registers of their own",
+                    (r.go_hit == (r.go & r.look_hit)) & (r.go_miss == (r.go & r.miss_ok)))
         read = r.q_f0 + r.q_f1 + r.q_v2 + r.q_v1
         self._lemma(m, "the queue's head may leave as its registers say", r.head_ok == r.pop_ok)
+        self._lemma(m, "the head register waits behind its full read and skid registers",
+                    r.hd_stall == (r.hd_valid & r.wd_valid & r.o_skid))
         self._lemma(m, "the queue's entries read and the ones unread are its queued ones",
                     read + r.q_unread == r.count)
         self._lemma(m, "the queue has an entry to read", r.q_avail == (r.q_unread != 0))

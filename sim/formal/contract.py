@@ -583,11 +583,15 @@ class StreamContract(Elaboratable):
         self._lemma(m, r.q_avail == (r.q_unread != 0), "the cache's queue has an entry to read")
         self._lemma(m, r.q_en == ~(r.q_f1 & r.q_v2), "the cache's queue read is enabled")
         self._lemma(m, r.head_ok == r.pop_ok, "the cache's queue head may leave as its registers say")
+        self._lemma(m, r.hd_stall == (r.hd_valid & r.wd_valid & r.o_skid),
+                    "the cache's head register waits behind its full read and skid registers")
         self._lemma(m, ~r.q_f1 | r.q_f0, "the cache's queue fabric registers fill in order")
         self._lemma(m, r.q_wr == r.q_rd ^ (r.q_f0 & ~r.q_f1),
                     "the cache's queue ring writes past its entries")
         self._lemma(m, r.go == (~r.flushing & r.look_valid & (r.count != c.geom.queue)),
                     "the cache's lookup may go: not flushing, a pixel, a free entry")
+        self._lemma(m, (r.go_hit == (r.go & r.look_hit)) & (r.go_miss == (r.go & r.miss_ok)),
+                    "the cache's lookup's go and hit, go and miss_ok in registers of their own")
         self._lemma(m, ~r.sk_valid | r.ws_valid,
                     "the cache's skid register is full only behind its words settled")
         self._lemma(m, ghost == r.in_valid + r.rw_valid + r.sk_valid + r.ws_valid + r.ds_valid
