@@ -42,7 +42,7 @@ def level_bits(scene):
 
 
 def _level_texels(scene):
-    return [(scene.texture_size >> n) * (scene.map_height >> n) for n in range(scene.mip_levels)]
+    return [w * h for w, h in map(scene.level_size, range(scene.mip_levels))]
 
 
 def level_bases(scene):

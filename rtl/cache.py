@@ -41,7 +41,7 @@ from amaranth.lib.wiring import In, Out
 from bumprtl.rtl.bumpfetch import coord_bits, fetched_field, level_bits, level_coords, texel_shape
 from bumprtl.rtl.config import BumpError, check_pow2
 from bumprtl.rtl.scene import CACHE_DEFAULTS as SCENE_CACHE
-from bumprtl.rtl.scene import HardwareScene, check_scene
+from bumprtl.rtl.scene import HardwareScene, MapSize, check_scene
 from bumprtl.rtl.targets import RegisteredRAM
 
 __all__ = ["CacheGeometry", "AXI_DATA_BITS", "axi_read_signature", "tiled_layout",
@@ -68,7 +68,7 @@ CACHE_DEFAULTS = {name: SCENE_CACHE[key] for name, key in SCENE_KEYS.items()}
 
 
 @dataclass(frozen=True)
-class CacheGeometry:
+class CacheGeometry(MapSize):
     """The map in memory and the cache in front of it.
 
     Parameters
@@ -119,7 +119,7 @@ class CacheGeometry:
         check_pow2("texture_size", self.texture_size, 1, 1 << 16)
         if self.texture_height is not None:
             check_pow2("texture_height", self.texture_height, 1, self.texture_size)
-        top = self.height.bit_length()
+        top = self.map_height.bit_length()
         if not isinstance(self.mip_levels, int) or not 1 <= self.mip_levels <= top:
             raise BumpError(f"mip_levels must be an integer in [1, {top}], got "
                             f"{self.mip_levels!r}", "mip_levels")
@@ -131,7 +131,7 @@ class CacheGeometry:
                             f"{self.texel_bits!r}", "texel_bits")
         check_pow2("sets", self.sets, 1, 1 << 14)
         check_pow2("ways", self.ways, 1, 16)
-        check_pow2("block", self.block, 2, min(16, self.height))
+        check_pow2("block", self.block, 2, min(16, self.map_height))
         if self.line_bytes < self.data_bits // 8 or self.beats > MAX_BURST \
                 or self.line_bytes > AXI_PAGE:
             raise BumpError(f"block must make a line of {self.data_bits // 8} to "
@@ -161,11 +161,6 @@ class CacheGeometry:
 
     # --- the layout in memory ---
     @property
-    def height(self):
-        """H, the height of level 0: ``texture_height``, or W (a square map)."""
-        return self.texture_size if self.texture_height is None else self.texture_height
-
-    @property
     def slot_bytes(self):
         """Bytes of one texel slot: the least power of two >= texel_bits / 8."""
         return 1 << max(0, (self.texel_bits - 1).bit_length() - 3)
@@ -191,17 +186,11 @@ class CacheGeometry:
     def slots_per_beat(self):
         return self.data_bits // (8 * self.slot_bytes)
 
-    def level_width(self, level):
-        return self.texture_size >> level
-
-    def level_height(self, level):
-        return self.height >> level
-
     def blocks_per_row(self, level):
-        return max(1, self.level_width(level) >> self.block_bits)
+        return max(1, self.level_size(level)[0] >> self.block_bits)
 
     def blocks_per_column(self, level):
-        return max(1, self.level_height(level) >> self.block_bits)
+        return max(1, self.level_size(level)[1] >> self.block_bits)
 
     def level_blocks(self, level):
         """Lines of ``level``: its blocks a row times its blocks a column."""
@@ -262,8 +251,7 @@ def tiled_layout(u, v, level, geom: CacheGeometry):
     first = geom.level_lines[level]
     if _is_hdl(u):
         u, v = Value.cast(u), Value.cast(v)
-        side = geom.level_width(level).bit_length() - 1
-        tall = geom.level_height(level).bit_length() - 1
+        side, tall = (n.bit_length() - 1 for n in geom.level_size(level))
         inner = Cat(u[b:max(b, side)], v[b:max(b, tall)]) if row_bits else Const(0, 1)
         return inner + first, Cat(u[:b], v[:b])
     u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
@@ -282,7 +270,7 @@ def tiled_image(geom: CacheGeometry, levels):
     [v, u]; each word little-endian in its slot, unused slots zero."""
     image = np.zeros(geom.lines * geom.line_texels, np.uint64)
     for level in range(geom.mip_levels):
-        side, tall = geom.level_width(level), geom.level_height(level)
+        side, tall = geom.level_size(level)
         words = np.asarray(levels[level], np.int64)
         if words.shape != (tall, side):
             raise BumpError(f"level {level} must be {side} x {tall} texels (width x height, "
@@ -430,7 +418,7 @@ class TextureCache(wiring.Component):
             pop_ok=Signal(name="pop_ok"),         # the same from this cycle's registers (comb)
             f_in=Signal(range(geom.misses), name="f_in"), f_out=Signal(range(geom.misses), name="f_out"),
             beat=Signal(range(geom.beats), name="beat"))          # the R beat of the line
-        tb, hb = geom.texture_size.bit_length() - 1, geom.height.bit_length() - 1
+        tb, hb = geom.texture_bits, geom.height_bits
         fields = {"u": unsigned(max(1, tb)), "v": unsigned(max(1, hb))}
         if geom.mip_levels > 1:
             fields["level"] = unsigned((geom.mip_levels - 1).bit_length())

@@ -228,7 +228,6 @@ class HardwareScene(MapSize):
         keys = {k: getattr(self, k) for k in self.__dataclass_fields__}
         return HardwareScene(**{**keys, "rotation": None, **own, "config": config})
 
-
     @property
     def lights(self):
         return self.config.lights

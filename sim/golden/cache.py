@@ -198,7 +198,7 @@ def run_cache(geom: CacheGeometry, u, v, level, levels=None):
 def random_levels(geom: CacheGeometry, seed=0):
     """Random texel words for every level of ``geom`` (``[v, u]`` arrays)."""
     rng = np.random.default_rng(seed)
-    return [rng.integers(0, 1 << geom.texel_bits, (geom.level_height(lv), geom.level_width(lv)))
+    return [rng.integers(0, 1 << geom.texel_bits, geom.level_size(lv)[::-1])
             for lv in range(geom.mip_levels)]
 
 
@@ -209,7 +209,7 @@ def cache_stimulus(geom: CacheGeometry, n, seed):
     u, v, level = [], [], []
     while len(u) < n:
         lv = int(rng.integers(0, geom.mip_levels))
-        side, tall = geom.level_width(lv), geom.level_height(lv)
+        side, tall = geom.level_size(lv)
         u0, v0, run = int(rng.integers(0, side)), int(rng.integers(0, tall)), int(rng.integers(1, 12))
         for k in range(run):
             u.append((u0 + k) % side)

@@ -207,7 +207,7 @@ def test_pipeline_axi_nonsquare_map_bit_exact(addressing):
     inputs = random_inputs(scene, 80, rng)
     dut = BumpPipeline(scene.hardware, cache={"sets": 4})
     geom = dut.units["fetch"].geom
-    assert (geom.texture_size, geom.height) == (32, 16)
+    assert (geom.texture_size, geom.map_height) == (32, 16)
     mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
                         latency=7, ar_stall=0.3, r_stall=0.3, seed=5)
     payloads = as_payload_list(inputs)

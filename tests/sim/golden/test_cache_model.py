@@ -43,7 +43,7 @@ def test_layout_round_trip(texel_bits, block, levels):
     assert len(image) == g.image_bytes
     seen = set()
     for lv in range(levels):
-        side = g.level_width(lv)
+        side = g.level_size(lv)[0]
         v, u = np.mgrid[0:side, 0:side]
         addr = texel_byte_address(u, v, lv, g)
         for uu, vv, a in zip(u.ravel(), v.ravel(), addr.ravel(), strict=True):
@@ -52,7 +52,7 @@ def test_layout_round_trip(texel_bits, block, levels):
             got = int.from_bytes(image[off:off + g.slot_bytes], "little")
             assert got == words[lv][vv, uu], (lv, uu, vv)
             seen.add(off)
-    assert len(seen) == sum(g.level_width(lv) ** 2 for lv in range(levels))   # a bijection
+    assert len(seen) == sum(g.level_size(lv)[0] ** 2 for lv in range(levels))   # a bijection
 
 
 def _nonsquare_image(width, height, levels, block, slot, texel_bits, seed):
@@ -94,7 +94,7 @@ def test_nonsquare_tiled_image_is_the_independent_one(width, height, levels, blo
                       texture_height=None if height == width else height)
     want, words, lines = _nonsquare_image(width, height, levels, block, g.slot_bytes,
                                           texel_bits, width + levels)
-    assert g.height == height and g.lines == lines and g.image_bytes == len(want)
+    assert g.map_height == height and g.lines == lines and g.image_bytes == len(want)
     assert [g.blocks_per_row(lv) * g.blocks_per_column(lv) for lv in range(levels)] == \
         [max(1, (width >> lv) // block) * max(1, (height >> lv) // block) for lv in range(levels)]
     assert [w.shape for w in random_levels(g)] == [(height >> lv, width >> lv) for lv in range(levels)]
