@@ -7,7 +7,7 @@ from bumprtl.rtl.config import Config
 from bumprtl.rtl.tables import SPEC_FRAC_BITS
 
 __all__ = ["angle_shape", "polar_layout", "light_layout", "light_fields", "light_keys",
-           "pixel_layout", "shade_layout", "layout_fields"]
+           "pixel_layout", "shade_layout", "layout_fields", "pack", "unpack"]
 
 
 def angle_shape(cfg: Config):
@@ -91,4 +91,27 @@ def layout_fields(layout, prefix=""):
         else:
             s = Shape.cast(shape)
             out[f"{prefix}{name}"] = [field.offset, s.width, s.signed]
+    return out
+
+
+def pack(fields, values):
+    """Pack ``{field: int}`` into one integer; negative values are two's complement."""
+    word = 0
+    for name, (offset, width, _signed) in fields.items():
+        v = int(values.get(name, 0))
+        lo, hi = (-(1 << (width - 1)), (1 << (width - 1)) - 1) if _signed else (0, (1 << width) - 1)
+        if width and not lo <= v <= hi:
+            raise ValueError(f"payload field {name} = {v} does not fit {width} bits")
+        word |= (v & ((1 << width) - 1)) << offset
+    return word
+
+
+def unpack(fields, word):
+    """Inverse of :func:`pack`: ``{field: int}`` with signed fields sign-extended."""
+    out = {}
+    for name, (offset, width, _signed) in fields.items():
+        v = (word >> offset) & ((1 << width) - 1)
+        if _signed and width and v >> (width - 1):
+            v -= 1 << width
+        out[name] = v
     return out

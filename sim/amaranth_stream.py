@@ -10,11 +10,12 @@ dicts (with nested layouts flattened to dotted names).
 import random
 from collections import deque
 
-from amaranth.hdl import Cat, Module, Shape, Signal, Value
+from amaranth.hdl import Cat, Module, Signal, Value
 from amaranth.lib import data
 from amaranth.sim import Simulator
 
 from bumprtl.rtl.illumination import Illumination
+from bumprtl.rtl.layouts import layout_fields, unpack
 from bumprtl.rtl.rotation import VectorRotation
 from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads
@@ -79,35 +80,8 @@ def driven(dut, *drives):
     return m
 
 
-class Sample:
-    """The fields of a payload View read from one sampled value: ``fields(bits)`` ->
-    {dotted name: int} (signed fields sign-extended), as :func:`flatten_payload`'s values
-    read one by one would give them."""
-
-    def __init__(self, view):
-        self.value = Value.cast(view)
-        self.slots = list(_slots(view.shape(), 0, ""))
-
-    def fields(self, bits):
-        bits, out = int(bits), {}
-        for name, offset, width, signed in self.slots:
-            x = (bits >> offset) & ((1 << width) - 1)
-            out[name] = x - (1 << width) if signed and x >> (width - 1) else x
-        return out
-
-
-def _slots(layout, base, prefix):
-    for name, field in layout:
-        shape = field.shape
-        if isinstance(shape, data.Layout):
-            yield from _slots(shape, base + field.offset, f"{prefix}{name}.")
-        else:
-            s = Shape.cast(shape)
-            yield f"{prefix}{name}", base + field.offset, s.width, s.signed
-
-
 def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None,
-                    pipe_handshake=False, processes=()):
+                    pipe_handshake=False, models=()):
     """Drive ``inputs`` into ``dut.i``; return ``(outputs, cycles)`` from ``dut.o``.
 
     Each input is a dict ``{field: int}`` (dotted names for nested layouts). Outputs come
@@ -117,10 +91,9 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     is high exactly while fewer than ``dut.fifo_depth`` pixels are inside (taken at ``i``
     before this cycle and not taken at ``o`` before it), and an output offered and not taken
     is offered again the next cycle (a ready that waits on ``o.ready``, or a credit lost or
-    made, is bit-exact and fails only this check). ``processes``: more testbenches run beside
-    the stream's: an async function, or a bench model with a ``process`` of its own and the
-    :class:`Drive` of its inputs as ``drive`` (a memory model on another port,
-    sim/axi_memory.py), whose Drive is wired into the top.
+    made, is bit-exact and fails only this check). ``models``: bench models run beside the
+    stream's testbench, each with an async ``process`` and the :class:`Drive` of its inputs
+    as ``drive``, wired into the top (a memory model on another port, sim/axi_memory.py).
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
@@ -133,7 +106,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     drive = Drive({**flatten_payload(dut.i.payload), "i.valid": dut.i.valid,
                    "o.ready": dut.o.ready})
 
-    out = Sample(dut.o.payload)      # the output's payload read as one value a cycle
+    # the output's payload read as one value a cycle, cut into its fields
+    o_payload, o_fields = Value.cast(dut.o.payload), layout_fields(dut.o.payload.shape())
 
     async def testbench(ctx):
         pending = deque(inputs)
@@ -147,7 +121,7 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
             drive["o.ready"] = rng.random() >= bp_p
             drive.set(ctx)
             _, _, i_valid, i_ready, o_valid, o_ready, o_bits = await ctx.tick().sample(
-                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, out.value)
+                dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, o_payload)
             if pipe_handshake:
                 inside = state["inside"]
                 assert bool(i_ready) == (inside < dut.fifo_depth), (
@@ -160,16 +134,15 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
             if offered is not None and i_ready:
                 offered = None
             if o_valid and o_ready:
-                outputs.append(out.fields(o_bits))
+                outputs.append(unpack(o_fields, int(o_bits)))
             state["cycles"] += 1
             assert state["cycles"] < limit, f"timeout after {limit} cycles ({len(outputs)} outputs)"
 
-    models = [p for p in processes if hasattr(p, "process")]
-    sim = Simulator(driven(dut, drive, *(p.drive for p in models)))
+    sim = Simulator(driven(dut, drive, *(model.drive for model in models)))
     sim.add_clock(1e-8)
     sim.add_testbench(testbench)
-    for process in processes:
-        sim.add_testbench(getattr(process, "process", process), background=True)
+    for model in models:
+        sim.add_testbench(model.process, background=True)
     if vcd:
         with sim.write_vcd(vcd):
             sim.run()

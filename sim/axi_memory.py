@@ -29,7 +29,7 @@ class AxiReadMemory:
         self.rng = random.Random(seed)
         self.requests = []
         # ARREADY, RVALID, RDATA and RLAST in one set a cycle (wired into the top by
-        # simulate_stream when this model is passed as a process); RDATA and RLAST hold the
+        # simulate_stream when this model is one of its ``models``); RDATA and RLAST hold the
         # last beat's while none is presented
         self.drive = Drive({"arready": port.arready, "rvalid": port.rvalid,
                             "rdata": port.rdata, "rlast": port.rlast})

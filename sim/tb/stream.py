@@ -14,6 +14,7 @@ import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ReadOnly, RisingEdge
 
+from bumprtl.rtl.layouts import pack, unpack
 from bumprtl.rtl.sidecar import load
 from bumprtl.sim.traffic import PATTERNS
 
@@ -29,29 +30,6 @@ def load_sidecar():
 
 def samples(default):
     return int(os.environ.get("BUMPRTL_SAMPLES", default))
-
-
-def pack(fields, values):
-    """Pack ``{field: int}`` into one integer; negative values are two's complement."""
-    word = 0
-    for name, (offset, width, _signed) in fields.items():
-        v = int(values.get(name, 0))
-        lo, hi = (-(1 << (width - 1)), (1 << (width - 1)) - 1) if _signed else (0, (1 << width) - 1)
-        if width and not lo <= v <= hi:
-            raise ValueError(f"payload field {name} = {v} does not fit {width} bits")
-        word |= (v & ((1 << width) - 1)) << offset
-    return word
-
-
-def unpack(fields, word):
-    """Inverse of :func:`pack`: ``{field: int}`` with signed fields sign-extended."""
-    out = {}
-    for name, (offset, width, _signed) in fields.items():
-        v = (word >> offset) & ((1 << width) - 1)
-        if _signed and width and v >> (width - 1):
-            v -= 1 << width
-        out[name] = v
-    return out
 
 
 async def _reset(dut):

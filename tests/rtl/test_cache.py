@@ -51,7 +51,7 @@ def check_cache(geom, n=150, pattern="both", latency=2, ar_stall=0.3, r_stall=0.
                **({"level": int(level[k])} if geom.mip_levels > 1 else {})} for k in range(n)]
     out, cycles = simulate_stream(dut, inputs, pattern, seed=seed,
                                   max_cycles=(n + 1) * (latency + 4 * geom.beats + 20),
-                                  processes=[mem])
+                                  models=[mem])
     assert [o["tag"] for o in out] == [k & 255 for k in range(n)]
     bad = [k for k in range(n) if out[k]["texel"] != golden.texel[k]]
     assert not bad, (f"{len(bad)} texels differ, first pixel {bad[0]}: RTL "
@@ -116,7 +116,7 @@ def test_cache_hits_at_one_pixel_a_clock():
     for inputs in (one, one + one):
         dut = TextureCache(geom)
         mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), 32)
-        out, n = simulate_stream(dut, inputs, processes=[mem])
+        out, n = simulate_stream(dut, inputs, models=[mem])
         assert [o["texel"] for o in out] == [int(w) for w in levels[0].ravel()] * (len(inputs) // 256)
         assert len(mem.requests) == geom.lines
         cycles.append(n)
@@ -133,7 +133,7 @@ def _cycles(geom, latency, n, seed, levels_seed=None):
     dut = TextureCache(geom)
     mem = AxiReadMemory(dut.axi, tiled_image(geom, levels), geom.data_bits, latency=latency)
     pixels = [{"u": int(a), "v": int(b), "level": int(c)} for a, b, c in zip(u, v, level, strict=True)]
-    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, processes=[mem])
+    out, cycles = simulate_stream(dut, pixels, max_cycles=50_000, models=[mem])
     assert [o["texel"] for o in out] == golden.texel.tolist()
     assert mem.requests == golden.requests
     return cycles, geom.sets + stream_cycles(golden, geom, latency) + CACHE_LATENCY, golden
@@ -187,7 +187,7 @@ def test_pipeline_axi_bit_exact_under_memory_latency(base, addressing, latency, 
                         latency=latency, ar_stall=0.3, r_stall=0.3, seed=latency)
     payloads = as_payload_list(inputs)
     out, _ = simulate_stream(dut, payloads, pattern, seed=latency, max_cycles=40_000,
-                             processes=[mem])
+                             models=[mem])
     assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
     golden = run_scene_cache(scene.hardware, geom, inputs, words)
     assert mem.requests == golden.requests and golden.evictions
@@ -212,7 +212,7 @@ def test_pipeline_axi_nonsquare_map_bit_exact(addressing):
                         latency=7, ar_stall=0.3, r_stall=0.3, seed=5)
     payloads = as_payload_list(inputs)
     out, _ = simulate_stream(dut, payloads, "both", seed=5, max_cycles=40_000,
-                             processes=[mem])
+                             models=[mem])
     assert_bit_exact(out, pipeline_fixed(inputs, scene, words), payloads)
     golden = run_scene_cache(scene.hardware, geom, inputs, words)
     assert mem.requests == golden.requests
@@ -265,7 +265,7 @@ def _pipeline_cycles(scene, latency, n=120, seed=3):
     mem = AxiReadMemory(dut.axi, tiled_image(geom, scene_levels(scene, words)), geom.data_bits,
                         latency=latency)
     _, cycles = simulate_stream(dut, as_payload_list(inputs), max_cycles=50_000,
-                                processes=[mem])
+                                models=[mem])
     run = run_scene_cache(scene.hardware, geom, inputs, words)
     return cycles, geom.sets + stream_cycles(run, geom, latency) + dut.port_latency
 
