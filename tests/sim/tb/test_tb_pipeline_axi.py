@@ -64,6 +64,10 @@ def test_pipeline_axi_cocotb_against_axi_ram(sim, scene, build_dir):
     assert (run.tests, run.failures) == (3, 0)
 
 
+# make regress: make test checks the non-square map's pipeline bit for bit, its AR stream
+# the golden cache's, in the Amaranth simulator with the AXI memory model, wrap and clamp
+# (tests/rtl/test_cache.py), and AxiRamRead under cocotb on the square scene (above).
+@pytest.mark.regress
 def test_nonsquare_pipeline_axi_on_icarus(build_dir):
     """The 32 x 16 map's pipeline emitted with its _map.bin (32 x 16 + 16 x 8 texels in 2-byte
     slots; the sidecar records the map's width and height) under cocotb on Icarus against
