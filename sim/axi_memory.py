@@ -10,6 +10,8 @@ data width, no burst crossing 4 KiB, RREADY never needed for RVALID.
 
 import random
 
+from amaranth.hdl import Cat
+
 from bumprtl.sim.amaranth_stream import Drive
 
 __all__ = ["AxiReadMemory"]
@@ -48,6 +50,14 @@ class AxiReadMemory:
         p = self.port
         cycle, beats, held_ar, presenting = 0, [], None, None
         drive = self.drive
+        # the port's read-side signals sampled as one value a cycle, cut apart here
+        names = ("arvalid", "arready", "araddr", "arlen", "arsize", "arburst", "rvalid", "rready")
+        sampled = Cat(*(getattr(p, n) for n in names))
+        cuts, offset = [], 0
+        for n in names:
+            width = len(getattr(p, n))
+            cuts.append((offset, (1 << width) - 1))
+            offset += width
         while True:
             drive["arready"] = self.rng.random() >= self.ar_stall
             if presenting is None and beats and beats[0][0] <= cycle \
@@ -56,9 +66,9 @@ class AxiReadMemory:
                 drive["rdata"], drive["rlast"] = presenting[1], presenting[2]
             drive["rvalid"] = presenting is not None
             drive.set(ctx)
-            (_, _, arvalid, arready, araddr, arlen, arsize, arburst, rvalid,
-             rready) = await ctx.tick().sample(p.arvalid, p.arready, p.araddr, p.arlen,
-                                               p.arsize, p.arburst, p.rvalid, p.rready)
+            _, _, bits = await ctx.tick().sample(sampled)
+            (arvalid, arready, araddr, arlen, arsize, arburst, rvalid,
+             rready) = (bits >> at & mask for at, mask in cuts)
             ar = (araddr, arlen, arsize, arburst)
             if held_ar is not None:
                 assert arvalid and ar == held_ar, (
