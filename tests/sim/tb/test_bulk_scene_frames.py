@@ -45,7 +45,11 @@ def _stream(v, j, meta, frame, golden, work):
             assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
 
 
-@pytest.mark.parametrize("name", ["diffuse", "flat", "textured", "two-lights"])
+# two-lights in make regress: make test streams the full scene's coverage frame, whose
+# datapath is two-lights' with the texture and the mip levels added, every cycle from cocotb
+# on Icarus (tests/sim/tb/test_tb_pipeline.py).
+@pytest.mark.parametrize("name", ["diffuse", "flat", "textured",
+                                  pytest.param("two-lights", marks=pytest.mark.regress)])
 def test_scene_coverage_frame_equals_golden(name, build_dir):
     v, j, meta, frame, golden = _scene_frame(load_scene_config(name), build_dir)
     assert set(golden) == set(meta.output_fields)      # every output

@@ -27,9 +27,12 @@ def _cases():
                 # regress: lee on Verilator and lee's rotation on Icarus too (make test keeps
                 # its illumination there; tests/rtl/test_lee.py runs the rotation bit-exact in
                 # the Amaranth simulator); exact rotation on Verilator (its Icarus run stays,
-                # and the scene pipelines run it on Verilator in make test)
+                # and the scene pipelines run it on Verilator in make test); exact illumination
+                # on Icarus (its Verilator run stays, and make test streams it on Icarus
+                # inside the default and full scenes' pipelines: test_bulk, test_tb_pipeline)
                 slow = (sim, method) == ("verilator", "lee") or (sim, method, unit) in (
-                    ("verilator", "exact", "rotation"), ("icarus", "lee", "rotation"))
+                    ("verilator", "exact", "rotation"), ("icarus", "lee", "rotation"),
+                    ("icarus", "exact", "illumination"))
                 marks = pytest.mark.regress if slow else ()
                 yield pytest.param(sim, unit, method, marks=marks, id=f"{method}-{unit}-{sim}")
 
