@@ -25,6 +25,7 @@
 
 import hashlib
 import json
+import math
 import os
 import subprocess
 import time
@@ -66,7 +67,7 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
-           "MAP_FILE"]
+           "MAP_FILE", "sdram_preload"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -96,18 +97,41 @@ def board_data(scene):
     return words, texels, plane_constants(scene), light_table(scene)
 
 
-def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None):
+def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None,
+               preloaded=False):
     """The board's core (rtl/board.BoardCore) of ``scene`` in ``mode``; ``pipe_hz``: the
     source and pipeline in their own clock domain at that rate (None: the pixel clock);
     ``memory`` (a :class:`BoardMemory`, a map in the SDRAM): its SDRAM and flash parts, and
-    its pipe clock instead of ``pipe_hz``."""
+    its pipe clock instead of ``pipe_hz``; ``preloaded`` (simulation only): no flash loader,
+    the SDRAM's model holds the image from the start (:func:`sdram_preload`)."""
     words, texels, constants, table = board_data(scene) if data is None else data
     parts = {}
     if memory is not None:
         words, pipe_hz = None, memory.pipe_hz
         parts = {"sdram": memory.sdram, "flash": memory.flash}
+    if preloaded:
+        parts["preloaded"] = True
     return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
                      pipe_hz=pipe_hz, globe=surface(scene) == "sphere", **parts)
+
+
+def sdram_preload(sdram, base, image):
+    """What the SDRAM holds once the flash loader has copied ``image`` (bytes) to AXI byte
+    address ``base`` through the SdramController of ``sdram`` (its SdramConfig), as the
+    datasheet model's power-on contents (sim/sdram_model.py, ``preload``): an array of
+    16-bit words indexed [bank, row, column], zero elsewhere. The controller's mapping, from
+    the configuration's chip: the AXI byte address's bits above bit 0 are the word address
+    (wrapping at the chip's size), its lowest ``col_bits`` the column, the next
+    ``bank_bits`` the bank, the rest the row; the even byte is a word's low byte (DQ[7:0],
+    AXI's little-endian lanes). ``base`` and the image's length are even."""
+    chip = sdram.chip
+    col_bits, bank_bits, row_bits = chip.col_bits, chip.bank_bits, chip.row_bits
+    flat = np.zeros(1 << (col_bits + bank_bits + row_bits), np.uint16)
+    words = np.frombuffer(image, "<u2")
+    start = base >> 1
+    flat[(start + np.arange(len(words))) % len(flat)] = words
+    # word address = row, bank, column from the top: (rows, banks, columns) -> [bank, row, column]
+    return flat.reshape(1 << row_bits, 1 << bank_bits, 1 << col_bits).transpose(1, 0, 2)
 
 
 @dataclass(frozen=True)
@@ -412,20 +436,21 @@ def part_costs(scene, mode, work_dir, memory=None):
     return rows
 
 
-def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None, memory=None):
+def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None, memory=None, preloaded=False):
     """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``; with
     ``pipe_hz`` it has the pipeline's clock and reset ports too (``pipe_clk``, ``pipe_rst``);
-    with ``memory`` (:func:`board_memory`) the SDRAM's and the flash's pins as well."""
+    with ``memory`` (:func:`board_memory`) the SDRAM's and the flash's pins as well (the
+    SDRAM's only when ``preloaded``: no flash loader)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    top = SimTop(board_core(scene, mode, None, data, pipe_hz, memory))
+    top = SimTop(board_core(scene, mode, None, data, pipe_hz, memory, preloaded))
     path = out_dir / "board_sim.v"
     path.write_text(verilog.convert(top, name="board_sim", emit_src=False))
     return path, top
 
 
 def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_hz=None,
-                 memory=None):
+                 memory=None, preload=False):
     """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
     under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
     golden frame. ``opt_fast``: g++'s optimisation of the model's per-cycle code (verilated.mk's
@@ -436,14 +461,21 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
     (sim/sdram_model.py) on the SDRAM's pins and the flash model (sim/flash_model.py, the
     image at its offset) on the flash's, at the BoardMemory's pipe clock; the sink starts
     in the frame after the display's first, so the frames compared are golden frames 1 ..
-    ``frames``. Returns a dict: captured (list of arrays), golden, timing (the run lengths
+    ``frames``. ``preload`` (with ``memory``): no flash loader in the simulated top and no
+    flash model; the SDRAM's model starts holding what the loader would have written
+    (:func:`sdram_preload`), the map counts as loaded once the controller's initialisation
+    is done, and the testbench holds the display's (pixel) domain in reset until the
+    pipeline has had time to fill its buffers, so that the display starts at its first
+    frame. Returns a dict: captured (list of arrays), golden, timing (the run lengths
     the testbench measured), seconds, the verdicts, ``first`` (the golden frame of the
     first captured one)."""
     out_dir = Path(out_dir).resolve()
     data = board_data(scene) if data is None else data
+    if preload and memory is None:
+        raise BumpError("preload applies to a map in the SDRAM (memory)", "preload")
     if memory is not None:
         pipe_hz = memory.pipe_hz
-    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz, memory)
+    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz, memory, preload)
     result = out_dir / "frames.npz"
     if result.exists():
         result.unlink()
@@ -452,16 +484,23 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
            "BOARD_TIMING": ",".join(str(x) for x in (m.h_active, m.h_front, m.h_sync, m.h_back,
                                                      m.v_active, m.v_front, m.v_sync, m.v_back,
                                                      int(m.h_negative), int(m.v_negative))),
-           "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
-    if pipe_hz is not None:       # the same ratio to the simulated pixel period, in ps (even)
-        env["BOARD_PIPE_PS"] = 2 * round(5e2 * env["BOARD_PIXEL_NS"] * m.pixel_hz / pipe_hz)
-    if memory is not None:        # the flash's array: the image at its offset
+           # ps, a multiple of 10: the shift clock's (a fifth) half period is whole ps
+           "BOARD_PIXEL_PS": 10 * round(1e11 / m.pixel_hz)}
+    if memory is not None:
+        # the model's clock is the simulated pipe clock (ps), the controller's timings the
+        # SdramConfig's: the simulated period is the configured one rounded up to even ps
+        # (never shorter: every spacing the controller counts lasts its ns)
+        env["BOARD_PIPE_PS"] = 2 * math.ceil(5e11 / pipe_hz - 1e-6)
+        env.update(BOARD_SDRAM=memory.sdram.variant)
+    elif pipe_hz is not None:     # the same ratio to the simulated pixel period, in ps (even)
+        env["BOARD_PIPE_PS"] = 2 * round(0.5 * env["BOARD_PIXEL_PS"] * m.pixel_hz / pipe_hz)
+    if memory is not None and preload:     # what the loader would have written, [bank, row, col]
+        env["BOARD_PRELOAD"] = out_dir / "sdram_preload.npy"
+        np.save(env["BOARD_PRELOAD"], sdram_preload(memory.sdram, memory.flash.base, memory.image))
+    elif memory is not None:      # the flash's array: the image at its offset
         flash = out_dir / "flash.bin"
         flash.write_bytes(bytes(memory.flash.offset) + memory.image)
-        # the model's clock is the simulated pipe clock (ps), the controller's timings the
-        # SdramConfig's: the simulated period is the configured one rounded to even ps
-        env.update(BOARD_SDRAM=memory.sdram.variant, BOARD_FLASH=flash,
-                   BOARD_FLASH_PHASE=memory.flash.half_period)
+        env.update(BOARD_FLASH=flash, BOARD_FLASH_PHASE=memory.flash.half_period)
     t0 = time.perf_counter()
     # the flash loader's FSM and its "== 0" tests: incomplete cases and a vector's "!" in
     # Amaranth's Verilog, which Verilator's lint flags (the board's other units do not)
