@@ -14,7 +14,7 @@ Once a word, on the clock lane's rising edge, the testbench records the sink's d
 v negative); the disagreements go to ``timing_errors``.
 
 Environment: BOARD_RESULT (npz path), BOARD_FRAMES (frames to capture), BOARD_TIMING,
-BOARD_PIXEL_PS (pixel clock period, ps, a multiple of 5); BOARD_PIPE_PS (the pipe clock's period, ps, when
+BOARD_PIXEL_PS (pixel clock period, ps, a multiple of 10); BOARD_PIPE_PS (the pipe clock's period, ps, when
 the pipeline has its own domain).
 
 With the map in the SDRAM (BOARD_SDRAM: the chip's variant; BOARD_FLASH: the flash array's
@@ -206,8 +206,9 @@ async def board_frames(dut):
     for r in resets:
         r.value = 1
     await ClockCycles(dut.clk, 4)
-    for r in resets:
-        r.value = 0 if r is not dut.rst or not preloaded else 1
+    for r in resets:           # preloaded: the display's domain stays in reset (below)
+        if not (preloaded and r is dut.rst):
+            r.value = 0
     first = 0
     if preloaded:
         # The map is in the SDRAM from the start: the source starts once the controller's

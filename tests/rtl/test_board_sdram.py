@@ -6,7 +6,11 @@ cache reads it from there. In the Amaranth simulator, the pipeline at 4 x the pi
 the first frames shown equal the golden frames (the map in block RAM's), nothing underflows
 or comes out of order, and neither model saw a rule broken; once with the controller's pins
 the chip's, once with them registered as the ULX3S top's I/O does (``pin_cycles`` 2). Opt-in
-(``make regress``): the load and two frames take about a minute of simulation each."""
+(``make regress``): the load and two frames take about a minute of simulation each.
+
+In ``make test``: the preload that simulations without the flash copy start the SDRAM's
+model with (gen/flow/board.sdram_preload) against what the controller writes, and the
+memory parts' refusals."""
 
 import numpy as np
 import pytest
