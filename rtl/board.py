@@ -386,11 +386,12 @@ class BoardCore(Elaboratable):
         self.sdram, self.flash = sdram, flash
         self.preloaded = bool(preloaded)
         self.loader = self.spi = None
-        if sdram is not None:
+        if sdram is not None:     # (in this order: the elaborated names follow it)
             self.controller = SdramController(sdram)
-            self.sdram_pins = sdram_signature(sdram).flip().create(path=("sdram",))
             if not self.preloaded:
                 self.loader = FlashLoader(flash)
+            self.sdram_pins = sdram_signature(sdram).flip().create(path=("sdram",))
+            if not self.preloaded:
                 self.spi = spi_signature().flip().create(path=("spi",))
         self.timing = VideoTiming(mode)
         self.shows = Signal(name="display_shows")   # the display takes pixels (from a frame's start)
@@ -408,11 +409,13 @@ class BoardCore(Elaboratable):
             inner["globe"] = self.globe
         if self.sdram is not None:
             inner["sdram"] = self.controller
-            wiring.connect(m, p.axi, self.controller.rd)
-            wiring.connect(m, self.controller.sdram, self.sdram_pins)
             if self.loader is not None:
                 inner["flash_loader"] = self.loader
+            wiring.connect(m, p.axi, self.controller.rd)
+            if self.loader is not None:
                 wiring.connect(m, self.loader.axi, self.controller.wr)
+            wiring.connect(m, self.controller.sdram, self.sdram_pins)
+            if self.loader is not None:
                 wiring.connect(m, self.loader.spi, self.spi)
         for name, sub in inner.items():
             m.submodules[name] = sub if self.pipe_hz is None else DomainRenamer("pipe")(sub)
@@ -730,10 +733,10 @@ class SimTop(wiring.Component):
                  "underflow": wiring.Out(1), "order_error": wiring.Out(1),
                  "light_step": wiring.Out(len(core.source.frame))}
         if core.sdram is not None:
-            ports.update(sdram=wiring.Out(sdram_signature(core.sdram)),
-                         display_shows=wiring.Out(1))
+            ports["sdram"] = wiring.Out(sdram_signature(core.sdram))
             if core.spi is not None:
                 ports["spi"] = wiring.Out(spi_signature())
+            ports["display_shows"] = wiring.Out(1)
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -755,8 +758,8 @@ class SimTop(wiring.Component):
                 m.d.pipe += reg.eq(getattr(inner, name))
                 m.d.comb += getattr(pins, name).eq(reg)
             m.d.pipe += inner.dq_i.eq(pins.dq_i)
-            m.d.comb += self.display_shows.eq(core.shows)
             if core.spi is not None:
                 m.d.comb += [spi.sclk.eq(core.spi.sclk), spi.cs_n.eq(core.spi.cs_n),
                              spi.mosi.eq(core.spi.mosi), core.spi.miso.eq(spi.miso)]
+            m.d.comb += self.display_shows.eq(core.shows)
         return m
