@@ -23,17 +23,20 @@
   every captured frame with :func:`~bumprtl.sim.golden.board.golden_frame`.
 """
 
+import gc
 import hashlib
 import json
 import math
 import os
 import subprocess
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from amaranth.back import rtlil, verilog
+from amaranth.hdl import UnusedElaboratable
 
 from bumprtl.gen.flow.memories import (
     DEVICE_BRAM,
@@ -46,15 +49,21 @@ from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.board import (
+    CDC_SYNC_STAGES,
     SDRAM_PIN_CYCLES,
     BoardCore,
     SimTop,
     ULX3STop,
     buffer_depth,
+    cdc_depth,
     globe_config,
+    globe_offsets,
+    globe_rotation,
     sdram_clock,
+    texel_coords,
 )
-from bumprtl.rtl.cache import scene_geometry
+from bumprtl.rtl.bumpfetch import level_coords
+from bumprtl.rtl.cache import CACHE_LATENCY, scene_geometry
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.flash import FLASH_BYTES_MAX, FlashConfig
 from bumprtl.rtl.pipe import ECP5
@@ -62,12 +71,15 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sdram import CHIPS, SdramConfig
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants, surface
+from bumprtl.sim.golden.cache import run_cache
+from bumprtl.sim.golden.globe import globe_fixed
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
-           "MAP_FILE", "sdram_preload"]
+           "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
+           "predict_display"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -176,6 +188,142 @@ def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET
         words = board_data(scene)[0]
     image = memory_images("pipeline", scene, words)["map"]["bin"]
     return BoardMemory(hz, sdram, flash, image)
+
+
+def _frame_coords(scene, mode, frame, rows):
+    """Level-0 texel (u, v) the board's source gives the active pixels of ``rows``."""
+    y, x = np.mgrid[rows.start:rows.stop, 0:mode.h_active]
+    x, y = x.ravel().astype(np.int64), y.ravel().astype(np.int64)
+    if surface(scene) == "sphere":
+        gx, gy = globe_offsets(x, y, mode)
+        g = globe_fixed(gx, gy, globe_rotation(scene.hardware.config, frame),
+                        globe_config(scene.hardware, mode))
+        u, v = g["u"], g["v"]
+    else:
+        u, v = texel_coords(x, y, mode.zoom, scene.texture_size, scene.map_height)
+    return level_coords(np.asarray(u, np.int64), np.asarray(v, np.int64), 0, scene)
+
+
+def frame_misses(scene, mode, frame=1, rows=None, warm=True):
+    """Whether the texel cache misses, per active pixel of ``rows`` (a range of active lines;
+    None: all) of frame ``frame``, shape (lines, h_active): the golden cache model
+    (sim/golden/cache.run_cache, the RTL's hit/miss sequence) on the level-0 texel
+    coordinates the board's source gives (the globe's or the tiled plane's). ``warm``: the
+    cache as the frame before (all of it, frame - 1) left it, as on the board from its
+    second frame on; otherwise cold at the rows' start."""
+    rows = range(mode.v_active) if rows is None else rows
+    u, v = _frame_coords(scene, mode, frame, rows)
+    skip = 0
+    if warm:
+        u0, v0 = _frame_coords(scene, mode, frame - 1, range(mode.v_active))
+        u, v, skip = np.concatenate([u0, u]), np.concatenate([v0, v]), len(u0)
+    run = run_cache(scene_geometry(scene.hardware), u, v, np.zeros_like(u))
+    return ~run.hit[skip:].reshape(len(rows), mode.h_active)
+
+
+@dataclass(frozen=True)
+class DisplayBudget:
+    """What :func:`display_budget` found. Per line: ``misses`` (the cache's), each costing
+    ``line_cost`` pipe clocks of SDRAM reads, against ``line_clocks`` (the pipe clocks a
+    line lasts, blanking included). ``ahead``: the pixels the pipeline may hold ahead of
+    the display (its elastic buffer and the clock crossing), ``steady`` the pipe clocks
+    they leave to spare with every pixel a hit; ``slack``: the least, over every pixel, of
+    the pipe clocks between its arrival at the display's side and the display wanting it
+    (negative: the display starves), ``worst`` the (line, column) of the pixel with the
+    least (None: no miss); ``holds``: slack >= 0."""
+    rows: range
+    misses: np.ndarray
+    line_cost: float
+    line_clocks: float
+    ahead: int
+    steady: float
+    slack: float
+    worst: tuple
+
+    @property
+    def worst_line(self):
+        return self.rows.start + int(np.argmax(self.misses))
+
+    @property
+    def needed(self):
+        """Pipe clocks of SDRAM reads the worst line needs."""
+        return float(self.misses.max() * self.line_cost)
+
+    @property
+    def holds(self):
+        return self.slack >= 0
+
+
+def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clocks,
+                   rows=None):
+    """Whether the display is fed (:class:`DisplayBudget`), from ``miss`` (per active pixel
+    of ``rows``, :func:`frame_misses`) and the design's numbers: the pipeline's
+    ``latency`` and elastic buffer ``depth`` (credits), the clock crossing's ``cdc``
+    entries, a cache line's SDRAM read ``line_cost`` (pipe clocks a line when reads follow
+    back to back, a new row each: sim/sdram_bench.bandwidth's ``miss`` x 4) and
+    ``fill_clocks`` (an isolated miss's pixel leaves the cache that long after its lookup).
+
+    The model, in pipe clocks (``r`` = pipe / pixel clock): the display wants active pixel
+    k of line y, column x at r (y h_total + x); pixel k enters the pipeline when the
+    display has taken pixel k - ahead (ahead = depth + cdc; the buffers full at the rows'
+    start); a hit leaves the cache CACHE_LATENCY after it enters; the SDRAM reads the
+    missed lines one after another, miss j's pixel leaving at F_j = max(F_{j-1} +
+    line_cost, its entry + fill_clocks); from the cache to the display's side it takes
+    latency - CACHE_LATENCY more, and the crossing 2 + CDC_SYNC_STAGES pipe and 3 +
+    CDC_SYNC_STAGES pixel clocks. A pixel behind a miss leaves the cache a clock after the
+    one before, faster than the display's r a pixel, so only the misses can be late.
+    Left out: refresh (a few clocks every 7.8 us) and the cheaper reads of lines in an
+    open row (:func:`~bumprtl.sim.sdram_bench.bandwidth`'s ``hit``)."""
+    rows = range(mode.v_active) if rows is None else rows
+    miss = np.asarray(miss, bool).reshape(len(rows), mode.h_active)
+    r = pipe_hz / mode.pixel_hz
+    ahead = depth + cdc
+    cross = 2 + CDC_SYNC_STAGES + (3 + CDC_SYNC_STAGES) * r
+    steady = r * ahead - latency - cross
+    line, col = np.nonzero(miss)
+    k = line * mode.h_active + col
+    want = r * ((rows.start + line) * mode.h_total + col)
+    before = k - ahead
+    enter = np.where(before >= 0, r * ((rows.start + before // mode.h_active) * mode.h_total
+                                       + before % mode.h_active), -np.inf)
+    slack, worst, done = steady, None, -np.inf
+    after = latency - CACHE_LATENCY + cross
+    for j in range(len(k)):
+        done = max(done + line_cost, enter[j] + fill_clocks)
+        late = want[j] - (done + after)
+        if late < slack:
+            slack, worst = late, (rows.start + int(line[j]), int(col[j]))
+    return DisplayBudget(rows, miss.sum(1), line_cost, r * mode.h_total, ahead, steady,
+                         float(slack), worst)
+
+
+def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks=None,
+                    warm=True):
+    """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
+    ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them, the
+    pipeline's latency and depth as BoardCore builds it; ``line_cost`` and ``fill_clocks``
+    (None: measured on the controller and the SDRAM model by
+    sim/sdram_bench.bandwidth, a few seconds: ``miss`` x line bytes / 16, and
+    ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
+    pipe_hz = sdram_clock(mode.pixel_hz, DEFAULT_PIPE_MHZ * 1e6)
+    geom = scene_geometry(scene.hardware)
+    if line_cost is None or fill_clocks is None:
+        from bumprtl.sim.sdram_bench import bandwidth
+        sdram = SdramConfig(DEFAULT_SDRAM, freq_mhz=pipe_hz / 1e6, cas_latency=SDRAM_CAS_LATENCY,
+                            data_bits=geom.data_bits, addr_bits=geom.addr_bits,
+                            pin_cycles=SDRAM_PIN_CYCLES, powerup_cycles=20)
+        bw = bandwidth(sdram, line_bytes=geom.line_bytes)
+        line_cost = bw["miss"] * geom.line_bytes / 16 if line_cost is None else line_cost
+        fill_clocks = bw["miss_latency"] + geom.beats + 2 if fill_clocks is None else fill_clocks
+    with warnings.catch_warnings():       # built for its numbers only, never elaborated
+        warnings.simplefilter("ignore", UnusedElaboratable)
+        pipeline = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
+        latency, depth = pipeline.latency, pipeline.fifo_depth
+        del pipeline
+        gc.collect()
+    return display_budget(frame_misses(scene, mode, frame, rows, warm), mode, pipe_hz,
+                          latency, depth, cdc_depth(mode.pixel_hz, pipe_hz), line_cost,
+                          fill_clocks, rows)
 
 
 def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
