@@ -73,6 +73,7 @@ from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants, surface
 from bumprtl.sim.golden.cache import run_cache
 from bumprtl.sim.golden.globe import globe_fixed
+from bumprtl.sim.sdram_bench import bandwidth
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
@@ -308,7 +309,6 @@ def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks
     pipe_hz = sdram_clock(mode.pixel_hz, DEFAULT_PIPE_MHZ * 1e6)
     geom = scene_geometry(scene.hardware)
     if line_cost is None or fill_clocks is None:
-        from bumprtl.sim.sdram_bench import bandwidth
         sdram = SdramConfig(DEFAULT_SDRAM, freq_mhz=pipe_hz / 1e6, cas_latency=SDRAM_CAS_LATENCY,
                             data_bits=geom.data_bits, addr_bits=geom.addr_bits,
                             pin_cycles=SDRAM_PIN_CYCLES, powerup_cycles=20)
