@@ -344,7 +344,8 @@ class BoardCore(Elaboratable):
     0 outside the active raster."""
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
-                 target=None, depth=None, pipe_hz=None, globe=False, sdram=None, flash=None):
+                 target=None, depth=None, pipe_hz=None, globe=False, sdram=None, flash=None,
+                 preloaded=False):
         """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
         below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
         runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
@@ -359,8 +360,14 @@ class BoardCore(Elaboratable):
         flash by a :class:`~bumprtl.rtl.flash.FlashLoader`; the source starts once the copy
         is done. Both run in ``pipe`` (``pipe_hz`` is the SDRAM's clock); the pins are
         ``sdram_pins`` and ``spi``. The display starts showing at the first frame whose
-        first pixel is ready, black before it (``underflow`` counts from there)."""
+        first pixel is ready, black before it (``underflow`` counts from there).
+        ``preloaded`` (simulation only, with ``sdram``): no loader and no flash pins; the
+        map counts as loaded once the controller's initialisation is done, the SDRAM's
+        model holding the image already (its write port stays idle)."""
         _check_memory(scene, pipe_hz, sdram, flash)
+        if preloaded and sdram is None:
+            raise BumpError("preloaded applies to a map in the SDRAM (sdram and flash)",
+                            "preloaded")
         self.mode = mode
         self.pipe_hz = pipe_hz
         self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
@@ -377,11 +384,15 @@ class BoardCore(Elaboratable):
             self.globe = None
             self.source = PixelSource(self.pipeline, mode, constants, table, slice_)
         self.sdram, self.flash = sdram, flash
-        if sdram is not None:
+        self.preloaded = bool(preloaded)
+        self.loader = self.spi = None
+        if sdram is not None:     # (in this order: the elaborated names follow it)
             self.controller = SdramController(sdram)
-            self.loader = FlashLoader(flash)
+            if not self.preloaded:
+                self.loader = FlashLoader(flash)
             self.sdram_pins = sdram_signature(sdram).flip().create(path=("sdram",))
-            self.spi = spi_signature().flip().create(path=("spi",))
+            if not self.preloaded:
+                self.spi = spi_signature().flip().create(path=("spi",))
         self.timing = VideoTiming(mode)
         self.shows = Signal(name="display_shows")   # the display takes pixels (from a frame's start)
         self.underflow = Signal()
@@ -397,11 +408,15 @@ class BoardCore(Elaboratable):
         if self.globe is not None:
             inner["globe"] = self.globe
         if self.sdram is not None:
-            inner.update(sdram=self.controller, flash_loader=self.loader)
+            inner["sdram"] = self.controller
+            if self.loader is not None:
+                inner["flash_loader"] = self.loader
             wiring.connect(m, p.axi, self.controller.rd)
-            wiring.connect(m, self.loader.axi, self.controller.wr)
+            if self.loader is not None:
+                wiring.connect(m, self.loader.axi, self.controller.wr)
             wiring.connect(m, self.controller.sdram, self.sdram_pins)
-            wiring.connect(m, self.loader.spi, self.spi)
+            if self.loader is not None:
+                wiring.connect(m, self.loader.spi, self.spi)
         for name, sub in inner.items():
             m.submodules[name] = sub if self.pipe_hz is None else DomainRenamer("pipe")(sub)
         m.submodules.timing = t = self.timing
@@ -419,7 +434,9 @@ class BoardCore(Elaboratable):
             m.d.comb += src.allow.eq(1)
         else:                         # the loader's done (a comparison) as a register
             loaded = Signal(name="map_loaded")
-            m.d.pipe += loaded.eq(self.loader.done)
+            # preloaded (simulation): the controller's initialisation done instead
+            done = self.controller.regs.run if self.loader is None else self.loader.done
+            m.d.pipe += loaded.eq(done)
             m.d.comb += src.allow.eq(loaded)
         # the display shows from the first frame whose first pixel is ready
         running, shows = Signal(name="display_running"), self.shows
@@ -716,8 +733,10 @@ class SimTop(wiring.Component):
                  "underflow": wiring.Out(1), "order_error": wiring.Out(1),
                  "light_step": wiring.Out(len(core.source.frame))}
         if core.sdram is not None:
-            ports.update(sdram=wiring.Out(sdram_signature(core.sdram)),
-                         spi=wiring.Out(spi_signature()), display_shows=wiring.Out(1))
+            ports["sdram"] = wiring.Out(sdram_signature(core.sdram))
+            if core.spi is not None:
+                ports["spi"] = wiring.Out(spi_signature())
+            ports["display_shows"] = wiring.Out(1)
         super().__init__(ports)
 
     def elaborate(self, platform):
@@ -729,7 +748,8 @@ class SimTop(wiring.Component):
                      self.underflow.eq(core.underflow), self.order_error.eq(core.order_error),
                      self.light_step.eq(core.source.frame)]
         if core.sdram is not None:
-            inner, pins, spi = core.sdram_pins, self.sdram, self.spi
+            inner, pins = core.sdram_pins, self.sdram
+            spi = self.spi if core.spi is not None else None
             idle = {"cke": 1, "cs_n": 1, "ras_n": 1, "cas_n": 1, "we_n": 1}
             for name in ("cke", "cs_n", "ras_n", "cas_n", "we_n", "ba", "a", "dqm", "dq_o",
                          "dq_oe"):
@@ -738,7 +758,8 @@ class SimTop(wiring.Component):
                 m.d.pipe += reg.eq(getattr(inner, name))
                 m.d.comb += getattr(pins, name).eq(reg)
             m.d.pipe += inner.dq_i.eq(pins.dq_i)
-            m.d.comb += [spi.sclk.eq(core.spi.sclk), spi.cs_n.eq(core.spi.cs_n),
-                         spi.mosi.eq(core.spi.mosi), core.spi.miso.eq(spi.miso),
-                         self.display_shows.eq(core.shows)]
+            if core.spi is not None:
+                m.d.comb += [spi.sclk.eq(core.spi.sclk), spi.cs_n.eq(core.spi.cs_n),
+                             spi.mosi.eq(core.spi.mosi), core.spi.miso.eq(spi.miso)]
+            m.d.comb += self.display_shows.eq(core.shows)
         return m

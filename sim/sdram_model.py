@@ -56,10 +56,14 @@ class SdramModel:
 
     ``powerup_ns`` replaces the datasheet's 200 us power-up wait (a simulation's shortcut,
     said by the bench); ``init_refreshes``: AUTO REFRESH commands required before the mode
-    register is set. ``log``: commands seen, as (cycle, name, bank, address).
+    register is set. ``log``: commands seen, as (cycle, name, bank, address). ``preload``:
+    the words the memory holds at power-on, indexed ``[bank, row, column]`` (an array of
+    the chip's banks x rows x columns; None: zeros); a word written since reads back as
+    written.
     """
 
-    def __init__(self, variant, freq_mhz, powerup_ns=None, init_refreshes=2, log=False):
+    def __init__(self, variant, freq_mhz, powerup_ns=None, init_refreshes=2, log=False,
+                 preload=None):
         self.sheet = DATASHEET[variant]
         self.tck = Fraction(1000) / Fraction(str(freq_mhz))
         self.ns = dict(self.sheet.ns)
@@ -67,6 +71,11 @@ class SdramModel:
             self.ns["POWERUP"] = Fraction(powerup_ns)
         self.init_refreshes = init_refreshes
         self.mem = {}
+        shape = (self.sheet.banks, self.sheet.rows, self.sheet.cols)
+        if preload is not None and tuple(preload.shape) != shape:
+            raise ValueError(f"preload must be an array of shape {shape} (banks, rows, "
+                             f"columns), got {tuple(preload.shape)}")
+        self.preload = preload
         self.log = [] if log else None
         self.error = None             # the first violation seen by :meth:`process`
         self.reset()
@@ -115,7 +124,7 @@ class SdramModel:
             bank, row, col = self.writes.pop(self.n)
             if not dq_oe:
                 self._fail("write data not driven during a WRITE burst")
-            word = self.mem.get((bank, row, col), 0)
+            word = self.word((bank, row, col))
             for byte in range(2):
                 if not dqm >> byte & 1:
                     mask = 0xFF << 8 * byte
@@ -128,7 +137,15 @@ class SdramModel:
         nxt = self.reads.get(self.n)
         if nxt is None:
             return False, 0
-        return True, self.mem.get(nxt, 0)
+        return True, self.word(nxt)
+
+    def word(self, where):
+        """The word at ``where`` = (bank, row, column): the last written, else the
+        preload's, else 0."""
+        word = self.mem.get(where)
+        if word is None:
+            return 0 if self.preload is None else int(self.preload[where])
+        return word
 
     def _refresh_deadline(self):
         if self.state == "ready" or (self.state == "refreshing" and self.refs):

@@ -5,7 +5,8 @@
 ``--check-frames N``, simulates the top for N whole frames under Verilator, captures them
 with cocotbext-dvi's DVISink, compares each with the golden frame byte for byte and writes
 the first as ``frame0.png`` (with the map in the SDRAM the testbench runs the SDRAM's and
-the flash's models, and the frames start at the display's second). ``--mode test`` checks the reduced 32 x 24 mode only (no
+the flash's models, and the frames start at the display's second; ``--preload-sdram``
+skips the simulated flash copy, the SDRAM's model holding the image from the start). ``--mode test`` checks the reduced 32 x 24 mode only (no
 bitstream: it is no monitor mode). With the map in the SDRAM (``--map-memory axi`` or a
 scene with ``map_memory = "axi"``) it also writes the map's flash image
 (``ulx3s_85f_map.bin``, the bytes the flash loader copies into the SDRAM) and prints the
@@ -58,6 +59,12 @@ def run(args):
     seeds = _seeds(args.seeds)
     if args.check_frames < 0:
         raise BumpError(f"--check-frames must be >= 0, got {args.check_frames}", "check_frames")
+    if args.preload_sdram and not axi:
+        raise BumpError(f"--preload-sdram applies to a map in the SDRAM (--map-memory axi), the "
+                        f"scene's map_memory is {scene.map_memory!r}", "preload_sdram")
+    if args.preload_sdram and not args.check_frames:
+        raise BumpError("--preload-sdram applies to the simulation: it needs --check-frames N "
+                        "(N >= 1)", "preload_sdram")
     pipe_hz = None
     bitstream = mode.name != "test" and not args.no_bitstream
     if args.pipe_mhz is not None:      # refused below the pixel clock, one line
@@ -115,7 +122,9 @@ def run(args):
                 print(f"{part}: " + ", ".join(f"{k} {v}" for k, v in row.items()))
     if args.check_frames:
         r = check_frames(scene, mode, out / f"sim_{mode.name}", args.check_frames,
-                         board_data(scene), pipe_hz=pipe_hz, memory=memory)
+                         board_data(scene), pipe_hz=pipe_hz, memory=memory,
+                         # the keyword only when asked: stand-ins for check_frames need not know it
+                         **({"preload": True} if args.preload_sdram else {}))
         for k, same in enumerate(r["same"]):
             step = r["first"] + k
             print(f"frame {step} (light step {step}): {'identical to the golden frame' if same else 'DIFFERS from the golden frame'}")
@@ -198,4 +207,9 @@ def add_parser(sub):
     g.add_argument("--flash-offset", default=None, metavar="OFFSET",
                    help=f"flash byte of the map's image, a 64 KiB sector after the bitstream's, "
                         f"decimal or 0x hex (default 0x{DEFAULT_FLASH_OFFSET:x})")
+    g.add_argument("--preload-sdram", action="store_true",
+                   help="--check-frames without the flash copy: the simulated SDRAM starts "
+                        "holding the map's image as the loader would have written it, the "
+                        "simulated top has no flash loader (the bitstream keeps it); for maps "
+                        "whose simulated copy is too long (8 MiB: ~537 M pipe clocks)")
     p.set_defaults(func=run)

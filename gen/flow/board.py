@@ -23,16 +23,20 @@
   every captured frame with :func:`~bumprtl.sim.golden.board.golden_frame`.
 """
 
+import gc
 import hashlib
 import json
+import math
 import os
 import subprocess
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from amaranth.back import rtlil, verilog
+from amaranth.hdl import UnusedElaboratable
 
 from bumprtl.gen.flow.memories import (
     DEVICE_BRAM,
@@ -45,15 +49,21 @@ from bumprtl.gen.render.rtl import scene_memories
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.toolchain import VERILATOR_WAIVERS, require, tool_env
 from bumprtl.rtl.board import (
+    CDC_SYNC_STAGES,
     SDRAM_PIN_CYCLES,
     BoardCore,
     SimTop,
     ULX3STop,
     buffer_depth,
+    cdc_depth,
     globe_config,
+    globe_offsets,
+    globe_rotation,
     sdram_clock,
+    texel_coords,
 )
-from bumprtl.rtl.cache import scene_geometry
+from bumprtl.rtl.bumpfetch import level_coords
+from bumprtl.rtl.cache import CACHE_LATENCY, scene_geometry
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.flash import FLASH_BYTES_MAX, FlashConfig
 from bumprtl.rtl.pipe import ECP5
@@ -61,12 +71,16 @@ from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sdram import CHIPS, SdramConfig
 from bumprtl.rtl.video import get_mode
 from bumprtl.sim.golden.board import STEPS, golden_frame, light_table, plane_constants, surface
+from bumprtl.sim.golden.cache import run_cache
+from bumprtl.sim.golden.globe import globe_fixed
+from bumprtl.sim.sdram_bench import bandwidth
 
 __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
-           "MAP_FILE"]
+           "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
+           "predict_display"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -96,18 +110,41 @@ def board_data(scene):
     return words, texels, plane_constants(scene), light_table(scene)
 
 
-def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None):
+def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None,
+               preloaded=False):
     """The board's core (rtl/board.BoardCore) of ``scene`` in ``mode``; ``pipe_hz``: the
     source and pipeline in their own clock domain at that rate (None: the pixel clock);
     ``memory`` (a :class:`BoardMemory`, a map in the SDRAM): its SDRAM and flash parts, and
-    its pipe clock instead of ``pipe_hz``."""
+    its pipe clock instead of ``pipe_hz``; ``preloaded`` (simulation only): no flash loader,
+    the SDRAM's model holds the image from the start (:func:`sdram_preload`)."""
     words, texels, constants, table = board_data(scene) if data is None else data
     parts = {}
     if memory is not None:
         words, pipe_hz = None, memory.pipe_hz
         parts = {"sdram": memory.sdram, "flash": memory.flash}
+    if preloaded:
+        parts["preloaded"] = True
     return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
                      pipe_hz=pipe_hz, globe=surface(scene) == "sphere", **parts)
+
+
+def sdram_preload(sdram, base, image):
+    """What the SDRAM holds once the flash loader has copied ``image`` (bytes) to AXI byte
+    address ``base`` through the SdramController of ``sdram`` (its SdramConfig), as the
+    datasheet model's power-on contents (sim/sdram_model.py, ``preload``): an array of
+    16-bit words indexed [bank, row, column], zero elsewhere. The controller's mapping, from
+    the configuration's chip: the AXI byte address's bits above bit 0 are the word address
+    (wrapping at the chip's size), its lowest ``col_bits`` the column, the next
+    ``bank_bits`` the bank, the rest the row; the even byte is a word's low byte (DQ[7:0],
+    AXI's little-endian lanes). ``base`` and the image's length are even."""
+    chip = sdram.chip
+    col_bits, bank_bits, row_bits = chip.col_bits, chip.bank_bits, chip.row_bits
+    flat = np.zeros(1 << (col_bits + bank_bits + row_bits), np.uint16)
+    words = np.frombuffer(image, "<u2")
+    start = base >> 1
+    flat[(start + np.arange(len(words))) % len(flat)] = words
+    # word address = row, bank, column from the top: (rows, banks, columns) -> [bank, row, column]
+    return flat.reshape(1 << row_bits, 1 << bank_bits, 1 << col_bits).transpose(1, 0, 2)
 
 
 @dataclass(frozen=True)
@@ -152,6 +189,141 @@ def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET
         words = board_data(scene)[0]
     image = memory_images("pipeline", scene, words)["map"]["bin"]
     return BoardMemory(hz, sdram, flash, image)
+
+
+def _frame_coords(scene, mode, frame, rows):
+    """Level-0 texel (u, v) the board's source gives the active pixels of ``rows``."""
+    y, x = np.mgrid[rows.start:rows.stop, 0:mode.h_active]
+    x, y = x.ravel().astype(np.int64), y.ravel().astype(np.int64)
+    if surface(scene) == "sphere":
+        gx, gy = globe_offsets(x, y, mode)
+        g = globe_fixed(gx, gy, globe_rotation(scene.hardware.config, frame),
+                        globe_config(scene.hardware, mode))
+        u, v = g["u"], g["v"]
+    else:
+        u, v = texel_coords(x, y, mode.zoom, scene.texture_size, scene.map_height)
+    return level_coords(np.asarray(u, np.int64), np.asarray(v, np.int64), 0, scene)
+
+
+def frame_misses(scene, mode, frame=1, rows=None, warm=True):
+    """Whether the texel cache misses, per active pixel of ``rows`` (a range of active lines;
+    None: all) of frame ``frame``, shape (lines, h_active): the golden cache model
+    (sim/golden/cache.run_cache, the RTL's hit/miss sequence) on the level-0 texel
+    coordinates the board's source gives (the globe's or the tiled plane's). ``warm``: the
+    cache as the frame before (all of it, frame - 1) left it, as on the board from its
+    second frame on; otherwise cold at the rows' start."""
+    rows = range(mode.v_active) if rows is None else rows
+    u, v = _frame_coords(scene, mode, frame, rows)
+    skip = 0
+    if warm:
+        u0, v0 = _frame_coords(scene, mode, frame - 1, range(mode.v_active))
+        u, v, skip = np.concatenate([u0, u]), np.concatenate([v0, v]), len(u0)
+    run = run_cache(scene_geometry(scene.hardware), u, v, np.zeros_like(u))
+    return ~run.hit[skip:].reshape(len(rows), mode.h_active)
+
+
+@dataclass(frozen=True)
+class DisplayBudget:
+    """What :func:`display_budget` found. Per line: ``misses`` (the cache's), each costing
+    ``line_cost`` pipe clocks of SDRAM reads, against ``line_clocks`` (the pipe clocks a
+    line lasts, blanking included). ``ahead``: the pixels the pipeline may hold ahead of
+    the display (its elastic buffer and the clock crossing), ``steady`` the pipe clocks
+    they leave to spare with every pixel a hit; ``slack``: the least, over every pixel, of
+    the pipe clocks between its arrival at the display's side and the display wanting it
+    (negative: the display starves), ``worst`` the (line, column) of the pixel with the
+    least (None: no miss); ``holds``: slack >= 0."""
+    rows: range
+    misses: np.ndarray
+    line_cost: float
+    line_clocks: float
+    ahead: int
+    steady: float
+    slack: float
+    worst: tuple
+
+    @property
+    def worst_line(self):
+        return self.rows.start + int(np.argmax(self.misses))
+
+    @property
+    def needed(self):
+        """Pipe clocks of SDRAM reads the worst line needs."""
+        return float(self.misses.max() * self.line_cost)
+
+    @property
+    def holds(self):
+        return self.slack >= 0
+
+
+def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clocks,
+                   rows=None):
+    """Whether the display is fed (:class:`DisplayBudget`), from ``miss`` (per active pixel
+    of ``rows``, :func:`frame_misses`) and the design's numbers: the pipeline's
+    ``latency`` and elastic buffer ``depth`` (credits), the clock crossing's ``cdc``
+    entries, a cache line's SDRAM read ``line_cost`` (pipe clocks a line when reads follow
+    back to back, a new row each: sim/sdram_bench.bandwidth's ``miss`` x 4) and
+    ``fill_clocks`` (an isolated miss's pixel leaves the cache that long after its lookup).
+
+    The model, in pipe clocks (``r`` = pipe / pixel clock): the display wants active pixel
+    k of line y, column x at r (y h_total + x); pixel k enters the pipeline when the
+    display has taken pixel k - ahead (ahead = depth + cdc; the buffers full at the rows'
+    start); a hit leaves the cache CACHE_LATENCY after it enters; the SDRAM reads the
+    missed lines one after another, miss j's pixel leaving at F_j = max(F_{j-1} +
+    line_cost, its entry + fill_clocks); from the cache to the display's side it takes
+    latency - CACHE_LATENCY more, and the crossing 2 + CDC_SYNC_STAGES pipe and 3 +
+    CDC_SYNC_STAGES pixel clocks. A pixel behind a miss leaves the cache a clock after the
+    one before, faster than the display's r a pixel, so only the misses can be late.
+    Left out: refresh (a few clocks every 7.8 us) and the cheaper reads of lines in an
+    open row (:func:`~bumprtl.sim.sdram_bench.bandwidth`'s ``hit``)."""
+    rows = range(mode.v_active) if rows is None else rows
+    miss = np.asarray(miss, bool).reshape(len(rows), mode.h_active)
+    r = pipe_hz / mode.pixel_hz
+    ahead = depth + cdc
+    cross = 2 + CDC_SYNC_STAGES + (3 + CDC_SYNC_STAGES) * r
+    steady = r * ahead - latency - cross
+    line, col = np.nonzero(miss)
+    k = line * mode.h_active + col
+    want = r * ((rows.start + line) * mode.h_total + col)
+    before = k - ahead
+    enter = np.where(before >= 0, r * ((rows.start + before // mode.h_active) * mode.h_total
+                                       + before % mode.h_active), -np.inf)
+    slack, worst, done = steady, None, -np.inf
+    after = latency - CACHE_LATENCY + cross
+    for j in range(len(k)):
+        done = max(done + line_cost, enter[j] + fill_clocks)
+        late = want[j] - (done + after)
+        if late < slack:
+            slack, worst = late, (rows.start + int(line[j]), int(col[j]))
+    return DisplayBudget(rows, miss.sum(1), line_cost, r * mode.h_total, ahead, steady,
+                         float(slack), worst)
+
+
+def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks=None,
+                    warm=True):
+    """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
+    ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them, the
+    pipeline's latency and depth as BoardCore builds it; ``line_cost`` and ``fill_clocks``
+    (None: measured on the controller and the SDRAM model by
+    sim/sdram_bench.bandwidth, a few seconds: ``miss`` x line bytes / 16, and
+    ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
+    pipe_hz = sdram_clock(mode.pixel_hz, DEFAULT_PIPE_MHZ * 1e6)
+    geom = scene_geometry(scene.hardware)
+    if line_cost is None or fill_clocks is None:
+        sdram = SdramConfig(DEFAULT_SDRAM, freq_mhz=pipe_hz / 1e6, cas_latency=SDRAM_CAS_LATENCY,
+                            data_bits=geom.data_bits, addr_bits=geom.addr_bits,
+                            pin_cycles=SDRAM_PIN_CYCLES, powerup_cycles=20)
+        bw = bandwidth(sdram, line_bytes=geom.line_bytes)
+        line_cost = bw["miss"] * geom.line_bytes / 16 if line_cost is None else line_cost
+        fill_clocks = bw["miss_latency"] + geom.beats + 2 if fill_clocks is None else fill_clocks
+    with warnings.catch_warnings():       # built for its numbers only, never elaborated
+        warnings.simplefilter("ignore", UnusedElaboratable)
+        pipeline = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
+        latency, depth = pipeline.latency, pipeline.fifo_depth
+        del pipeline
+        gc.collect()
+    return display_budget(frame_misses(scene, mode, frame, rows, warm), mode, pipe_hz,
+                          latency, depth, cdc_depth(mode.pixel_hz, pipe_hz), line_cost,
+                          fill_clocks, rows)
 
 
 def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
@@ -412,20 +584,21 @@ def part_costs(scene, mode, work_dir, memory=None):
     return rows
 
 
-def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None, memory=None):
+def emit_sim(scene, mode, out_dir, data=None, pipe_hz=None, memory=None, preloaded=False):
     """The simulation top (rtl/board.SimTop, generic target) as ``board_sim.v``; with
     ``pipe_hz`` it has the pipeline's clock and reset ports too (``pipe_clk``, ``pipe_rst``);
-    with ``memory`` (:func:`board_memory`) the SDRAM's and the flash's pins as well."""
+    with ``memory`` (:func:`board_memory`) the SDRAM's and the flash's pins as well (the
+    SDRAM's only when ``preloaded``: no flash loader)."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    top = SimTop(board_core(scene, mode, None, data, pipe_hz, memory))
+    top = SimTop(board_core(scene, mode, None, data, pipe_hz, memory, preloaded))
     path = out_dir / "board_sim.v"
     path.write_text(verilog.convert(top, name="board_sim", emit_src=False))
     return path, top
 
 
 def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_hz=None,
-                 memory=None):
+                 memory=None, preload=False):
     """Simulate the board top for ``frames`` whole frames (after the first vertical sync)
     under Verilator, capture them with cocotbext-dvi's DVISink and compare each with the
     golden frame. ``opt_fast``: g++'s optimisation of the model's per-cycle code (verilated.mk's
@@ -436,14 +609,21 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
     (sim/sdram_model.py) on the SDRAM's pins and the flash model (sim/flash_model.py, the
     image at its offset) on the flash's, at the BoardMemory's pipe clock; the sink starts
     in the frame after the display's first, so the frames compared are golden frames 1 ..
-    ``frames``. Returns a dict: captured (list of arrays), golden, timing (the run lengths
+    ``frames``. ``preload`` (with ``memory``): no flash loader in the simulated top and no
+    flash model; the SDRAM's model starts holding what the loader would have written
+    (:func:`sdram_preload`), the map counts as loaded once the controller's initialisation
+    is done, and the testbench holds the display's (pixel) domain in reset until the
+    pipeline has had time to fill its buffers, so that the display starts at its first
+    frame. Returns a dict: captured (list of arrays), golden, timing (the run lengths
     the testbench measured), seconds, the verdicts, ``first`` (the golden frame of the
     first captured one)."""
     out_dir = Path(out_dir).resolve()
     data = board_data(scene) if data is None else data
+    if preload and memory is None:
+        raise BumpError("preload applies to a map in the SDRAM (memory)", "preload")
     if memory is not None:
         pipe_hz = memory.pipe_hz
-    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz, memory)
+    v_path, top = emit_sim(scene, mode, out_dir, data, pipe_hz, memory, preload)
     result = out_dir / "frames.npz"
     if result.exists():
         result.unlink()
@@ -452,16 +632,23 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
            "BOARD_TIMING": ",".join(str(x) for x in (m.h_active, m.h_front, m.h_sync, m.h_back,
                                                      m.v_active, m.v_front, m.v_sync, m.v_back,
                                                      int(m.h_negative), int(m.v_negative))),
-           "BOARD_PIXEL_NS": round(1e9 / m.pixel_hz)}
-    if pipe_hz is not None:       # the same ratio to the simulated pixel period, in ps (even)
-        env["BOARD_PIPE_PS"] = 2 * round(5e2 * env["BOARD_PIXEL_NS"] * m.pixel_hz / pipe_hz)
-    if memory is not None:        # the flash's array: the image at its offset
+           # ps, a multiple of 10: the shift clock's (a fifth) half period is whole ps
+           "BOARD_PIXEL_PS": 10 * round(1e11 / m.pixel_hz)}
+    if memory is not None:
+        # the model's clock is the simulated pipe clock (ps), the controller's timings the
+        # SdramConfig's: the simulated period is the configured one rounded up to even ps
+        # (never shorter: every spacing the controller counts lasts its ns)
+        env["BOARD_PIPE_PS"] = 2 * math.ceil(5e11 / pipe_hz - 1e-6)
+        env.update(BOARD_SDRAM=memory.sdram.variant)
+    elif pipe_hz is not None:     # the same ratio to the simulated pixel period, in ps (even)
+        env["BOARD_PIPE_PS"] = 2 * round(0.5 * env["BOARD_PIXEL_PS"] * m.pixel_hz / pipe_hz)
+    if memory is not None and preload:     # what the loader would have written, [bank, row, col]
+        env["BOARD_PRELOAD"] = out_dir / "sdram_preload.npy"
+        np.save(env["BOARD_PRELOAD"], sdram_preload(memory.sdram, memory.flash.base, memory.image))
+    elif memory is not None:      # the flash's array: the image at its offset
         flash = out_dir / "flash.bin"
         flash.write_bytes(bytes(memory.flash.offset) + memory.image)
-        # the model's clock is the simulated pipe clock (ps), the controller's timings the
-        # SdramConfig's: the simulated period is the configured one rounded to even ps
-        env.update(BOARD_SDRAM=memory.sdram.variant, BOARD_FLASH=flash,
-                   BOARD_FLASH_PHASE=memory.flash.half_period)
+        env.update(BOARD_FLASH=flash, BOARD_FLASH_PHASE=memory.flash.half_period)
     t0 = time.perf_counter()
     # the flash loader's FSM and its "== 0" tests: incomplete cases and a vector's "!" in
     # Amaranth's Verilog, which Verilator's lint flags (the board's other units do not)

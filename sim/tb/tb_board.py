@@ -14,7 +14,7 @@ Once a word, on the clock lane's rising edge, the testbench records the sink's d
 v negative); the disagreements go to ``timing_errors``.
 
 Environment: BOARD_RESULT (npz path), BOARD_FRAMES (frames to capture), BOARD_TIMING,
-BOARD_PIXEL_NS (pixel clock period, ns); BOARD_PIPE_PS (the pipe clock's period, ps, when
+BOARD_PIXEL_PS (pixel clock period, ps, a multiple of 10); BOARD_PIPE_PS (the pipe clock's period, ps, when
 the pipeline has its own domain).
 
 With the map in the SDRAM (BOARD_SDRAM: the chip's variant; BOARD_FLASH: the flash array's
@@ -28,9 +28,16 @@ loader allows). The display starts at a frame's first pixel once the map is load
 (``display_shows``); the sink starts in the next frame's vertical front porch, so the
 captured frames are golden frames 1, 2, ... (``first`` = 1 in the result). A model
 violation, a flash rule broken or a READ other than the one copy fails the test.
+
+BOARD_PRELOAD (a .npy of the SDRAM's words, [bank, row, column], in place of BOARD_FLASH):
+the top has no flash loader; the model starts holding what the loader would have written
+(gen/flow/board.sdram_preload), the source starts once the controller's initialisation is
+done, and the display's domain is held in reset until then and 4 lines more, so that the
+display starts at its first frame (the frames captured are still golden frames 1, 2, ...).
 """
 
 import os
+import time
 from fractions import Fraction
 from pathlib import Path
 
@@ -112,34 +119,54 @@ def timing_errors(de, hs, vs, t):
 
 class Memories:
     """The SDRAM model on ``sdram__*`` and the flash model on ``spi__*``, on ``pipe_clk``
-    (module docstring); ``errors`` collects what either reports."""
+    (module docstring); ``errors`` collects what either reports. With BOARD_PRELOAD (the
+    SDRAM's power-on contents, [bank, row, column]) there is no flash and no flash model."""
 
     def __init__(self, dut, pipe_ps):
         self.dut = dut
-        self.sdram = SdramModel(os.environ["BOARD_SDRAM"], Fraction(10**6, pipe_ps))
-        phase = int(os.environ["BOARD_FLASH_PHASE"])
-        self.flash = SpiFlash(Path(os.environ["BOARD_FLASH"]).read_bytes(), min_phase=phase,
-                              delay=phase - 1)
+        preload = os.environ.get("BOARD_PRELOAD")
+        self.sdram = SdramModel(os.environ["BOARD_SDRAM"], Fraction(10**6, pipe_ps),
+                                preload=None if preload is None else np.load(preload))
+        self.flash = None
+        if preload is None:
+            phase = int(os.environ["BOARD_FLASH_PHASE"])
+            self.flash = SpiFlash(Path(os.environ["BOARD_FLASH"]).read_bytes(),
+                                  min_phase=phase, delay=phase - 1)
         self.errors = []
 
     async def sdram_pins(self):
         dut, model = self.dut, self.sdram
         drive, value = False, 0
         pins = {name: getattr(dut, "sdram__" + name) for name in PINS}
+        command = [pins[name] for name in ("cs_n", "ras_n", "cas_n", "we_n")]
+        dq_i, rst, edge, settle = dut.sdram__dq_i, dut.pipe_rst, RisingEdge(dut.pipe_clk), ReadOnly()
+        idle = {"ba": 0, "a": 0, "dqm": 0, "dq_o": 0, "dq_oe": 0, "cke": 1}
+        in_reset = True
         while True:
-            await RisingEdge(dut.pipe_clk)
-            dut.sdram__dq_i.value = value if drive else 0
-            await ReadOnly()
-            if str(dut.pipe_rst.value) != "0":
-                model.reset()
-                drive = False
-                continue
-            raw = {name: v.value for name, v in pins.items()}
-            if any(not set(str(v)) <= {"0", "1"} for v in raw.values()):
+            await edge
+            dq_i.value = value if drive else 0
+            await settle
+            if in_reset:                  # the reset is held once, at the start
+                if str(rst.value) != "0":
+                    model.reset()
+                    drive = False
+                    continue
+                in_reset = False
+            try:
+                cmd = [int(h.value) for h in command]
+                # a NOP or DESELECT cycle with no burst word: the other pins do not matter
+                # to the model but DQ's enable (the chip's read data must not meet it)
+                if (cmd[0] or cmd[1:] == [1, 1, 1]) and model.n not in model.writes:
+                    quiet = dict(idle, dq_oe=int(pins["dq_oe"].value)) if model.n in model.reads \
+                        else idle
+                    drive, value = model.cycle(*cmd, **quiet)
+                    continue
+                raw = {name: int(v.value) for name, v in pins.items()}
+            except ValueError:            # X or Z: not an integer
                 self.errors.append(f"SDRAM cycle {model.n}: X or Z on the pins")
                 return
             try:
-                drive, value = model.cycle(**{k: int(v) for k, v in raw.items()})
+                drive, value = model.cycle(**raw)
             except AssertionError as e:           # the model's SdramViolation
                 self.errors.append(f"SDRAM: {e}")
                 return
@@ -159,27 +186,45 @@ class Memories:
 async def board_frames(dut):
     timing = [int(x) for x in os.environ["BOARD_TIMING"].split(",")]
     frames = int(os.environ["BOARD_FRAMES"])
-    period = int(os.environ["BOARD_PIXEL_NS"])
+    period = int(os.environ["BOARD_PIXEL_PS"])
     ha, va = timing[0], timing[4]
     htot, vtot = sum(timing[0:4]), sum(timing[4:8])
-    cocotb.start_soon(Clock(dut.clk, period, unit="ns").start())
-    cocotb.start_soon(Clock(dut.shift_clk, period / 5, unit="ns").start())
+    cocotb.start_soon(Clock(dut.clk, period, unit="ps").start())
+    cocotb.start_soon(Clock(dut.shift_clk, period // 5, unit="ps").start())
     pipe_ps = os.environ.get("BOARD_PIPE_PS")     # the pipeline in its own clock domain
     resets = [dut.rst, dut.shift_rst] + ([dut.pipe_rst] if pipe_ps else [])
     if pipe_ps:
         cocotb.start_soon(Clock(dut.pipe_clk, int(pipe_ps), unit="ps").start())
     memories = Memories(dut, int(pipe_ps)) if os.environ.get("BOARD_SDRAM") else None
+    preloaded = memories is not None and memories.flash is None
     if memories is not None:
-        dut.spi__miso.value = 0
         dut.sdram__dq_i.value = 0
         cocotb.start_soon(memories.sdram_pins())
-        cocotb.start_soon(memories.flash_pins())
+        if not preloaded:
+            dut.spi__miso.value = 0
+            cocotb.start_soon(memories.flash_pins())
     for r in resets:
         r.value = 1
     await ClockCycles(dut.clk, 4)
-    for r in resets:
-        r.value = 0
+    for r in resets:           # preloaded: the display's domain stays in reset (below)
+        if not (preloaded and r is dut.rst):
+            r.value = 0
     first = 0
+    if preloaded:
+        # The map is in the SDRAM from the start: the source starts once the controller's
+        # initialisation is done. The display's (pixel) domain stays in reset until then
+        # and 4 lines more, the buffers filling meanwhile, so that its first frame is the
+        # one it starts with (on the board it would start at the next frame's first pixel
+        # with the buffers as full, after an idle frame this skips).
+        waited = 0
+        while memories.sdram.state != "ready" and not memories.errors and waited < 10**6:
+            await ClockCycles(dut.pipe_clk, 256)
+            waited += 256
+        assert not memories.errors, memories.errors
+        assert memories.sdram.state == "ready", "the SDRAM was not initialised"
+        await ClockCycles(dut.clk, 4 * htot)
+        await FallingEdge(dut.clk)
+        dut.rst.value = 0
     if memories is not None:    # the display's first frame: wait for it (the copy, then a frame)
         waited, limit = 0, int(os.environ.get("BOARD_START_LIMIT", 2_000_000))
         while True:
@@ -215,10 +260,13 @@ async def board_frames(dut):
     cocotb.start_soon(monitor())
     done = lambda: [f for f in sink.rgb_out.frames if len(f.data)]
     limit = (frames + 2) * htot * vtot
-    waited = 0
+    waited, t0 = 0, time.perf_counter()
     while len(done()) < frames and waited < limit:
         await ClockCycles(dut.clk, htot)
         waited += htot
+        if waited % (64 * htot) == 0:     # progress: a long mode's frame takes a while
+            dut._log.info(f"sink: {waited // htot} lines, {len(done())} frames, "
+                          f"{time.perf_counter() - t0:.0f} s")
     got = done()
     assert len(got) >= frames, f"the DVI sink completed {len(got)} frames in {waited} clocks"
     arrays = {}
@@ -230,10 +278,12 @@ async def board_frames(dut):
         arrays[f"frame{k}"] = rgb
     errors = timing_errors(rec["de"], rec["hs"], rec["vs"], timing)
     if memories is not None:
-        errors += memories.errors + [f"flash: {e}" for e in memories.flash.errors]
-        reads = memories.flash.reads
-        if len(reads) != 1:
-            errors.append(f"flash: {len(reads)} READ commands, expected the one copy: {reads}")
+        errors += memories.errors
+        if memories.flash is not None:
+            errors += [f"flash: {e}" for e in memories.flash.errors]
+            reads = memories.flash.reads
+            if len(reads) != 1:
+                errors.append(f"flash: {len(reads)} READ commands, expected the one copy: {reads}")
     np.savez(os.environ["BOARD_RESULT"], **arrays, timing_errors=np.array(errors, dtype=str),
              underflow=int(dut.underflow.value), order_error=int(dut.order_error.value),
              samples=len(rec["de"]), first=first)

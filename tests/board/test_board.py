@@ -119,6 +119,31 @@ def test_reduced_mode_frames_with_the_map_in_sdram_through_the_dvi_sink(scene_na
     assert not all(bad["same"])
 
 
+@pytest.mark.regress
+def test_reduced_mode_frames_with_the_map_preloaded_in_sdram(build_dir, tmp_path):
+    """``preload``: no flash loader in the simulated top, the SDRAM's model holding the
+    map's image as the loader would have written it (gen/flow/board.sdram_preload); the
+    globe's frames equal the golden frames 1, 2, and with every texel's first byte changed
+    in the image the frames differ (the pixels come from the preloaded words)."""
+    (tmp_path / "globe.toml").write_text('image = "globe"\n')
+    scene = load_scene_config(str(tmp_path / "globe.toml"), {**SMALL, "map_memory": "axi"})
+    mode = MODES["test"]
+    memory = board_memory(scene, mode)
+    out = build_dir / "board_axi_preloaded"
+    r = check_frames(scene, mode, out, frames=2, memory=memory, preload=True)
+    assert "spi_" not in (out / "board_sim.v").read_text()      # no flash pins, no loader
+    assert r["first"] == 1 and r["timing_errors"] == []
+    assert r["underflow"] == 0 and r["order_error"] == 0
+    assert all(r["same"]), r["same"]
+    image = bytearray(memory.image)
+    for at in range(0, len(image), 4):
+        image[at] ^= 0x5A
+    bad = check_frames(scene, mode, out, frames=2, preload=True,
+                       memory=dataclasses.replace(memory, image=bytes(image)))
+    assert bad["build_s"] < 1.0
+    assert not all(bad["same"])
+
+
 def test_golden_frames_follow_the_light_table():
     scene = load_scene_config("default", SMALL)
     table = light_table(scene)
@@ -134,6 +159,9 @@ def test_golden_frames_follow_the_light_table():
     (["board", "ulx3s", "--mode", "1024x768"], "mode must be one of"),
     (["board", "ulx3s", "--scene", "palette"], "scene 'palette'"),
     (["board", "ulx3s", "--texture-size", "4096"], "block RAM"),
+    (["board", "ulx3s", "--check-frames", "1", "--preload-sdram"],
+     "--preload-sdram applies to a map in the SDRAM"),
+    (["board", "ulx3s", "--map-memory", "axi", "--preload-sdram"], "needs --check-frames"),
 ])
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, argv, word, run_cli):
     out = tmp_path / "out"

@@ -6,14 +6,18 @@ cache reads it from there. In the Amaranth simulator, the pipeline at 4 x the pi
 the first frames shown equal the golden frames (the map in block RAM's), nothing underflows
 or comes out of order, and neither model saw a rule broken; once with the controller's pins
 the chip's, once with them registered as the ULX3S top's I/O does (``pin_cycles`` 2). Opt-in
-(``make regress``): the load and two frames take about a minute of simulation each."""
+(``make regress``): the load and two frames take about a minute of simulation each.
+
+In ``make test``: the preload that simulations without the flash copy start the SDRAM's
+model with (gen/flow/board.sdram_preload) against what the controller writes, and the
+memory parts' refusals."""
 
 import numpy as np
 import pytest
 from amaranth.hdl import Elaboratable, Module, Signal
 from amaranth.sim import Simulator
 
-from bumprtl.gen.flow.board import board_data
+from bumprtl.gen.flow.board import board_data, sdram_preload
 from bumprtl.rtl.board import SDRAM_PIN_CYCLES, BoardCore
 from bumprtl.rtl.cache import scene_geometry, scene_levels, tiled_image
 from bumprtl.rtl.config import BumpError
@@ -23,6 +27,7 @@ from bumprtl.rtl.video import MODES
 from bumprtl.sim.flash_model import SpiFlash
 from bumprtl.sim.golden.board import golden_frame
 from bumprtl.sim.scenes.config import load_scene_config
+from bumprtl.sim.sdram_bench import run
 from bumprtl.sim.sdram_model import SdramModel
 
 PIPE_MHZ = 100
@@ -148,3 +153,30 @@ def test_the_memory_parts_must_agree():
         BoardCore(axi.hardware, mode, None, constants, table, texels, pipe_hz=1e8,
                   sdram=wide, flash=flash)
     assert e.value.field == "data_bits" and "64" in str(e.value)
+
+
+def test_the_preload_holds_what_the_controller_writes():
+    """gen/flow/board.sdram_preload (the SDRAM model's contents for a simulation without
+    the flash copy) against the controller itself: images written through its AXI port in
+    the loader's bursts (one SDRAM burst each), one across a bank's and a row's end, one
+    across the chip's end (the address wraps), land in the datasheet model at exactly the
+    [bank, row, column] words the preload puts them, and nowhere else."""
+    cfg = SdramConfig(powerup_cycles=20, init_refreshes=2)
+    step = 2 * cfg.burst                        # bytes a loader's AXI burst writes
+    rng = np.random.default_rng(5)
+    row_bytes = cfg.chip.cols * 2               # one row of one bank
+    images = {cfg.chip.banks * row_bytes - 256: rng.integers(0, 256, 512, np.uint8).tobytes(),
+              cfg.chip.bytes - 64: rng.integers(0, 256, 128, np.uint8).tobytes()}
+    ops = [("w", base + at, image[at:at + step], [(1 << cfg.data_bits // 8) - 1] * (step * 8 // cfg.data_bits))
+           for base, image in images.items() for at in range(0, len(image), step)]
+    # a read last: run() waits for its data, so the last WRITE burst has reached the chip
+    _, _, model = run(cfg, [*ops, ("r", 1 << 20, step)])
+    pre = sum(sdram_preload(cfg, base, image).astype(np.int64) for base, image in images.items())
+    assert len(model.mem) == sum(len(i) for i in images.values()) // 2
+    for where, word in model.mem.items():
+        assert pre[where] == word, f"{where}: preload {pre[where]:#06x}, written {word:#06x}"
+    assert np.count_nonzero(pre) == np.count_nonzero(list(model.mem.values()))
+    # the model reads the preload where nothing was written since
+    chip = SdramModel(cfg.variant, cfg.freq_mhz, preload=pre.astype(np.uint16))
+    where = next(iter(model.mem))
+    assert chip.word(where) == model.mem[where] and chip.word((0, 5, 5)) == 0
