@@ -65,14 +65,18 @@ def test_error_lsb_is_worst_of_sets():
     assert error_lsb(p) == 3
 
 
-@pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
+def _tiny_sweep(work, methods):
     grid = Grid(angle_bits=(6, 14), frac_bits=(5,), palette_sizes=(16,), samples=300,
                 maps=(("bumps", 16),), adversarial=4000)
-    opts = SimpleNamespace(methods=("exact", "palette", "baselines"), fpga=False, sim=False,
-                           device="LFE5U-85F")
-    work = tmp_path_factory.mktemp("sweep")
+    opts = SimpleNamespace(methods=methods, fpga=False, sim=False, device="LFE5U-85F")
     return sweep(grid, opts, work, seed=4, progress=False)
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """Our methods' points (the baselines' are make regress's, below: their costs against
+    their structure are tests/rtl/test_baselines_*'s in make test)."""
+    return _tiny_sweep(tmp_path_factory.mktemp("sweep"), ("exact", "palette"))
 
 
 def test_tiny_sweep_points(tiny):
@@ -94,6 +98,21 @@ def test_tiny_sweep_invalid_and_missing(tiny):
     by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
     invalid = by[("exact", 14)]                       # B = 5 < k - 1 = 11
     assert invalid["status"] == "invalid" and "frac_bits" in invalid["reason"]
+    assert not any(p["method"] in BASELINES for p in tiny["points"])    # not asked for
+    palette = by[("palette", None)]
+    assert palette["status"] == "ok" and "random" not in palette["error"]
+    assert palette["error"]["scenes"][map_key("bumps", 16)]["max_lsb"] == error_lsb(palette)
+    (record,) = tiny["maps"]                          # the map it measured on, named and counted
+    assert (record["name"], record["size"], record["texels"]) == ("bumps", 16, 256)
+    assert 16 < record["distinct_normals"] <= 256
+    assert palette["quantizes"] and palette["error"]["scenes"][map_key("bumps", 16)]["quantized"]
+    json.dumps(tiny)                                  # the sweep is JSON-serializable
+
+
+@pytest.mark.regress
+def test_tiny_sweep_baselines(tmp_path):
+    tiny = _tiny_sweep(tmp_path, ("exact", "baselines"))
+    by = {(p["method"], p.get("angle_bits")): p for p in tiny["points"]}
     for name in BASELINES:                              # real points at valid widths
         point = by[(name, 6)]
         assert point["status"] == "ok" and point["cost"]["multipliers"] > 0
@@ -103,14 +122,6 @@ def test_tiny_sweep_invalid_and_missing(tiny):
         assert by[(name, 14)]["status"] == "invalid"
     assert by[("peercy", 6)]["cost"]["dividers"] > 0 and by[("peercy", 6)]["cost"]["sqrts"] > 0
     assert by[("kim", 6)]["cost"]["dividers"] == 0 == by[("exact", 6)]["cost"]["sqrts"]
-    palette = by[("palette", None)]
-    assert palette["status"] == "ok" and "random" not in palette["error"]
-    assert palette["error"]["scenes"][map_key("bumps", 16)]["max_lsb"] == error_lsb(palette)
-    (record,) = tiny["maps"]                          # the map it measured on, named and counted
-    assert (record["name"], record["size"], record["texels"]) == ("bumps", 16, 256)
-    assert 16 < record["distinct_normals"] <= 256
-    assert palette["quantizes"] and palette["error"]["scenes"][map_key("bumps", 16)]["quantized"]
-    json.dumps(tiny)                                  # the sweep is JSON-serializable
 
 
 def test_markdown_and_plot(tiny, tmp_path):

@@ -41,9 +41,12 @@ NONSQUARE = load_scene_config({**BUILTIN["default"], "angle_bits": 8, "frac_bits
                                "mip_levels": 2, "map_memory": "axi"})
 
 
-# make test: the default scene on both simulators; the palette scene in make regress (make
-# test reads its indices through the cache in tests/rtl/test_palette.py's AXI cases)
-CASES = [pytest.param(sim, scene, marks=pytest.mark.regress if scene == "palette" else ())
+# make test: the default scene on Icarus; make regress: the palette scene (make test reads
+# its indices through the cache in tests/rtl/test_palette.py's AXI cases) and the default
+# scene on Verilator too (make test runs the texel cache against AxiRamRead on Verilator on
+# its own, tests/sim/tb/test_tb_cache.py)
+CASES = [pytest.param(sim, scene, marks=pytest.mark.regress
+                      if scene == "palette" or sim == "verilator" else ())
          for scene in SCENES for sim in SIMULATORS]
 
 
