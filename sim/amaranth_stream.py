@@ -21,7 +21,7 @@ from bumprtl.sim.golden.methods import illumination_fixed, rotation_fixed
 from bumprtl.sim.golden.vectors import as_payloads
 from bumprtl.sim.traffic import PATTERNS
 
-__all__ = ["PATTERNS", "flatten_payload", "Drive", "simulate_stream", "assert_bit_exact",
+__all__ = ["PATTERNS", "flatten_payload", "concatenation", "Sampled", "Drive", "simulate_stream", "assert_bit_exact",
            "check_rotation", "check_illumination", "check_datapath"]
 
 
@@ -37,6 +37,30 @@ def flatten_payload(value, prefix=""):
     return out
 
 
+def concatenation(signals):
+    """``signals`` ({name: Value or View}) as one value: (their concatenation, {name:
+    (offset, width)} in it)."""
+    values = [Value.cast(v) for v in signals.values()]
+    slots, offset = {}, 0
+    for name, v in zip(signals, values, strict=True):
+        slots[name] = (offset, len(v))
+        offset += len(v)
+    return Cat(*values), slots
+
+
+class Sampled:
+    """Signals a testbench reads together once a cycle: ``value`` (their concatenation, one
+    argument of ``ctx.tick().sample``) and :meth:`cut` (the sampled integer back into the
+    signals' values, in ``signals``' order, unsigned). ``signals``: {name: Value or View}."""
+
+    def __init__(self, signals):
+        self.value, slots = concatenation(signals)
+        self._cuts = [(offset, (1 << width) - 1) for offset, width in slots.values()]
+
+    def cut(self, bits):
+        return [bits >> offset & mask for offset, mask in self._cuts]
+
+
 class Drive:
     """Inputs a testbench drives, set together once a cycle: ``drive[name] = value`` records a
     value (held until changed, as a signal holds it) and ``drive.set(ctx)`` assigns every one
@@ -50,12 +74,7 @@ class Drive:
     simulator's interpreter each time)."""
 
     def __init__(self, signals):
-        self.values = [Value.cast(v) for v in signals.values()]
-        self.cat = Cat(*self.values)
-        self.slots, offset = {}, 0
-        for name, v in zip(signals, self.values, strict=True):
-            self.slots[name] = (offset, len(v))
-            offset += len(v)
+        self.cat, self.slots = concatenation(signals)
         self.bits = 0                   # every input 0 until set, wired or not
         self.bus = Signal(len(self.cat), name="drive")
         self.wired = False
@@ -109,7 +128,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     # the output's payload read as one value a cycle, cut into its fields; the handshake's
     # four bits as another (two samples a cycle, the ports looked up once)
     o_payload, o_fields = Value.cast(dut.o.payload), layout_fields(dut.o.payload.shape())
-    handshake = Cat(dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready)
+    handshake = Sampled({"i.valid": dut.i.valid, "i.ready": dut.i.ready,
+                         "o.valid": dut.o.valid, "o.ready": dut.o.ready})
     fifo_depth = dut.fifo_depth if pipe_handshake else None
 
     async def testbench(ctx):
@@ -123,8 +143,8 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
             drive["i.valid"] = offered is not None
             drive["o.ready"] = rng.random() >= bp_p
             drive.set(ctx)
-            _, _, bits, o_bits = await ctx.tick().sample(handshake, o_payload)
-            i_valid, i_ready, o_valid, o_ready = bits & 1, bits >> 1 & 1, bits >> 2 & 1, bits >> 3
+            _, _, bits, o_bits = await ctx.tick().sample(handshake.value, o_payload)
+            i_valid, i_ready, o_valid, o_ready = handshake.cut(bits)
             if pipe_handshake:
                 inside = state["inside"]
                 assert bool(i_ready) == (inside < fifo_depth), (

@@ -10,9 +10,7 @@ data width, no burst crossing 4 KiB, RREADY never needed for RVALID.
 
 import random
 
-from amaranth.hdl import Cat
-
-from bumprtl.sim.amaranth_stream import Drive
+from bumprtl.sim.amaranth_stream import Drive, Sampled
 
 __all__ = ["AxiReadMemory"]
 
@@ -50,14 +48,9 @@ class AxiReadMemory:
         p = self.port
         cycle, beats, held_ar, presenting = 0, [], None, None
         drive = self.drive
-        # the port's read-side signals sampled as one value a cycle, cut apart here
-        names = ("arvalid", "arready", "araddr", "arlen", "arsize", "arburst", "rvalid", "rready")
-        sampled = Cat(*(getattr(p, n) for n in names))
-        cuts, offset = [], 0
-        for n in names:
-            width = len(getattr(p, n))
-            cuts.append((offset, (1 << width) - 1))
-            offset += width
+        # the port's read-side signals sampled as one value a cycle
+        port = Sampled({n: getattr(p, n) for n in ("arvalid", "arready", "araddr", "arlen",
+                                                   "arsize", "arburst", "rvalid", "rready")})
         while True:
             drive["arready"] = self.rng.random() >= self.ar_stall
             if presenting is None and beats and beats[0][0] <= cycle \
@@ -66,9 +59,8 @@ class AxiReadMemory:
                 drive["rdata"], drive["rlast"] = presenting[1], presenting[2]
             drive["rvalid"] = presenting is not None
             drive.set(ctx)
-            _, _, bits = await ctx.tick().sample(sampled)
-            (arvalid, arready, araddr, arlen, arsize, arburst, rvalid,
-             rready) = (bits >> at & mask for at, mask in cuts)
+            _, _, bits = await ctx.tick().sample(port.value)
+            arvalid, arready, araddr, arlen, arsize, arburst, rvalid, rready = port.cut(bits)
             ar = (araddr, arlen, arsize, arburst)
             if held_ar is not None:
                 assert arvalid and ar == held_ar, (

