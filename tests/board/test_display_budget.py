@@ -77,3 +77,56 @@ def test_the_design_numbers_the_budget_uses():
                           fill_clocks=FILL, warm=False)
     assert got.ahead == 44 + 16 and got.line_clocks == pytest.approx(1650 * 1.25)
     assert got.steady == pytest.approx(75 - 36 - 4 - 5 * 1.25)
+
+
+def _burst_misses(n):
+    """A frame of 720p whose line 300 misses at n pixels in a row from column 400."""
+    miss = np.zeros((MODE.v_active, MODE.h_active), bool)
+    miss[300, 400:400 + n] = True
+    return miss
+
+
+@pytest.mark.parametrize("burst", [0, 3, 40, 200])
+def test_the_display_buffer_is_the_least_power_of_two_that_holds(monkeypatch, burst):
+    from bumprtl.gen.flow import board
+    misses = _burst_misses(burst)
+    monkeypatch.setattr(board, "frame_misses", lambda *a, **k: misses)
+    entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
+                                            fill_clocks=FILL)
+    assert all(b.holds for b in budgets) and len(budgets) == 2
+    assert entries >= 16 and entries & (entries - 1) == 0
+    # by the budget itself: these entries hold, half as many starve (above the least, 16)
+    assert _budget(misses, cdc=entries).holds
+    if entries > 16:
+        assert not _budget(misses, cdc=entries // 2).holds
+    # a burst of n line reads outlasts its n pixels by n (35.75 - 1.25) pipe clocks: the
+    # buffer must hold about that many pixels' time (1.25 pipe clocks a pixel) ahead
+    assert entries + 44 >= burst * (LINE_COST - 1.25) / 1.25 - 60
+    if burst == 0:                   # no miss: the least holds
+        assert entries == 16
+
+
+def test_the_display_buffer_search_stops_at_its_most(monkeypatch):
+    from bumprtl.gen.flow import board
+    misses = np.ones((MODE.v_active, MODE.h_active), bool)     # every pixel a miss
+    monkeypatch.setattr(board, "frame_misses", lambda *a, **k: misses)
+    entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
+                                            fill_clocks=FILL)
+    assert entries == board.MAX_DISPLAY_BUFFER and not any(b.holds for b in budgets)
+
+
+def test_the_display_buffer_searches_frame_0_cold_and_frame_1_warm(monkeypatch):
+    from bumprtl.gen.flow import board
+    calls = []
+
+    def misses(scene, mode, frame=1, rows=None, warm=True):
+        calls.append((frame, warm))
+        # frame 0 (cold) has the burst, frame 1 none: the buffer must still cover it
+        return _burst_misses(200 if frame == 0 else 0)
+    monkeypatch.setattr(board, "frame_misses", misses)
+    entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
+                                            fill_clocks=FILL)
+    assert sorted(calls) == [(0, False), (1, True)]
+    assert entries == board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
+                                           fill_clocks=FILL)[0] > 16
+    assert budgets[0].misses.sum() == 200 and budgets[1].misses.sum() == 0

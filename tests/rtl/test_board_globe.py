@@ -23,6 +23,7 @@ from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.globe import GlobeGeometry
 from bumprtl.rtl.video import MODES
 from bumprtl.sim.golden.board import STEPS, frame_inputs, golden_frame, light_table
+from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
 from bumprtl.sim.scenes.config import load_scene_config
 from tests.rtl.test_board import collect_payloads, unelaborated_pipeline
 
@@ -67,6 +68,32 @@ def test_globe_frames_equal_the_golden_frames(globe_scene):
         want = golden_frame(scene, mode, f, table, words, texels)
         assert np.array_equal(got[f], want), \
             f"frame {f}: {np.count_nonzero(np.any(got[f] != want, -1))} pixels differ"
+
+
+def test_globe_frame_with_mip_levels_equals_the_golden_frame():
+    """With mip levels the globe picks each pixel's level (rtl/globe.py) and the source
+    hands it to the pipeline's fetch: a 64 x 32 map in 6 levels at R = 11, whose disc reads
+    level 0 in its middle and coarser levels towards the rim. The frame equals the golden
+    frame, and the golden frame is not the one every pixel at level 0 would give."""
+    scene = load_scene_config("default", {**SMALL, "texture_size": 64, "texture_height": 32,
+                                          "mip_levels": 6})
+    words, texels, constants, table = board_data(scene)
+    mode = MODES["test"]
+    levels = frame_inputs(scene, mode, 0, table)["level"]
+    assert levels.max() >= 3 and np.count_nonzero(levels == 0) > mode.pixels // 4
+    got, underflow, order = shown_frames(board_core(scene, mode, data=(words, texels,
+                                                                       constants, table[:2])),
+                                         mode, 1)
+    assert (underflow, order) == (0, 0)
+    want = golden_frame(scene, mode, 0, table, words, texels)
+    assert np.array_equal(got[0], want), \
+        f"{np.count_nonzero(np.any(got[0] != want, -1))} pixels differ"
+    base = frame_inputs(scene, mode, 0, table)
+    inside = (base["tag"] >> (scene.tag_bits - 1) & 1) == 1
+    base["level"] = np.zeros_like(base["level"])
+    at0 = pipeline_fixed(base, scene, words, None, texels)["color"]
+    assert np.count_nonzero(want[..., 0].ravel()[inside] != at0[inside]) > 10, \
+        "the levels change nothing here"
 
 
 def test_golden_globe_covers_the_disc_and_is_black_outside(globe_scene):
