@@ -25,7 +25,14 @@ Method, one register stage per step, fixed latency, one pixel a clock:
   from :func:`cordic_angles` (the gain is irrelevant to the angle) starting at the
   rotation; ``phi`` is that sum less the rotation plus 3/4 turn, one addition later;
 * ``theta`` and ``v`` from two ROMs indexed by y (:func:`theta_table`, :func:`v_table`,
-  float64 contents): they depend on y alone.
+  float64 contents): they depend on y alone;
+* with ``mip_levels`` L > 1, the mip ``level`` of the texel footprint: ``rho = max(du/dx,
+  dv/dy)`` with ``du/dx = W / (2 pi z)`` and ``dv/dy = H / (pi s)``, ``s = sqrt(R**2 -
+  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part compares the root
+  with the constants of :func:`level_thresholds` the stage after it and counts the
+  comparisons the stage after that; the y part (:func:`level_y_table`, float64 contents,
+  only where it can raise the level: W = H) rides in spare bits of the v ROM's word; the
+  larger of the two is taken at the output. The latency does not change.
 
 Every output field but ``inside`` and ``tag`` is 0 outside the globe; on the column x = 0
 the longitude is exactly 0 (``atan2(0, z)``), so ``phi`` is exactly 3/4 turn there and ``u``
@@ -36,6 +43,7 @@ error bound against float64.
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
 from amaranth.hdl import Cat, Const, Mux, Value, signed, unsigned
 from amaranth.lib import data
 
@@ -44,6 +52,7 @@ from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
 __all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "theta_table",
+           "level_thresholds", "level_y_table", "level_y_used", "level_of", "latitude_words",
            "globe_in_layout", "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE",
            "FRAC_BITS_RANGE", "GUARD_BITS_RANGE", "COORD_BITS_MAX", "DATAPATH_BITS",
            "sqrt_stages", "cordic_stages", "fit_signed", "phi_offset"]
@@ -85,6 +94,9 @@ class GlobeConfig:
     iterations : None or int
         CORDIC stages, 2 to ``angle_frac_bits``; None: ``angle_frac_bits - 1`` (the last
         stage whose angle ``atan(2**-i)`` is at least half an internal step).
+    mip_levels : int
+        L, the levels of the map's mip chain the output ``level`` chooses among, 1 to
+        ``log2(map_height) + 1``; 1 (the default): no ``level`` field.
     """
 
     radius: int = 224
@@ -95,6 +107,7 @@ class GlobeConfig:
     frac_bits: int | None = None
     guard_bits: int = 8
     iterations: int | None = None
+    mip_levels: int = 1
 
     def __post_init__(self):
         check_int("radius", self.radius, *RADIUS_RANGE)
@@ -118,6 +131,9 @@ class GlobeConfig:
         if self.iterations is not None:
             check_int("iterations", self.iterations, 2, self.angle_frac_bits,
                        f"angle_frac_bits = {self.angle_frac_bits}")
+        check_int("mip_levels", self.mip_levels, 1, self.v_bits + 1,
+                  f"a map of height {self.map_height} has log2(map_height) + 1 = "
+                  f"{self.v_bits + 1} levels")
 
     # Derived facts.
     @property
@@ -132,6 +148,11 @@ class GlobeConfig:
     @property
     def v_bits(self):
         return self.map_height.bit_length() - 1
+
+    @property
+    def level_bits(self):
+        """Width of the output ``level``: ``(mip_levels - 1).bit_length()`` (0: no field)."""
+        return (self.mip_levels - 1).bit_length()
 
     @property
     def angle_bits(self):
@@ -209,6 +230,51 @@ def theta_table(gcfg: GlobeConfig):
     return _rows(gcfg, lambda y: round(math.acos(y / r) * (full / (2 * math.pi))) & (full - 1))
 
 
+def level_of(rho, levels):
+    """The mip level of a footprint of ``rho`` texels a pixel: ``clamp(floor(log2 rho), 0,
+    levels - 1)``, as the count of k in 1 .. levels - 1 with ``rho >= 2**k`` (exact on
+    float64, no logarithm rounded). Floats and numpy arrays alike (an int64 array back)."""
+    if isinstance(rho, np.ndarray):
+        return sum(((rho >= 2.0 ** k).astype(np.int64) for k in range(1, levels)),
+                   np.zeros(rho.shape, np.int64))
+    return sum(1 for k in range(1, levels) if rho >= 2.0 ** k)
+
+
+def level_thresholds(gcfg: GlobeConfig):
+    """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(W 2**F / (2 pi
+    2**k))`` (float64), the largest root ``z_fix = floor(z 2**F)`` with ``W / (2 pi z) >=
+    2**k`` but for a root within one unit of the real threshold (then the level is one
+    coarser than the exact one); decreasing in k. The x part's level is the count of k
+    with ``z_fix <= t_k``: the RTL's comparisons and the model's."""
+    w, f = gcfg.map_width, gcfg.fraction_bits
+    return [math.floor(w * 2.0 ** f / (2 * math.pi * 2.0 ** k))
+            for k in range(1, gcfg.mip_levels)]
+
+
+def level_y_table(gcfg: GlobeConfig):
+    """The y part (:func:`_rows`): ``level_of(H / (pi s), mip_levels)`` with ``s = sqrt(R**2 -
+    y**2)`` (float64), the level of dv/dy alone."""
+    r, h, n = gcfg.radius, gcfg.map_height, gcfg.mip_levels
+    return _rows(gcfg, lambda y: level_of(h / (math.pi * math.sqrt(r * r - y * y)), n))
+
+
+def level_y_used(gcfg: GlobeConfig):
+    """Whether the unit reads the y part at all: only a square map's can raise the level
+    (for W = 2H, ``dv/dy = W / (2 pi s) <= W / (2 pi z) = du/dx`` as z <= s), and only
+    where its table is not all 0."""
+    return (gcfg.mip_levels > 1 and gcfg.map_width == gcfg.map_height
+            and any(level_y_table(gcfg)))
+
+
+def latitude_words(gcfg: GlobeConfig):
+    """The v ROM's words: :func:`v_table`, with :func:`level_y_table` above its ``v_bits``
+    when :func:`level_y_used` (``v_bits + level_bits`` wide then, else ``v_bits``)."""
+    if not level_y_used(gcfg):
+        return v_table(gcfg)
+    return [v | ly << gcfg.v_bits for v, ly in zip(v_table(gcfg), level_y_table(gcfg),
+                                                   strict=True)]
+
+
 def phi_offset(gcfg: GlobeConfig, rotation):
     """What phi's addition adds to the longitude sum (which starts at the rotation): 3/4 turn
     less the rotation (a binary angle of ``angle_bits``), plus half a code step so that the
@@ -231,10 +297,14 @@ def globe_in_layout(gcfg: GlobeConfig):
 
 def globe_out_layout(gcfg: GlobeConfig):
     """``inside``; ``n``: the normal's phi and theta codes (rtl/layouts.polar_layout); ``u``,
-    ``v``: the texel; ``tag``."""
-    return data.StructLayout({"inside": unsigned(1), "n": polar_layout(gcfg.pipeline),
-                              "u": unsigned(gcfg.u_bits), "v": unsigned(gcfg.v_bits),
-                              "tag": unsigned(gcfg.pipeline.tag_bits)})
+    ``v``: the texel; ``level``: the mip level (``level_bits``, only when ``mip_levels > 1``);
+    ``tag``."""
+    fields = {"inside": unsigned(1), "n": polar_layout(gcfg.pipeline),
+              "u": unsigned(gcfg.u_bits), "v": unsigned(gcfg.v_bits)}
+    if gcfg.mip_levels > 1:
+        fields["level"] = unsigned(gcfg.level_bits)
+    fields["tag"] = unsigned(gcfg.pipeline.tag_bits)
+    return data.StructLayout(fields)
 
 
 def sqrt_stages(pipe, value, value_bits, frac_bits, name):
@@ -317,6 +387,15 @@ def cordic_stages(pipe, x, y, acc, angles, width, name):
     return acc
 
 
+def _count(bits):
+    """The number of set bits among ``bits`` (1-bit values), summed in pairs."""
+    values = [Value.cast(b) for b in bits]
+    while len(values) > 1:
+        pairs = [values[n] + values[n + 1] for n in range(0, len(values) - 1, 2)]
+        values = pairs + values[len(values) - len(values) % 2:]
+    return values[0]
+
+
 class GlobeGeometry(PipeUnit):
     """The globe's per-pixel geometry (module docstring).
 
@@ -333,8 +412,8 @@ class GlobeGeometry(PipeUnit):
     i : In(stream.Signature(globe_in_layout(gcfg)))
         x, y (signed, y up), rotation (a binary angle), tag.
     o : Out(stream.Signature(globe_out_layout(gcfg)))
-        inside, n.phi, n.theta (codes of ``angle_bits``), u, v, tag; bit-exact with
-        sim/golden/globe.globe_fixed.
+        inside, n.phi, n.theta (codes of ``angle_bits``), u, v, level (when
+        ``mip_levels > 1``), tag; bit-exact with sim/golden/globe.globe_fixed.
 
     Latency ``gcfg.latency`` (:attr:`GlobeConfig.latency`); one pixel per clock.
     """
@@ -388,7 +467,9 @@ class GlobeGeometry(PipeUnit):
         # register): their address registered at done - ROM_LATENCY, their words at done + 1
         at = done - ROM_LATENCY
         address = pipe.register(pipe.delay(y[:I + 1], at - 2, "y_rom"), "rom_address")
-        v_rom = pipe.rom(v_table(g), unsigned(g.v_bits), "v_rom", ports=1)
+        level_y = level_y_used(g)                    # the y part's level above v in its word
+        v_rom = pipe.rom(latitude_words(g), unsigned(g.v_bits + g.level_bits * level_y),
+                         "v_rom", ports=1)
         theta_rom = pipe.rom(theta_table(g), unsigned(A), "theta_rom", ports=1)
         m.d.comb += [v_rom.ports[0].addr.eq(address), theta_rom.ports[0].addr.eq(address)]
         v_word = pipe.register(v_rom.ports[0].data, "v_word")
@@ -402,6 +483,17 @@ class GlobeGeometry(PipeUnit):
                                          zero), "phi_out")),
             o.n.theta.eq(pipe.register(Mux(inside, theta_word, zero), "theta_out")),
             o.u.eq(pipe.register(Mux(inside, Mux(x_zero, u_rot, lam), zero), "u_out")),
-            o.v.eq(pipe.register(Mux(inside, v_word, zero), "v_out")),
+            o.v.eq(pipe.register(Mux(inside, v_word[:g.v_bits], zero), "v_out")),
             o.tag.eq(pipe.delay(p.tag, self.latency, "tag")),
         ]
+        if g.mip_levels > 1:
+            # the x part: z against each threshold the stage after the root (one carry chain
+            # each), their count the next, then carried to the output stage beside v's word
+            below = [pipe.register(z_root <= t, f"level_below{k}")
+                     for k, t in enumerate(level_thresholds(g), 1)]
+            level = pipe.register(_count(below)[:g.level_bits], "level_x")
+            level = pipe.delay(level, chain - 1, "level_x")
+            if level_y:
+                word = v_word[g.v_bits:]
+                level = Mux(word > level, word, level)
+            m.d.comb += o.level.eq(pipe.register(Mux(inside, level, zero), "level_out"))

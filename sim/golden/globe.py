@@ -12,13 +12,23 @@ import math
 import numpy as np
 
 from bumprtl.rtl.config import Config
-from bumprtl.rtl.globe import GlobeConfig, cordic_angles, phi_offset, theta_table, v_table
+from bumprtl.rtl.globe import (
+    GlobeConfig,
+    cordic_angles,
+    level_of,
+    level_thresholds,
+    level_y_table,
+    level_y_used,
+    phi_offset,
+    theta_table,
+    v_table,
+)
 from bumprtl.rtl.pipe import EDGE_LATENCY, min_fifo_depth
 from bumprtl.sim.golden.common import cartesian_to_polar
 from bumprtl.sim.golden.fixed.common import angle_codes
 
-__all__ = ["isqrt", "cordic", "globe_fixed", "globe_float", "error_bound_rad", "check_against_float",
-           "disc_pixels", "main"]
+__all__ = ["isqrt", "cordic", "globe_fixed", "globe_float", "footprints", "error_bound_rad",
+           "check_against_float", "disc_pixels", "main"]
 
 
 def isqrt(n):
@@ -51,7 +61,8 @@ def _inputs(x, y, rotation):
 
 def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
     """The unit's output fields (int64 arrays keyed like the flattened payload: ``inside``,
-    ``n.phi``, ``n.theta``, ``u``, ``v``) of pixels (x, y) (y up) at ``rotation`` (codes).
+    ``n.phi``, ``n.theta``, ``u``, ``v``, and ``level`` when ``mip_levels > 1``) of pixels
+    (x, y) (y up) at ``rotation`` (codes).
     ``fine``: also ``phi_fine`` and ``lambda_fine``, the angle sums before their rounding
     (full circle = 2**P; phi's without the half code step its codes round with; valid
     inside only)."""
@@ -74,6 +85,12 @@ def globe_fixed(x, y, rotation, gcfg: GlobeConfig, fine=False):
            "n.theta": np.where(inside, np.asarray(theta_table(gcfg), np.int64)[rows], zero),
            "u": np.where(inside, lam >> (P - gcfg.u_bits), zero),
            "v": np.where(inside, np.asarray(v_table(gcfg), np.int64)[rows], zero)}
+    if gcfg.mip_levels > 1:
+        # the x part: how many thresholds the root is at or below; the y part from its table
+        level = sum(((z <= t).astype(np.int64) for t in level_thresholds(gcfg)), zero)
+        if level_y_used(gcfg):
+            level = np.maximum(level, np.asarray(level_y_table(gcfg), np.int64)[rows])
+        out["level"] = np.where(inside, level, zero)
     if fine:
         out.update(phi_fine=np.where(x_zero, 3 << (P - 2), (phi - half) % full),
                    lambda_fine=lam)
@@ -84,8 +101,9 @@ def globe_float(x, y, rotation, gcfg: GlobeConfig):
     """The float64 reference: ``inside``, the codes ``n.phi``, ``n.theta`` of the normal
     ``(x, -z, y) / R`` in the scenes' world frame made as the board makes N's
     (sim/golden/common.cartesian_to_polar, sim/golden/fixed/common.angle_codes), ``u``,
-    ``v``; and the angles ``phi`` (radians) and ``lambda_turns`` (the longitude in turns,
-    [0, 1): the rotation added in turns, exactly)."""
+    ``v``, ``level`` when ``mip_levels > 1`` (``level_of(max(du/dx, dv/dy))`` from float64
+    z and s, :func:`footprints`); and the angles ``phi`` (radians) and ``lambda_turns`` (the
+    longitude in turns, [0, 1): the rotation added in turns, exactly)."""
     x, y, rotation = _inputs(x, y, rotation)
     R, W, H = float(gcfg.radius), gcfg.map_width, gcfg.map_height
     xf, yf = x.astype(np.float64), y.astype(np.float64)
@@ -98,11 +116,32 @@ def globe_float(x, y, rotation, gcfg: GlobeConfig):
     lam_turns = np.mod(np.arctan2(xf, z) / (2 * np.pi) + rotation / (1 << gcfg.angle_bits), 1.0)
     v = np.clip(np.floor(theta / np.pi * H), 0, H - 1).astype(np.int64)
     zero = np.zeros_like(x)
-    return {"inside": inside.astype(np.int64),
-            "n.phi": np.where(inside, angle_codes(phi, gcfg.pipeline), zero),
-            "n.theta": np.where(inside, angle_codes(theta, gcfg.pipeline), zero),
-            "u": np.where(inside, np.floor(lam_turns * W).astype(np.int64) % W, zero),
-            "v": np.where(inside, v, zero), "phi": phi, "lambda_turns": lam_turns}
+    out = {"inside": inside.astype(np.int64),
+           "n.phi": np.where(inside, angle_codes(phi, gcfg.pipeline), zero),
+           "n.theta": np.where(inside, angle_codes(theta, gcfg.pipeline), zero),
+           "u": np.where(inside, np.floor(lam_turns * W).astype(np.int64) % W, zero),
+           "v": np.where(inside, v, zero), "phi": phi, "lambda_turns": lam_turns}
+    if gcfg.mip_levels > 1:
+        d = footprints(x, y, gcfg)
+        rho = np.maximum(d["du_dx"], d["dv_dy"])
+        out["level"] = np.where(inside, level_of(rho, gcfg.mip_levels), zero)
+    return out
+
+
+def footprints(x, y, gcfg: GlobeConfig):
+    """The exact screen-space derivatives of the texel (float64, texels a pixel) at pixels
+    (x, y) inside (1 where outside): ``du_dx = W / (2 pi z)``, ``dv_dy = H / (pi s)`` with
+    ``s = sqrt(R**2 - y**2)``, and the cross term the level leaves out, ``du_dy = W x y /
+    (2 pi z s**2)`` (dv/dx is 0)."""
+    x, y, _ = _inputs(x, y, 0)
+    R, W, H = float(gcfg.radius), gcfg.map_width, gcfg.map_height
+    xf, yf = x.astype(np.float64), y.astype(np.float64)
+    inside = xf * xf + yf * yf < R * R
+    z = np.sqrt(np.where(inside, R * R - xf * xf - yf * yf, 1.0))
+    s = np.sqrt(np.where(inside, R * R - yf * yf, 1.0))
+    return {"du_dx": np.where(inside, W / (2 * np.pi * z), 1.0),
+            "dv_dy": np.where(inside, H / (np.pi * s), 1.0),
+            "du_dy": np.where(inside, W * xf * yf / (2 * np.pi * z * s * s), 0.0)}
 
 
 def error_bound_rad(gcfg: GlobeConfig):
@@ -138,7 +177,8 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
     (each comes from y alone, through a ROM of float64 words), a fine angle beyond
     :func:`error_bound_rad`, a code or texel off where the float64 value is further than the
     bound from a rounding boundary (or by more than one plus the bound's whole steps
-    anywhere)."""
+    anywhere); with ``mip_levels > 1``, a level other than float64's but where the root is
+    at a threshold (:func:`_check_level`)."""
     fx, fl = globe_fixed(x, y, rotation, gcfg, fine=True), globe_float(x, y, rotation, gcfg)
     P, A, W = gcfg.angle_frac_bits, gcfg.angle_bits, gcfg.map_width
     inside = fl["inside"].astype(bool)
@@ -169,8 +209,39 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
                      "bound_steps": bound * steps / (2 * np.pi),
                      "codes_differing": int(np.count_nonzero(diff)),
                      "codes_max_diff": int(np.abs(diff).max()) if diff.size else 0}
+    if gcfg.mip_levels > 1:
+        out["level"] = _check_level(x, y, fx["level"], fl["level"], gcfg, bad)
     out["violations"] = bad
     return out
+
+
+def _check_level(x, y, fixed, ref, gcfg: GlobeConfig, bad):
+    """The level's rule: the model's equals float64's except one coarser where the root
+    ``floor(z 2**F)`` (exact) is that coarser level's threshold ``t_k`` (the real z within
+    one unit above it); the y part comes from a table of the same float64 values, so no
+    other difference is allowed. Appends to ``bad``; returns the figures."""
+    x, y, _ = _inputs(x, y, 0)
+    R, F, L = gcfg.radius, gcfg.fraction_bits, gcfg.mip_levels
+    d = R * R - x * x - y * y
+    inside = d > 0
+    root = isqrt(np.where(inside, d, 0) << (2 * F))
+    t = np.asarray([-1, *level_thresholds(gcfg)], np.int64)      # t[k] for k >= 1
+    diff = fixed - ref
+    at_threshold = inside & np.isin(root, t[1:])
+    allowed = (diff == 0) | ((diff == 1) & (root == t[np.clip(fixed, 0, L - 1)]))
+    if np.any(~allowed):
+        n = int(np.count_nonzero(~allowed))
+        bad.append(f"level: {n} pixels differ from float64 other than one coarser at a "
+                   f"threshold")
+    fp = footprints(x, y, gcfg)
+    # the level with the cross term: the longer of the footprint's x and y derivatives
+    across = np.maximum(fp["du_dx"], np.hypot(fp["du_dy"], fp["dv_dy"]))
+    cross = np.where(inside, level_of(across, L), 0) - ref
+    return {"pixels_at_threshold": int(at_threshold.sum()),
+            "differing": int(np.count_nonzero(diff)),
+            "per_level": np.bincount(fixed[inside], minlength=L).tolist(),
+            "cross_coarser": int(np.count_nonzero(cross)),
+            "cross_max": int(cross.max()) if cross.size else 0}
 
 
 def disc_pixels(radius, margin=2):

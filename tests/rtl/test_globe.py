@@ -18,6 +18,9 @@ from bumprtl.rtl.globe import (
     GlobeConfig,
     GlobeGeometry,
     fit_signed,
+    globe_out_layout,
+    level_thresholds,
+    level_y_used,
     sqrt_stages,
     theta_table,
     v_table,
@@ -36,6 +39,13 @@ from bumprtl.sim.traffic import PATTERNS
 from tests.rtl.test_no_clock_enable import datapath_offenders, netlist
 
 SMALL = Config(angle_bits=10, frac_bits=9, tag_bits=8)
+# Globes with four mip levels and F = 4 (coarse roots: at R = 88 some pixel's root is each
+# threshold and one unit either side of it), on a 2:1 map (the x part alone decides) and a
+# square map (the y part's table raises it)
+LOD = {"radius": 88, "map_width": 1024, "pipeline": SMALL, "coord_bits": 8, "frac_bits": 4,
+       "mip_levels": 4}
+LOD_WIDE = GlobeConfig(map_height=512, **LOD)
+LOD_SQUARE = GlobeConfig(map_height=1024, **LOD)
 
 
 def rim_pixels(radius, limit=None):
@@ -273,6 +283,24 @@ def test_the_float_check_can_fail(monkeypatch):
     bad = check_against_float(x, y, 0, g)["violations"]
     assert "v differs" in bad and any(v.startswith("phi: fine error") for v in bad)
 
+    # the level one coarser or one finer where it can be, or one coarser only at the roots
+    # one unit above a threshold (where the exact level is already the finer one)
+    lx, ly = disc_pixels(LOD_WIDE.radius)
+    monkeypatch.setattr(model, "globe_fixed", real)
+    assert check_against_float(lx, ly, 0, LOD_WIDE)["violations"] == []
+    above = {t + 1 for t in level_thresholds(LOD_WIDE)}
+    roots = isqrt(np.maximum(LOD_WIDE.radius ** 2 - lx * lx - ly * ly, 0) << 8)
+    for change in (lambda lv, _: np.minimum(lv + 1, 3), lambda lv, _: np.maximum(lv - 1, 0),
+                   lambda lv, inside: np.where(inside & np.isin(roots, list(above)), lv + 1, lv)):
+        def off_level(*args, change=change, **kw):
+            out = real(*args, **kw)
+            out["level"] = np.where(out["inside"] == 1, change(out["level"], out["inside"] == 1), 0)
+            return out
+
+        monkeypatch.setattr(model, "globe_fixed", off_level)
+        bad = check_against_float(lx, ly, 0, LOD_WIDE)["violations"]
+        assert any(v.startswith("level:") for v in bad), bad
+
 
 def test_bound_shrinks_with_the_widths():
     """The derived bound is larger for narrower datapaths, fewer guard bits and a smaller
@@ -326,7 +354,10 @@ def test_model_square_root_is_exact():
     ({"frac_bits": 3}, "frac_bits"), ({"frac_bits": 21}, "frac_bits"),
     ({"guard_bits": 0}, "guard_bits"), ({"guard_bits": 9}, "guard_bits"),
     ({"iterations": 1}, "iterations"), ({"iterations": 23}, "iterations"),
-    ({"pipeline": "default"}, "pipeline")])
+    ({"pipeline": "default"}, "pipeline"),
+    ({"mip_levels": 0}, "mip_levels"), ({"mip_levels": 12}, "mip_levels"),
+    ({"map_width": 64, "map_height": 32, "mip_levels": 7}, "mip_levels"),
+    ({"mip_levels": 2.0}, "mip_levels")])
 def test_config_errors_name_the_parameter(changes, field):
     with pytest.raises(ConfigError) as err:
         GlobeConfig(**changes)
@@ -352,6 +383,9 @@ def test_config_accepts_the_edges():
     GlobeConfig(map_width=32768, map_height=16384, frac_bits=20, guard_bits=8, iterations=23)
     GlobeConfig(map_width=32768, map_height=32768)
     GlobeConfig(map_width=4, map_height=4, radius=1, coord_bits=2)
+    GlobeConfig(mip_levels=11)
+    GlobeConfig(map_width=4, map_height=2, radius=1, coord_bits=2, mip_levels=2)
+    GlobeConfig(map_width=32768, map_height=32768, mip_levels=16)
 
 
 def test_elaborates_for_ecp5_and_records_its_rom():
@@ -404,3 +438,134 @@ def test_fit_signed_extends_by_signedness_and_truncates_to_the_low_bits(value, w
     sim.add_testbench(bench)
     sim.run()
     assert out == [(width, True, expected)]
+
+
+def exact_level(x, y, gcfg):
+    """The level from the formula, in floats apart from either model: clamp(floor(log2
+    max(W / (2 pi z), H / (pi s))), 0, L - 1), 0 outside."""
+    R, W, H, L = gcfg.radius, gcfg.map_width, gcfg.map_height, gcfg.mip_levels
+    if x * x + y * y >= R * R:
+        return 0
+    z, s = math.sqrt(R * R - x * x - y * y), math.sqrt(R * R - y * y)
+    rho = max(W / (2 * math.pi * z), H / (math.pi * s))
+    return min(max(math.floor(math.log2(rho)), 0), L - 1)
+
+
+def threshold_pixels(gcfg):
+    """For each threshold t_k and each root t_k - 1, t_k, t_k + 1: the first pixel (x, y >= 0,
+    by rows from the centre) whose root floor(sqrt(R**2 - r**2) 2**F) (math.isqrt) is it;
+    {(k, offset): (x, y)}."""
+    R, F = gcfg.radius, gcfg.fraction_bits
+    want = {t + o: (k, o) for k, t in enumerate(level_thresholds(gcfg), 1) for o in (-1, 0, 1)}
+    found = {}
+    for y in range(R):
+        for x in range(R):
+            if x * x + y * y < R * R:
+                key = want.get(math.isqrt((R * R - x * x - y * y) << (2 * F)))
+                if key is not None and key not in found:
+                    found[key] = (x, y)
+    return found
+
+
+def test_level_thresholds_from_the_formula():
+    """t_k = floor(W 2**F / (2 pi 2**k)): W = 1024, F = 4 gives 16384 / (4 pi) = 1303.8..,
+    651.9.., 325.9..; the default F = 10 on a 2048-wide map 2**21 / (4 pi) = 166886.9.."""
+    assert level_thresholds(LOD_WIDE) == level_thresholds(LOD_SQUARE) == [1303, 651, 325]
+    assert level_thresholds(GlobeConfig(mip_levels=3)) == [166886, 83443]
+    assert level_thresholds(GlobeConfig()) == []
+
+
+@pytest.mark.parametrize("gcfg", [LOD_WIDE, LOD_SQUARE], ids=["wide", "square"])
+def test_level_bit_exact(gcfg):
+    """The level of the RTL bit for bit against the model's: the corners, the pixels on each
+    threshold and one unit either side of it, random pixels over the disc, under input gaps
+    and backpressure; on the 2:1 map (no y part) and the square one (its table in the v
+    ROM's word)."""
+    assert level_y_used(gcfg) == (gcfg.map_height == gcfg.map_width)
+    rng = np.random.default_rng(11)
+    pts = [*corner_pixels(gcfg), *threshold_pixels(gcfg).values(),
+           *zip(rng.integers(-92, 93, 100).tolist(), rng.integers(-92, 93, 100).tolist(),
+                strict=True)]
+    rtl_vs_model(gcfg, pts, [0, 700], "both")
+
+
+def _level_points(gcfg):
+    """(pixel, level) known from the formula."""
+    R = gcfg.radius
+    pts = [((0, 0), 1 if gcfg.map_height == gcfg.map_width else 0),   # rho 1.85 (W = 2H), 3.70
+           ((75, 46), 3), ((-46, -75), 3),      # r**2 = R**2 - 3: rho 94, clamped to L - 1
+           ((R, 0), 0), ((0, -R), 0), ((R, R), 0), ((-95, 3), 0)]          # outside: 0
+    for (k, o), (x, y) in threshold_pixels(gcfg).items():
+        # the root at t_k reaches level k (z may be up to a unit above the real threshold),
+        # a unit above it level k - 1, a unit below level k (t_(k+1) is far lower): the
+        # x part alone; the y part as the formula gives it
+        x_part = k - (o == 1)
+        y_part = exact_level(0, y, gcfg) if gcfg.map_height == gcfg.map_width else 0
+        pts.append(((x, y), max(x_part, y_part)))
+    return pts
+
+
+@pytest.mark.parametrize("gcfg", [LOD_WIDE, LOD_SQUARE], ids=["wide", "square"])
+def test_level_known_points(gcfg):
+    """Levels known from the formula, of the RTL and of the model: the centre (z = R, rho =
+    W / (2 pi R) = 1.85 on the 2:1 map, H / (pi R) = 3.70 on the square one), pixels next
+    to the rim (rho 94, clamped to L - 1), the pixels whose root is each threshold or one
+    unit off it, 0 outside."""
+    known = _level_points(gcfg)
+    assert len(known) == 7 + 9
+    pts = [p for p, _ in known]
+    inputs = [{"x": a, "y": b, "rotation": 3, "tag": n} for n, (a, b) in enumerate(pts)]
+    rtl, _ = simulate_stream(GlobeGeometry(gcfg), inputs, "no_stall")
+    fixed = globe_fixed([p[0] for p in pts], [p[1] for p in pts], 3, gcfg)
+    want = [lv for _, lv in known]
+    assert [o["level"] for o in rtl] == want
+    assert fixed["level"].tolist() == want
+    # the formula agrees away from the thresholds
+    assert [exact_level(*p, gcfg) for p in pts[:7]] == want[:7]
+
+
+def test_level_below_one_texel_is_zero():
+    """rho < 1 (a 512-wide map on R = 224: W / (2 pi R) = 0.36 at the centre) gives 0, not a
+    negative level; towards the rim rho grows to 3.9 at (223, 0) (z = sqrt 447), 4.4 at
+    (223, 10) (z = sqrt 347), the top level."""
+    g = GlobeConfig(map_width=512, map_height=256, mip_levels=3)
+    pts = [(0, 0), (100, 0), (223, 0), (223, 10), (10, -223)]
+    out = globe_fixed([p[0] for p in pts], [p[1] for p in pts], 0, g)
+    assert out["level"].tolist() == [exact_level(*p, g) for p in pts] == [0, 0, 1, 2, 2]
+
+
+@pytest.mark.parametrize("gcfg", [
+    LOD_WIDE, LOD_SQUARE, GlobeConfig(mip_levels=11),
+    GlobeConfig(map_width=1024, map_height=1024, mip_levels=11),
+    GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5)],
+    ids=["wide", "square", "default-11", "square-11", "square-F5"])
+def test_level_against_float(gcfg):
+    """Over the disc and a ring outside: the level equals float64's (max of du/dx and dv/dy
+    from float64 z and s) but one coarser where the root is on that level's threshold; on the
+    2:1 maps the model has no y part and float64 does, so the y part never raising a 2:1
+    map's level is checked too."""
+    x, y = disc_pixels(gcfg.radius)
+    res = check_against_float(x, y, 0, gcfg)
+    assert res["violations"] == [], res
+    per = res["level"]["per_level"]
+    assert per[0] + per[1] > 0 and per[-1] + per[-2] > 0 or gcfg.mip_levels > 8
+    if gcfg.frac_bits == 4:
+        assert res["level"]["pixels_at_threshold"] > 0
+        # every level on the 2:1 map; the square map's y part lifts its centre to 1
+        assert all(per) if gcfg.map_height < gcfg.map_width else per[0] == 0 < per[1]
+
+
+def test_level_layout_only_with_mip_levels():
+    """No level field at one level (the unit unchanged); level_bits wide from two."""
+    assert "level" not in dict(globe_out_layout(GlobeConfig())).keys()
+    for levels, bits in ((2, 1), (3, 2), (4, 2), (5, 3), (11, 4)):
+        g = GlobeConfig(mip_levels=levels)
+        assert g.level_bits == bits
+        assert dict(globe_out_layout(g))["level"].shape == unsigned(bits)
+
+
+def test_level_y_part_packed_in_the_v_rom():
+    """The square map's y part rides above v in the v ROM's word; a 2:1 map's ROM is v's."""
+    for g, width in ((LOD_SQUARE, 10 + 2), (LOD_WIDE, 9)):
+        _, records = unit_memory_records(dut := GlobeGeometry(g))
+        assert records.of(dut)["v_rom"]["width"] == width
