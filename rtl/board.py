@@ -246,8 +246,7 @@ def globe_config(scene: HardwareScene, mode: VideoMode):
     reach = max(mode.h_active, mode.v_active) // 2
     coord = max(reach.bit_length() + 1, radius.bit_length() + 1)
     return GlobeConfig(radius=radius, map_width=scene.texture_size, map_height=scene.map_height,
-                       pipeline=scene.config, coord_bits=coord,
-                       **({"mip_levels": scene.mip_levels} if scene.mip_levels > 1 else {}))
+                       pipeline=scene.config, coord_bits=coord, mip_levels=scene.mip_levels)
 
 
 def globe_offsets(x, y, mode: VideoMode):
