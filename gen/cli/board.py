@@ -57,8 +57,9 @@ def _with_display_buffer(args, scene, mode, variant, offset, memory):
     entries, budgets = display_buffer(scene, mode, memory.pipe_hz)
     least = cdc_depth(mode.pixel_hz, memory.pipe_hz)
     slack = " / ".join(f"{b.slack:,.1f}" for b in budgets)
-    print(f"display buffer: {entries} entries (the clock crossing; least slack {slack} pipe "
-          f"clocks in frames 0 / 1, {sum(int(b.misses.sum()) for b in budgets):,} misses)")
+    misses = " / ".join(f"{int(b.misses.sum()):,}" for b in budgets)
+    print(f"display buffer: {entries} entries (the clock crossing; frames 0 / 1: {misses} "
+          f"texel cache misses, least slack {slack} pipe clocks)")
     if not all(b.holds for b in budgets):
         late = next(b for b in budgets if not b.holds)
         print(f"bumprtl: warning: the display is predicted to starve even with {entries} "

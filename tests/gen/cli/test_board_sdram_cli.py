@@ -155,3 +155,47 @@ def test_the_2048_by_1024_globe_map_fits_the_flash_and_2048_square_does_not():
     with pytest.raises(BumpError, match="texture_height = texture_size / 2 = 1024") as e:
         check_board("ulx3s", "1280x720", load_scene_config({**keys, "texture_height": 512}))
     assert e.value.field == "texture_height"
+
+
+def _budgets(holds):
+    from types import SimpleNamespace
+    return [SimpleNamespace(holds=holds, slack=5.0 if holds else -7.0, worst=(12, 34),
+                            misses=np.array([1, 2])) for _ in range(2)]
+
+
+def test_the_display_buffer_goes_to_the_design_with_its_prediction(tmp_path, monkeypatch,
+                                                                   run_cli):
+    """The crossing's entries the prediction derives reach the design (BoardMemory), are
+    counted in the block-RAM budget, and a prediction that starves is a warning, not an
+    error; a buffer larger than the block RAM is refused before anything is written."""
+    seen = {}
+
+    def build(scene, mode, out, board, seeds, pipe_hz=None, memory=None):
+        seen["memory"] = memory
+        return [{"seed": 1, "seconds": 1.0, "resources": {}, "fmax": {}}]
+    monkeypatch.setattr(cli_board, "build_bitstream", build)
+    monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (4096, _budgets(False)))
+    r = run_cli(["board", "ulx3s", *AXI, "--out", tmp_path / "a"])
+    assert r.returncode == 0, r.stderr
+    assert seen["memory"].display_buffer == 4096
+    assert "display buffer: 4096 entries" in r.stdout and "3 / 3 texel cache misses" in r.stdout
+    assert r.stderr.startswith("bumprtl: warning: the display is predicted to starve even "
+                               "with 4096 entries (first late pixel at line 12, column 34)")
+    # the least (here the crossing's 8 at 89.3 MHz) leaves the design as it was
+    monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (8, _budgets(True)))
+    r = run_cli(["board", "ulx3s", *AXI, "--out", tmp_path / "b"])
+    assert r.returncode == 0 and "warning" not in r.stderr
+    assert seen["memory"].display_buffer is None
+    # 2**20 entries of 8 + 16 bits: more block RAM than the device has
+    monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (1 << 20, _budgets(True)))
+    out = tmp_path / "c"
+    r = run_cli(["board", "ulx3s", *AXI, "--out", out])
+    assert r.returncode == 2 and not out.exists()
+    assert r.stderr.strip().startswith("bumprtl: error: block RAM: the board needs")
+    assert "display buffer" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_the_display_buffer_is_not_predicted_without_a_design(tmp_path, monkeypatch, run_cli):
+    monkeypatch.setattr(cli_board, "display_buffer", _no)
+    r = run_cli(["board", "ulx3s", *AXI, "--out", tmp_path / "a", "--no-bitstream"])
+    assert r.returncode == 0, r.stderr
