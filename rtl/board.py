@@ -50,7 +50,7 @@ from amaranth.hdl import (
 )
 from amaranth.lib import io, stream, wiring
 from amaranth.lib.cdc import ResetSynchronizer
-from amaranth.lib.fifo import AsyncFIFO
+from amaranth.lib.fifo import AsyncFIFO, SyncFIFOBuffered
 from amaranth.lib.memory import Memory
 
 from bumprtl.rtl.cache import scene_geometry
@@ -339,20 +339,16 @@ def _check_memory(scene, pipe_hz, sdram, flash):
                         f"be equal", "data_bits")
 
 
-def _display_buffer(mode, pipe_hz, entries):
-    """The clock crossing's entries (BoardCore's ``display_buffer``), or BumpError."""
-    if pipe_hz is None:
-        if entries is not None:
-            raise BumpError("display_buffer is the clock crossing's depth: it needs the "
-                            "pipeline in its own clock domain (pipe_hz)", "display_buffer")
-        return None
-    least = cdc_depth(mode.pixel_hz, pipe_hz)
+def _display_buffer(pipe_hz, entries):
+    """BoardCore's ``display_buffer``, or BumpError."""
     if entries is None:
-        return least
-    if isinstance(entries, bool) or not isinstance(entries, int) or entries < least \
+        return None
+    if pipe_hz is None:
+        raise BumpError("display_buffer sits ahead of the clock crossing: it needs the "
+                        "pipeline in its own clock domain (pipe_hz)", "display_buffer")
+    if isinstance(entries, bool) or not isinstance(entries, int) or entries < 2 \
             or entries & (entries - 1):
-        raise BumpError(f"display_buffer must be a power of two >= {least} (the clock "
-                        f"crossing's least depth at this pipe clock), got {entries!r}",
+        raise BumpError(f"display_buffer must be a power of two >= 2, got {entries!r}",
                         "display_buffer")
     return entries
 
@@ -371,9 +367,12 @@ class BoardCore(Elaboratable):
         below ``min_fifo_depth`` of the latency the pipeline refuses it). ``pipe_hz``: None
         runs the source and the pipeline at the pixel clock (domain ``sync``); a frequency
         (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
-        :class:`~amaranth.lib.fifo.AsyncFIFO` of ``display_buffer`` entries into ``sync``
-        (None: :func:`cdc_depth`'s least; else a power of two at least that: more pixels
-        held ahead of the display, for a map in the SDRAM whose misses come in bursts).
+        :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``;
+        ``display_buffer`` (a power of two, at least 2; None: none) adds a
+        :class:`~amaranth.lib.fifo.SyncFIFOBuffered` of that many entries in ``pipe``
+        between the pipeline and the crossing: more pixels held ahead of the display, for
+        a map in the SDRAM whose misses come in bursts (the pixel and the tag only, not the
+        pipeline's whole payload).
         ``globe``: a turning globe (:class:`GlobeSource`, :func:`globe_config`) instead of
         the plane; ``constants`` is then unused. ``sdram`` (an
         :class:`~bumprtl.rtl.sdram.SdramConfig`) and ``flash`` (a
@@ -393,7 +392,8 @@ class BoardCore(Elaboratable):
                             "preloaded")
         self.mode = mode
         self.pipe_hz = pipe_hz
-        self.cdc_depth = _display_buffer(mode, pipe_hz, display_buffer)
+        self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
+        self.display_buffer = _display_buffer(pipe_hz, display_buffer)
         self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target,
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
@@ -469,8 +469,15 @@ class BoardCore(Elaboratable):
         else:                         # its FIFO feeds the crossing, which the display reads
             m.submodules.cdc = cdc = AsyncFIFO(width=len(rgb) + tag_bits, depth=self.cdc_depth,
                                                w_domain="pipe", r_domain="sync")
-            m.d.comb += [cdc.w_data.eq(Cat(rgb, o.tag)), cdc.w_en.eq(p.o.valid),
-                         p.o.ready.eq(cdc.w_rdy), cdc.r_en.eq(t.de & shows)]
+            valid, data, ready = p.o.valid, Cat(rgb, o.tag), p.o.ready
+            if self.display_buffer is not None:     # more pixels ahead, in the pipe domain
+                buf = DomainRenamer("pipe")(SyncFIFOBuffered(width=len(data),
+                                                             depth=self.display_buffer))
+                m.submodules.display_buffer = buf
+                m.d.comb += [buf.w_data.eq(data), buf.w_en.eq(valid), ready.eq(buf.w_rdy)]
+                valid, data, ready = buf.r_rdy, buf.r_data, buf.r_en
+            m.d.comb += [cdc.w_data.eq(data), cdc.w_en.eq(valid), ready.eq(cdc.w_rdy),
+                         cdc.r_en.eq(t.de & shows)]
             valid, color, tag = cdc.r_rdy, cdc.r_data[:len(rgb)], cdc.r_data[len(rgb):]
         # x == 0 as ~|x: an equality with 0 would be Verilog's ! of a vector, which lint refuses
         first = t.de & ~t.x.any() & ~t.y.any()

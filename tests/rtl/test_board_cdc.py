@@ -27,13 +27,15 @@ def scene_data():
     return scene, (words, constants, table[:4], texels)
 
 
-def shown(scene, data, mode, pipe_ratio=None, phase_ns=0.0):
+def shown(scene, data, mode, pipe_ratio=None, phase_ns=0.0, display_buffer=None):
     """(pixels the encoders get over one frame and a line, underflow, order_error) of a
     BoardCore in ``mode``; ``pipe_ratio``: the pipe clock over the pixel clock (None: one
-    domain), its first edge ``phase_ns`` after the pixel clock's."""
+    domain), its first edge ``phase_ns`` after the pixel clock's; ``display_buffer``: the
+    FIFO ahead of the crossing."""
     words, constants, table, texels = data
     pipe_hz = None if pipe_ratio is None else mode.pixel_hz * pipe_ratio
-    core = BoardCore(scene.hardware, mode, words, constants, table, texels, pipe_hz=pipe_hz)
+    core = BoardCore(scene.hardware, mode, words, constants, table, texels, pipe_hz=pipe_hz,
+                     display_buffer=display_buffer)
     seen = []
 
     async def bench(ctx):
@@ -51,15 +53,18 @@ def shown(scene, data, mode, pipe_ratio=None, phase_ns=0.0):
     return seen[:-2], seen[-2], seen[-1]
 
 
-@pytest.mark.parametrize("ratio, phase", [(1.0, 3.3),       # equal rates: the deepest need
-                                          pytest.param(1.37, 0.0, marks=pytest.mark.regress)])
-def test_the_crossing_shows_the_single_clock_pixels(scene_data, ratio, phase):
+@pytest.mark.parametrize("ratio, phase, ahead", [
+    (1.0, 3.3, None),                               # equal rates: the deepest need
+    (1.0, 3.3, 32),                                 # a FIFO ahead of the crossing
+    pytest.param(1.37, 0.0, None, marks=pytest.mark.regress)])
+def test_the_crossing_shows_the_single_clock_pixels(scene_data, ratio, phase, ahead):
     scene, data = scene_data
     latency = unelaborated_pipeline(scene).latency
-    mode = long_line_mode(latency + 8 + cdc_depth(1, ratio), latency)    # lines > both buffers
+    # lines longer than every buffer together
+    mode = long_line_mode(latency + 8 + cdc_depth(1, ratio) + (ahead or 0), latency)
     one, under, order = shown(scene, data, mode)
     assert (under, order) == (0, 0) and any(one)
-    two, under, order = shown(scene, data, mode, ratio, phase)
+    two, under, order = shown(scene, data, mode, ratio, phase, ahead)
     assert (under, order) == (0, 0)
     assert two == one, f"{sum(a != b for a, b in zip(two, one, strict=True))} pixels differ"
 

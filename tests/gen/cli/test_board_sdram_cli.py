@@ -165,8 +165,8 @@ def _budgets(holds):
 
 def test_the_display_buffer_goes_to_the_design_with_its_prediction(tmp_path, monkeypatch,
                                                                    run_cli):
-    """The crossing's entries the prediction derives reach the design (BoardMemory), are
-    counted in the block-RAM budget, and a prediction that starves is a warning, not an
+    """The FIFO ahead of the clock crossing the prediction derives reaches the design
+    (BoardMemory), is counted in the block-RAM budget, and a prediction that starves is a warning, not an
     error; a buffer larger than the block RAM is refused before anything is written."""
     seen = {}
 
@@ -180,11 +180,13 @@ def test_the_display_buffer_goes_to_the_design_with_its_prediction(tmp_path, mon
     assert seen["memory"].display_buffer == 4096
     assert "display buffer: 4096 entries" in r.stdout and "3 / 3 texel cache misses" in r.stdout
     assert r.stderr.startswith("bumprtl: warning: the display is predicted to starve even "
-                               "with 4096 entries (first late pixel at line 12, column 34)")
-    # the least (here the crossing's 8 at 89.3 MHz) leaves the design as it was
-    monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (8, _budgets(True)))
+                               "with 4096 entries ahead of the clock crossing (first late "
+                               "pixel at line 12, column 34)")
+    # none needed: the design as it was
+    monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (None, _budgets(True)))
     r = run_cli(["board", "ulx3s", *AXI, "--out", tmp_path / "b"])
     assert r.returncode == 0 and "warning" not in r.stderr
+    assert "display buffer: none (ahead of the clock crossing" in r.stdout
     assert seen["memory"].display_buffer is None
     # 2**20 entries of 8 + 16 bits: more block RAM than the device has
     monkeypatch.setattr(cli_board, "display_buffer", lambda *a, **k: (1 << 20, _budgets(True)))
