@@ -216,16 +216,19 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
 
 
 def _check_level(x, y, fixed, ref, gcfg: GlobeConfig, bad):
-    """The level's rule: the model's equals float64's except one coarser where the root
-    ``floor(z 2**F)`` (exact) is that coarser level's threshold ``t_k`` (the real z within
-    one unit above it); the y part comes from a table of the same float64 values, so no
-    other difference is allowed. Appends to ``bad``; returns the figures."""
+    """The level's rule: the model's equals float64's except one coarser, k, where the root
+    ``floor(z 2**F)`` (exact) is ``floor(W 2**F / (2 pi 2**k))`` (the real z within one
+    unit above the real threshold; made here from the formula, not taken from the unit's
+    :func:`level_thresholds`, so that a wrong constant shows); the y part comes from a table
+    of the same float64 values, so no other difference is allowed. Appends to ``bad``;
+    returns the figures."""
     x, y, _ = _inputs(x, y, 0)
-    R, F, L = gcfg.radius, gcfg.fraction_bits, gcfg.mip_levels
+    R, F, L, W = gcfg.radius, gcfg.fraction_bits, gcfg.mip_levels, gcfg.map_width
     d = R * R - x * x - y * y
     inside = d > 0
     root = isqrt(np.where(inside, d, 0) << (2 * F))
-    t = np.asarray([-1, *level_thresholds(gcfg)], np.int64)      # t[k] for k >= 1
+    t = np.floor(W * 2.0 ** F / (2 * np.pi * 2.0 ** np.arange(L))).astype(np.int64)
+    t[0] = -1                                                    # no threshold for level 0
     diff = fixed - ref
     at_threshold = inside & np.isin(root, t[1:])
     allowed = (diff == 0) | ((diff == 1) & (root == t[np.clip(fixed, 0, L - 1)]))
