@@ -542,16 +542,19 @@ def test_level_below_one_texel_is_zero():
 @pytest.mark.parametrize("gcfg", [
     LOD_WIDE, LOD_SQUARE, GlobeConfig(mip_levels=11),
     GlobeConfig(map_width=1024, map_height=1024, mip_levels=11),
-    GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5)],
-    ids=["wide", "square", "default-11", "square-11", "square-F5"])
+    GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5),
+    GlobeConfig(radius=26, map_width=256, map_height=128, mip_levels=4, frac_bits=4)],
+    ids=["wide", "square", "default-11", "square-11", "square-F5", "coarser"])
 def test_level_against_float(gcfg):
     """Over the disc and a ring outside: the level equals float64's (max of du/dx and dv/dy
     from float64 z and s) but one coarser where the root is on that level's threshold; on the
     2:1 maps the model has no y part and float64 does, so the y part never raising a 2:1
-    map's level is checked too."""
+    map's level is checked too. At R = 26 (W = 256, F = 4) some pixels have a root on a
+    threshold above the real one: their level is the coarser one."""
     x, y = disc_pixels(gcfg.radius)
     res = check_against_float(x, y, 0, gcfg)
     assert res["violations"] == [], res
+    assert (res["level"]["differing"] > 0) == (gcfg.radius == 26)
     per = res["level"]["per_level"]
     assert per[0] + per[1] > 0 and per[-1] + per[-2] > 0 or gcfg.mip_levels > 8
     if gcfg.frac_bits == 4:
