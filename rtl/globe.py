@@ -28,11 +28,12 @@ Method, one register stage per step, fixed latency, one pixel a clock:
   float64 contents): they depend on y alone;
 * with ``mip_levels`` L > 1, the mip ``level`` of the texel footprint: ``rho = max(du/dx,
   dv/dy)`` with ``du/dx = W / (2 pi z)`` and ``dv/dy = H / (pi s)``, ``s = sqrt(R**2 -
-  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part compares the root
-  with the constants of :func:`level_thresholds` the stage after it and counts the
-  comparisons the stage after that; the y part (:func:`level_y_table`, float64 contents,
-  only where it can raise the level: W = H) rides in spare bits of the v ROM's word; the
-  larger of the two is taken at the output. The latency does not change.
+  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part copies the root
+  into a register of its own, compares it with the constants of :func:`level_thresholds`
+  the next stage and counts the comparisons the stage after that; the y part
+  (:func:`level_y_table`, float64 contents, only where it can raise the level: W = H)
+  rides in spare bits of the v ROM's word; the larger of the two is taken at the output.
+  The latency does not change.
 
 Every output field but ``inside`` and ``tag`` is 0 outside the globe; on the column x = 0
 the longitude is exactly 0 (``atan2(0, z)``), so ``phi`` is exactly 3/4 turn there and ``u``
@@ -487,12 +488,15 @@ class GlobeGeometry(PipeUnit):
             o.tag.eq(pipe.delay(p.tag, self.latency, "tag")),
         ]
         if g.mip_levels > 1:
-            # the x part: z against each threshold the stage after the root (one carry chain
-            # each), their count the next, then carried to the output stage beside v's word
-            below = [pipe.register(z_root <= t, f"level_below{k}")
+            # the x part: z copied into a register of its own (the root's bits also drive the
+            # CORDIC's first stage, and its last bit is the complement of a remainder's sign),
+            # against each threshold the next stage (one carry chain each), their count the
+            # next, then carried to the output stage beside v's word
+            z_level = pipe.register(z_root, "z_level")
+            below = [pipe.register(z_level <= t, f"level_below{k}")
                      for k, t in enumerate(level_thresholds(g), 1)]
             level = pipe.register(_count(below)[:g.level_bits], "level_x")
-            level = pipe.delay(level, chain - 1, "level_x")
+            level = pipe.delay(level, chain - 2, "level_x")
             if level_y:
                 word = v_word[g.v_bits:]
                 level = Mux(word > level, word, level)

@@ -216,16 +216,19 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
 
 
 def _check_level(x, y, fixed, ref, gcfg: GlobeConfig, bad):
-    """The level's rule: the model's equals float64's except one coarser where the root
-    ``floor(z 2**F)`` (exact) is that coarser level's threshold ``t_k`` (the real z within
-    one unit above it); the y part comes from a table of the same float64 values, so no
-    other difference is allowed. Appends to ``bad``; returns the figures."""
+    """The level's rule: the model's equals float64's except one coarser, k, where the root
+    ``floor(z 2**F)`` (exact) is ``floor(W 2**F / (2 pi 2**k))`` (the real z within one
+    unit above the real threshold; made here from the formula, not taken from the unit's
+    :func:`level_thresholds`, so that a wrong constant shows); the y part comes from a table
+    of the same float64 values, so no other difference is allowed. Appends to ``bad``;
+    returns the figures."""
     x, y, _ = _inputs(x, y, 0)
-    R, F, L = gcfg.radius, gcfg.fraction_bits, gcfg.mip_levels
+    R, F, L, W = gcfg.radius, gcfg.fraction_bits, gcfg.mip_levels, gcfg.map_width
     d = R * R - x * x - y * y
     inside = d > 0
     root = isqrt(np.where(inside, d, 0) << (2 * F))
-    t = np.asarray([-1, *level_thresholds(gcfg)], np.int64)      # t[k] for k >= 1
+    t = np.floor(W * 2.0 ** F / (2 * np.pi * 2.0 ** np.arange(L))).astype(np.int64)
+    t[0] = -1                                                    # no threshold for level 0
     diff = fixed - ref
     at_threshold = inside & np.isin(root, t[1:])
     allowed = (diff == 0) | ((diff == 1) & (root == t[np.clip(fixed, 0, L - 1)]))
@@ -260,12 +263,17 @@ def main(argv=None):
                     help="F (default: DATAPATH_BITS - 2 - I, rtl/globe.py)")
     ap.add_argument("--guard-bits", type=int, default=GlobeConfig().guard_bits)
     ap.add_argument("--map-width", type=int, default=GlobeConfig().map_width)
+    ap.add_argument("--square", action="store_true",
+                    help="a square map (map_height = map_width; default: map_width / 2)")
+    ap.add_argument("--mip-levels", type=int, default=1,
+                    help="L: with L > 1, the level against float64 too")
     ap.add_argument("--rotations", type=int, nargs="*", default=[0, 1, 4095, 16383])
     args = ap.parse_args(argv)
     gcfg = GlobeConfig(radius=args.radius, map_width=args.map_width,
-                       map_height=args.map_width // 2,
+                       map_height=args.map_width if args.square else args.map_width // 2,
                        pipeline=Config(angle_bits=args.angle_bits),
-                       frac_bits=args.frac_bits, guard_bits=args.guard_bits)
+                       frac_bits=args.frac_bits, guard_bits=args.guard_bits,
+                       mip_levels=args.mip_levels)
     x, y = disc_pixels(gcfg.radius)
     rots = [r % (1 << gcfg.angle_bits) for r in args.rotations]
     print(f"R = {gcfg.radius}, angle_bits = {gcfg.angle_bits}, W x H = {gcfg.map_width} x "
@@ -274,9 +282,17 @@ def main(argv=None):
     print(f"widths: I = {gcfg.int_bits}, root {gcfg.root_bits} bits ({gcfg.root_bits} "
           f"stages), CORDIC X/Y {gcfg.datapath_bits} bits signed, angle sum "
           f"{gcfg.angle_frac_bits} bits, v and theta ROMs "
-          f"{2 << gcfg.int_bits} x {gcfg.v_bits} and x {gcfg.angle_bits}; latency "
+          f"{2 << gcfg.int_bits} x {gcfg.v_bits + gcfg.level_bits * level_y_used(gcfg)} and "
+          f"x {gcfg.angle_bits}; latency "
           f"{gcfg.latency} (+{EDGE_LATENCY} with the unit's credit edge, FIFO depth "
           f"{min_fifo_depth(gcfg.latency)})")
+    if gcfg.mip_levels > 1:
+        print(f"level: L = {gcfg.mip_levels} ({gcfg.level_bits} bits), thresholds t_k "
+              f"{level_thresholds(gcfg)} (z = t_k / 2**F: "
+              f"{', '.join(f'{t / (1 << gcfg.fraction_bits):.2f}' for t in level_thresholds(gcfg))}"
+              f" pixels), y part "
+              + (f"in the v ROM's word ({gcfg.v_bits} + {gcfg.level_bits} bits)"
+                 if level_y_used(gcfg) else "not built"))
     b = error_bound_rad(gcfg)
     print(f"bound phi, lambda: {b:.3e} rad = {b * (1 << gcfg.angle_bits) / (2 * math.pi):.4f} "
           f"codes = {b * gcfg.map_width / (2 * math.pi):.4f} texels")
@@ -293,6 +309,12 @@ def main(argv=None):
                   f"{s['max_error_steps']:.4f} {unit} (bound {s['bound_rad']:.3e} rad = "
                   f"{s['bound_steps']:.4f}); {s['codes_differing']} pixels off by "
                   f"{s['codes_max_diff']} from float64")
+        if "level" in res:
+            lv = res["level"]
+            print(f"  level  {lv['differing']} pixels differ from float64 (one coarser, at a "
+                  f"threshold; {lv['pixels_at_threshold']} pixels have a root on a threshold); "
+                  f"pixels per level {lv['per_level']}; with du/dy in the footprint "
+                  f"{lv['cross_coarser']} pixels would be coarser, by up to {lv['cross_max']}")
         for v in res["violations"]:
             print("  VIOLATION:", v)
         ok &= not res["violations"]

@@ -288,7 +288,7 @@ def test_the_float_check_can_fail(monkeypatch):
     lx, ly = disc_pixels(LOD_WIDE.radius)
     monkeypatch.setattr(model, "globe_fixed", real)
     assert check_against_float(lx, ly, 0, LOD_WIDE)["violations"] == []
-    above = {t + 1 for t in level_thresholds(LOD_WIDE)}
+    above = {t + 1 for t in LOD_THRESHOLDS}
     roots = isqrt(np.maximum(LOD_WIDE.radius ** 2 - lx * lx - ly * ly, 0) << 8)
     for change in (lambda lv, _: np.minimum(lv + 1, 3), lambda lv, _: np.maximum(lv - 1, 0),
                    lambda lv, inside: np.where(inside & np.isin(roots, list(above)), lv + 1, lv)):
@@ -451,12 +451,17 @@ def exact_level(x, y, gcfg):
     return min(max(math.floor(math.log2(rho)), 0), L - 1)
 
 
+# The thresholds of LOD_WIDE and LOD_SQUARE, floor(W 2**F / (2 pi 2**k)) for W = 1024, F = 4:
+# 16384 / (4 pi) = 1303.8.., 651.9.., 325.9..
+LOD_THRESHOLDS = [1303, 651, 325]
+
+
 def threshold_pixels(gcfg):
-    """For each threshold t_k and each root t_k - 1, t_k, t_k + 1: the first pixel (x, y >= 0,
-    by rows from the centre) whose root floor(sqrt(R**2 - r**2) 2**F) (math.isqrt) is it;
-    {(k, offset): (x, y)}."""
+    """For each threshold t_k of LOD_THRESHOLDS and each root t_k - 1, t_k, t_k + 1: the
+    first pixel (x, y >= 0, by rows from the centre) whose root floor(sqrt(R**2 - r**2) 2**F)
+    (math.isqrt) is it; {(k, offset): (x, y)}."""
     R, F = gcfg.radius, gcfg.fraction_bits
-    want = {t + o: (k, o) for k, t in enumerate(level_thresholds(gcfg), 1) for o in (-1, 0, 1)}
+    want = {t + o: (k, o) for k, t in enumerate(LOD_THRESHOLDS, 1) for o in (-1, 0, 1)}
     found = {}
     for y in range(R):
         for x in range(R):
@@ -468,9 +473,9 @@ def threshold_pixels(gcfg):
 
 
 def test_level_thresholds_from_the_formula():
-    """t_k = floor(W 2**F / (2 pi 2**k)): W = 1024, F = 4 gives 16384 / (4 pi) = 1303.8..,
-    651.9.., 325.9..; the default F = 10 on a 2048-wide map 2**21 / (4 pi) = 166886.9.."""
-    assert level_thresholds(LOD_WIDE) == level_thresholds(LOD_SQUARE) == [1303, 651, 325]
+    """t_k = floor(W 2**F / (2 pi 2**k)): LOD_THRESHOLDS; the default F = 10 on a 2048-wide
+    map 2**21 / (4 pi) = 166886.9.."""
+    assert level_thresholds(LOD_WIDE) == level_thresholds(LOD_SQUARE) == LOD_THRESHOLDS
     assert level_thresholds(GlobeConfig(mip_levels=3)) == [166886, 83443]
     assert level_thresholds(GlobeConfig()) == []
 
@@ -537,16 +542,19 @@ def test_level_below_one_texel_is_zero():
 @pytest.mark.parametrize("gcfg", [
     LOD_WIDE, LOD_SQUARE, GlobeConfig(mip_levels=11),
     GlobeConfig(map_width=1024, map_height=1024, mip_levels=11),
-    GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5)],
-    ids=["wide", "square", "default-11", "square-11", "square-F5"])
+    GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5),
+    GlobeConfig(radius=26, map_width=256, map_height=128, mip_levels=4, frac_bits=4)],
+    ids=["wide", "square", "default-11", "square-11", "square-F5", "coarser"])
 def test_level_against_float(gcfg):
     """Over the disc and a ring outside: the level equals float64's (max of du/dx and dv/dy
     from float64 z and s) but one coarser where the root is on that level's threshold; on the
     2:1 maps the model has no y part and float64 does, so the y part never raising a 2:1
-    map's level is checked too."""
+    map's level is checked too. At R = 26 (W = 256, F = 4) some pixels have a root on a
+    threshold above the real one: their level is the coarser one."""
     x, y = disc_pixels(gcfg.radius)
     res = check_against_float(x, y, 0, gcfg)
     assert res["violations"] == [], res
+    assert (res["level"]["differing"] > 0) == (gcfg.radius == 26)
     per = res["level"]["per_level"]
     assert per[0] + per[1] > 0 and per[-1] + per[-2] > 0 or gcfg.mip_levels > 8
     if gcfg.frac_bits == 4:
