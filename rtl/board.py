@@ -57,16 +57,18 @@ from bumprtl.rtl.cache import scene_geometry
 from bumprtl.rtl.config import BumpError
 from bumprtl.rtl.flash import FlashLoader, spi_signature
 from bumprtl.rtl.globe import GlobeConfig, GlobeGeometry
+from bumprtl.rtl.pipe import RAM_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.scene import HardwareScene
 from bumprtl.rtl.sdram import SdramController, sdram_signature
+from bumprtl.rtl.targets import RegisteredRAM
 from bumprtl.rtl.tmds import CLOCK_WORD, Serializer, TMDSEncoder
 from bumprtl.rtl.video import VideoMode, VideoTiming
 
 __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "RasterSource",
            "register_slice",
            "PixelSource",
-           "GlobeSource", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
+           "GlobeSource", "DisplayBuffer", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
            "GLOBE_TURN_FRAMES",
            "GLOBE_RADIUS", "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
            "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider", "sdram_clock",
@@ -346,11 +348,72 @@ def _display_buffer(pipe_hz, entries):
     if pipe_hz is None:
         raise BumpError("display_buffer sits ahead of the clock crossing: it needs the "
                         "pipeline in its own clock domain (pipe_hz)", "display_buffer")
+    return _check_entries(entries)
+
+
+def _check_entries(entries):
     if isinstance(entries, bool) or not isinstance(entries, int) or entries < 2 \
             or entries & (entries - 1):
         raise BumpError(f"display_buffer must be a power of two >= 2, got {entries!r}",
                         "display_buffer")
     return entries
+
+
+class DisplayBuffer(Elaboratable):
+    """A FIFO of ``depth`` words (a power of two, at least 2) of ``width`` bits in block
+    RAM: BoardCore's ``display_buffer``, ahead of the clock crossing. It has
+    ``amaranth.lib.fifo``'s port names (``w_en``, ``w_data``, ``w_rdy``, ``r_en``,
+    ``r_data``, ``r_rdy``) and ``level``.
+
+    The memory is a :class:`~bumprtl.rtl.targets.RegisteredRAM` (on ECP5 DP16KD blocks read
+    through their output registers, so that no route from a block RAM spread over the die
+    ends in logic): a word is read from it RAM_LATENCY cycles after its address, into an
+    output queue of OUT_SLOTS words (a ``SyncFIFOBuffered`` beside the crossing). A read is
+    issued while the memory holds a word and the queue has room for it and for the reads in
+    flight, so the queue never overflows. A word holds its slot from the cycle after its
+    read's issue until it leaves the queue: its flight, the queue's memory and its output
+    register, RAM_LATENCY + 3 cycles when read at once, so that many slots let a word a
+    cycle through (one fewer loses cycles: tests/rtl/test_display_buffer.py). ``w_rdy`` is
+    one bit of the memory's count, a register. Never read, it holds ``depth`` + OUT_SLOTS
+    words."""
+
+    OUT_SLOTS = RAM_LATENCY + 3
+
+    def __init__(self, width, depth, target=None):
+        self.width, self.depth, self.target = width, _check_entries(depth), target
+        self.bits = depth.bit_length() - 1
+        self.w_en, self.w_rdy, self.w_data = Signal(), Signal(), Signal(width)
+        self.r_en, self.r_rdy, self.r_data = Signal(), Signal(), Signal(width)
+        self.level = Signal(range(depth + self.OUT_SLOTS + RAM_LATENCY + 1))
+        self.count = Signal(self.bits + 1, name="buffer_count")     # words in the memory
+
+    def elaborate(self, platform):
+        m, bits = Module(), self.bits
+        m.submodules.ram = ram = RegisteredRAM(self.depth, self.width, "display_buffer",
+                                               target=self.target)
+        m.submodules.out = out = SyncFIFOBuffered(width=self.width, depth=self.OUT_SLOTS)
+        wp = Signal(bits, name="buffer_write")
+        rp = Signal(bits, name="buffer_read")
+        stored = Signal(name="buffer_stored")                   # count != 0, a register
+        flight = Signal(RAM_LATENCY, name="buffer_flight")      # reads on their way
+        put = self.w_en & self.w_rdy
+        in_flight = sum(flight[k] for k in range(RAM_LATENCY))
+        issue = stored & (out.level + in_flight < self.OUT_SLOTS)
+        m.d.comb += [self.w_rdy.eq(~self.count[bits]),
+                     ram.w_en.eq(put), ram.w_addr.eq(wp), ram.w_data.eq(self.w_data),
+                     ram.en.eq(1), ram.r_addr.eq(rp),
+                     out.w_en.eq(flight[-1]), out.w_data.eq(ram.r_data),
+                     out.r_en.eq(self.r_en), self.r_rdy.eq(out.r_rdy),
+                     self.r_data.eq(out.r_data),
+                     self.level.eq(self.count + in_flight + out.level)]
+        m.d.sync += [wp.eq(wp + put), rp.eq(rp + issue),
+                     self.count.eq(self.count + put - issue),
+                     flight.eq(Cat(issue, flight[:-1]))]
+        with m.If(put & ~issue):
+            m.d.sync += stored.eq(1)
+        with m.Elif(issue & ~put):
+            m.d.sync += stored.eq(self.count != 1)
+        return m
 
 
 class BoardCore(Elaboratable):
@@ -369,10 +432,10 @@ class BoardCore(Elaboratable):
         (at least the mode's pixel clock) runs them in their own domain ``pipe`` behind an
         :class:`~amaranth.lib.fifo.AsyncFIFO` of :func:`cdc_depth` entries into ``sync``;
         ``display_buffer`` (a power of two, at least 2; None: none) adds a
-        :class:`~amaranth.lib.fifo.SyncFIFOBuffered` of that many entries in ``pipe``
-        between the pipeline and the crossing: more pixels held ahead of the display, for
-        a map in the SDRAM whose misses come in bursts (the pixel and the tag only, not the
-        pipeline's whole payload).
+        :class:`DisplayBuffer` of that many entries in ``pipe`` between the pipeline and
+        the crossing: more pixels held ahead of the display, for a map in the SDRAM whose
+        misses come in bursts (the pixel and the tag only, not the pipeline's whole
+        payload).
         ``globe``: a turning globe (:class:`GlobeSource`, :func:`globe_config`) instead of
         the plane; ``constants`` is then unused. ``sdram`` (an
         :class:`~bumprtl.rtl.sdram.SdramConfig`) and ``flash`` (a
@@ -394,6 +457,7 @@ class BoardCore(Elaboratable):
         self.pipe_hz = pipe_hz
         self.cdc_depth = None if pipe_hz is None else cdc_depth(mode.pixel_hz, pipe_hz)
         self.display_buffer = _display_buffer(pipe_hz, display_buffer)
+        self.target = target
         self.pipeline = BumpPipeline(scene, init=words, texture=texels, target=target,
                                      fifo_depth=buffer_depth if depth is None else depth)
         self.scene = self.pipeline.scene
@@ -471,8 +535,8 @@ class BoardCore(Elaboratable):
                                                w_domain="pipe", r_domain="sync")
             valid, data, ready = p.o.valid, Cat(rgb, o.tag), p.o.ready
             if self.display_buffer is not None:     # more pixels ahead, in the pipe domain
-                buf = DomainRenamer("pipe")(SyncFIFOBuffered(width=len(data),
-                                                             depth=self.display_buffer))
+                buf = DomainRenamer("pipe")(DisplayBuffer(len(data), self.display_buffer,
+                                                          self.target))
                 m.submodules.display_buffer = buf
                 m.d.comb += [buf.w_data.eq(data), buf.w_en.eq(valid), ready.eq(buf.w_rdy)]
                 valid, data, ready = buf.r_rdy, buf.r_data, buf.r_en

@@ -437,8 +437,7 @@ def bram_budget(scene, mode, device, display_buffer=None):
             "buffer": bram_blocks(p.fifo_depth, len(p.o.payload.as_value()))}
     if display_buffer is not None:    # its words: the grey byte or RGB, the tag
         width = (24 if scene.texture else 8) + scene.tag_bits
-        # (SyncFIFOBuffered: a memory of one entry fewer, and its output register)
-        need["display buffer"] = bram_blocks(display_buffer - 1, width)
+        need["display buffer"] = bram_blocks(display_buffer, width)
     if surface(scene) == "sphere":
         g = globe_config(scene.hardware, mode)
         need["globe"] = bram_blocks(2 << g.int_bits, g.v_bits) + bram_blocks(2 << g.int_bits,
