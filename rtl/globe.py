@@ -242,11 +242,12 @@ def level_of(rho, levels):
 
 
 def level_thresholds(gcfg: GlobeConfig):
-    """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(W 2**F / (2 pi
-    2**k))`` (float64), the largest root ``z_fix = floor(z 2**F)`` with ``W / (2 pi z) >=
-    2**k`` but for a root within one unit of the real threshold (then the level is one
-    coarser than the exact one); decreasing in k. The x part's level is the count of k
-    with ``z_fix <= t_k``: the RTL's comparisons and the model's."""
+    """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(T_k 2**F)``
+    (float64) with ``T_k = W / (2 pi 2**k)``, the z at or below which ``W / (2 pi z) >=
+    2**k``; decreasing in k. The x part's level is the count of k with ``z_fix <= t_k``
+    (``z_fix = floor(z 2**F)``, the unit's root): the RTL's comparisons and the model's.
+    That holds wherever ``z <= T_k``, and also where z is above T_k by less than ``2**-F``
+    with the same root, where the level is one coarser than the exact one."""
     w, f = gcfg.map_width, gcfg.fraction_bits
     return [math.floor(w * 2.0 ** f / (2 * math.pi * 2.0 ** k))
             for k in range(1, gcfg.mip_levels)]
