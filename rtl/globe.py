@@ -28,9 +28,11 @@ Method, one register stage per step, fixed latency, one pixel a clock:
   float64 contents): they depend on y alone;
 * with ``mip_levels`` L > 1, the mip ``level`` of the texel footprint: ``rho = max(du/dx,
   dv/dy)`` with ``du/dx = W / (2 pi z)`` and ``dv/dy = H / (pi s)``, ``s = sqrt(R**2 -
-  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part copies the root
-  into a register of its own, compares it with the constants of :func:`level_thresholds`
-  the next stage and counts the comparisons the stage after that; the y part
+  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part counts the
+  constants of :func:`level_thresholds` the root is at or below: the stage after the
+  radicand ``d = R**2 - r**2`` compares d with their form on it
+  (:func:`level_radicand_limits`), the next counts, and the count rides beside the root
+  and the CORDIC chain; the y part
   (:func:`level_y_table`, float64 contents, only where it can raise the level: W = H)
   rides in spare bits of the v ROM's word; the larger of the two is taken at the output.
   The latency does not change.
@@ -53,7 +55,8 @@ from bumprtl.rtl.layouts import polar_layout
 from bumprtl.rtl.pipe import PRODUCT_LATENCY, ROM_LATENCY, PipeUnit
 
 __all__ = ["GlobeConfig", "GlobeGeometry", "cordic_angles", "v_table", "theta_table",
-           "level_thresholds", "level_y_table", "level_y_used", "level_of", "latitude_words",
+           "level_thresholds", "level_radicand_limits", "level_y_table", "level_y_used",
+           "level_of", "latitude_words",
            "globe_in_layout", "globe_out_layout", "RADIUS_RANGE", "MAP_WIDTH_RANGE",
            "FRAC_BITS_RANGE", "GUARD_BITS_RANGE", "COORD_BITS_MAX", "DATAPATH_BITS",
            "sqrt_stages", "cordic_stages", "fit_signed", "phi_offset"]
@@ -242,14 +245,24 @@ def level_of(rho, levels):
 
 
 def level_thresholds(gcfg: GlobeConfig):
-    """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(W 2**F / (2 pi
-    2**k))`` (float64), the largest root ``z_fix = floor(z 2**F)`` with ``W / (2 pi z) >=
-    2**k`` but for a root within one unit of the real threshold (then the level is one
-    coarser than the exact one); decreasing in k. The x part's level is the count of k
-    with ``z_fix <= t_k``: the RTL's comparisons and the model's."""
+    """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(T_k 2**F)``
+    (float64) with ``T_k = W / (2 pi 2**k)``, the z at or below which ``W / (2 pi z) >=
+    2**k``; decreasing in k. The x part's level is the count of k with ``z_fix <= t_k``
+    (``z_fix = floor(z 2**F)``, the unit's root): the RTL's comparisons and the model's.
+    That holds wherever ``z <= T_k``, and also where z is above T_k by less than ``2**-F``
+    with the same root, where the level is one coarser than the exact one."""
     w, f = gcfg.map_width, gcfg.fraction_bits
     return [math.floor(w * 2.0 ** f / (2 * math.pi * 2.0 ** k))
             for k in range(1, gcfg.mip_levels)]
+
+
+def level_radicand_limits(gcfg: GlobeConfig):
+    """The RTL's form of :func:`level_thresholds`, on the root's radicand ``d = R**2 - r**2``
+    rather than the root: ``c_k = ((t_k + 1)**2 - 1) >> 2F``, the largest d with
+    ``floor(sqrt(d 2**(2F))) <= t_k`` (that is ``d 2**(2F) < (t_k + 1)**2``), so ``d <= c_k``
+    exactly when ``z_fix <= t_k``."""
+    shift = 2 * gcfg.fraction_bits
+    return [((t + 1) ** 2 - 1) >> shift for t in level_thresholds(gcfg)]
 
 
 def level_y_table(gcfg: GlobeConfig):
@@ -488,15 +501,14 @@ class GlobeGeometry(PipeUnit):
             o.tag.eq(pipe.delay(p.tag, self.latency, "tag")),
         ]
         if g.mip_levels > 1:
-            # the x part: z copied into a register of its own (the root's bits also drive the
-            # CORDIC's first stage, and its last bit is the complement of a remainder's sign),
-            # against each threshold the next stage (one carry chain each), their count the
-            # next, then carried to the output stage beside v's word
-            z_level = pipe.register(z_root, "z_level")
-            below = [pipe.register(z_level <= t, f"level_below{k}")
-                     for k, t in enumerate(level_thresholds(g), 1)]
+            # the x part: z_fix <= t_k as the radicand against its limit (the root's bits,
+            # which drive the CORDIC's first stage, take no more load), the stage after d (one
+            # carry chain each), their count the next, then carried beside the root and the
+            # CORDIC chain to the output stage
+            below = [pipe.register(d <= c, f"level_below{k}")
+                     for k, c in enumerate(level_radicand_limits(g), 1)]
             level = pipe.register(_count(below)[:g.level_bits], "level_x")
-            level = pipe.delay(level, chain - 2, "level_x")
+            level = pipe.delay(level, g.root_bits + chain - 1, "level_x")
             if level_y:
                 word = v_word[g.v_bits:]
                 level = Mux(word > level, word, level)

@@ -3,7 +3,8 @@ equals bit for bit (:func:`globe_fixed`), the float64 reference (:func:`globe_fl
 derived bound between their angles (:func:`error_bound_rad`).
 
 ``python -m bumprtl.sim.golden.globe`` measures the model against float64 over every pixel of
-the disc (and the rim's neighbours) at a few rotations and prints the bound beside it.
+the disc (and the rim's neighbours) at a few rotations and prints the bound beside it; with
+``--mip-levels`` L > 1 the mip level too (``--square`` for a W = H map).
 """
 
 import argparse

@@ -19,6 +19,7 @@ from bumprtl.rtl.globe import (
     GlobeGeometry,
     fit_signed,
     globe_out_layout,
+    level_radicand_limits,
     level_thresholds,
     level_y_used,
     sqrt_stages,
@@ -478,6 +479,21 @@ def test_level_thresholds_from_the_formula():
     assert level_thresholds(LOD_WIDE) == level_thresholds(LOD_SQUARE) == LOD_THRESHOLDS
     assert level_thresholds(GlobeConfig(mip_levels=3)) == [166886, 83443]
     assert level_thresholds(GlobeConfig()) == []
+
+
+def test_level_radicand_limits_are_the_thresholds_on_the_radicand():
+    """The RTL compares the radicand d with c_k where the model compares the root with t_k:
+    c_k is the largest d whose root floor(sqrt(d 2**(2F))) (math.isqrt) is at most t_k. A
+    4096-wide map at F = 4 has t_1 = floor(2**15 / (2 pi)) = 5215, t_1 + 1 a multiple of
+    2**F: there (t_1 + 1)**2 is a whole d 2**(2F), whose root is t_1 + 1."""
+    edge = GlobeConfig(map_width=4096, map_height=2048, frac_bits=4, mip_levels=2)
+    assert level_thresholds(edge) == [5215] and level_radicand_limits(edge) == [106275]
+    for g in (LOD_WIDE, edge, GlobeConfig(mip_levels=11), GlobeConfig(radius=2047, mip_levels=11),
+              GlobeConfig(radius=3, map_width=32768, map_height=16384, frac_bits=20,
+                          mip_levels=15)):
+        f = g.fraction_bits
+        for t, c in zip(level_thresholds(g), level_radicand_limits(g), strict=True):
+            assert math.isqrt(c << 2 * f) <= t < math.isqrt((c + 1) << 2 * f)
 
 
 @pytest.mark.parametrize("gcfg", [LOD_WIDE, LOD_SQUARE], ids=["wide", "square"])
