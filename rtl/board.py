@@ -68,7 +68,7 @@ from bumprtl.rtl.video import VideoMode, VideoTiming
 __all__ = ["texel_coords", "buffer_depth", "BUFFER_MARGIN", "payload_field", "RasterSource",
            "register_slice",
            "PixelSource",
-           "GlobeSource", "DisplayBuffer", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
+           "GlobeSource", "DisplayBuffer", "ar_queue", "globe_config", "globe_offsets", "globe_turn_step", "globe_rotation",
            "GLOBE_TURN_FRAMES",
            "GLOBE_RADIUS", "BoardCore", "ULX3STop", "SimTop", "pll_params", "pll_dividers", "pll_clock",
            "cdc_depth", "CDC_SYNC_STAGES", "pll_pipe_divider", "sdram_clock",
@@ -359,6 +359,34 @@ def _check_entries(entries):
     return entries
 
 
+AR_FIELDS = ("arid", "araddr", "arlen", "arsize", "arburst")
+
+
+def ar_queue(m, manager, subordinate, depth, name="ar_queue", domain="sync"):
+    """Join an AXI4 read ``manager`` port to a ``subordinate`` (rtl/cache.axi_read_signature)
+    through a queue of ``depth`` read addresses (a ``SyncFIFOBuffered`` in ``domain``,
+    submodule ``name``),
+    the R channel straight through: the manager's bursts are taken while the queue has
+    room, and the subordinate serves them one after another. The SDRAM controller takes an
+    AR only once its burst before is issued, and the texel cache looks up no pixel while
+    its AR waits, so without the queue the cache could run at most one miss ahead of the
+    SDRAM; with ``depth`` at least the cache's bursts outstanding it never waits for one."""
+    width = sum(len(getattr(manager, f)) for f in AR_FIELDS)
+    m.submodules[name] = q = DomainRenamer(domain)(SyncFIFOBuffered(width=width, depth=depth))
+    m.d.comb += [q.w_data.eq(Cat(*(getattr(manager, f) for f in AR_FIELDS))),
+                 q.w_en.eq(manager.arvalid), manager.arready.eq(q.w_rdy),
+                 subordinate.arvalid.eq(q.r_rdy), q.r_en.eq(subordinate.arready)]
+    at = 0
+    for f in AR_FIELDS:
+        n = len(getattr(manager, f))
+        m.d.comb += getattr(subordinate, f).eq(q.r_data[at:at + n])
+        at += n
+    m.d.comb += [manager.rid.eq(subordinate.rid), manager.rdata.eq(subordinate.rdata),
+                 manager.rresp.eq(subordinate.rresp), manager.rlast.eq(subordinate.rlast),
+                 manager.rvalid.eq(subordinate.rvalid), subordinate.rready.eq(manager.rready)]
+    return q
+
+
 class DisplayBuffer(Elaboratable):
     """A FIFO of ``depth`` words (a power of two, at least 2) of ``width`` bits in block
     RAM: BoardCore's ``display_buffer``, ahead of the clock crossing. It has
@@ -498,7 +526,9 @@ class BoardCore(Elaboratable):
             inner["sdram"] = self.controller
             if self.loader is not None:
                 inner["flash_loader"] = self.loader
-            wiring.connect(m, p.axi, self.controller.rd)
+            # the cache's bursts queue in front of the controller
+            ar_queue(m, p.axi, self.controller.rd, scene_geometry(self.scene).misses,
+                     domain="pipe")
             if self.loader is not None:
                 wiring.connect(m, self.loader.axi, self.controller.wr)
             wiring.connect(m, self.controller.sdram, self.sdram_pins)

@@ -158,8 +158,11 @@ def run(args):
             print(f"frame {step} (light step {step}): {'identical to the golden frame' if same else 'DIFFERS from the golden frame'}")
         for e in r["timing_errors"]:
             print(f"timing: {e}")
+        at = r.get("underflow_at", [-1, -1, -1])
+        first = (f" (first in the display's frame {at[0]}, line {at[1]}, column {at[2]})"
+                 if r["underflow"] and at[0] >= 0 else "")
         print(f"sync/blanking: {'as the VESA table' if not r['timing_errors'] else 'WRONG'}"
-              f"; underflow {r['underflow']}, order error {r['order_error']}; "
+              f"; underflow {r['underflow']}{first}, order error {r['order_error']}; "
               f"Verilator build {r['build_s']:.1f} s, simulation {r['run_s']:.1f} s")
         png = save_png(out / f"frame0_{mode.name}.png", r["captured"][0])
         print(f"wrote {png}")

@@ -272,18 +272,24 @@ class DisplayBudget:
 
 
 def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clocks,
-                   rows=None):
+                   rows=None, queue=None):
     """Whether the display is fed (:class:`DisplayBudget`), from ``miss`` (per active pixel
     of ``rows``, :func:`frame_misses`) and the design's numbers: the pipeline's
-    ``latency`` and elastic buffer ``depth`` (credits), the clock crossing's ``cdc``
-    entries, a cache line's SDRAM read ``line_cost`` (pipe clocks a line when reads follow
+    ``latency`` and elastic buffer ``depth``, the ``cdc`` entries after it (the display
+    buffer's and the clock crossing's), the texel cache's ``queue`` (None: no bound), a
+    cache line's SDRAM read ``line_cost`` (pipe clocks a line when reads follow
     back to back, a new row each: sim/sdram_bench.bandwidth's ``miss`` x 4) and
     ``fill_clocks`` (an isolated miss's pixel leaves the cache that long after its lookup).
 
     The model, in pipe clocks (``r`` = pipe / pixel clock): the display wants active pixel
     k of line y, column x at r (y h_total + x); pixel k enters the pipeline when the
     display has taken pixel k - ahead (ahead = depth + cdc; the buffers full at the rows'
-    start); a hit leaves the cache CACHE_LATENCY after it enters; the SDRAM reads the
+    start) and pixel k - queue has left the cache, at the earliest F_i + (k - queue - k_i)
+    + 1 for miss i the last at or before that pixel (the pixels behind a miss leave a
+    clock apart): the cache looks up no pixel further ahead than its queue, so a miss
+    further than that behind the one before is not even requested until the pixels
+    between have left; a hit leaves the cache CACHE_LATENCY after it enters; the
+    SDRAM reads the
     missed lines one after another, miss j's pixel leaving at F_j = max(F_{j-1} +
     line_cost, its entry + fill_clocks); from the cache to the display's side it takes
     latency - CACHE_LATENCY more, and the crossing 2 + CDC_SYNC_STAGES pipe and 3 +
@@ -305,8 +311,17 @@ def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clo
                                        + before % mode.h_active), -np.inf)
     slack, worst, done = steady, None, -np.inf
     after = latency - CACHE_LATENCY + cross
+    back = k - (len(miss.ravel()) + 1 if queue is None else queue)  # its queue's room
+    last = np.searchsorted(k, back, side="right") - 1    # the last miss at or before it
+    done_at = np.empty(len(k))
+    post = 1
     for j in range(len(k)):
-        done = max(done + line_cost, enter[j] + fill_clocks)
+        e = enter[j]
+        i = last[j]
+        if back[j] >= 0 and i >= 0:
+            e = max(e, done_at[i] + (back[j] - k[i]) + post)
+        done = max(done + line_cost, e + fill_clocks)
+        done_at[j] = done
         late = want[j] - (done + after)
         if late < slack:
             slack, worst = late, (rows.start + int(line[j]), int(col[j]))
@@ -315,7 +330,7 @@ def display_budget(miss, mode, pipe_hz, latency, depth, cdc, line_cost, fill_clo
 
 
 def _budget_design(scene, mode, pipe_hz, line_cost, fill_clocks):
-    """(pipe_hz, line_cost, fill_clocks, latency, depth) for :func:`display_budget`."""
+    """(pipe_hz, line_cost, fill_clocks, latency, depth, queue) for :func:`display_budget`."""
     pipe_hz = sdram_clock(mode.pixel_hz, (DEFAULT_PIPE_MHZ * 1e6) if pipe_hz is None else pipe_hz)
     geom = scene_geometry(scene.hardware)
     if line_cost is None or fill_clocks is None:
@@ -331,7 +346,7 @@ def _budget_design(scene, mode, pipe_hz, line_cost, fill_clocks):
         latency, depth = pipeline.latency, pipeline.fifo_depth
         del pipeline
         gc.collect()
-    return pipe_hz, line_cost, fill_clocks, latency, depth
+    return pipe_hz, line_cost, fill_clocks, latency, depth, geom.queue
 
 
 def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks=None,
@@ -339,15 +354,15 @@ def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks
     """:func:`display_budget` of ``scene`` (its map in the SDRAM) in ``mode``, frame
     ``frame``: the pipe clock and SdramConfig as :func:`board_memory` makes them (the PLL's
     nearest at or below ``pipe_hz``; None: DEFAULT_PIPE_MHZ), the pipeline's latency and
-    depth as BoardCore builds it, the clock crossing's entries (rtl/board.cdc_depth) and
-    the ``display_buffer``'s ahead of it (None: none); ``line_cost`` and ``fill_clocks`` (None: measured on the
+    depth as BoardCore builds it, the texel cache's queue, the clock crossing's entries
+    (rtl/board.cdc_depth) and the ``display_buffer``'s ahead of it (None: none); ``line_cost`` and ``fill_clocks`` (None: measured on the
     controller and the SDRAM model by sim/sdram_bench.bandwidth, a few seconds: ``miss`` x
     line bytes / 16, and ``miss_latency`` + beats + 2, rtl/cache's miss path)."""
-    pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
-                                                                     line_cost, fill_clocks)
+    pipe_hz, line_cost, fill_clocks, latency, depth, queue = _budget_design(
+        scene, mode, pipe_hz, line_cost, fill_clocks)
     cdc = cdc_depth(mode.pixel_hz, pipe_hz) + (display_buffer or 0)
     return display_budget(frame_misses(scene, mode, frame, rows, warm), mode, pipe_hz,
-                          latency, depth, cdc, line_cost, fill_clocks, rows)
+                          latency, depth, cdc, line_cost, fill_clocks, rows, queue)
 
 
 def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
@@ -358,13 +373,13 @@ def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
     (the cache as frame 0 left it) keep the display fed. Returns (entries, [frame 0's,
     frame 1's DisplayBudget]); when none holds, MAX_DISPLAY_BUFFER and its budgets
     (``holds`` False). Arguments as :func:`predict_display`'s."""
-    pipe_hz, line_cost, fill_clocks, latency, depth = _budget_design(scene, mode, pipe_hz,
-                                                                     line_cost, fill_clocks)
+    pipe_hz, line_cost, fill_clocks, latency, depth, queue = _budget_design(
+        scene, mode, pipe_hz, line_cost, fill_clocks)
     misses = [frame_misses(scene, mode, 0, warm=False), frame_misses(scene, mode, 1)]
     cdc, entries = cdc_depth(mode.pixel_hz, pipe_hz), None
     while True:
         budgets = [display_budget(m, mode, pipe_hz, latency, depth, cdc + (entries or 0),
-                                  line_cost, fill_clocks) for m in misses]
+                                  line_cost, fill_clocks, queue=queue) for m in misses]
         if all(b.holds for b in budgets) or entries == MAX_DISPLAY_BUFFER:
             return entries, budgets
         entries = MIN_DISPLAY_BUFFER if entries is None else 2 * entries
@@ -719,6 +734,8 @@ def check_frames(scene, mode, out_dir, frames=2, data=None, opt_fast=None, pipe_
     return {"captured": captured, "golden": golden, "same": same, "first": first,
             "timing_errors": [str(e) for e in res["timing_errors"]],
             "underflow": int(res["underflow"]), "order_error": int(res["order_error"]),
+            # the display's first underflow (frame shown, line, column; -1s: none seen)
+            "underflow_at": [int(x) for x in res.get("underflow_at", [-1, -1, -1])],
             "run_s": run_s, "build_s": build_s, "seconds": time.perf_counter() - t0}
 
 

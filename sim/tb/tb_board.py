@@ -46,6 +46,7 @@ import cocotb
 import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotb.utils import get_sim_time
 from cocotbext.dvi import DVIBus, DVISink
 
 from bumprtl.sim.flash_model import SpiFlash
@@ -183,6 +184,17 @@ class Memories:
             dut.spi__miso.value = miso
 
 
+async def underflow_watch(dut, period, htot, vtot, where):
+    """From the display's first pixel on: where (frame shown, line, column) the sticky
+    ``underflow`` rises, into ``where``."""
+    start = get_sim_time("ps")
+    await RisingEdge(dut.underflow)
+    clocks = int(get_sim_time("ps") - start) // period
+    frame, rest = divmod(clocks, htot * vtot)
+    where.extend([frame, rest // htot, rest % htot])
+    dut._log.info(f"underflow in frame {frame}, line {rest // htot}, column {rest % htot}")
+
+
 @cocotb.test()
 async def board_frames(dut):
     timing = [int(x) for x in os.environ["BOARD_TIMING"].split(",")]
@@ -211,6 +223,7 @@ async def board_frames(dut):
         if not (preloaded and r is dut.rst):
             r.value = 0
     first = 0
+    where = []                 # the display's first underflow: frame, line, column
     if preloaded:
         # The map is in the SDRAM from the start: the source starts once the controller's
         # initialisation is done. The display's (pixel) domain stays in reset until then
@@ -236,6 +249,7 @@ async def board_frames(dut):
             waited += 1
         assert not memories.errors, memories.errors
         assert waited <= limit, f"the display did not start in {limit} pixel clocks"
+        cocotb.start_soon(underflow_watch(dut, period, htot, vtot, where))
         # at its first pixel (x = 0 of line 0): on to the first front-porch line, below
         await ClockCycles(dut.clk, va * htot)
         first = 1
@@ -287,4 +301,5 @@ async def board_frames(dut):
                 errors.append(f"flash: {len(reads)} READ commands, expected the one copy: {reads}")
     np.savez(os.environ["BOARD_RESULT"], **arrays, timing_errors=np.array(errors, dtype=str),
              underflow=int(dut.underflow.value), order_error=int(dut.order_error.value),
-             samples=len(rec["de"]), first=first)
+             samples=len(rec["de"]), first=first,
+             underflow_at=np.array(where[:3] if where else [-1, -1, -1]))

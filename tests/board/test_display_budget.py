@@ -157,3 +157,38 @@ def board_core_with(scene, mode, entries, pipe_hz=True):
     words, texels, constants, table = board_data(scene)
     return BoardCore(scene.hardware, mode, words, constants, table[:2], texels,
                      pipe_hz=2 * mode.pixel_hz if pipe_hz else None, display_buffer=entries)
+
+
+def _model(miss, rows, ahead, queue):
+    """The documented model written out pixel by pixel (display_budget's docstring):
+    every pixel's entry and exit, not only the misses'."""
+    r, after = 1.25, 36 - 12 + 4 + 5 * 1.25
+    flat = miss.ravel()
+    n = len(flat)
+    k = np.arange(n)
+    shown = r * ((rows.start + k // MODE.h_active) * MODE.h_total + k % MODE.h_active)
+    leave, served, slack = np.zeros(n), -np.inf, r * ahead - 36 - after - 12
+    for p in range(n):
+        e = shown[p - ahead] if p >= ahead else -np.inf
+        if queue is not None and p >= queue:        # its slot frees the cycle after
+            e = max(e, leave[p - queue] + 1)
+        if flat[p]:
+            served = max(served + LINE_COST, e + FILL)
+            leave[p] = served
+            slack = min(slack, shown[p] - (served + after))
+        else:                                 # a hit: a clock after the pixel before
+            leave[p] = max(e + 12, leave[p - 1] + 1 if p else -np.inf)
+    return slack
+
+
+@pytest.mark.parametrize("queue", [None, 64])
+def test_the_budget_is_the_documented_model_with_the_caches_queue(queue):
+    # random misses (5 % of ten lines), the buffers 244 pixels: display_budget against the
+    # model written out pixel by pixel above
+    rows = range(100, 110)
+    miss = np.random.default_rng(0).random((10, MODE.h_active)) < 0.05
+    got = display_budget(miss, MODE, PIPE_HZ, 36, 44, 200, LINE_COST, FILL, rows, queue)
+    assert got.slack == pytest.approx(_model(miss, rows, 244, queue))
+    if queue is not None:                     # a miss further ahead waits: later still
+        free = display_budget(miss, MODE, PIPE_HZ, 36, 44, 200, LINE_COST, FILL, rows)
+        assert got.slack < free.slack - 100
