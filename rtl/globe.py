@@ -28,7 +28,8 @@ Method, one register stage per step, fixed latency, one pixel a clock:
   float64 contents): they depend on y alone;
 * with ``mip_levels`` L > 1, the mip ``level`` of the texel footprint: ``rho = max(du/dx,
   dv/dy)`` with ``du/dx = W / (2 pi z)`` and ``dv/dy = H / (pi s)``, ``s = sqrt(R**2 -
-  y**2)``, and ``level = clamp(floor(log2 rho), 0, L - 1)``. The x part counts the
+  y**2)``, and ``level`` = log2 rho rounded to the nearest level, clamped to [0, L - 1]
+  (:func:`level_of`, OpenGL's nearest-mipmap rule). The x part counts the
   constants of :func:`level_thresholds` the root is at or below: the stage after the
   radicand ``d = R**2 - r**2`` compares d with their form on it
   (:func:`level_radicand_limits`), the next counts, and the count rides beside the root
@@ -234,25 +235,32 @@ def theta_table(gcfg: GlobeConfig):
     return _rows(gcfg, lambda y: round(math.acos(y / r) * (full / (2 * math.pi))) & (full - 1))
 
 
+# rho at which level k starts: 2**(k - 1/2) (rounding log2 rho to the nearest level)
+LEVEL_STEP = [2.0 ** (k - 0.5) for k in range(16)]
+
+
 def level_of(rho, levels):
-    """The mip level of a footprint of ``rho`` texels a pixel: ``clamp(floor(log2 rho), 0,
-    levels - 1)``, as the count of k in 1 .. levels - 1 with ``rho >= 2**k`` (exact on
-    float64, no logarithm rounded). Floats and numpy arrays alike (an int64 array back)."""
+    """The mip level of a footprint of ``rho`` texels a pixel: log2 rho rounded to the
+    nearest level, clamped to [0, levels - 1] (OpenGL's nearest-mipmap rule: level 0 up to
+    lambda = log2 rho = 1/2, then ceil(lambda + 1/2) - 1), as the count of k in 1 ..
+    levels - 1 with ``rho >= 2**(k - 1/2)`` (no logarithm rounded; 2**(k - 1/2) is never
+    a float64's exact value of rho in practice, so >= and > agree). Floats and numpy
+    arrays alike (an int64 array back)."""
     if isinstance(rho, np.ndarray):
-        return sum(((rho >= 2.0 ** k).astype(np.int64) for k in range(1, levels)),
+        return sum(((rho >= LEVEL_STEP[k]).astype(np.int64) for k in range(1, levels)),
                    np.zeros(rho.shape, np.int64))
-    return sum(1 for k in range(1, levels) if rho >= 2.0 ** k)
+    return sum(1 for k in range(1, levels) if rho >= LEVEL_STEP[k])
 
 
 def level_thresholds(gcfg: GlobeConfig):
     """The x part's constants, for k = 1 .. mip_levels - 1: ``t_k = floor(T_k 2**F)``
-    (float64) with ``T_k = W / (2 pi 2**k)``, the z at or below which ``W / (2 pi z) >=
-    2**k``; decreasing in k. The x part's level is the count of k with ``z_fix <= t_k``
+    (float64) with ``T_k = W / (2 pi 2**(k - 1/2))``, the z at or below which ``W / (2 pi
+    z) >= 2**(k - 1/2)`` (:func:`level_of`'s rule); decreasing in k. The x part's level is the count of k with ``z_fix <= t_k``
     (``z_fix = floor(z 2**F)``, the unit's root): the RTL's comparisons and the model's.
     That holds wherever ``z <= T_k``, and also where z is above T_k by less than ``2**-F``
     with the same root, where the level is one coarser than the exact one."""
     w, f = gcfg.map_width, gcfg.fraction_bits
-    return [math.floor(w * 2.0 ** f / (2 * math.pi * 2.0 ** k))
+    return [math.floor(w * 2.0 ** f / (2 * math.pi * LEVEL_STEP[k]))
             for k in range(1, gcfg.mip_levels)]
 
 

@@ -218,7 +218,7 @@ def check_against_float(x, y, rotation, gcfg: GlobeConfig):
 
 def _check_level(x, y, fixed, ref, gcfg: GlobeConfig, bad):
     """The level's rule: the model's equals float64's except one coarser, k, where the root
-    ``floor(z 2**F)`` (exact) is ``floor(W 2**F / (2 pi 2**k))`` (the real z within one
+    ``floor(z 2**F)`` (exact) is ``floor(W 2**F / (2 pi 2**(k - 1/2)))`` (the real z within one
     unit above the real threshold; made here from the formula, not taken from the unit's
     :func:`level_thresholds`, so that a wrong constant shows); the y part comes from a table
     of the same float64 values, so no other difference is allowed. Appends to ``bad``;
@@ -228,7 +228,7 @@ def _check_level(x, y, fixed, ref, gcfg: GlobeConfig, bad):
     d = R * R - x * x - y * y
     inside = d > 0
     root = isqrt(np.where(inside, d, 0) << (2 * F))
-    t = np.floor(W * 2.0 ** F / (2 * np.pi * 2.0 ** np.arange(L))).astype(np.int64)
+    t = np.floor(W * 2.0 ** F / (2 * np.pi * 2.0 ** (np.arange(L) - 0.5))).astype(np.int64)
     t[0] = -1                                                    # no threshold for level 0
     diff = fixed - ref
     at_threshold = inside & np.isin(root, t[1:])

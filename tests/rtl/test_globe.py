@@ -43,10 +43,10 @@ SMALL = Config(angle_bits=10, frac_bits=9, tag_bits=8)
 # Globes with four mip levels and F = 4 (coarse roots: at R = 88 some pixel's root is each
 # threshold and one unit either side of it), on a 2:1 map (the x part alone decides) and a
 # square map (the y part's table raises it)
-LOD = {"radius": 88, "map_width": 1024, "pipeline": SMALL, "coord_bits": 8, "frac_bits": 4,
+LOD = {"radius": 88, "map_width": 512, "pipeline": SMALL, "coord_bits": 8, "frac_bits": 4,
        "mip_levels": 4}
-LOD_WIDE = GlobeConfig(map_height=512, **LOD)
-LOD_SQUARE = GlobeConfig(map_height=1024, **LOD)
+LOD_WIDE = GlobeConfig(map_height=256, **LOD)
+LOD_SQUARE = GlobeConfig(map_height=512, **LOD)
 
 
 def rim_pixels(radius, limit=None):
@@ -442,19 +442,20 @@ def test_fit_signed_extends_by_signedness_and_truncates_to_the_low_bits(value, w
 
 
 def exact_level(x, y, gcfg):
-    """The level from the formula, in floats apart from either model: clamp(floor(log2
-    max(W / (2 pi z), H / (pi s))), 0, L - 1), 0 outside."""
+    """The level from the formula, in floats apart from either model: log2 max(W / (2 pi
+    z), H / (pi s)) rounded to the nearest whole level (OpenGL's nearest mipmap),
+    clamped to [0, L - 1], 0 outside."""
     R, W, H, L = gcfg.radius, gcfg.map_width, gcfg.map_height, gcfg.mip_levels
     if x * x + y * y >= R * R:
         return 0
     z, s = math.sqrt(R * R - x * x - y * y), math.sqrt(R * R - y * y)
     rho = max(W / (2 * math.pi * z), H / (math.pi * s))
-    return min(max(math.floor(math.log2(rho)), 0), L - 1)
+    return min(max(math.floor(math.log2(rho) + 0.5), 0), L - 1)
 
 
-# The thresholds of LOD_WIDE and LOD_SQUARE, floor(W 2**F / (2 pi 2**k)) for W = 1024, F = 4:
-# 16384 / (4 pi) = 1303.8.., 651.9.., 325.9..
-LOD_THRESHOLDS = [1303, 651, 325]
+# The thresholds of LOD_WIDE and LOD_SQUARE, floor(W 2**F / (2 pi 2**(k - 1/2))) for W =
+# 512, F = 4: 8192 / (2 pi sqrt 2) = 921.9.., 460.9.., 230.4..
+LOD_THRESHOLDS = [921, 460, 230]
 
 
 def threshold_pixels(gcfg):
@@ -474,20 +475,21 @@ def threshold_pixels(gcfg):
 
 
 def test_level_thresholds_from_the_formula():
-    """t_k = floor(W 2**F / (2 pi 2**k)): LOD_THRESHOLDS; the default F = 10 on a 2048-wide
-    map 2**21 / (4 pi) = 166886.9.."""
+    """t_k = floor(W 2**F / (2 pi 2**(k - 1/2))): LOD_THRESHOLDS; the default F = 10 on a
+    2048-wide map 2**21 / (2 pi sqrt 2) = 236012.1.., 118006.0.."""
     assert level_thresholds(LOD_WIDE) == level_thresholds(LOD_SQUARE) == LOD_THRESHOLDS
-    assert level_thresholds(GlobeConfig(mip_levels=3)) == [166886, 83443]
+    assert level_thresholds(GlobeConfig(mip_levels=3)) == [236012, 118006]
     assert level_thresholds(GlobeConfig()) == []
 
 
 def test_level_radicand_limits_are_the_thresholds_on_the_radicand():
     """The RTL compares the radicand d with c_k where the model compares the root with t_k:
     c_k is the largest d whose root floor(sqrt(d 2**(2F))) (math.isqrt) is at most t_k. A
-    4096-wide map at F = 4 has t_1 = floor(2**15 / (2 pi)) = 5215, t_1 + 1 a multiple of
-    2**F: there (t_1 + 1)**2 is a whole d 2**(2F), whose root is t_1 + 1."""
+    4096-wide map at F = 4 has t_1 = floor(2**16 / (2 pi sqrt 2)) = 7375, t_1 + 1 a multiple
+    of 2**F: there (t_1 + 1)**2 is a whole d 2**(2F), whose root is t_1 + 1, and c_1 =
+    (7376**2 - 1) >> 8 = 212520."""
     edge = GlobeConfig(map_width=4096, map_height=2048, frac_bits=4, mip_levels=2)
-    assert level_thresholds(edge) == [5215] and level_radicand_limits(edge) == [106275]
+    assert level_thresholds(edge) == [7375] and level_radicand_limits(edge) == [212520]
     for g in (LOD_WIDE, edge, GlobeConfig(mip_levels=11), GlobeConfig(radius=2047, mip_levels=11),
               GlobeConfig(radius=3, map_width=32768, map_height=16384, frac_bits=20,
                           mip_levels=15)):
@@ -513,8 +515,8 @@ def test_level_bit_exact(gcfg):
 def _level_points(gcfg):
     """(pixel, level) known from the formula."""
     R = gcfg.radius
-    pts = [((0, 0), 1 if gcfg.map_height == gcfg.map_width else 0),   # rho 1.85 (W = 2H), 3.70
-           ((75, 46), 3), ((-46, -75), 3),      # r**2 = R**2 - 3: rho 94, clamped to L - 1
+    pts = [((0, 0), 1 if gcfg.map_height == gcfg.map_width else 0),   # rho 0.93 (W = 2H), 1.85
+           ((75, 46), 3), ((-46, -75), 3),      # r**2 = R**2 - 3: rho 47, clamped to L - 1
            ((R, 0), 0), ((0, -R), 0), ((R, R), 0), ((-95, 3), 0)]          # outside: 0
     for (k, o), (x, y) in threshold_pixels(gcfg).items():
         # the root at t_k reaches level k (z may be up to a unit above the real threshold),
@@ -529,11 +531,14 @@ def _level_points(gcfg):
 @pytest.mark.parametrize("gcfg", [LOD_WIDE, LOD_SQUARE], ids=["wide", "square"])
 def test_level_known_points(gcfg):
     """Levels known from the formula, of the RTL and of the model: the centre (z = R, rho =
-    W / (2 pi R) = 1.85 on the 2:1 map, H / (pi R) = 3.70 on the square one), pixels next
-    to the rim (rho 94, clamped to L - 1), the pixels whose root is each threshold or one
+    W / (2 pi R) = 0.93 on the 2:1 map, H / (pi R) = 1.85 on the square one: levels 0 and
+    1, log2 rounded), pixels next to the rim (rho 47, clamped to L - 1), the pixels whose root is each threshold or one
     unit off it, 0 outside."""
     known = _level_points(gcfg)
-    assert len(known) == 7 + 9
+    # every threshold's own root and the root a unit below it are reached at R = 88 (the
+    # unit above only where some x**2 + y**2 gives it: 461 and 231 are not)
+    assert {(k, o) for k in (1, 2, 3) for o in (-1, 0)} <= set(threshold_pixels(gcfg))
+    assert len(known) >= 7 + 6
     pts = [p for p, _ in known]
     inputs = [{"x": a, "y": b, "rotation": 3, "tag": n} for n, (a, b) in enumerate(pts)]
     rtl, _ = simulate_stream(GlobeGeometry(gcfg), inputs, "no_stall")
@@ -547,26 +552,26 @@ def test_level_known_points(gcfg):
 
 def test_level_below_one_texel_is_zero():
     """rho < 1 (a 512-wide map on R = 224: W / (2 pi R) = 0.36 at the centre) gives 0, not a
-    negative level; towards the rim rho grows to 3.9 at (223, 0) (z = sqrt 447), 4.4 at
-    (223, 10) (z = sqrt 347), the top level."""
+    negative level; towards the rim rho grows to 3.9 at (223, 0) (z = sqrt 447) and 4.4 at
+    (10, -223) (z = sqrt 347): log2 1.96 and 2.13, rounded to the top level, 2."""
     g = GlobeConfig(map_width=512, map_height=256, mip_levels=3)
     pts = [(0, 0), (100, 0), (223, 0), (223, 10), (10, -223)]
     out = globe_fixed([p[0] for p in pts], [p[1] for p in pts], 0, g)
-    assert out["level"].tolist() == [exact_level(*p, g) for p in pts] == [0, 0, 1, 2, 2]
+    assert out["level"].tolist() == [exact_level(*p, g) for p in pts] == [0, 0, 2, 2, 2]
 
 
 @pytest.mark.parametrize("gcfg", [
     LOD_WIDE, LOD_SQUARE, GlobeConfig(mip_levels=11),
     GlobeConfig(map_width=1024, map_height=1024, mip_levels=11),
     GlobeConfig(radius=60, map_width=256, map_height=256, mip_levels=9, frac_bits=5),
-    GlobeConfig(radius=26, map_width=256, map_height=128, mip_levels=4, frac_bits=4)],
+    GlobeConfig(radius=26, map_width=128, map_height=64, mip_levels=4, frac_bits=4)],
     ids=["wide", "square", "default-11", "square-11", "square-F5", "coarser"])
 def test_level_against_float(gcfg):
     """Over the disc and a ring outside: the level equals float64's (max of du/dx and dv/dy
     from float64 z and s) but one coarser where the root is on that level's threshold; on the
     2:1 maps the model has no y part and float64 does, so the y part never raising a 2:1
-    map's level is checked too. At R = 26 (W = 256, F = 4) some pixels have a root on a
-    threshold above the real one: their level is the coarser one."""
+    map's level is checked too. At R = 26 (F = 4) some pixels have a root on a
+    threshold above the real one: their level is the coarser one (W = 128 there)."""
     x, y = disc_pixels(gcfg.radius)
     res = check_against_float(x, y, 0, gcfg)
     assert res["violations"] == [], res
@@ -590,6 +595,6 @@ def test_level_layout_only_with_mip_levels():
 
 def test_level_y_part_packed_in_the_v_rom():
     """The square map's y part rides above v in the v ROM's word; a 2:1 map's ROM is v's."""
-    for g, width in ((LOD_SQUARE, 10 + 2), (LOD_WIDE, 9)):
+    for g, width in ((LOD_SQUARE, 9 + 2), (LOD_WIDE, 8)):
         _, records = unit_memory_records(dut := GlobeGeometry(g))
         assert records.of(dut)["v_rom"]["width"] == width
