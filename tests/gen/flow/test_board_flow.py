@@ -223,12 +223,15 @@ def test_part_costs_with_the_map_in_sdram_keep_its_pins_and_name_its_parts(monke
                                                                            tmp_path):
     """With the map in the SDRAM the pins of the SDRAM and the flash are the core's ports
     (else synthesis would drop the controller and the loader), and the controller, the
-    loader and the clock crossing are parts of their own."""
+    loader, the read-address queue, the display buffer and the clock crossing are parts of
+    their own."""
     netlist = {"modules": {
         "core": {"cells": {"pipeline": {"type": "pipe"}, "sdram": {"type": "ctrl"},
-                           "flash_loader": {"type": "ldr"}, "cdc": {"type": "cdc"}}},
+                           "flash_loader": {"type": "ldr"}, "cdc": {"type": "cdc"},
+                           "ar_queue": {"type": "arq"}, "display_buffer": {"type": "dbuf"}}},
         "pipe": {"cells": _cells(LUT4=1)}, "ctrl": {"cells": _cells(LUT4=4, TRELLIS_FF=2)},
-        "ldr": {"cells": _cells(TRELLIS_FF=3)}, "cdc": {"cells": _cells(TRELLIS_DPR16X4=1)}}}
+        "ldr": {"cells": _cells(TRELLIS_FF=3)}, "cdc": {"cells": _cells(TRELLIS_DPR16X4=1)},
+        "arq": {"cells": _cells(TRELLIS_FF=5)}, "dbuf": {"cells": _cells(DP16KD=12)}}}
 
     def fake_yosys(script, log, work):
         il = (work / "core.il").read_text()
@@ -248,6 +251,8 @@ def test_part_costs_with_the_map_in_sdram_keep_its_pins_and_name_its_parts(monke
     assert rows["SDRAM controller"] == {"LUT4": 4, "FF": 2, "DSP": 0, "BRAM": 0}
     assert rows["flash loader"] == {"LUT4": 0, "FF": 3, "DSP": 0, "BRAM": 0}
     assert rows["clock crossing"] == {"LUT4": 2, "FF": 0, "DSP": 0, "BRAM": 0}
+    assert rows["read-address queue"] == {"LUT4": 0, "FF": 5, "DSP": 0, "BRAM": 0}
+    assert rows["display buffer"] == {"LUT4": 0, "FF": 0, "DSP": 0, "BRAM": 12}
     assert "globe" not in rows
 
 
