@@ -11,8 +11,8 @@ bitstream: it is no monitor mode). With the map in the SDRAM (``--map-memory axi
 scene with ``map_memory = "axi"``) it also writes the map's flash image
 (``ulx3s_85f_map.bin``, the bytes the flash loader copies into the SDRAM) and prints the
 openFPGALoader commands that program the bitstream and the image (``--flash-offset``,
-``--sdram``), and sizes the display's buffer (the clock crossing) from the texel cache's
-predicted misses (a warning when no size keeps the display fed). Bad input (board, mode, scene, a map that does not fit beside the video logic
+``--sdram``), and sizes the display buffer (a FIFO ahead of the clock crossing) from the
+texel cache's predicted misses (a warning when no size keeps the display fed). Bad input (board, mode, scene, a map that does not fit beside the video logic
 or in the SDRAM, a flash offset inside the bitstream) prints one line and exits 2 before
 anything is written.
 """
