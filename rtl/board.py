@@ -827,14 +827,20 @@ class ULX3STop(Elaboratable):
         # the lanes' DDR registers: an ODDRX1F a pin before a plain output buffer, not the
         # platform's DDR buffer (xdr=2), whose output enable of an output-only pin comes
         # from two fabric flip-flops in the shift domain (Amaranth's ECP5 DDRBuffer), a
-        # route to the I/O cell as long as 720p's shift period
+        # route to the I/O cell as long as 720p's shift period. The serializer's bits pass
+        # one more shift-domain register on the way (every lane alike, the clock's too):
+        # a flip-flop with one input and one load, which the placer puts between the
+        # serializer and the pins, so neither route is the whole distance.
+        o0 = Signal.like(core.o0, name="hdmi_o0", reset_less=True)
+        o1 = Signal.like(core.o1, name="hdmi_o1", reset_less=True)
+        m.d.shift += [o0.eq(core.o0), o1.eq(core.o1)]
         hdmi = platform.request("hdmi", 0, dir="-")
         for name, port, bits in (("d", hdmi.d, range(3)), ("clk", hdmi.clk, [3])):
             m.submodules[f"hdmi_{name}"] = buf = io.Buffer("o", port)
             for k, lane in enumerate(bits):
                 m.submodules[f"hdmi_{name}_ddr{k}"] = Instance(
-                    "ODDRX1F", i_SCLK=ClockSignal("shift"), i_RST=0, i_D0=core.o0[lane],
-                    i_D1=core.o1[lane], o_Q=buf.o[k])
+                    "ODDRX1F", i_SCLK=ClockSignal("shift"), i_RST=0, i_D0=o0[lane],
+                    i_D1=o1[lane], o_Q=buf.o[k])
         leds = [platform.request("led", n) for n in (0, 1, 7)]
         m.d.comb += [leds[0].o.eq(core.underflow), leds[1].o.eq(core.order_error),
                      leds[2].o.eq(core.source.frame[4] if len(core.source.frame) > 4 else 0)]

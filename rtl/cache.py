@@ -534,7 +534,9 @@ class TextureCache(wiring.Component):
             look_set = Const(0, 1)
         look_tag = tag_of(look_line)
         hit = r.look_hit                          # look_hits.any(), a register
-        victim = self._plru_hdl(look_plru, look_hits)[0]
+        # the victim the bits point to, one-hot, a register of its own (set with the bits,
+        # below): the lock, and so the advance, one LUT shorter than decoding the bits
+        victim = Signal(g.ways, init=1 << plru_victim(0, g.ways), name="look_victim")
         way_hot = Signal(g.ways)                  # the way the pixel uses, one-hot
         m.d.comb += way_hot.eq(Mux(hit, look_hits, victim))
         way = Signal(max(1, g.way_bits))
@@ -933,7 +935,10 @@ class TextureCache(wiring.Component):
 
         def look_next(a, held, moved):              # the lookup's next, advance a
             return Mux(~full1 | a, moved, held)
-        late(look_plru, lambda a: look_next(a, look_plru, Mux(same_set & a, touched, ds_plru)))
+        def plru_next(a):
+            return look_next(a, look_plru, Mux(same_set & a, touched, ds_plru))
+        late(look_plru, plru_next)
+        late(victim, lambda a: self._plru_hdl(plru_next(a), look_hits)[0])
         late(look_hits, lambda a: look_next(a, look_hits, new_hits_if[a]))
         hit_next = Signal(name="look_hit_next")
         m.d.comb += hit_next.eq(Mux(advance, look_next(1, hit, new_hits_if[1].any()),
