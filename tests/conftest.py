@@ -15,6 +15,32 @@ settings.load_profile("ci")
 # tool_env) only while it builds and runs one.
 
 
+# The tests that take longest (each several seconds on the 2-core machine), run first:
+# pytest-xdist's worksteal gives each worker a contiguous half of the collection and an idle
+# worker steals the back half of the other's queue, so with these at the front both workers
+# end on short tests instead of one waiting for the other's last long one. Only the order
+# changes (the same for every worker, as xdist requires); a name no longer collected is
+# ignored.
+SLOW_FIRST = (          # whole files: a module's fixtures are set up once a run of its tests
+    "tests/board/test_board.py", "tests/rtl/test_baselines_kim.py",
+    "tests/sim/tb/test_bulk_scene_frames.py", "tests/sim/tb/test_tb_datapath.py",
+    "tests/gen/report/test_table1.py", "tests/rtl/test_palette.py",
+    "tests/sim/tb/test_tb_cache.py", "tests/rtl/test_board_globe.py",
+    "tests/gen/render/test_demo.py", "tests/sim/tb/test_bulk.py",
+    "tests/sim/tb/test_tb_pipeline_axi.py", "tests/docs_examples/test_examples.py",
+    "tests/sim/tb/test_tb_sdram_cache.py",
+)
+
+
+def _slow_rank(item):
+    path = item.nodeid.split("::")[0]
+    return SLOW_FIRST.index(path) if path in SLOW_FIRST else len(SLOW_FIRST)
+
+
+def pytest_collection_modifyitems(config, items):
+    items.sort(key=_slow_rank)              # stable: the rest keep their order
+
+
 @pytest.fixture
 def build_dir(request):
     """A per-test directory under build/test/ (kept for inspection; git-ignored)."""

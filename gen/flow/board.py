@@ -79,7 +79,7 @@ __all__ = ["BOARDS", "board_data", "board_core", "check_board", "bram_budget",
            "build_bitstream", "part_costs", "emit_sim", "check_frames", "board_memory",
            "BoardMemory", "BITSTREAM_BYTES", "FLASH_SECTOR", "DEFAULT_FLASH_OFFSET",
            "DEFAULT_SDRAM", "DEFAULT_PIPE_MHZ", "SDRAM_CAS_LATENCY", "FLASH_HALF_PERIOD", "flash_commands",
-           "MAP_FILE", "sdram_preload", "frame_misses", "display_budget", "DisplayBudget",
+           "MAP_FILE", "sdram_preload", "frame_misses", "frames_misses", "display_budget", "DisplayBudget",
            "predict_display", "display_buffer", "MIN_DISPLAY_BUFFER",
            "MAX_DISPLAY_BUFFER", "DISPLAY_MARGIN_LINES"]
 
@@ -241,6 +241,16 @@ def frame_misses(scene, mode, frame=1, rows=None, warm=True):
     return ~run.hit[skip:].reshape(len(rows), mode.h_active)
 
 
+def frames_misses(scene, mode, count):
+    """:func:`frame_misses` of frames 0 .. ``count`` - 1 in one run of the cache model from
+    cold: frame 0's as ``warm=False`` gives them, each later frame's as ``warm=True`` does
+    (the cache as the frames before left it), without running any frame twice."""
+    coords = [_frame_coords(scene, mode, f, range(mode.v_active)) for f in range(count)]
+    u, v, level = (np.concatenate([c[k] for c in coords]) for k in range(3))
+    miss = ~run_cache(scene_geometry(scene.hardware), u, v, level).hit
+    return list(miss.reshape(count, mode.v_active, mode.h_active))
+
+
 @dataclass(frozen=True)
 class DisplayBudget:
     """What :func:`display_budget` found. Per line: ``misses`` (the cache's), each costing
@@ -381,7 +391,7 @@ def display_buffer(scene, mode, pipe_hz=None, line_cost=None, fill_clocks=None,
     :func:`predict_display`'s."""
     pipe_hz, line_cost, fill_clocks, latency, depth, queue = _budget_design(
         scene, mode, pipe_hz, line_cost, fill_clocks)
-    misses = [frame_misses(scene, mode, 0, warm=False), frame_misses(scene, mode, 1)]
+    misses = frames_misses(scene, mode, 2)
     cdc, entries = cdc_depth(mode.pixel_hz, pipe_hz), None
     while True:
         budgets = [display_budget(m, mode, pipe_hz, latency, depth, cdc + (entries or 0),

@@ -90,7 +90,7 @@ def _burst_misses(n):
 def test_the_display_buffer_is_the_least_power_of_two_that_holds(monkeypatch, burst):
     from bumprtl.gen.flow import board
     misses = _burst_misses(burst)
-    monkeypatch.setattr(board, "frame_misses", lambda *a, **k: misses)
+    monkeypatch.setattr(board, "frames_misses", lambda *a, **k: [misses, misses])
     entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
                                             fill_clocks=FILL)
     assert all(b.holds for b in budgets) and len(budgets) == 2
@@ -115,7 +115,7 @@ def test_the_display_buffer_search_stops_at_its_most(monkeypatch):
     from bumprtl.gen.flow import board
     misses = np.zeros((MODE.v_active, MODE.h_active), bool)
     misses[300:310] = True                                      # ten lines, every pixel a miss
-    monkeypatch.setattr(board, "frame_misses", lambda *a, **k: misses)
+    monkeypatch.setattr(board, "frames_misses", lambda *a, **k: [misses, misses])
     monkeypatch.setattr(board, "MAX_DISPLAY_BUFFER", 256)
     entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
                                             fill_clocks=FILL)
@@ -126,17 +126,31 @@ def test_the_display_buffer_searches_frame_0_cold_and_frame_1_warm(monkeypatch):
     from bumprtl.gen.flow import board
     calls = []
 
-    def misses(scene, mode, frame=1, rows=None, warm=True):
-        calls.append((frame, warm))
+    def misses(scene, mode, count):
+        calls.append(count)
         # frame 0 (cold) has the burst, frame 1 none: the buffer must still cover it
-        return _burst_misses(200 if frame == 0 else 0)
-    monkeypatch.setattr(board, "frame_misses", misses)
+        return [_burst_misses(200), _burst_misses(0)]
+    monkeypatch.setattr(board, "frames_misses", misses)
     entries, budgets = board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
                                             fill_clocks=FILL)
-    assert sorted(calls) == [(0, False), (1, True)]
+    assert calls == [2]
     assert entries == board.display_buffer(_globe(64, 32), MODE, line_cost=LINE_COST,
                                            fill_clocks=FILL)[0] >= 16
     assert budgets[0].misses.sum() == 200 and budgets[1].misses.sum() == 0
+
+
+def test_one_run_over_frames_gives_each_frames_misses():
+    # frames 0 (cold) and 1 (warm) of one run equal frame_misses' separate runs, on a
+    # turning globe whose frame 1 misses neither as frame 0 nor as frame 1 from cold do
+    from bumprtl.gen.flow.board import frames_misses
+    scene = _globe(256, 128)
+    mode = MODES["test"]
+    got = frames_misses(scene, mode, 2)
+    assert len(got) == 2 and got[0].shape == (mode.v_active, mode.h_active)
+    assert np.array_equal(got[0], frame_misses(scene, mode, 0, warm=False))
+    assert np.array_equal(got[1], frame_misses(scene, mode, 1))
+    assert not np.array_equal(got[1], got[0])
+    assert not np.array_equal(got[1], frame_misses(scene, mode, 1, warm=False))
 
 
 def test_board_core_takes_the_display_buffer_ahead_of_the_crossing():

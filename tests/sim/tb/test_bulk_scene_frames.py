@@ -2,9 +2,9 @@
 on Icarus under the four traffic patterns, every output field against the golden model:
 ``diffuse`` (no specular term), ``flat`` (no map: the polygon registers), ``textured`` (the
 colour texture blended with the shading), ``two-lights`` (two illumination units and their
-sum) and the palette scenes. The default scene streams it in tests/sim/tb/test_bulk.py
-(before its rendered frame), the full scene in tests/sim/tb/test_tb_pipeline.py (every
-cycle from cocotb). This is the frame and the four traffic patterns the netlist mutants of
+sum), ``full`` (both, with two mip levels) and the palette scenes. The default scene
+streams it in tests/sim/tb/test_bulk.py (before its rendered frame), the full scene also in
+tests/sim/tb/test_tb_pipeline.py (every cycle from cocotb, make regress). This is the frame and the four traffic patterns the netlist mutants of
 these scenes run (tests/mutants/netlist.py), so a mutant that frame kills is killed by
 make test."""
 
@@ -45,10 +45,11 @@ def _stream(v, j, meta, frame, golden, work):
             assert np.array_equal(r.outputs[pattern][field], want), (pattern, field)
 
 
-# two-lights in make regress: make test streams the full scene's coverage frame, whose
-# datapath is two-lights' with the texture and the mip levels added, every cycle from cocotb
-# on Icarus (tests/sim/tb/test_tb_pipeline.py).
-@pytest.mark.parametrize("name", ["diffuse", "flat", "textured",
+# textured and two-lights in make regress: make test streams the full scene's coverage
+# frame here, whose datapath is two-lights' with textured's colour texture and the mip
+# levels added (its per-cycle cocotb run is make regress's, tests/sim/tb/test_tb_pipeline.py).
+@pytest.mark.parametrize("name", ["diffuse", "flat", "full",
+                                  pytest.param("textured", marks=pytest.mark.regress),
                                   pytest.param("two-lights", marks=pytest.mark.regress)])
 def test_scene_coverage_frame_equals_golden(name, build_dir):
     v, j, meta, frame, golden = _scene_frame(load_scene_config(name), build_dir)

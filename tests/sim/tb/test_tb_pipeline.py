@@ -23,14 +23,14 @@ from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
 from bumprtl.sim.traffic import PATTERNS
 
 
-# make test: the full scene's coverage frame on Icarus (a build costs little there); the
-# default scene's per-cycle run is in make regress, since make test streams that scene's
-# pipeline on Icarus under the same traffic patterns through the bulk path
-# (tests/sim/tb/test_bulk.py: the coverage frame, then the render frame); make regress: the
-# render frame behind the coverage frame, and the full scene's build on Verilator too (a
-# minute of C++ compilation).
+# make regress: every per-cycle run here. make test streams the same coverage frames on
+# Icarus under the same traffic patterns through the bulk path, every output field against
+# the golden model: the full scene's (tests/sim/tb/test_bulk_scene_frames.py) and the
+# default scene's, then its render frame (tests/sim/tb/test_bulk.py). Here: the render frame
+# behind the coverage frame, and the full scene's build on Verilator too (a minute of C++
+# compilation).
 @pytest.mark.parametrize("sim, name, render", [
-    ("icarus", "full", False),
+    pytest.param("icarus", "full", False, marks=pytest.mark.regress),
     pytest.param("icarus", "full", True, marks=pytest.mark.regress),
     pytest.param("icarus", "default", True, marks=pytest.mark.regress),
     pytest.param("verilator", "full", True, marks=pytest.mark.regress)])
