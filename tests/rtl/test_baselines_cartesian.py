@@ -131,6 +131,9 @@ def test_emission_lint_clean_and_deterministic(unit, build_dir):
     assert lint(v1) == []
 
 
+# make regress: make test checks Ernst's sidecar and recorded command below
+# (test_sidecar_of_ernst_names_its_method) and Peercy's setup, which is Ernst's, above
+@pytest.mark.regress
 def test_ernst_emits_the_same_setup_hardware(build_dir):
     """Ernst's setup is Peercy's: the same Verilog apart from the command in the header (at
     10-bit angles, B = 11: the structure does not depend on the widths)."""
@@ -172,7 +175,8 @@ def test_cli_emit_rotation_method_peercy(tmp_path, run_cli):
 
 # --- Yosys counts against the structure (rtl/baselines/peercy.py docstring) -------------------
 
-@pytest.mark.parametrize("specular", [True, False])
+# with the H path in make test; without it (the same structure, one vector) in make regress
+@pytest.mark.parametrize("specular", [True, pytest.param(False, marks=pytest.mark.regress)])
 def test_setup_counts_match_the_structure(specular, build_dir):
     """Per normalized vector: 9 transform products of two signed(B + 2) inputs and 3 squares
     of signed(B + 5) components; 6 + 2 adders; one square root; 3 dividers of |a| 2**(B+2)
