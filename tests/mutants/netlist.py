@@ -74,11 +74,13 @@ SOURCE_KIND = {"sincos": "sincos", "rotation": "datapath", "illumination": "data
                "palette": "palette"}
 PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
 # The test of make test that streams a built-in scene's coverage frame through its pipeline,
-# on Icarus under the four patterns: every built-in scene has one
+# on Icarus under the four patterns (tests/mutants/test_netlist_frames.py holds this to the
+# tests' markers), and the scenes make regress streams instead, make test streaming the full
+# scene, whose datapath holds theirs
 MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py, before its 16 x 16 render frame",
-                    "full": "tests/sim/tb/test_tb_pipeline.py, before its 16 x 16 render frame",
                     **{name: "tests/sim/tb/test_bulk_scene_frames.py"
-                       for name in ("diffuse", "flat", "textured", "two-lights", "palette")}}
+                       for name in ("diffuse", "flat", "full", "palette")}}
+REGRESS_FRAMES = {name: "tests/sim/tb/test_bulk_scene_frames.py" for name in ("textured", "two-lights")}
 SECTIONS = ("netlist", "netlist-board", "netlist-seeds")   # --doc-section: a table's markers
 
 
@@ -761,6 +763,9 @@ def _stimulus_words(target, n, sim="verilator"):
     if name in MAKE_TEST_FRAMES:
         where = (f"as make test streams it through the {name} scene ({MAKE_TEST_FRAMES[name]})"
                  + ("" if sim == "icarus" else ", there on Icarus"))
+    elif name in REGRESS_FRAMES:
+        where = (f"as make regress streams it through the {name} scene ({REGRESS_FRAMES[name]}"
+                 f"{'' if sim == 'icarus' else ', on Icarus'}; make test: the full scene's)")
     else:
         where = "a frame make test streams through no pipeline"
     extra = _table_pixels(scene)
