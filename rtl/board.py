@@ -616,6 +616,9 @@ class BoardCore(Elaboratable):
 # input (reference / CLKI_DIV) at least PFD_MIN_HZ, the VCO (CLKOP x CLKOP_DIV) within
 # VCO_HZ, each output at most OUT_MAX_HZ, every divider 1 .. DIV_MAX.
 PFD_MIN_HZ, VCO_HZ, OUT_MAX_HZ, DIV_MAX = 3.125e6, (400e6, 800e6), 400e6, 128
+# registers of the shift domain between the serializer and the HDMI pins' ODDRX1F
+# (ULX3STop), besides the serializer's own output register
+PIN_STAGES = 3
 
 
 def pll_dividers(pixel_hz, ref_hz=25e6):
@@ -828,12 +831,18 @@ class ULX3STop(Elaboratable):
         # platform's DDR buffer (xdr=2), whose output enable of an output-only pin comes
         # from two fabric flip-flops in the shift domain (Amaranth's ECP5 DDRBuffer), a
         # route to the I/O cell as long as 720p's shift period. The serializer's bits pass
-        # one more shift-domain register on the way (every lane alike, the clock's too):
-        # a flip-flop with one input and one load, which the placer puts between the
-        # serializer and the pins, so neither route is the whole distance.
-        o0 = Signal.like(core.o0, name="hdmi_o0", reset_less=True)
-        o1 = Signal.like(core.o1, name="hdmi_o1", reset_less=True)
-        m.d.shift += [o0.eq(core.o0), o1.eq(core.o1)]
+        # PIN_STAGES more shift-domain registers on the way (every lane alike, the clock's
+        # too): flip-flops of one input and one load each, which the placer spreads between
+        # the serializer and the pins. The serializer sits near the encoders that feed it
+        # (forty nets from the pixel domain, whose routes nextpnr does not time), which
+        # may be half the die from the HDMI pins: one register in between still left a
+        # route of 33 columns, longer than the period.
+        o0, o1 = core.o0, core.o1
+        for k in range(PIN_STAGES):
+            r0 = Signal.like(core.o0, name=f"hdmi_o0_s{k}", reset_less=True)
+            r1 = Signal.like(core.o1, name=f"hdmi_o1_s{k}", reset_less=True)
+            m.d.shift += [r0.eq(o0), r1.eq(o1)]
+            o0, o1 = r0, r1
         hdmi = platform.request("hdmi", 0, dir="-")
         for name, port, bits in (("d", hdmi.d, range(3)), ("clk", hdmi.clk, [3])):
             m.submodules[f"hdmi_{name}"] = buf = io.Buffer("o", port)

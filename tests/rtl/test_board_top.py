@@ -134,6 +134,46 @@ def test_the_top_with_the_map_in_block_ram_has_none_of_them():
     assert "CLKOS3_ENABLE" not in il
 
 
+def _driver(text, wire):
+    """The $dff cell of ``text`` whose Q is ``wire`` (RTLIL, a whole wire): (its D, its
+    clock), or None."""
+    for body in re.findall(r"^\s*cell \$dff \S+$(.*?)^\s*end$", text, re.MULTILINE | re.DOTALL):
+        if re.search(rf"connect \\Q {re.escape(wire)}$", body, re.MULTILINE):
+            d = re.search(r"connect \\D (.+)$", body, re.MULTILINE).group(1)
+            clk = re.search(r"connect \\CLK (.+)$", body, re.MULTILINE).group(1)
+            return d, clk
+    return None
+
+
+def test_every_hdmi_lane_passes_the_same_registers_to_its_oddr():
+    # each lane's two bits, the clock lane's too, reach their ODDRX1F through PIN_STAGES
+    # shift-domain registers from the serializer's output (the core's o0, o1), so the
+    # lanes leave in step
+    from bumprtl.rtl.board import PIN_STAGES
+    il, _, _ = _plan("bram")
+    [top] = [t for t in _modules(il).values() if _cells(t, "ODDRX1F")]
+    lanes = {name: body for name, body in _cells(top, "ODDRX1F")}
+    assert sorted(lanes) == ["\\hdmi_clk_ddr0", "\\hdmi_d_ddr0", "\\hdmi_d_ddr1", "\\hdmi_d_ddr2"]
+    core_out = {}
+    cells = re.findall(r"^\s*cell (\S+) (\S+)$(.*?)^\s*end$", top, re.MULTILINE | re.DOTALL)
+    [core] = [body for kind, _, body in cells if kind.endswith(".core")]
+    for port in ("o0", "o1"):
+        core_out[port] = re.search(rf"connect \\{port} (\S+)", core).group(1)
+    for name, body in lanes.items():
+        for port in ("D0", "D1"):
+            wire, bit = re.search(rf"connect \\{port} (\S+) \[(\d+)\]", body).groups()
+            stages = 0
+            while wire != core_out["o0" if port == "D0" else "o1"]:
+                driver = _driver(top, wire)
+                assert driver is not None, (name, port, wire)
+                wire = driver[0].split(" [")[0]
+                assert driver[1].startswith("\\shift_clk"), (name, port, driver)
+                stages += 1
+            assert stages == PIN_STAGES, (name, port, stages)
+            lane = 3 if "clk" in name else int(name[-1])
+            assert int(bit) == lane, (name, port, bit)
+
+
 @pytest.mark.parametrize("name", [n for n in MODES])
 def test_the_pipe_clock_is_never_above_the_sdram_configs(name):
     mode = MODES[name]
