@@ -79,8 +79,9 @@ PATTERNS = ("no_stall", "input_gaps", "backpressure", "both")
 # scene, whose datapath holds theirs
 MAKE_TEST_FRAMES = {"default": "tests/sim/tb/test_bulk.py, before its 16 x 16 render frame",
                     **{name: "tests/sim/tb/test_bulk_scene_frames.py"
-                       for name in ("diffuse", "flat", "full", "palette")}}
-REGRESS_FRAMES = {name: "tests/sim/tb/test_bulk_scene_frames.py" for name in ("textured", "two-lights")}
+                       for name in ("flat", "full", "palette")}}
+REGRESS_FRAMES = {name: "tests/sim/tb/test_bulk_scene_frames.py"
+                  for name in ("diffuse", "textured", "two-lights")}
 SECTIONS = ("netlist", "netlist-board", "netlist-seeds")   # --doc-section: a table's markers
 
 
