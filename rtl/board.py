@@ -834,9 +834,9 @@ class ULX3STop(Elaboratable):
         # PIN_STAGES more shift-domain registers on the way (every lane alike, the clock's
         # too): flip-flops of one input and one load each, which the placer spreads between
         # the serializer and the pins. The serializer sits near the encoders that feed it
-        # (forty nets from the pixel domain, whose routes nextpnr does not time), which
-        # may be half the die from the HDMI pins: one register in between still left a
-        # route of 33 columns, longer than the period.
+        # (a word a lane from the pixel domain, routes nextpnr does not time), which may be
+        # half the die from the HDMI pins: one register in between can still leave a route
+        # longer than the period (docs/board.md).
         o0, o1 = core.o0, core.o1
         for k in range(PIN_STAGES):
             r0 = Signal.like(core.o0, name=f"hdmi_o0_s{k}", reset_less=True)
