@@ -235,8 +235,9 @@ def theta_table(gcfg: GlobeConfig):
     return _rows(gcfg, lambda y: round(math.acos(y / r) * (full / (2 * math.pi))) & (full - 1))
 
 
-# rho at which level k starts: 2**(k - 1/2) (rounding log2 rho to the nearest level)
-LEVEL_STEP = [2.0 ** (k - 0.5) for k in range(16)]
+def level_step(k):
+    """The rho at which level k starts: 2**(k - 1/2) (log2 rho rounded to the nearest)."""
+    return 2.0 ** (k - 0.5)
 
 
 def level_of(rho, levels):
@@ -247,9 +248,9 @@ def level_of(rho, levels):
     a float64's exact value of rho in practice, so >= and > agree). Floats and numpy
     arrays alike (an int64 array back)."""
     if isinstance(rho, np.ndarray):
-        return sum(((rho >= LEVEL_STEP[k]).astype(np.int64) for k in range(1, levels)),
+        return sum(((rho >= level_step(k)).astype(np.int64) for k in range(1, levels)),
                    np.zeros(rho.shape, np.int64))
-    return sum(1 for k in range(1, levels) if rho >= LEVEL_STEP[k])
+    return sum(1 for k in range(1, levels) if rho >= level_step(k))
 
 
 def level_thresholds(gcfg: GlobeConfig):
@@ -260,7 +261,7 @@ def level_thresholds(gcfg: GlobeConfig):
     That holds wherever ``z <= T_k``, and also where z is above T_k by less than ``2**-F``
     with the same root, where the level is one coarser than the exact one."""
     w, f = gcfg.map_width, gcfg.fraction_bits
-    return [math.floor(w * 2.0 ** f / (2 * math.pi * LEVEL_STEP[k]))
+    return [math.floor(w * 2.0 ** f / (2 * math.pi * level_step(k)))
             for k in range(1, gcfg.mip_levels)]
 
 
