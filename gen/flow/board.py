@@ -231,24 +231,26 @@ def frame_misses(scene, mode, frame=1, rows=None, warm=True):
     the cache as the frame before (all of it, frame - 1) left it, as on the board from its
     second frame on; otherwise cold at the rows' start."""
     rows = range(mode.v_active) if rows is None else rows
-    u, v, level = _frame_coords(scene, mode, frame, rows)
-    skip = 0
-    if warm:
-        u0, v0, l0 = _frame_coords(scene, mode, frame - 1, range(mode.v_active))
-        u, v, level = (np.concatenate(p) for p in ((u0, u), (v0, v), (l0, level)))
-        skip = len(u0)
-    run = run_cache(scene_geometry(scene.hardware), u, v, level)
-    return ~run.hit[skip:].reshape(len(rows), mode.h_active)
+    before = [(frame - 1, range(mode.v_active))] if warm else []
+    return _run_misses(scene, mode, [*before, (frame, rows)])[-1]
 
 
 def frames_misses(scene, mode, count):
     """:func:`frame_misses` of frames 0 .. ``count`` - 1 in one run of the cache model from
     cold: frame 0's as ``warm=False`` gives them, each later frame's as ``warm=True`` does
     (the cache as the frames before left it), without running any frame twice."""
-    coords = [_frame_coords(scene, mode, f, range(mode.v_active)) for f in range(count)]
+    return _run_misses(scene, mode, [(f, range(mode.v_active)) for f in range(count)])
+
+
+def _run_misses(scene, mode, parts):
+    """One run of the cache model, from cold, over ``parts`` ((frame, rows) each, in
+    order): each part's misses, shape (len(rows), h_active)."""
+    coords = [_frame_coords(scene, mode, f, rows) for f, rows in parts]
     u, v, level = (np.concatenate([c[k] for c in coords]) for k in range(3))
     miss = ~run_cache(scene_geometry(scene.hardware), u, v, level).hit
-    return list(miss.reshape(count, mode.v_active, mode.h_active))
+    ends = np.cumsum([len(rows) * mode.h_active for _, rows in parts])[:-1]
+    return [m.reshape(len(rows), mode.h_active)
+            for m, (_, rows) in zip(np.split(miss, ends), parts, strict=True)]
 
 
 @dataclass(frozen=True)
