@@ -10,7 +10,9 @@ Control (cocotb, between chunks): ``rst``; ``start`` (level) with ``count`` word
 ``bulk_in.bin``, or with ``setup_mode`` set ``count`` set-up words in ``bulk_setup.bin``,
 played one per clock into the host ports; ``gap_seed``/``gap_density``,
 ``bp_seed``/``bp_density`` (a gap or a stall when the upper 16 bits of the next xorshift32
-state are below the density, out of 2**16); ``idle_limit``. Status: ``done`` (held until
+state are below the density, out of 2**16); ``fill_hold`` (non-zero: the chunk's first
+stall, o.ready low until i.ready has been low or the input all taken for that many
+cycles, sim/traffic.fill_hold); ``idle_limit``. Status: ``done`` (held until
 ``start`` falls), ``timed_out``, ``n_in``, ``n_out``, ``cycles``. Outputs go to
 ``bulk_out.bin``, one ``%u`` word each. A unit with an AXI4 read port (``axi__*``,
 ``map_memory = "axi"``) gets the wrapper's memory model on it (``BULK_AXI``): it holds

@@ -3,7 +3,9 @@
 // part of any emitted unit.
 //
 // Stimulus words come from bulk_in.bin ($fread into a memory), traffic from two xorshift32
-// generators, every output word goes to bulk_out.bin ($fwrite %u); with BUMPRTL_BULK_DPI
+// generators (with fill_hold > 0 each chunk first holds o.ready low until i.ready has been
+// low, every credit spent, or the chunk's input all taken, for fill_hold cycles: the unit's
+// FIFO full, then drained under the random stalls), every output word goes to bulk_out.bin ($fwrite %u); with BUMPRTL_BULK_DPI
 // defined (Verilator) the same files go through DPI-C (bulk_dpi.cpp). With BULK_OWN_CLOCK
 // defined (Icarus) the wrapper toggles clk itself; otherwise clk is an input, toggled by
 // the Verilator build's C++ main (bulk_main.cpp).
@@ -62,6 +64,7 @@ module bulk_wrapper #(
   input wire [31:0] bp_seed /*verilator public_flat_rw*/,
   input wire [DENSITY_BITS:0] bp_density /*verilator public_flat_rw*/,
   input wire [31:0] idle_limit /*verilator public_flat_rw*/,
+  input wire [31:0] fill_hold /*verilator public_flat_rw*/,
   input wire setup_mode /*verilator public_flat_rw*/,
   output reg done /*verilator public_flat_rw*/,
   output reg timed_out /*verilator public_flat_rw*/,
@@ -101,6 +104,8 @@ module bulk_wrapper #(
   reg [31:0] gap_rng;
   reg [31:0] bp_rng;
   reg [31:0] idle;
+  reg filling;                         // the chunk's first stall, until the FIFO is full
+  reg [31:0] fill_n;                   // cycles i.ready low (or the input all taken) so far
   integer fd;
   integer nread;
   wire in_ready;
@@ -223,6 +228,7 @@ module bulk_wrapper #(
   initial done = 1'b0;
   initial hword = {HWS{1'b0}};
   initial playing = 1'b0;
+  initial filling = 1'b0;
 
   always @(posedge clk) begin
     unit_rst <= rst;
@@ -275,6 +281,8 @@ module bulk_wrapper #(
         timed_out <= 1'b0;
         gap_rng <= (gap_seed == 32'd0) ? 32'd1 : gap_seed;
         bp_rng <= (bp_seed == 32'd0) ? 32'd1 : bp_seed;
+        filling <= fill_hold != 32'd0;
+        fill_n <= 32'd0;
       end else if (!start)
         done <= 1'b0;
     end else if (playing) begin
@@ -307,7 +315,12 @@ module bulk_wrapper #(
         end else
           in_valid <= 1'b0;
       end
-      out_ready <= !stall;
+      if (filling) begin
+        fill_n <= (!in_ready || (rd == count && !in_valid)) ? fill_n + 32'd1 : 32'd0;
+        if (fill_n == fill_hold)
+          filling <= 1'b0;
+      end
+      out_ready <= !stall && !filling;
       if (give) begin
 `ifdef BUMPRTL_BULK_DPI
         bulk_dpi_put(out_payload);

@@ -35,6 +35,7 @@ from bumprtl.sim.tb.bulk_wrapper import (
     host_fields,
     setup_arrays,
 )
+from bumprtl.sim.traffic import fill_hold
 
 DENSITY_ONE = 1 << DENSITY_BITS
 
@@ -133,6 +134,7 @@ async def _run(dut, job, meta, summary, make_source):
         for j, pattern in enumerate(patterns):
             gap, stall = job["traffic"][pattern]
             dut.gap_density.value, dut.bp_density.value = gap, stall
+            dut.fill_hold.value = fill_hold(meta.latency) if stall else 0
             dut.gap_seed.value = _seed(job["seed"], k, j, 0)
             dut.bp_seed.value = _seed(job["seed"], k, j, 1)
             dut.count.value = n

@@ -740,7 +740,7 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
     return {"target": target, "sample": len(lines), "seed": seed, "killed": killed,
             "equivalent": equivalent, "counted": len(lines) - equivalent,
             "survivors": survivors, "seconds": time.perf_counter() - t0,
-            "stimulus": _stimulus_words(target, stim_n, sim)}
+            "stimulus": _stimulus_words(target, stim_n, sim) + FILL_WORDS}
 
 
 def _short(line):
@@ -785,13 +785,20 @@ def _table_pixels(scene):
     return len(frame.inputs["tag"]) - PIXELS
 
 
+# what a run's bulk stimulus adds since the wrapper's first stall fills the credit FIFO
+# (sim/traffic.fill_hold); a run saved before it says nothing of it
+FILL_WORDS = ("; under backpressure each chunk first holds o.ready low until the credit FIFO "
+              "is full (sim/traffic.fill_hold)")
+
+
 def _stimulus_now(r):
     """A result's stimulus in today's words (a pipeline's: which frames make test streams
-    has changed since some runs were saved; the frame itself is the saved run's)."""
+    has changed since some runs were saved; the frame itself is the saved run's, and so is
+    whether its backpressure began by filling the FIFO)."""
     if not r["target"].startswith("pipeline:"):
         return r["stimulus"]
     sim = "verilator" if "on Verilator" in r["stimulus"] else "icarus"
-    return _stimulus_words(r["target"], 0, sim)
+    return _stimulus_words(r["target"], 0, sim) + (FILL_WORDS if FILL_WORDS in r["stimulus"] else "")
 
 
 def report(results, runs, section="netlist"):

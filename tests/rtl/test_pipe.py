@@ -321,35 +321,41 @@ UNITS = {
 }
 
 
-def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles):
+def run_traffic(dut, n, gap_p, bp_p, seed, max_cycles, hold=0, after=0):
     """Offer ``n`` payloads, tag k on the k-th (tags wrap at the tag width), to ``dut.i``
     with input gaps of probability ``gap_p`` and hold ``dut.o.ready`` low with probability
-    ``bp_p`` (valid never waits on ready); returns the per-cycle samples ``(i.valid, i.ready,
-    o.valid, o.ready, o.tag)`` of every cycle until the n-th output is taken, or of
-    ``max_cycles`` cycles."""
+    ``bp_p`` (valid never waits on ready), and always in the first ``hold`` cycles; returns
+    the per-cycle samples ``(i.valid, i.ready, o.valid, o.ready, o.tag)`` of every cycle
+    until the n-th output is taken and ``after`` cycles more, or of ``max_cycles`` cycles."""
     rng = np.random.default_rng(seed)
     samples = []
 
     drive = Drive({"valid": dut.i.valid, "tag": dut.i.payload.tag, "ready": dut.o.ready})
 
     async def bench(ctx):
-        pending, taken, offered = n, 0, False
-        for _ in range(max_cycles):
+        pending, taken, offered, tail = n, 0, False, None
+        for cycle in range(max_cycles):
             if not offered and pending and rng.random() >= gap_p:
                 offered = True
             drive["valid"] = offered
             drive["tag"] = n - pending
-            drive["ready"] = bool(rng.random() >= bp_p)
+            drive["ready"] = bool(rng.random() >= bp_p) and cycle >= hold
             drive.set(ctx)
             _, _, i_valid, i_ready, o_valid, o_ready, tag = await ctx.tick().sample(
                 dut.i.valid, dut.i.ready, dut.o.valid, dut.o.ready, dut.o.payload.tag)
             samples.append((bool(i_valid), bool(i_ready), bool(o_valid), bool(o_ready), int(tag)))
             if i_valid and i_ready:
                 offered, pending = False, pending - 1
-            if o_valid and o_ready:
+            if tail is not None:
+                tail -= 1
+                if tail == 0:
+                    return
+            elif o_valid and o_ready:
                 taken += 1
                 if taken == n:
-                    return
+                    if not after:
+                        return
+                    tail = after
 
     sim = Simulator(driven(dut, drive))
     sim.add_clock(1e-6)
@@ -371,6 +377,25 @@ def test_pipe_takes_its_credits_while_its_output_waits(unit):
     first = next(c for c, s in enumerate(samples) if s[2])
     assert first == dut.port_latency, (unit, first)
     assert all(s[2] for s in samples[first:])              # held, never withdrawn
+
+
+@pytest.mark.parametrize("unit", list(UNITS))
+def test_a_full_fifo_drains_in_order_and_then_runs_dry(unit):
+    """o.ready low until the FIFO is full (every credit spent, the last pixel through the
+    pipe), then high: the ``fifo_depth`` pixels inside leave back to back, the credits they
+    free take the rest, every pixel leaves once, in order, and then o.valid stays low (the
+    FIFO empty: nothing is offered that was not taken)."""
+    dut = UNITS[unit]()
+    n, hold = 2 * dut.fifo_depth + 3, dut.fifo_depth + dut.port_latency + 4
+    samples = run_traffic(dut, n, 0.0, 0.0, 0, max_cycles=20 * (n + hold), hold=hold,
+                          after=dut.port_latency + 8)
+    assert sum(v and r for v, r, *_ in samples[:hold]) == dut.fifo_depth, unit
+    assert not any(ov for _, _, ov, *_ in samples[:dut.port_latency]), unit
+    assert all(ov for _, _, ov, *_ in samples[hold:hold + dut.fifo_depth]), unit
+    taken = [tag for _, _, ov, orr, tag in samples if ov and orr]
+    width = len(dut.o.payload.tag)
+    assert taken == [k % (1 << width) for k in range(n)], unit
+    assert not any(ov for _, _, ov, *_ in samples[-dut.port_latency - 8:]), unit
 
 
 @pytest.mark.parametrize("unit", list(UNITS))
