@@ -737,7 +737,9 @@ def run_target(target, n, seed, out, jobs, stim_n, eq_timeout, log=print, pipeli
         (rtl / SAMPLE_STAMP).write_text(json.dumps({"sample": n, "seed": seed}))
     # a kept mutated.v is used only when today's script and shim built it; else it is built
     # again from the kept prepared netlist and mutation list
-    mutated_netlist(v, design, _listed(rtl), rtl, reuse=kept is not None)
+    # pmuxtree: Icarus reads the function Yosys writes for a $pmux named \$procmux$N (a
+    # banked FIFO's read select) as a system function, as for the board's units
+    mutated_netlist(v, design, _listed(rtl), rtl, reuse=kept is not None, passes=("pmuxtree",))
     lines = _listed(rtl)
     mv = rtl / "mutated.v"
     base = run_one(mv, j, job, work / "run0", 0, sim)
