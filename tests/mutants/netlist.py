@@ -540,9 +540,9 @@ def _rel_steps(net, line, work, timeout, has_stream, steps):
             continue                        # never: not a cnot mutation
         if verdict == "equivalent":
             if step == "never":
-                return (f"equivalent (never: z3 proves on the design alone, memories cut to "
-                        f"free read data, {how}; the mutant computes what the design does "
-                        f"in every such state)"), why
+                return (f"equivalent (never: on the design alone, memories cut to free read "
+                        f"data, {how}; the mutant computes what the design does in every "
+                        f"such state)"), why
             return _proved(f"rel: z3 proves on the product machine of design and mutant, "
                            f"memories cut to free read data, {how}", has_stream), why
         why.append(how)

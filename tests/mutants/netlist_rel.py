@@ -41,6 +41,7 @@ input differs) must hold in every state satisfying it; sat finding a state that 
 ends the step undecided.
 """
 
+import itertools
 import json
 import sys
 import time
@@ -311,11 +312,108 @@ def never(net, line, rtl, yosys_run, timeout, log=None, detail=None, depths=NEVE
                               f" <= {bound[n]:#x}" for n in sorted(start, key=str)
                               if n in bound and bound[n] < top[n])[:300]
             return "equivalent", (f"the control bit is {'0' if active else '1'} (inactive) in "
-                                  f"every reachable state of the design: upper bounds "
-                                  f"inductive, {last}; {size}; at the control bit: {shown}")
+                                  f"every reachable state of the design: z3 proves upper "
+                                  f"bounds inductive, {last}; {size}; at the control bit: {shown}")
         if depth is None or all(k <= depth for k in dist.values()):
             break
-    return "undecided", f"never: the bounds do not show the control bit inactive ({last})"
+    said = f"never: the bounds do not show the control bit inactive ({last})"
+    left = timeout - (time.monotonic() - t0)
+    try:
+        verdict, how = reach(text, active, work, yosys_run, left)
+    except nc.Undecided as e:
+        return "undecided", f"{said}; reach: {e}"
+    if verdict == "equivalent":
+        return "equivalent", how
+    return "undecided", f"{said}; {how}"
+
+
+# --- reach: every reachable state of a small cone, enumerated ------------------------------
+
+REACH_LATCHES = 24       # the largest cone reach enumerates: 2**24 states at most
+REACH_INPUTS = 12        # 2**12 input vectors a state at most
+REACH_STATES = 1 << 18   # states visited before the step gives up
+
+
+def reach(text, active, work, yosys_run, timeout):
+    """The control bit's cone of the design alone (``text``, :func:`single`'s JSON with its
+    output ``target``), every reachable state enumerated: ``("equivalent", how)`` when
+    ``target`` is never ``active`` in any of them under any input, else ``("undecided",
+    why)``. Yosys keeps only the cone of ``target`` (``opt -fast``; ``opt_clean``), so a
+    counter bounded only by its relation to other registers (a FIFO's count by the credits
+    it shares with the pipe's valid bits) is decided exactly where inductive upper bounds
+    cannot state it. The memories' read data are free inputs each cycle (any contents) and
+    so are ``rst`` and every other port: a state reached here may be unreachable in the
+    design, never the other way round, so "never active" is a proof and "active" is not a
+    kill. A register without an initial value starts at either value."""
+    d = json.loads(text)
+    mod = d["modules"]["product"]
+    mod["ports"] = {k: v for k, v in mod["ports"].items()
+                    if v["direction"] == "input" or k == "target"}
+    t0 = time.monotonic()
+    got = npdr.blast(json.dumps(d), Path(work), yosys_run, max(1, int(timeout)) + 1, "reach_cone")
+    if got is None:
+        return "undecided", f"reach: no proof within {timeout:.0f} s (bit-blasting)"
+    aag = npdr.parse_aag(got[0].read_text())
+    ands = {x[0] >> 1: (x[1], x[2]) for x in aag["and"]}
+    latches = aag["l"]
+    (out,) = aag["o"]
+    inputs = {i >> 1 for i in aag["i"]}
+    seen, stack, support = set(), [out >> 1] + [l[1] >> 1 for l in latches], set()
+    while stack:
+        v = stack.pop()
+        if v in seen or not v:
+            continue
+        seen.add(v)
+        if v in ands:
+            stack += [w >> 1 for w in ands[v]]
+        elif v in inputs:
+            support.add(v)
+    support = sorted(support)
+    size = f"{len(latches)} latches, {len(support)} inputs, {len(ands)} and gates"
+    if len(latches) > REACH_LATCHES or len(support) > REACH_INPUTS:
+        return "undecided", f"reach: the cone is too large to enumerate ({size})"
+    order = sorted(ands)                 # AIGER numbers an and gate after its operands
+
+    def step(state, vector):
+        val = {0: False}
+        val.update((l[0] >> 1, b) for l, b in zip(latches, state, strict=True))
+        val.update(zip(support, vector, strict=True))
+
+        def lit(x):
+            return val[x >> 1] ^ bool(x & 1)
+        for v in order:
+            a, b = ands[v]
+            val[v] = lit(a) and lit(b)
+        return tuple(lit(l[1]) for l in latches), lit(out)
+
+    # a latch's reset is 0, 1 or itself (either value); under -zinit Yosys resets every
+    # latch to 0 and gives a register without an initial value its first value from an input
+    choices = [(False,) if l[2] == 0 else (True,) if l[2] == 1 else (False, True) for l in latches]
+    start = set(itertools.product(*choices))
+    vectors = list(itertools.product((False, True), repeat=len(support)))
+    reached, frontier = set(start), list(start)
+    while frontier:
+        nxt = []
+        for state in frontier:
+            if time.monotonic() - t0 > timeout:
+                return "undecided", (f"reach: no proof within {timeout:.0f} s ({len(reached)} "
+                                     f"states so far; {size})")
+            for vector in vectors:
+                new, bit = step(state, vector)
+                if bit == active:
+                    return "undecided", (f"reach: the control bit is {int(active)} (active) "
+                                         f"in a reachable state of its cone with the memories' "
+                                         f"read data free ({size})")
+                if new not in reached:
+                    if len(reached) >= REACH_STATES:
+                        return "undecided", f"reach: more than {REACH_STATES} states ({size})"
+                    reached.add(new)
+                    nxt.append(new)
+        frontier = nxt
+    return "equivalent", (f"the control bit is {int(not active)} (inactive) in every "
+                          f"reachable state of the design: reach enumerated all {len(reached)} "
+                          f"reachable states of its cone ({size}; the memories' read data and "
+                          f"every input free)")
 
 
 # --- rel: Houdini with relational clauses on the product machine ---------------------------
