@@ -18,10 +18,10 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   product), theta at or next to 0 and 180 degrees, phi next to 0 / 360, and directions
   within a few degrees of the bumped normal N'' and of -N'' (N''.L and N''.H near +-1,
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
-* (exact method, varying map) 28 pixels whose positive dot products sit within 2 LSBs of
-  their rounding carry (the nearest of CARRY_POOL random pixels), their N' written into the
-  map: a wrong low bit of a product moves the dot, which random pixels show about once in
-  ten thousand;
+* (exact method) 28 pixels whose positive dot products sit within 2 LSBs of their rounding
+  carry (the nearest of CARRY_POOL random pixels), with a varying map their N' written into
+  the map, with a flat map searched over the lights alone (N and N' the polygon's): a wrong
+  low bit of a product moves the dot, which random pixels show about once in ten thousand;
 * (exact method) the table-sensitivity pixels, after the ``n`` others: a wrong low bit of a
   quarter-wave sine/cosine ROM word moves a dot product by a fraction of an LSB, which a
   rendered frame practically never shows. Every ROM read the golden rotation makes
@@ -260,14 +260,16 @@ CARRY_POOL = 1 << 20
 CARRY_PIXELS = 14            # kept a dot product (positive dots only)
 
 
-def _near_carry(scene, seed):
+def _near_carry(scene, seed, fixed=None):
     """Angle codes (N, N', L, H of light 0) of a few pixels whose exact-method dot products
-    sit within a few tens of LSBs of their rounding carry (sim/tb/bulk_sources.py's
-    rounding_codes over CARRY_POOL pixels), or None (another method, a flat map or palette
-    shading): a wrong low bit of a product moves their dot."""
-    if scene.shading != "per-pixel" or scene.bump_map != "varying":
+    sit within a few LSBs of their rounding carry (sim/tb/bulk_sources.py's rounding_codes
+    over CARRY_POOL pixels), or None (another method or palette shading): a wrong low bit of
+    a product moves their dot. ``fixed``: a flat map's N and N' codes (its polygon's), the
+    search then over the lights alone."""
+    if scene.shading != "per-pixel" or (scene.bump_map != "varying" and fixed is None):
         return None
-    return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS, lit=True)
+    return rounding_codes(scene.config, seed, pool=CARRY_POOL, count=CARRY_PIXELS, lit=True,
+                          fixed=fixed)
 
 
 # The table-sensitivity pixels: random pixels searched (a flipped bit 0 of one read's word
@@ -409,6 +411,14 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
             for own, key in keys.items():
                 if own.endswith(".phi"):
                     inputs[key], inputs[keys[own[:-4] + ".theta"]] = _light(rng, n, cfg, axis)
+        if polygon is not None:     # a flat map's pixels next to a rounding carry: its lights
+            plane = _near_carry(scene, seed, {"n.phi": n_phi[0], "n.theta": 0,
+                                              "b.phi": b_phi[0], "b.theta": b_theta[0]})
+            if plane is not None:
+                pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(plane["l.phi"])]
+                for key in ("l.phi", "l.theta", "h.phi", "h.theta"):
+                    if key in inputs:
+                        inputs[key][pick] = plane[key][:len(pick)]
     if addr is not None and near is not None:   # the pixels next to a rounding carry
         pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(slots)]
         u, v, level = _address_coords(scene, slots[:len(pick)], rng)

@@ -80,7 +80,7 @@ ROUNDING_POOL = 1 << 14      # random pixels searched for the dot products' roun
 ROUNDING_PIXELS = 64         # pixels kept a dot product (L's, and H's with specular)
 
 
-def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS, lit=False):
+def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS, lit=False, fixed=None):
     """Angle codes of pixels whose exact-method dot products sit next to their one rounding
     (rtl/exact.py: ``(pair + zz_half) >> (B + 3)``, the rounding half in ``zz_half``): of
     ``pool`` random pixels (ROUNDING_POOL), the ``count`` per dot (ROUNDING_PIXELS) whose
@@ -88,10 +88,13 @@ def rounding_codes(cfg, seed=0, pool=ROUNDING_POOL, count=ROUNDING_PIXELS, lit=F
     carry into bit B + 3, either side (a few hundred LSBs at most), so a wrong low bit of
     either adder operand moves the dot. Random pixels reach such a sum about once in a
     thousand. ``lit``: only pixels whose dot is positive (a negative one is clamped to 0
-    before any output shows it). None for the other methods (other dot products)."""
+    before any output shows it). ``fixed``: codes every pixel of the pool shares (a flat
+    map's N and N', searched over the lights alone). None for the other methods (other dot
+    products)."""
     if cfg.method != "exact":
         return None
     codes = random_codes(pool, cfg, seed=seed)
+    codes.update({k: np.full(pool, int(v), np.int64) for k, v in (fixed or {}).items()})
     rot = rotation_fixed(codes, cfg)
     shift = cfg.frac_bits + 3
     picks = []

@@ -81,3 +81,36 @@ def test_bulk_palette_frame_equals_golden(name, build_dir):
     stacked = np.stack([golden[c] for c in channels])
     assert (stacked != stacked[:1]).any(axis=0).mean() > 0.9     # channels differ
     _stream(v, j, meta, frame, golden, build_dir / "bulk")
+
+
+def _dot_residues(rot, n_terms, v, shift):
+    """Distance of each pixel's exact-method dot sum n''.v'' (rtl/exact.py: x4 p2 + 2 y2 y2 +
+    2 z4 z, rounded once at ``shift`` bits) to its rounding carry, and whether the sum is
+    positive; ``n_terms`` the n'' terms, ``rot`` the rotated vector terms."""
+    acc = (n_terms["n.x4"] * rot[f"{v}.p2"] + 2 * n_terms["n.y2"] * rot[f"{v}.y2"]
+           + 2 * n_terms["n.z4"] * rot[f"{v}.z"])
+    d = (acc + (1 << (shift - 1))) & ((1 << shift) - 1)
+    return np.minimum(d, (1 << shift) - d), acc > 0
+
+
+def test_a_flat_maps_frame_holds_dots_next_to_their_rounding_carry():
+    """A flat map's N and N' are its polygon's, so its frame's near-carry pixels are searched
+    over the lights: at least CARRY_PIXELS of them have a positive L (and H) dot sum within 2
+    LSBs of the carry, where a wrong low bit of a product moves the dot; random lights put
+    one there about once in ten thousand. Computed here from the frame's own codes and the
+    polygon's n'' terms (rtl/exact.py's sum), not by the frame's search."""
+    from bumprtl.sim.golden.fixed.exact import rotation_fixed
+    from bumprtl.sim.tb.bulk_frame import CARRY_PIXELS, PIXELS
+    scene = load_scene_config("flat")
+    cfg = scene.config
+    _, words, _, _, base = scene_stimulus(scene, 16)
+    frame = coverage_frame(scene, words, scene_texels(scene, base))
+    codes = {k: np.asarray(frame.inputs[k][:PIXELS], np.int64)
+             for k in ("l.phi", "l.theta", "h.phi", "h.theta")}
+    # the plane faces +z (theta_N = 0) at the polygon's phi_N; its n'' terms are registers
+    codes["n.phi"] = np.full(PIXELS, frame.polygon["n_phi"], np.int64)
+    codes["n.theta"] = codes["b.phi"] = codes["b.theta"] = np.zeros(PIXELS, np.int64)
+    rot = {k: np.asarray(v, np.int64) for k, v in rotation_fixed(codes, cfg).items()}
+    for v in ("l", "h") if cfg.specular else ("l",):
+        dist, lit = _dot_residues(rot, frame.polygon, v, cfg.frac_bits + 3)
+        assert np.count_nonzero((dist <= 2) & lit) >= CARRY_PIXELS, v
