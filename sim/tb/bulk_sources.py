@@ -36,8 +36,16 @@ def _counts(n, chunk):
     return [min(chunk, n - s) for s in range(0, n, chunk)]
 
 
+# odd, so k -> k * TAG_STEP is a bijection modulo 2**bits: 2**bits pixels in a row carry
+# every tag once, and the tags' high bits toggle from the second pixel on
+TAG_STEP = 0x9E37
+
+
 def _tags(n, start, bits):
-    return (np.arange(start, start + n, dtype=np.int64)) & ((1 << bits) - 1)
+    """The tags of pixels ``start`` .. ``start + n - 1``: k * TAG_STEP modulo 2**bits. Counting
+    tags (k itself) would leave a 16-bit tag's high bits 0 for the first 2**15 pixels, and
+    with them every register and FIFO slice that carries only those bits."""
+    return (np.arange(start, start + n, dtype=np.int64) * TAG_STEP) & ((1 << bits) - 1)
 
 
 def _out_fields(meta):

@@ -1,5 +1,5 @@
 """The bulk path's stimulus generators (sim/tb/bulk_sources.py) outside the simulator, at
-tiny sizes: the chunks cover ``n`` with tags counting on across them, each source puts
+tiny sizes: the chunks cover ``n`` with tags counting on across them (k * TAG_STEP), each source puts
 what its docstring promises first (quadrant edges, the edge cases and rounding carries,
 the palette's corners and a decoy table swapped out, the pipeline's corners), and the
 expected outputs are the golden model's on exactly those inputs. make regress streams 10^7
@@ -23,6 +23,7 @@ from bumprtl.sim.golden.vectors import edge_codes, random_codes
 from bumprtl.sim.scenes.config import load_scene_config
 from bumprtl.sim.tb.bulk_sources import (
     SOURCES,
+    TAG_STEP,
     make_source,
     palette_table,
     pipeline_map,
@@ -52,8 +53,13 @@ def _all(meta, spec, chunk):
 
 
 def _tags_count_on(chunks, n, bits):
+    """Pixel k's tag is k * TAG_STEP modulo 2**bits across the chunks: every tag once in a
+    run of 2**bits pixels, the top bit set among the first few."""
     tags = np.concatenate([i["tag"] for i, _ in chunks])
-    assert np.array_equal(tags, np.arange(n) % (1 << bits))
+    assert np.array_equal(tags, (np.arange(n) * TAG_STEP) % (1 << bits))
+    assert np.any(tags[:4] >> (bits - 1)), tags[:4]
+    if n >= 1 << bits:
+        assert len(set(tags[:1 << bits].tolist())) == 1 << bits
     for inputs, want in chunks:
         if want is not None:
             assert np.array_equal(want["tag"], inputs["tag"])
