@@ -12,7 +12,9 @@ played one per clock into the host ports; ``gap_seed``/``gap_density``,
 ``bp_seed``/``bp_density`` (a gap or a stall when the upper 16 bits of the next xorshift32
 state are below the density, out of 2**16); ``fill_hold`` (non-zero: the chunk's first
 stall, o.ready low until i.ready has been low or the input all taken for that many
-cycles, sim/traffic.fill_hold); ``idle_limit``. Status: ``done`` (held until
+cycles, sim/traffic.fill_hold); ``reset_prefix`` (non-zero: the run begins with that
+many cycles of junk pixels offered to a stalled sink, then a one-cycle reset of the unit
+with them in flight; with ``count`` 0 that is the whole run, :func:`reset_prefix`); ``idle_limit``. Status: ``done`` (held until
 ``start`` falls), ``timed_out``, ``n_in``, ``n_out``, ``cycles``. Outputs go to
 ``bulk_out.bin``, one ``%u`` word each. A unit with an AXI4 read port (``axi__*``,
 ``map_memory = "axi"``) gets the wrapper's memory model on it (``BULK_AXI``): it holds
@@ -27,7 +29,7 @@ import numpy as np
 
 __all__ = ["TEMPLATE", "TOP", "HOOK", "PERIOD", "DENSITY_BITS", "IN_FILE", "OUT_FILE",
            "SETUP_FILE", "AXI_FILE", "OWN_CLOCK_DEFINE", "AXI_DEFINE", "has_axi", "host_fields",
-           "setup_arrays", "setup_writes", "wrapper_verilog"]
+           "setup_arrays", "setup_writes", "wrapper_verilog", "reset_prefix"]
 
 TEMPLATE = files("bumprtl.sim.tb").joinpath("bulk_wrapper.v")
 TOP = "bulk_wrapper"
@@ -147,3 +149,14 @@ def wrapper_verilog(meta, own_clock, chunk):
         defines[AXI_DEFINE] = 1
     head = f"// bulk wrapper around `{unit}` (widths from {unit}.json): {parameters}\n"
     return TOP, head + template.replace(HOOK, _connections(meta)), parameters, defines
+
+
+def reset_prefix(meta):
+    """The junk cycles of the run before the set-up (``reset_prefix`` of the wrapper, with
+    ``count`` = 0) for the unit of sidecar ``meta``: its latency + 2, so every stage of the
+    pipe holds a pixel and the FIFO has begun to fill when the unit is reset; after the
+    reset no pixel may be in flight (docs/integration.md, Clock and reset), so any that
+    comes out later is an output the golden model does not have. It runs before the host's
+    set-up because a reset clears the host's registers (a flat map's polygon, the palette's
+    bank in front), not the memories; an AXI memory drops its outstanding bursts with it."""
+    return meta.latency + 2

@@ -3,7 +3,9 @@
 // part of any emitted unit.
 //
 // Stimulus words come from bulk_in.bin ($fread into a memory), traffic from two xorshift32
-// generators (with fill_hold > 0 each chunk first holds o.ready low until i.ready has been
+// generators (with reset_prefix > 0 a run first offers that many cycles of junk pixels,
+// every bit 1, to a stalled sink and then resets the unit for one cycle with them in flight:
+// none may come out; with count = 0 that prefix is the whole run; with fill_hold > 0 each chunk first holds o.ready low until i.ready has been
 // low, every credit spent, or the chunk's input all taken, for fill_hold cycles: the unit's
 // FIFO full, then drained under the random stalls), every output word goes to bulk_out.bin ($fwrite %u); with BUMPRTL_BULK_DPI
 // defined (Verilator) the same files go through DPI-C (bulk_dpi.cpp). With BULK_OWN_CLOCK
@@ -65,6 +67,7 @@ module bulk_wrapper #(
   input wire [DENSITY_BITS:0] bp_density /*verilator public_flat_rw*/,
   input wire [31:0] idle_limit /*verilator public_flat_rw*/,
   input wire [31:0] fill_hold /*verilator public_flat_rw*/,
+  input wire [31:0] reset_prefix /*verilator public_flat_rw*/,
   input wire setup_mode /*verilator public_flat_rw*/,
   output reg done /*verilator public_flat_rw*/,
   output reg timed_out /*verilator public_flat_rw*/,
@@ -105,6 +108,10 @@ module bulk_wrapper #(
   reg [31:0] bp_rng;
   reg [31:0] idle;
   reg filling;                         // the chunk's first stall, until the FIFO is full
+  reg junking;                         // the chunk's reset prefix: junk pixels, then a reset
+  reg junk_rst;                        // the unit's reset at the prefix's end (one cycle)
+  reg [31:0] junk_n;                   // junk pixel cycles so far
+  wire dut_rst = unit_rst | junk_rst;
   reg [31:0] fill_n;                   // cycles i.ready low (or the input all taken) so far
   integer fd;
   integer nread;
@@ -181,6 +188,10 @@ module bulk_wrapper #(
       ax_clock <= 48'd0;
       ar_count <= 32'd0;
       ar_sum <= 64'd0;
+    end else if (junk_rst) begin         // the reset prefix: outstanding bursts dropped
+      ax_wr <= {(QW + 1){1'b0}};
+      ax_rd <= {(QW + 1){1'b0}};
+      ax_beat <= 8'd0;
     end else begin
       ax_clock <= ax_clock + 48'd1;
       if (ax_arvalid && ax_arready) begin
@@ -204,7 +215,7 @@ module bulk_wrapper #(
 
   `BULK_UNIT dut (
     .clk(clk),
-    .rst(unit_rst),
+    .rst(dut_rst),
     .i__valid(in_valid),
     .i__payload(in_payload),
     .i__ready(in_ready),
@@ -229,6 +240,8 @@ module bulk_wrapper #(
   initial hword = {HWS{1'b0}};
   initial playing = 1'b0;
   initial filling = 1'b0;
+  initial junking = 1'b0;
+  initial junk_rst = 1'b0;
 
   always @(posedge clk) begin
     unit_rst <= rst;
@@ -271,7 +284,9 @@ module bulk_wrapper #(
           fd = $fopen("bulk_out.bin", "wb");
 `endif
           run <= 1'b1;
-        end else
+        end else if (reset_prefix != 32'd0)
+          run <= 1'b1;                   // the reset prefix alone (count = 0)
+        else
           done <= 1'b1;
         rd <= {AW{1'b0}};
         n_in <= {AW{1'b0}};
@@ -283,6 +298,9 @@ module bulk_wrapper #(
         bp_rng <= (bp_seed == 32'd0) ? 32'd1 : bp_seed;
         filling <= fill_hold != 32'd0;
         fill_n <= 32'd0;
+        junking <= reset_prefix != 32'd0;
+        junk_n <= 32'd0;
+        junk_rst <= 1'b0;
       end else if (!start)
         done <= 1'b0;
     end else if (playing) begin
@@ -295,6 +313,25 @@ module bulk_wrapper #(
         hword <= {HWS{1'b0}};
         playing <= 1'b0;
         done <= 1'b1;
+      end
+    end else if (junking) begin
+      // the reset prefix: junk pixels (every bit 1) taken while the sink stalls, then one
+      // cycle of reset with them in flight; none of them may come out
+      out_ready <= 1'b0;
+      if (junk_rst) begin
+        junk_rst <= 1'b0;
+        junking <= 1'b0;
+        if (count == {AW{1'b0}}) begin   // the prefix alone: done
+          run <= 1'b0;
+          done <= 1'b1;
+        end
+      end else if (junk_n == reset_prefix) begin
+        in_valid <= 1'b0;
+        junk_rst <= 1'b1;
+      end else begin
+        in_valid <= 1'b1;
+        in_payload <= {IW{1'b1}};
+        junk_n <= junk_n + 32'd1;
       end
     end else begin
       cycles <= cycles + 48'd1;

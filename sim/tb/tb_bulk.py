@@ -33,6 +33,7 @@ from bumprtl.sim.tb.bulk_wrapper import (
     PERIOD,
     SETUP_FILE,
     host_fields,
+    reset_prefix,
     setup_arrays,
 )
 from bumprtl.sim.traffic import fill_hold
@@ -57,7 +58,8 @@ async def _cycle(n=1):
 
 
 async def _reset_and_setup(dut, meta, setup, chunk):
-    """Reset, then the host set-up cycles (``[{port: int}]``, one per clock), played by the
+    """Reset, junk pixels in flight and a reset again (the wrapper's reset prefix), then the
+    host set-up cycles (``[{port: int}]``, one per clock), played by the
     wrapper from ``bulk_setup.bin`` in chunks: a map written through its port costs one
     clock a word, not one cocotb wake-up."""
     dut.start.value = 0
@@ -68,6 +70,16 @@ async def _reset_and_setup(dut, meta, setup, chunk):
     await _cycle(4)
     dut.rst.value = 0
     await _cycle(2)
+    # junk pixels in flight, then a reset (bulk_wrapper.reset_prefix): none may come out
+    dut.reset_prefix.value = reset_prefix(meta)
+    dut.fill_hold.value = 0
+    dut.start.value = 1
+    if not await _wait_done(dut, reset_prefix(meta), 0, 0):
+        raise AssertionError("timeout: the wrapper never finished the reset prefix")
+    dut.start.value = 0
+    while int(dut.done.value):
+        await _cycle()
+    dut.reset_prefix.value = 0
     if not setup:
         return
     fields, width = host_fields(meta)
