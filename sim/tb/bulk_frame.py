@@ -20,8 +20,10 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   where cos^n is steepest) and of its tangent plane (N''.L near 0: the clamp's edge);
 * (exact method) 28 pixels whose positive dot products sit within 2 LSBs of their rounding
   carry (the nearest of CARRY_POOL random pixels), with a varying map their N' written into
-  the map, with a flat map searched over the lights alone (N and N' the polygon's): a wrong
-  low bit of a product moves the dot, which random pixels show about once in ten thousand;
+  the map, with a flat map searched over the lights alone (N and N' the polygon's), every
+  light given the same L and H there (each light's illumination unit its own carries): a
+  wrong low bit of a product moves the dot, which random pixels show about once in ten
+  thousand;
 * (exact method) the table-sensitivity pixels, after the ``n`` others: a wrong low bit of a
   quarter-wave sine/cosine ROM word moves a dot product by a fraction of an LSB, which a
   rendered frame practically never shows. Every ROM read the golden rotation makes
@@ -416,18 +418,22 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
                                               "b.phi": b_phi[0], "b.theta": b_theta[0]})
             if plane is not None:
                 pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(plane["l.phi"])]
-                for key in ("l.phi", "l.theta", "h.phi", "h.theta"):
-                    if key in inputs:
-                        inputs[key][pick] = plane[key][:len(pick)]
+                for keys in light_keys(cfg):            # every light the same L and H
+                    for own, key in keys.items():
+                        inputs[key][pick] = plane[own][:len(pick)]
     if addr is not None and near is not None:   # the pixels next to a rounding carry
         pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(slots)]
         u, v, level = _address_coords(scene, slots[:len(pick)], rng)
         inputs["u"][pick], inputs["v"][pick] = u, v
         if "level" in inputs:
             inputs["level"][pick] = level
-        for key in ("n.phi", "n.theta", "l.phi", "l.theta", "h.phi", "h.theta"):
+        for key in ("n.phi", "n.theta"):
             if key in inputs:
                 inputs[key][pick] = near[key][:len(pick)]
+        if scene.shading != "palette":
+            for keys in light_keys(cfg):                # every light the same L and H
+                for own, key in keys.items():
+                    inputs[key][pick] = near[own][:len(pick)]
     table_px = _table_sensitive(scene, words, polygon, texels, seed, list(inputs))
     if table_px is not None:        # after the frame's own pixels
         inputs = {k: np.concatenate([np.asarray(v, np.int64), table_px[k]]) for k, v in inputs.items()}

@@ -114,3 +114,31 @@ def test_a_flat_maps_frame_holds_dots_next_to_their_rounding_carry():
     for v in ("l", "h") if cfg.specular else ("l",):
         dist, lit = _dot_residues(rot, frame.polygon, v, cfg.frac_bits + 3)
         assert np.count_nonzero((dist <= 2) & lit) >= CARRY_PIXELS, v
+
+
+def test_every_lights_dots_sit_next_to_their_rounding_carry():
+    """Each light has its own illumination unit, so each light's L and H dots need pixels
+    near their rounding carry: the two-light scene's frame has at least CARRY_PIXELS for
+    each light's L and H within 8 LSBs of it (the nearest of CARRY_POOL random pixels at
+    this scene's widths), its N' the texel each pixel fetches (the golden fetch)."""
+    from bumprtl.rtl.layouts import light_keys
+    from bumprtl.sim.golden.fixed.exact import rotation_fixed
+    from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, unpack_texels
+    from bumprtl.sim.tb.bulk_frame import CARRY_PIXELS, PIXELS
+    scene = load_scene_config("two-lights")
+    cfg = scene.config
+    _, words, _, _, base = scene_stimulus(scene, 16)
+    frame = coverage_frame(scene, words, scene_texels(scene, base))
+    ins = {k: np.asarray(v[:PIXELS], np.int64) for k, v in frame.inputs.items()}
+    b = unpack_texels(fetch_fixed(ins["u"], ins["v"], ins.get("level"), frame.words, scene), scene)
+    keys = light_keys(cfg)
+    assert len(keys) == 2
+    for light in keys:
+        codes = {"n.phi": ins["n.phi"], "n.theta": ins["n.theta"],
+                 "b.phi": np.asarray(b["b.phi"], np.int64),
+                 "b.theta": np.asarray(b["b.theta"], np.int64),
+                 **{own: ins[key] for own, key in light.items()}}
+        rot = {k: np.asarray(v, np.int64) for k, v in rotation_fixed(codes, cfg).items()}
+        for v in ("l", "h"):
+            dist, lit = _dot_residues(rot, rot, v, cfg.frac_bits + 3)
+            assert np.count_nonzero((dist <= 8) & lit) >= CARRY_PIXELS, (light[f"{v}.phi"], v)
