@@ -329,7 +329,7 @@ def never(net, line, rtl, yosys_run, timeout, log=None, detail=None, depths=NEVE
 
 # --- reach: every reachable state of a small cone, enumerated ------------------------------
 
-REACH_LATCHES = 24       # the largest cone reach enumerates: 2**24 states at most
+REACH_LATCHES = 32       # the largest cone reach enumerates (REACH_STATES bounds the visit)
 REACH_INPUTS = 12        # 2**12 input vectors a state at most
 REACH_STATES = 1 << 18   # states visited before the step gives up
 
