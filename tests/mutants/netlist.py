@@ -891,7 +891,7 @@ def _tally(r):
 # the start of what each of steps 4 to 8 says of a survivor it leaves undecided
 _NOTES = {"cone": ("cone reaches", "cone:"), "cut": ("cut:", "no invariant within",
                                                        "no proof of the cut"),
-          "never": ("never:",), "rel": ("rel:",), "pdr": ("pdr:",)}
+          "never": ("never:", "reach:"), "rel": ("rel:",), "pdr": ("pdr:",)}
 
 
 def _without_notes(verdict, steps):
