@@ -353,30 +353,17 @@ def reach(text, active, work, yosys_run, timeout):
     got = npdr.blast(json.dumps(d), Path(work), yosys_run, max(1, int(timeout)) + 1, "reach_cone")
     if got is None:
         return "undecided", f"reach: no proof within {timeout:.0f} s (bit-blasting)"
-    aag = npdr.parse_aag(got[0].read_text())
-    ands = {x[0] >> 1: (x[1], x[2]) for x in aag["and"]}
-    latches = aag["l"]
-    (out,) = aag["o"]
-    inputs = {i >> 1 for i in aag["i"]}
-    seen, stack, support = set(), [out >> 1] + [l[1] >> 1 for l in latches], set()
-    while stack:
-        v = stack.pop()
-        if v in seen or not v:
-            continue
-        seen.add(v)
-        if v in ands:
-            stack += [w >> 1 for w in ands[v]]
-        elif v in inputs:
-            support.add(v)
-    support = sorted(support)
-    size = f"{len(latches)} latches, {len(support)} inputs, {len(ands)} and gates"
-    if len(latches) > REACH_LATCHES or len(support) > REACH_INPUTS:
+    aig = npdr.Aig(got[0])
+    ands, (out,) = aig.defs, aig.outs
+    support = sorted(aig.support([out, *aig.next_lit])[1])
+    size = f"{len(aig.latch)} latches, {len(support)} inputs, {len(ands)} and gates"
+    if len(aig.latch) > REACH_LATCHES or len(support) > REACH_INPUTS:
         return "undecided", f"reach: the cone is too large to enumerate ({size})"
     order = sorted(ands)                 # AIGER numbers an and gate after its operands
 
     def step(state, vector):
         val = {0: False}
-        val.update((l[0] >> 1, b) for l, b in zip(latches, state, strict=True))
+        val.update((lat >> 1, b) for lat, b in zip(aig.latch, state, strict=True))
         val.update(zip(support, vector, strict=True))
 
         def lit(x):
@@ -384,11 +371,11 @@ def reach(text, active, work, yosys_run, timeout):
         for v in order:
             a, b = ands[v]
             val[v] = lit(a) and lit(b)
-        return tuple(lit(l[1]) for l in latches), lit(out)
+        return tuple(lit(x) for x in aig.next_lit), lit(out)
 
     # a latch's reset is 0, 1 or itself (either value); under -zinit Yosys resets every
     # latch to 0 and gives a register without an initial value its first value from an input
-    choices = [(False,) if l[2] == 0 else (True,) if l[2] == 1 else (False, True) for l in latches]
+    choices = [(False,) if r == 0 else (True,) if r == 1 else (False, True) for r in aig.init]
     start = set(itertools.product(*choices))
     vectors = list(itertools.product((False, True), repeat=len(support)))
     reached, frontier = set(start), list(start)
