@@ -280,7 +280,10 @@ def _buffer(ctx, rng):
 def _source(ctx, rng):
     from bumprtl.rtl.board import texel_coords
     md, table, fields = ctx["mode"], ctx["table"], ctx["leaves"]
-    n = int(2.0 * md.pixels * (LIGHT_STEPS + 1))
+    # two frames a light step, and past the tag's wrap: the tag counts the pixels issued
+    # (allow and ready each 0.8 of the cycles), so its top bits are reached only after
+    # 2**(tag_bits - 1) of them
+    n = max(int(2.0 * md.pixels * (LIGHT_STEPS + 1)), int(1.25 * (1 << ctx["tag_bits"]) / 0.64))
     ins = {"allow": (rng.random(n) < 0.8).astype(np.int64),
            "o__ready": (rng.random(n) < 0.8).astype(np.int64), "rst": _reset_at(rng, n)}
     ins["rst"][1:] = 0                # a reset part way would need one more frame wrap:
