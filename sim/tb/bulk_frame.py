@@ -377,7 +377,7 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     cfg = scene.config
     rng = np.random.default_rng([seed, n])
     inputs, writes, polygon, table, decoys = {}, [], None, None, []
-    addr = near = None
+    addr = near = slots = None
     if has_map(scene) or scene.texture:
         addr, words, texels, writes = _texel_writes(scene, rng, words, texels)
         near = _near_carry(scene, seed)
@@ -408,32 +408,26 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
             b_phi = np.full(n, int(rng.integers(0, cfg.full_circle)))
             b_theta = np.full(n, int(rng.integers(q // 3, 2 * q // 3)))
             polygon = polygon_fixed(n_phi[0], 0, b_phi[0], b_theta[0], scene)
+            # its pixels next to a rounding carry: the search over the lights alone
+            near = _near_carry(scene, seed, {"n.phi": n_phi[0], "n.theta": 0,
+                                             "b.phi": b_phi[0], "b.theta": b_theta[0]})
         axis = _world_normal(n_phi, n_theta, b_phi, b_theta, cfg)
         for keys in light_keys(cfg):
             for own, key in keys.items():
                 if own.endswith(".phi"):
                     inputs[key], inputs[keys[own[:-4] + ".theta"]] = _light(rng, n, cfg, axis)
-        if polygon is not None:     # a flat map's pixels next to a rounding carry: its lights
-            plane = _near_carry(scene, seed, {"n.phi": n_phi[0], "n.theta": 0,
-                                              "b.phi": b_phi[0], "b.theta": b_theta[0]})
-            if plane is not None:
-                pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(plane["l.phi"])]
-                for keys in light_keys(cfg):            # every light the same L and H
-                    for own, key in keys.items():
-                        inputs[key][pick] = plane[own][:len(pick)]
-    if addr is not None and near is not None:   # the pixels next to a rounding carry
-        pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(slots)]
-        u, v, level = _address_coords(scene, slots[:len(pick)], rng)
-        inputs["u"][pick], inputs["v"][pick] = u, v
-        if "level" in inputs:
-            inputs["level"][pick] = level
-        for key in ("n.phi", "n.theta"):
-            if key in inputs:
+    if near is not None:            # the pixels next to a rounding carry
+        pick = np.nonzero(np.arange(n) % 3 == 0)[0][:len(near["l.phi"] if slots is None else slots)]
+        if slots is not None:       # a varying map: N and the texel of the N' written
+            u, v, level = _address_coords(scene, slots[:len(pick)], rng)
+            inputs["u"][pick], inputs["v"][pick] = u, v
+            if "level" in inputs:
+                inputs["level"][pick] = level
+            for key in ("n.phi", "n.theta"):
                 inputs[key][pick] = near[key][:len(pick)]
-        if scene.shading != "palette":
-            for keys in light_keys(cfg):                # every light the same L and H
-                for own, key in keys.items():
-                    inputs[key][pick] = near[own][:len(pick)]
+        for keys in light_keys(cfg):                    # every light the same L and H
+            for own, key in keys.items():
+                inputs[key][pick] = near[own][:len(pick)]
     table_px = _table_sensitive(scene, words, polygon, texels, seed, list(inputs))
     if table_px is not None:        # after the frame's own pixels
         inputs = {k: np.concatenate([np.asarray(v, np.int64), table_px[k]]) for k, v in inputs.items()}
