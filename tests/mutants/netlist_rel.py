@@ -344,7 +344,8 @@ def reach(text, active, work, yosys_run, timeout):
     cannot state it. The memories' read data are free inputs each cycle (any contents) and
     so are ``rst`` and every other port: a state reached here may be unreachable in the
     design, never the other way round, so "never active" is a proof and "active" is not a
-    kill. A register without an initial value starts at either value."""
+    kill. A register without an initial value takes its first value from an input (Yosys's
+    ``-zinit``), so it starts at either value."""
     d = json.loads(text)
     mod = d["modules"]["product"]
     mod["ports"] = {k: v for k, v in mod["ports"].items()
@@ -373,10 +374,11 @@ def reach(text, active, work, yosys_run, timeout):
             val[v] = lit(a) and lit(b)
         return tuple(lit(x) for x in aig.next_lit), lit(out)
 
-    # a latch's reset is 0, 1 or itself (either value); under -zinit Yosys resets every
-    # latch to 0 and gives a register without an initial value its first value from an input
-    choices = [(False,) if r == 0 else (True,) if r == 1 else (False, True) for r in aig.init]
-    start = set(itertools.product(*choices))
+    # under -zinit (npdr.blast) Yosys resets every latch to 0 and gives a register without an
+    # initial value its first value from an input: one initial state
+    if None in aig.init:
+        return "undecided", f"reach: a latch without a reset value ({size})"
+    start = {tuple(bool(r) for r in aig.init)}
     vectors = list(itertools.product((False, True), repeat=len(support)))
     reached, frontier = set(start), list(start)
     while frontier:
