@@ -14,9 +14,9 @@ state are below the density, out of 2**16); ``fill_hold`` (non-zero: the chunk's
 stall, o.ready low until i.ready has been low or the input all taken for that many
 cycles, sim/traffic.fill_hold); ``reset_prefix`` (non-zero: the run begins with that
 many cycles of junk pixels offered to a stalled sink, then a one-cycle reset of the unit
-with them in flight; with ``count`` 0 that is the whole run, :func:`reset_prefix`); ``idle_limit``. Status: ``done`` (held until
-``start`` falls), ``timed_out``, ``n_in``, ``n_out``, ``cycles``. Outputs go to
-``bulk_out.bin``, one ``%u`` word each. A unit with an AXI4 read port (``axi__*``,
+with them in flight; with ``count`` 0 that is the whole run, :func:`reset_prefix`);
+``idle_limit``. Status: ``done`` (held until ``start`` falls), ``timed_out``, ``n_in``,
+``n_out``, ``cycles``. Outputs go to ``bulk_out.bin``, one ``%u`` word each. A unit with an AXI4 read port (``axi__*``,
 ``map_memory = "axi"``) gets the wrapper's memory model on it (``BULK_AXI``): it holds
 ``bulk_axi.bin`` (:data:`AXI_FILE`, the unit's ``_map.bin``), answers each burst
 ``axi_latency`` cycles after its AR handshake, and counts the requests (``ar_count``,

@@ -3,11 +3,12 @@
 // part of any emitted unit.
 //
 // Stimulus words come from bulk_in.bin ($fread into a memory), traffic from two xorshift32
-// generators (with reset_prefix > 0 a run first offers that many cycles of junk pixels,
-// every bit 1, to a stalled sink and then resets the unit for one cycle with them in flight:
-// none may come out; with count = 0 that prefix is the whole run; with fill_hold > 0 each chunk first holds o.ready low until i.ready has been
-// low, every credit spent, or the chunk's input all taken, for fill_hold cycles: the unit's
-// FIFO full, then drained under the random stalls), every output word goes to bulk_out.bin ($fwrite %u); with BUMPRTL_BULK_DPI
+// generators, every output word goes to bulk_out.bin ($fwrite %u). With reset_prefix > 0 a
+// run first offers that many cycles of junk pixels, every bit 1, to a stalled sink and then
+// resets the unit for one cycle with them in flight: none may come out (with count = 0 that
+// prefix is the whole run). With fill_hold > 0 each chunk first holds o.ready low until
+// i.ready has been low (every credit spent) or the chunk's input all taken for fill_hold
+// cycles: the unit's FIFO full, then drained under the random stalls. With BUMPRTL_BULK_DPI
 // defined (Verilator) the same files go through DPI-C (bulk_dpi.cpp). With BULK_OWN_CLOCK
 // defined (Icarus) the wrapper toggles clk itself; otherwise clk is an input, toggled by
 // the Verilator build's C++ main (bulk_main.cpp).
