@@ -436,6 +436,45 @@ def lay_out(dest, src, files):
     shutil.rmtree(dest / "tests" / "mutants", ignore_errors=True)
 
 
+# in the laid-out copy but not of the commit: mutmut's own files and the runner's
+OWN = {"mutants", "setup.cfg", "preload_modules.txt", ".commit"}
+
+
+def update_tree(tree, src, files):
+    """Lay out another commit over a copy mutmut has already mutated, so that it generates
+    again only the files the commit changed (it regenerates a file whose source is newer
+    than its mutated copy, and mutating every file takes tens of minutes). Changed and new
+    files are copied with the current time, removed files go from both copies, and the
+    results and test record of the old commit are dropped (its tests may differ). Returns
+    the paths changed."""
+    new = tree.parent / "tree.new"
+    lay_out(new, src, files)
+    changed, now = [], time.time()
+    for f in sorted(p for p in new.rglob("*") if p.is_file()):
+        rel = f.relative_to(new)
+        old = tree / rel
+        if not old.is_file() or old.read_bytes() != f.read_bytes():
+            old.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(f, old)
+            os.utime(old, (now, now))
+            changed.append(str(rel))
+    for f in sorted(p for p in tree.rglob("*") if p.is_file()):
+        rel = f.relative_to(tree)
+        if rel.parts[0] in OWN or (new / rel).exists():
+            continue
+        f.unlink()
+        for gone in (tree / "mutants" / rel, tree / "mutants" / f"{rel}.meta"):
+            gone.unlink(missing_ok=True)
+        changed.append(f"{rel} (removed)")
+    shutil.rmtree(new)
+    (tree / "mutants" / "mutmut-stats.json").unlink(missing_ok=True)
+    for meta in (tree / "mutants").rglob("*.meta"):
+        data = json.loads(meta.read_text())
+        data["exit_code_by_key"] = dict.fromkeys(data.get("exit_code_by_key", {}))
+        meta.write_text(json.dumps(data))
+    return changed
+
+
 def selected_tests(dest, tests=None):
     """The tests (default TESTS) that the commit has (the scene tests moved with the scene
     module)."""
@@ -443,13 +482,18 @@ def selected_tests(dest, tests=None):
     return [t for t in tests if (dest / t).exists()]
 
 
-def failing_tests(dest, env, log, tests=None, jobs=1):
+def failing_tests(dest, env, log, tests=None, jobs=1, recording=False):
     """The selected tests that fail on the unmutated commit (mutmut needs a green run):
     their node ids, to deselect and to list. ``jobs`` pytest workers (``-j``: no more
-    processes than the mutants themselves get)."""
+    processes than the mutants themselves get). ``recording``: with the trampolines
+    counting calls, as in mutmut's record (``MUTANT_UNDER_TEST=stats``, run in its
+    ``mutants/`` copy, whose setup.cfg the trampolines read): a test can fail there only,
+    and mutmut's record stops at its first failure without saying which."""
+    plugin = ["-p", "pymut_sim"] if recording else []
     r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rf", "-n", str(jobs), "-p", "no:cacheprovider",
-                        "-m", "not regress and not fpga and not formal", *selected_tests(dest, tests)],
-                       cwd=dest, env={**env, "PYTHONPATH": str(dest), "MUTANT_UNDER_TEST": ""},
+                        *plugin, "-m", "not regress and not fpga and not formal", *selected_tests(dest, tests)],
+                       cwd=dest, env={**env, "PYTHONPATH": str(dest),
+                                      "MUTANT_UNDER_TEST": "stats" if recording else ""},
                        capture_output=True, text=True)
     with open(log, "a") as f:
         f.write("\n$ baseline pytest\n" + r.stdout[-3000:] + r.stderr[-2000:])
@@ -703,6 +747,10 @@ def main(argv=None):
                    help="mutate only these files (bumprtl/<package>/... globs; default: all of MUTATE)")
     p.add_argument("--tests", action="append", default=None, metavar="PATH",
                    help="the tests mutmut selects from (default: TESTS)")
+    p.add_argument("--deselect", action="append", default=[], metavar="NODEID",
+                   help="leave this test out of the record and the runs (a test known to fail in "
+                        "mutmut's copy; the runner finds such tests itself when the record fails, "
+                        "at the cost of a run of the whole selection)")
     a = p.parse_args(argv)
     for name, value, lo in (("--sample", a.sample, 1), ("--jobs", a.jobs, 1), ("--min-area", a.min_area, 0)):
         if value < lo:
@@ -731,14 +779,21 @@ def main(argv=None):
         commit = head                    # the same commit laid out before: mutmut reuses its mutants
     else:
         files, commit = committed_tree(a.out / "head", a.commit)
-        lay_out(tree, a.out / "head", files)
+        if stamp.exists() and (tree / "mutants").is_dir():
+            changed = update_tree(tree, a.out / "head", files)
+            print(f"the copy of {stamp.read_text()} laid out again at {commit}: {len(changed)} "
+                  f"file(s) changed, mutmut mutates only those again", flush=True)
+        else:
+            lay_out(tree, a.out / "head", files)
         stamp.write_text(commit)
     # 1. generate every mutant and record which tests reach each function; the name filter
     #    matches none, so no mutant runs yet (mutmut stops there with an error we expect).
     #    mutmut's own record runs every selected test, so a separate clean run first is needed
     #    only when a test fails there (its record is then missing): then the baseline names
     #    the failing tests, they are left out, and the record is made again
-    deselect = failing_tests(tree, env, log, a.tests, a.jobs) if a.baseline else []
+    deselect = list(a.deselect)
+    if a.baseline:
+        deselect += failing_tests(tree, env, log, a.tests, a.jobs)
 
     def record():
         configure(tree, deselect, a.only, a.tests)
@@ -746,11 +801,13 @@ def main(argv=None):
         return all_results(tree) if (tree / "mutants" / "mutmut-stats.json").exists() else {}
     results = record()
     if not results and not a.baseline:
-        # where mutmut ran them: its mutants/ copy (the trampolines switched off), which
-        # holds only what mutmut copies there
+        # where mutmut ran them: its mutants/ copy, which holds only what mutmut copies
+        # there, with the trampolines recording as in mutmut's record
         where = tree / "mutants" if (tree / "mutants").is_dir() else tree
-        deselect = failing_tests(where, env, log, a.tests, a.jobs)
-        results = record() if deselect else {}
+        found = [t for t in failing_tests(where, env, log, a.tests, a.jobs, recording=where != tree)
+                 if t not in deselect]
+        deselect += found
+        results = record() if found else {}
     if deselect:
         print(f"{len(deselect)} selected test(s) fail on commit {commit} itself and are left out: "
               + ", ".join(deselect))
