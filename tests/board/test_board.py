@@ -75,7 +75,7 @@ def test_reduced_mode_frames_match_the_golden_frames_through_the_dvi_sink(build_
     with one clock."""
     scene = load_scene_config("default", SMALL)
     mode = MODES["test"]
-    r = check_frames(scene, mode, build_dir / "board", frames=3, opt_fast="-O0",   # a cocotb-paced run
+    r = check_frames(scene, mode, build_dir / "board", frames=2, opt_fast="-O0",   # a cocotb-paced run
                      pipe_hz=1.3 * mode.pixel_hz)
     assert (build_dir / "board" / "board_sim.v").read_text().count("pipe_clk") >= 2
     assert r["timing_errors"] == []

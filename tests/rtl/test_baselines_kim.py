@@ -125,6 +125,9 @@ def test_emission_lint_clean_and_deterministic(unit, build_dir):
     assert lint(v1) == []
 
 
+# make regress: make test runs the command line's emission of a baseline with Peercy's
+# (tests/rtl/test_baselines_cartesian.py) and Kim's emission through the API above
+@pytest.mark.regress
 def test_cli_emit_rotation_method_kim(tmp_path, run_cli):
     """The command line writes what emit_unit writes, byte for byte (deterministic across
     processes), and it is lint-clean. At 10-bit angles, B = 11: the default widths' ROMs

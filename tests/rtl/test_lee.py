@@ -52,8 +52,10 @@ def test_tables_against_float(cfg):
     assert np.all(np.abs(prop - (1 - np.arccos(y) / (np.pi / 2))) <= 0.5 / cfg.one + 1e-12)
 
 
-@pytest.mark.parametrize("cfg", [Config(method="lee"), TINY.replace(method="lee"),
-                                 Config(angle_bits=8, frac_bits=7)])
+# every ratio of the tiny and the 8-bit configuration in make test; the default's 2**W
+# ratios (a million) in make regress
+@pytest.mark.parametrize("cfg", [pytest.param(Config(method="lee"), marks=pytest.mark.regress),
+                                 TINY.replace(method="lee"), Config(angle_bits=8, frac_bits=7)])
 def test_atan_address_and_table(cfg):
     """Every ratio p < 2**W (k fractional bits) gets an address whose entry is atan(p / 2**k)
     within half an angle step plus the mantissa's error 2**-(M+2) rad; the address is
