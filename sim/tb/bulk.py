@@ -92,7 +92,7 @@ class BulkResult:
 
 
 def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, source, keep,
-             clock, chunk, idle_limit, seed, traffic, axi_latency):
+             clock, chunk, idle_limit, seed, traffic, axi_latency, between=()):
     """Write the job (and the stimulus arrays), run the cocotb test, read the summary and
     the outputs: ``(summary, outputs, run seconds)``."""
     module = "bumprtl.sim.tb.tb_bulk_gen"
@@ -109,7 +109,7 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
            "setup": list(setup), "source": source, "keep": bool(keep), "clock": clock,
            "chunk": chunk, "idle_limit": idle_limit, "seed": seed,
            "result": str(work / "bulk_result.npz"), "summary": str(summary_path),
-           "axi_latency": axi_latency}
+           "axi_latency": axi_latency, "between": list(between)}
     (work / "bulk_job.json").write_text(json.dumps(job, indent=1))
     summary_path.unlink(missing_ok=True)
     t0 = time.perf_counter()
@@ -142,7 +142,7 @@ def _run_job(sim, top, bdir, work, j_path, patterns, inputs, expected, setup, so
 def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None, expected=None,
              setup=(), source=None, widths=None, keep=True, clock=None, chunk=CHUNK,
              idle_limit=IDLE_LIMIT, seed=1, cache=None, traffic=None, io=None, opt_fast=None,
-             extra=None, axi_latency=AXI_LATENCY):
+             extra=None, axi_latency=AXI_LATENCY, between=()):
     """Stream stimulus through the emitted unit ``v_path`` (sidecar ``j_path``) on ``sim``
     under each traffic pattern, in bulk.
 
@@ -151,7 +151,8 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
     only the tags are checked, each once and in order) or ``source`` (``{"kind": name, "n":
     count, "seed": s}`` of sim/tb/bulk_sources.py: stimulus and golden outputs made and
     checked chunk by chunk inside the simulator process). ``setup``: host cycles
-    (:func:`setup_writes`) after reset. ``traffic`` adds or overrides patterns
+    (:func:`setup_writes`) after reset; ``between``: host cycles before every run of a
+    chunk under a pattern but the first (the pipeline drained). ``traffic`` adds or overrides patterns
     (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
     (regressions). ``clock``, ``io``, ``opt_fast``, ``extra``: the build
     (:func:`build_options`; None: the simulator's fastest, :data:`DEFAULTS`). A unit with
@@ -192,7 +193,7 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
         summary, outputs, run_s = _run_job(sim, top, bdir, work, j_path, patterns, inputs,
                                            expected, setup, source, keep, opts["clock"], chunk,
                                            idle_limit, seed, traffic,
-                                           axi_latency if axi else None)
+                                           axi_latency if axi else None, between)
     pats = summary["patterns"]
     per = lambda key: {p: pats[p][key] for p in patterns}
     return BulkResult(outputs, per("cycles"), per("pixels"), per("sim_s"), per("sim_cpu_s"),

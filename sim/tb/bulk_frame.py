@@ -42,7 +42,8 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
 * a palette scene's colour table random, read from bank 1 with decoy tables around it
-  (:meth:`CoverageFrame.setup`).
+  (:meth:`CoverageFrame.setup`), and from each bank in turn in the runs after the first,
+  a decoy in the other (:meth:`CoverageFrame.between`).
 
 The golden outputs are sim/golden/fixed/pipeline.py's on the memories as the host left
 them. Deterministic in ``seed``: make test's bulk pipeline test and the netlist mutants of
@@ -111,6 +112,16 @@ class CoverageFrame:
             cycles += setup_writes(meta, None, t)
         cycles += setup_writes(meta, None, last)[:-1]          # written, not swapped in
         return cycles + setup_writes(meta, self.polygon, None)
+
+    def between(self, meta):
+        """The host cycles before every run but the first (run_bulk's ``between``). A
+        palette scene's: the table written into the back bank and swapped in, then a decoy
+        written behind it, so the runs read the table from bank 1, bank 0, bank 1, ... with
+        the other bank holding a decoy (a pixel that reads the wrong bank shows it, in
+        either direction). Nothing for other scenes."""
+        if not self.decoys:
+            return []
+        return setup_writes(meta, None, self.table) + setup_writes(meta, None, self.decoys[-1])[:-1]
 
     def expected(self, meta):
         """The golden outputs of the pipeline's output fields, the tag included."""

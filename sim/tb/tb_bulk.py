@@ -80,6 +80,12 @@ async def _reset_and_setup(dut, meta, setup, chunk):
     while int(dut.done.value):
         await _cycle()
     dut.reset_prefix.value = 0
+    await _host_cycles(dut, meta, setup, chunk)
+
+
+async def _host_cycles(dut, meta, setup, chunk):
+    """Host cycles (``[{port: int}]``, one per clock) played by the wrapper from
+    ``bulk_setup.bin`` in chunks, with no pixel in flight."""
     if not setup:
         return
     fields, width = host_fields(meta)
@@ -144,6 +150,8 @@ async def _run(dut, job, meta, summary, make_source):
         n = len(inputs["tag"])
         Path(IN_FILE).write_bytes(encode_words(fin, iw, inputs))
         for j, pattern in enumerate(patterns):
+            if k or j:               # every run but the first: the job's host cycles between
+                await _host_cycles(dut, meta, job.get("between", []), job["chunk"])
             gap, stall = job["traffic"][pattern]
             dut.gap_density.value, dut.bp_density.value = gap, stall
             dut.fill_hold.value = fill_hold(meta.latency) if stall else 0

@@ -198,7 +198,8 @@ def emit_target(target, out, n, seed):
     if set(expected) == {"tag"}:
         raise NetlistError(f"{target}: no golden field matches the outputs "
                            f"{list(side.output_fields)}")
-    return v, j, {"inputs": frame.inputs, "expected": expected, "setup": frame.setup(side)}
+    return v, j, {"inputs": frame.inputs, "expected": expected, "setup": frame.setup(side),
+                  "between": frame.between(side)}
 
 
 # --- Yosys: the sample of mutations and the one netlist holding them all ---------------------

@@ -75,7 +75,7 @@ def test_bulk_pipeline_frame_equals_golden(sim, build_dir):
     assert n > size * size                                # the table-sensitivity pixels
     golden = frame.expected(meta)
     r = run_bulk(sim, v, j, build_dir / f"bulk_{sim}", tuple(TRAFFIC), inputs=frame.inputs,
-                 expected=golden, setup=frame.setup(meta))
+                 expected=golden, setup=frame.setup(meta), between=frame.between(meta))
     outs, cycles = r.outputs, r.cycles
     assert r.checked
     assert set(golden) == set(meta.output_fields)

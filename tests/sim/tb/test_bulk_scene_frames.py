@@ -36,7 +36,7 @@ def _scene_frame(scene, build_dir):
 def _stream(v, j, meta, frame, golden, work):
     """The frame through the build: each pixel once, in order, every field the golden one."""
     r = run_bulk("icarus", v, j, work, TRAFFIC, inputs=frame.inputs, expected=golden,
-                 setup=frame.setup(meta))
+                 setup=frame.setup(meta), between=frame.between(meta))
     assert r.checked
     for pattern in TRAFFIC:
         assert r.pixels[pattern] == len(frame.inputs["tag"]), pattern
@@ -70,7 +70,8 @@ PALETTE_SCENES = {"palette": "palette",
 @pytest.mark.parametrize("name", PALETTE_SCENES)
 def test_bulk_palette_frame_equals_golden(name, build_dir):
     """A palette scene's coverage frame: a random colour table read from bank 1 between
-    decoy tables, random indices written through the map's host port, and (textured)
+    decoy tables, then from bank 0 and bank 1 in turn with a decoy in the other bank (one
+    traffic pattern a bank: a bank stuck at either value shows), random indices written through the map's host port, and (textured)
     random texels. Every channel of the colour (r, g, b, a each a field of its own) equals
     the golden model's, so the RTL and the model cannot agree on a channel mix-up of the
     table entry or of eq. 2 unless both make it; the colours depend on the channel (a test
