@@ -38,6 +38,14 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   fewer), chosen greedily so that one pixel serves every read it moves: about 60 pixels for
   the reads of two lights, fewer for the default scene's (whose unrounded outputs show
   most flips);
+* (exact method, per-pixel shading) the dot-sensitivity pixels, after those: a wrong bit
+  of a product or partial sum moves a dot's unrounded sum by 2^k, which a rendered frame
+  shows only where the sum sits within 2^k of its rounding carry and the 8-bit shading is
+  steep there. Each light's L and H sums of DOT_POOL = 2^18 seeded random pixels are
+  recorded (sim/golden/fixed/exact.DOT_SUM); for every bit k up to the rounding point and
+  either sign, the pixels whose rounded dot the move of 2^k changes (at most DOT_CAP of
+  them) run with it, and the frame keeps DOT_QUOTA = 1 whose output changes (greedily, one
+  pixel serving every move it shows): a few dozen pixels;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
@@ -62,6 +70,7 @@ from bumprtl.rtl.bumpfetch import (
     memory_depth,
     pack_texels,
 )
+from bumprtl.rtl.fixed import round_shift
 from bumprtl.rtl.layouts import light_keys
 from bumprtl.rtl.palette import index_bits
 from bumprtl.sim.golden.common import cartesian_to_polar, world_bump_normal
@@ -375,6 +384,87 @@ def _table_sensitive(scene, words, polygon, texels, seed, keys):
     return {key: pool[key][pick] for key in keys}
 
 
+# The dot-sensitivity pixels: a wrong bit k of a product or of a partial sum moves a dot's
+# unrounded sum by 2**k, which changes the rounded dot only where the sum sits within 2**k of
+# its rounding carry, and an 8-bit output only where the shading is steep there too: for
+# k below the rounding point random pixels almost never show it. The sums of DOT_POOL seeded
+# random pixels are recorded (sim/golden/fixed/exact.DOT_SUM), and for each light, vector
+# (L, H), bit k below the rounding point plus the next one and sign, the pixels whose rounded
+# dot the move changes (at most DOT_CAP of them, a seeded choice) are run with it; the frame
+# keeps DOT_QUOTA of those whose output changes.
+DOT_POOL = 1 << 18
+DOT_CAP = 2048
+DOT_QUOTA = 1
+
+
+class _DotSums:
+    """The hook of sim/golden/fixed/exact.dot_fixed (DOT_SUM): records each light's L and H
+    sums of a golden run, or adds ``delta`` to one of them."""
+
+    def __init__(self):
+        self.site, self.delta, self.light, self.sums = None, 0, -1, {}
+
+    def __call__(self, v, acc):
+        if v == "l":
+            self.light += 1
+        if self.site is None:
+            self.sums[(self.light, v)] = np.array(acc, np.int64)
+        elif self.site == (self.light, v):
+            return acc + self.delta
+        return acc
+
+    def run(self, fn, site=None, delta=0):
+        saved, exact.DOT_SUM = exact.DOT_SUM, self
+        self.site, self.delta, self.light = site, delta, -1
+        try:
+            return fn()
+        finally:
+            exact.DOT_SUM = saved
+
+
+def _dot_sensitive(scene, words, polygon, texels, seed, keys):
+    """Inputs (``keys``) of the dot-sensitivity pixels of ``scene`` (see DOT_POOL), or None
+    (no exact-method dot product in its golden model: palette shading, another method)."""
+    cfg = scene.config
+    if scene.shading != "per-pixel" or cfg.method != "exact":
+        return None
+    rng = np.random.default_rng([seed, DOT_POOL, 3])
+    pool = random_inputs(scene, DOT_POOL, rng)
+    golden = lambda px: (lambda: pipeline_fixed(px, scene, words, polygon, texels))
+    hook = _DotSums()
+    base = hook.run(golden(pool))
+    shift = cfg.frac_bits + 3
+    groups = []                     # per light, vector, bit and sign: its sensitive pixels
+    for site, acc in sorted(hook.sums.items()):
+        dot = round_shift(acc, shift)
+        for k in range(shift + 1):
+            for delta in (1 << k, -(1 << k)):
+                cand = np.nonzero(round_shift(acc + delta, shift) != dot)[0]
+                if len(cand) > DOT_CAP:
+                    cand = np.sort(rng.choice(cand, DOT_CAP, replace=False))
+                out = hook.run(golden({key: v[cand] for key, v in pool.items()}), site, delta)
+                moved = np.zeros(len(cand), bool)
+                for key, want in base.items():
+                    moved |= np.asarray(out[key]) != np.asarray(want)[cand]
+                groups.append(cand[moved])
+    pick, need = [], [min(len(g), DOT_QUOTA) for g in groups]
+    sets = [set(g.tolist()) for g in groups]
+    while any(need):               # the pixel in most unfilled groups, then the next
+        counts = {}
+        for g, n in zip(sets, need, strict=True):
+            if n:
+                for p in g:
+                    counts[p] = counts.get(p, 0) + 1
+        best = min(counts, key=lambda p: (-counts[p], p))
+        pick.append(best)
+        need = [n - (n > 0 and best in g) for g, n in zip(sets, need, strict=True)]
+        for g in sets:
+            g.discard(best)
+    pick = np.sort(np.asarray(pick, np.int64))
+    assert set(keys) == set(pool) - {"tag"}, (sorted(keys), sorted(pool))
+    return {key: pool[key][pick] for key in keys}
+
+
 def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
     """The bumped normal N'' in the world (n, 3) from the angle codes."""
     rad = lambda c: np.asarray(c, np.float64) * (TWO_PI / cfg.full_circle)
@@ -384,7 +474,8 @@ def _world_normal(n_phi, n_theta, b_phi, b_theta, cfg):
 def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
     """The coverage frame of ``scene``'s pipeline emitted with map ``words`` and colour
     texture ``texels`` (as gen/render/rtl.scene_stimulus gives them; None without one):
-    ``n`` pixels, then the table-sensitivity pixels (none for palette shading)."""
+    ``n`` pixels, then the table-sensitivity and the dot-sensitivity pixels (none for
+    palette shading)."""
     cfg = scene.config
     rng = np.random.default_rng([seed, n])
     inputs, writes, polygon, table, decoys = {}, [], None, None, []
@@ -439,10 +530,11 @@ def coverage_frame(scene, words, texels, n=PIXELS, seed=SEED):
         for keys in light_keys(cfg):                    # every light the same L and H
             for own, key in keys.items():
                 inputs[key][pick] = near[own][:len(pick)]
-    table_px = _table_sensitive(scene, words, polygon, texels, seed, list(inputs))
-    if table_px is not None:        # after the frame's own pixels
-        inputs = {k: np.concatenate([np.asarray(v, np.int64), table_px[k]]) for k, v in inputs.items()}
-        n += len(next(iter(table_px.values())))
+    for extra in (_table_sensitive(scene, words, polygon, texels, seed, list(inputs)),
+                  _dot_sensitive(scene, words, polygon, texels, seed, list(inputs))):
+        if extra is not None:       # after the frame's own pixels
+            inputs = {k: np.concatenate([np.asarray(v, np.int64), extra[k]]) for k, v in inputs.items()}
+            n += len(next(iter(extra.values())))
     mask = (1 << scene.tag_bits) - 1
     tag = rng.integers(0, mask + 1, n)
     tag[:2] = (0, mask)

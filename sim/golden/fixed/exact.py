@@ -33,6 +33,12 @@ __all__ = ["rotation_fixed", "illumination_fixed", "dot_fixed", "vectors", "dot_
 # returns replaces the word. None changes nothing.
 TABLE_READ = None
 
+# A test hook like TABLE_READ, None outside sim/tb/bulk_frame.py's search for dot-sensitivity
+# pixels: ``f(v, acc) -> acc`` sees each dot_fixed call's unrounded sum (``v`` the vector,
+# "l" or "h", in the order illumination_fixed computes them, light after light); what it
+# returns is rounded instead.
+DOT_SUM = None
+
 
 def rotation_fixed(codes, cfg: Config):
     """VectorRotation (exact): n'' of the bump normal and p, y, cos th of L and H."""
@@ -62,6 +68,8 @@ def dot_fixed(rot, v, cfg: Config):
     wide = lambda key: rot[key].astype(np.int64)          # products need up to 2B + 8 bits
     acc = (wide("n.x4") * rot[f"{v}.p2"] + 2 * wide("n.y2") * rot[f"{v}.y2"]
            + 2 * wide("n.z4") * rot[f"{v}.z"])
+    if DOT_SUM is not None:
+        acc = DOT_SUM(v, acc)
     return round_shift(acc, cfg.frac_bits + 3)
 
 

@@ -117,7 +117,14 @@ def test_a_flat_maps_frame_holds_dots_next_to_their_rounding_carry():
         assert np.count_nonzero((dist <= 2) & lit) >= CARRY_PIXELS, v
 
 
-def test_every_lights_dots_sit_next_to_their_rounding_carry():
+@pytest.fixture(scope="module")
+def two_lights_frame():
+    scene = load_scene_config("two-lights")
+    _, words, _, _, base = scene_stimulus(scene, 16)
+    return scene, coverage_frame(scene, words, scene_texels(scene, base))
+
+
+def test_every_lights_dots_sit_next_to_their_rounding_carry(two_lights_frame):
     """Each light has its own illumination unit, so each light's L and H dots need pixels
     near their rounding carry: the two-light scene's frame has at least CARRY_PIXELS for
     each light's L and H within 8 LSBs of it (the nearest of CARRY_POOL random pixels at
@@ -126,10 +133,8 @@ def test_every_lights_dots_sit_next_to_their_rounding_carry():
     from bumprtl.sim.golden.fixed.exact import rotation_fixed
     from bumprtl.sim.golden.fixed.pipeline import fetch_fixed, unpack_texels
     from bumprtl.sim.tb.bulk_frame import CARRY_PIXELS, PIXELS
-    scene = load_scene_config("two-lights")
+    scene, frame = two_lights_frame
     cfg = scene.config
-    _, words, _, _, base = scene_stimulus(scene, 16)
-    frame = coverage_frame(scene, words, scene_texels(scene, base))
     ins = {k: np.asarray(v[:PIXELS], np.int64) for k, v in frame.inputs.items()}
     b = unpack_texels(fetch_fixed(ins["u"], ins["v"], ins.get("level"), frame.words, scene), scene)
     keys = light_keys(cfg)
@@ -143,3 +148,51 @@ def test_every_lights_dots_sit_next_to_their_rounding_carry():
         for v in ("l", "h"):
             dist, lit = _dot_residues(rot, rot, v, cfg.frac_bits + 3)
             assert np.count_nonzero((dist <= 8) & lit) >= CARRY_PIXELS, (light[f"{v}.phi"], v)
+
+
+def test_a_move_of_each_dot_sum_by_a_few_bits_below_its_lsb_shows(two_lights_frame):
+    """A wrong bit k of a product or a partial sum moves a dot's unrounded sum by 2**k. On
+    the two-light scene's frame (its dot-sensitivity pixels included) every light's L and H
+    sum moved by +2**k or by -2**k, for every k from 5 bits below the dot's rounding point
+    up, changes some output of the golden model; the frame's pixels before the
+    dot-sensitivity ones (the rendered-like, near-carry and table-sensitivity pixels) leave
+    some of those moves unseen. The moves are made through the golden model's DOT_SUM hook
+    on the frame's own inputs, not by the frame's search."""
+    from bumprtl.sim.golden.fixed import exact
+    from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed
+    scene, frame = two_lights_frame
+    cfg = scene.config
+    shift = cfg.frac_bits + 3
+    ins = {k: np.asarray(v, np.int64) for k, v in frame.inputs.items() if k != "tag"}
+
+    def unseen(px):
+        sums, site = [], {"at": None, "delta": 0}
+
+        def hook(v, acc):
+            if v == "l":
+                sums.append(v)
+            return acc + site["delta"] if site["at"] == (len(sums) - 1, v) else acc
+        saved, exact.DOT_SUM = exact.DOT_SUM, hook
+        try:
+            base = pipeline_fixed(px, scene, frame.words, frame.polygon, frame.texels)
+            lights = len(sums)
+            out = []
+            for at in [(j, v) for j in range(lights) for v in ("l", "h")]:
+                for k in range(shift - 5, shift + 2):
+                    for delta in (1 << k, -(1 << k)):
+                        sums.clear()
+                        site.update(at=at, delta=delta)
+                        got = pipeline_fixed(px, scene, frame.words, frame.polygon, frame.texels)
+                        if all(np.array_equal(got[f], base[f]) for f in base):
+                            out.append((at, k, delta))
+            return lights, out
+        finally:
+            exact.DOT_SUM = saved
+    lights, missed = unseen(ins)
+    assert lights == 2
+    assert missed == [], f"moves no output shows: {missed}"
+    from bumprtl.sim.tb.bulk_frame import SEED, _dot_sensitive
+    dots = _dot_sensitive(scene, frame.words, frame.polygon, frame.texels, SEED, list(ins))
+    first = len(frame.inputs["tag"]) - len(dots["u"])          # they end the frame
+    _, before = unseen({k: v[:first] for k, v in ins.items()})
+    assert before, "the frame's other pixels show every move already: the test sees nothing"
