@@ -770,8 +770,11 @@ def main(argv=None):
     a.out.mkdir(parents=True, exist_ok=True)
     log = a.out / "mutmut.log"
     log.write_text("")
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    # bytecode is written: the mutated copy holds every mutant of every file (hundreds of MB
+    # of source), and each process that imports it without .pyc files compiles all of it
+    # again (a cocotb bench's simulator then took minutes and GBs of memory before its
+    # first test, and the record failed on it)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONDONTWRITEBYTECODE")}
     head = subprocess.run(["git", "rev-parse", "--short", a.commit], cwd=ROOT, capture_output=True,
                           text=True, check=True).stdout.strip()
     stamp = tree / ".commit"
