@@ -458,6 +458,11 @@ def update_tree(tree, src, files):
             shutil.copyfile(f, old)
             os.utime(old, (now, now))
             changed.append(str(rel))
+            if rel.parts[0] == "bumprtl" and rel.suffix != ".py" and (tree / "mutants").is_dir():
+                # mutmut copies a package's other files (Verilog templates, C++) into its
+                # copy only when it first makes it: a changed one goes there now
+                (tree / "mutants" / rel).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(f, tree / "mutants" / rel)
     for f in sorted(p for p in tree.rglob("*") if p.is_file()):
         rel = f.relative_to(tree)
         if rel.parts[0] in OWN or (new / rel).exists():

@@ -26,6 +26,7 @@ def _commit(src, files):
 
 def test_update_touches_only_what_the_commit_changed(tmp_path):
     first = {"rtl/a.py": "def f():\n    return 1\n", "rtl/b.py": "def g():\n    return 2\n",
+             "sim/w.v": "module w; endmodule\n",
              "sim/c.py": "def h():\n    return 3\n", "tests/test_a.py": "def test_a():\n    pass\n"}
     src, tree = tmp_path / "src", tmp_path / "out" / "tree"
     pymut.lay_out(tree, src, _commit(src, first))
@@ -40,9 +41,11 @@ def test_update_touches_only_what_the_commit_changed(tmp_path):
         meta = {"exit_code_by_key": {f"bumprtl.{name[:-3].replace('/', '.')}.x_f__mutmut_1": 1},
                 "hash_by_function_name": {"x_f": "h"}}
         Path(f"{path}.meta").write_text(json.dumps(meta))
+    (mutants / "sim" / "w.v").write_text(first["sim/w.v"])            # copied when made
     (tree / "mutants" / "mutmut-stats.json").write_text("{}")
 
-    second = {**first, "rtl/a.py": "def f():\n    return 5\n", "gen/d.py": "def k():\n    return 4\n"}
+    second = {**first, "rtl/a.py": "def f():\n    return 5\n", "gen/d.py": "def k():\n    return 4\n",
+              "sim/w.v": "module w(input a); endmodule\n"}
     del second["sim/c.py"]
     src2 = tmp_path / "src2"
     files = _commit(src2, second)
@@ -50,10 +53,13 @@ def test_update_touches_only_what_the_commit_changed(tmp_path):
         os.utime(f, (OLD - 10, OLD - 10))      # git archive's times: the commit's, maybe older
     changed = pymut.update_tree(tree, src2, files)
 
-    assert sorted(changed) == ["bumprtl/gen/d.py", "bumprtl/rtl/a.py", "bumprtl/sim/c.py (removed)"]
+    assert sorted(changed) == ["bumprtl/gen/d.py", "bumprtl/rtl/a.py", "bumprtl/sim/c.py (removed)",
+                               "bumprtl/sim/w.v"]
     newer = {str(p.relative_to(tree)) for p in tree.rglob("*")
              if p.is_file() and "mutants" not in p.parts and p.stat().st_mtime > OLD}
-    assert newer == {"bumprtl/gen/d.py", "bumprtl/rtl/a.py"}
+    assert newer == {"bumprtl/gen/d.py", "bumprtl/rtl/a.py", "bumprtl/sim/w.v"}
+    # mutmut does not copy a file it does not mutate again: the runner puts it there
+    assert (mutants / "sim" / "w.v").read_text() == second["sim/w.v"]
     assert (tree / "bumprtl" / "rtl" / "a.py").read_text() == second["rtl/a.py"]
     assert not (tree / "bumprtl" / "sim" / "c.py").exists()
     assert not (mutants / "sim" / "c.py").exists() and not (mutants / "sim" / "c.py.meta").exists()
