@@ -67,8 +67,8 @@ def test_update_touches_only_what_the_commit_changed(tmp_path):
     assert (tree / "setup.cfg").read_text() == "[mutmut]\n"               # mutmut's own: kept
     assert not (tree / "mutants" / "mutmut-stats.json").exists()
     assert not (tree.parent / "tree.new").exists()
-    meta = json.loads((mutants / "rtl" / "b.py.meta").read_text())
-    assert meta["exit_code_by_key"] == {"bumprtl.rtl.b.x_f__mutmut_1": None}
-    assert meta["hash_by_function_name"] == {"x_f": "h"}
+    kept = json.loads((mutants / "rtl" / "b.py.meta").read_text())
+    assert kept["exit_code_by_key"] == {"bumprtl.rtl.b.x_f__mutmut_1": None}
+    assert kept["hash_by_function_name"] == {"x_f": "h"}
     assert pymut.all_results(tree) == {"bumprtl.rtl.a.x_f__mutmut_1": None,
                                        "bumprtl.rtl.b.x_f__mutmut_1": None}
