@@ -152,9 +152,9 @@ def run_bulk(sim, v_path, j_path, work_dir, patterns=("no_stall",), inputs=None,
     count, "seed": s}`` of sim/tb/bulk_sources.py: stimulus and golden outputs made and
     checked chunk by chunk inside the simulator process). ``setup``: host cycles
     (:func:`setup_writes`) after reset; ``between``: host cycles before every run of a
-    chunk under a pattern but the first (the pipeline drained). ``traffic`` adds or overrides patterns
-    (``{name: (gap probability, stall probability)}``). ``keep=False`` drops the outputs
-    (regressions). ``clock``, ``io``, ``opt_fast``, ``extra``: the build
+    chunk under a pattern but the first (the pipeline drained). ``traffic`` adds or
+    overrides patterns (``{name: (gap probability, stall probability)}``). ``keep=False``
+    drops the outputs (regressions). ``clock``, ``io``, ``opt_fast``, ``extra``: the build
     (:func:`build_options`; None: the simulator's fastest, :data:`DEFAULTS`). A unit with
     an AXI4 read port (``map_memory = "axi"``) reads its ``_map.bin`` (beside the sidecar)
     from the wrapper's memory model, each burst ``axi_latency`` cycles after its AR

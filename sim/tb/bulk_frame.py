@@ -370,18 +370,24 @@ def _table_sensitive(scene, words, polygon, texels, seed, keys):
                 groups.append(moved & ((word >> b) & 1 == value))
     cover = np.stack(groups, axis=1)
     cand = np.nonzero(cover.any(axis=1))[0]
-    cand = cand[rng.permutation(len(cand))]
-    cover = cover[cand].astype(np.int32)
-    need = np.minimum(cover.sum(axis=0), TABLE_QUOTA)
-    pick = []
-    while need.any():               # the pixel that fills most unfilled places, then the next
-        best = int(np.argmax(cover @ (need > 0)))
-        pick.append(cand[best])
-        need = np.maximum(need - cover[best], 0)
-        cover[best] = 0
-    pick = np.sort(np.asarray(pick, np.int64))
+    cand = cand[rng.permutation(len(cand))]          # ties go to a seeded random pixel
+    pick = np.sort(cand[_greedy_cover(cover[cand], TABLE_QUOTA)])
     assert set(keys) == set(pool) - {"tag"}, (sorted(keys), sorted(pool))
     return {key: pool[key][pick] for key in keys}
+
+
+def _greedy_cover(cover, quota):
+    """Rows of the boolean matrix ``cover`` (candidate pixels x places: a read's bit, a
+    dot's move) picked greedily until every place holds ``quota`` of its pixels, or all it
+    has: each time the row that fills most unfilled places, the first such row on a tie."""
+    cover = cover.astype(np.int32)
+    need, pick = np.minimum(cover.sum(axis=0), quota), []
+    while need.any():
+        best = int(np.argmax(cover @ (need > 0)))
+        pick.append(best)
+        need = np.maximum(need - cover[best], 0)
+        cover[best] = 0
+    return np.asarray(pick, np.int64)
 
 
 # The dot-sensitivity pixels: a wrong bit k of a product or of a partial sum moves a dot's
@@ -447,20 +453,9 @@ def _dot_sensitive(scene, words, polygon, texels, seed, keys):
                 for key, want in base.items():
                     moved |= np.asarray(out[key]) != np.asarray(want)[cand]
                 groups.append(cand[moved])
-    pick, need = [], [min(len(g), DOT_QUOTA) for g in groups]
-    sets = [set(g.tolist()) for g in groups]
-    while any(need):               # the pixel in most unfilled groups, then the next
-        counts = {}
-        for g, n in zip(sets, need, strict=True):
-            if n:
-                for p in g:
-                    counts[p] = counts.get(p, 0) + 1
-        best = min(counts, key=lambda p: (-counts[p], p))
-        pick.append(best)
-        need = [n - (n > 0 and best in g) for g, n in zip(sets, need, strict=True)]
-        for g in sets:
-            g.discard(best)
-    pick = np.sort(np.asarray(pick, np.int64))
+    cand = np.unique(np.concatenate(groups))          # ascending: ties go to the lowest pixel
+    cover = np.stack([np.isin(cand, g) for g in groups], axis=1)
+    pick = np.sort(cand[_greedy_cover(cover, DOT_QUOTA)])
     assert set(keys) == set(pool) - {"tag"}, (sorted(keys), sorted(pool))
     return {key: pool[key][pick] for key in keys}
 

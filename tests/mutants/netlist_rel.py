@@ -344,8 +344,9 @@ def reach(text, active, work, yosys_run, timeout):
     cannot state it. The memories' read data are free inputs each cycle (any contents) and
     so are ``rst`` and every other port: a state reached here may be unreachable in the
     design, never the other way round, so "never active" is a proof and "active" is not a
-    kill. A register without an initial value takes its first value from an input (Yosys's
-    ``-zinit``), so it starts at either value."""
+    kill. The enumeration starts from the cone's one initial state (Yosys's ``-zinit``
+    resets every latch to 0); a latch the AIGER leaves without a reset value leaves the
+    step undecided."""
     d = json.loads(text)
     mod = d["modules"]["product"]
     mod["ports"] = {k: v for k, v in mod["ports"].items()

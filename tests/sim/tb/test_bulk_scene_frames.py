@@ -71,8 +71,8 @@ PALETTE_SCENES = {"palette": "palette",
 def test_bulk_palette_frame_equals_golden(name, build_dir):
     """A palette scene's coverage frame: a random colour table read from bank 1 between
     decoy tables, then from bank 0 and bank 1 in turn with a decoy in the other bank (one
-    traffic pattern a bank: a bank stuck at either value shows), random indices written through the map's host port, and (textured)
-    random texels. Every channel of the colour (r, g, b, a each a field of its own) equals
+    traffic pattern a bank: a bank stuck at either value shows), random indices written
+    through the map's host port, and (textured) random texels. Every channel of the colour (r, g, b, a each a field of its own) equals
     the golden model's, so the RTL and the model cannot agree on a channel mix-up of the
     table entry or of eq. 2 unless both make it; the colours depend on the channel (a test
     whose every channel carried the same value could not see one swapped)."""
