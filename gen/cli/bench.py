@@ -115,8 +115,10 @@ def add_memory(kinds):
                    help="demo scenes (their geometry decides the texel stream)")
     p.add_argument("--sizes", nargs="+", type=int, default=list(memory.MAP_SIZES),
                    help="map sides T (a T x T frame at one texel per pixel)")
-    p.add_argument("--caches", nargs="+", default=list(memory.CACHES), choices=list(memory.CACHES))
-    p.add_argument("--methods", nargs="+", default=list(memory.METHODS), choices=list(memory.METHODS))
+    p.add_argument("--caches", nargs="+", default=list(memory.CACHES), choices=list(memory.CACHES),
+                   help="cache geometries measured (default: all of them)")
+    p.add_argument("--methods", nargs="+", default=list(memory.METHODS), choices=list(memory.METHODS),
+                   help="methods whose texel stream is measured (default: all of them)")
     p.add_argument("--latencies", nargs="+", type=int, default=list(memory.LATENCIES),
                    help="memory latencies (cycles from the AR handshake to the first beat)")
     p.add_argument("--rows", type=int, default=memory.BAND_ROWS,
@@ -133,7 +135,7 @@ def add_lee_widths(kinds):
                                    "reference for a range of widths, beside the exact datapath at "
                                    "the same widths: the lee error is in the geometry, not the bits.")
     p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--seed", type=int, default=1, help="seed of the random inputs (default: 1)")
     p.set_defaults(func=run_lee_widths)
 
 
@@ -144,7 +146,7 @@ def add_float64(kinds):
                                    "Cartesian reference, and each model's speed, in one run; "
                                    "then lee_corrected's errors binned by theta_N.")
     p.add_argument("--samples", type=int, default=100_000, help="random valid inputs (default: 100000)")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--seed", type=int, default=1, help="seed of the random inputs (default: 1)")
     p.set_defaults(func=run_float64)
 
 
@@ -155,10 +157,14 @@ def add_accuracy(kinds):
                                    "on random inputs and on adversarial searches aimed at each, "
                                    "beside the proven bound of each. Exits 1, printing the "
                                    "offending input, if an error exceeds its bound.")
-    p.add_argument("--method", default="exact", choices=tuple(METHODS))
-    p.add_argument("--samples", type=int, default=1_000_000)
-    p.add_argument("--angle-bits", type=int, nargs="+", default=[12, 13, 14, 15])
-    p.add_argument("--frac-bits", type=int, nargs="+", default=[13, 15, 16])
+    p.add_argument("--method", default="exact", choices=tuple(METHODS),
+                   help="the datapath measured (default: exact)")
+    p.add_argument("--samples", type=int, default=1_000_000,
+                   help="random valid inputs per width point (default: 10^6)")
+    p.add_argument("--angle-bits", type=int, nargs="+", default=[12, 13, 14, 15],
+                   help="angle widths of the grid (default: 12 13 14 15)")
+    p.add_argument("--frac-bits", type=int, nargs="+", default=[13, 15, 16],
+                   help="value widths of the grid (default: 13 15 16)")
     p.add_argument("--spec-exponent", type=int, nargs="+", default=[16],
                    help="Phong exponents n (default: 16)")
     p.add_argument("--spec-index-bits", type=int, default=10, help="specular table address bits (default: 10)")
@@ -180,7 +186,8 @@ def add_sweep(kinds):
                                    "(optionally ECP5), golden/simulation/hardware speed. JSON, "
                                    "Pareto plot, markdown table.")
     p.add_argument("--quick", action="store_true", help="small grid (angle 10,12 x frac 11,13; sN 16,256)")
-    p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES)
+    p.add_argument("--methods", nargs="+", default=list(METHOD_CHOICES), choices=METHOD_CHOICES,
+                   help="methods swept (default: all of them)")
     p.add_argument("--maps", nargs="+", default=None, metavar="NAME:SIZE",
                    help="the maps the scene errors are measured on, each a scene of `bumprtl render "
                         f"--help` at SIZE x SIZE texels (a power of two in [{MAP_SIZES[0]}, "
@@ -198,13 +205,15 @@ def add_sweep(kinds):
                    help="with --fpga: local worker processes, one placement each at a time "
                         "(default: the number of cores; ignored with --scheduler)")
     add_job_arguments(p)
-    p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"))
+    p.add_argument("--out", type=Path, default=Path("build/bench/sweep.json"),
+                   help="the sweep's JSON (default: build/bench/sweep.json)")
     p.add_argument("--work", type=Path, default=Path("build/bench/sweep"),
                    help="netlists and cached cost per config")
     p.add_argument("--docs", type=Path, default=None, help="write the sweep section of this markdown file "
                                                            "(docs/bench.md) and docs/img/bench_pareto.png")
     p.add_argument("--data-copy", type=Path, default=None, help="also copy the JSON here (docs/data/)")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress line per finished point on the terminal")
     p.set_defaults(func=run_sweep)
 
 
@@ -216,7 +225,8 @@ def add_golden(kinds):
     p.add_argument("--sim-samples", type=int, default=5000,
                    help="random vectors per traffic pattern in the simulations (default: 5000; "
                         "0: no simulations)")
-    p.add_argument("--methods", nargs="+", default=list(PER_PIXEL), choices=PER_PIXEL)
+    p.add_argument("--methods", nargs="+", default=list(PER_PIXEL), choices=PER_PIXEL,
+                   help="per-pixel methods timed (default: all of them)")
     p.set_defaults(func=run_golden)
 
 
@@ -226,8 +236,9 @@ def add_stress(kinds):
                                    "at the narrowest/widest widths and extreme specular exponents: "
                                    "max error, NaN and overflow counts -> docs/stability.md.")
     p.add_argument("--samples", type=int, default=20_000, help="pixels per case (default: 20000)")
-    p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--out", type=Path, default=Path("docs/stability.md"))
+    p.add_argument("--seed", type=int, default=1, help="seed of the random pixels (default: 1)")
+    p.add_argument("--out", type=Path, default=Path("docs/stability.md"),
+                   help="the page written (default: docs/stability.md)")
     p.set_defaults(func=run_stress)
 
 
@@ -236,8 +247,10 @@ def add_specular(kinds):
                        description="cos^n by a nearest-entry table, an interpolated table, an "
                                    "interpolated table finer near 1 and repeated squaring: error "
                                    "against float64 and cost per exponent.")
-    p.add_argument("--samples", type=int, default=1_000_000)
-    p.add_argument("--spec-exponent", type=int, nargs="+", default=[1, 2, 16, 64, 256, 1024])
+    p.add_argument("--samples", type=int, default=1_000_000,
+                   help="random cosines per exponent (default: 10^6)")
+    p.add_argument("--spec-exponent", type=int, nargs="+", default=[1, 2, 16, 64, 256, 1024],
+                   help="Phong exponents n (default: 1 2 16 64 256 1024)")
     p.add_argument("--work", type=Path, default=Path("build/bench/specular"),
                    help="netlist of the Illumination unit counted at the end")
     p.set_defaults(func=run_specular)
@@ -249,7 +262,8 @@ def add_skip(kinds):
                                    "with nothing skipped: golden-model time and Yosys cost, one run.")
     p.add_argument("--size", type=int, default=128, help="frame size for the golden model (default: 128)")
     p.add_argument("--scenes", nargs="+", default=None, help="scene classes (default: all built-in)")
-    p.add_argument("--work", type=Path, default=Path("build/bench/skip"))
+    p.add_argument("--work", type=Path, default=Path("build/bench/skip"),
+                   help="netlists of the pipelines counted (default: build/bench/skip)")
     p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
     p.set_defaults(func=run_skip)
 
@@ -262,13 +276,15 @@ def add_rtl_sim(kinds):
                                    "pixels per second and the ratios.")
     p.add_argument("--size", type=int, default=256, help="frame size (default: 256)")
     p.add_argument("--scene", default="default", help="scene class (default: default)")
-    p.add_argument("--simulators", nargs="+", default=list(SIMULATORS), choices=SIMULATORS)
+    p.add_argument("--simulators", nargs="+", default=list(SIMULATORS), choices=SIMULATORS,
+                   help="simulators timed (default: both)")
     p.add_argument("--quick", action="store_true",
                    help="only the default bulk build of each simulator "
                         f"(Verilator: {build_label(build_options('verilator'))})")
     p.add_argument("--repeat", type=int, default=3,
                    help="bulk runs per build, the best (least streaming CPU) reported (default: 3)")
-    p.add_argument("--work", type=Path, default=Path("build/bench/rtl_sim"))
+    p.add_argument("--work", type=Path, default=Path("build/bench/rtl_sim"),
+                   help="the simulator builds (default: build/bench/rtl_sim)")
     p.add_argument("--docs", type=Path, default=None, help="write the section into this markdown file")
     p.set_defaults(func=run_rtl_sim)
 
@@ -277,9 +293,12 @@ def add_palette(kinds):
     p = kinds.add_parser("palette", help="palette method: per-frame cost and accuracy vs per-pixel",
                        description="Palette method of Tarini et al.: colour table + lookup against "
                                    "per-pixel shading (speed), PSNR vs sN (accuracy), demo renders.")
-    p.add_argument("--what", nargs="+", default=["speed", "accuracy"], choices=["speed", "accuracy", "images"])
-    p.add_argument("--sizes", nargs="+", type=int, default=list(SPEED_SIZES), help="speed: image sizes")
-    p.add_argument("--palettes", nargs="+", type=int, default=list(SPEED_PALETTES), help="speed: sN values")
+    p.add_argument("--what", nargs="+", default=["speed", "accuracy"], choices=["speed", "accuracy", "images"],
+                   help="the parts run (default: speed accuracy)")
+    p.add_argument("--sizes", nargs="+", type=int, default=list(SPEED_SIZES),
+                   help=f"speed: image sizes (default: {' '.join(map(str, SPEED_SIZES))})")
+    p.add_argument("--palettes", nargs="+", type=int, default=list(SPEED_PALETTES),
+                   help=f"speed: sN values (default: {' '.join(map(str, SPEED_PALETTES))})")
     p.add_argument("--scenes", nargs="+", default=list(ACC_SCENES), help="accuracy: scenes")
     p.add_argument("--size", type=int, default=256, help="accuracy/images: image size (default 256)")
     p.add_argument("--plot", type=Path, default=None, help="accuracy: write the PSNR plot here")

@@ -151,7 +151,9 @@ def add_parser(sub):
                    help="light elevation above the screen plane, [-90, 90] (default: 45)")
     p.add_argument("--light-azimuth", type=float, default=30.0, metavar="DEG",
                    help="light azimuth in the screen plane, [-360, 360] (default: 30)")
-    p.add_argument("--light", default="directional", choices=["directional", "point"])
+    p.add_argument("--light", default="directional", choices=["directional", "point"],
+                   help="a light at infinity in the direction of --light-elevation and "
+                        "--light-azimuth, or a point light 3 radii away in it (default: directional)")
     p.add_argument("--out", type=Path, default=Path("build/render/render.png"), help="output PNG")
     p.add_argument("--compare", action="store_true",
                    help="also write reference | method | |diff| x10 and print PSNR / max diff vs conventional")

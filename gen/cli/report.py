@@ -43,9 +43,12 @@ def run_integration(args):
 
 def add_table1(kinds):
     t = kinds.add_parser("table1", help="recount Lee et al. Table 1 -> docs/table1.md")
-    t.add_argument("--out", type=Path, default=Path("docs/table1.md"))
-    t.add_argument("--work", type=Path, default=Path("build/report/table1"))
-    t.add_argument("--samples", type=int, default=100_000)
+    t.add_argument("--out", type=Path, default=Path("docs/table1.md"),
+                   help="the page written (default: docs/table1.md)")
+    t.add_argument("--work", type=Path, default=Path("build/report/table1"),
+                   help="the netlists counted (default: build/report/table1)")
+    t.add_argument("--samples", type=int, default=100_000,
+                   help="random inputs of each design's error column (default: 10^5)")
     t.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="local worker processes, one Yosys count each at a time (default: the "
                         "number of cores; ignored with --scheduler)")
@@ -68,11 +71,13 @@ def add_fpga(kinds):
     f = kinds.add_parser("fpga", help="ECP5 place and route of every design -> docs/report.md")
     f.add_argument("--device", default="LFE5U-85F", help="LFE5U-25F, LFE5U-45F or LFE5U-85F")
     f.add_argument("--unit", action="append", help="place only this unit (repeatable)")
-    f.add_argument("--out", type=Path, default=Path("docs/report.md"))
+    f.add_argument("--out", type=Path, default=Path("docs/report.md"),
+                   help="the page written (default: docs/report.md)")
     f.add_argument("--work", type=Path, default=Path("build/fpga_cache"),
                    help="placements, cached by Verilog digest (shared with bench sweep --fpga; "
                         "default: build/fpga_cache)")
-    f.add_argument("--samples", type=int, default=100_000)
+    f.add_argument("--samples", type=int, default=100_000,
+                   help="random inputs of each design's error column (default: 10^5)")
     f.add_argument("--seeds", type=_seeds, default=[1],
                    help="nextpnr seeds, comma-separated (default 1); Fmax is their minimum")
     f.add_argument("--scene-seeds", type=_seeds, default=None,
@@ -91,7 +96,8 @@ def add_fpga(kinds):
 def add_timing(kinds):
     t = kinds.add_parser("timing", help="WaveDrom handshake/stall/latency diagrams of the "
                                         "default pipeline -> docs/timing/")
-    t.add_argument("--out", type=Path, default=Path("docs/timing"))
+    t.add_argument("--out", type=Path, default=Path("docs/timing"),
+                   help="the diagrams' directory, WaveDrom JSON and SVG (default: docs/timing)")
     t.add_argument("--doc", type=Path, default=Path("docs/timing.md"),
                    help="the page whose Made-at record is rewritten (when it exists)")
     t.set_defaults(func=run_timing)
