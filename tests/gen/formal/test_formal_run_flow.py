@@ -267,3 +267,38 @@ def test_a_property_filter_picks_the_broken_units_of_that_property(monkeypatch, 
     assert [a for a in jobs if a[0] == "axi_mutant"] == \
         [("axi_mutant", n, "axi") for n in axi.MUTANTS]
     assert not any(a[0] == "target" for a in jobs)          # sincos has no axi property
+
+
+def test_the_bank_properties_covers_run_two_cycles_past_its_margin(sby, tmp_path):
+    """The bank property's own covers reach a bank swap seen through the unit: latency +
+    BANK_MARGIN + 2, not the stream covers' latency + BMC_MARGIN."""
+    target = next(t for t in TARGETS.values() if "bank_cover" in t.props)
+    assert fr.check(target, "bank_cover", tmp_path).result == "covered"
+    dut = target.unit()
+    assert sby.calls[0][:3] == ("bank_cover", "cover", fr._cover_depth(dut, fr.BANK_MARGIN + 2))
+    assert fr._cover_depth(dut, fr.BANK_MARGIN + 2) != fr._cover_depth(dut, fr.BMC_MARGIN)
+
+
+def test_a_failure_names_every_failed_assertion_joined_by_semicolons(monkeypatch, tmp_path):
+    def two_failures(top, workdir, name, mode="prove", depth=10, script=(), timeout=3600, **_):
+        return FormalResult(name, mode, depth, "FAIL", 0.01, Path(workdir), tmp_path / "t.vcd",
+                            ["model.il:7.1-7.9", "model.il:9.1-9.9"], "", False)
+    monkeypatch.setattr(fr, "run_sby", two_failures)
+    row = fr.check(TARGETS["sincos"], "hold", tmp_path)
+    assert row.result == "FAIL" and row.trace == str(tmp_path / "t.vcd")
+    # an unknown location is described as itself (StreamContract.describe)
+    assert row.detail == "model.il:7.1-7.9; model.il:9.1-9.9"
+
+
+@pytest.mark.parametrize("kind, name, prop", [("target", "sincos", "hold"),
+                                              ("mutant", next(iter(MUTANTS)), None)])
+def test_a_formal_job_checks_what_its_kind_names_and_returns_its_logs(sby, kind, name, prop):
+    """formal_job runs the target's property or the broken unit named, in a temporary
+    directory, and returns the row with the sby logs it kept (none here: the stand-in
+    writes no files)."""
+    out = fr.formal_job(kind, name, prop or MUTANTS[name][1])
+    row = fr.Row(**out["row"])
+    assert row.unit == (name if kind == "target" else f"mutant {name}")
+    assert row.prop == (prop or MUTANTS[name][1])
+    assert sby.calls[0][0] == (prop if kind == "target" else name)
+    assert out["files"] == {} and out["log"] == ""
