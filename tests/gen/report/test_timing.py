@@ -2,6 +2,7 @@
 pipeline, and the trace shows what the diagrams say."""
 
 import json
+from pathlib import Path
 
 from bumprtl.gen.cli.main import main
 from bumprtl.gen.report.timing import _bit, _bus
@@ -32,6 +33,12 @@ def test_timing_report_from_the_default_pipeline(tmp_path, capsys):
     hs = {s["name"]: s for s in json.loads((tmp_path / "handshake.json").read_text())["signal"]}
     assert hs["o.tag"]["data"] == [str(n) for n in range(6)]    # in order, each once
     assert f"default pipeline latency: {latency} cycles" in capsys.readouterr().out
+    # the committed diagrams are this run's, byte for byte: docs/timing.md shows them
+    docs = Path(__file__).resolve().parents[3] / "docs" / "timing"
+    assert sorted(p.name for p in docs.iterdir()) == sorted(p.name for p in tmp_path.iterdir())
+    for name in sorted(p.name for p in docs.iterdir()):
+        assert (docs / name).read_bytes() == (tmp_path / name).read_bytes(), \
+            f"docs/timing/{name} is stale: bumprtl report timing"
 
 
 def _expand(wave):

@@ -1,0 +1,50 @@
+"""docs/report.md and docs/table1.md's ECP5 section against the placement rows they were
+written from (docs/data/fpga.json, which ``bumprtl report fpga`` saves beside its page and
+``report table1`` reads): written again from those rows, without placing anything, they are
+the committed text. A row, a column or a heading changed in the writers, or a page whose
+rows were placed again without the other page following, fails here."""
+
+import json
+import shlex
+from pathlib import Path
+
+from bumprtl.gen.report.fpga import FpgaRun, write_report
+from bumprtl.gen.report.table1 import fpga_section
+from bumprtl.rtl.config import Config
+
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+DATA = DOCS / "data" / "fpga.json"
+
+
+def _run(command, out):
+    """The FpgaRun the saved command line names."""
+    words, kw = shlex.split(command)[3:], {}
+    for flag, value in zip(words[::2], words[1::2], strict=True):
+        if flag == "--unit":
+            kw["unit"] = kw.get("unit", ()) + (value,)
+        else:
+            key = flag[2:].replace("-", "_")
+            kw[key] = value if key == "device" else int(value) if key == "samples" else \
+                tuple(int(s) for s in value.split(","))
+    return FpgaRun(out=out, **kw)
+
+
+def test_table1s_ecp5_section_is_the_fpga_runs():
+    assert fpga_section(DATA) in (DOCS / "table1.md").read_text(), \
+        "docs/table1.md's ECP5 section is stale: bumprtl report table1"
+
+
+def test_the_report_page_is_written_again_from_its_rows(tmp_path, capsys):
+    """Everything up to the primitives' ceiling (whose own placements the saved rows do not
+    hold) is what write_report makes of the saved rows."""
+    data = json.loads(DATA.read_text())
+    run = _run(data["command"], tmp_path / "report.md")
+    write_report(run, data["rows"], data["accuracy"], Config())
+    assert (tmp_path / "data" / "fpga.json").read_text() == DATA.read_text()
+    mark = "\n## The primitives' own ceiling"
+    ours, page = (tmp_path / "report.md").read_text(), (DOCS / "report.md").read_text()
+    assert mark in page
+    assert mark not in ours                         # no ceilings given: the notes follow
+    assert ours.split("\n## Notes")[0].rstrip() == page.split(mark)[0].rstrip()
+    assert (tmp_path / "img" / "cost_vs_error.png").stat().st_size > 0
+    assert f"wrote {tmp_path / 'report.md'}" in capsys.readouterr().out
