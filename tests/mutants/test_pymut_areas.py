@@ -55,3 +55,14 @@ def test_docs_list_the_areas():
     line = next((l for l in text.splitlines() if l.startswith("Areas of `make mutate-py`")), None)
     assert line is not None, "docs/mutation.md has no line 'Areas of `make mutate-py` ...'"
     assert re.findall(r"`([^`]+)`", line)[1:] == list(pymut.AREAS)
+
+
+def test_the_draw_runs_make_tests_tests_but_the_toolings_own():
+    """Every test file of make test is in the selection mutmut picks each mutant's tests from
+    (pymut.TESTS), but tests/mutants and tests/tools, which check this tooling, not the
+    package: a mutant only those tests would kill counts as a survivor."""
+    files = {str(f.relative_to(ROOT)) for f in (ROOT / "tests").rglob("test_*.py")}
+    covered = {f for f in files if any(f == t or f.startswith(t + "/") for t in pymut.TESTS)}
+    left = {f for f in files - covered if not f.startswith(("tests/mutants/", "tests/tools/"))}
+    assert not left, f"test files outside pymut.TESTS: {sorted(left)}"
+    assert all((ROOT / t).exists() for t in pymut.TESTS)
