@@ -84,3 +84,14 @@ def test_texture_needs_an_image_with_a_colour_texture():
     from bumprtl.rtl.config import BumpError
     with pytest.raises(BumpError, match="texture = true needs an image with a colour texture"):
         golden_render(load_scene_config({"name": "t", "texture": True, "image": "moon"}), 16)
+
+
+def test_render_rtl_of_a_palette_scene_writes_its_table_first(build_dir):
+    """The palette scene through render --rtl's bulk path: its colour table reaches the
+    LUT through the host port before the first pixel (the set-up writes), so the image is
+    the golden render's, byte for byte, and holds more than one colour."""
+    scene = load_scene_config("palette")
+    r = render_rtl(scene, 16, "icarus", build_dir, progress=False)
+    assert r.image.tobytes() == golden_render(scene, 16).tobytes()
+    assert r.image.tobytes() == r.golden.tobytes()
+    assert len(np.unique(r.image.reshape(-1, 3), axis=0)) > 8
