@@ -267,3 +267,31 @@ def test_report_fpga_places_the_default_scene_with_its_map_behind_the_cache(tmp_
     notes = text.split("## Notes")[1].splitlines()
     note = [ln for ln in notes if ln.startswith("- scene_default_axi: ")]
     assert len(note) == 1 and 'map_memory = "axi"' in note[0] and "AXI4 read port" in note[0]
+
+
+def test_a_placement_job_reports_the_devices_resources_and_its_logs(monkeypatch):
+    """place_text with nextpnr stood in: the row gains what the device has of each resource
+    the report counts (nextpnr's utilization names: TRELLIS_COMB, MULT18X18D, DP16KD; a
+    resource nextpnr does not list is None), and the job returns the synthesis and
+    placement logs and report by name, the two logs joined in order."""
+    import json
+
+    seen = {}
+
+    def place_and_route(v_path, label, device, work, lpf, seed):
+        seen.update(text=v_path.read_text(), lpf=lpf.read_text(), device=device, seed=seed)
+        (work / f"{label}.synth.log").write_text("yosys said\n")
+        (work / f"{label}.pnr.log").write_text("nextpnr said\n")
+        (work / f"{label}.pnr.json").write_text(json.dumps({"utilization": {
+            "TRELLIS_COMB": {"used": 10, "available": 83640},
+            "MULT18X18D": {"used": 1, "available": 156}}}))
+        return {"LUT4": 10, "fmax_mhz": 250.0}
+
+    monkeypatch.setattr(fpga, "place_and_route", place_and_route)
+    out = fpga.place_text("module u; endmodule\n", "u", "LFE5U-85F", "FREQUENCY 200 MHz;\n", seed=3)
+    assert seen == {"text": "module u; endmodule\n", "lpf": "FREQUENCY 200 MHz;\n",
+                    "device": "LFE5U-85F", "seed": 3}
+    assert out["row"] == {"LUT4": 10, "fmax_mhz": 250.0,
+                          "available": {"LUT4": 83640, "DSP": 156, "BRAM": None}}
+    assert sorted(out["files"]) == ["u.pnr.json", "u.pnr.log", "u.synth.log"]
+    assert out["log"] == "==== u.synth.log\nyosys said\n\n==== u.pnr.log\nnextpnr said\n"
