@@ -45,9 +45,14 @@ def test_speed_rows_add_the_table_and_the_lookup_and_divide(monkeypatch, capsys)
     assert shapes[9][0] == 32 and shapes[10][:2] == (16, 16) and shapes[11][0] == 256
 
 
-def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys):
+def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys, monkeypatch):
+    import matplotlib.figure
+
     size, palettes = 16, (16, 256)
     plot = tmp_path / "plots" / "acc.png"
+    figures, save = [], matplotlib.figure.Figure.savefig
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
+                        lambda fig, *a, **k: (figures.append(fig), save(fig, *a, **k))[1])
     palette.accuracy(Config(), ("wood", "bumps"), palettes, size, plot)
     out = capsys.readouterr().out
     assert "| scene | quantizer | sN=16 | sN=256 |" in out
@@ -70,6 +75,22 @@ def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys):
     assert sum("(all" in r for r in rows) >= 2          # bumps at 16 has fewer than 256
     assert f"plot -> {plot}" in out
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the plot: one curve a (scene, quantizer), labelled so, at the table's PSNRs over sN,
+    # one colour a scene, solid k-means and dashed median cut
+    (ax,) = figures[0].axes
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    assert sorted(lines) == ["bumps kmeans", "bumps median-cut", "wood kmeans", "wood median-cut"]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == sorted(lines)
+    for r in rows:
+        name, quantizer = (c.strip() for c in r.split("|")[1:3])
+        line = lines[f"{name} {quantizer}"]
+        assert list(line.get_xdata()) == list(palettes)
+        shown = [f"{y:.1f}" for y in line.get_ydata()]
+        assert shown == [c.strip().split(" dB")[0] for c in r.split("|")[3:-1]]
+        assert line.get_linestyle() == ("-" if quantizer == "kmeans" else "--")
+        assert line.get_color() == lines[f"{name} kmeans"].get_color()
+    assert lines["wood kmeans"].get_color() != lines["bumps kmeans"].get_color()
+    assert ax.get_title() == f"Palette method accuracy, {size}x{size}"
 
 
 def test_images_named_by_scene_lighting_size_and_dither(tmp_path, capsys):
