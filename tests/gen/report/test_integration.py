@@ -118,3 +118,23 @@ def test_the_latency_the_page_states_is_the_simulated_one():
     sim.run()
     assert seen["reset"] == (1, 0)                     # after reset: in_ready high, out_valid low
     assert seen["edges"] == dut.port_latency
+
+
+def test_the_page_is_what_the_report_writes_but_for_numbers_and_the_small_flags(small, tmp_path):
+    """Every generated block of docs/integration.md, written again from this module's small
+    pipeline (10/11-bit widths, a 16-texel map), is the committed block with its numbers and
+    hex constants masked and the small run's own flags taken out of its command lines: the
+    port table's rows, the timing, the example, the load and sidecar blocks are the
+    writer's."""
+    import shutil
+
+    page = tmp_path / "integration.md"
+    shutil.copy(DOC, page)
+    write_doc(page, blocks(small))
+
+    def masked(text):
+        text = text.replace("--texture-size 16 --angle-bits 10 --frac-bits 11 ", "")
+        text = text.replace(", {'texture_size': 16, 'angle_bits': 10, 'frac_bits': 11})", ")")
+        text = re.sub(r"\d+'h[0-9a-f]+", "#'h#", text)
+        return re.sub(r"\d+", "#", text)
+    assert masked(page.read_text()) == masked(DOC.read_text())
