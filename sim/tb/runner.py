@@ -78,13 +78,30 @@ def run_cocotb(sim, v_path, test_module, build_dir, extra_env=None, waves=None, 
         runner.build(sources=[v_path, *[Path(s).resolve() for s in sources]],
                      includes=[Path(d).resolve() for d in includes], hdl_toplevel=top, build_dir=build_dir,
                      timescale=("1ns", "1ps"), build_args=build_args, waves=waves, always=True)
-        t1 = time.perf_counter()
-        results = runner.test(hdl_toplevel=top, test_module=test_module, build_dir=build_dir,
-                              test_dir=build_dir,
-                              extra_env={k: str(v) for k, v in (extra_env or {}).items()},
-                              waves=waves, timescale=("1ns", "1ps"))
+        t1, started = time.perf_counter(), time.time()
+        try:
+            results = runner.test(hdl_toplevel=top, test_module=test_module, build_dir=build_dir,
+                                  test_dir=build_dir,
+                                  extra_env={k: str(v) for k, v in (extra_env or {}).items()},
+                                  waves=waves, timescale=("1ns", "1ps"))
+        except SystemExit as e:
+            # under pytest cocotb_tools exits on a failed test or simulator instead of
+            # returning its results: the same AssertionError either way, naming the file
+            results = _newest_results(build_dir, started)
+            if results is None:
+                raise AssertionError(f"the {sim} simulation exited with status {e.code} and wrote "
+                                     f"no results in {build_dir}") from None
         t2 = time.perf_counter()
     tests, failures = get_results(results)
     assert tests > 0, f"no cocotb test ran on {sim} ({results})"
     assert failures == 0, f"{failures} of {tests} cocotb tests failed on {sim}; see {results}"
     return CocotbRun(tests, failures, build_s=t1 - t0, run_s=t2 - t1)
+
+
+def _newest_results(build_dir, since):
+    """The results file cocotb_tools wrote last in ``build_dir`` (``*.result.xml`` under
+    pytest, ``results.xml`` otherwise) at or after ``since`` (``time.time()``), or None: an
+    earlier run's file is not this run's."""
+    files = sorted((f for f in Path(build_dir).glob("*result*.xml") if f.stat().st_mtime >= since - 1),
+                   key=lambda f: f.stat().st_mtime)
+    return files[-1] if files else None
