@@ -44,8 +44,11 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   steep there. Each light's L and H sums of DOT_POOL = 2^18 seeded random pixels are
   recorded (sim/golden/fixed/exact.DOT_SUM); for every bit k up to the rounding point and
   either sign, the pixels whose rounded dot the move of 2^k changes (at most DOT_CAP of
-  them) run with it, and the frame keeps DOT_QUOTA = 1 whose output changes (greedily, one
-  pixel serving every move it shows): a few dozen pixels;
+  them) run with it, and the frame keeps DOT_QUOTA = 3 whose output changes (greedily, one
+  pixel serving every move it shows): a hundred pixels or two. A wrong bit moves the sum
+  up where the bit should be 0 and down where it should be 1 (or only while an operand is
+  negative): each kept pixel shows it with even odds, so three a move leave about one
+  chance in 64 that neither direction's pixels do;
 * tags random over the whole tag range (0 and the largest tag included);
 * the map's (and texture's) word 0 written with every bit a word may set and read back (the
   write ports idle at address 0 during the stream);
@@ -397,10 +400,12 @@ def _greedy_cover(cover, quota):
 # random pixels are recorded (sim/golden/fixed/exact.DOT_SUM), and for each light, vector
 # (L, H), bit k below the rounding point plus the next one and sign, the pixels whose rounded
 # dot the move changes (at most DOT_CAP of them, a seeded choice) are run with it; the frame
-# keeps DOT_QUOTA of those whose output changes.
+# keeps DOT_QUOTA of those whose output changes. A mutant's move of 2**k has the sign of the
+# bit it breaks (or exists only for one sign of an operand), which the search does not know:
+# each kept pixel shows it with even odds, so one a move missed a quarter of them.
 DOT_POOL = 1 << 18
 DOT_CAP = 2048
-DOT_QUOTA = 1
+DOT_QUOTA = 3
 
 
 class _DotSums:
