@@ -67,3 +67,20 @@ def test_a_broken_units_row_has_no_lemmas_and_a_units_cover_none_either():
     for r in MAIN + AXI:
         if r.unit.startswith("mutant ") or r.result == "covered":
             assert r.lemmas == 0, r
+
+
+@pytest.mark.parametrize("command, says", [
+    ("--from-results --out build/formal", "Produced by `make formal` (`python -m bumprtl.gen.formal.run -j 2 --doc docs/formal.md`; `bumprtl formal` is the same command)"),
+    ("-j 2 --doc docs/formal.md", "Produced by `make formal` (`python -m bumprtl.gen.formal.run -j 2 --doc docs/formal.md`; `bumprtl formal` is the same command)"),
+    ("", "Produced by `make formal` ("),
+    ("sincos --prop hold", "Produced by `python -m bumprtl.gen.formal.run sincos --prop hold` (`make formal` runs these"),
+    ("sincos --merge", "the rows it names re-checked by `python -m bumprtl.gen.formal.run sincos --merge`")])
+def test_the_page_names_the_command_its_rows_came_from(tmp_path, command, says):
+    """A table reprinted from saved results (``--from-results``) or written by make formal's
+    own flags names make formal; a run of some checks names its command; a merged run names
+    both."""
+    page = tmp_path / "formal.md"
+    fdoc.write_doc(page, MAIN[:2], command)
+    text = page.read_text()
+    assert says in text, text[:400]
+    assert fdoc.table(MAIN[:2]) in text

@@ -181,7 +181,8 @@ def test_the_axi_covers_are_covered_or_not(monkeypatch, tmp_path, axi_target, st
     fake = FakeAxi({"cover": (status, None, False)})
     monkeypatch.setattr(fr.axi, "cover", fake.cover)
     assert fr.check(axi_target, "axi_cover", tmp_path).result == word
-    assert fake.calls[0][0] == "cover"
+    geom = axi.geometry(axi_target.config["geometry"])
+    assert fake.calls == [("cover", "axi_cover", axi.cover_depth(geom))]   # its own job name
 
 
 @pytest.mark.parametrize("status,trace,word", [("FAIL", Path("m.vcd"), "fails as expected"),
@@ -302,3 +303,53 @@ def test_a_formal_job_checks_what_its_kind_names_and_returns_its_logs(sby, kind,
     assert row.prop == (prop or MUTANTS[name][1])
     assert sby.calls[0][0] == (prop if kind == "target" else name)
     assert out["files"] == {} and out["log"] == ""
+
+
+def test_bumprtl_formal_hands_every_flag_to_the_runner(monkeypatch):
+    """`bumprtl formal` and `python -m bumprtl.gen.formal.run` take the same flags
+    (add_arguments) and hand each to execute: every flag at a non-default value arrives."""
+    from bumprtl.gen.cli import formal as cli_formal
+    from bumprtl.gen.cli.main import main
+    seen = []
+    monkeypatch.setattr(cli_formal, "execute", lambda **kw: seen.append(kw) or 0)
+    monkeypatch.setattr(fr, "execute", lambda **kw: seen.append(kw) or 0)
+    argv = ["sincos", "--prop", "hold", "--prop", "order", "--no-mutants", "--quick", "-j", "3",
+            "--job-timeout", "5", "--scheduler", "tcp://host:8786", "--out", "somewhere",
+            "--merge", "--from-results", "--doc", "page.md"]
+    assert main(["formal", *argv]) == 0
+    assert fr.main(argv) == 0
+    want = {"units": ["sincos"], "props": ["hold", "order"], "mutants": False, "quick": True,
+            "jobs": 3, "job_timeout": 5.0, "scheduler": "tcp://host:8786", "out": Path("somewhere"),
+            "merge": True, "from_results": True, "doc": Path("page.md")}
+    assert seen == [want, want]
+
+
+def test_a_broken_unit_of_the_bank_property_gets_the_memories_mapped(sby, tmp_path):
+    """The bank property reads the colour table's memory: its broken units' BMC maps the
+    memories (``memory_map``, ``opt -fast``), the others' runs add nothing to the script."""
+    bank = next(n for n, (_c, prop) in MUTANTS.items() if prop == "bank")
+    other = next(n for n, (_c, prop) in MUTANTS.items() if prop != "bank")
+    sby.default = ("FAIL", tmp_path / "t.vcd", False, "")
+    fr.check_mutant(bank, tmp_path)
+    fr.check_mutant(other, tmp_path)
+    assert sby.calls[0][3] == ("memory_map", "opt -fast") and sby.calls[1][3] == ()
+
+
+def test_a_formal_job_keeps_the_sby_logs_and_the_trace_only(monkeypatch):
+    """The files a job returns: every sby run's logfile.txt and the counterexample trace,
+    by their path under the job's directory, nothing else the run left there."""
+    def fake_sby(top, workdir, name, mode="prove", depth=10, script=(), timeout=3600, **_):
+        run = Path(workdir) / name
+        run.mkdir(parents=True)
+        (run / "logfile.txt").write_text("the log\n")
+        (run / "engine_0").mkdir()
+        (run / "engine_0" / "trace.vcd").write_text("$date\n")
+        (run / "engine_0" / "trace_tb.v").write_text("module tb;\n")
+        (run / "model.il").write_text("attribute\n")
+        return FormalResult(name, mode, depth, "FAIL", 0.01, run, run / "engine_0" / "trace.vcd",
+                            ["model.il:7.1-7.9"], "", False)
+    monkeypatch.setattr(fr, "run_sby", fake_sby)
+    out = fr.formal_job("target", "sincos", "hold")
+    assert sorted(out["files"]) == ["sincos/hold/engine_0/trace.vcd", "sincos/hold/logfile.txt"]
+    assert out["row"]["trace"] == "sincos/hold/engine_0/trace.vcd"
+    assert out["log"] == "==== sincos/hold/logfile.txt\nthe log\n"
