@@ -414,12 +414,15 @@ def _emit_unit_named(v: Vectors, out, module):
     return _add_named(vpath, jpath), [vpath, vpath.with_name(f"{named_module(module)}.v"), jpath]
 
 
-def _add_named(vpath, jpath):
-    """Write the named-ports wrapper and record it in the sidecar; returns the sidecar."""
+def _add_named(vpath, jpath, device=DEFAULT_DEVICE):
+    """Write the named-ports wrapper and record it in the sidecar, whose ``command`` becomes
+    the ``bumprtl emit ... --ports named`` line that writes these files (as emit records
+    it: ``--device`` when not the default); returns the sidecar."""
     meta = load(jpath)
     command = meta.command + " --ports named"
     write_named(vpath, meta, command)
     meta = with_named(meta, named_module(vpath.stem), command)
+    meta = meta.replace(command=command + (f" --device {device}" if device != DEFAULT_DEVICE else ""))
     meta.dump(jpath)
     return meta
 
@@ -431,7 +434,7 @@ def _emit_named(v: Vectors, out, module, load, device):
     vpath, jpath, hexes = emit_scene_unit("pipeline", v.scene, out, images, device,
                                           scene_command("pipeline", v.scene, load, module),
                                           module=module)
-    meta = _add_named(vpath, jpath)
+    meta = _add_named(vpath, jpath, device)
     return meta, [vpath, vpath.with_name(f"{named_module(module)}.v"), jpath, *hexes]
 
 

@@ -310,3 +310,18 @@ def test_unit_vectors_from_the_frame_and_at_random_chain_rotation_into_illuminat
         other = unit_vectors("rotation", cfg, source, count=64, seed=2)
         same = all(np.array_equal(other.inputs[k], rot.inputs[k]) for k in rot.inputs)
         assert same == (source == "frame"), source
+
+
+def test_the_design_vectors_writes_is_emit_pipelines_with_named_ports(default_bench, tmp_path):
+    """`bumprtl vectors` writes the pipeline as `bumprtl emit pipeline --scene default
+    --ports named --name bumprtl_pipeline` does: the same Verilog, named wrapper, memory
+    images and sidecar (the command it records included)."""
+    from bumprtl.gen.cli.main import main
+    out, _vvp_path = default_bench
+    emitted = tmp_path / "emit"
+    assert main(["emit", "pipeline", "--scene", "default", "--ports", "named", "--name",
+                 "bumprtl_pipeline", "--out", str(emitted)]) == 0
+    files = sorted(p.name for p in emitted.iterdir() if p.is_file())
+    assert "bumprtl_pipeline.json" in files and "bumprtl_pipeline_named.v" in files
+    for name in files:
+        assert (out / name).read_bytes() == (emitted / name).read_bytes(), name
