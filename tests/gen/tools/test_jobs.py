@@ -5,6 +5,7 @@ scheduler and worker processes are tests/gen/test_cluster.py's."""
 import subprocess
 import sys
 import time
+from types import SimpleNamespace
 
 import pytest
 
@@ -106,3 +107,48 @@ def test_jobs_given_a_timeout_that_finish_in_time_keep_their_value_or_error(thre
     assert out["ok"].ok and out["ok"].value == {"slept": 0}
     assert out["plain"].ok and out["plain"].value == 42
     assert not out["bad"].ok and out["bad"].error == "ValueError: no such thing"
+
+
+class _Future:
+    """A finished future whose result raises ``exc``."""
+
+    def __init__(self, exc):
+        self.exc = exc
+
+    def result(self):
+        raise self.exc
+
+
+def test_a_job_without_a_result_is_an_error_outcome_named_after_it(monkeypatch, tmp_path, capsys):
+    """A job whose future was cancelled (the scheduler went away), whose worker died each
+    time, or whose result raised anything else has an Outcome of its own name with a
+    one-line error, a log file of that name and one line on stderr; the others keep
+    theirs."""
+    import distributed
+    from distributed.client import FutureCancelledError
+    from distributed.scheduler import KilledWorker
+    runner = jobs.Runner(None, 1, log_dir=tmp_path, progress=False)
+    futures = iter([_Future(FutureCancelledError("k", None)),
+                    _Future(KilledWorker("k", SimpleNamespace(address="tcp://w:1"), 3)),
+                    _Future(RuntimeError("boom\nsecond line"))])
+    monkeypatch.setattr(runner, "submit", lambda job: next(futures))
+    monkeypatch.setattr(distributed, "as_completed", lambda fs: fs)
+    done = []
+    out = runner.run([jobs.Job(n, _fails) for n in ("gone", "killed", "raised")], on_done=done.append)
+    assert list(out) == ["gone", "killed", "raised"] and [o.name for o in done] == list(out)
+    assert out["gone"].error == "cancelled (the scheduler went away)"
+    assert out["killed"].error.startswith("its worker died each time it ran it")
+    assert out["raised"].error == "RuntimeError: boom"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gone.log", "killed.log", "raised.log"]
+    assert "result error: RuntimeError: boom" in (tmp_path / "raised.log").read_text()
+    err = capsys.readouterr().err
+    assert "job gone failed: cancelled (the scheduler went away)" in err
+
+
+def test_progress_follows_the_argument_then_the_environment(monkeypatch):
+    monkeypatch.delenv("BUMPRTL_PROGRESS", raising=False)
+    assert jobs.Runner(None, 1).progress is True
+    assert jobs.Runner(None, 1, progress=False).progress is False
+    monkeypatch.setenv("BUMPRTL_PROGRESS", "0")
+    assert jobs.Runner(None, 1).progress is False
+    assert jobs.Runner(None, 1, progress=True).progress is True

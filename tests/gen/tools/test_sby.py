@@ -76,6 +76,7 @@ def test_a_failure_gives_its_assertions_and_the_last_trace(tools, tmp_path):
     assert res.failed == ["a.py:7.1-7.9: hold broken", "a.py:9.1-9.9: order broken"]
     assert res.trace == (tmp_path / "w" / "hold" / "engine_0" / "trace.vcd").resolve()
     assert (res.name, res.mode, res.depth) == ("hold", "bmc", 5)
+    assert res.workdir == (tmp_path / "w" / "hold").resolve()       # sby's run directory
     assert (tmp_path / "w" / "hold.il").read_text().startswith("attribute")
     assert "mode bmc" in (tmp_path / "w" / "hold.sby").read_text()
 
