@@ -211,3 +211,28 @@ def test_refresh_timing():
     c.cmd("REF")
     c.nop(150)                                           # a refresh in time resets the clock
     assert c.m.state == "ready"
+
+
+@pytest.mark.parametrize("first", ["READ", "WRITE"])
+@pytest.mark.parametrize("bl_code, beats", [(1, 2), (2, 4), (3, 8)])
+def test_a_column_command_may_follow_a_burst_exactly_when_it_ends(first, bl_code, beats):
+    """A READ or WRITE burst of BL beats holds the bus through its last beat: a column
+    command in that cycle interrupts it, one in the next cycle (BL after the first) is
+    legal."""
+    def start():
+        c = Chip(bl_code=bl_code, cl=2).init()
+        c.cmd("ACT", a=1)
+        c.cmd(first, a=0, dq=1, oe=int(first == "WRITE"))
+        return c
+
+    def data(c):
+        return {"dq": 1, "oe": 1} if first == "WRITE" else {}
+    c = start()
+    for _ in range(beats - 2):
+        c.cmd(**data(c))
+    _violates(lambda: c.cmd(first, a=0, dq=1, oe=int(first == "WRITE")),
+              f"{first} interrupts the burst under way (until cycle")
+    c = start()
+    for _ in range(beats - 1):
+        c.cmd(**data(c))
+    c.cmd(first, a=0, dq=1, oe=int(first == "WRITE"))      # the cycle after its last beat
