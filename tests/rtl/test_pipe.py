@@ -559,3 +559,39 @@ def test_elaborating_a_pipeline_sets_nothing_on_it_or_its_units(scene):
         now = attributes(u)
         assert now.keys() == was.keys(), (type(u).__name__, now.keys() - was.keys())
         assert all(now[k] is was[k] for k in was), type(u).__name__
+
+
+def _pipe_units():
+    """Every PipeUnit class of rtl/ (the modules imported), subclasses of subclasses too."""
+    import importlib
+    import pkgutil
+
+    import bumprtl.rtl as pkg
+    from bumprtl.rtl.pipe import PipeUnit
+    for mod in pkgutil.walk_packages(pkg.__path__, "bumprtl.rtl."):
+        importlib.import_module(mod.name)
+    out, todo = [], [PipeUnit]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            out.append(sub)
+            todo.append(sub)
+    return sorted(set(out), key=lambda c: (c.__module__, c.__qualname__))
+
+
+def test_a_unit_built_from_its_configuration_alone_has_its_own_credit_edge():
+    """PipeUnit's contract: ``credit=True`` is the default, a unit on its own with its own
+    edge (the least FIFO depth for its latency); a chain's owner asks for ``credit=False``.
+    Every unit class that is built from a Config alone keeps that default."""
+    from bumprtl.rtl.config import BumpError, Config
+    from bumprtl.rtl.pipe import min_fifo_depth
+    built = []
+    for cls in _pipe_units():
+        try:
+            unit = cls(Config())
+        except (TypeError, AttributeError, ValueError, BumpError):
+            continue                          # built from more than a Config (a scene, layouts)
+        unit._MustUse__silence = True
+        built.append(cls.__name__)
+        assert unit.credit is True, cls
+        assert unit.fifo_depth == min_fifo_depth(unit.latency), cls
+    assert {"BackEnd", "SinCos"} <= set(built), built
