@@ -563,3 +563,19 @@ def test_render_palette_dithers_when_asked():
     got = render_palette(scene, cfg, 16, "median-cut", dither=True).color
     assert np.array_equal(got, palette_rgb(scene, cfg, qmap=dithered)[0].mean(-1))
     assert not np.array_equal(got, render_palette(scene, cfg, 16, "median-cut").color)
+
+
+def test_the_chrome_environment_is_a_colour_brown_below_and_blue_above():
+    """Tarini et al. Fig. 7's landscape (_environment): every direction's colour is in
+    [0, 1], brown (r > g > b) below the horizon and blue (b > g > r) above it."""
+    from bumprtl.sim.golden.float.palette import _environment
+    rng = np.random.default_rng(7)
+    r = rng.normal(size=(4000, 3))
+    r /= np.linalg.norm(r, axis=1, keepdims=True)
+    r = np.concatenate([r, [[1, 0, 0], [0, 0, 1], [0, 0, -1], [0, 1, -1e-9]]])
+    c = _environment(r)
+    assert c.shape == (len(r), 3) and (c >= 0).all() and (c <= 1).all()
+    below = (r[:, 2] < -1e-3) & (r[:, 2] > -1 + 1e-6)       # straight down is black
+    above = r[:, 2] >= 0
+    assert ((c[below, 0] > c[below, 1]) & (c[below, 1] > c[below, 2])).all()
+    assert ((c[above, 2] > c[above, 1]) & (c[above, 1] > c[above, 0])).all()
