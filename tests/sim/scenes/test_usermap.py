@@ -454,3 +454,26 @@ def test_a_w_by_h_map_is_its_own_size_with_texture_height(tmp_path):
         load_scene_config({"height_map": str(path)})
     with pytest.raises(MapError, match="64x32 texels but texture_size x texture_height = 64 x 16"):
         load_scene_config({"height_map": str(path), "texture_height": 16})
+
+
+@pytest.mark.parametrize("size, height", [(None, 16), (32, 16), (64, 16)])
+def test_a_non_square_normal_map_keeps_its_shape_and_content(tmp_path, size, height):
+    """A 32 x 16 normal map read at ``height`` 16 (its own width, or resampled to 64 wide)
+    keeps its aspect: the result is ``height`` rows of ``size`` texels, each the unit
+    normal of the file's texel there (resampled: the per-channel Lanczos of the unit
+    normals, normalised, as a square map is)."""
+    from bumprtl.sim.scenes.usermap import _resize
+    rng = np.random.default_rng(5)
+    n = rng.normal(size=(16, 32, 3))
+    n[..., 2] = np.abs(n[..., 2]) + 0.5
+    path = tmp_path / "wide.png"
+    write_png(path, normals_to_rgb(n / np.linalg.norm(n, axis=-1, keepdims=True)))
+    own = read_normals(path, height=16)
+    assert own.shape == (16, 32, 3)
+    got = read_normals(path, size=size, height=height, resample=True)
+    width = size or 32
+    assert got.shape == (height, width, 3)
+    want = own if width == 32 else _resize(own, width, height)
+    want = want / np.linalg.norm(want, axis=-1, keepdims=True)
+    assert np.allclose(got, want, rtol=0, atol=1e-6)
+    assert np.allclose(np.linalg.norm(got, axis=-1), 1)
