@@ -105,3 +105,18 @@ def test_scene_command_gives_a_boolean_key_as_its_flag_or_no_flag():
         command = scene_command("pipeline", scene)
         args = build_parser().parse_args(command.split()[1:])
         assert getattr(args, key) is (not getattr(base, key)), command
+
+
+@pytest.mark.parametrize("load", ["initial", "port"])
+def test_an_axis_scene_unit_carries_the_maps_the_stream_one_does(tmp_path, load):
+    """`--interface axis` wraps the same scene pipeline: its map image (built in, or for the
+    host write port) is the stream emission's, byte for byte, and its sidecar records it."""
+    base = ["pipeline", *SMALL, "--load", load, "--name", "m"]
+    _emit(base, tmp_path / "stream")
+    _emit([*base, "--interface", "axis"], tmp_path / "axis")
+    stream, axis = _files(tmp_path / "stream"), _files(tmp_path / "axis")
+    assert axis["m_axis_map.hex"] == stream["m_map.hex"]
+    meta = loads(axis["m_axis.json"])
+    assert meta.memory_images["map"]["load"] == load
+    assert meta.memory_images["map"]["file"] == "m_axis_map.hex"
+    assert ("map_w_en" in axis["m_axis.v"].decode()) == (load == "port")
