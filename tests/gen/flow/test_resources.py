@@ -212,3 +212,17 @@ def test_the_same_design_is_synthesized_once_per_process(tmp_path, monkeypatch):
     assert len(runs) == 1
     added = count_verilog(other, "twice", tmp_path / "w3").summary()
     assert len(runs) == 2 and added["multipliers"] == 0 and added["adders"] == 1
+
+
+@pytest.mark.parametrize("addends, const_adders", [
+    ([[50, 51, 52]], []),                                        # signal addends only
+    ([[50, 51, 52], ["0", "0", "0"]], []),                       # a constant 0 adds nothing
+    ([[50, 51, 52], ["1", "0", "0"]], [16]),                     # a constant 1 is an adder
+])
+def test_a_macc_has_a_constant_adder_only_for_a_nonzero_constant_addend(addends, const_adders):
+    cell = _macc([(list(range(2, 8)), list(range(10, 15)))], addends=addends)
+    netlist = {"modules": {"top": {"ports": {"y": {"direction": "output", "bits": list(range(100, 116))}},
+                                   "cells": {"m": cell}}}}
+    counts = count_netlist(netlist, "top")
+    assert counts.const_adders == const_adders
+    assert counts.adders == [16]                                 # product + the signal addend
