@@ -155,3 +155,33 @@ def test_a_table1_baseline_renders_with_its_fixed_point_model(tmp_path, run_cli)
     assert pictures["fixed"].shape[:2] == (32, 32) == pictures["float64"].shape[:2]
     diff = np.abs(pictures["fixed"] - pictures["float64"])
     assert diff.max() <= 2 and diff.any(), diff.max()
+
+
+def test_a_palette_scenes_colour_table_is_shaded_with_the_scenes_coefficients():
+    """The palette scene's colour table (gen/render/rtl._palette_maps, what render --rtl
+    writes into the LUT) is Tarini's Sec. 5.1 table shaded with the scene's own ka, kd, ks
+    and exponent: a scene with other coefficients gets another table, entry by entry the
+    8-bit colour_table of its Config."""
+    from bumprtl.gen.render.rtl import _palette_maps, sim_scene
+    from bumprtl.sim.golden.common import to_8bit
+    from bumprtl.sim.golden.fixed.palette_lut import pack_rgba
+    from bumprtl.sim.golden.float.palette import (
+        color_table,
+        frame_directions,
+        quantize_normal_map,
+        world_normal_map,
+    )
+    from bumprtl.sim.scenes.config import load_scene_config
+
+    tables = []
+    for keys in ({}, {"kd": 0.4, "ks": 0.5, "ka": 0.05}):
+        scene = load_scene_config({"name": "palette", **keys}) if keys else load_scene_config("palette")
+        base = sim_scene(scene, 32)
+        _, table = _palette_maps(base, scene)
+        normals, counts = world_normal_map(base)
+        qmap = quantize_normal_map(normals, scene.palette_size, weights=counts)
+        l, v = frame_directions(base)
+        want = pack_rgba(to_8bit(color_table(qmap.table, "phong", l, v, scene.config)), scene.config)
+        assert np.array_equal(np.asarray(table), np.asarray(want))
+        tables.append(np.asarray(table))
+    assert not np.array_equal(tables[0], tables[1])
