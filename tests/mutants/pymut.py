@@ -399,6 +399,78 @@ KNOWN = [
      "dominated by the positive errors); "
      "tests/sim/golden/test_accuracy_builders.py::test_arithmetic_pixels_keep_errors_of_both_polarities "
      "(checked with the mutant switched on)"),
+    # seed 33 (the first draw with make test's whole selection): each "killed since" checked
+    # with its mutant switched on
+    ("bumprtl.gen.bench.rtl_sim.x_rtl_sim_bench", "json.dumps(rows, indent=None)", "equivalent",
+     "rows.json holds the same JSON on one line: only the whitespace changes, and its readers "
+     "parse it"),
+    ("bumprtl.gen.bench.sweep.x_plot", "strict=None", "equivalent",
+     "zip's strict takes a truth value: None is false, as False is"),
+    ("bumprtl.gen.tools.toolchain.x_roms_as_readmemh", "v.replace('XX_XX', '')", "equivalent",
+     "int() accepts the underscores of a Verilog literal itself (PEP 515), so removing them "
+     "first or not gives the same word"),
+    ("bumprtl.rtl.ecp5.xǁECP5Loweringǁram", "one = Const(0, 1), Const(1, )", "equivalent",
+     "Const(1) is one bit wide already"),
+    ("bumprtl.gen.cli.formal.x_run", "==merge=args.merge, from_results=args.from_results, doc=args.doc)",
+     "killed since", "no test ran `bumprtl formal` with --out; "
+     "test_bumprtl_formal_hands_every_flag_to_the_runner passes every flag"),
+    ("bumprtl.gen.flow.vectors.x__emit_named", "None,", "killed since",
+     "no test compared vectors' design with emit's; "
+     "test_the_design_vectors_writes_is_emit_pipelines_with_named_ports does (and found its "
+     "sidecar's command without --ports named)"),
+    ("bumprtl.gen.formal.doc.x__write_section", "XX--from-resultsXX", "killed since",
+     "test_the_page_names_the_command_its_rows_came_from"),
+    ("bumprtl.gen.formal.run.x_check_axi", "name=None", "killed since",
+     "test_the_axi_covers_are_covered_or_not now checks the job's name and depth"),
+    ("bumprtl.gen.formal.run.x_check_mutant", "(prop == \"bank\") and False", "killed since",
+     "test_a_broken_unit_of_the_bank_property_gets_the_memories_mapped"),
+    ("bumprtl.gen.formal.run.x_formal_job", "p.resolve() != Path(row.trace).resolve()", "killed since",
+     "test_a_formal_job_keeps_the_sby_logs_and_the_trace_only"),
+    ("bumprtl.gen.report.fpga.x__plot", 'r["row"] != "pipeline"', "killed since",
+     "tests/docs/test_fpga_pages.py now reads the plot's points and names"),
+    ("bumprtl.gen.report.table1.x__count_row", "mults = None", "killed outside the selection",
+     "test_the_page_is_docs_table1_md_but_for_the_numbers fails with it, but the page is "
+     "written by the module's fixture, and mutmut credits what a module-scoped fixture calls "
+     "to the first test that uses it only (test_lee_counts_agree_with_the_paper_where_they_should, "
+     "which parses the numbers and passes)"),
+    ("bumprtl.gen.report.table1.x_count_all", 'desc="XXcountXX"', "wording",
+     "the progress bar's label on stderr"),
+    ("bumprtl.gen.tools.jobs.xǁRunnerǁ__init__", "(progress is None) or True", "killed since",
+     "test_progress_follows_the_argument_then_the_environment"),
+    ("bumprtl.gen.tools.jobs.xǁRunnerǁrun", "Outcome(None, error=", "killed since",
+     "test_a_job_without_a_result_is_an_error_outcome_named_after_it"),
+    ("bumprtl.gen.tools.jobs.xǁRunnerǁrun", "outcome = Outcome(error=", "killed since",
+     "test_a_job_without_a_result_is_an_error_outcome_named_after_it"),
+    ("bumprtl.gen.tools.sby.x_run_sby", "seconds, None, trace", "killed since",
+     "test_a_failure_gives_its_assertions_and_the_last_trace checks the run directory"),
+    ("bumprtl.rtl.sdram.xǁSdramConfigǁ__post_init__", "self.init_refreshes <= 17", "killed since",
+     "every range end of SdramConfig is tested on both sides now (and freq_mhz's stated lower "
+     "end was found refused: fixed)"),
+    ("bumprtl.rtl.shade.xǁBackEndǁ__init__", "credit=False", "killed since",
+     "test_a_unit_built_from_its_configuration_alone_has_its_own_credit_edge"),
+    ("bumprtl.sim.golden.float.palette.x__environment", "np.array([1.45, 0.3, 0.15])", "killed since",
+     "test_the_chrome_environment_is_a_colour_brown_below_and_blue_above"),
+    ("bumprtl.sim.scenes.usermap.x_read_normals", "_sized(path, n, size, resample, )", "killed since",
+     "test_a_non_square_normal_map_keeps_its_shape_and_content"),
+    ("bumprtl.sim.sdram_model.xǁSdramModelǁ_write", "self.n + self.bl - 2", "killed since",
+     "test_a_column_command_may_follow_a_burst_exactly_when_it_ends"),
+    ("bumprtl.gen.cli.emit.x_run", "==images = None", "killed since",
+     "no test emitted a scene unit through the CLI with --interface axis and looked at its map; "
+     "test_an_axis_scene_unit_carries_the_maps_the_stream_one_does"),
+    ("bumprtl.gen.flow.resources.x__count_macc", "_constant(x) in (None, 0)", "killed since",
+     "test_a_macc_has_a_constant_adder_only_for_a_nonzero_constant_addend"),
+    ("bumprtl.gen.render.rtl.x__palette_maps", 'color_table(qmap.table, "phong", l, v, )', "killed since",
+     "test_a_palette_scenes_colour_table_is_shaded_with_the_scenes_coefficients"),
+    ("bumprtl.sim.formal.sdram.xǁSdramCommandContractǁelaborate", '"burst: read after read"', "wording",
+     "a cover's name, printed when it is not reached"),
+    ("bumprtl.sim.formal.axi.x_bmc", '"bmc", None)', "make formal",
+     "the AXI contract's BMC runs only in make formal (its broken managers and the fallback "
+     "of its proofs); make test proves the rules by induction"),
+    ("bumprtl.sim.formal.mutants.xǁSwapAheadPaletteǁelaborate", "self.i.ready.eq(None)", "make formal",
+     "a broken unit built for make formal's bank proofs; make test runs three others"),
+    ("bumprtl.sim.formal.contract.xǁStreamContractǁ_fifo_lemmas", "(produce < n) | (consume < n)",
+     "equivalent", "a weaker auxiliary lemma: it is still true, and the properties proved with "
+     "it (order, credit) are the same; only the induction's help is weaker, and it still closes"),
 ]
 
 
