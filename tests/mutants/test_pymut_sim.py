@@ -67,3 +67,47 @@ def test_the_runner_lays_the_recorder_out(tmp_path):
     assert ["    -p", "    pymut_sim"] == [a for a in args if a.strip() in ("-p", "pymut_sim")][-2:]
     copied = cfg[cfg.index("also_copy =") + 1:]
     assert "    sitecustomize.py" in copied and "    pymut_sim.py" in copied
+
+
+PROJECT = {
+    "conftest.py": (
+        "import json, os\n"
+        "from mutmut.state import state\n"
+        "CREDITS = {}\n"
+        "def pytest_runtest_teardown(item, nextitem):\n"      # mutmut's StatsCollector, in short
+        "    CREDITS[item.name] = sorted(state()._stats)\n"
+        "    state()._stats.clear()\n"
+        "def pytest_sessionfinish(session):\n"
+        "    open(os.environ['CREDITS_OUT'], 'w').write(json.dumps(CREDITS))\n"),
+    "test_m.py": (
+        "import pytest\n"
+        "from mutmut.state import state\n"
+        "@pytest.fixture(scope='module')\n"
+        "def table():\n"
+        "    state()._stats.add('pkg.x_write_table')\n"      # a trampoline's hit in the set-up
+        "    return 1\n"
+        "def test_first(table):\n"
+        "    state()._stats.add('pkg.x_first')\n"
+        "def test_second(table):\n"
+        "    pass\n"
+        "def test_without(tmp_path):\n"
+        "    pass\n"),
+}
+
+
+def test_what_a_module_fixture_calls_is_credited_to_every_test_using_it(tmp_path):
+    """mutmut credits a hit to the test in whose protocol it happens: a module fixture's
+    set-up runs in its first test's. The plugin credits it to each test that uses the
+    fixture (test_second too), and to no other."""
+    for name, text in PROJECT.items():
+        (tmp_path / name).write_text(text)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYMUT_SIM_HITS",)}
+    env.update(MUTANT_UNDER_TEST="stats", CREDITS_OUT=str(tmp_path / "credits.json"),
+               PYTHONPATH=str(HERE))
+    subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p",
+                    "no:xdist", "-p", "pymut_sim", "test_m.py"], cwd=tmp_path, env=env,
+                   check=True, capture_output=True, text=True)
+    import json
+    credits = json.loads((tmp_path / "credits.json").read_text())
+    assert credits == {"test_first": ["pkg.x_first", "pkg.x_write_table"],
+                       "test_second": ["pkg.x_write_table"], "test_without": []}
