@@ -93,3 +93,23 @@ def test_replace_changes_switches_and_config_fields_and_checks_them():
     with pytest.raises(BumpError) as e:
         s.replace(mip_levels=7)
     assert e.value.field == "mip_levels"
+
+
+def test_every_unit_a_scene_pipeline_builds_says_why_it_is_there():
+    """The sidecar's list of built units gives each its reason (the scene key and the
+    paper's equation it serves): a non-empty sentence for every unit of every built-in
+    scene, the texture blend's naming its lights where there are several."""
+    from bumprtl.rtl.pipeline import BumpPipeline
+    from bumprtl.sim.scenes.config import BUILTIN, load_scene_config
+    for name in BUILTIN:
+        scene = load_scene_config(name)
+        pipeline = BumpPipeline(scene.hardware)
+        pipeline._MustUse__silence = True
+        for entry in pipeline.built:
+            assert isinstance(entry["why"], str) and len(entry["why"].split()) >= 3, (name, entry)
+        assert [e["unit"] for e in pipeline.built] == list(pipeline.units), name
+    full = BumpPipeline(load_scene_config({"name": "x", "texture": True, "image": "bricks",
+                                           "lights": 2}).hardware)
+    full._MustUse__silence = True
+    blend = next(e for e in full.built if e["unit"] == "blend")
+    assert blend["why"].startswith("texture = true") and "summed over the 2 lights" in blend["why"]
