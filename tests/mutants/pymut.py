@@ -471,6 +471,9 @@ KNOWN = [
      "only the per-cycle render passes it on, which make test does not run (make regress's "
      "per-cycle renders do not read their progress lines); the progress output is not specified "
      "by a test"),
+    ("bumprtl.rtl.pipeline.xǁBumpPipelineǁ_plan_shading", "==None)", "killed since",
+     "no test read the reasons the sidecar gives for each unit built; "
+     "test_every_unit_a_scene_pipeline_builds_says_why_it_is_there"),
     ("bumprtl.sim.formal.axi.x_bmc", '"bmc", None)', "make formal",
      "the AXI contract's BMC runs only in make formal (its broken managers and the fallback "
      "of its proofs); make test proves the rules by induction"),
