@@ -474,6 +474,9 @@ KNOWN = [
     ("bumprtl.rtl.pipeline.xǁBumpPipelineǁ_plan_shading", "==None)", "killed since",
      "no test read the reasons the sidecar gives for each unit built; "
      "test_every_unit_a_scene_pipeline_builds_says_why_it_is_there"),
+    ("bumprtl.rtl.config.xǁConfigǁ__post_init__", '_check_int("lights", 1, 8)', "stopped",
+     "the run was stopped while this mutant's tests ran: _check_int takes the value and both "
+     "ends, so every Config raises TypeError and every test that builds one fails"),
     ("bumprtl.sim.formal.axi.x_bmc", '"bmc", None)', "make formal",
      "the AXI contract's BMC runs only in make formal (its broken managers and the fallback "
      "of its proofs); make test proves the rules by induction"),
