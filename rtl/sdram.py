@@ -126,9 +126,6 @@ ADDR_PINS = 13                       # A0..A12 on the ULX3S
 DATA_BITS = (32, 64)
 
 
-MIN_MHZ = 2      # the slowest clock SdramConfig takes (every chip, burst and CAS latency)
-
-
 def ns_to_cycles(ns, freq_mhz):
     """Least whole cycles at ``freq_mhz`` covering ``ns``: ceil(ns * f), exactly."""
     return ceil(Fraction(str(ns)) * Fraction(str(freq_mhz)) / 1000)
@@ -191,10 +188,9 @@ class SdramConfig:
         if self.cas_latency not in (2, 3):
             raise BumpError(f"cas_latency must be 2 or 3, got {self.cas_latency!r}", "cas_latency")
         fmax = Fraction(1000) / Fraction(str(self.chip.tck_min[self.cas_latency - 2]))
-        # below 2 MHz tREFI (7.8 us) holds too few cycles for the refresh's own slack
         if not isinstance(self.freq_mhz, (int, float)) or isinstance(self.freq_mhz, bool) \
-                or not MIN_MHZ <= Fraction(str(self.freq_mhz)) <= fmax:
-            raise BumpError(f"freq_mhz must be in [{MIN_MHZ}, {float(fmax):g}] for cas_latency "
+                or not 1 <= Fraction(str(self.freq_mhz)) <= fmax:
+            raise BumpError(f"freq_mhz must be in [1, {float(fmax):g}] for cas_latency "
                             f"{self.cas_latency} ({self.chip.part}), got {self.freq_mhz!r}",
                             "freq_mhz")
         if not is_pow2(self.burst) or self.burst > 8:
@@ -223,7 +219,7 @@ class SdramConfig:
             raise BumpError(f"pin_cycles must be an integer in [0, 4], got {self.pin_cycles!r}",
                             "pin_cycles")
         if self.refresh_reload < 1:
-            raise BumpError(f"freq_mhz must be in [{MIN_MHZ}, {float(fmax):g}]: at {self.freq_mhz} MHz "
+            raise BumpError(f"freq_mhz must be in [1, {float(fmax):g}]: at {self.freq_mhz} MHz "
                             f"a refresh cannot be scheduled within tREFI", "freq_mhz")
 
     @property

@@ -444,8 +444,7 @@ KNOWN = [
     ("bumprtl.gen.tools.sby.x_run_sby", "seconds, None, trace", "killed since",
      "test_a_failure_gives_its_assertions_and_the_last_trace checks the run directory"),
     ("bumprtl.rtl.sdram.xǁSdramConfigǁ__post_init__", "self.init_refreshes <= 17", "killed since",
-     "every range end of SdramConfig is tested on both sides now (and freq_mhz's stated lower "
-     "end was found refused: fixed)"),
+     "every range end of SdramConfig is tested on both sides now"),
     ("bumprtl.rtl.shade.xǁBackEndǁ__init__", "credit=False", "killed since",
      "test_a_unit_built_from_its_configuration_alone_has_its_own_credit_edge"),
     ("bumprtl.sim.golden.float.palette.x__environment", "np.array([1.45, 0.3, 0.15])", "killed since",
