@@ -14,13 +14,37 @@ from pathlib import Path
 
 from bumprtl.gen.cli.main import build_parser
 
-__all__ = ["reference", "main"]
+__all__ = ["reference", "subcommands", "options", "main"]
 
 HEAD = ("# Command-line reference\n\n"
         "Every command of `bumprtl` and its options, as `bumprtl COMMAND --help` prints them. "
         "Written by `python -m bumprtl.gen.cli.reference docs/cli.md` from the parsers "
         "themselves; tests/gen/cli/test_reference.py fails when this page and the parsers "
         "differ.\n")
+
+
+def subcommands(parser):
+    """``(name, one-line help, parser)`` of each subcommand of ``parser``, in order."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps = {a.dest: a.help for a in action._choices_actions}
+            for name, child in action.choices.items():
+                yield name, helps.get(name, ""), child
+
+
+def _own(parser):
+    """The options and arguments of ``parser`` itself (not ``--help``, not its subcommands)."""
+    return [a for a in parser._actions
+            if not isinstance(a, (argparse._HelpAction, argparse._SubParsersAction))]
+
+
+def options(parser, path=()):
+    """``(command path, action)`` of every option and argument of ``parser`` (path ``()``)
+    and of its subcommands, depth first; ``--help`` left out."""
+    for action in _own(parser):
+        yield path, action
+    for name, _help, child in subcommands(parser):
+        yield from options(child, (*path, name))
 
 
 def _cell(text):
@@ -47,19 +71,14 @@ def _section(name, help_text, parser):
     if parser.description and parser.description != help_text:
         lines += [_cell(parser.description), ""]
     rows = []
-    for action in parser._actions:
-        if isinstance(action, (argparse._HelpAction, argparse._SubParsersAction)):
-            continue
+    for action in _own(parser):
         flags = ", ".join(f"`{f}`" for f in action.option_strings) or f"`{action.dest}`"
         value = _value(action)
         rows.append(f"| {flags} | {'`' + _cell(value) + '`' if value else ''} | {_cell(action.help or '')} |")
     if rows:
         lines += ["| option | takes | what it does |", "| --- | --- | --- |", *rows, ""]
-    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
-    for sub in subs:
-        helps = {a.dest: a.help for a in sub._choices_actions}
-        for child, child_parser in sub.choices.items():
-            lines += _section(f"{name} {child}", helps.get(child, ""), child_parser)
+    for child, help_text, child_parser in subcommands(parser):
+        lines += _section(f"{name} {child}", help_text, child_parser)
     return lines
 
 
@@ -67,13 +86,12 @@ def reference():
     """The page's text."""
     parser = build_parser()
     lines = [HEAD, _cell(parser.description), ""]
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    helps = {a.dest: a.help for a in sub._choices_actions}
+    commands = list(subcommands(parser))
     lines += ["| command | what it does |", "| --- | --- |"]
-    lines += [f"| [`{c}`](#bumprtl-{c}) | {_cell(helps.get(c, ''))} |" for c in sub.choices]
+    lines += [f"| [`{c}`](#bumprtl-{c}) | {_cell(h)} |" for c, h, _ in commands]
     lines.append("")
-    for command, child in sub.choices.items():
-        lines += _section(f"bumprtl {command}", helps.get(command, ""), child)
+    for command, help_text, child in commands:
+        lines += _section(f"bumprtl {command}", help_text, child)
     return "\n".join(lines).rstrip() + "\n"
 
 

@@ -15,7 +15,6 @@ sidecar's ``command``, ``config`` and ``scene``) are set aside: a flag recorded 
 effect on the hardware is no change.
 """
 
-import argparse
 import contextlib
 import io
 import json
@@ -25,6 +24,7 @@ import pytest
 from PIL import Image
 
 from bumprtl.gen.cli.main import build_parser, main
+from bumprtl.gen.cli.reference import options
 
 # Commands another change owns: classified when it lands.
 EXCLUDED = set()
@@ -123,13 +123,9 @@ EMIT_BASE = {"sincos": ["--angle-bits", "5"], "rotation": ["--angle-bits", "5", 
 RENDER_BASE = ["--size", "16", "--texture-size", "16"]
 
 
-def _walk(parser, path=()):
-    for a in parser._actions:
-        if isinstance(a, argparse._SubParsersAction):
-            for name, sub in a.choices.items():
-                yield from _walk(sub, (*path, name))
-        elif path and not isinstance(a, (argparse._HelpAction, argparse._VersionAction)):
-            yield path, a
+def _walk(parser):
+    """Every option of every command (the top level's --version left out)."""
+    return ((path, a) for path, a in options(parser) if path)
 
 
 def _flag(action):

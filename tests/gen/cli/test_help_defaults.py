@@ -13,19 +13,10 @@ import pytest
 
 from bumprtl.gen.bench.sweep import DEFAULT_MAPS
 from bumprtl.gen.cli.main import build_parser
+from bumprtl.gen.cli.reference import options
 from bumprtl.rtl.config import Config
 
-
-def walk(parser, path=()):
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for name, sub in action.choices.items():
-                yield from walk(sub, path + (name,))
-        elif not isinstance(action, argparse._HelpAction):
-            yield path, action
-
-
-ACTIONS = list(walk(build_parser()))
+ACTIONS = list(options(build_parser()))
 IDS = [" ".join(path + (a.option_strings[-1] if a.option_strings else a.dest,)) for path, a in ACTIONS]
 
 

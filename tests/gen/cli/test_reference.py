@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from bumprtl.gen.cli.main import build_parser
-from bumprtl.gen.cli.reference import main, reference
+from bumprtl.gen.cli.reference import main, reference, subcommands
 
 PAGE = Path(__file__).resolve().parents[3] / "docs" / "cli.md"
 
@@ -19,14 +19,10 @@ def test_the_page_is_what_the_parsers_say():
 def test_every_command_and_subcommand_has_a_section_and_the_index_links_resolve():
     text = PAGE.read_text()
     headings = re.findall(r"^## `(bumprtl[^`]*)`$", text, flags=re.M)
-    parser = build_parser()
-    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
-    for command, child in sub.choices.items():
+    for command, _help, child in subcommands(build_parser()):
         assert f"bumprtl {command}" in headings
         assert f"](#bumprtl-{command})" in text
-        for a in child._actions:
-            if a.__class__.__name__ == "_SubParsersAction":
-                assert {f"bumprtl {command} {k}" for k in a.choices} <= set(headings)
+        assert {f"bumprtl {command} {k}" for k, _h, _p in subcommands(child)} <= set(headings)
     assert len(headings) == len(set(headings))
 
 
