@@ -25,12 +25,16 @@ def run_table1(args):
                          args.jobs, args.scheduler)
 
 
+def fpga_run_of(args):
+    """The FpgaRun ``report fpga``'s parsed flags ask for."""
+    return FpgaRun(device=args.device, out=args.out, work=args.work, samples=args.samples,
+                   unit=tuple(args.unit or ()), seeds=tuple(args.seeds or (1,)),
+                   scene_seeds=tuple(args.scene_seeds or ()), jobs=args.jobs,
+                   job_timeout=args.job_timeout, scheduler=args.scheduler)
+
+
 def run_fpga(args):
-    run = FpgaRun(device=args.device, out=args.out, work=args.work, samples=args.samples,
-                  unit=tuple(args.unit or ()), seeds=tuple(args.seeds or (1,)),
-                  scene_seeds=tuple(args.scene_seeds or ()), jobs=args.jobs,
-                  job_timeout=args.job_timeout, scheduler=args.scheduler)
-    return fpga_run(config_from_args(args), run)
+    return fpga_run(config_from_args(args), fpga_run_of(args))
 
 
 def run_timing(args):

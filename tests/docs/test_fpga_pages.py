@@ -6,11 +6,14 @@ rows were placed again without the other page following, fails here."""
 
 import json
 import shlex
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
-from bumprtl.gen.report.fpga import FpgaRun, write_report
+from bumprtl.gen.cli.main import build_parser
+from bumprtl.gen.cli.report import fpga_run_of
+from bumprtl.gen.report.fpga import write_report
 from bumprtl.gen.report.table1 import fpga_section
 from bumprtl.rtl.config import Config
 
@@ -19,16 +22,10 @@ DATA = DOCS / "data" / "fpga.json"
 
 
 def _run(command, out):
-    """The FpgaRun the saved command line names."""
-    words, kw = shlex.split(command)[3:], {}
-    for flag, value in zip(words[::2], words[1::2], strict=True):
-        if flag == "--unit":
-            kw["unit"] = kw.get("unit", ()) + (value,)
-        else:
-            key = flag[2:].replace("-", "_")
-            kw[key] = value if key == "device" else int(value) if key == "samples" else \
-                tuple(int(s) for s in value.split(","))
-    return FpgaRun(out=out, **kw)
+    """The FpgaRun the saved command line names, parsed by the command's own parser, its
+    page written to ``out``."""
+    args = build_parser().parse_args(shlex.split(command)[1:])
+    return replace(fpga_run_of(args), out=out)
 
 
 def test_table1s_ecp5_section_is_the_fpga_runs():
