@@ -71,3 +71,17 @@ def run_cli(capfd):
         out = capfd.readouterr()
         return subprocess.CompletedProcess(argv, code, out.out, out.err)
     return run
+
+
+@pytest.fixture
+def saved_figures(monkeypatch):
+    """The matplotlib figures the test saves, in order (each is still written to its file):
+    a plot's content is checked on the figure, not on its pixels."""
+    import matplotlib.figure
+    figures, save = [], matplotlib.figure.Figure.savefig
+
+    def savefig(fig, *args, **kwargs):
+        figures.append(fig)
+        return save(fig, *args, **kwargs)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", savefig)
+    return figures

@@ -33,14 +33,10 @@ def test_table1s_ecp5_section_is_the_fpga_runs():
         "docs/table1.md's ECP5 section is stale: bumprtl report table1"
 
 
-def test_the_report_page_is_written_again_from_its_rows(tmp_path, capsys, monkeypatch):
+def test_the_report_page_is_written_again_from_its_rows(tmp_path, capsys, saved_figures):
     """Everything up to the primitives' ceiling (whose own placements the saved rows do not
     hold) is what write_report makes of the saved rows; its plot puts each design's
     pipeline row (placed) at its LUT4 against its max and mean error, named."""
-    import matplotlib.figure
-    figures, save = [], matplotlib.figure.Figure.savefig
-    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
-                        lambda fig, *a, **k: (figures.append(fig), save(fig, *a, **k))[1])
     data = json.loads(DATA.read_text())
     run = _run(data["command"], tmp_path / "report.md")
     write_report(run, data["rows"], data["accuracy"], Config())
@@ -51,7 +47,7 @@ def test_the_report_page_is_written_again_from_its_rows(tmp_path, capsys, monkey
     assert mark not in ours                         # no ceilings given: the notes follow
     assert ours.split("\n## Notes")[0].rstrip() == page.split(mark)[0].rstrip()
     assert (tmp_path / "img" / "cost_vs_error.png").stat().st_size > 0
-    (ax,) = figures[0].axes
+    (ax,) = saved_figures[0].axes
     pipelines = {r["design"]: r["LUT4"] for r in data["rows"] if r["row"] == "pipeline" and "error" not in r}
     assert {t.get_text() for t in ax.texts} == set(pipelines)
     points = sorted(tuple(map(float, xy)) for c in ax.collections for xy in c.get_offsets())

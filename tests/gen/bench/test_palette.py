@@ -45,14 +45,9 @@ def test_speed_rows_add_the_table_and_the_lookup_and_divide(monkeypatch, capsys)
     assert shapes[9][0] == 32 and shapes[10][:2] == (16, 16) and shapes[11][0] == 256
 
 
-def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys, monkeypatch):
-    import matplotlib.figure
-
+def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys, saved_figures):
     size, palettes = 16, (16, 256)
     plot = tmp_path / "plots" / "acc.png"
-    figures, save = [], matplotlib.figure.Figure.savefig
-    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
-                        lambda fig, *a, **k: (figures.append(fig), save(fig, *a, **k))[1])
     palette.accuracy(Config(), ("wood", "bumps"), palettes, size, plot)
     out = capsys.readouterr().out
     assert "| scene | quantizer | sN=16 | sN=256 |" in out
@@ -77,7 +72,7 @@ def test_accuracy_marks_a_palette_that_holds_every_normal(tmp_path, capsys, monk
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # the plot: one curve a (scene, quantizer), labelled so, at the table's PSNRs over sN,
     # one colour a scene, solid k-means and dashed median cut
-    (ax,) = figures[0].axes
+    (ax,) = saved_figures[0].axes
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
     assert sorted(lines) == ["bumps kmeans", "bumps median-cut", "wood kmeans", "wood median-cut"]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == sorted(lines)
