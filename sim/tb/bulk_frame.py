@@ -45,7 +45,7 @@ pipeline as it is emitted (its map, colour texture and tables built in) and, per
   recorded (sim/golden/fixed/exact.DOT_SUM); for every bit k up to the rounding point and
   either sign, the pixels whose rounded dot the move of 2^k changes (at most DOT_CAP of
   them) run with it, and the frame keeps DOT_QUOTA = 3 whose output changes (greedily, one
-  pixel serving every move it shows): a hundred pixels or two. A wrong bit moves the sum
+  pixel serving every move it shows; fewer where the pool has fewer). A wrong bit moves the sum
   up where the bit should be 0 and down where it should be 1 (or only while an operand is
   negative): each kept pixel shows it with even odds, so three a move leave about one
   chance in 64 that neither direction's pixels do;
