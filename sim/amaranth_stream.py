@@ -100,7 +100,7 @@ def driven(dut, *drives):
 
 
 def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vcd=None,
-                    pipe_handshake=False, models=()):
+                    pipe_handshake=False, models=(), hold_first=0):
     """Drive ``inputs`` into ``dut.i``; return ``(outputs, cycles)`` from ``dut.o``.
 
     Each input is a dict ``{field: int}`` (dotted names for nested layouts). Outputs come
@@ -113,6 +113,9 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
     made, is bit-exact and fails only this check). ``models``: bench models run beside the
     stream's testbench, each with an async ``process`` and the :class:`Drive` of its inputs
     as ``drive``, wired into the top (a memory model on another port, sim/axi_memory.py).
+    ``hold_first``: ``o.ready`` low for the first this many cycles, whatever the pattern
+    (long enough, every credit is spent before the pattern's stalls drain the unit: random
+    stalls alone never fill its FIFO, :func:`bumprtl.sim.traffic.fill_hold`).
     """
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
@@ -141,7 +144,7 @@ def simulate_stream(dut, inputs, pattern="no_stall", seed=0, max_cycles=None, vc
                 for name, value in offered.items():
                     drive[name] = value
             drive["i.valid"] = offered is not None
-            drive["o.ready"] = rng.random() >= bp_p
+            drive["o.ready"] = rng.random() >= bp_p and state["cycles"] >= hold_first
             drive.set(ctx)
             _, _, bits, o_bits = await ctx.tick().sample(handshake.value, o_payload)
             i_valid, i_ready, o_valid, o_ready = handshake.cut(bits)

@@ -26,6 +26,7 @@ from bumprtl.rtl.pipe import EDGE_LATENCY
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.sim.amaranth_stream import Drive, driven
 from bumprtl.sim.axi_memory import AxiReadMemory
+from bumprtl.sim.formal.mutants import SwapAheadPalette
 from bumprtl.sim.golden.cache import run_scene_cache
 from bumprtl.sim.golden.fixed.palette_lut import PaletteLUTModel, host_op, pack_rgba, unpack_rgba
 from bumprtl.sim.golden.fixed.pipeline import pipeline_fixed, random_inputs, random_map
@@ -49,9 +50,10 @@ def _inputs(cfg, n, seed):
     return out
 
 
-def run_lut(cfg, inputs, pattern, seed=1):
-    """Drive pixels and random host traffic; return (received, expected) output dicts."""
-    dut = PaletteLUT(cfg)
+def run_lut(cfg, inputs, pattern, seed=1, unit=PaletteLUT):
+    """Drive pixels and random host traffic into ``unit(cfg)``; return (received, expected)
+    output dicts."""
+    dut = unit(cfg)
     gap_p, bp_p = PATTERNS[pattern]
     rng = random.Random(seed)
     model = PaletteLUTModel(cfg)
@@ -116,6 +118,17 @@ def test_bit_exact_with_racing_host(cfg, pattern):
     oor = sum(e["oor"] for e in expected)
     assert 0 < oor < len(expected)                # out-of-range indices were exercised
     assert any(e["color.r"] for e in expected)    # and written entries were read back
+
+
+def test_a_stage_ahead_that_does_not_carry_the_swap_reads_the_wrong_bank():
+    """The broken unit make formal's bank proof must fail (sim/formal/mutants.py's
+    SwapAheadPalette: a register stage in front of the LUT, the swap not carried with the
+    pixel) differs from the cycle model under the same racing host: the model reads the
+    bank of each pixel's acceptance, so the check above can tell."""
+    cfg = CONFIGS[0]
+    received, expected = run_lut(cfg, _inputs(cfg, 400, seed=3), "both", unit=SwapAheadPalette)
+    assert [r["tag"] for r in received] == [e["tag"] for e in expected]   # nothing lost
+    assert received != expected
 
 
 def test_out_of_range_reads_zero_even_after_writes():

@@ -2,7 +2,8 @@
 and credit loop and one scene pipeline's order, palette double buffer and credit loop
 proved by k-induction, PaletteLUT's double buffer proved and covered, three broken units caught (a credit edge whose i.ready reads
 o.ready, the palette pipeline's old bank wiring, a unit dropping a pixel), and the lemma
-bookkeeping without sby. The rest (the other broken units here, marked ``formal``; every
+bookkeeping without sby. The rest (the other broken units here, marked ``formal``, and
+simulated at their ports in make test: test_broken_units_simulated.py; every
 unit and scene pipeline in the table) is `make formal`."""
 
 from collections import Counter
