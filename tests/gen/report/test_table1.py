@@ -12,6 +12,7 @@ from bumprtl.gen.tools.toolchain import ToolMissing
 from bumprtl.rtl.config import Config
 from bumprtl.sim.golden.fixed import exact as fixed_exact
 from bumprtl.sim.golden.methods import BASELINES
+from tests.conftest import masked_numbers
 
 # Table 1's counts do not depend on the widths (the same units, narrower), so the module counts
 # them at 10-bit angles, B = 11: the default widths' tables (2049 words) would double the time.
@@ -249,7 +250,4 @@ def test_the_page_is_docs_table1_md_but_for_the_numbers(table1):
     start, end = page.index("\n## On the ECP5"), page.index("\n## Status")
     page = page[:start] + page[end:]
     assert "\n## On the ECP5" not in table1
-
-    def masked(text):
-        return re.sub(r"\d+(\.\d+)?", "#", text)
-    assert masked(table1) == masked(page)
+    assert masked_numbers(table1) == masked_numbers(page)
