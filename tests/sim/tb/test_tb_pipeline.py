@@ -2,7 +2,8 @@
 the coverage frame (sim/tb/bulk_frame.py) and a small render through one build, one pixel per
 clock without stalls, and under random backpressure and input gaps every pixel comes out
 once, in order, bit-exact with the golden model; render --rtl's image equals the golden
-render byte for byte. One build per simulator."""
+render byte for byte (the bulk path, and the per-cycle path on two 16 x 16 frames, in make
+test). One build per simulator."""
 
 
 import numpy as np
@@ -23,7 +24,7 @@ from bumprtl.sim.tb.bulk_frame import PIXELS, coverage_frame
 from bumprtl.sim.traffic import PATTERNS
 
 
-# make regress: every per-cycle run here. make test streams the same coverage frames on
+# make regress: the per-cycle runs of the coverage frame. make test streams the same coverage frames on
 # Icarus under the same traffic patterns through the bulk path, every output field against
 # the golden model: the full scene's (tests/sim/tb/test_bulk_scene_frames.py) and the
 # default scene's, then its render frame (tests/sim/tb/test_bulk.py). Here: the render frame
@@ -95,3 +96,18 @@ def test_render_rtl_of_a_palette_scene_writes_its_table_first(build_dir):
     assert r.image.tobytes() == golden_render(scene, 16).tobytes()
     assert r.image.tobytes() == r.golden.tobytes()
     assert len(np.unique(r.image.reshape(-1, 3), axis=0)) > 8
+
+
+@pytest.mark.parametrize("name, load", [("palette", "port"), ("flat", "initial")])
+def test_render_rtl_per_cycle_equals_golden_bytes(name, load, build_dir, capfd):
+    """The per-cycle path of render --rtl (``--per-cycle``: every pixel driven from cocotb,
+    tb_pipeline.py) on a 16 x 16 frame, on Icarus: the palette scene with its map written
+    through the host port (``--load port``) and its colour table by the host, the flat
+    scene with its polygon registers; the image equals the golden render byte for byte and
+    the progress bar counts the pixels."""
+    scene = load_scene_config(name)
+    r = render_rtl(scene, 16, "icarus", build_dir, per_cycle=True, load=load)
+    assert r.image.tobytes() == golden_render(scene, 16).tobytes() == r.golden.tobytes()
+    assert len(np.unique(r.image.reshape(-1, r.image.shape[-1]), axis=0)) > 1
+    assert "256/256" in capfd.readouterr().err        # rtl: 256 pixels of 256
+
