@@ -16,6 +16,7 @@ import argparse
 import random
 from dataclasses import fields
 
+from amaranth.hdl import Module, Signal
 from amaranth.sim import Simulator
 
 from bumprtl.rtl.sdram import SdramConfig, SdramController
@@ -60,31 +61,34 @@ def short_config(cfg, timing):
 def run(cfg: SdramConfig, ops, r_stall=0.0, seed=0, limit=200_000):
     """Play ``ops`` through a controller built from ``cfg``. Returns ``(reads, beats,
     model)``: the bytes of each read in order, the cycle of every R beat taken (with its
-    RLAST), and the model (its command log)."""
+    RLAST), and the model (its command log). A cycle is a clock edge's number, read from a
+    counter register sampled at that edge by the process that saw the handshake (a
+    counting process of its own would run before or after the others at the same edge,
+    as the simulator orders them, and move the numbers by one from run to run)."""
     dut = SdramController(cfg)
     model = model_for(cfg)
     nbytes = cfg.data_bits // 8
     rng = random.Random(seed)
-    reads, beats, state = [], [], {"cycle": 0, "ar": []}
-    sim = Simulator(dut)
+    reads, beats, state = [], [], {"ar": []}
+    top = Module()
+    top.submodules.dut = dut
+    cycle = Signal(32, name="cycle")
+    top.d.sync += cycle.eq(cycle + 1)
+    sim = Simulator(top)
     sim.add_clock(1e-6 / cfg.freq_mhz)
 
     async def chip(ctx):
         await model.process(ctx, dut.sdram)
 
-    async def clock(ctx):
-        async for _ in ctx.tick():
-            state["cycle"] += 1
-
     async def r_channel(ctx):
         rd, data, pending = dut.rd, bytearray(), [op for op in ops if op[0] == "r"]
         while pending:
             ctx.set(rd.rready, rng.random() >= r_stall)
-            _, _, valid, ready, word, last = await ctx.tick().sample(
-                rd.rvalid, rd.rready, rd.rdata, rd.rlast)
+            _, _, valid, ready, word, last, now = await ctx.tick().sample(
+                rd.rvalid, rd.rready, rd.rdata, rd.rlast, cycle)
             if valid and ready:
                 data += word.to_bytes(nbytes, "little")
-                beats.append((state["cycle"], last))
+                beats.append((now, last))
                 if len(data) == pending[0][2]:
                     assert last, f"RLAST missing at the end of read {len(reads)}"
                     reads.append(bytes(data))
@@ -102,8 +106,8 @@ def run(cfg: SdramConfig, ops, r_stall=0.0, seed=0, limit=200_000):
                 ctx.set(rd.arsize, nbytes.bit_length() - 1)
                 ctx.set(rd.arburst, 1)
                 ctx.set(rd.arvalid, 1)
-                await ctx.tick().until(rd.arready)
-                state["ar"].append(state["cycle"])
+                now, _ = await ctx.tick().sample(cycle, rd.arready).until(rd.arready)
+                state["ar"].append(now)
                 ctx.set(rd.arvalid, 0)
                 continue
             _, addr, data, strobes = op
@@ -127,10 +131,9 @@ def run(cfg: SdramConfig, ops, r_stall=0.0, seed=0, limit=200_000):
             ctx.set(wr.bready, 0)
         while len(reads) < sum(op[0] == "r" for op in ops):
             await ctx.tick()
-            assert state["cycle"] < limit, f"only {len(reads)} reads answered in {limit} cycles"
+            assert ctx.get(cycle) < limit, f"only {len(reads)} reads answered in {limit} cycles"
 
     sim.add_process(chip)
-    sim.add_process(clock)
     sim.add_process(r_channel)
     sim.add_testbench(manager)
     sim.run()

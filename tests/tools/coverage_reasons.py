@@ -318,11 +318,8 @@ REASONS = [
     ("sim/scenes/usermap.py", "if h.shape != (hh, w):", None,
      "defensive", "Pillow decodes the size the PNG header says"),
     ("sim/scenes/usermap.py", "if rgb.shape != (hh, w, channels):", None, "defensive", "as above"),
-    ("sim/sdram_bench.py", "async for _ in ctx.tick():", None,
-     "never empty", "the clock process runs until the simulation stops (an exit Amaranth "
-     "never takes)"),
     ("sim/sdram_bench.py", 'if __name__ == "__main__":', None,
-     "by hand", "`python -m bumprtl.sim.sdram_bench` (docs/memory.md's numbers)"),
+     "by hand", "`python -m bumprtl.sim.sdram_bench` (docs/sdram.md's numbers; make test calls its main)"),
     ("sim/sdram_model.py", "if rst:", None,
      "no test yet", "a reset in the middle of a run of the SDRAM model"),
     ("sim/tb/bulk.py", "if inputs is not None:", None,
