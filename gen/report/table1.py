@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bumprtl.gen.flow.resources import count_unit, count_verilog
+from bumprtl.gen.flow.resources import count_verilog
 from bumprtl.gen.flow.units import emit_unit
 from bumprtl.gen.tools import yosys
 from bumprtl.gen.tools.docs import made_at
@@ -25,7 +25,7 @@ from bumprtl.sim.golden.common import PixelInputs
 from bumprtl.sim.golden.methods import METHODS, datapath_fixed
 
 __all__ = ["PAPER", "TABLE1_ORDER", "paper_multiplier_savings", "netlist_multiplier_savings",
-           "count_design", "accuracy", "check_samples",
+           "accuracy", "check_samples",
            "table1_markdown", "table1_report", "count_all"]
 
 # Lee et al. 2003, Table 1 (per pixel, L and H). None = "Not Available" in the paper.
@@ -77,14 +77,6 @@ def netlist_multiplier_savings(counts):
         return {}
     return {d: (total(d), total("lee"), 1 - total("lee") / total(d))
             for d in counts if METHODS[d].baseline and total(d)}
-
-
-def count_design(name, cfg, work_dir):
-    """Counts of a design's two units: ``{"setup": Counts, "illumination": Counts}``."""
-    cfg = cfg.replace(method=name)
-    work = Path(work_dir) / name
-    return {"setup": count_unit("rotation", cfg, work / "setup"),
-            "illumination": count_unit("illumination", cfg, work / "illumination")}
 
 
 def accuracy(name, cfg, samples, seed=11):

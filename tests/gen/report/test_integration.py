@@ -138,3 +138,33 @@ def test_the_page_is_what_the_report_writes_but_for_numbers_and_the_small_flags(
         text = text.replace(", {'texture_size': 16, 'angle_bits': 10, 'frac_bits': 11})", ")")
         return masked_numbers(text)
     assert masked(page.read_text()) == masked(DOC.read_text())
+
+
+def test_report_integration_emits_the_scene_asked_and_writes_the_doc_given(small, tmp_path,
+                                                                           monkeypatch, capsys):
+    """``bumprtl report integration --scene --out --name --doc``: the emission gets the
+    scene, directory and port prefix asked for (the emission itself is the fixture's, the
+    Verilator build shared), the page given gets the blocks of what was emitted, and one
+    line names it with the record of its widths."""
+    import shutil
+
+    from bumprtl.gen.cli.main import main
+    from bumprtl.gen.report import integration
+
+    seen = {}
+
+    def emit(scene, out, name):
+        seen.update(scene=scene, out=out, name=name)
+        return small
+    monkeypatch.setattr(integration, "emit_for_integration", emit)
+    page = tmp_path / "page.md"
+    shutil.copy(DOC, page)
+    argv = ["report", "integration", "--scene", "palette", "--out", str(tmp_path / "o"),
+            "--doc", str(page), "--name", "shade"]
+    assert main(argv) == 0
+    assert seen == {"scene": "palette", "out": tmp_path / "o", "name": "shade"}
+    expected = tmp_path / "expected.md"
+    shutil.copy(DOC, expected)
+    write_doc(expected, blocks(small))
+    assert page.read_text() == expected.read_text() != DOC.read_text()
+    assert capsys.readouterr().out == f"wrote {page} ({blocks(small)['made-at']})\n"
