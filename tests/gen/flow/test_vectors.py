@@ -146,6 +146,28 @@ def test_palette_bench_with_the_users_pixels_and_the_table_through_the_port(tmp_
     assert lines[-1] == f"PASS {n}", lines
 
 
+def test_flat_bench_loads_its_polygon_word_and_fails_with_another(tmp_path):
+    """A flat map (its tangent frame from the polygon registers, no map): the bench writes
+    ``<module>_poly.hex``, the polygon's fields packed at the sidecar's offsets, loads it
+    into ``poly`` and passes; with one bit of that word flipped it fails."""
+    from bumprtl.gen.cli.main import main
+    out = tmp_path / "flat"
+    n = 60
+    assert main(["vectors", "--pipeline", "flat", "--count", str(n), "--out", str(out)]) == 0
+    meta = load_sidecar(out / "bumprtl_pipeline.json")
+    poly = out / "bumprtl_pipeline_poly.hex"
+    word = int(poly.read_text(), 16)
+    vec = pipeline_vectors(load_scene_config("flat"), "random", n)
+    for name, (off, width, _signed) in meta.fields_of("poly").items():
+        assert (word >> off) & ((1 << width) - 1) == int(vec.polygon[name]) & ((1 << width) - 1), name
+    vvp = _icarus(out, _sources())
+    assert _vvp(out, vvp)[-1] == f"PASS {n}"
+    bad = _copy(out, tmp_path / "bad")
+    off, width, _ = next(iter(meta.fields_of("poly").values()))
+    (bad / poly.name).write_text(f"{word ^ (1 << (off + width - 2)):0{len(poly.read_text().strip())}x}\n")
+    assert _vvp(bad, bad / vvp.name)[-1].startswith("FAIL")
+
+
 def _angles(rng, n, hi):
     a = rng.uniform(0, hi, n)
     a[:3] = (0.0, hi, hi / 2)                 # both ends; 2 pi is the full circle, code 0
