@@ -41,7 +41,6 @@ from bumprtl.gen.flow.fpga import (
     Placement,
     check_device,
     pipeline_component,
-    place_component,
     place_text,
 )
 from bumprtl.gen.flow.resources import count_verilog
@@ -268,13 +267,6 @@ def unit_cost(units, cfg, work):
 
     key = text_digest(*(v.read_text() for v in paths.values()))
     return cached_json(work / "cost" / f"{_tag(cfg)}_{'+'.join(units)}_{key}.json", compute)
-
-
-def fpga_cost(component_fn, label, cfg, device, work):
-    """Place ``component_fn(cfg, ECP5())`` on ``device`` here, now: gen/flow/fpga.py's ECP5
-    form (DSP and block-RAM registers, as ``report fpga``), cached per emitted Verilog in the
-    cache both share. ``sweep`` itself places as jobs (:func:`place_pending`)."""
-    return place_component(component_fn(cfg, ECP5()), label, device)
 
 
 def place_pending(ctx, opts, progress=True):
