@@ -318,6 +318,9 @@ REASONS = [
     ("sim/scenes/usermap.py", "if h.shape != (hh, w):", None,
      "defensive", "Pillow decodes the size the PNG header says"),
     ("sim/scenes/usermap.py", "if rgb.shape != (hh, w, channels):", None, "defensive", "as above"),
+    ("sim/sdram_bench.py", "async for _ in ctx.tick():", None,
+     "never empty", "the clock process runs until the simulation stops (an exit Amaranth "
+     "never takes)"),
     ("sim/sdram_bench.py", 'if __name__ == "__main__":', None,
      "by hand", "`python -m bumprtl.sim.sdram_bench` (docs/sdram.md's numbers; make test calls its main)"),
     ("sim/sdram_model.py", "if rst:", None,
@@ -361,8 +364,8 @@ REASONS = [
     ("sim/tb/tb_palette.py", "for _cycle in range(30 * total):", None,
      "simulator", "the bench running out of cycles (a hung unit)"),
     ("sim/tb/tb_pipeline.py", 'if "poly" in ports:', None,
-     "simulator", "the per-cycle bench of a flat-map scene (make test renders its flat scene on "
-     "the bulk path)"),
+     "covered since", "the per-cycle bench of a flat-map scene: tests/sim/tb/test_tb_pipeline.py's "
+     "per-cycle render of the flat scene"),
     ("sim/tb/tb_pipeline_axi.py", 'if os.environ.get("BUMPRTL_STIMULUS") == "raster":', None,
      "make regress", "the raster stimulus of the AXI pipeline bench"),
     ("sim/tb/tb_sdram.py", "if unknown:", None, "simulator", "X or Z on an SDRAM pin"),
@@ -381,25 +384,25 @@ REASONS = [
      "2047 (checked radius by radius when this was written): the guard keeps the bound "
      "finite for a narrower datapath"),
     ("sim/golden/globe.py", "for rot in rots:", None,
-     "by hand", "`python -m bumprtl.sim.golden.globe`: the printed check against float64 "
-     "(docs/globe.md); make test calls check_against_float itself"),
+     "covered since", "tests/docs/test_globe_page.py runs the model's main for each run "
+     "docs/globe.md quotes"),
     ("sim/golden/globe.py", 'for name in ("phi", "lambda"):', None,
-     "by hand", "`python -m bumprtl.sim.golden.globe` (above)"),
+     "covered since", "tests/docs/test_globe_page.py (above)"),
     ("sim/golden/globe.py", 'for v in res["violations"]:', None,
-     "by hand", "`python -m bumprtl.sim.golden.globe` (above)"),
+     "never empty", "a violation is a model bug: the runs docs/globe.md quotes print none "
+     "(tests/docs/test_globe_page.py asserts exit 0)"),
     ("sim/golden/globe.py", 'if __name__ == "__main__":', None,
-     "by hand", "`python -m bumprtl.sim.golden.globe` (above)"),
+     "by hand", "`python -m bumprtl.sim.golden.globe`; make test calls its main"),
     ("sim/tb/stream.py", "if setup is not None:", None,
      "make regress", "only the palette scene's AXI bench passes a setup (its colour table "
      "written before the first pixel): tests/sim/tb/test_tb_pipeline_axi.py's palette case"),
     ("sim/tb/tb_pipeline.py", 'if "lut_w_en" in ports:', None,
-     "make regress", "host_setup's colour-table writes: the palette scene's AXI bench "
-     "(tests/sim/tb/test_tb_pipeline_axi.py's palette case); make test's palette frames go "
-     "the bulk path, which writes the table through its own host queue"),
+     "covered since", "host_setup's colour-table writes: tests/sim/tb/test_tb_pipeline.py's "
+     "per-cycle render of the palette scene"),
     ("sim/tb/tb_pipeline.py", 'for addr, word in enumerate(stim["lut"].tolist()):', None,
-     "make regress", "host_setup's colour-table writes (above)"),
+     "covered since", "host_setup's colour-table writes (above)"),
     ("sim/tb/tb_pipeline.py", "while not taken:                # held until lut_w_ready (rtl/pipeline.py)",
-     None, "make regress", "host_setup's colour-table writes (above)"),
+     None, "covered since", "host_setup's colour-table writes (above)"),
     ("sim/tb/tb_pipeline_axi.py", "for addr, word in enumerate(table.tolist()):", None,
      "make regress", "the palette scene's AXI bench (tests/sim/tb/test_tb_pipeline_axi.py's "
      "palette case)"),
