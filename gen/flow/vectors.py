@@ -52,7 +52,7 @@ from bumprtl.gen.flow.vectors_tb import bench_verilog, run_commands
 from bumprtl.gen.render.rtl import scene_memories, scene_stimulus, sim_scene
 from bumprtl.rtl.bumpfetch import coord_bits, level_bits
 from bumprtl.rtl.config import BumpError, Config
-from bumprtl.rtl.layouts import light_keys
+from bumprtl.rtl.layouts import light_keys, pack
 from bumprtl.rtl.pipeline import BumpPipeline
 from bumprtl.rtl.sidecar import load, ports_from_table
 from bumprtl.sim.golden.common import PixelInputs
@@ -442,13 +442,6 @@ def _field_hex(values, width):
     return hex_text(np.asarray(values, np.int64) & ((1 << width) - 1), width)
 
 
-def _poly_word(meta, polygon):
-    word = 0
-    for name, (off, w, _s) in meta.fields_of("poly").items():
-        word |= (int(polygon[name]) & ((1 << w) - 1)) << off
-    return word
-
-
 def write_vectors(v: Vectors, out, module="bumprtl_pipeline", load="initial", top=None,
                   device=DEFAULT_DEVICE, command=None):
     """Write into ``out``: the design (``<module>.v``, ``<module>_named.v``, the sidecar and
@@ -477,7 +470,7 @@ def write_vectors(v: Vectors, out, module="bumprtl_pipeline", load="initial", to
     poly = None
     if "poly" in meta.ports and v.polygon is not None:
         poly = out / f"{module}_poly.hex"
-        poly.write_text(hex_text([_poly_word(meta, v.polygon)], meta.port("poly").width))
+        poly.write_text(hex_text([pack(meta.fields_of("poly"), v.polygon)], meta.port("poly").width))
         paths.append(poly)
     command = command or (f"bumprtl vectors --unit {v.unit}" if v.scene is None else
                           f"bumprtl vectors --pipeline {v.scene.name}") + f" --count {len(v)}"

@@ -27,6 +27,8 @@ from importlib.resources import files
 
 import numpy as np
 
+from bumprtl.rtl.layouts import pack
+
 __all__ = ["TEMPLATE", "TOP", "HOOK", "PERIOD", "DENSITY_BITS", "IN_FILE", "OUT_FILE",
            "SETUP_FILE", "AXI_FILE", "OWN_CLOCK_DEFINE", "AXI_DEFINE", "has_axi", "host_fields",
            "setup_arrays", "setup_writes", "wrapper_verilog", "reset_prefix"]
@@ -93,11 +95,7 @@ def setup_writes(meta, polygon=None, table=None):
     swapped in). A list of ``{port: int}``, one per clock."""
     ports, cycles = meta.ports, []
     if polygon is not None and "poly" in ports:
-        fields = meta.fields_of("poly")
-        word = 0
-        for name, (off, w, _s) in fields.items():
-            word |= (int(polygon[name]) & ((1 << w) - 1)) << off
-        cycles.append({"poly": word, "poly_en": 1})
+        cycles.append({"poly": pack(meta.fields_of("poly"), polygon), "poly_en": 1})
     if table is not None and "lut_w_en" in ports:
         cycles += [{"lut_w_en": 1, "lut_w_addr": a, "lut_w_data": int(w)}
                    for a, w in enumerate(np.asarray(table).tolist())]

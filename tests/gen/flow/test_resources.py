@@ -226,3 +226,21 @@ def test_a_macc_has_a_constant_adder_only_for_a_nonzero_constant_addend(addends,
     counts = count_netlist(netlist, "top")
     assert counts.const_adders == const_adders
     assert counts.adders == [16]                                 # product + the signal addend
+
+
+@pytest.mark.parametrize("b, multipliers, const_multipliers", [
+    (list(range(10, 15)), ["6x5"], []),                         # signal x signal
+    (["1", "1", "0"], [], [6]),                                 # x 3: a constant multiplier
+    (["0", "0", "1"], [], []),                                  # x 4: a shift
+])
+def test_a_mul_cell_is_counted_as_a_macc_product_is(b, multipliers, const_multipliers):
+    """A ``$mul`` (Yosys writes one before ``alumacc`` turns it into a ``$macc``; a netlist
+    from another script may keep it): the same rules as a product of a ``$macc``, on its A
+    and B operands."""
+    cell = {"type": "$mul", "port_directions": {"Y": "output"},
+            "parameters": {"A_WIDTH": 6, "B_WIDTH": len(b), "Y_WIDTH": 11},
+            "connections": {"A": list(range(2, 8)), "B": b, "Y": list(range(100, 111))}}
+    netlist = {"modules": {"top": {"ports": {"y": {"direction": "output", "bits": list(range(100, 111))}},
+                                   "cells": {"m": cell}}}}
+    counts = count_netlist(netlist, "top")
+    assert counts.multipliers == multipliers and counts.const_multipliers == const_multipliers
