@@ -36,8 +36,18 @@ def _both_orders(points, bound=1, device=None):
     return best, meeting
 
 
+def _palette_point(**kw):
+    """A point whose widths are only in its configuration, as a palette point's are (the
+    sweep records palette_size at the top, angle and fraction bits in ``config``)."""
+    point = _point(method="palette", **kw)
+    del point["angle_bits"], point["frac_bits"]
+    return point
+
+
 # Each case: points tied on cost (generic and on the device), and the one the rule picks.
 CASES = {
+    "widths read from the configuration: fewer angle bits": (
+        [_palette_point(), _palette_point(angle_bits=11)], 1),
     "equal cost: the smaller error": ([_point(err=1), _point(angle_bits=11, err=0)], 1),
     "equal cost and error: fewer angle bits": ([_point(), _point(angle_bits=11)], 1),
     "equal cost, error, angle bits: fewer fraction bits": ([_point(), _point(frac_bits=12)], 1),
