@@ -39,8 +39,11 @@ def test_every_option_appears_in_its_commands_table():
 def test_check_says_current_or_stale_and_writes_nothing(tmp_path, capsys):
     page = tmp_path / "cli.md"
     assert main([str(page), "--check"]) == 1 and not page.exists()
+    assert capsys.readouterr().out == f"{page}: differs from the parsers; write it again\n"
     assert main([str(page)]) == 0 and page.read_text() == reference()
+    assert capsys.readouterr().out == f"wrote {page}\n"
     assert main([str(page), "--check"]) == 0
+    assert capsys.readouterr().out == f"{page}: current\n"
     page.write_text(page.read_text().replace("output directory", "output folder", 1))
     before = page.read_text()
     assert main([str(page), "--check"]) == 1
