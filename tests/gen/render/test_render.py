@@ -185,3 +185,23 @@ def test_a_palette_scenes_colour_table_is_shaded_with_the_scenes_coefficients():
         assert np.array_equal(np.asarray(table), np.asarray(want))
         tables.append(np.asarray(table))
     assert not np.array_equal(tables[0], tables[1])
+
+
+@pytest.mark.parametrize("toml, flags, message", [
+    ('shading = "per-pixel"', ["--method", "palette"],
+     "--method palette contradicts shading = 'per-pixel'"),
+    ('method = "lee_corrected"', ["--method", "exact"],
+     "--method exact contradicts method = 'lee_corrected'"),
+    ('image = "bricks"', ["--scene", "wood"], "--scene wood contradicts image = 'bricks'"),
+])
+def test_a_render_flag_that_contradicts_the_scene_file_is_named(tmp_path, run_cli, toml, flags,
+                                                                message):
+    """render sets a scene's shading and method from --method and its image from --scene:
+    against a scene file that sets the key otherwise, the one line names the flag the user
+    typed (not the scene key behind it), exit 2, nothing written."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'name = "s"\n{toml}\n')
+    where = ["--pipeline", str(scene)] if flags[0] == "--scene" else ["--scene", str(scene)]
+    r = run_cli(["render", *where, *flags, "--model", "fixed", "--out", tmp_path / "x.png"])
+    assert r.returncode == 2 and not (tmp_path / "x.png").exists()
+    assert r.stderr == f"bumprtl: error: {message} in scene file {scene}: drop one\n"
