@@ -133,3 +133,13 @@ def test_two_named_pipelines_side_by_side_match_the_golden_model(side_by_side, s
         assert {"diffuse", "specular", "color"} <= set(compared), compared
         for k in compared:
             assert np.array_equal(got[f"out_{k}"], golden[k]), (prefix, k)
+
+
+@pytest.mark.parametrize("flags", [["--ports", "named"], ["--interface", "axis"]])
+def test_emit_lint_lints_each_wrapper_with_the_design_it_wraps(tmp_path, run_cli, flags):
+    """``bumprtl emit --lint`` with a wrapper (named ports, AXI4-Stream): the design and the
+    wrapper, linted with the design's Verilog beside it (alone it names a module Verilator
+    cannot find), are clean, and the command says so."""
+    r = run_cli(["emit", "sincos", *flags, "--lint", "--out", tmp_path])
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.stdout.splitlines()[-1] == "lint: clean"
