@@ -279,3 +279,36 @@ def test_board_memory_images_the_words_it_is_given():
     image = board.board_memory(scene, mode, words=words).image
     assert sorted(np.frombuffer(image, "<u4").tolist()) == sorted(words.tolist())
     assert board.board_memory(scene, mode).image != image
+
+
+# DP16KD (Lattice FPGA-TN-02204): 18 kbit as 16384 x 1, 8192 x 2, 4096 x 4, 2048 x 9,
+# 1024 x 18 or 512 x 36; typed here from the note, not read from gen/flow/memories.py
+DP16KD = ((1, 16384), (2, 8192), (4, 4096), (9, 2048), (18, 1024), (36, 512))
+
+
+def _blocks(words, width):
+    return min(-(-width // w) * -(-words // d) for w, d in DP16KD)
+
+
+@pytest.mark.parametrize("name", ["globe", "default"])
+def test_only_a_globe_budgets_its_latitude_roms(name, tmp_path):
+    """bram_budget counts a globe's two latitude ROMs (v and theta, 2^(I+1) words each,
+    rtl/globe.py) beside the pipeline, the light table and the buffer; a plane has none."""
+    from bumprtl.gen.flow.board import bram_budget
+    from bumprtl.rtl.board import globe_config
+    from bumprtl.rtl.video import MODES
+    from bumprtl.sim.scenes.config import load_scene_config
+
+    if name == "globe":                        # the globe picture: a scene on the sphere
+        (tmp_path / "globe.toml").write_text('image = "globe"\n')
+        name = str(tmp_path / "globe.toml")
+    scene, mode = load_scene_config(name), MODES["1280x720"]
+    need, have = bram_budget(scene, mode, "LFE5U-85F")
+    assert have == 208                                      # the LFE5U-85F's DP16KD
+    assert {"pipeline tables", "light table", "buffer"} <= set(need)
+    if scene.image == "globe":
+        g = globe_config(scene.hardware, mode)
+        words = 2 << g.int_bits
+        assert need["globe"] == _blocks(words, g.v_bits) + _blocks(words, g.angle_bits)
+    else:
+        assert "globe" not in need
