@@ -312,3 +312,39 @@ def test_only_a_globe_budgets_its_latitude_roms(name, tmp_path):
         assert need["globe"] == _blocks(words, g.v_bits) + _blocks(words, g.angle_bits)
     else:
         assert "globe" not in need
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("mode_name, pipe_mhz", [("640x480", None), ("1280x720", 92.86),
+                                                  ("test", 40.0)])
+def test_the_board_bench_runs_the_modes_pixel_clock_and_the_pipes_ratio(mode_name, pipe_mhz,
+                                                                         monkeypatch, tmp_path):
+    """check_frames hands the bench (sim/tb/tb_board.py) the clocks it simulates: the pixel
+    period is the mode's pixel clock in ps, a multiple of 10 (the shift clock's half period
+    whole ps) within 5 ps; a pipe clock of its own keeps the pixel clock's ratio to it
+    within the rounding to even ps."""
+    from bumprtl.rtl.video import MODES
+
+    seen = {}
+
+    def run(v_path, build_dir, env, opt_fast=None, waivers=()):
+        seen.update(env)
+        raise _Stop
+    monkeypatch.setattr(board, "emit_sim", lambda *a, **k: (tmp_path / "top.v", None))
+    monkeypatch.setattr(board, "_run_verilator", run)
+    mode = MODES[mode_name]
+    with pytest.raises(_Stop):
+        board.check_frames(load_scene_config("default"), mode, tmp_path, frames=1,
+                           data=(None, None, None, None),
+                           pipe_hz=None if pipe_mhz is None else pipe_mhz * 1e6)
+    pixel_ps = seen["BOARD_PIXEL_PS"]
+    assert pixel_ps % 10 == 0 and abs(pixel_ps - 1e12 / mode.pixel_hz) <= 5
+    if pipe_mhz is None:
+        assert "BOARD_PIPE_PS" not in seen
+    else:
+        pipe_ps = seen["BOARD_PIPE_PS"]
+        assert pipe_ps % 2 == 0
+        assert abs(pixel_ps / pipe_ps - pipe_mhz * 1e6 / mode.pixel_hz) < 2 / pipe_ps * 2
