@@ -348,3 +348,34 @@ def test_the_board_bench_runs_the_modes_pixel_clock_and_the_pipes_ratio(mode_nam
         pipe_ps = seen["BOARD_PIPE_PS"]
         assert pipe_ps % 2 == 0
         assert abs(pixel_ps / pipe_ps - pipe_mhz * 1e6 / mode.pixel_hz) < 2 / pipe_ps * 2
+
+
+def test_the_board_bench_is_built_again_exactly_when_its_digest_changes(monkeypatch, tmp_path):
+    """_run_verilator keeps a ``digest`` of the Verilog and the build options beside the
+    build: no build directory or another digest builds, the same digest runs the kept
+    build; the stamp is written only after a build."""
+    import cocotb_tools.runner
+
+    builds = []
+
+    class Runner:
+        def build(self, **kw):
+            builds.append(kw["build_dir"])
+
+        def test(self, **kw):
+            return tmp_path / "results.xml"
+    monkeypatch.setattr(board, "_top_ports_verilator", lambda vlt: Runner())
+    monkeypatch.setattr(board, "require", lambda tool: tool)
+    monkeypatch.setattr(cocotb_tools.runner, "get_results", lambda path: (1, 0))
+    v = tmp_path / "top.v"
+    v.write_text("module top; endmodule\n")
+    out = tmp_path / "verilator"
+    board._run_verilator(v, out, {})
+    assert len(builds) == 1 and (out / "digest").is_file()
+    board._run_verilator(v, out, {})                       # the same Verilog: kept
+    assert len(builds) == 1
+    board._run_verilator(v, out, {}, opt_fast="-O0")       # another option: built again
+    assert len(builds) == 2
+    v.write_text("module top; wire w; endmodule\n")        # another text: built again
+    board._run_verilator(v, out, {}, opt_fast="-O0")
+    assert len(builds) == 3
