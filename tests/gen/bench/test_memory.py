@@ -76,3 +76,23 @@ def test_the_page_gives_no_number_for_a_latency_that_was_not_run():
                        rows=4)
     page = _page(full, sorted({ZERO_WAIT, 20, 60}), Path("img/memory.png"))
     assert re.search(r"at L = 20 every case keeps at least\s+[\d.]+ %", page)
+
+
+def test_the_page_quotes_the_worst_case_of_each_cache_at_each_latency():
+    """The summary's four numbers: the least throughput against the zero-wait memory of any
+    row, at L = 20 and 60, of the overlapping cache and of the blocking one; the blocking
+    cache, which waits out every miss, never keeps more than the overlapping one."""
+    import re
+    from pathlib import Path
+
+    from bumprtl.gen.bench.memory import ZERO_WAIT, _page
+
+    rows = memory_rows(scenes=["globe"], sizes=[256], caches=["64x2 4x4", "64x2 8x8"],
+                       latencies=[20, 60], rows=4)
+    page = " ".join(_page(rows, sorted({ZERO_WAIT, 20, 60}), Path("img/memory.png")).split())
+    got = re.search(r"at L = 20 every case keeps at least ([\d.]+) % of its zero-wait throughput "
+                    r"\(the blocking cache: ([\d.]+) %\), at L = 60 at least ([\d.]+) % "
+                    r"\(blocking: ([\d.]+) %\)", page).groups()
+    want = [100 * min(r.ratio(lat, blocking=b) for r in rows) for lat in (20, 60) for b in (False, True)]
+    assert [float(g) for g in got] == [round(w, 1) for w in want]
+    assert want[1] < want[0] and want[3] < want[2]           # blocking keeps less
