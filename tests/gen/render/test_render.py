@@ -205,3 +205,21 @@ def test_a_render_flag_that_contradicts_the_scene_file_is_named(tmp_path, run_cl
     r = run_cli(["render", *where, *flags, "--model", "fixed", "--out", tmp_path / "x.png"])
     assert r.returncode == 2 and not (tmp_path / "x.png").exists()
     assert r.stderr == f"bumprtl: error: {message} in scene file {scene}: drop one\n"
+
+
+def test_fixed_palette_of_a_textured_scene_is_the_pipelines_golden_render(tmp_path, run_cli):
+    """``render --model fixed --method palette`` of a scene with a colour texture: the palette
+    pipeline's golden render at the size asked (the RTL's picture byte for byte), where an
+    untextured scene shows the LUT colour's grey."""
+    from bumprtl.gen.render.rtl import golden_render
+    from bumprtl.sim.scenes.config import load_scene_config
+
+    out = tmp_path / "p.png"
+    r = run_cli(["render", "--pipeline", "textured", "--model", "fixed", "--method", "palette",
+                 "--size", "32", "--out", out])
+    assert r.returncode == 0, r.stderr
+    img = np.asarray(Image.open(out))
+    # render's map is as large as its image unless the scene says otherwise
+    scene = load_scene_config("textured", defaults={"texture_size": 32})
+    want = golden_render(scene.replace(shading="palette"), 32)
+    assert img.shape[:2] == (32, 32) and np.array_equal(img, want)
