@@ -52,3 +52,18 @@ def _expand(wave):
 def test_wave_encoding():
     assert _bit([0, 0, 1, 1, 0]) == "0.1.0"
     assert _bus([5, 5, 6, 6], [1, 1, 0, 1]) == ("=.x=", ["5", "6"])
+
+
+def test_the_stall_facts_are_the_cycles_its_trace_holds_o_ready_low():
+    """scenarios()'s facts name what each diagram shows: the stall's are the cycles the
+    trace holds o.ready low (4 in a row, after the first pixel is out), the latency's the
+    cycle the first pixel leaves."""
+    from bumprtl.gen.report.timing import scenarios
+
+    facts = {name: info for name, (_src, info) in scenarios().items()}
+    stall, lat = facts["stall"], facts["latency"]
+    tr = stall["trace"]
+    low = [n for n, r in enumerate(tr["o.ready"]) if not r and n > 0]
+    assert stall["stall"] == low and len(low) == 4 and low == list(range(low[0], low[0] + 4))
+    assert tr["o.valid"][low[0]] == 1                          # a pixel is waiting when it starts
+    assert lat["trace"]["o.valid"].index(1) == lat["first_out"] == 1 + lat["latency"]
