@@ -228,6 +228,19 @@ def test_model_against_float_over_the_default_disc():
             assert res[name]["codes_differing"] < res["pixels"] // 50
 
 
+def test_model_against_float_of_pixels_all_outside_the_disc():
+    """Pixels none of which is inside (the corners of the screen): nothing to measure, so
+    every figure is 0 and nothing is violated (an empty maximum is no error)."""
+    g = GlobeConfig(radius=17)
+    x = np.array([-40, 40, -40, 40, 18, 0])
+    y = np.array([-40, -40, 40, 40, 0, 18])
+    res = check_against_float(x, y, 0, g)
+    assert res["pixels"] == 0 and res["violations"] == []
+    for name in ("phi", "lambda"):
+        assert res[name]["max_error_rad"] == 0 and res[name]["codes_max_diff"] == 0
+        assert res[name]["codes_differing"] == 0
+
+
 @pytest.mark.parametrize("radius,angle_bits,width,height,frac,guard", [
     (1, 8, 4, 2, 4, 1), (2, 8, 16, 8, 8, 2), (3, 16, 32768, 16384, 20, 8),
     (17, 10, 64, 32, 12, 3), (100, 12, 512, 256, 14, 4), (60, 12, 256, 256, 12, 4)])
