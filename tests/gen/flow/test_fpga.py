@@ -295,3 +295,32 @@ def test_a_placement_job_reports_the_devices_resources_and_its_logs(monkeypatch)
                           "available": {"LUT4": 83640, "DSP": 156, "BRAM": None}}
     assert sorted(out["files"]) == ["u.pnr.json", "u.pnr.log", "u.synth.log"]
     assert out["log"] == "==== u.synth.log\nyosys said\n\n==== u.pnr.log\nnextpnr said\n"
+
+
+@pytest.mark.parametrize("achieved, met", [(212.5, True), (175.0, True), (170.25, False), (None, False)])
+def test_a_placement_row_holds_the_lpf_target_and_whether_it_was_met(achieved, met, tmp_path,
+                                                                      monkeypatch):
+    """place_and_route's row from nextpnr's report (the tools stood in: Yosys does nothing,
+    nextpnr writes the report): the utilisation columns, Fmax rounded to 0.1 MHz, the target
+    read from the LPF's FREQUENCY line (a 175 MHz one here) and met = Fmax >= target."""
+    import json
+
+    lpf = tmp_path / "c.lpf"
+    lpf.write_text('FREQUENCY PORT "clk" 175 MHZ;\n')
+    report = {"utilization": {"TRELLIS_COMB": {"used": 120}, "TRELLIS_FF": {"used": 80},
+                              "MULT18X18D": {"used": 2}, "DP16KD": {"used": 1}},
+              "fmax": {"clk": {"achieved": achieved}} if achieved is not None else {},
+              "critical_paths": []}
+
+    def nextpnr(argv, cwd):
+        (cwd / argv[argv.index("--report") + 1]).write_text(json.dumps(report))
+    monkeypatch.setattr(fpga, "run_yosys", lambda *a, **k: None)
+    monkeypatch.setattr(fpga, "yosys_input", lambda v, work, top: v)
+    monkeypatch.setattr(fpga, "require", lambda tool: tool)
+    monkeypatch.setattr(fpga, "_nextpnr", nextpnr)
+    v = tmp_path / "u.v"
+    v.write_text("module u; endmodule\n")
+    row = fpga.place_and_route(v, "u", "LFE5U-25F", tmp_path / "w", lpf=lpf, seed=3)
+    assert row == {"unit": "u", "device": "LFE5U-25F", "LUT4": 120, "FF": 80, "DSP": 2, "BRAM": 1,
+                   "fmax_mhz": None if achieved is None else round(achieved, 1),
+                   "target_mhz": 175.0, "met": met, "seed": 3, "critical_path": None}
