@@ -484,6 +484,77 @@ KNOWN = [
     ("bumprtl.sim.formal.contract.xǁStreamContractǁ_fifo_lemmas", "(produce < n) | (consume < n)",
      "equivalent", "a weaker auxiliary lemma: it is still true, and the properties proved with "
      "it (order, credit) are the same; only the induction's help is weaker, and it still closes"),
+    # seed 34
+    ("bumprtl.gen.bench.memory.x__page", "_worst(rows, 20, None)", "killed since",
+     "the summary's throughputs were only checked to be numbers; "
+     "tests/gen/bench/test_memory.py::test_the_page_quotes_the_worst_case_of_each_cache_at_each_latency"),
+    ("bumprtl.gen.cli.emit.x_run", "lint(wrapper, )", "killed since",
+     "no test ran emit --lint with a wrapper; "
+     "tests/gen/flow/test_named_ports.py::test_emit_lint_lints_each_wrapper_with_the_design_it_wraps"),
+    ("bumprtl.gen.cli.reference.x_main", "print(None)", "killed since",
+     "tests/gen/cli/test_reference.py::test_check_says_current_or_stale_and_writes_nothing reads "
+     "each of the three messages word for word now"),
+    ("bumprtl.gen.cli.render.x_render_scene", '"shading": "--METHOD"', "killed since",
+     "no test read which flag a contradiction names; tests/gen/render/test_render.py::"
+     "test_a_render_flag_that_contradicts_the_scene_file_is_named"),
+    ("bumprtl.gen.flow.board.x__run_verilator", "stamp.is_file() or stamp.read_text()", "killed since",
+     "tests/gen/flow/test_board_flow.py::test_the_board_bench_is_built_again_exactly_when_its_digest_changes"),
+    ("bumprtl.gen.flow.board.x_bram_budget", 'surface(scene) != "sphere"', "killed since",
+     "tests/gen/flow/test_board_flow.py::test_only_a_globe_budgets_its_latitude_roms"),
+    ("bumprtl.gen.flow.board.x_check_frames", "11 * round(1e11 / m.pixel_hz)", "killed since",
+     "the bench's frames stay equal with a pixel clock 10 % slow (the pipe clock follows it); "
+     "tests/gen/flow/test_board_flow.py::"
+     "test_the_board_bench_runs_the_modes_pixel_clock_and_the_pipes_ratio"),
+    ("bumprtl.gen.flow.fpga.x_place_and_route", "==target = None", "killed since",
+     "the success path ran only under make fpga; tests/gen/flow/test_fpga.py::"
+     "test_a_placement_row_holds_the_lpf_target_and_whether_it_was_met (the tools stood in)"),
+    ("bumprtl.gen.flow.resources.x_count_netlist", '["XXBXX"]', "killed since",
+     "make test's netlists hold products as $macc only; tests/gen/flow/test_resources.py::"
+     "test_a_mul_cell_is_counted_as_a_macc_product_is"),
+    ("bumprtl.gen.render.images.x_fixed_image", "golden_render(s, None,", "killed since",
+     "no test rendered the palette method on a textured scene; tests/gen/render/test_render.py::"
+     "test_fixed_palette_of_a_textured_scene_is_the_pipelines_golden_render"),
+    ("bumprtl.gen.render.rtl.x_render_rtl", "XXRTL render: pixel tags", "wording",
+     "the message of an internal check (a pipeline that loses or duplicates pixels); the "
+     "tests reach the check's passing side only"),
+    ("bumprtl.gen.render.rtl.x_run_pipeline_emitted", "run_cocotb(v, ", "killed since",
+     "the per-cycle render ran only in make regress; tests/sim/tb/test_tb_pipeline.py::"
+     "test_render_rtl_per_cycle_equals_golden_bytes"),
+    ("bumprtl.gen.report.fpga.x__plot", "figsize=(6, 3.5)", "killed since",
+     "the plot's content was checked, not its picture; tests/docs/test_fpga_pages.py::"
+     "test_the_report_page_is_written_again_from_its_rows compares the picture's size with "
+     "the one the page shows"),
+    ("bumprtl.gen.report.recommend.x_rank_key", "point.get(k, ) or 0", "killed since",
+     "no tie case had a point whose widths are only in its config (a palette point's); "
+     "tests/gen/report/test_ties.py's 'widths read from the configuration' case"),
+    ("bumprtl.gen.report.timing.x_scenarios", '"STALL": list(stall)', "killed since",
+     "no test read the scenarios' facts; tests/gen/report/test_timing.py::"
+     "test_the_stall_facts_are_the_cycles_its_trace_holds_o_ready_low"),
+    ("bumprtl.gen.tools.objcache.x__store", "shutil.rmtree(tmp, ignore_errors=False)", "equivalent",
+     "tmp is renamed into place before the finally clause, so the rmtree raises "
+     "FileNotFoundError, an OSError, which main() catches as it catches a cache that cannot "
+     "be written: the entry is stored and the compile returns 0 either way"),
+    ("bumprtl.sim.formal.contract.xǁStreamContractǁ_bank", "==valid = None", "make formal",
+     "the bank property of a scene pipeline (its fetch stages' valid bits) is proved in make "
+     "formal; make test proves PaletteLUT's alone"),
+    ("bumprtl.sim.formal.contract.xǁStreamContractǁ_cache_order", "TAG_CACHE_HEAD_REGISTER",
+     "make formal", "a lemma of the cached pipeline's order proof (232 s), make formal's"),
+    ("bumprtl.sim.formal.sdram.x_cover", '"COVER", depth)', "make formal",
+     "the SDRAM contract's covers run in make formal; make test proves its rules"),
+    ("bumprtl.sim.golden.globe.x_check_against_float", "if (diff.size) or True else 0", "killed since",
+     "tests/rtl/test_globe.py::test_model_against_float_of_pixels_all_outside_the_disc"),
+    ("bumprtl.sim.tb.bulk_wrapper.x_setup_writes", "((1 >> w) - 1)", "killed since",
+     "the copy of pack() it was in is gone: setup_writes calls rtl/layouts.pack, and "
+     "tests/rtl/test_layouts_pack.py fails with the same change there (a negative low field "
+     "spilling into the fields above it)"),
+    ("bumprtl.gen.cli.main.x_build_parser", 'dest="COMMAND"', "equivalent",
+     "the command's name is stored under dest and never read: each command's parser sets "
+     "func, and a missing command is refused by argparse with the metavar, COMMAND, either way"),
+    ("bumprtl.sim.scenes.heightfields.x_normals_from_gradient", "-np.asarray(dh_dv, )", "equivalent",
+     "its one caller, height_to_normals, passes float64 slopes (it casts the heights first); "
+     "for them asarray without a dtype is the same array"),
+    ("bumprtl.sim.tb.tb_sdram.x_start", 'unit="PS"', "equivalent",
+     "cocotb lower-cases a time unit before it looks it up (cocotb/simtime.py)"),
 ]
 
 
