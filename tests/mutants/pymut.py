@@ -553,6 +553,13 @@ KNOWN = [
     ("bumprtl.sim.scenes.heightfields.x_normals_from_gradient", "-np.asarray(dh_dv, )", "equivalent",
      "its one caller, height_to_normals, passes float64 slopes (it casts the heights first); "
      "for them asarray without a dtype is the same array"),
+    ("bumprtl.sim.golden.fixed.common.x_specular_fine_fixed", "specular_base(cfg, None)",
+     "killed since", "no test read the golden model at a table step other than the RTL's (bench "
+     "specular's candidates); tests/rtl/test_tables.py::"
+     "test_every_table_step_reads_its_own_words_from_x0_to_one"),
+    ("bumprtl.sim.scenes.config.xǁSceneConfigǁ__post_init__", '"TEXTURE_HEIGHT")', "killed since",
+     "tests/sim/scenes/test_config_rules.py::"
+     "test_a_palette_scene_of_a_non_square_map_is_refused_naming_texture_height"),
     ("bumprtl.sim.tb.tb_sdram.x_start", 'unit="PS"', "equivalent",
      "cocotb lower-cases a time unit before it looks it up (cocotb/simtime.py)"),
 ]

@@ -116,3 +116,26 @@ def test_sine_above_line_is_the_sine_minus_a_shift(angle_bits, frac_bits):
     assert above.min() == 0 and above[0] == 0 and above[-1] == 0
     assert above.max() <= peak * (1 << frac_bits) + 1
     assert int(above.max()).bit_length() <= frac_bits - 2
+
+
+@pytest.mark.parametrize("step_bits", [6, 7, 9, 10])
+def test_every_table_step_reads_its_own_words_from_x0_to_one(step_bits):
+    """``bumprtl bench specular``'s candidate steps (``step_bits`` t other than the RTL's):
+    the fine specular of the golden model reads the table of that step from its own x0 =
+    1 - 2**(s - t): word 0, round(255 x0**n 2**F), at and below x0, 255 2**F at N'.H = 1
+    (word 2**s), and within one table step's interpolation of 255 h**n 2**F between them."""
+    from bumprtl.rtl.tables import SPEC_FRAC_BITS, specular_base, specular_index_bits
+    from bumprtl.sim.golden.fixed.common import specular_fine_fixed
+
+    cfg = Config(angle_bits=10, frac_bits=10, spec_index_bits=6, spec_exponent=32)
+    s, one = specular_index_bits(cfg), cfg.one
+    x0 = one - (1 << (cfg.frac_bits - step_bits + s))          # typed from the docstring
+    assert specular_base(cfg, step_bits) == x0
+    h = np.arange(max(x0 - 8, 0), one + 1)
+    fine = specular_fine_fixed(h, cfg, step_bits)
+    assert fine[h == one][0] == 255 << SPEC_FRAC_BITS
+    word0 = round(255 * (x0 / one) ** cfg.spec_exponent * (1 << SPEC_FRAC_BITS))
+    assert np.all(fine[h <= x0] == word0)
+    exact = 255 * (h / one) ** cfg.spec_exponent * (1 << SPEC_FRAC_BITS)
+    step = 255 * (1 << SPEC_FRAC_BITS) * (1 - (1 - 2.0 ** -step_bits) ** cfg.spec_exponent)
+    assert np.all(np.abs(fine - exact)[h > x0] <= step)

@@ -456,3 +456,12 @@ def test_resample_sizes_a_map_to_the_nearest_allowed_side(tmp_path):
 def test_a_refusal_about_one_key_names_it_as_its_field(key, keys):
     """BumpError.field names the refused parameter (rtl/errors.py), not only the wording."""
     assert _refused(key, **keys).field == key
+
+
+def test_a_palette_scene_of_a_non_square_map_is_refused_naming_texture_height():
+    """The palette's quantizer and index mipmaps take square maps (Tarini Sec. 4-5): a
+    64 x 32 map with palette shading is refused on texture_height, naming the allowed
+    values."""
+    e = _refused("texture_height", texture_size=64, texture_height=32, shading="palette")
+    assert e.field == "texture_height"
+    assert "needs shading = 'per-pixel'" in str(e) and "allowed texture_height = 64 or none" in str(e)
