@@ -560,6 +560,9 @@ KNOWN = [
     ("bumprtl.sim.scenes.config.xǁSceneConfigǁ__post_init__", '"TEXTURE_HEIGHT")', "killed since",
      "tests/sim/scenes/test_config_rules.py::"
      "test_a_palette_scene_of_a_non_square_map_is_refused_naming_texture_height"),
+    ("bumprtl.gen.flow.units.x_faithful_widths", "cfg if (cfg.specular) or True else", "equivalent",
+     "without specular no channel's bound involves the exponent, so the search gives the same "
+     "widths at every exponent; setting it to 1 only lets one cached search serve them all"),
     ("bumprtl.sim.tb.tb_sdram.x_start", 'unit="PS"', "equivalent",
      "cocotb lower-cases a time unit before it looks it up (cocotb/simtime.py)"),
 ]
