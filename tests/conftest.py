@@ -14,6 +14,8 @@ def masked_numbers(text):
     page's small run and its committed run compare equal but for their numbers."""
     text = re.sub(r"\d+'[bodh][0-9a-fA-F_]+", "#'#", text)
     return re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "#", text)
+
+
 BUILD = ROOT / "build" / "test"
 
 settings.register_profile("ci", deadline=None, max_examples=200, derandomize=True)

@@ -15,10 +15,10 @@ PAGE = Path(__file__).resolve().parents[2] / "docs" / "globe.md"
 COMMAND = re.compile(r"`(?:\.venv/bin/python -m bumprtl\.sim\.golden\.globe|\.\.\.)([^`]*)`")
 
 
-def quoted_runs(text=None):
+def quoted_runs():
     """[(argv, quoted lines)]: each plain ``` block of the page with the last globe command
     named between it and the block before it."""
-    text = PAGE.read_text() if text is None else text
+    text = PAGE.read_text()
     runs, before, block, fence = [], [], [], None
     for line in text.splitlines():
         if line.startswith("```"):
@@ -35,16 +35,19 @@ def quoted_runs(text=None):
             block.append(line)
     return runs
 
+
+RUNS = quoted_runs()
+
+
 def test_the_page_quotes_every_run_it_names():
     """The parser finds the page's five quoted runs (a reworded command would otherwise
     drop its block from the check below)."""
-    runs = quoted_runs()
-    assert len(runs) == 5, [argv for argv, _ in runs]
+    assert len(RUNS) == 5, [argv for argv, _ in RUNS]
     assert ["--rotations", "0", "--radius", "26", "--map-width", "128", "--frac-bits", "4",
-            "--mip-levels", "4"] in [argv for argv, _ in runs]
+            "--mip-levels", "4"] in [argv for argv, _ in RUNS]
 
 
-@pytest.mark.parametrize("argv, lines", quoted_runs(), ids=[" ".join(a) or "defaults" for a, _ in quoted_runs()])
+@pytest.mark.parametrize("argv, lines", RUNS, ids=[" ".join(a) or "defaults" for a, _ in RUNS])
 def test_every_quoted_line_is_the_models_output(argv, lines, capsys):
     assert main(argv) == 0                   # no violation of the stated bounds
     printed = capsys.readouterr().out.splitlines()
